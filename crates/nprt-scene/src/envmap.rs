@@ -1,0 +1,307 @@
+//! Distant lighting: an equirectangular (lat-long) environment map with Mitsuba 3's `envmap`
+//! mapping and filtering, rotated about +Y, importance-sampled by luminance × sin θ.
+
+use std::path::Path;
+use std::sync::Arc;
+
+use anyhow::{bail, Context, Result};
+use glam::{Mat3, Vec2, Vec3};
+
+use crate::distribution::Distribution2D;
+use crate::luminance;
+
+use std::f32::consts::PI;
+
+#[derive(Debug)]
+struct EnvData {
+    name: String,
+    width: usize,
+    height: usize,
+    /// Row-major linear RGB radiance, top row = +Y pole.
+    texels: Vec<Vec3>,
+    /// Over the `width × (height-1)` bilinear patches between texel centres.
+    dist: Distribution2D,
+    /// Negative texel channels that were clamped to zero on load.
+    clamped: usize,
+}
+
+/// An environment map placed in the world. Cloning and rotating are cheap: texels and the
+/// sampling distribution are shared.
+#[derive(Clone, Debug)]
+pub struct EnvMap {
+    data: Arc<EnvData>,
+    to_world: Mat3,
+    to_local: Mat3,
+}
+
+/// Local direction of lat-long coordinates, the inverse of [`direction_to_uv`].
+pub fn uv_to_direction(uv: Vec2) -> Vec3 {
+    let (sin_t, cos_t) = (uv.y * PI).sin_cos();
+    let (sin_p, cos_p) = (uv.x * 2.0 * PI).sin_cos();
+    Vec3::new(sin_p * sin_t, cos_t, -cos_p * sin_t)
+}
+
+/// DESIGN.md's mapping (Mitsuba 3's): u = atan2(x, −z)/2π wrapped to [0,1), v = acos(y)/π.
+pub fn direction_to_uv(d: Vec3) -> Vec2 {
+    let u = d.x.atan2(-d.z) / (2.0 * PI);
+    Vec2::new(u - u.floor(), d.y.clamp(-1.0, 1.0).acos() / PI)
+}
+
+impl EnvMap {
+    /// Builds a map from row-major texels; `width` must be twice `height`. Negative channels
+    /// (small ones occur in real captures) are clamped to zero and counted; non-finite ones
+    /// are an error.
+    pub fn from_texels(name: &str, width: usize, height: usize, mut texels: Vec<Vec3>) -> Result<Self> {
+        if width != 2 * height || height < 2 {
+            bail!("{name}: a lat-long environment map must be 2:1 and at least 4×2 texels, got {width}×{height}");
+        }
+        if texels.len() != width * height {
+            bail!("{name}: expected {} texels, got {}", width * height, texels.len());
+        }
+        if let Some(i) = texels.iter().position(|t| !t.is_finite()) {
+            bail!("{name}: texel ({}, {}) is not finite: {}", i % width, i / width, texels[i]);
+        }
+        let clamped = texels.iter().map(|t| t.cmplt(Vec3::ZERO).bitmask().count_ones() as usize).sum();
+        for t in &mut texels {
+            *t = t.max(Vec3::ZERO);
+        }
+        let patches_y = height - 1;
+        let mut func = Vec::with_capacity(width * patches_y);
+        for y in 0..patches_y {
+            let sin_t = (((y as f32 + 0.5) / patches_y as f32) * PI).sin();
+            for x in 0..width {
+                let x1 = (x + 1) % width;
+                let corners = [
+                    texels[y * width + x],
+                    texels[y * width + x1],
+                    texels[(y + 1) * width + x],
+                    texels[(y + 1) * width + x1],
+                ];
+                // The brightest corner bounds the bilinear patch, so no lit direction gets pdf 0.
+                let lmax = corners.iter().map(|&c| luminance(c)).fold(0.0, f32::max);
+                func.push(lmax * sin_t);
+            }
+        }
+        let dist = Distribution2D::new(&func, width);
+        let data = EnvData { name: name.to_string(), width, height, texels, dist, clamped };
+        Ok(Self { data: Arc::new(data), to_world: Mat3::IDENTITY, to_local: Mat3::IDENTITY })
+    }
+
+    /// A uniform map: a white furnace when `radiance` is 1.
+    pub fn constant(radiance: Vec3) -> Self {
+        Self::from_texels("constant", 8, 4, vec![radiance; 32]).expect("valid constant map")
+    }
+
+    /// Reads an OpenEXR (.exr) or Radiance (.hdr) lat-long map, scaled by `scale`.
+    pub fn load(path: &Path, scale: f32) -> Result<Self> {
+        let name = path.display().to_string();
+        let ext = path.extension().and_then(|e| e.to_str()).unwrap_or("").to_ascii_lowercase();
+        let (w, h, texels) = match ext.as_str() {
+            "exr" => read_exr(path).with_context(|| format!("cannot read environment map '{name}'"))?,
+            "hdr" => read_hdr(path).with_context(|| format!("cannot read environment map '{name}'"))?,
+            _ => bail!("environment map '{name}': unsupported extension '.{ext}' (expected .exr or .hdr)"),
+        };
+        let texels = texels.into_iter().map(|t| t * scale).collect();
+        Self::from_texels(&name, w, h, texels).with_context(|| format!("environment map '{name}'"))
+    }
+
+    pub fn name(&self) -> &str {
+        &self.data.name
+    }
+    pub fn width(&self) -> usize {
+        self.data.width
+    }
+    pub fn height(&self) -> usize {
+        self.data.height
+    }
+    /// Row-major texels in the map's own frame.
+    pub fn texels(&self) -> &[Vec3] {
+        &self.data.texels
+    }
+    /// How many negative texel channels were clamped to zero on load.
+    pub fn clamped_negative(&self) -> usize {
+        self.data.clamped
+    }
+    pub fn to_world(&self) -> Mat3 {
+        self.to_world
+    }
+
+    /// The same map placed with `to_world` (a rotation; Mitsuba's emitter `to_world`).
+    pub fn with_to_world(&self, to_world: Mat3) -> Self {
+        Self { data: self.data.clone(), to_world, to_local: to_world.inverse() }
+    }
+
+    /// The map rotated by `degrees` about +Y, on top of its current placement.
+    pub fn rotated_y(&self, degrees: f32) -> Self {
+        self.with_to_world(Mat3::from_rotation_y(degrees.to_radians()) * self.to_world)
+    }
+
+    fn texel(&self, x: usize, y: usize) -> Vec3 {
+        self.data.texels[y * self.data.width + x % self.data.width]
+    }
+
+    /// Bilinear lookup at lat-long coordinates: columns at texel centres (periodic), rows from
+    /// pole (v=0) to pole (v=1), exactly as Mitsuba 3's `envmap`.
+    pub fn eval_uv(&self, uv: Vec2) -> Vec3 {
+        let (w, h) = (self.data.width, self.data.height);
+        let mut u = uv.x - 0.5 / w as f32;
+        u -= u.floor();
+        let px = u * w as f32;
+        let py = uv.y.clamp(0.0, 1.0) * (h - 1) as f32;
+        let x0 = (px as usize).min(w - 1);
+        let y0 = (py as usize).min(h - 2);
+        let (fx, fy) = (px - x0 as f32, py - y0 as f32);
+        let top = self.texel(x0, y0).lerp(self.texel(x0 + 1, y0), fx);
+        let bottom = self.texel(x0, y0 + 1).lerp(self.texel(x0 + 1, y0 + 1), fx);
+        top.lerp(bottom, fy)
+    }
+
+    /// Radiance arriving from world direction `d` (pointing away from the scene).
+    pub fn eval(&self, d: Vec3) -> Vec3 {
+        self.eval_uv(direction_to_uv(self.to_local * d))
+    }
+
+    /// Samples a world direction towards the map: (direction, radiance, solid-angle pdf).
+    pub fn sample(&self, u: Vec2) -> (Vec3, Vec3, f32) {
+        let (patch_uv, pdf_uv) = self.data.dist.sample(u);
+        let mut uv = patch_uv;
+        uv.x += 0.5 / self.data.width as f32;
+        uv.x -= uv.x.floor();
+        let sin_t = (uv.y * PI).sin();
+        if pdf_uv <= 0.0 || sin_t <= 1e-6 {
+            return (Vec3::Y, Vec3::ZERO, 0.0);
+        }
+        let d = self.to_world * uv_to_direction(uv);
+        (d, self.eval_uv(uv), pdf_uv / (2.0 * PI * PI * sin_t))
+    }
+
+    /// Solid-angle density with which [`EnvMap::sample`] picks world direction `d`.
+    pub fn pdf(&self, d: Vec3) -> f32 {
+        let local = self.to_local * d;
+        let mut uv = direction_to_uv(local);
+        let sin_t = (local.x * local.x + local.z * local.z).sqrt();
+        if sin_t <= 1e-6 {
+            return 0.0;
+        }
+        uv.x -= 0.5 / self.data.width as f32;
+        uv.x -= uv.x.floor();
+        self.data.dist.pdf(uv) / (2.0 * PI * PI * sin_t)
+    }
+
+    /// Mean radiance over the sphere (solid-angle weighted).
+    pub fn mean_radiance(&self) -> Vec3 {
+        let (w, h) = (self.data.width, self.data.height);
+        let (mut sum, mut wsum) = (Vec3::ZERO, 0.0);
+        for y in 0..h {
+            let s = ((y as f32 / (h - 1) as f32) * PI).sin().max(1e-4);
+            for x in 0..w {
+                sum += self.texel(x, y) * s;
+                wsum += s;
+            }
+        }
+        sum / wsum
+    }
+}
+
+fn read_exr(path: &Path) -> Result<(usize, usize, Vec<Vec3>)> {
+    use exr::prelude::*;
+    let image = read_first_rgba_layer_from_file(
+        path,
+        |res, _| (res.width(), res.height(), vec![Vec3::ZERO; res.width() * res.height()]),
+        |(w, _, px), pos, (r, g, b, _a): (f32, f32, f32, f32)| {
+            px[pos.y() * *w + pos.x()] = Vec3::new(r, g, b);
+        },
+    )?;
+    let (w, h, texels) = image.layer_data.channel_data.pixels;
+    Ok((w, h, texels))
+}
+
+fn read_hdr(path: &Path) -> Result<(usize, usize, Vec<Vec3>)> {
+    let img = image::ImageReader::open(path)?.with_guessed_format()?.decode()?.into_rgb32f();
+    let (w, h) = (img.width() as usize, img.height() as usize);
+    let texels = img.pixels().map(|p| Vec3::new(p[0], p[1], p[2])).collect();
+    Ok((w, h, texels))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn gradient_map() -> EnvMap {
+        let (w, h) = (32, 16);
+        let texels = (0..w * h)
+            .map(|i| {
+                let (x, y) = (i % w, i / w);
+                Vec3::new(x as f32 + 1.0, (h - y) as f32, if x == 5 && y == 4 { 500.0 } else { 0.5 })
+            })
+            .collect();
+        EnvMap::from_texels("gradient", w, h, texels).unwrap()
+    }
+
+    #[test]
+    fn uv_mapping_round_trips_and_matches_design() {
+        for &d in &[Vec3::new(0.3, 0.5, -0.8), Vec3::new(-0.9, -0.1, 0.2), Vec3::new(0.0, 0.2, 1.0)] {
+            let d = d.normalize();
+            assert!((uv_to_direction(direction_to_uv(d)) - d).length() < 1e-5);
+        }
+        // -Z is the centre column, +X a quarter turn to the right, +Y the top row.
+        assert!((direction_to_uv(-Vec3::Z) - Vec2::new(0.0, 0.5)).length() < 1e-6);
+        assert!((direction_to_uv(Vec3::X) - Vec2::new(0.25, 0.5)).length() < 1e-6);
+        assert!(direction_to_uv(Vec3::Y).y.abs() < 1e-6);
+    }
+
+    #[test]
+    fn lookup_hits_texel_centres_like_mitsuba() {
+        let m = gradient_map();
+        // Column x sits at u = (x+0.5)/w; row y at v = y/(h-1).
+        let v = m.eval_uv(Vec2::new(5.5 / 32.0, 4.0 / 15.0));
+        assert!((v - Vec3::new(6.0, 12.0, 500.0)).length() < 1e-3, "{v}");
+        // Wrap-around between the last and first column.
+        let v = m.eval_uv(Vec2::new(0.0, 0.0));
+        assert!((v.x - 16.5).abs() < 1e-3, "{v}");
+    }
+
+    #[test]
+    fn sampling_pdf_is_consistent_and_normalised() {
+        let m = gradient_map().rotated_y(37.0);
+        // pdf integrates to one over the sphere (midpoint rule in θ, φ).
+        let (nt, np) = (400, 800);
+        let mut total = 0.0f64;
+        for j in 0..nt {
+            let t = (j as f32 + 0.5) / nt as f32 * PI;
+            for i in 0..np {
+                let p = (i as f32 + 0.5) / np as f32 * 2.0 * PI;
+                let d = Vec3::new(t.sin() * p.cos(), t.cos(), t.sin() * p.sin());
+                total += (m.pdf(d) * t.sin()) as f64 * (PI as f64 / nt as f64) * (2.0 * PI as f64 / np as f64);
+            }
+        }
+        assert!((total - 1.0).abs() < 5e-3, "pdf integrates to {total}");
+        // Samples report the pdf and radiance that pdf() and eval() give for their direction.
+        for k in 0..200 {
+            // Irrational steps keep samples off cell edges, where rounding may pick either cell.
+            let u = Vec2::new(((k as f32 + 0.5) * 0.618).fract(), (k as f32 * 0.377 + 0.1).fract());
+            let (d, l, pdf) = m.sample(u);
+            assert!(pdf > 0.0);
+            assert!((m.pdf(d) - pdf).abs() <= 2e-3 * pdf, "{} vs {}", m.pdf(d), pdf);
+            assert!((m.eval(d) - l).length() <= 1e-3 * l.length().max(1.0));
+        }
+    }
+
+    #[test]
+    fn clamps_negative_texels_and_rejects_non_finite_ones() {
+        let mut t = vec![Vec3::ONE; 32];
+        t[3] = Vec3::new(-0.5, 1.0, -0.1);
+        let m = EnvMap::from_texels("neg", 8, 4, t.clone()).unwrap();
+        assert_eq!(m.clamped_negative(), 2);
+        assert_eq!(m.texels()[3], Vec3::new(0.0, 1.0, 0.0));
+        t[5] = Vec3::new(f32::NAN, 0.0, 0.0);
+        let err = EnvMap::from_texels("nan.exr", 8, 4, t).unwrap_err().to_string();
+        assert!(err.contains("nan.exr") && err.contains("(5, 0)"), "{err}");
+    }
+
+    #[test]
+    fn rejects_maps_that_are_not_two_to_one() {
+        let err = EnvMap::from_texels("odd.exr", 30, 16, vec![Vec3::ONE; 480]).unwrap_err();
+        assert!(err.to_string().contains("2:1"), "{err}");
+    }
+}

@@ -1,0 +1,33 @@
+//! Scene description for nprt: everything a renderer needs to know about a static scene and
+//! its distant lighting, and the file formats they come from.
+//!
+//! This crate owns geometry (triangle meshes in world space), materials (the DESIGN.md model:
+//! diffuse `kd`, GGX specular `ks`, GGX `alpha`, with textures), cameras, environment maps
+//! (lat-long, Mitsuba 3's mapping, importance sampling) and the procedural built-in content, plus
+//! the loaders for glTF 2.0, Mitsuba 3 XML, PLY and OBJ. It must not trace rays, sample paths or
+//! know about datasets and networks: those belong to `nprt-trace` and later stages.
+
+pub mod builtin;
+pub mod camera;
+pub mod distribution;
+pub mod envmap;
+pub mod gltf_scene;
+pub mod material;
+pub mod mesh;
+pub mod mesh_io;
+pub mod mitsuba;
+pub mod procedural;
+pub mod scene;
+pub mod texture;
+
+pub use camera::{Camera, FovAxis};
+pub use envmap::EnvMap;
+pub use material::{BsdfParams, Material, Surface};
+pub use mesh::Mesh;
+pub use scene::{load_scene, Scene, SceneOptions};
+pub use texture::{Bitmap, Texture};
+
+/// Linear Rec.709 luminance, the weights Mitsuba 3 uses for importance sampling.
+pub fn luminance(c: glam::Vec3) -> f32 {
+    0.212671 * c.x + 0.715160 * c.y + 0.072169 * c.z
+}

@@ -1,0 +1,107 @@
+//! A complete static scene, and the single entry point that loads one from any format.
+
+use std::path::Path;
+
+use anyhow::{bail, Result};
+use glam::Vec3;
+
+use crate::camera::Camera;
+use crate::envmap::EnvMap;
+use crate::material::Material;
+use crate::mesh::Mesh;
+
+/// Mitsuba's default Russian-roulette start depth.
+pub const DEFAULT_RR_DEPTH: u32 = 5;
+
+#[derive(Clone, Debug)]
+pub struct Scene {
+    pub name: String,
+    pub meshes: Vec<Mesh>,
+    pub materials: Vec<Material>,
+    /// The scene's own sensor and film, when the format has one.
+    pub camera: Option<Camera>,
+    pub envmap: Option<EnvMap>,
+    /// The integrator's `max_depth` (Mitsuba's meaning); `None` means unlimited.
+    pub max_depth: Option<u32>,
+    pub rr_depth: u32,
+    /// The scene's own sample count, when it names one.
+    pub spp: Option<u32>,
+    /// Approximations made while loading (e.g. a Beckmann lobe traced as GGX), for the user.
+    pub warnings: Vec<String>,
+}
+
+/// Settings that change how a scene file is read.
+#[derive(Clone, Debug, Default)]
+pub struct SceneOptions {
+    /// `NAME=VALUE` overrides of Mitsuba `<default>` parameters.
+    pub set: Vec<(String, String)>,
+}
+
+impl Scene {
+    pub fn empty(name: &str) -> Self {
+        Scene {
+            name: name.to_string(),
+            meshes: vec![],
+            materials: vec![],
+            camera: None,
+            envmap: None,
+            max_depth: None,
+            rr_depth: DEFAULT_RR_DEPTH,
+            spp: None,
+            warnings: vec![],
+        }
+    }
+
+    /// Adds a mesh with its own material; returns the mesh index.
+    pub fn add(&mut self, mut mesh: Mesh, material: Material) -> usize {
+        mesh.material = self.materials.len();
+        self.materials.push(material);
+        self.meshes.push(mesh);
+        self.meshes.len() - 1
+    }
+
+    /// Axis-aligned bounds of all geometry (min, max).
+    pub fn bounds(&self) -> (Vec3, Vec3) {
+        let mut lo = Vec3::splat(f32::INFINITY);
+        let mut hi = Vec3::splat(f32::NEG_INFINITY);
+        for p in self.meshes.iter().flat_map(|m| &m.positions) {
+            lo = lo.min(*p);
+            hi = hi.max(*p);
+        }
+        (lo, hi)
+    }
+
+    pub fn triangle_count(&self) -> usize {
+        self.meshes.iter().map(|m| m.indices.len()).sum()
+    }
+}
+
+/// Loads `spec`: a file (.xml Mitsuba 3, .gltf/.glb, .ply/.obj) or `builtin:NAME`.
+pub fn load_scene(spec: &str, opts: &SceneOptions) -> Result<Scene> {
+    if let Some(name) = spec.strip_prefix("builtin:") {
+        return crate::builtin::scene(name);
+    }
+    let path = Path::new(spec);
+    if !path.exists() {
+        bail!("scene file '{spec}' does not exist");
+    }
+    let ext = path.extension().and_then(|e| e.to_str()).unwrap_or("").to_ascii_lowercase();
+    let scene = match ext.as_str() {
+        "xml" => crate::mitsuba::load(path, opts)?,
+        "gltf" | "glb" => crate::gltf_scene::load(path)?,
+        "ply" | "obj" => {
+            let mut scene = Scene::empty(spec);
+            let mesh = crate::mesh_io::load_mesh(path, false)?;
+            scene.add(mesh, Material::diffuse("default", Vec3::splat(0.5)));
+            scene
+        }
+        _ => bail!(
+            "scene file '{spec}': unknown format '.{ext}' (expected .xml, .gltf, .glb, .ply, .obj or builtin:{})",
+            crate::builtin::NAMES.join("|builtin:")
+        ),
+    };
+    if scene.meshes.is_empty() {
+        bail!("scene file '{spec}' contains no geometry");
+    }
+    Ok(scene)
+}

@@ -1,0 +1,126 @@
+//! One light path: Mitsuba 3's `path` integrator for a scene lit only by a distant
+//! environment. `max_depth` counts path vertices as Mitsuba does (1: the emitter seen
+//! directly; 2: direct illumination; …), Russian roulette starts at `rr_depth`.
+
+use glam::{Vec2, Vec3};
+use nprt_scene::{BsdfParams, EnvMap, Scene};
+use rand::RngExt;
+use rand_pcg::Pcg64Mcg;
+
+use crate::accel::{Accel, Hit};
+use crate::bsdf::{Bsdf, Frame3};
+
+/// A surface point seen along a ray, oriented for shading.
+#[derive(Clone, Copy, Debug)]
+pub struct SurfacePoint {
+    pub p: Vec3,
+    /// Geometric normal, on the same side as the shading normal.
+    pub ng: Vec3,
+    /// Shading normal; flipped towards the viewer on two-sided materials.
+    pub ns: Vec3,
+    pub params: BsdfParams,
+}
+
+/// Power heuristic (β = 2) weight of the strategy with density `a` against `b`.
+fn mis(a: f32, b: f32) -> f32 {
+    let (a2, b2) = (a * a, b * b);
+    if a2 + b2 > 0.0 { a2 / (a2 + b2) } else { 0.0 }
+}
+
+/// Origin just off the surface on the side `dir` leaves towards (Mitsuba's ray epsilon scale).
+pub fn offset_origin(p: Vec3, ng: Vec3, dir: Vec3) -> Vec3 {
+    let eps = (1.0 + p.abs().max_element()) * 1e-4;
+    p + ng * eps.copysign(ng.dot(dir))
+}
+
+/// Interpolates position, normals and uv at a hit, and evaluates the material there.
+pub fn surface_point(scene: &Scene, hit: &Hit, dir: Vec3) -> SurfacePoint {
+    let mesh = &scene.meshes[hit.mesh as usize];
+    let tri = mesh.indices[hit.tri as usize];
+    let w = [1.0 - hit.b1 - hit.b2, hit.b1, hit.b2];
+    let lerp3 = |a: &[Vec3]| tri.iter().zip(w).map(|(&i, wi)| a[i as usize] * wi).sum::<Vec3>();
+    let p = lerp3(&mesh.positions);
+    let v = tri.map(|i| mesh.positions[i as usize]);
+    let mut ng = (v[1] - v[0]).cross(v[2] - v[0]).normalize_or(Vec3::Y);
+    let mut ns = if mesh.normals.is_empty() { ng } else { lerp3(&mesh.normals).normalize_or(ng) };
+    let uv = if mesh.uvs.is_empty() { Vec2::ZERO } else { tri.iter().zip(w).map(|(&i, wi)| mesh.uvs[i as usize] * wi).sum() };
+    let material = &scene.materials[mesh.material];
+    if material.two_sided && ns.dot(dir) > 0.0 {
+        ns = -ns;
+    }
+    if ng.dot(ns) < 0.0 {
+        ng = -ng;
+    }
+    SurfacePoint { p, ng, ns, params: material.eval(uv) }
+}
+
+/// Radiance carried by one path: all of it, and the direct part (the emitter seen directly
+/// plus light that reached the first surface straight from the emitter).
+#[derive(Clone, Copy, Debug, Default)]
+pub struct PathRadiance {
+    pub total: Vec3,
+    pub direct: Vec3,
+}
+
+pub struct PathSettings {
+    pub max_depth: u32,
+    pub rr_depth: u32,
+}
+
+pub fn trace_path(scene: &Scene, accel: &Accel, env: &EnvMap, mut origin: Vec3, mut dir: Vec3, s: &PathSettings, rng: &mut Pcg64Mcg) -> PathRadiance {
+    let mut out = PathRadiance::default();
+    if s.max_depth == 0 {
+        return out;
+    }
+    let mut beta = Vec3::ONE;
+    let mut prev_pdf = 0.0f32;
+    let mut depth = 0u32;
+    loop {
+        let Some(hit) = accel.intersect(origin, dir, f32::INFINITY) else {
+            let weight = if depth == 0 { 1.0 } else { mis(prev_pdf, env.pdf(dir)) };
+            let c = beta * env.eval(dir) * weight;
+            out.total += c;
+            if depth <= 1 {
+                out.direct += c;
+            }
+            break;
+        };
+        if depth + 1 >= s.max_depth {
+            break;
+        }
+        let sp = surface_point(scene, &hit, dir);
+        let frame = Frame3::new(sp.ns);
+        let wo = frame.to_local(-dir);
+        let bsdf = Bsdf::new(sp.params);
+        if wo.z <= 0.0 || bsdf.is_black() {
+            break;
+        }
+        // Next-event estimation towards the environment.
+        let (wi_world, le, light_pdf) = env.sample(Vec2::new(rng.random(), rng.random()));
+        if light_pdf > 0.0 {
+            let wi = frame.to_local(wi_world);
+            let f = bsdf.eval(wo, wi);
+            if f != Vec3::ZERO && !accel.occluded(offset_origin(sp.p, sp.ng, wi_world), wi_world, f32::INFINITY) {
+                let c = beta * f * le * (mis(light_pdf, bsdf.pdf(wo, wi)) / light_pdf);
+                out.total += c;
+                if depth == 0 {
+                    out.direct += c;
+                }
+            }
+        }
+        let Some(bs) = bsdf.sample(wo, Vec2::new(rng.random(), rng.random()), rng.random()) else { break };
+        dir = frame.to_world(bs.wi);
+        origin = offset_origin(sp.p, sp.ng, dir);
+        beta *= bs.weight;
+        prev_pdf = bs.pdf;
+        depth += 1;
+        if depth >= s.rr_depth {
+            let q = beta.max_element().min(0.95);
+            if rng.random::<f32>() >= q {
+                break;
+            }
+            beta /= q;
+        }
+    }
+    out
+}

@@ -1,0 +1,19 @@
+//! The path tracer: ray-scene intersection, the BSDF of DESIGN.md's material model, a path
+//! integrator that follows Mitsuba 3's `path` (same `max_depth` meaning, next-event estimation
+//! on the environment with power-heuristic MIS, Russian roulette), and per-pixel outputs:
+//! radiance, direct-lighting radiance and the G-buffer.
+//!
+//! It owns everything about light transport and pixels, and reads scenes only through
+//! `nprt-scene`; it must not parse files, place dataset cameras or know about networks.
+
+pub mod accel;
+pub mod bsdf;
+pub mod exr_io;
+pub mod frame;
+pub mod integrator;
+pub mod render;
+
+pub use accel::{Accel, Hit};
+pub use bsdf::Bsdf;
+pub use frame::{Frame, GBuffer};
+pub use render::{render, PixelFilter, RenderSettings, TraceScene};
