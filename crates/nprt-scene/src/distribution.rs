@@ -1,99 +1,66 @@
-//! Piecewise-constant 1D and 2D distributions used to importance-sample environment maps.
+//! A piecewise-constant distribution over the cells of a 2D grid on [0,1)², sampled in O(1)
+//! with Walker's alias method (Vose's construction). Binary searches over CDFs of a 512-wide
+//! map cost 12% of path-tracing time in a profile; an alias lookup is one or two reads.
 
-/// A piecewise-constant distribution over [0, 1) with `n` equal cells.
-#[derive(Clone, Debug)]
-pub struct Distribution1D {
-    /// Cumulative, normalised: `cdf[0] = 0`, `cdf[n] = 1`.
-    cdf: Vec<f32>,
-    /// Cell weights as given (not normalised).
-    func: Vec<f32>,
-    /// Integral of the weights over [0,1), i.e. their mean.
-    integral: f32,
-}
+use glam::{Vec2, Vec3};
 
-impl Distribution1D {
-    pub fn new(func: Vec<f32>) -> Self {
-        let n = func.len();
-        assert!(n > 0, "a distribution needs at least one cell");
-        let mut cdf = Vec::with_capacity(n + 1);
-        cdf.push(0.0f64);
-        let mut acc = 0.0f64;
-        for &f in &func {
-            acc += f.max(0.0) as f64 / n as f64;
-            cdf.push(acc);
-        }
-        let integral = acc;
-        let cdf = if integral > 0.0 {
-            cdf.iter().map(|c| (c / integral) as f32).collect()
-        } else {
-            // A black row or map: fall back to uniform so sampling stays defined.
-            (0..=n).map(|i| i as f32 / n as f32).collect()
-        };
-        Self { cdf, func, integral: integral as f32 }
-    }
-
-    pub fn len(&self) -> usize {
-        self.func.len()
-    }
-
-    pub fn is_empty(&self) -> bool {
-        self.func.is_empty()
-    }
-
-    pub fn integral(&self) -> f32 {
-        self.integral
-    }
-
-    /// Density of the continuous sample in cell `i`.
-    pub fn pdf(&self, i: usize) -> f32 {
-        if self.integral > 0.0 {
-            self.func[i].max(0.0) / self.integral
-        } else {
-            1.0
-        }
-    }
-
-    /// Returns (continuous sample in [0,1), cell index, density).
-    pub fn sample(&self, u: f32) -> (f32, usize, f32) {
-        let n = self.func.len();
-        // Last cell whose cdf start is <= u.
-        let i = self.cdf.partition_point(|&c| c <= u).saturating_sub(1).min(n - 1);
-        let width = self.cdf[i + 1] - self.cdf[i];
-        let du = if width > 0.0 { ((u - self.cdf[i]) / width).clamp(0.0, 1.0) } else { 0.5 };
-        let x = ((i as f32 + du) / n as f32).min(1.0 - f32::EPSILON);
-        (x, i, self.pdf(i))
-    }
-}
-
-/// A piecewise-constant 2D distribution over [0,1)²: a marginal over rows and one conditional
-/// per row.
 #[derive(Clone, Debug)]
 pub struct Distribution2D {
-    rows: Vec<Distribution1D>,
-    marginal: Distribution1D,
+    width: usize,
+    height: usize,
+    /// Density of each cell over the unit square (mean 1).
+    density: Vec<f32>,
+    /// Probability of keeping cell i rather than taking `alias[i]`.
+    keep: Vec<f32>,
+    alias: Vec<u32>,
 }
 
 impl Distribution2D {
-    /// `func` is row-major with `width` cells per row.
-    pub fn new(func: &[f32], width: usize) -> Self {
-        let rows: Vec<_> = func.chunks(width).map(|r| Distribution1D::new(r.to_vec())).collect();
-        let marginal = Distribution1D::new(rows.iter().map(|r| r.integral()).collect());
-        Self { rows, marginal }
+    /// `weights` is row-major with `width` cells per row; negative weights count as zero. An
+    /// all-zero grid samples uniformly.
+    pub fn new(weights: &[f32], width: usize) -> Self {
+        let n = weights.len();
+        assert!(n > 0 && n % width == 0, "weights must fill whole rows");
+        let total: f64 = weights.iter().map(|&w| w.max(0.0) as f64).sum();
+        let density: Vec<f32> = if total > 0.0 {
+            weights.iter().map(|&w| (w.max(0.0) as f64 * n as f64 / total) as f32).collect()
+        } else {
+            vec![1.0; n]
+        };
+        // Vose: split cells into under- and over-full, pair each under-full with an over-full.
+        let mut scaled: Vec<f64> = density.iter().map(|&d| d as f64).collect();
+        let mut keep = vec![1.0f32; n];
+        let mut alias: Vec<u32> = (0..n as u32).collect();
+        let (mut small, mut large): (Vec<usize>, Vec<usize>) = (0..n).partition(|&i| scaled[i] < 1.0);
+        while let (Some(s), Some(&l)) = (small.pop(), large.last()) {
+            keep[s] = scaled[s] as f32;
+            alias[s] = l as u32;
+            scaled[l] -= 1.0 - scaled[s];
+            if scaled[l] < 1.0 {
+                large.pop();
+                small.push(l);
+            }
+        }
+        Self { width, height: n / width, density, keep, alias }
     }
 
-    /// Returns ((u, v), density over the unit square).
-    pub fn sample(&self, u: glam::Vec2) -> (glam::Vec2, f32) {
-        let (v, row, pdf_v) = self.marginal.sample(u.y);
-        let (x, _, pdf_u) = self.rows[row].sample(u.x);
-        (glam::vec2(x, v), pdf_u * pdf_v)
+    /// Three uniforms → (point in [0,1)², density there over the unit square).
+    pub fn sample(&self, u: Vec3) -> (Vec2, f32) {
+        let n = self.density.len();
+        let i = ((u.x * n as f32) as usize).min(n - 1);
+        let cell = if u.y < self.keep[i] { i } else { self.alias[i] as usize };
+        // u.y is no longer uniform after the keep test; the in-cell position uses u.x's
+        // remainder (≥ 7 bits for 131 K cells) and a fresh uniform, so it stays exact.
+        let fx = (u.x * n as f32 - i as f32).clamp(0.0, 1.0 - f32::EPSILON);
+        let (x, y) = (cell % self.width, cell / self.width);
+        let p = Vec2::new((x as f32 + fx) / self.width as f32, (y as f32 + u.z) / self.height as f32);
+        (p.min(Vec2::splat(1.0 - f32::EPSILON)), self.density[cell])
     }
 
-    pub fn pdf(&self, p: glam::Vec2) -> f32 {
-        let h = self.marginal.len();
-        let row = ((p.y * h as f32) as usize).min(h - 1);
-        let w = self.rows[row].len();
-        let col = ((p.x * w as f32) as usize).min(w - 1);
-        self.marginal.pdf(row) * self.rows[row].pdf(col)
+    pub fn pdf(&self, p: Vec2) -> f32 {
+        let x = ((p.x * self.width as f32) as usize).min(self.width - 1);
+        let y = ((p.y * self.height as f32) as usize).min(self.height - 1);
+        self.density[y * self.width + x]
     }
 }
 
@@ -103,30 +70,29 @@ mod tests {
 
     #[test]
     fn sampling_follows_weights() {
-        let d = Distribution1D::new(vec![1.0, 0.0, 3.0]);
-        let n = 30000;
-        let mut counts = [0usize; 3];
+        let w = [1.0, 0.0, 3.0, 4.0, 2.0, 0.0];
+        let d = Distribution2D::new(&w, 3);
+        let n = 60_000;
+        let mut counts = [0usize; 6];
         for k in 0..n {
-            let (_, i, _) = d.sample((k as f32 + 0.5) / n as f32);
-            counts[i] += 1;
+            let u = Vec3::new((k as f32 + 0.5) / n as f32, ((k as f32 + 0.5) * 0.618_034).fract(), 0.5);
+            let (p, pdf) = d.sample(u);
+            let cell = (p.y * 2.0) as usize * 3 + (p.x * 3.0) as usize;
+            counts[cell] += 1;
+            assert_eq!(pdf, d.pdf(p));
         }
-        assert_eq!(counts[1], 0);
-        assert!((counts[0] as f32 / n as f32 - 0.25).abs() < 1e-3, "{counts:?}");
-        assert!((d.pdf(2) - 2.25).abs() < 1e-6);
+        for (c, wi) in counts.iter().zip(w) {
+            assert!((*c as f32 / n as f32 - wi / 10.0).abs() < 0.005, "{counts:?}");
+        }
+        assert!((d.pdf(Vec2::new(0.9, 0.1)) - 1.8).abs() < 1e-6);
     }
 
     #[test]
     fn density_integrates_to_one() {
         let f: Vec<f32> = (0..64).map(|i| ((i * 7) % 11) as f32).collect();
         let d = Distribution2D::new(&f, 8);
-        let mut total = 0.0;
-        for y in 0..8 {
-            for x in 0..8 {
-                total += d.pdf(glam::vec2((x as f32 + 0.5) / 8.0, (y as f32 + 0.5) / 8.0)) / 64.0;
-            }
-        }
+        let total: f32 = (0..64).map(|i| d.pdf(Vec2::new((i % 8) as f32 / 8.0 + 0.01, (i / 8) as f32 / 8.0 + 0.01))).sum::<f32>() / 64.0;
         assert!((total - 1.0).abs() < 1e-5, "{total}");
-        let (p, pdf) = d.sample(glam::vec2(0.3, 0.7));
-        assert!((d.pdf(p) - pdf).abs() < 1e-4 * pdf.max(1.0));
+        assert_eq!(Distribution2D::new(&[0.0; 4], 2).pdf(Vec2::splat(0.3)), 1.0);
     }
 }

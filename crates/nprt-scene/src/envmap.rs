@@ -161,8 +161,9 @@ impl EnvMap {
         self.eval_uv(direction_to_uv(self.to_local * d))
     }
 
-    /// Samples a world direction towards the map: (direction, radiance, solid-angle pdf).
-    pub fn sample(&self, u: Vec2) -> (Vec3, Vec3, f32) {
+    /// Samples a world direction towards the map from three uniforms: (direction, radiance,
+    /// solid-angle pdf).
+    pub fn sample(&self, u: Vec3) -> (Vec3, Vec3, f32) {
         let (patch_uv, pdf_uv) = self.data.dist.sample(u);
         let mut uv = patch_uv;
         uv.x += 0.5 / self.data.width as f32;
@@ -279,7 +280,7 @@ mod tests {
         // Samples report the pdf and radiance that pdf() and eval() give for their direction.
         for k in 0..200 {
             // Irrational steps keep samples off cell edges, where rounding may pick either cell.
-            let u = Vec2::new(((k as f32 + 0.5) * 0.618).fract(), (k as f32 * 0.377 + 0.1).fract());
+            let u = Vec3::new(((k as f32 + 0.5) * 0.618).fract(), (k as f32 * 0.377 + 0.1).fract(), (k as f32 * 0.123 + 0.3).fract());
             let (d, l, pdf) = m.sample(u);
             assert!(pdf > 0.0);
             assert!((m.pdf(d) - pdf).abs() <= 2e-3 * pdf, "{} vs {}", m.pdf(d), pdf);

@@ -216,7 +216,7 @@ mod tests {
         let zenith = m.eval(Vec3::Y);
         assert!(zenith.z > zenith.x, "clear zenith should be blue: {zenith}");
         // Most sampled directions point at the sun.
-        let hits = (0..1000).filter(|k| m.sample(Vec2::new((*k as f32 * 0.618).fract(), (*k as f32 + 0.5) / 1000.0)).0.dot(sun) > 0.99).count();
+        let hits = (0..1000).filter(|k| m.sample(Vec3::new((*k as f32 * 0.618).fract(), (*k as f32 + 0.5) / 1000.0, 0.5)).0.dot(sun) > 0.99).count();
         assert!(hits > 500, "{hits}");
     }
 

@@ -96,7 +96,7 @@ pub fn trace_path(scene: &Scene, accel: &Accel, env: &EnvMap, mut origin: Vec3, 
             break;
         }
         // Next-event estimation towards the environment.
-        let (wi_world, le, light_pdf) = env.sample(Vec2::new(rng.random(), rng.random()));
+        let (wi_world, le, light_pdf) = env.sample(Vec3::new(rng.random(), rng.random(), rng.random()));
         if light_pdf > 0.0 {
             let wi = frame.to_local(wi_world);
             let f = bsdf.eval(wo, wi);
