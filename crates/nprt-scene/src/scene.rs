@@ -71,6 +71,17 @@ impl Scene {
         (lo, hi)
     }
 
+    /// A camera for scenes that bring none: looking at the bounds' centre along −Z from far
+    /// enough that their bounding sphere fills a 45° view, 512×512.
+    pub fn framing_camera(&self) -> Camera {
+        let (lo, hi) = self.bounds();
+        let centre = (lo + hi) * 0.5;
+        let radius = ((hi - lo).length() * 0.5).max(1e-3);
+        let fov = 45.0f32;
+        let distance = radius / (fov.to_radians() * 0.5).sin();
+        Camera::look_at(centre + Vec3::new(0.0, 0.0, distance), centre, Vec3::Y, fov, 512, 512)
+    }
+
     pub fn triangle_count(&self) -> usize {
         self.meshes.iter().map(|m| m.indices.len()).sum()
     }

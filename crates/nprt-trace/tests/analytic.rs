@@ -84,13 +84,17 @@ fn max_depth_follows_mitsuba() {
     let s = sphere_scene(Material::diffuse("d", Vec3::splat(0.5)));
     let ts = TraceScene::new(&s);
     let env = EnvMap::constant(Vec3::ONE);
-    // max_depth 1: only the emitter seen directly; surfaces are black.
-    let f = render(&ts, &camera(), &env, &settings(4, Some(1)));
+    // max_depth 1: only the emitter seen directly; surfaces are black. Through pixel centres
+    // every pixel is exactly the sky (1) or a surface (0).
+    let centre = RenderSettings { filter: PixelFilter::Centre, ..settings(4, Some(1)) };
+    let f = render(&ts, &camera(), &env, &centre);
     for (r, m) in f.radiance.iter().zip(&f.gbuffer.mask) {
-        let expected = if *m > 0.0 { 0.0 } else { 1.0 };
-        assert!((r.x - expected).abs() < 1e-6 || (*m > 0.0) != (r.x > 0.0) && r.x < 1.0, "{r} mask {m}");
+        assert_eq!(r.x, 1.0 - *m, "pixel with mask {m} has radiance {r}");
     }
-    assert!(foreground_mean(&f).x == 0.0);
+    assert!(f.gbuffer.mask.iter().sum::<f32>() > 100.0);
+    // max_depth 2 lights the sphere (direct only), so surfaces are no longer black.
+    let f = render(&ts, &camera(), &env, &RenderSettings { max_depth: Some(2), ..centre });
+    assert!((foreground_mean(&f).x - 0.5).abs() < 0.02, "{}", foreground_mean(&f));
     // max_depth 0: nothing at all.
     assert_eq!(render(&ts, &camera(), &env, &settings(1, Some(0))).mean(), Vec3::ZERO);
 }

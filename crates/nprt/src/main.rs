@@ -125,7 +125,10 @@ fn reference(a: ReferenceArgs) -> Result<()> {
     if env.clamped_negative() > 0 {
         eprintln!("warning: environment map '{}': {} negative texel channels clamped to 0", env.name(), env.clamped_negative());
     }
-    let mut camera = scene.camera.clone().with_context(|| format!("scene '{}' has no camera (sensor)", a.scene))?;
+    let mut camera = scene.camera.clone().unwrap_or_else(|| {
+        eprintln!("note: scene '{}' has no camera; framing its bounds from +Z", a.scene);
+        scene.framing_camera()
+    });
     if let (Some(w), Some(h)) = (a.width, a.height) {
         camera = camera.with_resolution(w, h);
     }
