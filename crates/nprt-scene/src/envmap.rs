@@ -178,15 +178,23 @@ impl EnvMap {
 
     /// Solid-angle density with which [`EnvMap::sample`] picks world direction `d`.
     pub fn pdf(&self, d: Vec3) -> f32 {
+        self.eval_pdf(d).1
+    }
+
+    /// [`EnvMap::eval`] and [`EnvMap::pdf`] together, sharing the coordinate conversion (the
+    /// path tracer needs both for every ray that escapes).
+    pub fn eval_pdf(&self, d: Vec3) -> (Vec3, f32) {
         let local = self.to_local * d;
-        let mut uv = direction_to_uv(local);
+        let uv = direction_to_uv(local);
+        let radiance = self.eval_uv(uv);
         let sin_t = (local.x * local.x + local.z * local.z).sqrt();
         if sin_t <= 1e-6 {
-            return 0.0;
+            return (radiance, 0.0);
         }
-        uv.x -= 0.5 / self.data.width as f32;
-        uv.x -= uv.x.floor();
-        self.data.dist.pdf(uv) / (2.0 * PI * PI * sin_t)
+        let mut patch = uv;
+        patch.x -= 0.5 / self.data.width as f32;
+        patch.x -= patch.x.floor();
+        (radiance, self.data.dist.pdf(patch) / (2.0 * PI * PI * sin_t))
     }
 
     /// Mean radiance over the sphere (solid-angle weighted).

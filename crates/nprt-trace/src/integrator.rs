@@ -77,8 +77,9 @@ pub fn trace_path(scene: &Scene, accel: &Accel, env: &EnvMap, mut origin: Vec3, 
     let mut depth = 0u32;
     loop {
         let Some(hit) = accel.intersect(origin, dir, f32::INFINITY) else {
-            let weight = if depth == 0 { 1.0 } else { mis(prev_pdf, env.pdf(dir)) };
-            let c = beta * env.eval(dir) * weight;
+            let (le, light_pdf) = env.eval_pdf(dir);
+            let weight = if depth == 0 { 1.0 } else { mis(prev_pdf, light_pdf) };
+            let c = beta * le * weight;
             out.total += c;
             if depth <= 1 {
                 out.direct += c;
