@@ -26,12 +26,30 @@ pub fn look_at(origin: Vec3, target: Vec3, up: Vec3) -> Mat4 {
     let dir = (target - origin).normalize();
     let left = up.cross(dir).normalize();
     let new_up = dir.cross(left);
-    Mat4::from_cols(left.extend(0.0), new_up.extend(0.0), dir.extend(0.0), origin.extend(1.0))
+    Mat4::from_cols(
+        left.extend(0.0),
+        new_up.extend(0.0),
+        dir.extend(0.0),
+        origin.extend(1.0),
+    )
 }
 
 impl Camera {
-    pub fn look_at(origin: Vec3, target: Vec3, up: Vec3, fov_x_deg: f32, width: u32, height: u32) -> Self {
-        Camera { to_world: look_at(origin, target, up), fov_deg: fov_x_deg, fov_axis: FovAxis::X, width, height }
+    pub fn look_at(
+        origin: Vec3,
+        target: Vec3,
+        up: Vec3,
+        fov_x_deg: f32,
+        width: u32,
+        height: u32,
+    ) -> Self {
+        Camera {
+            to_world: look_at(origin, target, up),
+            fov_deg: fov_x_deg,
+            fov_axis: FovAxis::X,
+            width,
+            height,
+        }
     }
 
     /// tan of half the horizontal field of view.
@@ -64,12 +82,19 @@ impl Camera {
         let sx = film.x / self.width as f32;
         let sy = film.y / self.height as f32;
         let local = Vec3::new((0.5 - sx) * 2.0 * tx, (0.5 - sy) * 2.0 * ty, 1.0);
-        (self.origin(), self.to_world.transform_vector3(local).normalize())
+        (
+            self.origin(),
+            self.to_world.transform_vector3(local).normalize(),
+        )
     }
 
     /// A copy rendering at another resolution (same field of view along its axis).
     pub fn with_resolution(&self, width: u32, height: u32) -> Self {
-        Camera { width, height, ..self.clone() }
+        Camera {
+            width,
+            height,
+            ..self.clone()
+        }
     }
 }
 
@@ -85,7 +110,10 @@ mod tests {
         assert!((d - -Vec3::Z).length() < 1e-6);
         // Looking down -Z with +Y up, the image's left edge sees -X, its top edge +Y.
         let (_, left) = c.ray(Vec2::new(0.0, 50.0));
-        assert!((left - Vec3::new(-1.0, 0.0, -1.0).normalize()).length() < 1e-5, "{left}");
+        assert!(
+            (left - Vec3::new(-1.0, 0.0, -1.0).normalize()).length() < 1e-5,
+            "{left}"
+        );
         let (_, top) = c.ray(Vec2::new(100.0, 0.0));
         assert!(top.y > 0.0);
     }

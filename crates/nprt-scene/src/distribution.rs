@@ -20,10 +20,16 @@ impl Distribution2D {
     /// all-zero grid samples uniformly.
     pub fn new(weights: &[f32], width: usize) -> Self {
         let n = weights.len();
-        assert!(n > 0 && n % width == 0, "weights must fill whole rows");
+        assert!(
+            n > 0 && n.is_multiple_of(width),
+            "weights must fill whole rows"
+        );
         let total: f64 = weights.iter().map(|&w| w.max(0.0) as f64).sum();
         let density: Vec<f32> = if total > 0.0 {
-            weights.iter().map(|&w| (w.max(0.0) as f64 * n as f64 / total) as f32).collect()
+            weights
+                .iter()
+                .map(|&w| (w.max(0.0) as f64 * n as f64 / total) as f32)
+                .collect()
         } else {
             vec![1.0; n]
         };
@@ -31,7 +37,8 @@ impl Distribution2D {
         let mut scaled: Vec<f64> = density.iter().map(|&d| d as f64).collect();
         let mut keep = vec![1.0f32; n];
         let mut alias: Vec<u32> = (0..n as u32).collect();
-        let (mut small, mut large): (Vec<usize>, Vec<usize>) = (0..n).partition(|&i| scaled[i] < 1.0);
+        let (mut small, mut large): (Vec<usize>, Vec<usize>) =
+            (0..n).partition(|&i| scaled[i] < 1.0);
         while let (Some(s), Some(&l)) = (small.pop(), large.last()) {
             keep[s] = scaled[s] as f32;
             alias[s] = l as u32;
@@ -41,19 +48,32 @@ impl Distribution2D {
                 small.push(l);
             }
         }
-        Self { width, height: n / width, density, keep, alias }
+        Self {
+            width,
+            height: n / width,
+            density,
+            keep,
+            alias,
+        }
     }
 
     /// Three uniforms → (point in [0,1)², density there over the unit square).
     pub fn sample(&self, u: Vec3) -> (Vec2, f32) {
         let n = self.density.len();
         let i = ((u.x * n as f32) as usize).min(n - 1);
-        let cell = if u.y < self.keep[i] { i } else { self.alias[i] as usize };
+        let cell = if u.y < self.keep[i] {
+            i
+        } else {
+            self.alias[i] as usize
+        };
         // u.y is no longer uniform after the keep test; the in-cell position uses u.x's
         // remainder (≥ 7 bits for 131 K cells) and a fresh uniform, so it stays exact.
         let fx = (u.x * n as f32 - i as f32).clamp(0.0, 1.0 - f32::EPSILON);
         let (x, y) = (cell % self.width, cell / self.width);
-        let p = Vec2::new((x as f32 + fx) / self.width as f32, (y as f32 + u.z) / self.height as f32);
+        let p = Vec2::new(
+            (x as f32 + fx) / self.width as f32,
+            (y as f32 + u.z) / self.height as f32,
+        );
         (p.min(Vec2::splat(1.0 - f32::EPSILON)), self.density[cell])
     }
 
@@ -75,14 +95,21 @@ mod tests {
         let n = 60_000;
         let mut counts = [0usize; 6];
         for k in 0..n {
-            let u = Vec3::new((k as f32 + 0.5) / n as f32, ((k as f32 + 0.5) * 0.618_034).fract(), 0.5);
+            let u = Vec3::new(
+                (k as f32 + 0.5) / n as f32,
+                ((k as f32 + 0.5) * 0.618_034).fract(),
+                0.5,
+            );
             let (p, pdf) = d.sample(u);
             let cell = (p.y * 2.0) as usize * 3 + (p.x * 3.0) as usize;
             counts[cell] += 1;
             assert_eq!(pdf, d.pdf(p));
         }
         for (c, wi) in counts.iter().zip(w) {
-            assert!((*c as f32 / n as f32 - wi / 10.0).abs() < 0.005, "{counts:?}");
+            assert!(
+                (*c as f32 / n as f32 - wi / 10.0).abs() < 0.005,
+                "{counts:?}"
+            );
         }
         assert!((d.pdf(Vec2::new(0.9, 0.1)) - 1.8).abs() < 1e-6);
     }
@@ -91,7 +118,15 @@ mod tests {
     fn density_integrates_to_one() {
         let f: Vec<f32> = (0..64).map(|i| ((i * 7) % 11) as f32).collect();
         let d = Distribution2D::new(&f, 8);
-        let total: f32 = (0..64).map(|i| d.pdf(Vec2::new((i % 8) as f32 / 8.0 + 0.01, (i / 8) as f32 / 8.0 + 0.01))).sum::<f32>() / 64.0;
+        let total: f32 = (0..64)
+            .map(|i| {
+                d.pdf(Vec2::new(
+                    (i % 8) as f32 / 8.0 + 0.01,
+                    (i / 8) as f32 / 8.0 + 0.01,
+                ))
+            })
+            .sum::<f32>()
+            / 64.0;
         assert!((total - 1.0).abs() < 1e-5, "{total}");
         assert_eq!(Distribution2D::new(&[0.0; 4], 2).pdf(Vec2::splat(0.3)), 1.0);
     }

@@ -51,17 +51,34 @@ impl EnvMap {
     /// Builds a map from row-major texels; `width` must be twice `height`. Negative channels
     /// (small ones occur in real captures) are clamped to zero and counted; non-finite ones
     /// are an error.
-    pub fn from_texels(name: &str, width: usize, height: usize, mut texels: Vec<Vec3>) -> Result<Self> {
+    pub fn from_texels(
+        name: &str,
+        width: usize,
+        height: usize,
+        mut texels: Vec<Vec3>,
+    ) -> Result<Self> {
         if width != 2 * height || height < 2 {
             bail!("{name}: a lat-long environment map must be 2:1 and at least 4×2 texels, got {width}×{height}");
         }
         if texels.len() != width * height {
-            bail!("{name}: expected {} texels, got {}", width * height, texels.len());
+            bail!(
+                "{name}: expected {} texels, got {}",
+                width * height,
+                texels.len()
+            );
         }
         if let Some(i) = texels.iter().position(|t| !t.is_finite()) {
-            bail!("{name}: texel ({}, {}) is not finite: {}", i % width, i / width, texels[i]);
+            bail!(
+                "{name}: texel ({}, {}) is not finite: {}",
+                i % width,
+                i / width,
+                texels[i]
+            );
         }
-        let clamped = texels.iter().map(|t| t.cmplt(Vec3::ZERO).bitmask().count_ones() as usize).sum();
+        let clamped = texels
+            .iter()
+            .map(|t| t.cmplt(Vec3::ZERO).bitmask().count_ones() as usize)
+            .sum();
         for t in &mut texels {
             *t = t.max(Vec3::ZERO);
         }
@@ -83,8 +100,19 @@ impl EnvMap {
             }
         }
         let dist = Distribution2D::new(&func, width);
-        let data = EnvData { name: name.to_string(), width, height, texels, dist, clamped };
-        Ok(Self { data: Arc::new(data), to_world: Mat3::IDENTITY, to_local: Mat3::IDENTITY })
+        let data = EnvData {
+            name: name.to_string(),
+            width,
+            height,
+            texels,
+            dist,
+            clamped,
+        };
+        Ok(Self {
+            data: Arc::new(data),
+            to_world: Mat3::IDENTITY,
+            to_local: Mat3::IDENTITY,
+        })
     }
 
     /// A uniform map: a white furnace when `radiance` is 1.
@@ -95,12 +123,21 @@ impl EnvMap {
     /// Reads an OpenEXR (.exr) or Radiance (.hdr) lat-long map, scaled by `scale`.
     pub fn load(path: &Path, scale: f32) -> Result<Self> {
         let name = path.display().to_string();
-        let ext = path.extension().and_then(|e| e.to_str()).unwrap_or("").to_ascii_lowercase();
-        let (w, h, texels) = match ext.as_str() {
-            "exr" => read_exr(path).with_context(|| format!("cannot read environment map '{name}'"))?,
-            "hdr" => read_hdr(path).with_context(|| format!("cannot read environment map '{name}'"))?,
-            _ => bail!("environment map '{name}': unsupported extension '.{ext}' (expected .exr or .hdr)"),
-        };
+        let ext = path
+            .extension()
+            .and_then(|e| e.to_str())
+            .unwrap_or("")
+            .to_ascii_lowercase();
+        let (w, h, texels) =
+            match ext.as_str() {
+                "exr" => read_exr(path)
+                    .with_context(|| format!("cannot read environment map '{name}'"))?,
+                "hdr" => read_hdr(path)
+                    .with_context(|| format!("cannot read environment map '{name}'"))?,
+                _ => bail!(
+                "environment map '{name}': unsupported extension '.{ext}' (expected .exr or .hdr)"
+            ),
+            };
         let texels = texels.into_iter().map(|t| t * scale).collect();
         Self::from_texels(&name, w, h, texels).with_context(|| format!("environment map '{name}'"))
     }
@@ -128,7 +165,11 @@ impl EnvMap {
 
     /// The same map placed with `to_world` (a rotation; Mitsuba's emitter `to_world`).
     pub fn with_to_world(&self, to_world: Mat3) -> Self {
-        Self { data: self.data.clone(), to_world, to_local: to_world.inverse() }
+        Self {
+            data: self.data.clone(),
+            to_world,
+            to_local: to_world.inverse(),
+        }
     }
 
     /// The map rotated by `degrees` about +Y, on top of its current placement.
@@ -194,7 +235,10 @@ impl EnvMap {
         let mut patch = uv;
         patch.x -= 0.5 / self.data.width as f32;
         patch.x -= patch.x.floor();
-        (radiance, self.data.dist.pdf(patch) / (2.0 * PI * PI * sin_t))
+        (
+            radiance,
+            self.data.dist.pdf(patch) / (2.0 * PI * PI * sin_t),
+        )
     }
 
     /// Mean radiance over the sphere (solid-angle weighted).
@@ -216,7 +260,13 @@ fn read_exr(path: &Path) -> Result<(usize, usize, Vec<Vec3>)> {
     use exr::prelude::*;
     let image = read_first_rgba_layer_from_file(
         path,
-        |res, _| (res.width(), res.height(), vec![Vec3::ZERO; res.width() * res.height()]),
+        |res, _| {
+            (
+                res.width(),
+                res.height(),
+                vec![Vec3::ZERO; res.width() * res.height()],
+            )
+        },
         |(w, _, px), pos, (r, g, b, _a): (f32, f32, f32, f32)| {
             px[pos.y() * *w + pos.x()] = Vec3::new(r, g, b);
         },
@@ -226,7 +276,10 @@ fn read_exr(path: &Path) -> Result<(usize, usize, Vec<Vec3>)> {
 }
 
 fn read_hdr(path: &Path) -> Result<(usize, usize, Vec<Vec3>)> {
-    let img = image::ImageReader::open(path)?.with_guessed_format()?.decode()?.into_rgb32f();
+    let img = image::ImageReader::open(path)?
+        .with_guessed_format()?
+        .decode()?
+        .into_rgb32f();
     let (w, h) = (img.width() as usize, img.height() as usize);
     let texels = img.pixels().map(|p| Vec3::new(p[0], p[1], p[2])).collect();
     Ok((w, h, texels))
@@ -241,7 +294,11 @@ mod tests {
         let texels = (0..w * h)
             .map(|i| {
                 let (x, y) = (i % w, i / w);
-                Vec3::new(x as f32 + 1.0, (h - y) as f32, if x == 5 && y == 4 { 500.0 } else { 0.5 })
+                Vec3::new(
+                    x as f32 + 1.0,
+                    (h - y) as f32,
+                    if x == 5 && y == 4 { 500.0 } else { 0.5 },
+                )
             })
             .collect();
         EnvMap::from_texels("gradient", w, h, texels).unwrap()
@@ -249,7 +306,11 @@ mod tests {
 
     #[test]
     fn uv_mapping_round_trips_and_matches_design() {
-        for &d in &[Vec3::new(0.3, 0.5, -0.8), Vec3::new(-0.9, -0.1, 0.2), Vec3::new(0.0, 0.2, 1.0)] {
+        for &d in &[
+            Vec3::new(0.3, 0.5, -0.8),
+            Vec3::new(-0.9, -0.1, 0.2),
+            Vec3::new(0.0, 0.2, 1.0),
+        ] {
             let d = d.normalize();
             assert!((uv_to_direction(direction_to_uv(d)) - d).length() < 1e-5);
         }
@@ -281,17 +342,28 @@ mod tests {
             for i in 0..np {
                 let p = (i as f32 + 0.5) / np as f32 * 2.0 * PI;
                 let d = Vec3::new(t.sin() * p.cos(), t.cos(), t.sin() * p.sin());
-                total += (m.pdf(d) * t.sin()) as f64 * (PI as f64 / nt as f64) * (2.0 * PI as f64 / np as f64);
+                total += (m.pdf(d) * t.sin()) as f64
+                    * (PI as f64 / nt as f64)
+                    * (2.0 * PI as f64 / np as f64);
             }
         }
         assert!((total - 1.0).abs() < 5e-3, "pdf integrates to {total}");
         // Samples report the pdf and radiance that pdf() and eval() give for their direction.
         for k in 0..200 {
             // Irrational steps keep samples off cell edges, where rounding may pick either cell.
-            let u = Vec3::new(((k as f32 + 0.5) * 0.618).fract(), (k as f32 * 0.377 + 0.1).fract(), (k as f32 * 0.123 + 0.3).fract());
+            let u = Vec3::new(
+                ((k as f32 + 0.5) * 0.618).fract(),
+                (k as f32 * 0.377 + 0.1).fract(),
+                (k as f32 * 0.123 + 0.3).fract(),
+            );
             let (d, l, pdf) = m.sample(u);
             assert!(pdf > 0.0);
-            assert!((m.pdf(d) - pdf).abs() <= 2e-3 * pdf, "{} vs {}", m.pdf(d), pdf);
+            assert!(
+                (m.pdf(d) - pdf).abs() <= 2e-3 * pdf,
+                "{} vs {}",
+                m.pdf(d),
+                pdf
+            );
             assert!((m.eval(d) - l).length() <= 1e-3 * l.length().max(1.0));
         }
     }
@@ -304,7 +376,9 @@ mod tests {
         assert_eq!(m.clamped_negative(), 2);
         assert_eq!(m.texels()[3], Vec3::new(0.0, 1.0, 0.0));
         t[5] = Vec3::new(f32::NAN, 0.0, 0.0);
-        let err = EnvMap::from_texels("nan.exr", 8, 4, t).unwrap_err().to_string();
+        let err = EnvMap::from_texels("nan.exr", 8, 4, t)
+            .unwrap_err()
+            .to_string();
         assert!(err.contains("nan.exr") && err.contains("(5, 0)"), "{err}");
     }
 

@@ -19,16 +19,22 @@ pub fn load(path: &Path) -> Result<Scene> {
     let bytes = std::fs::read(path).with_context(|| format!("cannot read glTF file '{name}'"))?;
     // Required extensions are checked before validation, which would bury them in a list of
     // consequences (e.g. Draco-compressed accessors without buffer views).
-    let unvalidated = gltf::Gltf::from_slice_without_validation(&bytes).map_err(|e| anyhow!("cannot read glTF file '{name}': {e}"))?;
+    let unvalidated = gltf::Gltf::from_slice_without_validation(&bytes)
+        .map_err(|e| anyhow!("cannot read glTF file '{name}': {e}"))?;
     let required: Vec<&str> = unvalidated.document.extensions_required().collect();
     if !required.is_empty() {
-        let what = if required.contains(&"KHR_draco_mesh_compression") { " (Draco mesh compression)" } else { "" };
+        let what = if required.contains(&"KHR_draco_mesh_compression") {
+            " (Draco mesh compression)"
+        } else {
+            ""
+        };
         bail!(
             "glTF file '{name}' requires extension(s) {}{what}, which nprt does not support; re-export it without them",
             required.join(", ")
         );
     }
-    let gltf = gltf::Gltf::from_slice(&bytes).map_err(|e| anyhow!("invalid glTF file '{name}': {e}"))?;
+    let gltf =
+        gltf::Gltf::from_slice(&bytes).map_err(|e| anyhow!("invalid glTF file '{name}': {e}"))?;
     let doc = &gltf.document;
     let base = path.parent();
     let buffers = gltf::import_buffers(doc, base, gltf.blob.clone())
@@ -36,8 +42,18 @@ pub fn load(path: &Path) -> Result<Scene> {
     let images = gltf::import_images(doc, base, &buffers)
         .map_err(|e| anyhow!("glTF file '{name}': cannot load its images: {e}"))?;
 
-    let mut loader = Loader { name: &name, buffers, images, bitmaps: HashMap::new(), materials: HashMap::new(), scene: Scene::empty(&name) };
-    let gscene = doc.default_scene().or_else(|| doc.scenes().next()).with_context(|| format!("glTF file '{name}' has no scene"))?;
+    let mut loader = Loader {
+        name: &name,
+        buffers,
+        images,
+        bitmaps: HashMap::new(),
+        materials: HashMap::new(),
+        scene: Scene::empty(&name),
+    };
+    let gscene = doc
+        .default_scene()
+        .or_else(|| doc.scenes().next())
+        .with_context(|| format!("glTF file '{name}' has no scene"))?;
     for node in gscene.nodes() {
         loader.visit(&node, Mat4::IDENTITY)?;
     }
@@ -60,7 +76,11 @@ impl Loader<'_> {
         let world = parent * Mat4::from_cols_array_2d(&node.transform().matrix());
         if let Some(mesh) = node.mesh() {
             for prim in mesh.primitives() {
-                let what = format!("glTF file '{}', mesh '{}'", self.name, mesh.name().unwrap_or("?"));
+                let what = format!(
+                    "glTF file '{}', mesh '{}'",
+                    self.name,
+                    mesh.name().unwrap_or("?")
+                );
                 self.primitive(&prim, world, &what)?;
             }
         }
@@ -86,10 +106,17 @@ impl Loader<'_> {
 
     fn primitive(&mut self, prim: &gltf::Primitive, world: Mat4, what: &str) -> Result<()> {
         if prim.mode() != gltf::mesh::Mode::Triangles {
-            bail!("{what}: primitive mode {:?} is not supported (only triangles)", prim.mode());
+            bail!(
+                "{what}: primitive mode {:?} is not supported (only triangles)",
+                prim.mode()
+            );
         }
         let reader = prim.reader(|b| self.buffers.get(b.index()).map(|d| &d.0[..]));
-        let positions: Vec<Vec3> = reader.read_positions().with_context(|| format!("{what}: primitive has no POSITION"))?.map(Vec3::from).collect();
+        let positions: Vec<Vec3> = reader
+            .read_positions()
+            .with_context(|| format!("{what}: primitive has no POSITION"))?
+            .map(Vec3::from)
+            .collect();
         let n = positions.len() as u32;
         let indices: Vec<u32> = match reader.read_indices() {
             Some(i) => i.into_u32().collect(),
@@ -97,9 +124,18 @@ impl Loader<'_> {
         };
         let mut mesh = Mesh {
             name: what.to_string(),
-            normals: reader.read_normals().map(|r| r.map(Vec3::from).collect()).unwrap_or_default(),
-            uvs: reader.read_tex_coords(0).map(|r| r.into_f32().map(Vec2::from).collect()).unwrap_or_default(),
-            indices: indices.chunks_exact(3).map(|t| [t[0], t[1], t[2]]).collect(),
+            normals: reader
+                .read_normals()
+                .map(|r| r.map(Vec3::from).collect())
+                .unwrap_or_default(),
+            uvs: reader
+                .read_tex_coords(0)
+                .map(|r| r.into_f32().map(Vec2::from).collect())
+                .unwrap_or_default(),
+            indices: indices
+                .chunks_exact(3)
+                .map(|t| [t[0], t[1], t[2]])
+                .collect(),
             positions,
             material: 0,
         };
@@ -136,7 +172,10 @@ impl Loader<'_> {
         };
         let material = Material {
             name: m.name().unwrap_or("default").to_string(),
-            surface: Surface::MetallicRoughness { base, metallic_roughness },
+            surface: Surface::MetallicRoughness {
+                base,
+                metallic_roughness,
+            },
             two_sided: m.double_sided(),
         };
         self.scene.materials.push(material);
@@ -147,19 +186,30 @@ impl Loader<'_> {
 
     fn texture(&mut self, info: &gltf::texture::Info, srgb: bool, factor: Vec3) -> Result<Texture> {
         if info.tex_coord() != 0 {
-            bail!("glTF file '{}': textures on TEXCOORD_{} are not supported", self.name, info.tex_coord());
+            bail!(
+                "glTF file '{}': textures on TEXCOORD_{} are not supported",
+                self.name,
+                info.tex_coord()
+            );
         }
         let index = info.texture().source().index();
         let image = match self.bitmaps.get(&(index, srgb)) {
             Some(b) => b.clone(),
             None => {
                 let data = &self.images[index];
-                let bitmap = Arc::new(bitmap_from_gltf(data, srgb).with_context(|| format!("glTF file '{}', image {index}", self.name))?);
+                let bitmap = Arc::new(
+                    bitmap_from_gltf(data, srgb)
+                        .with_context(|| format!("glTF file '{}', image {index}", self.name))?,
+                );
                 self.bitmaps.insert((index, srgb), bitmap.clone());
                 bitmap
             }
         };
-        Ok(Texture::Bitmap { image, to_uv: Affine2::IDENTITY, factor })
+        Ok(Texture::Bitmap {
+            image,
+            to_uv: Affine2::IDENTITY,
+            factor,
+        })
     }
 }
 
@@ -181,7 +231,10 @@ fn bitmap_from_gltf(data: &gltf::image::Data, srgb: bool) -> Result<Bitmap> {
             _ => image::Rgb([p[0], p[1], p[2]]),
         }
     });
-    Ok(Bitmap::from_rgb8_or_f32(image::DynamicImage::ImageRgb8(buf), !srgb))
+    Ok(Bitmap::from_rgb8_or_f32(
+        image::DynamicImage::ImageRgb8(buf),
+        !srgb,
+    ))
 }
 
 #[cfg(test)]
@@ -198,14 +251,30 @@ mod tests {
         let uv: [[f32; 2]; 4] = [[0., 1.], [1., 1.], [1., 0.], [0., 0.]];
         let idx: [u16; 6] = [0, 1, 2, 0, 2, 3];
         let mut bin = vec![];
-        pos.iter().flatten().for_each(|v| bin.extend(v.to_le_bytes()));
-        uv.iter().flatten().for_each(|v| bin.extend(v.to_le_bytes()));
+        pos.iter()
+            .flatten()
+            .for_each(|v| bin.extend(v.to_le_bytes()));
+        uv.iter()
+            .flatten()
+            .for_each(|v| bin.extend(v.to_le_bytes()));
         idx.iter().for_each(|v| bin.extend(v.to_le_bytes()));
         std::fs::write(dir.join("quad.bin"), &bin).unwrap();
         // Base colour: left half sRGB 255 red, right half sRGB 128 grey. Metal-rough: G = 128 (roughness), B = 255 (metal) on the right.
-        let base = image::RgbImage::from_fn(2, 1, |x, _| if x == 0 { image::Rgb([255, 0, 0]) } else { image::Rgb([128, 128, 128]) });
+        let base = image::RgbImage::from_fn(2, 1, |x, _| {
+            if x == 0 {
+                image::Rgb([255, 0, 0])
+            } else {
+                image::Rgb([128, 128, 128])
+            }
+        });
         base.save(dir.join("base.png")).unwrap();
-        let mr = image::RgbImage::from_fn(2, 1, |x, _| if x == 0 { image::Rgb([0, 128, 0]) } else { image::Rgb([0, 128, 255]) });
+        let mr = image::RgbImage::from_fn(2, 1, |x, _| {
+            if x == 0 {
+                image::Rgb([0, 128, 0])
+            } else {
+                image::Rgb([0, 128, 255])
+            }
+        });
         mr.save(dir.join("mr.png")).unwrap();
         let json = serde_json::json!({
             "asset": {"version": "2.0"},
@@ -245,17 +314,28 @@ mod tests {
         let s = load(&write_quad(&dir)).unwrap();
         assert_eq!(s.triangle_count(), 2);
         let (lo, hi) = s.bounds();
-        assert!((lo - Vec3::new(-3.0, -1.0, 0.0)).length() < 1e-5 && (hi - Vec3::new(3.0, 5.0, 0.0)).length() < 1e-5);
+        assert!(
+            (lo - Vec3::new(-3.0, -1.0, 0.0)).length() < 1e-5
+                && (hi - Vec3::new(3.0, 5.0, 0.0)).length() < 1e-5
+        );
         let m = &s.materials[s.meshes[0].material];
         assert!(m.two_sided);
         // Left texel: dielectric red, α = (128/255)².
         let left = m.eval(Vec2::new(0.25, 0.5));
-        assert!((left.kd - Vec3::new(1.0, 0.0, 0.0)).length() < 1e-4, "{:?}", left);
+        assert!(
+            (left.kd - Vec3::new(1.0, 0.0, 0.0)).length() < 1e-4,
+            "{:?}",
+            left
+        );
         assert!((left.ks - Vec3::splat(0.04)).length() < 1e-4);
         assert!((left.alpha - (128.0f32 / 255.0).powi(2)).abs() < 1e-4);
         // Right texel: metal, so no diffuse and ks = linear(128/255) ≈ 0.2158.
         let right = m.eval(Vec2::new(0.75, 0.5));
-        assert!(right.kd.length() < 1e-4 && (right.ks.x - 0.2158).abs() < 1e-3, "{:?}", right);
+        assert!(
+            right.kd.length() < 1e-4 && (right.ks.x - 0.2158).abs() < 1e-3,
+            "{:?}",
+            right
+        );
         let cam = s.camera.as_ref().unwrap();
         assert_eq!((cam.width, cam.height), (512, 256));
         assert!((cam.origin() - Vec3::new(0.0, 2.0, 10.0)).length() < 1e-5);

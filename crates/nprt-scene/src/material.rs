@@ -23,10 +23,17 @@ pub struct BsdfParams {
 #[derive(Clone, Debug)]
 pub enum Surface {
     /// kd, ks and α given directly (α in the texture's `.x`).
-    Direct { kd: Texture, ks: Texture, alpha: Texture },
+    Direct {
+        kd: Texture,
+        ks: Texture,
+        alpha: Texture,
+    },
     /// glTF metallic-roughness: kd = base·(1−m), ks = mix(0.04, base, m), α = roughness².
     /// `metallic_roughness` holds roughness in `.y` and metallic in `.z` (glTF's G and B).
-    MetallicRoughness { base: Texture, metallic_roughness: Texture },
+    MetallicRoughness {
+        base: Texture,
+        metallic_roughness: Texture,
+    },
 }
 
 #[derive(Clone, Debug)]
@@ -58,8 +65,13 @@ impl Material {
     /// True when no parameter varies over the surface.
     pub fn surface_is_constant(&self) -> bool {
         match &self.surface {
-            Surface::Direct { kd, ks, alpha } => kd.is_constant() && ks.is_constant() && alpha.is_constant(),
-            Surface::MetallicRoughness { base, metallic_roughness } => base.is_constant() && metallic_roughness.is_constant(),
+            Surface::Direct { kd, ks, alpha } => {
+                kd.is_constant() && ks.is_constant() && alpha.is_constant()
+            }
+            Surface::MetallicRoughness {
+                base,
+                metallic_roughness,
+            } => base.is_constant() && metallic_roughness.is_constant(),
         }
     }
 
@@ -70,7 +82,10 @@ impl Material {
                 ks: ks.eval(uv),
                 alpha: alpha.eval(uv).x.max(MIN_ALPHA),
             },
-            Surface::MetallicRoughness { base, metallic_roughness } => {
+            Surface::MetallicRoughness {
+                base,
+                metallic_roughness,
+            } => {
                 let b = base.eval(uv);
                 let mr = metallic_roughness.eval(uv);
                 let (rough, metal) = (mr.y.clamp(0.0, 1.0), mr.z.clamp(0.0, 1.0));

@@ -40,7 +40,10 @@ impl Mesh {
                 normals[tri[k] as usize] += n * d0.dot(d1).clamp(-1.0, 1.0).acos();
             }
         }
-        self.normals = normals.into_iter().map(|n| n.normalize_or(Vec3::Y)).collect();
+        self.normals = normals
+            .into_iter()
+            .map(|n| n.normalize_or(Vec3::Y))
+            .collect();
     }
 
     /// Reverses triangle winding, which flips geometric normals only.
@@ -64,24 +67,47 @@ impl Mesh {
         if self.indices.is_empty() {
             anyhow::bail!("{what}: mesh '{}' has no triangles", self.name);
         }
-        if let Some(t) = self.indices.iter().find(|t| t.iter().any(|&i| i as usize >= n)) {
-            anyhow::bail!("{what}: mesh '{}' has face {t:?} referring past its {n} vertices", self.name);
+        if let Some(t) = self
+            .indices
+            .iter()
+            .find(|t| t.iter().any(|&i| i as usize >= n))
+        {
+            anyhow::bail!(
+                "{what}: mesh '{}' has face {t:?} referring past its {n} vertices",
+                self.name
+            );
         }
-        if (!self.normals.is_empty() && self.normals.len() != n) || (!self.uvs.is_empty() && self.uvs.len() != n) {
-            anyhow::bail!("{what}: mesh '{}' has attribute arrays of inconsistent length", self.name);
+        if (!self.normals.is_empty() && self.normals.len() != n)
+            || (!self.uvs.is_empty() && self.uvs.len() != n)
+        {
+            anyhow::bail!(
+                "{what}: mesh '{}' has attribute arrays of inconsistent length",
+                self.name
+            );
         }
         if self.positions.iter().any(|p| !p.is_finite()) {
-            anyhow::bail!("{what}: mesh '{}' has non-finite vertex positions", self.name);
+            anyhow::bail!(
+                "{what}: mesh '{}' has non-finite vertex positions",
+                self.name
+            );
         }
         Ok(())
     }
 
     /// Mitsuba's `rectangle`: [-1,1]² in the z=0 plane facing +Z, uv = (x+1)/2, (y+1)/2.
     pub fn rectangle() -> Self {
-        let positions = vec![Vec3::new(-1., -1., 0.), Vec3::new(1., -1., 0.), Vec3::new(1., 1., 0.), Vec3::new(-1., 1., 0.)];
+        let positions = vec![
+            Vec3::new(-1., -1., 0.),
+            Vec3::new(1., -1., 0.),
+            Vec3::new(1., 1., 0.),
+            Vec3::new(-1., 1., 0.),
+        ];
         Mesh {
             name: "rectangle".into(),
-            uvs: positions.iter().map(|p| Vec2::new(p.x * 0.5 + 0.5, p.y * 0.5 + 0.5)).collect(),
+            uvs: positions
+                .iter()
+                .map(|p| Vec2::new(p.x * 0.5 + 0.5, p.y * 0.5 + 0.5))
+                .collect(),
             positions,
             normals: vec![Vec3::Z; 4],
             indices: vec![[0, 1, 2], [0, 2, 3]],
@@ -91,7 +117,10 @@ impl Mesh {
 
     /// Mitsuba's `cube`: [-1,1]³ with flat, outward faces.
     pub fn cube() -> Self {
-        let mut m = Mesh { name: "cube".into(), ..Default::default() };
+        let mut m = Mesh {
+            name: "cube".into(),
+            ..Default::default()
+        };
         for axis in 0..3 {
             for sign in [-1.0f32, 1.0] {
                 let mut rect = Mesh::rectangle();
@@ -109,21 +138,34 @@ impl Mesh {
     /// local +Z as Mitsuba's.
     pub fn sphere(center: Vec3, radius: f32, segments: u32) -> Self {
         let (nu, nv) = (2 * segments, segments);
-        let mut m = Mesh { name: "sphere".into(), ..Default::default() };
+        let mut m = Mesh {
+            name: "sphere".into(),
+            ..Default::default()
+        };
         for j in 0..=nv {
             let theta = j as f32 / nv as f32 * std::f32::consts::PI;
             for i in 0..=nu {
                 let phi = i as f32 / nu as f32 * 2.0 * std::f32::consts::PI;
-                let n = Vec3::new(theta.sin() * phi.cos(), theta.sin() * phi.sin(), theta.cos());
+                let n = Vec3::new(
+                    theta.sin() * phi.cos(),
+                    theta.sin() * phi.sin(),
+                    theta.cos(),
+                );
                 m.positions.push(center + radius * n);
                 m.normals.push(n);
-                m.uvs.push(Vec2::new(i as f32 / nu as f32, j as f32 / nv as f32));
+                m.uvs
+                    .push(Vec2::new(i as f32 / nu as f32, j as f32 / nv as f32));
             }
         }
         let row = nu + 1;
         for j in 0..nv {
             for i in 0..nu {
-                let (a, b, c, d) = (j * row + i, j * row + i + 1, (j + 1) * row + i, (j + 1) * row + i + 1);
+                let (a, b, c, d) = (
+                    j * row + i,
+                    j * row + i + 1,
+                    (j + 1) * row + i,
+                    (j + 1) * row + i + 1,
+                );
                 // Outward winding; skip the degenerate triangles at the poles.
                 if j != 0 {
                     m.indices.push([a, d, b]);
@@ -139,12 +181,17 @@ impl Mesh {
     /// Appends another mesh's triangles (keeping this mesh's material).
     pub fn append(&mut self, other: Mesh) {
         let base = self.positions.len() as u32;
-        let fill_n = self.normals.is_empty() != other.normals.is_empty() || self.uvs.is_empty() != other.uvs.is_empty();
-        assert!(!fill_n || self.positions.is_empty(), "appending meshes with different attributes");
+        let same_attributes = self.normals.is_empty() == other.normals.is_empty()
+            && self.uvs.is_empty() == other.uvs.is_empty();
+        assert!(
+            same_attributes || self.positions.is_empty(),
+            "appending meshes with different attributes"
+        );
         self.positions.extend(other.positions);
         self.normals.extend(other.normals);
         self.uvs.extend(other.uvs);
-        self.indices.extend(other.indices.into_iter().map(|t| t.map(|i| i + base)));
+        self.indices
+            .extend(other.indices.into_iter().map(|t| t.map(|i| i + base)));
     }
 
     pub fn area(&self) -> f32 {

@@ -12,14 +12,21 @@ use crate::mesh::Mesh;
 /// Loads a .ply or .obj mesh; vertex normals are computed when the file has none, unless
 /// `face_normals` asks for flat shading (Mitsuba's `face_normals`).
 pub fn load_mesh(path: &Path, face_normals: bool) -> Result<Mesh> {
-    let ext = path.extension().and_then(|e| e.to_str()).unwrap_or("").to_ascii_lowercase();
+    let ext = path
+        .extension()
+        .and_then(|e| e.to_str())
+        .unwrap_or("")
+        .to_ascii_lowercase();
     let mut mesh = match ext.as_str() {
         "ply" => load_ply(path),
         "obj" => load_obj(path),
         _ => bail!("unsupported mesh format '.{ext}' (expected .ply or .obj)"),
     }
     .with_context(|| format!("cannot load mesh '{}'", path.display()))?;
-    mesh.name = path.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default();
+    mesh.name = path
+        .file_stem()
+        .map(|s| s.to_string_lossy().into_owned())
+        .unwrap_or_default();
     mesh.validate(&path.display().to_string())?;
     if face_normals {
         mesh.normals.clear();
@@ -30,7 +37,10 @@ pub fn load_mesh(path: &Path, face_normals: bool) -> Result<Mesh> {
 }
 
 fn scalar(e: &DefaultElement, names: &[&str]) -> Option<f32> {
-    names.iter().find_map(|n| e.get(*n)).and_then(Property::to_f32_lossy)
+    names
+        .iter()
+        .find_map(|n| e.get(*n))
+        .and_then(Property::to_f32_lossy)
 }
 
 fn index_list(p: &Property) -> Option<Vec<u32>> {
@@ -54,45 +64,75 @@ fn fan(poly: &[u32], out: &mut Vec<[u32; 3]>) {
 
 fn load_ply(path: &Path) -> Result<Mesh> {
     let mut file = std::io::BufReader::new(std::fs::File::open(path)?);
-    let ply = Parser::<DefaultElement>::new().read_ply(&mut file).map_err(|e| anyhow::anyhow!("{e}"))?;
+    let ply = Parser::<DefaultElement>::new()
+        .read_ply(&mut file)
+        .map_err(|e| anyhow::anyhow!("{e}"))?;
     let vertices = ply.payload.get("vertex").context("no 'vertex' element")?;
     let faces = ply.payload.get("face").context("no 'face' element")?;
     let mut mesh = Mesh::default();
     for v in vertices {
         let p = (scalar(v, &["x"]), scalar(v, &["y"]), scalar(v, &["z"]));
-        let (Some(x), Some(y), Some(z)) = p else { bail!("a vertex lacks x, y or z") };
+        let (Some(x), Some(y), Some(z)) = p else {
+            bail!("a vertex lacks x, y or z")
+        };
         mesh.positions.push(Vec3::new(x, y, z));
-        if let (Some(nx), Some(ny), Some(nz)) = (scalar(v, &["nx"]), scalar(v, &["ny"]), scalar(v, &["nz"])) {
+        if let (Some(nx), Some(ny), Some(nz)) =
+            (scalar(v, &["nx"]), scalar(v, &["ny"]), scalar(v, &["nz"]))
+        {
             mesh.normals.push(Vec3::new(nx, ny, nz).normalize_or_zero());
         }
-        if let (Some(u), Some(t)) = (scalar(v, &["u", "s", "texture_u"]), scalar(v, &["v", "t", "texture_v"])) {
+        if let (Some(u), Some(t)) = (
+            scalar(v, &["u", "s", "texture_u"]),
+            scalar(v, &["v", "t", "texture_v"]),
+        ) {
             mesh.uvs.push(Vec2::new(u, t));
         }
     }
     for f in faces {
-        let list = f.get("vertex_indices").or_else(|| f.get("vertex_index")).context("a face lacks vertex_indices")?;
-        fan(&index_list(list).context("face indices are not an integer list")?, &mut mesh.indices);
+        let list = f
+            .get("vertex_indices")
+            .or_else(|| f.get("vertex_index"))
+            .context("a face lacks vertex_indices")?;
+        fan(
+            &index_list(list).context("face indices are not an integer list")?,
+            &mut mesh.indices,
+        );
     }
     Ok(mesh)
 }
 
 fn load_obj(path: &Path) -> Result<Mesh> {
-    let opts = tobj::LoadOptions { single_index: true, triangulate: true, ignore_points: true, ignore_lines: true, ..Default::default() };
+    let opts = tobj::LoadOptions {
+        single_index: true,
+        triangulate: true,
+        ignore_points: true,
+        ignore_lines: true,
+    };
     let (models, _) = tobj::load_obj(path, &opts)?;
     let mut mesh = Mesh::default();
     for m in models {
         let src = m.mesh;
         let base = mesh.positions.len() as u32;
         let n = src.positions.len() / 3;
-        mesh.positions.extend(src.positions.chunks(3).map(|p| Vec3::new(p[0], p[1], p[2])));
+        mesh.positions
+            .extend(src.positions.chunks(3).map(|p| Vec3::new(p[0], p[1], p[2])));
         if src.normals.len() == 3 * n {
-            mesh.normals.extend(src.normals.chunks(3).map(|p| Vec3::new(p[0], p[1], p[2]).normalize_or_zero()));
+            mesh.normals.extend(
+                src.normals
+                    .chunks(3)
+                    .map(|p| Vec3::new(p[0], p[1], p[2]).normalize_or_zero()),
+            );
         }
         if src.texcoords.len() == 2 * n {
             // OBJ's v runs upwards; Mitsuba flips it so images are not upside down.
-            mesh.uvs.extend(src.texcoords.chunks(2).map(|t| Vec2::new(t[0], 1.0 - t[1])));
+            mesh.uvs
+                .extend(src.texcoords.chunks(2).map(|t| Vec2::new(t[0], 1.0 - t[1])));
         }
-        mesh.indices.extend(src.indices.chunks(3).map(|t| [t[0] + base, t[1] + base, t[2] + base]));
+        mesh.indices.extend(
+            src.indices
+                .chunks(3)
+                .map(|t| [t[0] + base, t[1] + base, t[2] + base]),
+        );
     }
     if mesh.normals.len() != mesh.positions.len() {
         mesh.normals.clear();

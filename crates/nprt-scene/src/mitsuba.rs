@@ -9,9 +9,9 @@ use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
 use anyhow::{anyhow, bail, Context, Result};
-use glam::{Affine2, Mat3, Mat4, Vec3};
 #[cfg(test)]
 use glam::Vec2;
+use glam::{Affine2, Mat3, Mat4, Vec3};
 use roxmltree::{Document, Node};
 
 use crate::camera::{look_at, Camera, FovAxis};
@@ -27,11 +27,16 @@ const SPHERE_SEGMENTS: u32 = 96;
 
 pub fn load(path: &Path, opts: &SceneOptions) -> Result<Scene> {
     let file = path.display().to_string();
-    let text = std::fs::read_to_string(path).with_context(|| format!("cannot read scene file '{file}'"))?;
-    let doc = Document::parse(&text).map_err(|e| anyhow!("scene file '{file}' is not valid XML: {e}"))?;
+    let text = std::fs::read_to_string(path)
+        .with_context(|| format!("cannot read scene file '{file}'"))?;
+    let doc =
+        Document::parse(&text).map_err(|e| anyhow!("scene file '{file}' is not valid XML: {e}"))?;
     let root = doc.root_element();
     if root.tag_name().name() != "scene" {
-        bail!("scene file '{file}': the root element is <{}>, expected <scene>", root.tag_name().name());
+        bail!(
+            "scene file '{file}': the root element is <{}>, expected <scene>",
+            root.tag_name().name()
+        );
     }
     let mut params: HashMap<String, String> = HashMap::new();
     for d in root.children().filter(|n| n.has_tag_name("default")) {
@@ -55,9 +60,7 @@ pub fn load(path: &Path, opts: &SceneOptions) -> Result<Scene> {
         bitmaps: HashMap::new(),
         scene: Scene::empty(&file),
         rfilter_box: false,
-        film: None,
     };
-    ctx.scene.max_depth = None;
     for node in root.children().filter(Node::is_element) {
         ctx.top_level(node)?;
     }
@@ -69,8 +72,16 @@ pub fn load(path: &Path, opts: &SceneOptions) -> Result<Scene> {
 
 fn pos(file: &str, doc: &Document, node: Node) -> String {
     let p = doc.text_pos_at(node.range().start);
-    let ty = node.attribute("type").map(|t| format!(" type=\"{t}\"")).unwrap_or_default();
-    format!("{file}:{}:{}: <{}{ty}>", p.row, p.col, node.tag_name().name())
+    let ty = node
+        .attribute("type")
+        .map(|t| format!(" type=\"{t}\""))
+        .unwrap_or_default();
+    format!(
+        "{file}:{}:{}: <{}{ty}>",
+        p.row,
+        p.col,
+        node.tag_name().name()
+    )
 }
 
 struct Ctx<'a> {
@@ -83,7 +94,6 @@ struct Ctx<'a> {
     bitmaps: HashMap<(PathBuf, bool), Arc<Bitmap>>,
     scene: Scene,
     rfilter_box: bool,
-    film: Option<(u32, u32)>,
 }
 
 #[derive(Clone)]
@@ -103,17 +113,28 @@ impl<'a> Ctx<'a> {
 
     /// An attribute with `$name` parameters substituted.
     fn attr(&self, node: Node, key: &str) -> Result<Option<String>> {
-        let Some(raw) = node.attribute(key) else { return Ok(None) };
+        let Some(raw) = node.attribute(key) else {
+            return Ok(None);
+        };
         let mut out = String::new();
         let mut rest = raw;
         while let Some(i) = rest.find('$') {
             out.push_str(&rest[..i]);
             let tail = &rest[i + 1..];
-            let end = tail.find(|c: char| !(c.is_alphanumeric() || c == '_')).unwrap_or(tail.len());
+            let end = tail
+                .find(|c: char| !(c.is_alphanumeric() || c == '_'))
+                .unwrap_or(tail.len());
             let name = &tail[..end];
             match self.params.get(name) {
                 Some(v) => out.push_str(v),
-                None => return self.fail(node, format!("parameter ${name} has no <default> and was not set (--set {name}=...)")),
+                None => {
+                    return self.fail(
+                        node,
+                        format!(
+                            "parameter ${name} has no <default> and was not set (--set {name}=...)"
+                        ),
+                    )
+                }
             }
             rest = &tail[end..];
         }
@@ -131,7 +152,10 @@ impl<'a> Ctx<'a> {
     fn numbers(&self, node: Node, s: &str) -> Result<Vec<f32>> {
         s.split(|c: char| c == ',' || c.is_whitespace())
             .filter(|t| !t.is_empty())
-            .map(|t| t.parse::<f32>().or_else(|_| self.fail(node, format!("'{t}' is not a number"))))
+            .map(|t| {
+                t.parse::<f32>()
+                    .or_else(|_| self.fail(node, format!("'{t}' is not a number")))
+            })
             .collect()
     }
 
@@ -171,25 +195,35 @@ impl<'a> Ctx<'a> {
 
     /// The child property element with `name="..."`.
     fn prop(&self, node: Node<'a, 'a>, name: &str) -> Option<Node<'a, 'a>> {
-        node.children().find(|c| c.is_element() && c.attribute("name") == Some(name))
+        node.children()
+            .find(|c| c.is_element() && c.attribute("name") == Some(name))
     }
 
     fn float_prop(&self, node: Node<'a, 'a>, name: &str, default: f32) -> Result<f32> {
-        self.prop(node, name).map_or(Ok(default), |p| self.float_value(p))
+        self.prop(node, name)
+            .map_or(Ok(default), |p| self.float_value(p))
     }
 
     fn int_prop(&self, node: Node<'a, 'a>, name: &str) -> Result<Option<i64>> {
-        let Some(p) = self.prop(node, name) else { return Ok(None) };
+        let Some(p) = self.prop(node, name) else {
+            return Ok(None);
+        };
         let v = self.req(p, "value")?;
-        v.trim().parse::<i64>().map(Some).or_else(|_| self.fail(p, format!("'{v}' is not an integer")))
+        v.trim()
+            .parse::<i64>()
+            .map(Some)
+            .or_else(|_| self.fail(p, format!("'{v}' is not an integer")))
     }
 
     fn string_prop(&self, node: Node<'a, 'a>, name: &str) -> Result<Option<String>> {
-        self.prop(node, name).map_or(Ok(None), |p| self.req(p, "value").map(Some))
+        self.prop(node, name)
+            .map_or(Ok(None), |p| self.req(p, "value").map(Some))
     }
 
     fn bool_prop(&self, node: Node<'a, 'a>, name: &str, default: bool) -> Result<bool> {
-        let Some(p) = self.prop(node, name) else { return Ok(default) };
+        let Some(p) = self.prop(node, name) else {
+            return Ok(default);
+        };
         match self.req(p, "value")?.as_str() {
             "true" | "1" => Ok(true),
             "false" | "0" => Ok(false),
@@ -199,7 +233,9 @@ impl<'a> Ctx<'a> {
 
     /// A colour or texture property; `default` when absent.
     fn texture_prop(&mut self, node: Node<'a, 'a>, name: &str, default: Vec3) -> Result<Texture> {
-        let Some(p) = self.prop(node, name) else { return Ok(Texture::Constant(default)) };
+        let Some(p) = self.prop(node, name) else {
+            return Ok(Texture::Constant(default));
+        };
         match p.tag_name().name() {
             "rgb" => Ok(Texture::Constant(self.vec3_value(p, 0.0)?)),
             "float" => Ok(Texture::Constant(Vec3::splat(self.float_value(p)?))),
@@ -223,18 +259,27 @@ impl<'a> Ctx<'a> {
         let to_uv = match self.prop(node, "to_uv") {
             Some(t) => {
                 let m = self.transform(t)?;
-                Affine2::from_cols(m.x_axis.truncate().truncate(), m.y_axis.truncate().truncate(), m.w_axis.truncate().truncate())
+                Affine2::from_cols(
+                    m.x_axis.truncate().truncate(),
+                    m.y_axis.truncate().truncate(),
+                    m.w_axis.truncate().truncate(),
+                )
             }
             None => Affine2::IDENTITY,
         };
         match node.attribute("type").unwrap_or("") {
             "bitmap" => {
-                let filename = self.string_prop(node, "filename")?.ok_or_else(|| anyhow!("{}: missing 'filename'", self.at(node)))?;
+                let filename = self
+                    .string_prop(node, "filename")?
+                    .ok_or_else(|| anyhow!("{}: missing 'filename'", self.at(node)))?;
                 let path = self.path(node, &filename)?;
                 let raw = self.bool_prop(node, "raw", false)?;
                 if let Some(w) = self.string_prop(node, "wrap_mode")? {
                     if w != "repeat" {
-                        self.scene.warnings.push(format!("{}: wrap_mode '{w}' is traced as 'repeat'", self.at(node)));
+                        self.scene.warnings.push(format!(
+                            "{}: wrap_mode '{w}' is traced as 'repeat'",
+                            self.at(node)
+                        ));
                     }
                 }
                 let key = (path.clone(), raw);
@@ -246,17 +291,30 @@ impl<'a> Ctx<'a> {
                         b
                     }
                 };
-                Ok(Texture::Bitmap { image, to_uv, factor: Vec3::ONE })
+                Ok(Texture::Bitmap {
+                    image,
+                    to_uv,
+                    factor: Vec3::ONE,
+                })
             }
             "checkerboard" => {
                 let c0 = self.texture_prop(node, "color0", Vec3::splat(0.4))?;
                 let c1 = self.texture_prop(node, "color1", Vec3::splat(0.2))?;
                 match (c0, c1) {
-                    (Texture::Constant(color0), Texture::Constant(color1)) => Ok(Texture::Checkerboard { color0, color1, to_uv }),
+                    (Texture::Constant(color0), Texture::Constant(color1)) => {
+                        Ok(Texture::Checkerboard {
+                            color0,
+                            color1,
+                            to_uv,
+                        })
+                    }
                     _ => self.fail(node, "checkerboard colours must be constants"),
                 }
             }
-            other => self.fail(node, format!("unsupported texture plugin '{other}' (supported: bitmap, checkerboard)")),
+            other => self.fail(
+                node,
+                format!("unsupported texture plugin '{other}' (supported: bitmap, checkerboard)"),
+            ),
         }
     }
 
@@ -268,7 +326,11 @@ impl<'a> Ctx<'a> {
                 "scale" => Mat4::from_scale(self.vec3_value(t, 1.0)?),
                 "rotate" => {
                     let axis = self.vec3_value(t, 0.0)?;
-                    let angle: f32 = self.req(t, "angle")?.trim().parse().or_else(|_| self.fail(t, "angle is not a number"))?;
+                    let angle: f32 = self
+                        .req(t, "angle")?
+                        .trim()
+                        .parse()
+                        .or_else(|_| self.fail(t, "angle is not a number"))?;
                     if axis.length_squared() == 0.0 {
                         return self.fail(t, "rotation axis is zero");
                     }
@@ -278,8 +340,12 @@ impl<'a> Ctx<'a> {
                     let v = self.numbers(t, &self.req(t, "value")?)?;
                     match v.len() {
                         16 => Mat4::from_cols_array(&v.try_into().unwrap()).transpose(),
-                        9 => Mat4::from_mat3(Mat3::from_cols_array(&v.try_into().unwrap()).transpose()),
-                        n => return self.fail(t, format!("a matrix needs 9 or 16 values, got {n}")),
+                        9 => Mat4::from_mat3(
+                            Mat3::from_cols_array(&v.try_into().unwrap()).transpose(),
+                        ),
+                        n => {
+                            return self.fail(t, format!("a matrix needs 9 or 16 values, got {n}"))
+                        }
                     }
                 }
                 "lookat" => {
@@ -290,7 +356,11 @@ impl<'a> Ctx<'a> {
                         }
                         Ok(Vec3::new(v[0], v[1], v[2]))
                     };
-                    let up = if t.attribute("up").is_some() { get("up")? } else { Vec3::Y };
+                    let up = if t.attribute("up").is_some() {
+                        get("up")?
+                    } else {
+                        Vec3::Y
+                    };
                     look_at(get("origin")?, get("target")?, up)
                 }
                 other => return self.fail(t, format!("unknown transform operation <{other}>")),
@@ -343,7 +413,11 @@ impl<'a> Ctx<'a> {
             Some(t) => self.transform(t)?,
             None => Mat4::IDENTITY,
         };
-        let fov_axis = match self.string_prop(node, "fov_axis")?.as_deref().unwrap_or("x") {
+        let fov_axis = match self
+            .string_prop(node, "fov_axis")?
+            .as_deref()
+            .unwrap_or("x")
+        {
             "x" => FovAxis::X,
             "y" => FovAxis::Y,
             "diagonal" => FovAxis::Diagonal,
@@ -367,10 +441,14 @@ impl<'a> Ctx<'a> {
                     }
                     width = self.int_prop(child, "width")?.unwrap_or(768).max(1) as u32;
                     height = self.int_prop(child, "height")?.unwrap_or(576).max(1) as u32;
-                    if self.prop(child, "crop_width").is_some() || self.prop(child, "crop_offset_x").is_some() {
+                    if self.prop(child, "crop_width").is_some()
+                        || self.prop(child, "crop_offset_x").is_some()
+                    {
                         return self.fail(child, "film crop windows are not supported");
                     }
-                    self.rfilter_box = child.children().any(|r| r.has_tag_name("rfilter") && r.attribute("type") == Some("box"));
+                    self.rfilter_box = child
+                        .children()
+                        .any(|r| r.has_tag_name("rfilter") && r.attribute("type") == Some("box"));
                 }
                 "sampler" => {
                     if let Some(n) = self.int_prop(child, "sample_count")? {
@@ -380,8 +458,13 @@ impl<'a> Ctx<'a> {
                 _ => {}
             }
         }
-        self.film = Some((width, height));
-        self.scene.camera = Some(Camera { to_world, fov_deg, fov_axis, width, height });
+        self.scene.camera = Some(Camera {
+            to_world,
+            fov_deg,
+            fov_axis,
+            width,
+            height,
+        });
         Ok(())
     }
 
@@ -391,7 +474,9 @@ impl<'a> Ctx<'a> {
         }
         let map = match node.attribute("type").unwrap_or("") {
             "envmap" => {
-                let filename = self.string_prop(node, "filename")?.ok_or_else(|| anyhow!("{}: missing 'filename'", self.at(node)))?;
+                let filename = self
+                    .string_prop(node, "filename")?
+                    .ok_or_else(|| anyhow!("{}: missing 'filename'", self.at(node)))?;
                 let path = self.path(node, &filename)?;
                 let scale = self.float_prop(node, "scale", 1.0)?;
                 EnvMap::load(&path, scale).with_context(|| self.at(node))?
@@ -400,7 +485,12 @@ impl<'a> Ctx<'a> {
                 Texture::Constant(c) => EnvMap::constant(c),
                 _ => return self.fail(node, "constant emitter radiance must be a colour"),
             },
-            other => return self.fail(node, format!("unsupported emitter plugin '{other}' (supported: envmap, constant)")),
+            other => {
+                return self.fail(
+                    node,
+                    format!("unsupported emitter plugin '{other}' (supported: envmap, constant)"),
+                )
+            }
         };
         let to_world = match self.prop(node, "to_world") {
             Some(t) => Mat3::from_mat4(self.transform(t)?),
@@ -447,7 +537,12 @@ impl<'a> Ctx<'a> {
                     Some(Named::Material(m)) => material = Some(*m),
                     _ => return self.fail(child, "does not refer to a BSDF declared earlier"),
                 },
-                "emitter" => return self.fail(child, "area emitters are not supported: light comes from the environment"),
+                "emitter" => {
+                    return self.fail(
+                        child,
+                        "area emitters are not supported: light comes from the environment",
+                    )
+                }
                 _ => {}
             }
         }
@@ -478,7 +573,12 @@ impl<'a> Ctx<'a> {
         for c in node.children().filter(Node::is_element) {
             match c.tag_name().name() {
                 "bsdf" => out.push(c),
-                "ref" => return self.fail(c, "references inside twosided/blendbsdf are not supported; nest the BSDF"),
+                "ref" => {
+                    return self.fail(
+                        c,
+                        "references inside twosided/blendbsdf are not supported; nest the BSDF",
+                    )
+                }
                 _ => {}
             }
         }
@@ -527,7 +627,11 @@ impl<'a> Ctx<'a> {
             "blendbsdf" => return self.blend(node, name),
             other => return self.fail(node, format!("unsupported BSDF plugin '{other}' (supported: diffuse, conductor, roughconductor, plastic, roughplastic, twosided, blendbsdf of diffuse + conductor)")),
         };
-        Ok(Material { name, surface: Surface::Direct { kd, ks, alpha }, two_sided: false })
+        Ok(Material {
+            name,
+            surface: Surface::Direct { kd, ks, alpha },
+            two_sided: false,
+        })
     }
 
     /// `blendbsdf` of one diffuse and one (rough)conductor is exactly DESIGN.md's model:
@@ -543,29 +647,41 @@ impl<'a> Ctx<'a> {
         }
         let parts = [self.bsdf_material(inner[0])?, self.bsdf_material(inner[1])?];
         let consts = |m: &Material| match &m.surface {
-            Surface::Direct { kd: Texture::Constant(kd), ks: Texture::Constant(ks), alpha: Texture::Constant(a) } => Some((*kd, *ks, a.x)),
+            Surface::Direct {
+                kd: Texture::Constant(kd),
+                ks: Texture::Constant(ks),
+                alpha: Texture::Constant(a),
+            } => Some((*kd, *ks, a.x)),
             _ => None,
         };
         match (consts(&parts[0]), consts(&parts[1])) {
             (Some((kd, ks0, _)), Some((kd1, ks, a))) if ks0 == Vec3::ZERO && kd1 == Vec3::ZERO => {
-                Ok(Material::glossy(&name, kd * (1.0 - w), ks * w, a)).map(|mut m| {
-                    m.two_sided = false;
-                    m
-                })
+                Ok(Material { two_sided: false, ..Material::glossy(&name, kd * (1.0 - w), ks * w, a) })
             }
             _ => self.fail(node, "blendbsdf is supported only as (diffuse, conductor/roughconductor) with constant parameters"),
         }
     }
 
     fn microfacet_alpha(&mut self, node: Node<'a, 'a>, default: f32) -> Result<f32> {
-        let dist = self.string_prop(node, "distribution")?.unwrap_or_else(|| "beckmann".into());
+        let dist = self
+            .string_prop(node, "distribution")?
+            .unwrap_or_else(|| "beckmann".into());
         if dist != "ggx" {
-            self.scene.warnings.push(format!("{}: distribution '{dist}' is traced as GGX", self.at(node)));
+            self.scene.warnings.push(format!(
+                "{}: distribution '{dist}' is traced as GGX",
+                self.at(node)
+            ));
         }
         if self.prop(node, "alpha_u").is_some() || self.prop(node, "alpha_v").is_some() {
-            let (u, v) = (self.float_prop(node, "alpha_u", default)?, self.float_prop(node, "alpha_v", default)?);
+            let (u, v) = (
+                self.float_prop(node, "alpha_u", default)?,
+                self.float_prop(node, "alpha_v", default)?,
+            );
             if (u - v).abs() > 1e-6 {
-                return self.fail(node, "anisotropic roughness (alpha_u != alpha_v) is not supported");
+                return self.fail(
+                    node,
+                    "anisotropic roughness (alpha_u != alpha_v) is not supported",
+                );
             }
             return Ok(u.max(MIN_ALPHA));
         }
@@ -613,7 +729,9 @@ mod tests {
     fn parses_parameters_transforms_and_materials() {
         let dir = std::env::temp_dir().join(format!("nprt-mi-{}", std::process::id()));
         let p = write(&dir, "s.xml", SCENE);
-        let opts = SceneOptions { set: vec![("r".into(), "0.75".into())] };
+        let opts = SceneOptions {
+            set: vec![("r".into(), "0.75".into())],
+        };
         let s = load(&p, &opts).unwrap();
         assert_eq!(s.max_depth, Some(4));
         assert_eq!(s.spp, Some(16));
@@ -622,7 +740,10 @@ mod tests {
         assert!((cam.origin() - Vec3::new(0.0, 1.0, 5.0)).length() < 1e-6);
         // Scale, then rotate -90° about X (z=0 plane → y=0 plane facing +Y), then translate.
         let floor = &s.meshes[0];
-        assert!(floor.positions.iter().all(|p| (p.y - 0.5).abs() < 1e-6 && p.x.abs() <= 2.0 + 1e-6));
+        assert!(floor
+            .positions
+            .iter()
+            .all(|p| (p.y - 0.5).abs() < 1e-6 && p.x.abs() <= 2.0 + 1e-6));
         assert!((floor.normals[0] - Vec3::Y).length() < 1e-6);
         let m = s.materials[floor.material].eval(Vec2::ZERO);
         assert_eq!(m.kd, Vec3::new(0.75, 0.5, 0.5));
@@ -636,17 +757,38 @@ mod tests {
     #[test]
     fn errors_name_file_line_and_element() {
         let dir = std::env::temp_dir().join(format!("nprt-mi-err-{}", std::process::id()));
-        let bad = SCENE.replace(r#"<bsdf type="roughconductor">"#, r#"<bsdf type="dielectric">"#);
+        let bad = SCENE.replace(
+            r#"<bsdf type="roughconductor">"#,
+            r#"<bsdf type="dielectric">"#,
+        );
         let p = write(&dir, "bad.xml", &bad);
         let err = format!("{:#}", load(&p, &SceneOptions::default()).unwrap_err());
-        assert!(err.contains("bad.xml:17:") && err.contains("dielectric"), "{err}");
+        assert!(
+            err.contains("bad.xml:17:") && err.contains("dielectric"),
+            "{err}"
+        );
 
-        let p = write(&dir, "missing.xml", &SCENE.replace(r#"<shape type="cube">"#, r#"<shape type="ply"><string name="filename" value="nope.ply"/>"#));
+        let p = write(
+            &dir,
+            "missing.xml",
+            &SCENE.replace(
+                r#"<shape type="cube">"#,
+                r#"<shape type="ply"><string name="filename" value="nope.ply"/>"#,
+            ),
+        );
         let err = format!("{:#}", load(&p, &SceneOptions::default()).unwrap_err());
-        assert!(err.contains("nope.ply") && err.contains("does not exist"), "{err}");
+        assert!(
+            err.contains("nope.ply") && err.contains("does not exist"),
+            "{err}"
+        );
 
-        let opts = SceneOptions { set: vec![("unknown".into(), "1".into())] };
-        let err = format!("{:#}", load(&write(&dir, "ok.xml", SCENE), &opts).unwrap_err());
+        let opts = SceneOptions {
+            set: vec![("unknown".into(), "1".into())],
+        };
+        let err = format!(
+            "{:#}",
+            load(&write(&dir, "ok.xml", SCENE), &opts).unwrap_err()
+        );
         assert!(err.contains("no parameter 'unknown'"), "{err}");
 
         let p = write(&dir, "unset.xml", &SCENE.replace("$spp", "$nosuch"));

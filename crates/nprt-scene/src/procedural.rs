@@ -25,7 +25,12 @@ pub struct SkyParams {
 
 impl Default for SkyParams {
     fn default() -> Self {
-        SkyParams { elevation: 35.0, azimuth: 120.0, turbidity: 3.0, width: 256 }
+        SkyParams {
+            elevation: 35.0,
+            azimuth: 120.0,
+            turbidity: 3.0,
+            width: 256,
+        }
     }
 }
 
@@ -35,7 +40,8 @@ const SUN_RADIUS_DEG: f32 = 1.5;
 
 /// Perez et al. luminance distribution F(θ, γ).
 fn perez(c: [f32; 5], cos_theta: f32, gamma: f32) -> f32 {
-    (1.0 + c[0] * (c[1] / cos_theta.max(0.01)).exp()) * (1.0 + c[2] * (c[3] * gamma).exp() + c[4] * gamma.cos().powi(2))
+    (1.0 + c[0] * (c[1] / cos_theta.max(0.01)).exp())
+        * (1.0 + c[2] * (c[3] * gamma).exp() + c[4] * gamma.cos().powi(2))
 }
 
 /// Linear Rec.709 RGB from CIE xyY.
@@ -51,14 +57,36 @@ fn xyy_to_rgb(x: f32, y: f32, big_y: f32) -> Vec3 {
 
 /// Preetham, Shirley and Smits, "A Practical Analytic Model for Daylight" (SIGGRAPH 1999).
 pub fn sky(p: SkyParams) -> Result<EnvMap> {
-    if !(0.5..=90.0).contains(&p.elevation) || !(1.7..=10.0).contains(&p.turbidity) || p.width < 8 || p.width % 2 != 0 {
+    if !(0.5..=90.0).contains(&p.elevation)
+        || !(1.7..=10.0).contains(&p.turbidity)
+        || p.width < 8
+        || !p.width.is_multiple_of(2)
+    {
         bail!("sky parameters out of range: elevation {}° (0.5..90), turbidity {} (1.7..10), width {} (even, ≥ 8)", p.elevation, p.turbidity, p.width);
     }
     let t = p.turbidity;
     let theta_s = (90.0 - p.elevation).to_radians();
-    let coef_y = [0.1787 * t - 1.4630, -0.3554 * t + 0.4275, -0.0227 * t + 5.3251, 0.1206 * t - 2.5771, -0.0670 * t + 0.3703];
-    let coef_x = [-0.0193 * t - 0.2592, -0.0665 * t + 0.0008, -0.0004 * t + 0.2125, -0.0641 * t - 0.8989, -0.0033 * t + 0.0452];
-    let coef_yc = [-0.0167 * t - 0.2608, -0.0950 * t + 0.0092, -0.0079 * t + 0.2102, -0.0441 * t - 1.6537, -0.0109 * t + 0.0529];
+    let coef_y = [
+        0.1787 * t - 1.4630,
+        -0.3554 * t + 0.4275,
+        -0.0227 * t + 5.3251,
+        0.1206 * t - 2.5771,
+        -0.0670 * t + 0.3703,
+    ];
+    let coef_x = [
+        -0.0193 * t - 0.2592,
+        -0.0665 * t + 0.0008,
+        -0.0004 * t + 0.2125,
+        -0.0641 * t - 0.8989,
+        -0.0033 * t + 0.0452,
+    ];
+    let coef_yc = [
+        -0.0167 * t - 0.2608,
+        -0.0950 * t + 0.0092,
+        -0.0079 * t + 0.2102,
+        -0.0441 * t - 1.6537,
+        -0.0109 * t + 0.0529,
+    ];
     let chi = (4.0 / 9.0 - t / 120.0) * (std::f32::consts::PI - 2.0 * theta_s);
     let zenith_y = ((4.0453 * t - 4.9710) * chi.tan() - 0.2155 * t + 2.4192).max(0.05);
     let poly = |m: [[f32; 4]; 3]| {
@@ -66,8 +94,16 @@ pub fn sky(p: SkyParams) -> Result<EnvMap> {
         let row = |r: [f32; 4]| r.iter().zip(th).map(|(a, b)| a * b).sum::<f32>();
         t * t * row(m[0]) + t * row(m[1]) + row(m[2])
     };
-    let zenith_x = poly([[0.00166, -0.00375, 0.00209, 0.0], [-0.02903, 0.06377, -0.03202, 0.00394], [0.11693, -0.21196, 0.06052, 0.25886]]);
-    let zenith_yc = poly([[0.00275, -0.00610, 0.00317, 0.0], [-0.04214, 0.08970, -0.04153, 0.00516], [0.15346, -0.26756, 0.06670, 0.26688]]);
+    let zenith_x = poly([
+        [0.00166, -0.00375, 0.00209, 0.0],
+        [-0.02903, 0.06377, -0.03202, 0.00394],
+        [0.11693, -0.21196, 0.06052, 0.25886],
+    ]);
+    let zenith_yc = poly([
+        [0.00275, -0.00610, 0.00317, 0.0],
+        [-0.04214, 0.08970, -0.04153, 0.00516],
+        [0.15346, -0.26756, 0.06670, 0.26688],
+    ]);
 
     let sun_dir = uv_to_direction(Vec2::new(p.azimuth / 360.0, theta_s / std::f32::consts::PI));
     // kcd/m² to scene units: a clear zenith comes out near 1.
@@ -76,11 +112,18 @@ pub fn sky(p: SkyParams) -> Result<EnvMap> {
     let mut texels = vec![Vec3::ZERO; w * h];
     for y in 0..h {
         for x in 0..w {
-            let d = uv_to_direction(Vec2::new((x as f32 + 0.5) / w as f32, y as f32 / (h - 1) as f32));
+            let d = uv_to_direction(Vec2::new(
+                (x as f32 + 0.5) / w as f32,
+                y as f32 / (h - 1) as f32,
+            ));
             let cos_theta = d.y.max(0.0);
             let gamma = d.dot(sun_dir).clamp(-1.0, 1.0).acos();
             let f = |c: [f32; 5], z: f32| z * perez(c, cos_theta, gamma) / perez(c, 1.0, theta_s);
-            texels[y * w + x] = xyy_to_rgb(f(coef_x, zenith_x), f(coef_yc, zenith_yc), f(coef_y, zenith_y)) * unit;
+            texels[y * w + x] = xyy_to_rgb(
+                f(coef_x, zenith_x),
+                f(coef_yc, zenith_yc),
+                f(coef_y, zenith_y),
+            ) * unit;
         }
     }
     // Horizontal sky irradiance (Riemann sum over texels), which sets the sun and ground.
@@ -91,7 +134,10 @@ pub fn sky(p: SkyParams) -> Result<EnvMap> {
     let mut e_sky = Vec3::ZERO;
     for y in 0..h {
         for x in 0..w {
-            let d = uv_to_direction(Vec2::new((x as f32 + 0.5) / w as f32, y as f32 / (h - 1) as f32));
+            let d = uv_to_direction(Vec2::new(
+                (x as f32 + 0.5) / w as f32,
+                y as f32 / (h - 1) as f32,
+            ));
             if d.y > 0.0 {
                 e_sky += texels[y * w + x] * d.y * solid(y);
             }
@@ -102,13 +148,21 @@ pub fn sky(p: SkyParams) -> Result<EnvMap> {
     let elev = p.elevation;
     let air_mass = 1.0 / (elev.to_radians().sin() + 0.50572 * (elev + 6.07995).powf(-1.6364));
     let tau = Vec3::new(0.06, 0.11, 0.24) * (t / 3.0);
-    let transmittance = Vec3::new((-tau.x * air_mass).exp(), (-tau.y * air_mass).exp(), (-tau.z * air_mass).exp());
+    let transmittance = Vec3::new(
+        (-tau.x * air_mass).exp(),
+        (-tau.y * air_mass).exp(),
+        (-tau.z * air_mass).exp(),
+    );
     let sun_omega = 2.0 * std::f32::consts::PI * (1.0 - SUN_RADIUS_DEG.to_radians().cos());
-    let sun_radiance = transmittance * (4.0 * luminance(e_sky) / (sun_omega * luminance(transmittance)));
+    let sun_radiance =
+        transmittance * (4.0 * luminance(e_sky) / (sun_omega * luminance(transmittance)));
     let ground = e_sky * (0.3 / std::f32::consts::PI);
     for y in 0..h {
         for x in 0..w {
-            let d = uv_to_direction(Vec2::new((x as f32 + 0.5) / w as f32, y as f32 / (h - 1) as f32));
+            let d = uv_to_direction(Vec2::new(
+                (x as f32 + 0.5) / w as f32,
+                y as f32 / (h - 1) as f32,
+            ));
             let texel = &mut texels[y * w + x];
             if d.y < 0.0 {
                 *texel = ground;
@@ -120,7 +174,10 @@ pub fn sky(p: SkyParams) -> Result<EnvMap> {
     }
     // Guarantee the sun lands on at least one texel whatever the resolution.
     let uv = direction_to_uv(sun_dir);
-    let (sx, sy) = (((uv.x * w as f32) as usize).min(w - 1), ((uv.y * (h - 1) as f32).round() as usize).min(h - 1));
+    let (sx, sy) = (
+        ((uv.x * w as f32) as usize).min(w - 1),
+        ((uv.y * (h - 1) as f32).round() as usize).min(h - 1),
+    );
     if luminance(texels[sy * w + sx]) < luminance(sun_radiance) {
         texels[sy * w + sx] += sun_radiance;
     }
@@ -131,12 +188,16 @@ pub fn sky(p: SkyParams) -> Result<EnvMap> {
 /// An indoor-style map: a dim, slightly graded surround with 1–3 bright rectangular windows or
 /// lamps of random size, place, colour and strength, all drawn from `seed`.
 pub fn indoor(seed: u64, width: usize) -> Result<EnvMap> {
-    if width < 8 || width % 2 != 0 {
+    if width < 8 || !width.is_multiple_of(2) {
         bail!("indoor map width {width} must be even and at least 8");
     }
     let mut rng = Pcg64Mcg::seed_from_u64(seed ^ 0x1d00_2d00);
     let (w, h) = (width, width / 2);
-    let wall = Vec3::new(rng.random_range(0.7..1.0), rng.random_range(0.7..1.0), rng.random_range(0.7..1.0)) * rng.random_range(0.04..0.12);
+    let wall = Vec3::new(
+        rng.random_range(0.7..1.0),
+        rng.random_range(0.7..1.0),
+        rng.random_range(0.7..1.0),
+    ) * rng.random_range(0.04..0.12);
     struct Light {
         centre: Vec2,
         half: Vec2,
@@ -191,7 +252,12 @@ pub fn open_envmap(spec: &str) -> Result<EnvMap> {
     };
     let mut parts = rest.split(':');
     let kind = parts.next().unwrap_or("");
-    let nums: Vec<f32> = parts.map(|s| s.parse::<f32>().with_context(|| format!("environment map '{spec}': '{s}' is not a number"))).collect::<Result<_>>()?;
+    let nums: Vec<f32> = parts
+        .map(|s| {
+            s.parse::<f32>()
+                .with_context(|| format!("environment map '{spec}': '{s}' is not a number"))
+        })
+        .collect::<Result<_>>()?;
     match kind {
         "sky" => {
             let d = SkyParams::default();
@@ -209,14 +275,30 @@ mod tests {
 
     #[test]
     fn sky_is_brightest_at_the_sun_and_bluer_than_the_sun() {
-        let m = sky(SkyParams { elevation: 40.0, azimuth: 90.0, ..Default::default() }).unwrap();
+        let m = sky(SkyParams {
+            elevation: 40.0,
+            azimuth: 90.0,
+            ..Default::default()
+        })
+        .unwrap();
         let sun = uv_to_direction(Vec2::new(0.25, 50.0 / 180.0));
         let brightest = m.texels().iter().map(|&t| luminance(t)).fold(0.0, f32::max);
         assert!((luminance(m.eval(sun)) - brightest).abs() / brightest < 0.5);
         let zenith = m.eval(Vec3::Y);
         assert!(zenith.z > zenith.x, "clear zenith should be blue: {zenith}");
         // Most sampled directions point at the sun.
-        let hits = (0..1000).filter(|k| m.sample(Vec3::new((*k as f32 * 0.618).fract(), (*k as f32 + 0.5) / 1000.0, 0.5)).0.dot(sun) > 0.99).count();
+        let hits = (0..1000)
+            .filter(|k| {
+                m.sample(Vec3::new(
+                    (*k as f32 * 0.618).fract(),
+                    (*k as f32 + 0.5) / 1000.0,
+                    0.5,
+                ))
+                .0
+                .dot(sun)
+                    > 0.99
+            })
+            .count();
         assert!(hits > 500, "{hits}");
     }
 
@@ -228,7 +310,10 @@ mod tests {
         assert_eq!(a.texels(), b.texels());
         assert_ne!(a.texels(), c.texels());
         let peak = a.texels().iter().map(|&t| luminance(t)).fold(0.0, f32::max);
-        assert!(peak > 20.0 * luminance(a.mean_radiance()) / 2.0, "lights should stand out");
+        assert!(
+            peak > 20.0 * luminance(a.mean_radiance()) / 2.0,
+            "lights should stand out"
+        );
     }
 
     #[test]

@@ -79,7 +79,14 @@ impl Scene {
         let radius = ((hi - lo).length() * 0.5).max(1e-3);
         let fov = 45.0f32;
         let distance = radius / (fov.to_radians() * 0.5).sin();
-        Camera::look_at(centre + Vec3::new(0.0, 0.0, distance), centre, Vec3::Y, fov, 512, 512)
+        Camera::look_at(
+            centre + Vec3::new(0.0, 0.0, distance),
+            centre,
+            Vec3::Y,
+            fov,
+            512,
+            512,
+        )
     }
 
     pub fn triangle_count(&self) -> usize {
@@ -96,7 +103,11 @@ pub fn load_scene(spec: &str, opts: &SceneOptions) -> Result<Scene> {
     if !path.exists() {
         bail!("scene file '{spec}' does not exist");
     }
-    let ext = path.extension().and_then(|e| e.to_str()).unwrap_or("").to_ascii_lowercase();
+    let ext = path
+        .extension()
+        .and_then(|e| e.to_str())
+        .unwrap_or("")
+        .to_ascii_lowercase();
     let scene = match ext.as_str() {
         "xml" => crate::mitsuba::load(path, opts)?,
         "gltf" | "glb" => crate::gltf_scene::load(path)?,

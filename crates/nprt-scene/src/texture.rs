@@ -33,7 +33,10 @@ impl Bitmap {
             .with_context(|| format!("cannot open texture '{}'", path.display()))?
             .decode()
             .with_context(|| format!("cannot decode texture '{}'", path.display()))?;
-        let float_source = matches!(img, image::DynamicImage::ImageRgb32F(_) | image::DynamicImage::ImageRgba32F(_));
+        let float_source = matches!(
+            img,
+            image::DynamicImage::ImageRgb32F(_) | image::DynamicImage::ImageRgba32F(_)
+        );
         Ok(Self::from_rgb8_or_f32(img, raw || float_source))
     }
 
@@ -44,10 +47,22 @@ impl Bitmap {
             .pixels()
             .map(|p| {
                 let c = Vec3::new(p[0], p[1], p[2]);
-                if linear { c } else { Vec3::new(srgb_to_linear(c.x), srgb_to_linear(c.y), srgb_to_linear(c.z)) }
+                if linear {
+                    c
+                } else {
+                    Vec3::new(
+                        srgb_to_linear(c.x),
+                        srgb_to_linear(c.y),
+                        srgb_to_linear(c.z),
+                    )
+                }
             })
             .collect();
-        Self { width: rgb.width() as usize, height: rgb.height() as usize, texels }
+        Self {
+            width: rgb.width() as usize,
+            height: rgb.height() as usize,
+            texels,
+        }
     }
 
     fn texel(&self, x: i64, y: i64) -> Vec3 {
@@ -74,10 +89,18 @@ impl Bitmap {
 pub enum Texture {
     Constant(Vec3),
     /// `factor * bitmap(to_uv(uv))`.
-    Bitmap { image: Arc<Bitmap>, to_uv: Affine2, factor: Vec3 },
+    Bitmap {
+        image: Arc<Bitmap>,
+        to_uv: Affine2,
+        factor: Vec3,
+    },
     /// Mitsuba's checkerboard: `color0` where the fractional parts of u and v fall on the same
     /// side of ½, else `color1`.
-    Checkerboard { color0: Vec3, color1: Vec3, to_uv: Affine2 },
+    Checkerboard {
+        color0: Vec3,
+        color1: Vec3,
+        to_uv: Affine2,
+    },
 }
 
 impl Texture {
@@ -88,11 +111,23 @@ impl Texture {
     pub fn eval(&self, uv: Vec2) -> Vec3 {
         match self {
             Texture::Constant(c) => *c,
-            Texture::Bitmap { image, to_uv, factor } => *factor * image.eval(to_uv.transform_point2(uv)),
-            Texture::Checkerboard { color0, color1, to_uv } => {
+            Texture::Bitmap {
+                image,
+                to_uv,
+                factor,
+            } => *factor * image.eval(to_uv.transform_point2(uv)),
+            Texture::Checkerboard {
+                color0,
+                color1,
+                to_uv,
+            } => {
                 let p = to_uv.transform_point2(uv);
                 let f = p - p.floor();
-                if (f.x > 0.5) == (f.y > 0.5) { *color0 } else { *color1 }
+                if (f.x > 0.5) == (f.y > 0.5) {
+                    *color0
+                } else {
+                    *color1
+                }
             }
         }
     }
@@ -108,7 +143,11 @@ mod tests {
 
     #[test]
     fn bitmap_centres_and_wrap() {
-        let b = Bitmap { width: 2, height: 1, texels: vec![Vec3::ZERO, Vec3::ONE] };
+        let b = Bitmap {
+            width: 2,
+            height: 1,
+            texels: vec![Vec3::ZERO, Vec3::ONE],
+        };
         assert_eq!(b.eval(Vec2::new(0.25, 0.5)), Vec3::ZERO);
         assert_eq!(b.eval(Vec2::new(0.75, 0.5)), Vec3::ONE);
         // Halfway between the last and (wrapped) first texel.
@@ -117,7 +156,11 @@ mod tests {
 
     #[test]
     fn checkerboard_matches_mitsuba_rule() {
-        let t = Texture::Checkerboard { color0: Vec3::ONE, color1: Vec3::ZERO, to_uv: Affine2::IDENTITY };
+        let t = Texture::Checkerboard {
+            color0: Vec3::ONE,
+            color1: Vec3::ZERO,
+            to_uv: Affine2::IDENTITY,
+        };
         assert_eq!(t.eval(Vec2::new(0.25, 0.25)), Vec3::ONE);
         assert_eq!(t.eval(Vec2::new(0.75, 0.25)), Vec3::ZERO);
         assert_eq!(t.eval(Vec2::new(0.75, 0.75)), Vec3::ONE);

@@ -16,7 +16,10 @@ struct Tri {
 
 impl bvh::aabb::Bounded<f32, 3> for Tri {
     fn aabb(&self) -> bvh::aabb::Aabb<f32, 3> {
-        bvh::aabb::Aabb::empty().grow(&self.p[0]).grow(&self.p[1]).grow(&self.p[2])
+        bvh::aabb::Aabb::empty()
+            .grow(&self.p[0])
+            .grow(&self.p[1])
+            .grow(&self.p[2])
     }
 }
 
@@ -64,19 +67,36 @@ fn bench(c: &mut Criterion) {
     g.bench_function("obvhs", |b| b.iter(|| Accel::new(&scene)));
     g.bench_function("bvh", |b| {
         b.iter(|| {
-            let mut shapes: Vec<Tri> = tris.iter().map(|t| Tri { p: t.map(point), node: 0 }).collect();
+            let mut shapes: Vec<Tri> = tris
+                .iter()
+                .map(|t| Tri {
+                    p: t.map(point),
+                    node: 0,
+                })
+                .collect();
             bvh::bvh::Bvh::build(&mut shapes)
         })
     });
     g.finish();
 
     let accel = Accel::new(&scene);
-    let mut shapes: Vec<Tri> = tris.iter().map(|t| Tri { p: t.map(point), node: 0 }).collect();
+    let mut shapes: Vec<Tri> = tris
+        .iter()
+        .map(|t| Tri {
+            p: t.map(point),
+            node: 0,
+        })
+        .collect();
     let tree = bvh::bvh::Bvh::build(&mut shapes);
     let mut g = c.benchmark_group("closest_hit");
     g.throughput(Throughput::Elements(rays.len() as u64));
     g.bench_function("obvhs", |b| {
-        b.iter(|| rays.iter().filter_map(|(o, d)| accel.intersect(*o, *d, f32::INFINITY)).map(|h| h.t).sum::<f32>())
+        b.iter(|| {
+            rays.iter()
+                .filter_map(|(o, d)| accel.intersect(*o, *d, f32::INFINITY))
+                .map(|h| h.t)
+                .sum::<f32>()
+        })
     });
     g.bench_function("bvh", |b| {
         b.iter(|| {

@@ -72,18 +72,31 @@ impl Accel {
         for (mi, mesh) in scene.meshes.iter().enumerate() {
             for (ti, t) in mesh.indices.iter().enumerate() {
                 let p = t.map(|i| Vec3A::from(mesh.positions[i as usize]));
-                tris.push(Triangle { v0: p[0], v1: p[1], v2: p[2] });
+                tris.push(Triangle {
+                    v0: p[0],
+                    v1: p[1],
+                    v2: p[2],
+                });
                 refs.push((mi as u32, ti as u32));
             }
         }
-        let bvh = build_cwbvh_from_tris(&tris, BvhBuildParams::medium_build(), &mut Duration::default());
+        let bvh = build_cwbvh_from_tris(
+            &tris,
+            BvhBuildParams::medium_build(),
+            &mut Duration::default(),
+        );
         let order = &bvh.primitive_indices;
         let tris = order
             .iter()
             .map(|&i| {
                 let t = &tris[i as usize];
                 let (e1, e2) = (t.v0 - t.v1, t.v2 - t.v0);
-                Tri { v0: t.v0, e1, e2, n: e1.cross(e2) }
+                Tri {
+                    v0: t.v0,
+                    e1,
+                    e2,
+                    n: e1.cross(e2),
+                }
             })
             .collect();
         let refs = order.iter().map(|&i| refs[i as usize]).collect();
@@ -99,17 +112,25 @@ impl Accel {
         let mut rh = RayHit::none();
         let mut best = (0usize, 0.0f32, 0.0f32);
         let mut closest = tmax;
-        let found = self.bvh.ray_traverse(ray, &mut rh, |r, id| match self.tris[id].intersect(r) {
-            Some((t, b1, b2)) if t < closest => {
-                closest = t;
-                best = (id, b1, b2);
-                t
-            }
-            _ => f32::INFINITY,
-        });
+        let found = self
+            .bvh
+            .ray_traverse(ray, &mut rh, |r, id| match self.tris[id].intersect(r) {
+                Some((t, b1, b2)) if t < closest => {
+                    closest = t;
+                    best = (id, b1, b2);
+                    t
+                }
+                _ => f32::INFINITY,
+            });
         found.then(|| {
             let (mesh, tri) = self.refs[best.0];
-            Hit { t: closest, mesh, tri, b1: best.1, b2: best.2 }
+            Hit {
+                t: closest,
+                mesh,
+                tri,
+                b1: best.1,
+                b2: best.2,
+            }
         })
     }
 
@@ -119,7 +140,9 @@ impl Accel {
             return false;
         }
         let ray = bvh_ray(origin, dir, tmax);
-        !self.bvh.ray_traverse_miss(ray, |r, id| self.tris[id].intersect(r).map_or(f32::INFINITY, |h| h.0))
+        !self.bvh.ray_traverse_miss(ray, |r, id| {
+            self.tris[id].intersect(r).map_or(f32::INFINITY, |h| h.0)
+        })
     }
 }
 
@@ -134,16 +157,23 @@ mod tests {
         let mut m = Mesh::rectangle();
         m.transform(glam::Mat4::from_translation(Vec3::new(0.0, 0.0, -2.0)));
         s.add(m, Material::diffuse("d", Vec3::ONE));
-        s.add(Mesh::sphere(Vec3::new(5.0, 0.0, 0.0), 1.0, 16), Material::diffuse("d", Vec3::ONE));
+        s.add(
+            Mesh::sphere(Vec3::new(5.0, 0.0, 0.0), 1.0, 16),
+            Material::diffuse("d", Vec3::ONE),
+        );
         let a = Accel::new(&s);
-        let h = a.intersect(Vec3::new(0.2, 0.3, 0.0), -Vec3::Z, f32::INFINITY).unwrap();
+        let h = a
+            .intersect(Vec3::new(0.2, 0.3, 0.0), -Vec3::Z, f32::INFINITY)
+            .unwrap();
         assert!((h.t - 2.0).abs() < 1e-5);
         assert_eq!(h.mesh, 0);
         let mesh = &s.meshes[0];
         let t = mesh.indices[h.tri as usize].map(|i| mesh.positions[i as usize]);
         let p = t[0] * (1.0 - h.b1 - h.b2) + t[1] * h.b1 + t[2] * h.b2;
         assert!((p - Vec3::new(0.2, 0.3, -2.0)).length() < 1e-5, "{p}");
-        assert!(a.intersect(Vec3::new(0.2, 0.3, 0.0), Vec3::Z, f32::INFINITY).is_none());
+        assert!(a
+            .intersect(Vec3::new(0.2, 0.3, 0.0), Vec3::Z, f32::INFINITY)
+            .is_none());
         assert!(a.occluded(Vec3::ZERO, -Vec3::Z, 3.0));
         assert!(!a.occluded(Vec3::ZERO, -Vec3::Z, 1.5));
         // The sphere is found from the side, nearest face first.

@@ -44,7 +44,11 @@ fn smith_g1(alpha: f32, v: Vec3, m: Vec3) -> f32 {
 fn sample_vndf(alpha: f32, wo: Vec3, u: Vec2) -> Vec3 {
     let vh = Vec3::new(alpha * wo.x, alpha * wo.y, wo.z).normalize();
     let len2 = vh.x * vh.x + vh.y * vh.y;
-    let t1 = if len2 > 0.0 { Vec3::new(-vh.y, vh.x, 0.0) / len2.sqrt() } else { Vec3::X };
+    let t1 = if len2 > 0.0 {
+        Vec3::new(-vh.y, vh.x, 0.0) / len2.sqrt()
+    } else {
+        Vec3::X
+    };
     let t2 = vh.cross(t1);
     let r = u.x.sqrt();
     let phi = 2.0 * PI * u.y;
@@ -59,7 +63,12 @@ impl Bsdf {
     pub fn new(p: BsdfParams) -> Self {
         let (ld, ls) = (luminance(p.kd), luminance(p.ks));
         let p_spec = if ld + ls > 0.0 { ls / (ld + ls) } else { 0.0 };
-        Bsdf { kd: p.kd, ks: p.ks, alpha: p.alpha, p_spec }
+        Bsdf {
+            kd: p.kd,
+            ks: p.ks,
+            alpha: p.alpha,
+            p_spec,
+        }
     }
 
     pub fn is_black(&self) -> bool {
@@ -109,7 +118,11 @@ impl Bsdf {
         if pdf <= 0.0 {
             return None;
         }
-        Some(BsdfSample { wi, weight: self.eval(wo, wi) / pdf, pdf })
+        Some(BsdfSample {
+            wi,
+            weight: self.eval(wo, wi) / pdf,
+            pdf,
+        })
     }
 }
 
@@ -144,14 +157,23 @@ mod tests {
     use rand::{RngExt, SeedableRng};
 
     fn params(kd: f32, ks: f32, alpha: f32) -> BsdfParams {
-        BsdfParams { kd: Vec3::splat(kd), ks: Vec3::splat(ks), alpha }
+        BsdfParams {
+            kd: Vec3::splat(kd),
+            ks: Vec3::splat(ks),
+            alpha,
+        }
     }
 
     /// Albedo ∫ f cos dωi by uniform hemisphere sampling and by importance sampling must agree.
     #[test]
     fn importance_sampling_matches_uniform_integration() {
         let mut rng = rand_pcg::Pcg64Mcg::seed_from_u64(1);
-        for (kd, ks, alpha) in [(0.8, 0.0, 0.3), (0.0, 1.0, 0.05), (0.0, 1.0, 0.5), (0.5, 0.5, 0.2)] {
+        for (kd, ks, alpha) in [
+            (0.8, 0.0, 0.3),
+            (0.0, 1.0, 0.05),
+            (0.0, 1.0, 0.5),
+            (0.5, 0.5, 0.2),
+        ] {
             let b = Bsdf::new(params(kd, ks, alpha));
             let wo = Vec3::new(0.5, 0.1, 0.8).normalize();
             let n = 400_000;
@@ -169,7 +191,10 @@ mod tests {
             }
             let (uni, imp) = (uni / n as f64, imp / n as f64);
             let tol = if alpha < 0.1 { 0.03 } else { 0.01 };
-            assert!((uni - imp).abs() < tol * uni.max(0.1), "kd {kd} ks {ks} α {alpha}: uniform {uni} vs sampled {imp}");
+            assert!(
+                (uni - imp).abs() < tol * uni.max(0.1),
+                "kd {kd} ks {ks} α {alpha}: uniform {uni} vs sampled {imp}"
+            );
             if ks == 0.0 {
                 assert!((imp - kd as f64).abs() < 0.005, "diffuse albedo {imp}");
             }
@@ -187,30 +212,45 @@ mod tests {
             let st = (1.0 - ct * ct).sqrt();
             for i in 0..np {
                 let phi = (i as f32 + 0.5) / np as f32 * 2.0 * PI;
-                total += (b.pdf(wo, Vec3::new(st * phi.cos(), st * phi.sin(), ct)) * 2.0 * PI) as f64 / (nt * np) as f64;
+                total += (b.pdf(wo, Vec3::new(st * phi.cos(), st * phi.sin(), ct)) * 2.0 * PI)
+                    as f64
+                    / (nt * np) as f64;
             }
         }
         // Mass missing from the hemisphere is exactly the specular samples reflected below it.
         let n = 200_000;
         let lost = (0..n)
             .filter(|k| {
-                let u = Vec2::new(((*k as f32 + 0.5) * 0.618_034).fract(), (*k as f32 + 0.5) / n as f32);
+                let u = Vec2::new(
+                    ((*k as f32 + 0.5) * 0.618_034).fract(),
+                    (*k as f32 + 0.5) / n as f32,
+                );
                 b.sample(wo, u, ((*k as f32) * 0.414_213).fract()).is_none()
             })
             .count() as f64
             / n as f64;
         assert!(lost > 0.0 && lost < 0.1);
-        assert!((total - (1.0 - lost)).abs() < 0.005, "pdf integrates to {total}, sampling loses {lost}");
+        assert!(
+            (total - (1.0 - lost)).abs() < 0.005,
+            "pdf integrates to {total}, sampling loses {lost}"
+        );
     }
 
     #[test]
     fn reciprocal_and_frame_orthonormal() {
         let b = Bsdf::new(params(0.2, 0.9, 0.3));
-        let (a, c) = (Vec3::new(0.3, 0.2, 0.9).normalize(), Vec3::new(-0.6, 0.1, 0.5).normalize());
+        let (a, c) = (
+            Vec3::new(0.3, 0.2, 0.9).normalize(),
+            Vec3::new(-0.6, 0.1, 0.5).normalize(),
+        );
         assert!((b.eval(a, c) / c.z - b.eval(c, a) / a.z).length() < 1e-5);
         for n in [Vec3::Z, -Vec3::Z, Vec3::new(0.3, -0.8, 0.1).normalize()] {
             let f = Frame3::new(n);
-            assert!(f.s.dot(f.t).abs() < 1e-6 && f.s.dot(n).abs() < 1e-6 && (f.s.cross(f.t) - n).length() < 1e-5);
+            assert!(
+                f.s.dot(f.t).abs() < 1e-6
+                    && f.s.dot(n).abs() < 1e-6
+                    && (f.s.cross(f.t) - n).length() < 1e-5
+            );
         }
     }
 }

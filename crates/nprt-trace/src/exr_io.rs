@@ -8,36 +8,69 @@ use anyhow::{bail, Context, Result};
 use exr::prelude::*;
 
 /// Writes `channels` (name, row-major data of `width × height`) to `path`.
-pub fn write_channels(path: &Path, width: usize, height: usize, channels: &[(String, Vec<f32>)]) -> Result<()> {
+pub fn write_channels(
+    path: &Path,
+    width: usize,
+    height: usize,
+    channels: &[(String, Vec<f32>)],
+) -> Result<()> {
     for (name, data) in channels {
         if data.len() != width * height {
-            bail!("channel '{name}' has {} values for a {width}×{height} image", data.len());
+            bail!(
+                "channel '{name}' has {} values for a {width}×{height} image",
+                data.len()
+            );
         }
     }
-    let list: SmallVec<[AnyChannel<FlatSamples>; 4]> =
-        channels.iter().map(|(n, d)| AnyChannel::new(n.as_str(), FlatSamples::F32(d.clone()))).collect();
-    let layer = Layer::new((width, height), LayerAttributes::default(), Encoding::SMALL_LOSSLESS, AnyChannels::sort(list));
-    let dir = path.parent().filter(|p| !p.as_os_str().is_empty()).unwrap_or(Path::new("."));
-    std::fs::create_dir_all(dir).with_context(|| format!("cannot create folder '{}'", dir.display()))?;
+    let list: SmallVec<[AnyChannel<FlatSamples>; 4]> = channels
+        .iter()
+        .map(|(n, d)| AnyChannel::new(n.as_str(), FlatSamples::F32(d.clone())))
+        .collect();
+    let layer = Layer::new(
+        (width, height),
+        LayerAttributes::default(),
+        Encoding::SMALL_LOSSLESS,
+        AnyChannels::sort(list),
+    );
+    let dir = path
+        .parent()
+        .filter(|p| !p.as_os_str().is_empty())
+        .unwrap_or(Path::new("."));
+    std::fs::create_dir_all(dir)
+        .with_context(|| format!("cannot create folder '{}'", dir.display()))?;
     let tmp = tempfile_in(dir, path)?;
-    Image::from_layer(layer).write().to_file(&tmp).with_context(|| format!("cannot write '{}'", tmp.display()))?;
-    std::fs::rename(&tmp, path).with_context(|| format!("cannot move '{}' into place", path.display()))?;
+    Image::from_layer(layer)
+        .write()
+        .to_file(&tmp)
+        .with_context(|| format!("cannot write '{}'", tmp.display()))?;
+    std::fs::rename(&tmp, path)
+        .with_context(|| format!("cannot move '{}' into place", path.display()))?;
     Ok(())
 }
 
 fn tempfile_in(dir: &Path, path: &Path) -> Result<std::path::PathBuf> {
-    let name = path.file_name().context("output path has no file name")?.to_string_lossy();
+    let name = path
+        .file_name()
+        .context("output path has no file name")?
+        .to_string_lossy();
     Ok(dir.join(format!(".{name}.{}.tmp", std::process::id())))
 }
 
 /// Reads every f32/f16 channel of the first layer: (width, height, name → data).
 pub fn read_channels(path: &Path) -> Result<(usize, usize, HashMap<String, Vec<f32>>)> {
-    let image = read_all_flat_layers_from_file(path).with_context(|| format!("cannot read '{}'", path.display()))?;
-    let layer = image.layer_data.first().with_context(|| format!("'{}' has no layers", path.display()))?;
+    let image = read_all_flat_layers_from_file(path)
+        .with_context(|| format!("cannot read '{}'", path.display()))?;
+    let layer = image
+        .layer_data
+        .first()
+        .with_context(|| format!("'{}' has no layers", path.display()))?;
     let (w, h) = (layer.size.width(), layer.size.height());
     let mut out = HashMap::new();
     for ch in &layer.channel_data.list {
-        out.insert(ch.name.to_string(), ch.sample_data.values_as_f32().collect());
+        out.insert(
+            ch.name.to_string(),
+            ch.sample_data.values_as_f32().collect(),
+        );
     }
     Ok((w, h, out))
 }

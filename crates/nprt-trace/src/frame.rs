@@ -22,6 +22,30 @@ pub struct GBuffer {
     pub mask: Vec<f32>,
 }
 
+/// The G-buffer of one pixel; all zeros where the centre ray sees the background.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct GSample {
+    pub position: Vec3,
+    pub normal: Vec3,
+    pub view: Vec3,
+    pub kd: Vec3,
+    pub ks: Vec3,
+    pub alpha: f32,
+    pub mask: f32,
+}
+
+impl GBuffer {
+    pub fn push(&mut self, s: GSample) {
+        self.position.push(s.position);
+        self.normal.push(s.normal);
+        self.view.push(s.view);
+        self.kd.push(s.kd);
+        self.ks.push(s.ks);
+        self.alpha.push(s.alpha);
+        self.mask.push(s.mask);
+    }
+}
+
 #[derive(Clone, Debug)]
 pub struct Frame {
     pub width: usize,
@@ -34,7 +58,11 @@ pub struct Frame {
 fn split(prefix: &str, names: [&str; 3], data: &[Vec3]) -> Vec<(String, Vec<f32>)> {
     (0..3)
         .map(|k| {
-            let name = if prefix.is_empty() { names[k].to_string() } else { format!("{prefix}.{}", names[k]) };
+            let name = if prefix.is_empty() {
+                names[k].to_string()
+            } else {
+                format!("{prefix}.{}", names[k])
+            };
             (name, data.iter().map(|v| v[k]).collect())
         })
         .collect()

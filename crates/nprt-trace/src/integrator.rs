@@ -24,7 +24,11 @@ pub struct SurfacePoint {
 /// Power heuristic (β = 2) weight of the strategy with density `a` against `b`.
 fn mis(a: f32, b: f32) -> f32 {
     let (a2, b2) = (a * a, b * b);
-    if a2 + b2 > 0.0 { a2 / (a2 + b2) } else { 0.0 }
+    if a2 + b2 > 0.0 {
+        a2 / (a2 + b2)
+    } else {
+        0.0
+    }
 }
 
 /// Origin just off the surface on the side `dir` leaves towards (Mitsuba's ray epsilon scale).
@@ -38,12 +42,28 @@ pub fn surface_point(scene: &Scene, hit: &Hit, dir: Vec3) -> SurfacePoint {
     let mesh = &scene.meshes[hit.mesh as usize];
     let tri = mesh.indices[hit.tri as usize];
     let w = [1.0 - hit.b1 - hit.b2, hit.b1, hit.b2];
-    let lerp3 = |a: &[Vec3]| tri.iter().zip(w).map(|(&i, wi)| a[i as usize] * wi).sum::<Vec3>();
+    let lerp3 = |a: &[Vec3]| {
+        tri.iter()
+            .zip(w)
+            .map(|(&i, wi)| a[i as usize] * wi)
+            .sum::<Vec3>()
+    };
     let p = lerp3(&mesh.positions);
     let v = tri.map(|i| mesh.positions[i as usize]);
     let mut ng = (v[1] - v[0]).cross(v[2] - v[0]).normalize_or(Vec3::Y);
-    let mut ns = if mesh.normals.is_empty() { ng } else { lerp3(&mesh.normals).normalize_or(ng) };
-    let uv = if mesh.uvs.is_empty() { Vec2::ZERO } else { tri.iter().zip(w).map(|(&i, wi)| mesh.uvs[i as usize] * wi).sum() };
+    let mut ns = if mesh.normals.is_empty() {
+        ng
+    } else {
+        lerp3(&mesh.normals).normalize_or(ng)
+    };
+    let uv = if mesh.uvs.is_empty() {
+        Vec2::ZERO
+    } else {
+        tri.iter()
+            .zip(w)
+            .map(|(&i, wi)| mesh.uvs[i as usize] * wi)
+            .sum()
+    };
     let material = &scene.materials[mesh.material];
     if material.two_sided && ns.dot(dir) > 0.0 {
         ns = -ns;
@@ -51,7 +71,12 @@ pub fn surface_point(scene: &Scene, hit: &Hit, dir: Vec3) -> SurfacePoint {
     if ng.dot(ns) < 0.0 {
         ng = -ng;
     }
-    SurfacePoint { p, ng, ns, params: material.eval(uv) }
+    SurfacePoint {
+        p,
+        ng,
+        ns,
+        params: material.eval(uv),
+    }
 }
 
 /// Radiance carried by one path: all of it, and the direct part (the emitter seen directly
@@ -67,7 +92,15 @@ pub struct PathSettings {
     pub rr_depth: u32,
 }
 
-pub fn trace_path(scene: &Scene, accel: &Accel, env: &EnvMap, mut origin: Vec3, mut dir: Vec3, s: &PathSettings, rng: &mut Pcg64Mcg) -> PathRadiance {
+pub fn trace_path(
+    scene: &Scene,
+    accel: &Accel,
+    env: &EnvMap,
+    mut origin: Vec3,
+    mut dir: Vec3,
+    s: &PathSettings,
+    rng: &mut Pcg64Mcg,
+) -> PathRadiance {
     let mut out = PathRadiance::default();
     if s.max_depth == 0 {
         return out;
@@ -78,7 +111,11 @@ pub fn trace_path(scene: &Scene, accel: &Accel, env: &EnvMap, mut origin: Vec3, 
     loop {
         let Some(hit) = accel.intersect(origin, dir, f32::INFINITY) else {
             let (le, light_pdf) = env.eval_pdf(dir);
-            let weight = if depth == 0 { 1.0 } else { mis(prev_pdf, light_pdf) };
+            let weight = if depth == 0 {
+                1.0
+            } else {
+                mis(prev_pdf, light_pdf)
+            };
             let c = beta * le * weight;
             out.total += c;
             if depth <= 1 {
@@ -97,11 +134,18 @@ pub fn trace_path(scene: &Scene, accel: &Accel, env: &EnvMap, mut origin: Vec3, 
             break;
         }
         // Next-event estimation towards the environment.
-        let (wi_world, le, light_pdf) = env.sample(Vec3::new(rng.random(), rng.random(), rng.random()));
+        let (wi_world, le, light_pdf) =
+            env.sample(Vec3::new(rng.random(), rng.random(), rng.random()));
         if light_pdf > 0.0 {
             let wi = frame.to_local(wi_world);
             let f = bsdf.eval(wo, wi);
-            if f != Vec3::ZERO && !accel.occluded(offset_origin(sp.p, sp.ng, wi_world), wi_world, f32::INFINITY) {
+            if f != Vec3::ZERO
+                && !accel.occluded(
+                    offset_origin(sp.p, sp.ng, wi_world),
+                    wi_world,
+                    f32::INFINITY,
+                )
+            {
                 let c = beta * f * le * (mis(light_pdf, bsdf.pdf(wo, wi)) / light_pdf);
                 out.total += c;
                 if depth == 0 {
@@ -109,7 +153,9 @@ pub fn trace_path(scene: &Scene, accel: &Accel, env: &EnvMap, mut origin: Vec3, 
                 }
             }
         }
-        let Some(bs) = bsdf.sample(wo, Vec2::new(rng.random(), rng.random()), rng.random()) else { break };
+        let Some(bs) = bsdf.sample(wo, Vec2::new(rng.random(), rng.random()), rng.random()) else {
+            break;
+        };
         dir = frame.to_world(bs.wi);
         origin = offset_origin(sp.p, sp.ng, dir);
         beta *= bs.weight;

@@ -15,5 +15,5 @@ pub mod render;
 
 pub use accel::{Accel, Hit};
 pub use bsdf::Bsdf;
-pub use frame::{Frame, GBuffer};
+pub use frame::{Frame, GBuffer, GSample};
 pub use render::{render, PixelFilter, RenderSettings, TraceScene};

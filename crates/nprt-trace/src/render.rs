@@ -9,7 +9,7 @@ use rand_pcg::Pcg64Mcg;
 use rayon::prelude::*;
 
 use crate::accel::Accel;
-use crate::frame::{Frame, GBuffer};
+use crate::frame::{Frame, GBuffer, GSample};
 use crate::integrator::{surface_point, trace_path, PathRadiance, PathSettings};
 
 /// Where a pixel's samples go through the film.
@@ -41,7 +41,10 @@ pub struct TraceScene<'a> {
 
 impl<'a> TraceScene<'a> {
     pub fn new(scene: &'a Scene) -> Self {
-        TraceScene { scene, accel: Accel::new(scene) }
+        TraceScene {
+            scene,
+            accel: Accel::new(scene),
+        }
     }
 }
 
@@ -55,51 +58,73 @@ fn mix(mut z: u64) -> u64 {
 struct PixelOut {
     radiance: Vec3,
     direct: Vec3,
-    gb: (Vec3, Vec3, Vec3, Vec3, Vec3, f32, f32),
+    gb: GSample,
 }
 
 pub fn render(ts: &TraceScene, camera: &Camera, env: &EnvMap, s: &RenderSettings) -> Frame {
     let (w, h) = (camera.width as usize, camera.height as usize);
-    let bar = if s.progress { ProgressBar::new(h as u64) } else { ProgressBar::hidden() };
+    let bar = if s.progress {
+        ProgressBar::new(h as u64)
+    } else {
+        ProgressBar::hidden()
+    };
     bar.set_style(
-        ProgressStyle::with_template("{spinner} rendering [{bar:40}] {pos}/{len} rows, {elapsed} elapsed, ETA {eta}")
-            .expect("valid template")
-            .progress_chars("=> "),
+        ProgressStyle::with_template(
+            "{spinner} rendering [{bar:40}] {pos}/{len} rows, {elapsed} elapsed, ETA {eta}",
+        )
+        .expect("valid template")
+        .progress_chars("=> "),
     );
-    let path_settings = PathSettings { max_depth: s.max_depth.unwrap_or(u32::MAX), rr_depth: s.rr_depth };
+    let path_settings = PathSettings {
+        max_depth: s.max_depth.unwrap_or(u32::MAX),
+        rr_depth: s.rr_depth,
+    };
     let rows: Vec<Vec<PixelOut>> = (0..h)
         .into_par_iter()
         .map(|y| {
-            let row = (0..w).map(|x| pixel(ts, camera, env, s, &path_settings, x, y)).collect();
+            let row = (0..w)
+                .map(|x| pixel(ts, camera, env, s, &path_settings, x, y))
+                .collect();
             bar.inc(1);
             row
         })
         .collect();
     bar.finish_and_clear();
-    let mut f = Frame { width: w, height: h, radiance: vec![], direct: vec![], gbuffer: GBuffer::default() };
+    let mut f = Frame {
+        width: w,
+        height: h,
+        radiance: vec![],
+        direct: vec![],
+        gbuffer: GBuffer::default(),
+    };
     for p in rows.into_iter().flatten() {
         f.radiance.push(p.radiance);
         f.direct.push(p.direct);
-        let g = &mut f.gbuffer;
-        g.position.push(p.gb.0);
-        g.normal.push(p.gb.1);
-        g.view.push(p.gb.2);
-        g.kd.push(p.gb.3);
-        g.ks.push(p.gb.4);
-        g.alpha.push(p.gb.5);
-        g.mask.push(p.gb.6);
+        f.gbuffer.push(p.gb);
     }
     f
 }
 
-fn pixel(ts: &TraceScene, camera: &Camera, env: &EnvMap, s: &RenderSettings, ps: &PathSettings, x: usize, y: usize) -> PixelOut {
+fn pixel(
+    ts: &TraceScene,
+    camera: &Camera,
+    env: &EnvMap,
+    s: &RenderSettings,
+    ps: &PathSettings,
+    x: usize,
+    y: usize,
+) -> PixelOut {
     let index = (y * camera.width as usize + x) as u64;
-    let mut rng = Pcg64Mcg::seed_from_u64(mix(s.seed.wrapping_mul(0x9e37_79b9_7f4a_7c15) ^ mix(index)));
+    let mut rng =
+        Pcg64Mcg::seed_from_u64(mix(s.seed.wrapping_mul(0x9e37_79b9_7f4a_7c15) ^ mix(index)));
     let centre = Vec2::new(x as f32 + 0.5, y as f32 + 0.5);
     let mut sum = PathRadiance::default();
     for _ in 0..s.spp {
         let film = match s.filter {
-            PixelFilter::Box => Vec2::new(x as f32 + rng.random::<f32>(), y as f32 + rng.random::<f32>()),
+            PixelFilter::Box => Vec2::new(
+                x as f32 + rng.random::<f32>(),
+                y as f32 + rng.random::<f32>(),
+            ),
             PixelFilter::Centre => centre,
         };
         let (o, d) = camera.ray(film);
@@ -112,9 +137,21 @@ fn pixel(ts: &TraceScene, camera: &Camera, env: &EnvMap, s: &RenderSettings, ps:
     let gb = match ts.accel.intersect(o, d, f32::INFINITY) {
         Some(hit) => {
             let sp = surface_point(ts.scene, &hit, d);
-            (sp.p, sp.ns, -d, sp.params.kd, sp.params.ks, sp.params.alpha, 1.0)
+            GSample {
+                position: sp.p,
+                normal: sp.ns,
+                view: -d,
+                kd: sp.params.kd,
+                ks: sp.params.ks,
+                alpha: sp.params.alpha,
+                mask: 1.0,
+            }
         }
-        None => (Vec3::ZERO, Vec3::ZERO, Vec3::ZERO, Vec3::ZERO, Vec3::ZERO, 0.0, 0.0),
+        None => GSample::default(),
     };
-    PixelOut { radiance: sum.total / n, direct: sum.direct / n, gb }
+    PixelOut {
+        radiance: sum.total / n,
+        direct: sum.direct / n,
+        gb,
+    }
 }

@@ -6,7 +6,14 @@ use nprt_scene::{Camera, EnvMap, Material, Mesh, Scene};
 use nprt_trace::{render, Frame, PixelFilter, RenderSettings, TraceScene};
 
 fn settings(spp: u32, max_depth: Option<u32>) -> RenderSettings {
-    RenderSettings { spp, max_depth, rr_depth: 5, seed: 7, filter: PixelFilter::Box, progress: false }
+    RenderSettings {
+        spp,
+        max_depth,
+        rr_depth: 5,
+        seed: 7,
+        filter: PixelFilter::Box,
+        progress: false,
+    }
 }
 
 fn sphere_scene(material: Material) -> Scene {
@@ -38,11 +45,23 @@ fn white_furnace_returns_the_environment() {
     white.two_sided = false;
     let s = sphere_scene(white);
     let ts = TraceScene::new(&s);
-    let f = render(&ts, &camera(), &EnvMap::constant(Vec3::ONE), &settings(64, None));
+    let f = render(
+        &ts,
+        &camera(),
+        &EnvMap::constant(Vec3::ONE),
+        &settings(64, None),
+    );
     let m = foreground_mean(&f);
-    assert!((m - Vec3::ONE).abs().max_element() < 0.005, "furnace mean {m}");
+    assert!(
+        (m - Vec3::ONE).abs().max_element() < 0.005,
+        "furnace mean {m}"
+    );
     // No pixel deviates beyond noise either (64 spp with Russian roulette: σ ≈ 0.03).
-    let worst = f.radiance.iter().map(|r| (r.x - 1.0).abs()).fold(0.0, f32::max);
+    let worst = f
+        .radiance
+        .iter()
+        .map(|r| (r.x - 1.0).abs())
+        .fold(0.0, f32::max);
     assert!(worst < 0.15, "a pixel strays from 1 by {worst}");
 }
 
@@ -56,10 +75,16 @@ fn convex_diffuse_object_reflects_albedo_times_sky() {
     let f = render(&ts, &camera(), &EnvMap::constant(sky), &settings(64, None));
     let m = foreground_mean(&f);
     let expected = kd * sky;
-    assert!(((m - expected) / expected).abs().max_element() < 0.01, "{m} vs {expected}");
+    assert!(
+        ((m - expected) / expected).abs().max_element() < 0.01,
+        "{m} vs {expected}"
+    );
     let direct: Vec3 = f.direct.iter().sum::<Vec3>() / f.direct.len() as f32;
     let total = f.mean();
-    assert!(((direct - total) / total).abs().max_element() < 1e-3, "a convex object has no indirect light");
+    assert!(
+        ((direct - total) / total).abs().max_element() < 1e-3,
+        "a convex object has no indirect light"
+    );
 }
 
 #[test]
@@ -68,12 +93,26 @@ fn diffuse_plane_under_constant_map() {
     // direct illumination alone (max_depth 2) and with full transport alike.
     let mut s = Scene::empty("plane");
     let mut plane = Mesh::rectangle();
-    plane.transform(Mat4::from_rotation_x(-std::f32::consts::FRAC_PI_2) * Mat4::from_scale(Vec3::splat(50.0)));
+    plane.transform(
+        Mat4::from_rotation_x(-std::f32::consts::FRAC_PI_2) * Mat4::from_scale(Vec3::splat(50.0)),
+    );
     s.add(plane, Material::diffuse("d", Vec3::splat(0.6)));
     let ts = TraceScene::new(&s);
-    let cam = Camera::look_at(Vec3::new(0.0, 1.0, 0.0), Vec3::new(0.0, 0.0, -1.0), Vec3::Y, 45.0, 24, 24);
+    let cam = Camera::look_at(
+        Vec3::new(0.0, 1.0, 0.0),
+        Vec3::new(0.0, 0.0, -1.0),
+        Vec3::Y,
+        45.0,
+        24,
+        24,
+    );
     for depth in [Some(2), None] {
-        let f = render(&ts, &cam, &EnvMap::constant(Vec3::splat(1.5)), &settings(64, depth));
+        let f = render(
+            &ts,
+            &cam,
+            &EnvMap::constant(Vec3::splat(1.5)),
+            &settings(64, depth),
+        );
         let m = foreground_mean(&f);
         assert!((m.x - 0.9).abs() < 0.01, "max_depth {depth:?}: {m}");
     }
@@ -86,17 +125,35 @@ fn max_depth_follows_mitsuba() {
     let env = EnvMap::constant(Vec3::ONE);
     // max_depth 1: only the emitter seen directly; surfaces are black. Through pixel centres
     // every pixel is exactly the sky (1) or a surface (0).
-    let centre = RenderSettings { filter: PixelFilter::Centre, ..settings(4, Some(1)) };
+    let centre = RenderSettings {
+        filter: PixelFilter::Centre,
+        ..settings(4, Some(1))
+    };
     let f = render(&ts, &camera(), &env, &centre);
     for (r, m) in f.radiance.iter().zip(&f.gbuffer.mask) {
         assert_eq!(r.x, 1.0 - *m, "pixel with mask {m} has radiance {r}");
     }
     assert!(f.gbuffer.mask.iter().sum::<f32>() > 100.0);
     // max_depth 2 lights the sphere (direct only), so surfaces are no longer black.
-    let f = render(&ts, &camera(), &env, &RenderSettings { max_depth: Some(2), ..centre });
-    assert!((foreground_mean(&f).x - 0.5).abs() < 0.02, "{}", foreground_mean(&f));
+    let f = render(
+        &ts,
+        &camera(),
+        &env,
+        &RenderSettings {
+            max_depth: Some(2),
+            ..centre
+        },
+    );
+    assert!(
+        (foreground_mean(&f).x - 0.5).abs() < 0.02,
+        "{}",
+        foreground_mean(&f)
+    );
     // max_depth 0: nothing at all.
-    assert_eq!(render(&ts, &camera(), &env, &settings(1, Some(0))).mean(), Vec3::ZERO);
+    assert_eq!(
+        render(&ts, &camera(), &env, &settings(1, Some(0))).mean(),
+        Vec3::ZERO
+    );
 }
 
 #[test]
@@ -106,8 +163,14 @@ fn same_seed_same_image_whatever_the_thread_count() {
     let cam = s.camera.clone().unwrap().with_resolution(24, 24);
     let env = s.envmap.clone().unwrap();
     let run = |threads: usize, seed: u64| {
-        let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
-        let st = RenderSettings { seed, ..settings(4, Some(5)) };
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap();
+        let st = RenderSettings {
+            seed,
+            ..settings(4, Some(5))
+        };
         pool.install(|| render(&ts, &cam, &env, &st))
     };
     let (a, b, c) = (run(1, 3), run(2, 3), run(2, 4));
@@ -118,16 +181,35 @@ fn same_seed_same_image_whatever_the_thread_count() {
 
 #[test]
 fn gbuffer_holds_the_centre_hit() {
-    let s = sphere_scene(Material::glossy("g", Vec3::splat(0.25), Vec3::splat(0.5), 0.3));
+    let s = sphere_scene(Material::glossy(
+        "g",
+        Vec3::splat(0.25),
+        Vec3::splat(0.5),
+        0.3,
+    ));
     let ts = TraceScene::new(&s);
     let cam = Camera::look_at(Vec3::new(0.0, 0.0, 2.2), Vec3::ZERO, Vec3::Y, 70.0, 32, 32);
-    let f = render(&ts, &cam, &EnvMap::constant(Vec3::ONE), &RenderSettings { filter: PixelFilter::Centre, ..settings(1, Some(3)) });
+    let f = render(
+        &ts,
+        &cam,
+        &EnvMap::constant(Vec3::ONE),
+        &RenderSettings {
+            filter: PixelFilter::Centre,
+            ..settings(1, Some(3))
+        },
+    );
     let c = 16 * 32 + 16;
     let g = &f.gbuffer;
     assert_eq!(g.mask[c], 1.0);
     assert!((g.position[c].length() - 1.0).abs() < 1e-3);
-    assert!(g.normal[c].dot(g.view[c]) > 0.99, "normal faces the camera at the centre");
-    assert_eq!((g.kd[c], g.ks[c], g.alpha[c]), (Vec3::splat(0.25), Vec3::splat(0.5), 0.3));
+    assert!(
+        g.normal[c].dot(g.view[c]) > 0.99,
+        "normal faces the camera at the centre"
+    );
+    assert_eq!(
+        (g.kd[c], g.ks[c], g.alpha[c]),
+        (Vec3::splat(0.25), Vec3::splat(0.5), 0.3)
+    );
     assert_eq!(g.mask[0], 0.0);
     // The frame survives an EXR round trip channel for channel.
     let path = std::env::temp_dir().join(format!("nprt-gb-{}.exr", std::process::id()));

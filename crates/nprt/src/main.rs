@@ -11,7 +11,11 @@ use nprt_scene::{load_scene, procedural, SceneOptions};
 use nprt_trace::{render, Frame, PixelFilter, RenderSettings, TraceScene};
 
 #[derive(Parser)]
-#[command(name = "nprt", version, about = "Neural precomputed radiance transfer: path-traced data, per-scene networks, relighting")]
+#[command(
+    name = "nprt",
+    version,
+    about = "Neural precomputed radiance transfer: path-traced data, per-scene networks, relighting"
+)]
 struct Cli {
     /// Worker threads (default: all cores).
     #[arg(long, global = true)]
@@ -91,7 +95,10 @@ fn main() {
 
 fn run(cli: Cli) -> Result<()> {
     if let Some(n) = cli.threads {
-        rayon::ThreadPoolBuilder::new().num_threads(n).build_global().context("cannot set up worker threads")?;
+        rayon::ThreadPoolBuilder::new()
+            .num_threads(n)
+            .build_global()
+            .context("cannot set up worker threads")?;
     }
     match cli.command {
         Command::Reference(a) => reference(a),
@@ -111,7 +118,9 @@ fn parse_set(items: &[String]) -> Result<Vec<(String, String)>> {
 
 fn reference(a: ReferenceArgs) -> Result<()> {
     let t0 = Instant::now();
-    let opts = SceneOptions { set: parse_set(&a.set)? };
+    let opts = SceneOptions {
+        set: parse_set(&a.set)?,
+    };
     let scene = load_scene(&a.scene, &opts)?;
     for w in &scene.warnings {
         eprintln!("warning: {w}");
@@ -119,14 +128,24 @@ fn reference(a: ReferenceArgs) -> Result<()> {
     let env = match (&a.envmap, &scene.envmap) {
         (Some(spec), _) => procedural::open_envmap(spec)?,
         (None, Some(env)) => env.clone(),
-        (None, None) => bail!("scene '{}' has no environment emitter; give one with --envmap", a.scene),
+        (None, None) => bail!(
+            "scene '{}' has no environment emitter; give one with --envmap",
+            a.scene
+        ),
     }
     .rotated_y(a.rotate);
     if env.clamped_negative() > 0 {
-        eprintln!("warning: environment map '{}': {} negative texel channels clamped to 0", env.name(), env.clamped_negative());
+        eprintln!(
+            "warning: environment map '{}': {} negative texel channels clamped to 0",
+            env.name(),
+            env.clamped_negative()
+        );
     }
     let mut camera = scene.camera.clone().unwrap_or_else(|| {
-        eprintln!("note: scene '{}' has no camera; framing its bounds from +Z", a.scene);
+        eprintln!(
+            "note: scene '{}' has no camera; framing its bounds from +Z",
+            a.scene
+        );
         scene.framing_camera()
     });
     if let (Some(w), Some(h)) = (a.width, a.height) {
@@ -142,7 +161,11 @@ fn reference(a: ReferenceArgs) -> Result<()> {
         max_depth,
         rr_depth: scene.rr_depth,
         seed: a.seed,
-        filter: if a.centre { PixelFilter::Centre } else { PixelFilter::Box },
+        filter: if a.centre {
+            PixelFilter::Centre
+        } else {
+            PixelFilter::Box
+        },
         progress: true,
     };
     check_writable(&a.out)?;
@@ -166,16 +189,27 @@ fn reference(a: ReferenceArgs) -> Result<()> {
         samples / secs / 1e6,
         scene.triangle_count(),
     );
-    println!("mean radiance {:.5} {:.5} {:.5}; wrote {}", m.x, m.y, m.z, a.out.display());
+    println!(
+        "mean radiance {:.5} {:.5} {:.5}; wrote {}",
+        m.x,
+        m.y,
+        m.z,
+        a.out.display()
+    );
     Ok(())
 }
 
 /// Fails early, before a long render, if `path` cannot be written.
 fn check_writable(path: &Path) -> Result<()> {
-    let dir = path.parent().filter(|p| !p.as_os_str().is_empty()).unwrap_or(Path::new("."));
-    std::fs::create_dir_all(dir).with_context(|| format!("cannot create output folder '{}'", dir.display()))?;
+    let dir = path
+        .parent()
+        .filter(|p| !p.as_os_str().is_empty())
+        .unwrap_or(Path::new("."));
+    std::fs::create_dir_all(dir)
+        .with_context(|| format!("cannot create output folder '{}'", dir.display()))?;
     let probe = dir.join(format!(".nprt-write-test-{}", std::process::id()));
-    std::fs::write(&probe, b"").with_context(|| format!("output folder '{}' is not writable", dir.display()))?;
+    std::fs::write(&probe, b"")
+        .with_context(|| format!("output folder '{}' is not writable", dir.display()))?;
     std::fs::remove_file(&probe).ok();
     Ok(())
 }
@@ -184,7 +218,11 @@ fn check_writable(path: &Path) -> Result<()> {
 fn write_png(frame: &Frame, path: &Path) -> Result<()> {
     let encode = |c: f32| {
         let c = c.clamp(0.0, 1.0);
-        let s = if c <= 0.0031308 { 12.92 * c } else { 1.055 * c.powf(1.0 / 2.4) - 0.055 };
+        let s = if c <= 0.0031308 {
+            12.92 * c
+        } else {
+            1.055 * c.powf(1.0 / 2.4) - 0.055
+        };
         (s * 255.0 + 0.5) as u8
     };
     let img = image::RgbImage::from_fn(frame.width as u32, frame.height as u32, |x, y| {
@@ -192,19 +230,37 @@ fn write_png(frame: &Frame, path: &Path) -> Result<()> {
         image::Rgb([encode(v.x), encode(v.y), encode(v.z)])
     });
     let tmp = path.with_extension("png.tmp");
-    img.save_with_format(&tmp, image::ImageFormat::Png).with_context(|| format!("cannot write '{}'", tmp.display()))?;
-    std::fs::rename(&tmp, path).with_context(|| format!("cannot move '{}' into place", path.display()))
+    img.save_with_format(&tmp, image::ImageFormat::Png)
+        .with_context(|| format!("cannot write '{}'", tmp.display()))?;
+    std::fs::rename(&tmp, path)
+        .with_context(|| format!("cannot move '{}' into place", path.display()))
 }
 
 fn demo(a: DemoArgs) -> Result<()> {
     let scene = load_scene("builtin:room", &SceneOptions::default())?;
-    let camera = scene.camera.clone().context("built-in scene has a camera")?;
+    let camera = scene
+        .camera
+        .clone()
+        .context("built-in scene has a camera")?;
     check_writable(&a.out.join("x"))?;
     let ts = TraceScene::new(&scene);
-    println!("nprt demo: builtin:room ({} triangles), {}×{}, {} spp", scene.triangle_count(), camera.width, camera.height, a.spp);
+    println!(
+        "nprt demo: builtin:room ({} triangles), {}×{}, {} spp",
+        scene.triangle_count(),
+        camera.width,
+        camera.height,
+        a.spp
+    );
     for (name, spec) in [("sky", "builtin:sky"), ("indoor", "builtin:indoor:1")] {
         let env = procedural::open_envmap(spec)?;
-        let settings = RenderSettings { spp: a.spp, max_depth: scene.max_depth, rr_depth: scene.rr_depth, seed: 1, filter: PixelFilter::Box, progress: true };
+        let settings = RenderSettings {
+            spp: a.spp,
+            max_depth: scene.max_depth,
+            rr_depth: scene.rr_depth,
+            seed: 1,
+            filter: PixelFilter::Box,
+            progress: true,
+        };
         let t = Instant::now();
         let frame = render(&ts, &camera, &env, &settings);
         let secs = t.elapsed().as_secs_f64();
@@ -213,7 +269,11 @@ fn demo(a: DemoArgs) -> Result<()> {
         frame.write_exr(&exr)?;
         write_png(&frame, &png)?;
         let samples = camera.width as f64 * camera.height as f64 * a.spp as f64;
-        println!("  {spec:<18} {secs:6.2} s, {:.3} Msamples/s -> {}", samples / secs / 1e6, png.display());
+        println!(
+            "  {spec:<18} {secs:6.2} s, {:.3} Msamples/s -> {}",
+            samples / secs / 1e6,
+            png.display()
+        );
     }
     println!("demo images in {}", a.out.display());
     Ok(())

@@ -7,11 +7,17 @@ use std::process::{Command, Output};
 use nprt_trace::exr_io::{read_channels, write_channels};
 
 fn nprt(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_nprt")).args(args).output().expect("run nprt")
+    Command::new(env!("CARGO_BIN_EXE_nprt"))
+        .args(args)
+        .output()
+        .expect("run nprt")
 }
 
 fn shared() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("../../../shared").canonicalize().expect("../shared beside the checkout")
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../../../shared")
+        .canonicalize()
+        .expect("../shared beside the checkout")
 }
 
 fn tmp(name: &str) -> PathBuf {
@@ -24,7 +30,11 @@ fn tmp(name: &str) -> PathBuf {
 fn fails(args: &[&str], needles: &[&str]) -> String {
     let out = nprt(args);
     let err = String::from_utf8_lossy(&out.stderr).into_owned();
-    assert_eq!(out.status.code(), Some(1), "expected exit 1 for {args:?}; stderr: {err}");
+    assert_eq!(
+        out.status.code(),
+        Some(1),
+        "expected exit 1 for {args:?}; stderr: {err}"
+    );
     for n in needles {
         assert!(err.contains(n), "stderr for {args:?} lacks '{n}':\n{err}");
     }
@@ -39,17 +49,44 @@ fn reference_renders_a_gltf_and_reports_speed() {
     let png = out_dir.join("bunny.png");
     let bunny = shared().join("models/bunny_plain.glb");
     let o = nprt(&[
-        "reference", bunny.to_str().unwrap(), "--out", exr.to_str().unwrap(), "--png", png.to_str().unwrap(),
-        "--envmap", "builtin:sky:30:200:3", "--width", "48", "--height", "48", "--spp", "4",
+        "reference",
+        bunny.to_str().unwrap(),
+        "--out",
+        exr.to_str().unwrap(),
+        "--png",
+        png.to_str().unwrap(),
+        "--envmap",
+        "builtin:sky:30:200:3",
+        "--width",
+        "48",
+        "--height",
+        "48",
+        "--spp",
+        "4",
     ]);
     let stdout = String::from_utf8_lossy(&o.stdout);
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
-    assert!(stdout.contains("Msamples/s") && stdout.contains("48×48 at 4 spp"), "{stdout}");
+    assert!(
+        stdout.contains("Msamples/s") && stdout.contains("48×48 at 4 spp"),
+        "{stdout}"
+    );
     let (w, h, ch) = read_channels(&exr).unwrap();
     assert_eq!((w, h), (48, 48));
     let covered: f32 = ch["mask"].iter().sum();
-    assert!(covered > 200.0 && covered < 2000.0, "the framed bunny covers part of the image: {covered}");
-    for name in ["R", "direct.G", "position.X", "normal.Z", "view.Y", "kd.R", "ks.B", "alpha"] {
+    assert!(
+        covered > 200.0 && covered < 2000.0,
+        "the framed bunny covers part of the image: {covered}"
+    );
+    for name in [
+        "R",
+        "direct.G",
+        "position.X",
+        "normal.Z",
+        "view.Y",
+        "kd.R",
+        "ks.B",
+        "alpha",
+    ] {
         assert!(ch.contains_key(name), "missing channel {name}");
     }
     assert!(png.exists());
@@ -59,7 +96,17 @@ fn reference_renders_a_gltf_and_reports_speed() {
 fn draco_gltf_is_refused_by_name() {
     let out = tmp("draco").join("x.exr");
     let bunny = shared().join("models/bunny.glb");
-    fails(&["reference", bunny.to_str().unwrap(), "--out", out.to_str().unwrap(), "--envmap", "builtin:sky"], &["bunny.glb", "KHR_draco_mesh_compression"]);
+    fails(
+        &[
+            "reference",
+            bunny.to_str().unwrap(),
+            "--out",
+            out.to_str().unwrap(),
+            "--envmap",
+            "builtin:sky",
+        ],
+        &["bunny.glb", "KHR_draco_mesh_compression"],
+    );
     assert!(!out.exists());
 }
 
@@ -70,21 +117,77 @@ fn bad_environment_maps_are_refused_by_name() {
     let scene = "builtin:room";
     // Not 2:1.
     let odd = dir.join("odd.hdr");
-    image::Rgb32FImage::from_pixel(30, 16, image::Rgb([1.0, 1.0, 1.0])).save(&odd).unwrap();
-    fails(&["reference", scene, "--out", out.to_str().unwrap(), "--envmap", odd.to_str().unwrap()], &["odd.hdr", "2:1", "30×16"]);
+    image::Rgb32FImage::from_pixel(30, 16, image::Rgb([1.0, 1.0, 1.0]))
+        .save(&odd)
+        .unwrap();
+    fails(
+        &[
+            "reference",
+            scene,
+            "--out",
+            out.to_str().unwrap(),
+            "--envmap",
+            odd.to_str().unwrap(),
+        ],
+        &["odd.hdr", "2:1", "30×16"],
+    );
     // A compression the reader lacks: a valid file whose header claims HTJ2K.
     let htj2k = dir.join("htj2k.exr");
     let data = vec![0.5f32; 16 * 8];
-    write_channels(&htj2k, 16, 8, &[("R".into(), data.clone()), ("G".into(), data.clone()), ("B".into(), data)]).unwrap();
+    write_channels(
+        &htj2k,
+        16,
+        8,
+        &[
+            ("R".into(), data.clone()),
+            ("G".into(), data.clone()),
+            ("B".into(), data),
+        ],
+    )
+    .unwrap();
     let mut bytes = std::fs::read(&htj2k).unwrap();
     let key = b"compression\0compression\0\x01\0\0\0";
-    let at = bytes.windows(key.len()).position(|w| w == key).expect("compression attribute") + key.len();
+    let at = bytes
+        .windows(key.len())
+        .position(|w| w == key)
+        .expect("compression attribute")
+        + key.len();
     bytes[at] = 10;
     std::fs::write(&htj2k, bytes).unwrap();
-    fails(&["reference", scene, "--out", out.to_str().unwrap(), "--envmap", htj2k.to_str().unwrap()], &["htj2k.exr", "compression"]);
+    fails(
+        &[
+            "reference",
+            scene,
+            "--out",
+            out.to_str().unwrap(),
+            "--envmap",
+            htj2k.to_str().unwrap(),
+        ],
+        &["htj2k.exr", "compression"],
+    );
     // Missing file and unknown built-in.
-    fails(&["reference", scene, "--out", out.to_str().unwrap(), "--envmap", "/nonexistent/map.exr"], &["/nonexistent/map.exr"]);
-    fails(&["reference", scene, "--out", out.to_str().unwrap(), "--envmap", "builtin:moon"], &["builtin:moon"]);
+    fails(
+        &[
+            "reference",
+            scene,
+            "--out",
+            out.to_str().unwrap(),
+            "--envmap",
+            "/nonexistent/map.exr",
+        ],
+        &["/nonexistent/map.exr"],
+    );
+    fails(
+        &[
+            "reference",
+            scene,
+            "--out",
+            out.to_str().unwrap(),
+            "--envmap",
+            "builtin:moon",
+        ],
+        &["builtin:moon"],
+    );
     assert!(!out.exists());
 }
 
@@ -93,16 +196,45 @@ fn bad_scenes_arguments_and_outputs_are_refused() {
     let dir = tmp("scenes");
     let out = dir.join("x.exr");
     let o = out.to_str().unwrap();
-    fails(&["reference", "/nonexistent/scene.xml", "--out", o], &["/nonexistent/scene.xml", "does not exist"]);
-    fails(&["reference", "builtin:attic", "--out", o], &["builtin:attic", "builtin:room"]);
+    fails(
+        &["reference", "/nonexistent/scene.xml", "--out", o],
+        &["/nonexistent/scene.xml", "does not exist"],
+    );
+    fails(
+        &["reference", "builtin:attic", "--out", o],
+        &["builtin:attic", "builtin:room"],
+    );
     let txt = dir.join("scene.txt");
     std::fs::write(&txt, "hello").unwrap();
-    fails(&["reference", txt.to_str().unwrap(), "--out", o], &["scene.txt", "unknown format"]);
+    fails(
+        &["reference", txt.to_str().unwrap(), "--out", o],
+        &["scene.txt", "unknown format"],
+    );
     let xml = dir.join("plugin.xml");
-    std::fs::write(&xml, "<scene version=\"3.0.0\">\n  <shape type=\"hair\"/>\n</scene>\n").unwrap();
-    fails(&["reference", xml.to_str().unwrap(), "--out", o], &["plugin.xml:2:", "hair"]);
-    fails(&["reference", "builtin:room", "--out", o, "--set", "novalue"], &["NAME=VALUE", "novalue"]);
-    fails(&["reference", "builtin:room", "--out", "/proc/nprt-cannot-write/x.exr", "--spp", "1"], &["/proc/nprt-cannot-write"]);
+    std::fs::write(
+        &xml,
+        "<scene version=\"3.0.0\">\n  <shape type=\"hair\"/>\n</scene>\n",
+    )
+    .unwrap();
+    fails(
+        &["reference", xml.to_str().unwrap(), "--out", o],
+        &["plugin.xml:2:", "hair"],
+    );
+    fails(
+        &["reference", "builtin:room", "--out", o, "--set", "novalue"],
+        &["NAME=VALUE", "novalue"],
+    );
+    fails(
+        &[
+            "reference",
+            "builtin:room",
+            "--out",
+            "/proc/nprt-cannot-write/x.exr",
+            "--spp",
+            "1",
+        ],
+        &["/proc/nprt-cannot-write"],
+    );
     assert!(!out.exists());
 }
 
@@ -110,7 +242,20 @@ fn bad_scenes_arguments_and_outputs_are_refused() {
 fn help_explains_every_flag() {
     let o = nprt(&["reference", "--help"]);
     let text = String::from_utf8_lossy(&o.stdout);
-    for flag in ["--out", "--spp", "--set", "--envmap", "--rotate", "--max-depth", "--width", "--height", "--seed", "--png", "--centre", "--threads"] {
+    for flag in [
+        "--out",
+        "--spp",
+        "--set",
+        "--envmap",
+        "--rotate",
+        "--max-depth",
+        "--width",
+        "--height",
+        "--seed",
+        "--png",
+        "--centre",
+        "--threads",
+    ] {
         assert!(text.contains(flag), "reference --help lacks {flag}");
     }
 }

@@ -15,22 +15,41 @@ use nprt_trace::{render, PixelFilter, RenderSettings, TraceScene};
 const SPP: u32 = 64;
 
 fn repo() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("../..").canonicalize().unwrap()
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../..")
+        .canonicalize()
+        .unwrap()
 }
 
 fn rgb(path: &Path) -> (usize, usize, Vec<Vec3>) {
     let (w, h, ch) = read_channels(path).unwrap();
-    let c = |n: &str| ch.get(n).unwrap_or_else(|| panic!("{} lacks channel {n}", path.display())).clone();
+    let c = |n: &str| {
+        ch.get(n)
+            .unwrap_or_else(|| panic!("{} lacks channel {n}", path.display()))
+            .clone()
+    };
     let (r, g, b) = (c("R"), c("G"), c("B"));
-    (w, h, (0..w * h).map(|i| Vec3::new(r[i], g[i], b[i])).collect())
+    (
+        w,
+        h,
+        (0..w * h).map(|i| Vec3::new(r[i], g[i], b[i])).collect(),
+    )
 }
 
 fn mean(img: &[Vec3]) -> Vec3 {
-    img.iter().map(|v| v.as_dvec3()).sum::<glam::DVec3>().as_vec3() / img.len() as f32
+    img.iter()
+        .map(|v| v.as_dvec3())
+        .sum::<glam::DVec3>()
+        .as_vec3()
+        / img.len() as f32
 }
 
 fn mse(a: &[Vec3], b: &[Vec3]) -> f64 {
-    a.iter().zip(b).map(|(x, y)| (*x - *y).length_squared() as f64).sum::<f64>() / (3 * a.len()) as f64
+    a.iter()
+        .zip(b)
+        .map(|(x, y)| (*x - *y).length_squared() as f64)
+        .sum::<f64>()
+        / (3 * a.len()) as f64
 }
 
 /// Both renderers get the same map with negative texels clamped, as nprt reads it: real
@@ -39,7 +58,11 @@ fn mse(a: &[Vec3], b: &[Vec3]) -> f64 {
 fn clean_map(spec: &Path, out: &Path) {
     let m = EnvMap::load(spec, 1.0).unwrap();
     let (w, h) = (m.width(), m.height());
-    let chans: Vec<(String, Vec<f32>)> = ["R", "G", "B"].iter().enumerate().map(|(k, n)| (n.to_string(), m.texels().iter().map(|t| t[k]).collect())).collect();
+    let chans: Vec<(String, Vec<f32>)> = ["R", "G", "B"]
+        .iter()
+        .enumerate()
+        .map(|(k, n)| (n.to_string(), m.texels().iter().map(|t| t[k]).collect()))
+        .collect();
     write_channels(out, w, h, &chans).unwrap();
 }
 
@@ -50,7 +73,14 @@ fn mitsuba(python: &str, scene: &Path, out: &Path, seed: u32, map: &Path) {
         .arg(&script)
         .arg(scene)
         .arg(out)
-        .args(["--variant", &variant, "--spp", &SPP.to_string(), "--seed", &seed.to_string()])
+        .args([
+            "--variant",
+            &variant,
+            "--spp",
+            &SPP.to_string(),
+            "--seed",
+            &seed.to_string(),
+        ])
         .arg(format!("--set=envmap={}", map.display()))
         .status()
         .expect("cannot start NPRT_PYTHON");
@@ -70,14 +100,23 @@ fn agree(name: &str, tolerance: f32) {
     let map = tmp.join("map.exr");
     clean_map(Path::new(raw.envmap.as_ref().unwrap().name()), &map);
 
-    let opts = SceneOptions { set: vec![("envmap".into(), map.display().to_string())] };
+    let opts = SceneOptions {
+        set: vec![("envmap".into(), map.display().to_string())],
+    };
     let scene = load_scene(scene_path.to_str().unwrap(), &opts).unwrap();
     let ts = TraceScene::new(&scene);
     let cam = scene.camera.clone().unwrap();
     let env = scene.envmap.clone().unwrap();
     let ours: Vec<Vec<Vec3>> = (1..=2)
         .map(|seed| {
-            let s = RenderSettings { spp: SPP, max_depth: scene.max_depth, rr_depth: scene.rr_depth, seed, filter: PixelFilter::Box, progress: false };
+            let s = RenderSettings {
+                spp: SPP,
+                max_depth: scene.max_depth,
+                rr_depth: scene.rr_depth,
+                seed,
+                filter: PixelFilter::Box,
+                progress: false,
+            };
             render(&ts, &cam, &env, &s).radiance
         })
         .collect();
@@ -91,7 +130,10 @@ fn agree(name: &str, tolerance: f32) {
         })
         .collect();
 
-    let (mo, mt) = ((mean(&ours[0]) + mean(&ours[1])) / 2.0, (mean(&theirs[0]) + mean(&theirs[1])) / 2.0);
+    let (mo, mt) = (
+        (mean(&ours[0]) + mean(&ours[1])) / 2.0,
+        (mean(&theirs[0]) + mean(&theirs[1])) / 2.0,
+    );
     let rel = ((mo - mt) / mt).abs();
     // Noise level: what two renders of the same renderer differ by; a bias would add to it.
     let (noise_ours, noise_theirs) = (mse(&ours[0], &ours[1]), mse(&theirs[0], &theirs[1]));
@@ -100,8 +142,14 @@ fn agree(name: &str, tolerance: f32) {
     eprintln!(
         "{name}: means ours {mo} mitsuba {mt} (rel. diff {rel}); per-pixel MSE ours-vs-mitsuba {cross:.5}, noise-only {expected:.5} (ours {noise_ours:.5}, mitsuba {noise_theirs:.5})"
     );
-    assert!(rel.max_element() < tolerance, "{name}: channel means differ by {rel} (tolerance {tolerance})");
-    assert!(cross < 1.25 * expected, "{name}: per-pixel error {cross} exceeds Monte Carlo noise {expected}");
+    assert!(
+        rel.max_element() < tolerance,
+        "{name}: channel means differ by {rel} (tolerance {tolerance})"
+    );
+    assert!(
+        cross < 1.25 * expected,
+        "{name}: per-pixel error {cross} exceeds Monte Carlo noise {expected}"
+    );
 }
 
 #[test]
