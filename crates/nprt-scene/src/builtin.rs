@@ -10,7 +10,7 @@ use std::sync::Arc;
 use anyhow::{bail, Result};
 use glam::{Affine2, Mat4, Quat, Vec3};
 
-use crate::camera::Camera;
+use crate::camera::{Camera, CameraVolume};
 use crate::material::{Material, Surface};
 use crate::mesh::Mesh;
 use crate::procedural::{sky, SkyParams};
@@ -193,6 +193,14 @@ fn room() -> Result<Scene> {
         256,
         256,
     ));
+    // Standing and sitting eye heights over the open half of the room, looking at the back.
+    s.camera_volume = Some(CameraVolume {
+        min: Vec3::new(-2.2, 0.9, -0.2),
+        max: Vec3::new(2.2, 2.2, 2.8),
+        look: Vec3::new(0.0, -0.25, -1.0).normalize(),
+        spread_deg: 30.0,
+        fov_deg: 60.0,
+    });
     s.envmap = Some(sky(SkyParams::default())?);
     s.max_depth = Some(6);
     s.spp = Some(64);

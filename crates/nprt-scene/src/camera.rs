@@ -12,6 +12,21 @@ pub enum FovAxis {
     Larger,
 }
 
+/// Where dataset cameras may go, as the paper places them: positions in an axis-aligned box
+/// (the active volume), view directions within a square pyramid around a main direction,
+/// +Y up, no roll.
+#[derive(Clone, Debug, PartialEq)]
+pub struct CameraVolume {
+    pub min: Vec3,
+    pub max: Vec3,
+    /// Main view direction (unit).
+    pub look: Vec3,
+    /// Half-angle of the pyramid of view directions, degrees, in yaw and in pitch.
+    pub spread_deg: f32,
+    /// Horizontal field of view of the placed cameras, degrees.
+    pub fov_deg: f32,
+}
+
 #[derive(Clone, Debug)]
 pub struct Camera {
     pub to_world: Mat4,

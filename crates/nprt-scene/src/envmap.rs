@@ -371,13 +371,18 @@ mod tests {
     #[test]
     fn radiance_hdr_files_load_texel_for_texel() {
         let path = std::env::temp_dir().join(format!("nprt-map-{}.hdr", std::process::id()));
-        let img = image::Rgb32FImage::from_fn(16, 8, |x, y| image::Rgb([x as f32 * 0.5, y as f32 * 2.0, 0.25]));
+        let img = image::Rgb32FImage::from_fn(16, 8, |x, y| {
+            image::Rgb([x as f32 * 0.5, y as f32 * 2.0, 0.25])
+        });
         img.save(&path).unwrap();
         let m = EnvMap::load(&path, 2.0).unwrap();
         assert_eq!((m.width(), m.height()), (16, 8));
         // RGBE keeps 8 mantissa bits per channel.
         let t = m.texels()[3 * 16 + 5];
-        assert!((t - Vec3::new(5.0, 12.0, 0.5)).abs().max_element() < 0.05 * 12.0, "{t}");
+        assert!(
+            (t - Vec3::new(5.0, 12.0, 0.5)).abs().max_element() < 0.05 * 12.0,
+            "{t}"
+        );
     }
 
     #[test]

@@ -20,7 +20,7 @@ pub mod procedural;
 pub mod scene;
 pub mod texture;
 
-pub use camera::{Camera, FovAxis};
+pub use camera::{Camera, CameraVolume, FovAxis};
 pub use envmap::EnvMap;
 pub use material::{BsdfParams, Material, Surface};
 pub use mesh::Mesh;

@@ -5,7 +5,7 @@ use std::path::Path;
 use anyhow::{bail, Result};
 use glam::Vec3;
 
-use crate::camera::Camera;
+use crate::camera::{Camera, CameraVolume};
 use crate::envmap::EnvMap;
 use crate::material::Material;
 use crate::mesh::Mesh;
@@ -20,6 +20,8 @@ pub struct Scene {
     pub materials: Vec<Material>,
     /// The scene's own sensor and film, when the format has one.
     pub camera: Option<Camera>,
+    /// Where dataset cameras may be placed; built-in scenes carry one.
+    pub camera_volume: Option<CameraVolume>,
     pub envmap: Option<EnvMap>,
     /// The integrator's `max_depth` (Mitsuba's meaning); `None` means unlimited.
     pub max_depth: Option<u32>,
@@ -44,6 +46,7 @@ impl Scene {
             meshes: vec![],
             materials: vec![],
             camera: None,
+            camera_volume: None,
             envmap: None,
             max_depth: None,
             rr_depth: DEFAULT_RR_DEPTH,
