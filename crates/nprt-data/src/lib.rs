@@ -1,9 +1,11 @@
 //! Dataset generation for training: where cameras go, which lighting each view gets, and how
-//! views are stored. It owns placement and dataset bookkeeping, and renders only through
-//! `nprt-trace`; it must not parse scene files, trace paths itself or know about networks.
-//!
-//! So far: camera placement in a scene's active volume (see [`cameras`]).
+//! views are stored and verified. It owns placement and dataset bookkeeping, and renders only
+//! through `nprt-trace`; it must not parse scene files, trace paths itself or know about
+//! networks.
 
 pub mod cameras;
+pub mod dataset;
+pub mod lighting;
 
 pub use cameras::{place_camera, PlacementError};
+pub use dataset::{Manifest, Request};

@@ -32,6 +32,111 @@ enum Command {
     /// Run the pipeline on the built-in scene and lighting, writing images and a summary.
     /// Today: reference renders of builtin:room under the built-in sky and an indoor map.
     Demo(DemoArgs),
+    /// Render a training dataset: G-buffers and radiance of many views under many lightings
+    /// (documented in docs/dataset.md). Resumable; shards may run at once into one folder.
+    Generate(GenerateArgs),
+    /// Inspect datasets.
+    #[command(subcommand)]
+    Dataset(DatasetCommand),
+}
+
+#[derive(Subcommand)]
+enum DatasetCommand {
+    /// Report completeness and problems of a dataset folder; exits 1 unless complete.
+    Verify {
+        /// Dataset folder (holding manifest.json).
+        dir: PathBuf,
+    },
+}
+
+#[derive(clap::Args)]
+struct GenerateArgs {
+    /// Scene: builtin:room, or a Mitsuba .xml / glTF / mesh file (then give the camera volume).
+    #[arg(long)]
+    scene: String,
+    /// Environment maps: a folder of .exr/.hdr lat-long maps, or `builtin` (16 skies, 8 indoor).
+    #[arg(long)]
+    envmaps: String,
+    /// Dataset folder; re-running with the same settings resumes it.
+    #[arg(long)]
+    out: PathBuf,
+    /// Training views (the paper: 3000). Default sized for a 2-core CPU (~4 min at defaults).
+    #[arg(long, default_value_t = 400)]
+    train_views: u64,
+    /// Test views, lit only by held-out maps (the paper: 200).
+    #[arg(long, default_value_t = 40)]
+    test_views: u64,
+    /// Training view resolution, N or WxH (the paper: 256).
+    #[arg(long, default_value = "128", value_parser = parse_resolution)]
+    train_res: [u32; 2],
+    /// Test view resolution, N or WxH (the paper: 400).
+    #[arg(long, default_value = "128", value_parser = parse_resolution)]
+    test_res: [u32; 2],
+    /// Samples per pixel, every one through the pixel centre.
+    #[arg(long, default_value_t = 64)]
+    spp: u32,
+    /// Seed of every random choice (cameras, split, rotations, pixels).
+    #[arg(long, default_value_t = 0)]
+    seed: u64,
+    /// Maps held out for testing (default: a fifth, at least one).
+    #[arg(long)]
+    test_maps: Option<usize>,
+    /// Render only views with index ≡ K (mod N), e.g. 0/4 … 3/4 on four machines.
+    #[arg(long, default_value = "0/1", value_parser = parse_shard)]
+    shard: (u64, u64),
+    /// Camera active volume, min corner x,y,z (overrides the scene's).
+    #[arg(long, value_parser = parse_vec3, requires_all = ["volume_max", "look"], allow_hyphen_values = true)]
+    volume_min: Option<glam::Vec3>,
+    /// Camera active volume, max corner x,y,z.
+    #[arg(long, value_parser = parse_vec3, allow_hyphen_values = true)]
+    volume_max: Option<glam::Vec3>,
+    /// Main view direction x,y,z.
+    #[arg(long, value_parser = parse_vec3, allow_hyphen_values = true)]
+    look: Option<glam::Vec3>,
+    /// Half-angle of the pyramid of view directions, degrees.
+    #[arg(long, default_value_t = 30.0)]
+    spread: f32,
+    /// Horizontal field of view of dataset cameras, degrees.
+    #[arg(long, default_value_t = 60.0)]
+    fov: f32,
+}
+
+fn parse_resolution(s: &str) -> Result<[u32; 2], String> {
+    let parse = |t: &str| {
+        t.parse::<u32>()
+            .ok()
+            .filter(|&v| v > 0)
+            .ok_or(format!("'{s}' is not N or WxH with positive sizes"))
+    };
+    match s.split_once('x') {
+        Some((w, h)) => Ok([parse(w)?, parse(h)?]),
+        None => parse(s).map(|n| [n, n]),
+    }
+}
+
+fn parse_shard(s: &str) -> Result<(u64, u64), String> {
+    let bad = || format!("'{s}' is not K/N with 0 ≤ K < N");
+    let (k, n) = s.split_once('/').ok_or_else(bad)?;
+    let (k, n) = (
+        k.parse::<u64>().map_err(|_| bad())?,
+        n.parse::<u64>().map_err(|_| bad())?,
+    );
+    if n == 0 || k >= n {
+        return Err(bad());
+    }
+    Ok((k, n))
+}
+
+fn parse_vec3(s: &str) -> Result<glam::Vec3, String> {
+    let v: Vec<f32> = s
+        .split(',')
+        .map(|t| t.trim().parse::<f32>())
+        .collect::<Result<_, _>>()
+        .map_err(|_| format!("'{s}' is not x,y,z"))?;
+    match v.as_slice() {
+        [x, y, z] => Ok(glam::Vec3::new(*x, *y, *z)),
+        _ => Err(format!("'{s}' is not x,y,z")),
+    }
 }
 
 #[derive(clap::Args)]
@@ -103,6 +208,8 @@ fn run(cli: Cli) -> Result<()> {
     match cli.command {
         Command::Reference(a) => reference(a),
         Command::Demo(a) => demo(a),
+        Command::Generate(a) => generate(a),
+        Command::Dataset(DatasetCommand::Verify { dir }) => verify(&dir),
     }
 }
 
@@ -276,5 +383,118 @@ fn demo(a: DemoArgs) -> Result<()> {
         );
     }
     println!("demo images in {}", a.out.display());
+    Ok(())
+}
+
+fn generate(a: GenerateArgs) -> Result<()> {
+    use nprt_data::{dataset, lighting};
+    let scene = load_scene(&a.scene, &SceneOptions::default())?;
+    let volume = match (a.volume_min, a.volume_max, a.look) {
+        (Some(min), Some(max), Some(look)) => {
+            if !min.cmple(max).all() || look.length() == 0.0 {
+                bail!("--volume-min must not exceed --volume-max, and --look must be non-zero");
+            }
+            nprt_scene::CameraVolume {
+                min,
+                max,
+                look: look.normalize(),
+                spread_deg: a.spread,
+                fov_deg: a.fov,
+            }
+        }
+        _ => scene.camera_volume.clone().with_context(|| {
+            format!(
+                "scene '{}' carries no camera volume; give --volume-min, --volume-max and --look",
+                a.scene
+            )
+        })?,
+    };
+    let specs = if a.envmaps == "builtin" {
+        lighting::builtin_specs()
+    } else {
+        lighting::specs_in_dir(Path::new(&a.envmaps))?
+    };
+    let maps = lighting::load_all(&specs)?;
+    for m in maps.iter().filter(|m| m.clamped_negative() > 0) {
+        eprintln!(
+            "warning: environment map '{}': {} negative texel channels clamped to 0",
+            m.name(),
+            m.clamped_negative()
+        );
+    }
+    let source = if a.scene.starts_with("builtin:") {
+        a.scene.clone().into_bytes()
+    } else {
+        std::fs::read(&a.scene)?
+    };
+    let request = nprt_data::Request {
+        scene_spec: a.scene.clone(),
+        scene: &scene,
+        scene_source: source,
+        volume,
+        test_maps: a
+            .test_maps
+            .unwrap_or_else(|| lighting::default_test_count(maps.len())),
+        map_specs: specs,
+        maps,
+        train_views: a.train_views,
+        test_views: a.test_views,
+        train_resolution: a.train_res,
+        test_resolution: a.test_res,
+        spp: a.spp,
+        seed: a.seed,
+    };
+    let ts = TraceScene::new(&scene);
+    // Planning validates the split and places cameras; only then is anything written.
+    let manifest = dataset::plan(&request, &ts)?;
+    dataset::prepare(&a.out, &manifest)?;
+    let s = &manifest.settings;
+    println!(
+        "dataset {}: {} train views ({}×{}) under {} maps, {} test views ({}×{}) under {} held-out maps, {} spp; shard {}/{}",
+        a.out.display(), s.train_views, s.train_resolution[0], s.train_resolution[1], s.train_maps.len(),
+        s.test_views, s.test_resolution[0], s.test_resolution[1], s.test_maps.len(), s.spp, a.shard.0, a.shard.1
+    );
+    let summary = dataset::run(&ts, &request.maps, &manifest, &a.out, a.shard, true)?;
+    for r in &summary.redone {
+        eprintln!("redone: {r}");
+    }
+    let per_view = if summary.rendered > 0 {
+        summary.seconds / summary.rendered as f64
+    } else {
+        0.0
+    };
+    println!(
+        "rendered {} views in {:.1} s ({:.3} s per view, {:.3} Msamples/s), {} already complete",
+        summary.rendered,
+        summary.seconds,
+        per_view,
+        summary.samples / summary.seconds.max(1e-9) / 1e6,
+        summary.skipped
+    );
+    Ok(())
+}
+
+fn verify(dir: &Path) -> Result<()> {
+    let r = nprt_data::dataset::verify(dir)?;
+    for f in &r.corrupt {
+        println!("corrupt: {f}");
+    }
+    for f in r.missing.iter().take(20) {
+        println!("missing: {f}");
+    }
+    if r.missing.len() > 20 {
+        println!("missing: … and {} more", r.missing.len() - 20);
+    }
+    println!(
+        "{}: {} of {} views complete, {} missing, {} corrupt",
+        dir.display(),
+        r.complete,
+        r.views,
+        r.missing.len(),
+        r.corrupt.len()
+    );
+    if r.complete != r.views {
+        bail!("dataset '{}' is incomplete", dir.display());
+    }
     Ok(())
 }

@@ -1,0 +1,341 @@
+//! `nprt generate` and `nprt dataset verify` as users run them: determinism across shards and
+//! thread counts, resuming after a kill or a corrupt file, and refusing bad input.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+fn nprt(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_nprt"))
+        .args(args)
+        .output()
+        .expect("run nprt")
+}
+
+fn ok(args: &[&str]) -> String {
+    let o = nprt(args);
+    assert!(
+        o.status.success(),
+        "{args:?} failed: {}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+    String::from_utf8_lossy(&o.stdout).into_owned()
+}
+
+fn fails(args: &[&str], needles: &[&str]) {
+    let o = nprt(args);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(
+        o.status.code(),
+        Some(1),
+        "{args:?} should fail; stderr: {err}"
+    );
+    for n in needles {
+        assert!(err.contains(n), "stderr for {args:?} lacks '{n}':\n{err}");
+    }
+}
+
+fn tmp(name: &str) -> PathBuf {
+    let d = std::env::temp_dir().join(format!("nprt-gen-{}-{name}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&d);
+    d
+}
+
+const SMALL: &[&str] = &[
+    "--scene",
+    "builtin:room",
+    "--envmaps",
+    "builtin",
+    "--train-views",
+    "5",
+    "--test-views",
+    "2",
+    "--train-res",
+    "24",
+    "--test-res",
+    "32x16",
+    "--spp",
+    "4",
+    "--seed",
+    "3",
+];
+
+fn generate(out: &Path, extra: &[&str]) -> String {
+    let mut args = vec!["generate", "--out", out.to_str().unwrap()];
+    args.extend_from_slice(SMALL);
+    args.extend_from_slice(extra);
+    ok(&args)
+}
+
+fn views(dir: &Path) -> Vec<(String, Vec<u8>)> {
+    let mut v: Vec<_> = std::fs::read_dir(dir.join("views"))
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .filter(|p| p.extension().is_some_and(|e| e == "exr"))
+        .map(|p| {
+            (
+                p.file_name().unwrap().to_string_lossy().into_owned(),
+                std::fs::read(&p).unwrap(),
+            )
+        })
+        .collect();
+    v.sort();
+    v
+}
+
+#[test]
+fn shards_and_thread_counts_give_byte_identical_datasets() {
+    let (a, b) = (tmp("one"), tmp("sharded"));
+    generate(&a, &[]);
+    let mut args = vec!["--threads", "1"];
+    args.extend(["generate", "--out", b.to_str().unwrap(), "--shard", "0/2"]);
+    args.extend_from_slice(SMALL);
+    ok(&args);
+    generate(&b, &["--shard", "1/2"]);
+    let (va, vb) = (views(&a), views(&b));
+    assert_eq!(va.len(), 7);
+    assert_eq!(va, vb, "views differ between one run and two shards");
+    assert_eq!(
+        std::fs::read(a.join("manifest.json")).unwrap(),
+        std::fs::read(b.join("manifest.json")).unwrap()
+    );
+    assert!(ok(&["dataset", "verify", a.to_str().unwrap()]).contains("7 of 7 views complete"));
+}
+
+#[test]
+fn resume_redoes_only_missing_and_corrupt_views() {
+    let dir = tmp("resume");
+    generate(&dir, &[]);
+    let before = views(&dir);
+    std::fs::remove_file(dir.join("views/train_00001.exr")).unwrap();
+    let corrupt = dir.join("views/test_00000.exr");
+    let bytes = std::fs::read(&corrupt).unwrap();
+    std::fs::write(&corrupt, &bytes[..bytes.len() / 2]).unwrap();
+    let o = nprt(&["dataset", "verify", dir.to_str().unwrap()]);
+    let report = String::from_utf8_lossy(&o.stdout);
+    assert_eq!(o.status.code(), Some(1));
+    assert!(
+        report.contains("missing: views/train_00001.exr")
+            && report.contains("corrupt: views/test_00000.exr"),
+        "{report}"
+    );
+    assert!(report.contains("5 of 7 views complete"), "{report}");
+    let out = generate(&dir, &[]);
+    assert!(
+        out.contains("rendered 2 views") && out.contains("5 already complete"),
+        "{out}"
+    );
+    assert_eq!(
+        views(&dir),
+        before,
+        "re-rendered views must equal the originals"
+    );
+    assert!(!std::fs::read_dir(dir.join("views")).unwrap().any(|e| e
+        .unwrap()
+        .file_name()
+        .to_string_lossy()
+        .ends_with(".tmp")));
+}
+
+#[test]
+fn manifest_records_split_rotations_and_cameras() {
+    let dir = tmp("manifest");
+    generate(&dir, &["--test-maps", "4"]);
+    let m: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(dir.join("manifest.json")).unwrap()).unwrap();
+    let s = &m["settings"];
+    let train: Vec<u64> = s["train_maps"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|v| v.as_u64().unwrap())
+        .collect();
+    let test: Vec<u64> = s["test_maps"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|v| v.as_u64().unwrap())
+        .collect();
+    assert_eq!((train.len(), test.len()), (20, 4));
+    assert!(
+        train.iter().all(|t| !test.contains(t)),
+        "test maps never appear in training"
+    );
+    for v in m["views"].as_array().unwrap() {
+        let map = v["map"].as_u64().unwrap();
+        let pool = if v["split"] == "train" { &train } else { &test };
+        assert!(
+            pool.contains(&map),
+            "view {} uses map {map} from the wrong split",
+            v["index"]
+        );
+        let r = v["rotation_deg"].as_f64().unwrap();
+        assert!((0.0..360.0).contains(&r));
+        assert_eq!(v["camera_to_world"].as_array().unwrap().len(), 16);
+    }
+    assert_eq!(m["views"][5]["file"], "views/test_00000.exr");
+    assert_eq!(
+        (
+            m["views"][5]["width"].as_u64(),
+            m["views"][5]["height"].as_u64()
+        ),
+        (Some(32), Some(16))
+    );
+}
+
+#[test]
+fn bad_input_is_refused_before_anything_is_written() {
+    let dir = tmp("bad");
+    let d = dir.to_str().unwrap();
+    generate(&dir, &[]);
+    // Same folder, other settings.
+    fails(
+        &[
+            "generate",
+            "--out",
+            d,
+            "--scene",
+            "builtin:room",
+            "--envmaps",
+            "builtin",
+            "--spp",
+            "8",
+            "--train-views",
+            "5",
+            "--test-views",
+            "2",
+        ],
+        &["different settings"],
+    );
+    // Map folders: missing, empty, a single map, an unreadable map.
+    let maps = tmp("maps");
+    std::fs::create_dir_all(&maps).unwrap();
+    let out = tmp("never");
+    let o = out.to_str().unwrap();
+    fails(
+        &[
+            "generate",
+            "--out",
+            o,
+            "--scene",
+            "builtin:room",
+            "--envmaps",
+            "/nonexistent/maps",
+        ],
+        &["/nonexistent/maps"],
+    );
+    fails(
+        &[
+            "generate",
+            "--out",
+            o,
+            "--scene",
+            "builtin:room",
+            "--envmaps",
+            maps.to_str().unwrap(),
+        ],
+        &["no .exr or .hdr"],
+    );
+    let shared = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../../shared/envmaps/sky.exr");
+    std::fs::copy(&shared, maps.join("sky.exr")).unwrap();
+    fails(
+        &[
+            "generate",
+            "--out",
+            o,
+            "--scene",
+            "builtin:room",
+            "--envmaps",
+            maps.to_str().unwrap(),
+        ],
+        &["at least 2"],
+    );
+    std::fs::write(maps.join("broken.exr"), b"not an exr").unwrap();
+    fails(
+        &[
+            "generate",
+            "--out",
+            o,
+            "--scene",
+            "builtin:room",
+            "--envmaps",
+            maps.to_str().unwrap(),
+        ],
+        &["broken.exr"],
+    );
+    // A file scene without a camera volume; an unwritable folder; a bad shard.
+    let mesh = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../../shared/models/bunny.ply");
+    fails(
+        &[
+            "generate",
+            "--out",
+            o,
+            "--scene",
+            mesh.to_str().unwrap(),
+            "--envmaps",
+            "builtin",
+        ],
+        &["camera volume", "--volume-min"],
+    );
+    fails(
+        &[
+            "generate",
+            "--out",
+            "/proc/nprt-no/ds",
+            "--scene",
+            "builtin:room",
+            "--envmaps",
+            "builtin",
+        ],
+        &["/proc/nprt-no"],
+    );
+    let o2 = nprt(&[
+        "generate",
+        "--out",
+        o,
+        "--scene",
+        "builtin:room",
+        "--envmaps",
+        "builtin",
+        "--shard",
+        "2/2",
+    ]);
+    assert!(!o2.status.success() && String::from_utf8_lossy(&o2.stderr).contains("K/N"));
+    assert!(!out.exists(), "nothing may be written on bad input");
+}
+
+#[test]
+fn real_maps_and_a_file_scene_with_flags_work() {
+    let dir = tmp("real");
+    let shared = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../../shared");
+    let xml = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../tests/mitsuba/diffuse_room.xml");
+    let out = ok(&[
+        "generate",
+        "--out",
+        dir.to_str().unwrap(),
+        "--scene",
+        xml.to_str().unwrap(),
+        "--envmaps",
+        shared.join("envmaps").to_str().unwrap(),
+        "--volume-min",
+        "-1,1,2",
+        "--volume-max",
+        "1,1.6,3.5",
+        "--look",
+        "0,-0.2,-1",
+        "--train-views",
+        "2",
+        "--test-views",
+        "1",
+        "--train-res",
+        "16",
+        "--test-res",
+        "16",
+        "--spp",
+        "2",
+    ]);
+    assert!(
+        out.contains("under 10 maps") && out.contains("under 3 held-out maps"),
+        "{out}"
+    );
+    assert!(ok(&["dataset", "verify", dir.to_str().unwrap()]).contains("3 of 3"));
+}
