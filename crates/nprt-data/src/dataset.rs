@@ -10,7 +10,7 @@ use anyhow::{bail, Context, Result};
 use glam::Mat4;
 use indicatif::{ProgressBar, ProgressStyle};
 use nprt_scene::{Camera, CameraVolume, EnvMap, FovAxis, Scene};
-use nprt_trace::exr_io::read_channels;
+use nprt_trace::exr_io::{read_channels, write_atomically};
 use nprt_trace::{render, PixelFilter, RenderSettings, TraceScene};
 use rand::{RngExt, SeedableRng};
 use rand_pcg::Pcg64Mcg;
@@ -269,18 +269,6 @@ pub fn plan(req: &Request, ts: &TraceScene) -> Result<Manifest> {
     })
 }
 
-/// Writes `bytes` to `path` through a temporary file and a rename.
-pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<()> {
-    let tmp = path.with_file_name(format!(
-        ".{}.{}.tmp",
-        path.file_name().unwrap().to_string_lossy(),
-        std::process::id()
-    ));
-    std::fs::write(&tmp, bytes).with_context(|| format!("cannot write '{}'", tmp.display()))?;
-    std::fs::rename(&tmp, path)
-        .with_context(|| format!("cannot move '{}' into place", path.display()))
-}
-
 pub fn load_manifest(dir: &Path) -> Result<Manifest> {
     let path = dir.join(MANIFEST);
     let text = std::fs::read_to_string(&path)
@@ -310,10 +298,8 @@ pub fn prepare(dir: &Path, manifest: &Manifest) -> Result<()> {
         }
         return Ok(());
     }
-    write_atomic(
-        &dir.join(MANIFEST),
-        serde_json::to_string_pretty(manifest)?.as_bytes(),
-    )
+    let text = serde_json::to_string_pretty(manifest)?;
+    write_atomically(&dir.join(MANIFEST), |tmp| Ok(std::fs::write(tmp, &text)?))
 }
 
 /// Checks that a view file reads back complete: right size, every channel, finite values.

@@ -32,28 +32,35 @@ pub fn write_channels(
         Encoding::SMALL_LOSSLESS,
         AnyChannels::sort(list),
     );
+    write_atomically(path, |tmp| {
+        Image::from_layer(layer).write().to_file(tmp)?;
+        Ok(())
+    })
+}
+
+/// Creates `path`'s folder, lets `write` fill a temporary file beside `path`, then renames it
+/// into place, so readers never see a partial file and a killed run leaves none behind.
+pub fn write_atomically(path: &Path, write: impl FnOnce(&Path) -> Result<()>) -> Result<()> {
     let dir = path
         .parent()
         .filter(|p| !p.as_os_str().is_empty())
         .unwrap_or(Path::new("."));
     std::fs::create_dir_all(dir)
         .with_context(|| format!("cannot create folder '{}'", dir.display()))?;
-    let tmp = tempfile_in(dir, path)?;
-    Image::from_layer(layer)
-        .write()
-        .to_file(&tmp)
-        .with_context(|| format!("cannot write '{}'", tmp.display()))?;
-    std::fs::rename(&tmp, path)
-        .with_context(|| format!("cannot move '{}' into place", path.display()))?;
-    Ok(())
-}
-
-fn tempfile_in(dir: &Path, path: &Path) -> Result<std::path::PathBuf> {
     let name = path
         .file_name()
-        .context("output path has no file name")?
-        .to_string_lossy();
-    Ok(dir.join(format!(".{name}.{}.tmp", std::process::id())))
+        .with_context(|| format!("output path '{}' has no file name", path.display()))?;
+    let tmp = dir.join(format!(
+        ".{}.{}.tmp",
+        name.to_string_lossy(),
+        std::process::id()
+    ));
+    if let Err(e) = write(&tmp) {
+        let _ = std::fs::remove_file(&tmp);
+        return Err(e.context(format!("cannot write '{}'", path.display())));
+    }
+    std::fs::rename(&tmp, path)
+        .with_context(|| format!("cannot move '{}' into place", path.display()))
 }
 
 /// Reads every f32/f16 channel of the first layer: (width, height, name → data).

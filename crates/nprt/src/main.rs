@@ -336,11 +336,9 @@ fn write_png(frame: &Frame, path: &Path) -> Result<()> {
         let v: Vec3 = frame.radiance[y as usize * frame.width + x as usize];
         image::Rgb([encode(v.x), encode(v.y), encode(v.z)])
     });
-    let tmp = path.with_extension("png.tmp");
-    img.save_with_format(&tmp, image::ImageFormat::Png)
-        .with_context(|| format!("cannot write '{}'", tmp.display()))?;
-    std::fs::rename(&tmp, path)
-        .with_context(|| format!("cannot move '{}' into place", path.display()))
+    nprt_trace::exr_io::write_atomically(path, |tmp| {
+        Ok(img.save_with_format(tmp, image::ImageFormat::Png)?)
+    })
 }
 
 fn demo(a: DemoArgs) -> Result<()> {

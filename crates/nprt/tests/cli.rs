@@ -1,45 +1,16 @@
 //! The `nprt` binary as a user meets it: successful renders, and bad input that must stop with
 //! an error naming the file and the reason, leaving no output behind.
 
-use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
+mod common;
 
+use common::{fails, fresh_dir, nprt, shared};
 use nprt_trace::exr_io::{read_channels, write_channels};
 
-fn nprt(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_nprt"))
-        .args(args)
-        .output()
-        .expect("run nprt")
-}
-
-fn shared() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("../../../shared")
-        .canonicalize()
-        .expect("../shared beside the checkout")
-}
-
-fn tmp(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("nprt-cli-{}-{name}", std::process::id()));
+/// A created scratch folder.
+fn tmp(name: &str) -> std::path::PathBuf {
+    let d = fresh_dir(name);
     std::fs::create_dir_all(&d).unwrap();
     d
-}
-
-/// Runs nprt expecting failure; returns stderr after checking each `needle` is in it.
-fn fails(args: &[&str], needles: &[&str]) -> String {
-    let out = nprt(args);
-    let err = String::from_utf8_lossy(&out.stderr).into_owned();
-    assert_eq!(
-        out.status.code(),
-        Some(1),
-        "expected exit 1 for {args:?}; stderr: {err}"
-    );
-    for n in needles {
-        assert!(err.contains(n), "stderr for {args:?} lacks '{n}':\n{err}");
-    }
-    assert!(!err.contains("panicked"), "{err}");
-    err
 }
 
 #[test]

@@ -1,44 +1,11 @@
 //! `nprt generate` and `nprt dataset verify` as users run them: determinism across shards and
 //! thread counts, resuming after a kill or a corrupt file, and refusing bad input.
 
-use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
+mod common;
 
-fn nprt(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_nprt"))
-        .args(args)
-        .output()
-        .expect("run nprt")
-}
+use std::path::Path;
 
-fn ok(args: &[&str]) -> String {
-    let o = nprt(args);
-    assert!(
-        o.status.success(),
-        "{args:?} failed: {}",
-        String::from_utf8_lossy(&o.stderr)
-    );
-    String::from_utf8_lossy(&o.stdout).into_owned()
-}
-
-fn fails(args: &[&str], needles: &[&str]) {
-    let o = nprt(args);
-    let err = String::from_utf8_lossy(&o.stderr);
-    assert_eq!(
-        o.status.code(),
-        Some(1),
-        "{args:?} should fail; stderr: {err}"
-    );
-    for n in needles {
-        assert!(err.contains(n), "stderr for {args:?} lacks '{n}':\n{err}");
-    }
-}
-
-fn tmp(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("nprt-gen-{}-{name}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&d);
-    d
-}
+use common::{fails, fresh_dir as tmp, nprt, ok, shared};
 
 const SMALL: &[&str] = &[
     "--scene",
@@ -235,8 +202,7 @@ fn bad_input_is_refused_before_anything_is_written() {
         ],
         &["no .exr or .hdr"],
     );
-    let shared = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../../shared/envmaps/sky.exr");
-    std::fs::copy(&shared, maps.join("sky.exr")).unwrap();
+    std::fs::copy(shared().join("envmaps/sky.exr"), maps.join("sky.exr")).unwrap();
     fails(
         &[
             "generate",
@@ -263,7 +229,7 @@ fn bad_input_is_refused_before_anything_is_written() {
         &["broken.exr"],
     );
     // A file scene without a camera volume; an unwritable folder; a bad shard.
-    let mesh = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../../shared/models/bunny.ply");
+    let mesh = shared().join("models/bunny.ply");
     fails(
         &[
             "generate",
@@ -306,7 +272,6 @@ fn bad_input_is_refused_before_anything_is_written() {
 #[test]
 fn real_maps_and_a_file_scene_with_flags_work() {
     let dir = tmp("real");
-    let shared = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../../shared");
     let xml = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../tests/mitsuba/diffuse_room.xml");
     let out = ok(&[
         "generate",
@@ -315,7 +280,7 @@ fn real_maps_and_a_file_scene_with_flags_work() {
         "--scene",
         xml.to_str().unwrap(),
         "--envmaps",
-        shared.join("envmaps").to_str().unwrap(),
+        shared().join("envmaps").to_str().unwrap(),
         "--volume-min",
         "-1,1,2",
         "--volume-max",

@@ -1,0 +1,53 @@
+//! Helpers shared by the integration tests that drive the `nprt` binary.
+#![allow(dead_code)] // each test file uses its own subset
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+pub fn nprt(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_nprt"))
+        .args(args)
+        .output()
+        .expect("run nprt")
+}
+
+/// Runs nprt expecting success; returns stdout.
+pub fn ok(args: &[&str]) -> String {
+    let o = nprt(args);
+    assert!(
+        o.status.success(),
+        "{args:?} failed: {}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+    String::from_utf8_lossy(&o.stdout).into_owned()
+}
+
+/// Runs nprt expecting exit 1 without a panic, with every `needle` in stderr.
+pub fn fails(args: &[&str], needles: &[&str]) {
+    let o = nprt(args);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(
+        o.status.code(),
+        Some(1),
+        "expected exit 1 for {args:?}; stderr: {err}"
+    );
+    for n in needles {
+        assert!(err.contains(n), "stderr for {args:?} lacks '{n}':\n{err}");
+    }
+    assert!(!err.contains("panicked"), "{err}");
+}
+
+/// A fresh, empty (not yet created) folder path unique to this test process.
+pub fn fresh_dir(name: &str) -> PathBuf {
+    let d = std::env::temp_dir().join(format!("nprt-it-{}-{name}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&d);
+    d
+}
+
+/// The shared data folder beside the checkout (env maps, meshes).
+pub fn shared() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../../../shared")
+        .canonicalize()
+        .expect("../shared beside the checkout")
+}
