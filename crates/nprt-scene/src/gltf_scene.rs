@@ -158,6 +158,27 @@ impl Loader<'_> {
         if let Some(&i) = self.materials.get(&m.index()) {
             return Ok(i);
         }
+        let label = format!(
+            "glTF file '{}', material '{}'",
+            self.name,
+            m.name().unwrap_or("default")
+        );
+        if m.normal_texture().is_some() {
+            self.scene.warnings.push(format!(
+                "{label}: its normal map is ignored (shading uses vertex normals)"
+            ));
+        }
+        if m.emissive_factor() != [0.0; 3] || m.emissive_texture().is_some() {
+            self.scene.warnings.push(format!(
+                "{label}: emission is ignored (light comes from the environment only)"
+            ));
+        }
+        if m.alpha_mode() != gltf::material::AlphaMode::Opaque {
+            self.scene.warnings.push(format!(
+                "{label}: alpha mode {:?} is traced as opaque",
+                m.alpha_mode()
+            ));
+        }
         let pbr = m.pbr_metallic_roughness();
         let bc = pbr.base_color_factor();
         let base_factor = Vec3::new(bc[0], bc[1], bc[2]);

@@ -60,7 +60,7 @@ struct GenerateArgs {
     /// Dataset folder; re-running with the same settings resumes it.
     #[arg(long)]
     out: PathBuf,
-    /// Training views (the paper: 3000). Default sized for a 2-core CPU (~4 min at defaults).
+    /// Training views (the paper: 3000). Defaults take ~7 min for builtin:room on a 2-core CPU.
     #[arg(long, default_value_t = 400)]
     train_views: u64,
     /// Test views, lit only by held-out maps (the paper: 200).

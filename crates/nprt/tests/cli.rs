@@ -36,6 +36,11 @@ fn reference_renders_a_gltf_and_reports_speed() {
         "4",
     ]);
     let stdout = String::from_utf8_lossy(&o.stdout);
+    let stderr = String::from_utf8_lossy(&o.stderr);
+    assert!(
+        stderr.contains("alpha mode Blend is traced as opaque"),
+        "{stderr}"
+    );
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     assert!(
         stdout.contains("Msamples/s") && stdout.contains("48×48 at 4 spp"),
