@@ -61,32 +61,28 @@ fn bench(c: &mut Criterion) {
         .flat_map(|m| m.indices.iter().map(|t| t.map(|i| m.positions[i as usize])))
         .collect();
     let point = |v: Vec3| Point3::new(v.x, v.y, v.z);
+    let bvh_shapes = || -> Vec<Tri> {
+        tris.iter()
+            .map(|t| Tri {
+                p: t.map(point),
+                node: 0,
+            })
+            .collect()
+    };
 
     let mut g = c.benchmark_group("build");
     g.sample_size(10);
     g.bench_function("obvhs", |b| b.iter(|| Accel::new(&scene)));
     g.bench_function("bvh", |b| {
         b.iter(|| {
-            let mut shapes: Vec<Tri> = tris
-                .iter()
-                .map(|t| Tri {
-                    p: t.map(point),
-                    node: 0,
-                })
-                .collect();
+            let mut shapes = bvh_shapes();
             bvh::bvh::Bvh::build(&mut shapes)
         })
     });
     g.finish();
 
     let accel = Accel::new(&scene);
-    let mut shapes: Vec<Tri> = tris
-        .iter()
-        .map(|t| Tri {
-            p: t.map(point),
-            node: 0,
-        })
-        .collect();
+    let mut shapes = bvh_shapes();
     let tree = bvh::bvh::Bvh::build(&mut shapes);
     let mut g = c.benchmark_group("closest_hit");
     g.throughput(Throughput::Elements(rays.len() as u64));

@@ -149,6 +149,22 @@ fn manifest_records_split_rotations_and_cameras() {
     );
 }
 
+/// `nprt generate` of `scene` under `envmaps` into `out` must fail naming `needles`.
+fn refused(out: &str, scene: &str, envmaps: &str, needles: &[&str]) {
+    fails(
+        &[
+            "generate",
+            "--out",
+            out,
+            "--scene",
+            scene,
+            "--envmaps",
+            envmaps,
+        ],
+        needles,
+    );
+}
+
 #[test]
 fn bad_input_is_refused_before_anything_is_written() {
     let dir = tmp("bad");
@@ -178,68 +194,28 @@ fn bad_input_is_refused_before_anything_is_written() {
     std::fs::create_dir_all(&maps).unwrap();
     let out = tmp("never");
     let o = out.to_str().unwrap();
-    fails(
-        &[
-            "generate",
-            "--out",
-            o,
-            "--scene",
-            "builtin:room",
-            "--envmaps",
-            "/nonexistent/maps",
-        ],
+    refused(
+        o,
+        "builtin:room",
+        "/nonexistent/maps",
         &["/nonexistent/maps"],
     );
-    fails(
-        &[
-            "generate",
-            "--out",
-            o,
-            "--scene",
-            "builtin:room",
-            "--envmaps",
-            maps.to_str().unwrap(),
-        ],
+    refused(
+        o,
+        "builtin:room",
+        maps.to_str().unwrap(),
         &["no .exr or .hdr"],
     );
     std::fs::copy(shared().join("envmaps/sky.exr"), maps.join("sky.exr")).unwrap();
-    fails(
-        &[
-            "generate",
-            "--out",
-            o,
-            "--scene",
-            "builtin:room",
-            "--envmaps",
-            maps.to_str().unwrap(),
-        ],
-        &["at least 2"],
-    );
+    refused(o, "builtin:room", maps.to_str().unwrap(), &["at least 2"]);
     std::fs::write(maps.join("broken.exr"), b"not an exr").unwrap();
-    fails(
-        &[
-            "generate",
-            "--out",
-            o,
-            "--scene",
-            "builtin:room",
-            "--envmaps",
-            maps.to_str().unwrap(),
-        ],
-        &["broken.exr"],
-    );
+    refused(o, "builtin:room", maps.to_str().unwrap(), &["broken.exr"]);
     // A file scene without a camera volume; an unwritable folder; a bad shard.
     let mesh = shared().join("models/bunny.ply");
-    fails(
-        &[
-            "generate",
-            "--out",
-            o,
-            "--scene",
-            mesh.to_str().unwrap(),
-            "--envmaps",
-            "builtin",
-        ],
+    refused(
+        o,
+        mesh.to_str().unwrap(),
+        "builtin",
         &["camera volume", "--volume-min"],
     );
     fails(
