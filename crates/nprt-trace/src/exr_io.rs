@@ -38,15 +38,21 @@ pub fn write_channels(
     })
 }
 
-/// Creates `path`'s folder, lets `write` fill a temporary file beside `path`, then renames it
-/// into place, so readers never see a partial file and a killed run leaves none behind.
-pub fn write_atomically(path: &Path, write: impl FnOnce(&Path) -> Result<()>) -> Result<()> {
+/// Creates the folder `path` goes in (the current one for a bare file name) and returns it.
+pub fn create_parent_dir(path: &Path) -> Result<&Path> {
     let dir = path
         .parent()
         .filter(|p| !p.as_os_str().is_empty())
         .unwrap_or(Path::new("."));
     std::fs::create_dir_all(dir)
         .with_context(|| format!("cannot create folder '{}'", dir.display()))?;
+    Ok(dir)
+}
+
+/// Creates `path`'s folder, lets `write` fill a temporary file beside `path`, then renames it
+/// into place, so readers never see a partial file and a killed run leaves none behind.
+pub fn write_atomically(path: &Path, write: impl FnOnce(&Path) -> Result<()>) -> Result<()> {
+    let dir = create_parent_dir(path)?;
     let name = path
         .file_name()
         .with_context(|| format!("output path '{}' has no file name", path.display()))?;

@@ -308,12 +308,7 @@ fn reference(a: ReferenceArgs) -> Result<()> {
 
 /// Fails early, before a long render, if `path` cannot be written.
 fn check_writable(path: &Path) -> Result<()> {
-    let dir = path
-        .parent()
-        .filter(|p| !p.as_os_str().is_empty())
-        .unwrap_or(Path::new("."));
-    std::fs::create_dir_all(dir)
-        .with_context(|| format!("cannot create output folder '{}'", dir.display()))?;
+    let dir = nprt_trace::exr_io::create_parent_dir(path)?;
     let probe = dir.join(format!(".nprt-write-test-{}", std::process::id()));
     std::fs::write(&probe, b"")
         .with_context(|| format!("output folder '{}' is not writable", dir.display()))?;

@@ -86,27 +86,29 @@ fn draco_gltf_is_refused_by_name() {
     assert!(!out.exists());
 }
 
+/// `nprt reference builtin:room --envmap MAP` must fail naming `needles`.
+fn map_refused(out: &std::path::Path, map: &str, needles: &[&str]) {
+    let args = [
+        "reference",
+        "builtin:room",
+        "--out",
+        out.to_str().unwrap(),
+        "--envmap",
+        map,
+    ];
+    fails(&args, needles);
+}
+
 #[test]
 fn bad_environment_maps_are_refused_by_name() {
     let dir = tmp("maps");
     let out = dir.join("x.exr");
-    let scene = "builtin:room";
     // Not 2:1.
     let odd = dir.join("odd.hdr");
     image::Rgb32FImage::from_pixel(30, 16, image::Rgb([1.0, 1.0, 1.0]))
         .save(&odd)
         .unwrap();
-    fails(
-        &[
-            "reference",
-            scene,
-            "--out",
-            out.to_str().unwrap(),
-            "--envmap",
-            odd.to_str().unwrap(),
-        ],
-        &["odd.hdr", "2:1", "30×16"],
-    );
+    map_refused(&out, odd.to_str().unwrap(), &["odd.hdr", "2:1", "30×16"]);
     // A compression the reader lacks: a valid file whose header claims HTJ2K.
     let htj2k = dir.join("htj2k.exr");
     let data = vec![0.5f32; 16 * 8];
@@ -130,40 +132,10 @@ fn bad_environment_maps_are_refused_by_name() {
         + key.len();
     bytes[at] = 10;
     std::fs::write(&htj2k, bytes).unwrap();
-    fails(
-        &[
-            "reference",
-            scene,
-            "--out",
-            out.to_str().unwrap(),
-            "--envmap",
-            htj2k.to_str().unwrap(),
-        ],
-        &["htj2k.exr", "compression"],
-    );
+    map_refused(&out, htj2k.to_str().unwrap(), &["htj2k.exr", "compression"]);
     // Missing file and unknown built-in.
-    fails(
-        &[
-            "reference",
-            scene,
-            "--out",
-            out.to_str().unwrap(),
-            "--envmap",
-            "/nonexistent/map.exr",
-        ],
-        &["/nonexistent/map.exr"],
-    );
-    fails(
-        &[
-            "reference",
-            scene,
-            "--out",
-            out.to_str().unwrap(),
-            "--envmap",
-            "builtin:moon",
-        ],
-        &["builtin:moon"],
-    );
+    map_refused(&out, "/nonexistent/map.exr", &["/nonexistent/map.exr"]);
+    map_refused(&out, "builtin:moon", &["builtin:moon"]);
     assert!(!out.exists());
 }
 

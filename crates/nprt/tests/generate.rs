@@ -218,16 +218,10 @@ fn bad_input_is_refused_before_anything_is_written() {
         "builtin",
         &["camera volume", "--volume-min"],
     );
-    fails(
-        &[
-            "generate",
-            "--out",
-            "/proc/nprt-no/ds",
-            "--scene",
-            "builtin:room",
-            "--envmaps",
-            "builtin",
-        ],
+    refused(
+        "/proc/nprt-no/ds",
+        "builtin:room",
+        "builtin",
         &["/proc/nprt-no"],
     );
     let o2 = nprt(&[
