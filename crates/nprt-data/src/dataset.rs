@@ -186,17 +186,10 @@ pub fn plan(req: &Request, ts: &TraceScene) -> Result<Manifest> {
         .iter()
         .zip(&req.maps)
         .map(|(spec, map)| {
-            let hash = if spec.starts_with("builtin:") {
-                blake3::hash(spec.as_bytes())
-            } else {
-                blake3::hash(
-                    &std::fs::read(spec)
-                        .with_context(|| format!("cannot read environment map '{spec}'"))?,
-                )
-            };
+            let hash = crate::lighting::map_hash(spec)?;
             Ok(MapRecord {
                 spec: spec.clone(),
-                hash: hash.to_hex().to_string(),
+                hash,
                 width: map.width(),
                 height: map.height(),
             })

@@ -57,6 +57,18 @@ pub fn load_all(specs: &[String]) -> Result<Vec<EnvMap>> {
     specs.iter().map(|s| open_envmap(s)).collect()
 }
 
+/// Identity of a map spec: BLAKE3 of the file's bytes, or of the spec for a built-in map.
+pub fn map_hash(spec: &str) -> Result<String> {
+    let hash = if spec.starts_with("builtin:") {
+        blake3::hash(spec.as_bytes())
+    } else {
+        blake3::hash(
+            &std::fs::read(spec).with_context(|| format!("cannot read environment map '{spec}'"))?,
+        )
+    };
+    Ok(hash.to_hex().to_string())
+}
+
 /// Draws `test_count` held-out maps with `seed`: (train indices, test indices), each sorted.
 pub fn split(count: usize, test_count: usize, seed: u64) -> Result<(Vec<usize>, Vec<usize>)> {
     if count < 2 {

@@ -10,6 +10,8 @@ use glam::Vec3;
 use nprt_scene::{load_scene, procedural, SceneOptions};
 use nprt_trace::{render, Frame, PixelFilter, RenderSettings, TraceScene};
 
+mod learn;
+
 #[derive(Parser)]
 #[command(
     name = "nprt",
@@ -38,6 +40,22 @@ enum Command {
     /// Inspect datasets.
     #[command(subcommand)]
     Dataset(DatasetCommand),
+    /// Describe networks.
+    #[command(subcommand)]
+    Model(ModelCommand),
+    /// Train one Neural PRT design (light encoder and transport, jointly) on a dataset; writes a
+    /// model folder with weights, config, loss.csv, loss.png and a resumable checkpoint.
+    Train(learn::TrainArgs),
+    /// Benchmarks.
+    #[command(subcommand)]
+    Bench(learn::BenchCommand),
+}
+
+#[derive(Subcommand)]
+enum ModelCommand {
+    /// Print the layer table and parameter counts of a design (transport counts exclude the
+    /// encoder, as the paper's Table 1).
+    Info(learn::ModelInfoArgs),
 }
 
 #[derive(Subcommand)]
@@ -210,6 +228,9 @@ fn run(cli: Cli) -> Result<()> {
         Command::Demo(a) => demo(a),
         Command::Generate(a) => generate(a),
         Command::Dataset(DatasetCommand::Verify { dir }) => verify(&dir),
+        Command::Model(ModelCommand::Info(a)) => learn::model_info(a),
+        Command::Train(a) => learn::train(a),
+        Command::Bench(c) => learn::bench(c),
     }
 }
 

@@ -1,0 +1,160 @@
+//! Training samples from a dataset folder: the 19 per-pixel inputs, the reference radiance and
+//! the pre-processed, rotated map of every view.
+
+use std::path::Path;
+
+use anyhow::{bail, Context, Result};
+use glam::Vec3;
+use nprt_data::dataset::{load_manifest, Manifest, ViewRecord, MANIFEST};
+use nprt_scene::envmap::EnvMap;
+use rayon::prelude::*;
+
+use crate::design::FEATURES;
+use crate::encoder::LightInput;
+
+/// The 19 network inputs of one surface point, in the order of [`crate::design::feature`].
+/// `bounds` normalises the position to [−1, 1]; ωr is ωo mirrored about n.
+pub fn pixel_features(
+    bounds: &[[f32; 3]; 2],
+    position: Vec3,
+    normal: Vec3,
+    view: Vec3,
+    kd: Vec3,
+    ks: Vec3,
+    alpha: f32,
+) -> [f32; FEATURES] {
+    let (lo, hi) = (Vec3::from(bounds[0]), Vec3::from(bounds[1]));
+    let x = (position - lo) / (hi - lo).max(Vec3::splat(1e-6)) * 2.0 - 1.0;
+    let mirror = 2.0 * normal.dot(view) * normal - view;
+    let mut f = [0.0; FEATURES];
+    for (i, v) in [x, view, mirror, normal, kd, ks].iter().enumerate() {
+        f[3 * i..3 * i + 3].copy_from_slice(&v.to_array());
+    }
+    f[18] = alpha;
+    f
+}
+
+/// The foreground pixels of one view.
+pub struct ViewSamples {
+    /// [n, 19] inputs.
+    pub features: Vec<f32>,
+    /// [n, 3] reference radiance.
+    pub radiance: Vec<f32>,
+    /// The view's map, rotated and pre-processed for the encoder.
+    pub light: LightInput,
+}
+
+impl ViewSamples {
+    pub fn len(&self) -> usize {
+        self.radiance.len() / 3
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.radiance.is_empty()
+    }
+}
+
+/// A dataset loaded for training: train and test views, and what identifies it.
+pub struct TrainingSet {
+    pub manifest: Manifest,
+    /// BLAKE3 of manifest.json: a model records which dataset it was trained on.
+    pub dataset_hash: String,
+    pub train: Vec<ViewSamples>,
+    pub test: Vec<ViewSamples>,
+}
+
+impl TrainingSet {
+    /// Reads every view of the dataset in `dir` (in parallel) and prepares its map for an
+    /// encoder of input width `encoder_width`.
+    pub fn load(dir: &Path, encoder_width: usize) -> Result<Self> {
+        let manifest = load_manifest(dir)?;
+        let bytes = std::fs::read(dir.join(MANIFEST))
+            .with_context(|| format!("cannot read '{}'", dir.join(MANIFEST).display()))?;
+        let maps = open_recorded_maps(&manifest)?;
+        let load = |split: &str| -> Result<Vec<ViewSamples>> {
+            manifest
+                .views
+                .par_iter()
+                .filter(|v| v.split == split)
+                .map(|v| load_view(dir, &manifest, &maps, v, encoder_width))
+                .collect()
+        };
+        let train = load("train")?;
+        let test = load("test")?;
+        if train.iter().all(|v| v.is_empty()) {
+            bail!(
+                "dataset '{}' has no foreground pixel in its training views",
+                dir.display()
+            );
+        }
+        Ok(TrainingSet {
+            manifest,
+            dataset_hash: blake3::hash(&bytes).to_hex().to_string(),
+            train,
+            test,
+        })
+    }
+}
+
+/// Opens the dataset's maps and checks each is the one the dataset was rendered with.
+pub fn open_recorded_maps(manifest: &Manifest) -> Result<Vec<EnvMap>> {
+    manifest
+        .settings
+        .envmaps
+        .iter()
+        .map(|rec| {
+            let hash = nprt_data::lighting::map_hash(&rec.spec)?;
+            if hash != rec.hash {
+                bail!(
+                    "environment map '{}' differs from the one the dataset was rendered with (hash {} ≠ {})",
+                    rec.spec,
+                    &hash[..12],
+                    &rec.hash[..12.min(rec.hash.len())]
+                );
+            }
+            nprt_scene::procedural::open_envmap(&rec.spec)
+        })
+        .collect()
+}
+
+fn load_view(
+    dir: &Path,
+    manifest: &Manifest,
+    maps: &[EnvMap],
+    view: &ViewRecord,
+    encoder_width: usize,
+) -> Result<ViewSamples> {
+    let path = dir.join(&view.file);
+    nprt_data::dataset::check_view(&path, view)
+        .with_context(|| format!("dataset view '{}' is unusable (run `nprt generate` again to redo it)", path.display()))?;
+    let (_, _, ch) = nprt_trace::exr_io::read_channels(&path)?;
+    let vec3 = |name: &str, i: usize| {
+        let c = |k: &str| ch[&format!("{name}.{k}")][i];
+        match name {
+            "kd" | "ks" => Vec3::new(c("R"), c("G"), c("B")),
+            _ => Vec3::new(c("X"), c("Y"), c("Z")),
+        }
+    };
+    let mut features = Vec::new();
+    let mut radiance = Vec::new();
+    for i in (0..ch["mask"].len()).filter(|&i| ch["mask"][i] > 0.5) {
+        features.extend(pixel_features(
+            &manifest.bounds,
+            vec3("position", i),
+            vec3("normal", i),
+            vec3("view", i),
+            vec3("kd", i),
+            vec3("ks", i),
+            ch["alpha"][i],
+        ));
+        radiance.extend([ch["R"][i], ch["G"][i], ch["B"][i]]);
+    }
+    let map = maps
+        .get(view.map)
+        .with_context(|| format!("view '{}' names map {} of {}", view.file, view.map, maps.len()))?;
+    Ok(ViewSamples {
+        features,
+        radiance,
+        light: LightInput::new(map, view.rotation_deg, encoder_width),
+    })
+}

@@ -1,0 +1,128 @@
+//! The light encoder F_L: a small CNN that turns a lat-long environment map into the light code ê.
+
+use burn::module::Module;
+use burn::nn::conv::Conv2d;
+use burn::nn::pool::{MaxPool2d, MaxPool2dConfig};
+use burn::nn::{Linear, PaddingConfig2d};
+use burn::tensor::activation::relu;
+use burn::tensor::Tensor;
+use glam::Vec2;
+use nprt_scene::envmap::{uv_to_direction, EnvMap};
+
+use crate::layers::{Activation, Init, Mlp};
+
+/// Convolution blocks of the paper's encoder.
+pub const BLOCKS: usize = 5;
+/// Channels of every convolution.
+pub const CHANNELS: usize = 32;
+/// Size of the light code ê.
+pub const CODE_SIZE: usize = 64;
+
+/// The encoder's input width must halve cleanly through every block, and the height is half
+/// the width.
+pub fn check_input_width(width: usize) -> anyhow::Result<()> {
+    let step = 2usize.pow(BLOCKS as u32 + 1);
+    if width < step || width % step != 0 {
+        anyhow::bail!(
+            "encoder input width {width} must be a positive multiple of {step} (the map is W×W/2 and {BLOCKS} blocks halve it)"
+        );
+    }
+    Ok(())
+}
+
+/// 5 × (3×3 conv with 32 channels, ReLU, skip connection, 2×2 max-pool), then one dense layer
+/// to the 64-d code. The skip adds the block's input to the ReLU output; the first block's
+/// 3-channel input is zero-padded to 32 channels for that sum, so the skips add no parameters.
+#[derive(Module, Debug)]
+pub struct LightEncoder {
+    pub convs: Vec<Conv2d>,
+    pub pool: MaxPool2d,
+    pub to_code: Linear,
+}
+
+impl LightEncoder {
+    pub fn new(init: &mut Init, width: usize) -> Self {
+        let convs = (0..BLOCKS)
+            .map(|i| {
+                let c_in = if i == 0 { 3 } else { CHANNELS };
+                // PyTorch's default Conv2d initialisation: U(±1/√fan_in) for weight and bias.
+                let bound = 1.0 / ((c_in * 9) as f32).sqrt();
+                Conv2d {
+                    weight: init.uniform([CHANNELS, c_in, 3, 3], bound),
+                    bias: Some(init.uniform([CHANNELS], bound)),
+                    stride: [1, 1],
+                    kernel_size: [3, 3],
+                    dilation: [1, 1],
+                    groups: 1,
+                    padding: PaddingConfig2d::Same,
+                }
+            })
+            .collect();
+        let flat = CHANNELS * (width >> BLOCKS) * (width >> (BLOCKS + 1));
+        let mut to_code = Mlp::new(init, &[flat, CODE_SIZE], Activation::Relu);
+        LightEncoder {
+            convs,
+            pool: MaxPool2dConfig::new([2, 2]).with_strides([2, 2]).init(),
+            to_code: to_code.layers.remove(0),
+        }
+    }
+
+    /// Maps [V, 3, W/2, W] pre-processed maps to [V, 64] codes.
+    pub fn forward(&self, mut x: Tensor<4>) -> Tensor<2> {
+        for conv in &self.convs {
+            let [v, c, h, w] = x.dims();
+            let skip = if c == CHANNELS {
+                x.clone()
+            } else {
+                let pad = Tensor::zeros([v, CHANNELS - c, h, w], (&x.device(), x.dtype()));
+                Tensor::cat(vec![x.clone(), pad], 1)
+            };
+            x = self.pool.forward(relu(conv.forward(x)) + skip);
+        }
+        self.to_code.forward(x.flatten(1, 3))
+    }
+}
+
+/// An environment map prepared for the encoder: box-filtered to W × W/2, divided by its mean
+/// and passed through log(1 + x), as the paper pre-processes it.
+///
+/// Radiance is linear in the lighting, so the network predicts radiance for the mean-normalised
+/// map and the model multiplies by `scale` (the mean) to restore the absolute level.
+#[derive(Clone, Debug)]
+pub struct LightInput {
+    /// Channel-major [3, W/2, W] values.
+    pub pixels: Vec<f32>,
+    /// The map's mean over texels and channels.
+    pub scale: f32,
+}
+
+impl LightInput {
+    pub fn new(map: &EnvMap, rotation_deg: f32, width: usize) -> Self {
+        let height = width / 2;
+        let map = map.rotated_y(rotation_deg);
+        // Enough sub-samples per encoder texel to cover every source texel it spans.
+        let ss = map.width().div_ceil(width).max(2);
+        let mut rgb = vec![glam::Vec3::ZERO; width * height];
+        for (i, out) in rgb.iter_mut().enumerate() {
+            let (x, y) = (i % width, i / width);
+            for s in 0..ss * ss {
+                let (sx, sy) = (s % ss, s / ss);
+                let uv = Vec2::new(
+                    (x as f32 + (sx as f32 + 0.5) / ss as f32) / width as f32,
+                    (y as f32 + (sy as f32 + 0.5) / ss as f32) / height as f32,
+                );
+                *out += map.eval(uv_to_direction(uv));
+            }
+            *out /= (ss * ss) as f32;
+        }
+        let mean = rgb.iter().map(|c| c.x + c.y + c.z).sum::<f32>() / (3 * rgb.len()) as f32;
+        let scale = mean.max(f32::MIN_POSITIVE);
+        let mut pixels = vec![0.0; 3 * width * height];
+        for (i, c) in rgb.iter().enumerate() {
+            for k in 0..3 {
+                pixels[k * width * height + i] = (c[k] / scale).ln_1p();
+            }
+        }
+        LightInput { pixels, scale }
+    }
+}

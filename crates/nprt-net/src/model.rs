@@ -1,0 +1,203 @@
+//! Model description: the config that travels with the weights, and the layer table.
+
+use std::path::Path;
+
+use anyhow::{bail, Context, Result};
+use burn::module::Module;
+use burn::store::{ModuleSnapshot, SafetensorsStore};
+use burn::tensor::Device;
+use nprt_trace::exr_io::write_atomically;
+use serde::{Deserialize, Serialize};
+
+use crate::design::{Design, NprtNet};
+use crate::layers::{Activation, Init};
+
+/// Identifies a model folder's config file.
+pub const MODEL_FORMAT: &str = "nprt-model";
+/// Bumped whenever a saved model would be read differently.
+pub const MODEL_VERSION: u32 = 1;
+pub const CONFIG_FILE: &str = "model.json";
+pub const WEIGHTS_FILE: &str = "weights.safetensors";
+
+/// One row of `nprt model info`.
+pub struct LayerRow {
+    pub name: String,
+    pub shape: String,
+    pub params: usize,
+}
+
+/// Everything needed to rebuild a network, besides its weights.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct ModelConfig {
+    pub design: Design,
+    pub activation: Activation,
+    /// Width W of the encoder's W × W/2 input map.
+    pub encoder_width: usize,
+}
+
+impl ModelConfig {
+    pub fn new(design: Design, activation: Option<Activation>) -> Self {
+        ModelConfig {
+            design,
+            activation: activation.unwrap_or(design.default_activation()),
+            encoder_width: 128,
+        }
+    }
+
+    pub fn build(&self, init: &mut Init) -> NprtNet {
+        NprtNet::new(init, self.design, self.activation, self.encoder_width)
+    }
+}
+
+/// The config file of a model folder: what to build, how to feed it, where it came from.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct ModelFile {
+    pub format: String,
+    pub version: u32,
+    #[serde(flatten)]
+    pub config: ModelConfig,
+    /// Scene bounds that normalise positions to [−1, 1].
+    pub bounds: [[f32; 3]; 2],
+    /// The scene the model was trained for (BLAKE3, as in the dataset manifest).
+    pub scene_hash: String,
+    /// BLAKE3 of the training dataset's manifest.json.
+    pub dataset_hash: String,
+    pub transport_params: usize,
+    pub encoder_params: usize,
+    /// Training settings and progress (informative).
+    pub training: serde_json::Value,
+}
+
+/// Writes `model.json` and the weights of `net` into `dir`, each file atomically.
+pub fn save_model(dir: &Path, file: &ModelFile, net: &NprtNet) -> Result<()> {
+    save_weights(&dir.join(WEIGHTS_FILE), net, file.config.design)?;
+    let json = serde_json::to_vec_pretty(file)?;
+    write_atomically(&dir.join(CONFIG_FILE), |tmp| Ok(std::fs::write(tmp, &json)?))
+}
+
+/// Weights as safetensors, tagged with the design that produced them.
+pub fn save_weights(path: &Path, net: &NprtNet, design: Design) -> Result<()> {
+    let mut store = SafetensorsStore::from_bytes(None).metadata("nprt_design", design.name());
+    net.save_into(&mut store)
+        .map_err(|e| anyhow::anyhow!("cannot serialise weights: {e}"))?;
+    let bytes = store
+        .get_bytes()
+        .map_err(|e| anyhow::anyhow!("cannot serialise weights: {e}"))?;
+    write_atomically(path, |tmp| Ok(std::fs::write(tmp, &bytes)?))
+}
+
+/// Loads weights saved by [`save_weights`] into `net`, which must be of the same design.
+pub fn load_weights(path: &Path, net: &mut NprtNet, design: Design) -> Result<()> {
+    let bytes =
+        std::fs::read(path).with_context(|| format!("cannot read weights '{}'", path.display()))?;
+    let saved_design = read_design_tag(&bytes)
+        .with_context(|| format!("'{}' is not an nprt weights file", path.display()))?;
+    if saved_design != design.name() {
+        bail!(
+            "weights '{}' belong to design '{saved_design}', not '{}'",
+            path.display(),
+            design.name()
+        );
+    }
+    let mut store = SafetensorsStore::from_bytes(Some(bytes)).validate(true);
+    let result = net
+        .load_from(&mut store)
+        .map_err(|e| anyhow::anyhow!("cannot load weights '{}': {e}", path.display()))?;
+    if !result.errors.is_empty() || !result.missing.is_empty() || !result.unused.is_empty() {
+        bail!(
+            "weights '{}' do not fit the '{}' network: {} missing, {} unexpected, {} bad tensors (first: {})",
+            path.display(),
+            design.name(),
+            result.missing.len(),
+            result.unused.len(),
+            result.errors.len(),
+            result
+                .missing
+                .first()
+                .map(|m| m.0.clone())
+                .or(result.unused.first().cloned())
+                .or(result.errors.first().map(|e| format!("{e:?}")))
+                .unwrap_or_default()
+        );
+    }
+    Ok(())
+}
+
+/// The `nprt_design` entry of a safetensors header.
+fn read_design_tag(bytes: &[u8]) -> Result<String> {
+    let len = u64::from_le_bytes(bytes.get(..8).context("file too short")?.try_into()?) as usize;
+    let header: serde_json::Value =
+        serde_json::from_slice(bytes.get(8..8 + len).context("truncated header")?)?;
+    header["__metadata__"]["nprt_design"]
+        .as_str()
+        .map(str::to_string)
+        .context("no nprt_design tag in its metadata")
+}
+
+/// Reads a model folder's config, refusing other formats and versions.
+pub fn read_model_file(dir: &Path) -> Result<ModelFile> {
+    let path = dir.join(CONFIG_FILE);
+    let text = std::fs::read_to_string(&path).with_context(|| {
+        format!("'{}' is not a model folder (no readable {CONFIG_FILE})", dir.display())
+    })?;
+    let value: serde_json::Value = serde_json::from_str(&text)
+        .with_context(|| format!("'{}' is not valid JSON", path.display()))?;
+    if value["format"] != MODEL_FORMAT {
+        bail!("'{}' is not an nprt model config", path.display());
+    }
+    if value["version"] != MODEL_VERSION {
+        bail!(
+            "model '{}' is format version {}, this nprt reads version {MODEL_VERSION}; retrain it with this version",
+            dir.display(),
+            value["version"]
+        );
+    }
+    serde_json::from_value(value).with_context(|| format!("'{}' is malformed", path.display()))
+}
+
+/// Loads a trained model folder onto `device`.
+pub fn load_model(dir: &Path, device: &Device) -> Result<(ModelFile, NprtNet)> {
+    let file = read_model_file(dir)?;
+    let mut net = file.config.build(&mut Init::new(0, device));
+    load_weights(&dir.join(WEIGHTS_FILE), &mut net, file.config.design)?;
+    Ok((file, net))
+}
+
+/// Every parameterised layer of a network with its shape and parameter count.
+pub fn layer_table(net: &NprtNet) -> Vec<LayerRow> {
+    let mut rows = Vec::new();
+    for (i, conv) in net.encoder.convs.iter().enumerate() {
+        let [o, c, kh, kw] = conv.weight.val().dims();
+        rows.push(LayerRow {
+            name: format!("encoder.conv{i}"),
+            shape: format!("{c}→{o}, {kh}×{kw}"),
+            params: conv.num_params(),
+        });
+    }
+    let [i, o] = net.encoder.to_code.weight.val().dims();
+    rows.push(LayerRow {
+        name: "encoder.to_code".into(),
+        shape: format!("{i}→{o}"),
+        params: net.encoder.to_code.num_params(),
+    });
+    for track in &net.tracks {
+        let track_name = match net.tracks.len() {
+            1 => String::new(),
+            _ => format!("{:?}.", track.kind).to_lowercase(),
+        };
+        let parts = [("transfer", track.transfer.as_ref()), ("shading", Some(&track.shading))];
+        for (part, mlp) in parts {
+            let Some(mlp) = mlp else { continue };
+            for (l, ([i, o], layer)) in mlp.shapes().into_iter().zip(&mlp.layers).enumerate() {
+                let last = l + 1 == mlp.layers.len();
+                let act = if last { "linear" } else { mlp.activation.name() };
+                rows.push(LayerRow {
+                    name: format!("{track_name}{part}.{l}"),
+                    shape: format!("{i}→{o} {act}"),
+                    params: layer.num_params(),
+                });
+            }
+        }
+    }
+    rows
+}

@@ -1,0 +1,251 @@
+//! `nprt model info`, `nprt train` and `nprt bench train`.
+
+use std::path::PathBuf;
+use std::process::Command as Process;
+
+use anyhow::{bail, Context, Result};
+use nprt_net::Device;
+use nprt_net::data::TrainingSet;
+use nprt_net::encoder::check_input_width;
+use nprt_net::{layer_table, measure_throughput, Activation, Design, Init, ModelConfig, TrainOptions};
+
+#[derive(clap::Args)]
+pub struct ModelInfoArgs {
+    /// Transport design: baseline, prt (PRT-inspired), albedo (albedo factorisation) or dsep
+    /// (diffuse/specular separation).
+    #[arg(long)]
+    arch: Design,
+    /// Activation of the layers that read the pixel inputs (siren or relu). Default: the
+    /// paper's (relu for baseline, siren for the others).
+    #[arg(long)]
+    activation: Option<Activation>,
+    /// Width W of the encoder's W × W/2 input map (a multiple of 64).
+    #[arg(long, default_value_t = 128)]
+    encoder_width: usize,
+}
+
+#[derive(clap::Args)]
+pub struct TrainArgs {
+    /// Dataset folder made by `nprt generate` (holding manifest.json).
+    #[arg(long)]
+    data: PathBuf,
+    /// Transport design: baseline, prt, albedo or dsep.
+    #[arg(long)]
+    arch: Design,
+    /// siren or relu for the layers that read the pixel inputs (default: the paper's choice).
+    #[arg(long)]
+    activation: Option<Activation>,
+    /// Model folder to write; re-running with the same settings resumes the run in it, and a
+    /// larger --epochs continues a finished one.
+    #[arg(long)]
+    out: PathBuf,
+    /// Passes over all foreground pixels of the training views (the paper: 500).
+    #[arg(long, default_value_t = 20)]
+    epochs: usize,
+    /// Samples per batch.
+    #[arg(long, default_value_t = 16_384)]
+    batch_size: usize,
+    /// Adam learning rate (the paper: 1e-4).
+    #[arg(long, default_value_t = 1e-4)]
+    lr: f64,
+    /// Seed of the initial weights and of the batch order.
+    #[arg(long, default_value_t = 0)]
+    seed: u64,
+    /// Views whose pixels are mixed in each batch, each lit by its own rotated map.
+    #[arg(long, default_value_t = 8)]
+    views_per_batch: usize,
+    /// Test-view pixels (held-out lighting) used for the validation loss after each epoch.
+    #[arg(long, default_value_t = 65_536)]
+    val_samples: usize,
+    /// Width W of the encoder's W × W/2 input map (a multiple of 64).
+    #[arg(long, default_value_t = 128)]
+    encoder_width: usize,
+    /// Minutes between checkpoints within an epoch (one is always written at an epoch's end).
+    #[arg(long, default_value_t = 5.0)]
+    checkpoint_minutes: f64,
+}
+
+#[derive(clap::Subcommand)]
+pub enum BenchCommand {
+    /// Training samples/s of each design (forward, backward and Adam on one batch), beside
+    /// bench/train_pytorch.py running the same networks, batch and loss when --python is given.
+    Train(BenchTrainArgs),
+}
+
+#[derive(clap::Args)]
+pub struct BenchTrainArgs {
+    /// Designs to measure, comma-separated.
+    #[arg(long, default_value = "baseline,prt,albedo,dsep", value_delimiter = ',')]
+    arch: Vec<Design>,
+    /// siren or relu (default: each design's own).
+    #[arg(long)]
+    activation: Option<Activation>,
+    #[arg(long, default_value_t = 16_384)]
+    batch_size: usize,
+    /// Maps (views) per batch.
+    #[arg(long, default_value_t = 8)]
+    views: usize,
+    /// Timed steps per design, after 2 untimed ones.
+    #[arg(long, default_value_t = 10)]
+    steps: usize,
+    /// Python with PyTorch for the side-by-side peer (bench/train-vs-pytorch.sh installs one).
+    #[arg(long)]
+    python: Option<PathBuf>,
+}
+
+fn config(arch: Design, activation: Option<Activation>, encoder_width: usize) -> Result<ModelConfig> {
+    check_input_width(encoder_width)?;
+    Ok(ModelConfig {
+        encoder_width,
+        ..ModelConfig::new(arch, activation)
+    })
+}
+
+pub fn model_info(a: ModelInfoArgs) -> Result<()> {
+    let config = config(a.arch, a.activation, a.encoder_width)?;
+    let net = config.build(&mut Init::new(0, &Device::flex()));
+    println!(
+        "design {} ({} transport layers), light encoder input {}×{}",
+        a.arch.name(),
+        config.activation.name(),
+        config.encoder_width,
+        config.encoder_width / 2
+    );
+    println!("{:<24} {:<22} {:>10}", "layer", "shape", "params");
+    for row in layer_table(&net) {
+        println!("{:<24} {:<22} {:>10}", row.name, row.shape, row.params);
+    }
+    let transport = net.transport_params();
+    let encoder = nprt_net::NprtNet::total_params(&net) - transport;
+    let paper = a.arch.paper_params();
+    println!("encoder parameters:   {encoder:>10}");
+    println!(
+        "transport parameters: {transport:>10} (paper: {paper}, {:+.2}%)",
+        (transport as f64 / paper as f64 - 1.0) * 100.0
+    );
+    println!("total parameters:     {:>10}", transport + encoder);
+    Ok(())
+}
+
+pub fn train(a: TrainArgs) -> Result<()> {
+    let config = config(a.arch, a.activation, a.encoder_width)?;
+    if a.batch_size == 0 || a.epochs == 0 || a.views_per_batch == 0 {
+        bail!("--epochs, --batch-size and --views-per-batch must be positive");
+    }
+    if !(a.lr > 0.0 && a.lr.is_finite()) {
+        bail!("--lr must be a positive number, got {}", a.lr);
+    }
+    let t0 = std::time::Instant::now();
+    let set = TrainingSet::load(&a.data, config.encoder_width)?;
+    let count = |v: &[nprt_net::data::ViewSamples]| v.iter().map(|s| s.len()).sum::<usize>();
+    println!(
+        "dataset '{}': {} training views ({} foreground pixels), {} test views ({} pixels), loaded in {:.1} s",
+        a.data.display(),
+        set.train.len(),
+        count(&set.train),
+        set.test.len(),
+        count(&set.test),
+        t0.elapsed().as_secs_f64()
+    );
+    let opts = TrainOptions {
+        epochs: a.epochs,
+        batch_size: a.batch_size,
+        learning_rate: a.lr,
+        seed: a.seed,
+        views_per_batch: a.views_per_batch,
+        val_samples: a.val_samples,
+        checkpoint_secs: a.checkpoint_minutes * 60.0,
+        progress: true,
+    };
+    let s = nprt_net::train(&set, &config, &opts, &a.out, &Device::flex())?;
+    if let Some(e) = s.resumed_from_epoch {
+        println!("resumed from epoch {e:.2}");
+    }
+    println!(
+        "trained {} ({}) for {} epochs: {} steps, {:.2} M samples in {:.1} s ({:.0} K samples/s); training loss {:.5}, validation loss {:.5}",
+        a.arch.name(),
+        config.activation.name(),
+        a.epochs,
+        s.steps,
+        s.samples as f64 / 1e6,
+        s.seconds,
+        s.samples as f64 / s.seconds.max(1e-9) / 1e3,
+        s.final_train,
+        s.final_val
+    );
+    println!(
+        "model in '{}' (loss curves: loss.csv, loss.png)",
+        a.out.display()
+    );
+    Ok(())
+}
+
+pub fn bench(cmd: BenchCommand) -> Result<()> {
+    let BenchCommand::Train(a) = cmd;
+    let threads = rayon::current_num_threads();
+    println!(
+        "training throughput, batch {}, {} maps per batch, {} timed steps, {threads} threads",
+        a.batch_size, a.views, a.steps
+    );
+    let peer = match &a.python {
+        Some(py) => run_pytorch(py, &a, threads)?,
+        None => {
+            println!("(no --python given: PyTorch peer skipped; bench/train-vs-pytorch.sh sets one up)");
+            Vec::new()
+        }
+    };
+    println!(
+        "{:<10} {:<6} {:>14} {:>16} {:>8}",
+        "design", "act", "nprt samples/s", "PyTorch samples/s", "ratio"
+    );
+    for &arch in &a.arch {
+        let config = ModelConfig::new(arch, a.activation);
+        let ours = measure_throughput(&config, a.batch_size, a.views, a.steps, 2, &Device::flex());
+        let theirs = peer.iter().find(|p| p.0 == arch.name()).map(|p| p.1);
+        println!(
+            "{:<10} {:<6} {:>14.0} {:>16} {:>8}",
+            arch.name(),
+            config.activation.name(),
+            ours,
+            theirs.map_or("-".into(), |t| format!("{t:.0}")),
+            theirs.map_or("-".into(), |t| format!("{:.2}×", ours / t))
+        );
+    }
+    Ok(())
+}
+
+/// Runs bench/train_pytorch.py first (so both see the same idle machine state in turn) and
+/// returns (design, samples/s) pairs.
+fn run_pytorch(python: &PathBuf, a: &BenchTrainArgs, threads: usize) -> Result<Vec<(String, f64)>> {
+    let script = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../bench/train_pytorch.py");
+    let designs: Vec<&str> = a.arch.iter().map(|d| d.name()).collect();
+    let mut cmd = Process::new(python);
+    cmd.arg(&script)
+        .args(["--designs", &designs.join(",")])
+        .args(["--batch-size", &a.batch_size.to_string()])
+        .args(["--views", &a.views.to_string()])
+        .args(["--steps", &a.steps.to_string()])
+        .args(["--threads", &threads.to_string()]);
+    if let Some(act) = a.activation {
+        cmd.args(["--activation", act.name()]);
+    }
+    let out = cmd
+        .output()
+        .with_context(|| format!("cannot run '{}'", python.display()))?;
+    if !out.status.success() {
+        bail!(
+            "PyTorch peer failed: {}",
+            String::from_utf8_lossy(&out.stderr).lines().last().unwrap_or("")
+        );
+    }
+    String::from_utf8_lossy(&out.stdout)
+        .lines()
+        .map(|l| {
+            let v: serde_json::Value = serde_json::from_str(l).context("PyTorch peer printed non-JSON")?;
+            Ok((
+                v["design"].as_str().unwrap_or_default().to_string(),
+                v["samples_per_s"].as_f64().unwrap_or(f64::NAN),
+            ))
+        })
+        .collect()
+}
