@@ -74,17 +74,17 @@ impl Init {
         let values: Vec<f32> = (0..n)
             .map(|_| (self.rng.random::<f32>() * 2.0 - 1.0) * bound)
             .collect();
-        let data = TensorData::new(values, shape).convert_dtype(self.dtype);
+        let data = TensorData::new(values, shape);
         let id = ParamId::from(self.next_id);
         self.next_id += 1;
-        let tensor = Tensor::from_data(data, &self.device);
+        let tensor = Tensor::from_data(data, (&self.device, self.dtype));
         let tensor = if self.device.is_autodiff() { tensor.require_grad() } else { tensor };
         Param::initialized(id, tensor)
     }
 
     /// A constant input tensor in this initialiser's precision.
     pub fn tensor<const D: usize>(&self, values: Vec<f32>, shape: [usize; D]) -> Tensor<D> {
-        Tensor::from_data(TensorData::new(values, shape).convert_dtype(self.dtype), &self.device)
+        Tensor::from_data(TensorData::new(values, shape), (&self.device, self.dtype))
     }
 }
 

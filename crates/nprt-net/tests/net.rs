@@ -1,0 +1,197 @@
+//! Networks: parameter counts, gradients against finite differences, weight round-trips.
+
+use burn::module::{Module, ModuleMapper, ModuleVisitor, Param, ParamId};
+use burn::optim::GradientsParams;
+use burn::tensor::{DType, Int, Tensor, TensorData};
+use nprt_net::design::{log_l1, FEATURES};
+use nprt_net::model::{load_weights, save_weights};
+use nprt_net::{Activation, Design, Device, Init, ModelConfig, NprtNet};
+use rand::{RngExt, SeedableRng};
+use rand_pcg::Pcg64Mcg;
+
+#[test]
+fn transport_parameter_counts_are_the_papers() {
+    for design in Design::ALL {
+        for activation in [Activation::Siren, Activation::Relu] {
+            let net = ModelConfig::new(design, Some(activation)).build(&mut Init::new(0, &Device::flex()));
+            let (ours, paper) = (net.transport_params(), design.paper_params());
+            match design {
+                Design::Dsep => assert!(
+                    (ours as f64 / paper as f64 - 1.0).abs() < 0.02,
+                    "dsep: {ours} vs {paper}"
+                ),
+                _ => assert_eq!(ours, paper, "{design:?} {activation:?}"),
+            }
+        }
+    }
+}
+
+/// A tiny batch in the initialiser's precision: features in the ranges the data has,
+/// two maps of 64×32, positive reference radiance.
+struct Tiny {
+    features: Tensor<2>,
+    light: Tensor<4>,
+    view: Tensor<1, Int>,
+    scale: Tensor<2>,
+    reference: Tensor<2>,
+}
+
+fn tiny_batch(init: &Init, n: usize, seed: u64) -> Tiny {
+    let mut rng = Pcg64Mcg::seed_from_u64(seed);
+    let mut r = |lo: f32, hi: f32| lo + (hi - lo) * rng.random::<f32>();
+    let features: Vec<f32> = (0..n * FEATURES).map(|_| r(-1.0, 1.0).abs()).collect();
+    let light: Vec<f32> = (0..2 * 3 * 32 * 64).map(|_| r(0.0, 2.0)).collect();
+    let scale: Vec<f32> = (0..n).map(|_| r(0.5, 1.5)).collect();
+    let reference: Vec<f32> = (0..n * 3).map(|_| r(0.0, 3.0)).collect();
+    let view: Vec<i64> = (0..n as i64).map(|i| i % 2).collect();
+    Tiny {
+        features: init.tensor(features, [n, FEATURES]),
+        light: init.tensor(light, [2, 3, 32, 64]),
+        view: Tensor::from_data(TensorData::new(view, [n]), &init.device),
+        scale: init.tensor(scale, [n, 1]),
+        reference: init.tensor(reference, [n, 3]),
+    }
+}
+
+fn loss(net: &NprtNet, b: &Tiny) -> Tensor<1> {
+    let pred = net.forward(b.features.clone(), b.light.clone(), b.view.clone(), b.scale.clone());
+    log_l1(pred, b.reference.clone())
+}
+
+/// Ids and shapes of every parameter tensor.
+struct Shapes(Vec<(ParamId, Vec<usize>)>);
+impl ModuleVisitor for Shapes {
+    fn visit_float<const D: usize>(&mut self, p: &Param<Tensor<D>>) {
+        self.0.push((p.id, p.val().dims().to_vec()));
+    }
+}
+
+/// Adds `delta` to one element of one parameter.
+struct Nudge {
+    id: ParamId,
+    index: usize,
+    delta: f64,
+}
+impl ModuleMapper for Nudge {
+    fn map_float<const D: usize>(&mut self, p: Param<Tensor<D>>) -> Param<Tensor<D>> {
+        if p.id != self.id {
+            return p;
+        }
+        let (index, delta) = (self.index, self.delta);
+        p.map(|t| {
+            let mut data = t.to_data().convert::<f64>();
+            data.as_mut_slice::<f64>().unwrap()[index] += delta;
+            Tensor::from_data(data, (&t.device(), DType::F64))
+        })
+    }
+}
+
+fn value(t: Tensor<1>) -> f64 {
+    t.into_data().convert::<f64>().as_slice::<f64>().unwrap()[0]
+}
+
+/// Every parameter tensor of every design (encoder included), two entries each: the autodiff
+/// gradient against a central difference in f64.
+#[test]
+fn gradients_match_finite_differences() {
+    let device = Device::flex().autodiff();
+    for design in Design::ALL {
+        for activation in [Activation::Siren, Activation::Relu] {
+            let mut init = Init::with_dtype(3, &device, DType::F64);
+            let config = ModelConfig {
+                encoder_width: 64,
+                ..ModelConfig::new(design, Some(activation))
+            };
+            let net = config.build(&mut init);
+            let batch = tiny_batch(&init, 6, 5);
+            let grads = GradientsParams::from_grads(loss(&net, &batch).backward(), &net);
+            let mut shapes = Shapes(Vec::new());
+            net.visit(&mut shapes);
+            let mut rng = Pcg64Mcg::seed_from_u64(9);
+            let mut checked = 0;
+            for (id, dims) in shapes.0 {
+                let grad: Vec<f64> = match dims.len() {
+                    1 => grads.get::<1>(id).map(|g| g.into_data()),
+                    2 => grads.get::<2>(id).map(|g| g.into_data()),
+                    4 => grads.get::<4>(id).map(|g| g.into_data()),
+                    _ => unreachable!(),
+                }
+                .expect("every parameter has a gradient")
+                .convert::<f64>()
+                .try_into_vec::<f64>()
+                .unwrap();
+                for _ in 0..2 {
+                    let index = rng.random_range(0..grad.len());
+                    let h = 1e-6;
+                    let at = |delta| {
+                        let nudged = net.clone().map(&mut Nudge { id, index, delta });
+                        value(loss(&nudged, &batch).inner())
+                    };
+                    let fd = (at(h) - at(-h)) / (2.0 * h);
+                    let ad = grad[index];
+                    assert!(
+                        (fd - ad).abs() <= 1e-6 + 1e-4 * fd.abs().max(ad.abs()),
+                        "{design:?}/{activation:?} param {id} [{index}] of {dims:?}: autodiff {ad:e}, finite difference {fd:e}"
+                    );
+                    checked += 1;
+                }
+            }
+            assert!(checked >= 20, "{design:?}: only {checked} entries checked");
+        }
+    }
+}
+
+#[test]
+fn saved_weights_load_into_a_fresh_network_exactly() {
+    let device = Device::flex();
+    let dir = std::env::temp_dir().join(format!("nprt-net-weights-{}", std::process::id()));
+    for design in Design::ALL {
+        let config = ModelConfig {
+            encoder_width: 64,
+            ..ModelConfig::new(design, None)
+        };
+        let init = Init::new(1, &device);
+        let batch = tiny_batch(&init, 16, 2);
+        let net = config.build(&mut Init::new(1, &device));
+        let path = dir.join(format!("{}.safetensors", design.name()));
+        save_weights(&path, &net, design).unwrap();
+        let mut other = config.build(&mut Init::new(2, &device));
+        let before = value(loss(&other, &batch));
+        load_weights(&path, &mut other, design).unwrap();
+        assert_eq!(value(loss(&other, &batch)), value(loss(&net, &batch)));
+        assert_ne!(before, value(loss(&net, &batch)), "different seeds give different nets");
+        // Weights of one design refuse to load into another, naming both.
+        let wrong = if design == Design::Dsep { Design::Prt } else { Design::Dsep };
+        let mut wrong_net = ModelConfig { encoder_width: 64, ..ModelConfig::new(wrong, None) }
+            .build(&mut Init::new(1, &device));
+        let err = load_weights(&path, &mut wrong_net, wrong).unwrap_err().to_string();
+        assert!(err.contains(design.name()) && err.contains(wrong.name()), "{err}");
+    }
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+#[test]
+fn encoder_input_is_mean_normalised_log_of_the_rotated_map() {
+    use nprt_scene::envmap::EnvMap;
+    // A constant map: every texel is log(1 + 1) after dividing by the mean; scale is the mean.
+    let map = EnvMap::constant(glam::Vec3::new(2.0, 4.0, 6.0));
+    let input = nprt_net::LightInput::new(&map, 37.0, 64);
+    assert!((input.scale - 4.0).abs() < 1e-5);
+    let expect = [0.5f32.ln_1p(), 1.0f32.ln_1p(), 1.5f32.ln_1p()];
+    for (k, e) in expect.iter().enumerate() {
+        let channel = &input.pixels[k * 64 * 32..(k + 1) * 64 * 32];
+        assert!(channel.iter().all(|v| (v - e).abs() < 1e-5));
+    }
+    // A bright texel moves by the rotation: a quarter turn shifts it by a quarter of the width.
+    let mut texels = vec![glam::Vec3::splat(0.1); 256 * 128];
+    texels[64 * 256 + 32] = glam::Vec3::splat(1000.0);
+    let map = EnvMap::from_texels("spot", 256, 128, texels).unwrap();
+    let peak = |rot: f32| {
+        let p = nprt_net::LightInput::new(&map, rot, 64).pixels;
+        (0..64 * 32).max_by(|&a, &b| p[a].total_cmp(&p[b])).unwrap()
+    };
+    let (a, b) = (peak(0.0), peak(90.0));
+    assert_eq!(a / 64, b / 64, "same row");
+    let shift = (b % 64 + 64 - a % 64) % 64;
+    assert_eq!(shift.min(64 - shift), 16, "{a} → {b}");
+}
