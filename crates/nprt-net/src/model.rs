@@ -77,7 +77,10 @@ pub fn save_model(dir: &Path, file: &ModelFile, net: &NprtNet) -> Result<()> {
 
 /// Weights as safetensors, tagged with the design that produced them.
 pub fn save_weights(path: &Path, net: &NprtNet, design: Design) -> Result<()> {
-    let mut store = SafetensorsStore::from_bytes(None).metadata("nprt_design", design.name());
+    // One metadata key only: the header is then byte-for-byte reproducible.
+    let mut store = SafetensorsStore::from_bytes(None)
+        .clear_metadata()
+        .metadata("nprt_design", design.name());
     net.save_into(&mut store)
         .map_err(|e| anyhow::anyhow!("cannot serialise weights: {e}"))?;
     let bytes = store

@@ -59,6 +59,17 @@ impl Default for TrainOptions {
     }
 }
 
+impl TrainOptions {
+    /// Whether a checkpoint made with `other` can be resumed with these options: everything
+    /// that shapes the run must match; epochs may grow, reporting options may change.
+    fn same_run(&self, other: &TrainOptions) -> bool {
+        let key = |o: &TrainOptions| {
+            (o.batch_size, o.learning_rate.to_bits(), o.seed, o.views_per_batch, o.val_samples)
+        };
+        key(self) == key(other)
+    }
+}
+
 /// One row of loss.csv.
 #[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct LossRow {
@@ -296,8 +307,7 @@ pub fn train(
     if let Some(saved) = read_checkpoint(out)? {
         let same_run = saved.config == ck.config
             && saved.dataset_hash == ck.dataset_hash
-            && TrainOptions { epochs: 0, ..saved.options.clone() }
-                == TrainOptions { epochs: 0, ..ck.options.clone() };
+            && saved.options.same_run(&ck.options);
         if !same_run {
             bail!(
                 "model folder '{}' holds a run with other settings (design, activation, dataset or hyper-parameters); choose another --out or delete it",
@@ -352,11 +362,15 @@ pub fn train(
                 }
                 if !value.is_finite() || ema > 10.0 * best_ema {
                     bar.abandon();
+                    let kept = if checkpoint_dir(out).join(STATE_FILE).exists() {
+                        format!("the last good checkpoint in '{}' is kept", checkpoint_dir(out).display())
+                    } else {
+                        "no checkpoint had been written yet".to_string()
+                    };
                     bail!(
-                        "training diverged at epoch {} step {} (loss {value}, running mean {ema:.4}, best {best_ema:.4}); the last good checkpoint in '{}' is kept: lower --lr and re-run with another --out",
-                        ck.epoch,
-                        ck.step,
-                        checkpoint_dir(out).display()
+                        "training diverged at epoch {} step {} (loss {value}, running mean {ema:.4}, best {best_ema:.4}); {kept}; lower --lr and use another --out",
+                        ck.epoch + 1,
+                        ck.step
                     );
                 }
                 let grads = GradientsParams::from_grads(loss.backward(), &net);

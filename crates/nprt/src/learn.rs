@@ -13,8 +13,11 @@ use nprt_net::{layer_table, measure_throughput, Activation, Design, Init, ModelC
 pub struct ModelInfoArgs {
     /// Transport design: baseline, prt (PRT-inspired), albedo (albedo factorisation) or dsep
     /// (diffuse/specular separation).
+    #[arg(long, required_unless_present = "model", conflicts_with = "model")]
+    arch: Option<Design>,
+    /// A trained model folder: load it (checking its config and weights) and describe it.
     #[arg(long)]
-    arch: Design,
+    model: Option<PathBuf>,
     /// Activation of the layers that read the pixel inputs (siren or relu). Default: the
     /// paper's (relu for baseline, siren for the others).
     #[arg(long)]
@@ -102,11 +105,28 @@ fn config(arch: Design, activation: Option<Activation>, encoder_width: usize) ->
 }
 
 pub fn model_info(a: ModelInfoArgs) -> Result<()> {
-    let config = config(a.arch, a.activation, a.encoder_width)?;
-    let net = config.build(&mut Init::new(0, &Device::flex()));
+    let (config, net) = match (&a.model, a.arch) {
+        (Some(dir), _) => {
+            let (file, net) = nprt_net::load_model(dir, &Device::flex())?;
+            println!(
+                "model '{}': trained on dataset {} (scene {})",
+                dir.display(),
+                &file.dataset_hash[..12.min(file.dataset_hash.len())],
+                &file.scene_hash[..12.min(file.scene_hash.len())]
+            );
+            (file.config, net)
+        }
+        (None, Some(arch)) => {
+            let config = config(arch, a.activation, a.encoder_width)?;
+            let net = config.build(&mut Init::new(0, &Device::flex()));
+            (config, net)
+        }
+        (None, None) => bail!("give --arch or --model"),
+    };
+    let arch = config.design;
     println!(
         "design {} ({} transport layers), light encoder input {}×{}",
-        a.arch.name(),
+        arch.name(),
         config.activation.name(),
         config.encoder_width,
         config.encoder_width / 2
@@ -117,7 +137,7 @@ pub fn model_info(a: ModelInfoArgs) -> Result<()> {
     }
     let transport = net.transport_params();
     let encoder = nprt_net::NprtNet::total_params(&net) - transport;
-    let paper = a.arch.paper_params();
+    let paper = arch.paper_params();
     println!("encoder parameters:   {encoder:>10}");
     println!(
         "transport parameters: {transport:>10} (paper: {paper}, {:+.2}%)",

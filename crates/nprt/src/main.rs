@@ -21,6 +21,7 @@ static ALLOC: mimalloc::MiMalloc = mimalloc::MiMalloc;
 #[command(
     name = "nprt",
     version,
+    args_override_self = true,
     about = "Neural precomputed radiance transfer: path-traced data, per-scene networks, relighting"
 )]
 struct Cli {

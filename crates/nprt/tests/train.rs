@@ -1,0 +1,136 @@
+//! `nprt train` on a tiny real dataset: it learns, resumes exactly, refuses what it must.
+
+mod common;
+
+use std::path::{Path, PathBuf};
+use std::sync::OnceLock;
+
+use common::{fails, fresh_dir, ok};
+
+/// 3 training views and 1 test view of builtin:room at 12², 16 spp, made once per process.
+fn dataset() -> &'static Path {
+    static DIR: OnceLock<PathBuf> = OnceLock::new();
+    DIR.get_or_init(|| {
+        let dir = fresh_dir("train-data");
+        ok(&[
+            "generate", "--scene", "builtin:room", "--envmaps", "builtin", "--out",
+            dir.to_str().unwrap(), "--train-views", "3", "--test-views", "1", "--train-res",
+            "12", "--test-res", "12", "--spp", "16",
+        ]);
+        dir
+    })
+}
+
+/// Small-run settings: 64-wide encoder input, batches of 64 mixing all 3 views.
+fn train(out: &Path, arch: &str, extra: &[&str]) -> String {
+    let data = dataset().to_str().unwrap();
+    let mut args = vec![
+        "train", "--data", data, "--arch", arch, "--out", out.to_str().unwrap(),
+        "--encoder-width", "64", "--batch-size", "64", "--views-per-batch", "3",
+        "--val-samples", "256",
+    ];
+    args.extend_from_slice(extra);
+    ok(&args)
+}
+
+/// (train, val) columns of loss.csv, empty cells as None.
+fn losses(model: &Path) -> Vec<(Option<f64>, Option<f64>)> {
+    let csv = std::fs::read_to_string(model.join("loss.csv")).unwrap();
+    let mut lines = csv.lines();
+    assert_eq!(
+        lines.next(),
+        Some("step,epoch,samples,seconds,train_loss,val_loss")
+    );
+    lines
+        .map(|l| {
+            let c: Vec<&str> = l.split(',').collect();
+            (c[4].parse().ok(), c[5].parse().ok())
+        })
+        .collect()
+}
+
+#[test]
+fn a_tiny_dataset_is_overfit() {
+    for arch in ["prt", "dsep"] {
+        let out = fresh_dir(&format!("overfit-{arch}"));
+        // One full batch per epoch.
+        train(&out, arch, &["--epochs", "300", "--lr", "1e-3", "--batch-size", "4096"]);
+        let rows = losses(&out);
+        let train: Vec<f64> = rows.iter().filter_map(|r| r.0).collect();
+        let first = train[..3].iter().sum::<f64>() / 3.0;
+        let last = train[train.len() - 3..].iter().sum::<f64>() / 3.0;
+        assert!(
+            last < 0.03 && last < first / 8.0,
+            "{arch}: training loss {first:.4} → {last:.4}"
+        );
+        assert!(rows.iter().filter(|r| r.1.is_some()).count() == 300, "a validation loss per epoch");
+        let png = std::fs::read(out.join("loss.png")).unwrap();
+        assert_eq!(&png[1..4], b"PNG");
+        let info = ok(&["model", "info", "--model", out.to_str().unwrap()]);
+        assert!(info.contains(&format!("design {arch}")), "{info}");
+    }
+}
+
+#[test]
+fn resumed_training_equals_an_uninterrupted_run() {
+    let straight = fresh_dir("resume-straight");
+    let resumed = fresh_dir("resume-parts");
+    train(&straight, "albedo", &["--epochs", "3"]);
+    train(&resumed, "albedo", &["--epochs", "1"]);
+    let out = train(&resumed, "albedo", &["--epochs", "3"]);
+    assert!(out.contains("resumed from epoch 1.00"), "{out}");
+    let weights = |d: &Path| std::fs::read(d.join("weights.safetensors")).unwrap();
+    assert!(weights(&straight) == weights(&resumed), "resumed weights differ");
+    let val = |d: &Path| losses(d).iter().filter_map(|r| r.1).collect::<Vec<_>>();
+    assert_eq!(val(&straight), val(&resumed));
+    // The same seed gives the same model; another seed another one.
+    let again = fresh_dir("resume-again");
+    train(&again, "albedo", &["--epochs", "3"]);
+    assert!(weights(&again) == weights(&straight));
+    let other = fresh_dir("resume-seed");
+    train(&other, "albedo", &["--epochs", "1", "--seed", "7"]);
+    let one = fresh_dir("resume-one");
+    train(&one, "albedo", &["--epochs", "1"]);
+    assert!(weights(&other) != weights(&one));
+}
+
+#[test]
+fn bad_runs_stop_clearly_and_keep_the_last_good_checkpoint() {
+    let data = dataset().to_str().unwrap();
+    let out = fresh_dir("refuse");
+    let o = out.to_str().unwrap();
+    train(&out, "baseline", &["--epochs", "1"]);
+    let state = std::fs::read(out.join("checkpoint/state.json")).unwrap();
+    // Another design (or dataset, or hyper-parameters) in the same folder is refused.
+    fails(
+        &["train", "--data", data, "--arch", "prt", "--out", o, "--encoder-width", "64"],
+        &["holds a run with other settings"],
+    );
+    // A learning rate that blows up stops with a clear message; the checkpoint is untouched.
+    let boom = fresh_dir("diverge");
+    let b = boom.to_str().unwrap();
+    fails(
+        &["train", "--data", data, "--arch", "baseline", "--out", b, "--encoder-width", "64",
+          "--lr", "1e4", "--epochs", "5"],
+        &["training diverged"],
+    );
+    assert_eq!(std::fs::read(out.join("checkpoint/state.json")).unwrap(), state);
+    // Bad arguments and inputs.
+    let bad = common::nprt(&["train", "--data", data, "--arch", "mlp", "--out", o]);
+    assert!(!bad.status.success());
+    assert!(String::from_utf8_lossy(&bad.stderr).contains("unknown design 'mlp'"));
+    fails(
+        &["train", "--data", data, "--arch", "prt", "--out", o, "--encoder-width", "100"],
+        &["multiple of 64"],
+    );
+    fails(
+        &["train", "--data", "/nonexistent/ds", "--arch", "prt", "--out", o],
+        &["/nonexistent/ds"],
+    );
+    // A model of another version or whose weights belong to another design is refused.
+    let json = std::fs::read_to_string(out.join("model.json")).unwrap();
+    std::fs::write(out.join("model.json"), json.replace("\"version\": 1", "\"version\": 99")).unwrap();
+    fails(&["model", "info", "--model", o], &["format version 99"]);
+    std::fs::write(out.join("model.json"), json.replace("\"design\": \"baseline\"", "\"design\": \"prt\"")).unwrap();
+    fails(&["model", "info", "--model", o], &["belong to design 'baseline', not 'prt'"]);
+}
