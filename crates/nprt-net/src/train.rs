@@ -320,7 +320,11 @@ pub fn train(
             anyhow::anyhow!("cannot read optimiser state in '{}': {e:?}", dir.display())
         })?;
         let plan = EpochPlan::new(set, opts, saved.epoch);
-        resumed_from_epoch = Some(saved.epoch as f64 + saved.batch as f64 / plan.total().max(1) as f64);
+        let at = saved.epoch as f64 + saved.batch as f64 / plan.total().max(1) as f64;
+        if opts.progress {
+            eprintln!("resuming '{}' from epoch {at:.2}", out.display());
+        }
+        resumed_from_epoch = Some(at);
         ck = Checkpoint { options: opts.clone(), ..saved };
     }
 
@@ -399,7 +403,7 @@ pub fn train(
                     "epoch {}/{} loss {ema:.4} {:.0}K samples/s",
                     ck.epoch + 1,
                     opts.epochs,
-                    (ck.samples as f64 - 0.0) / ck.seconds.max(1e-9) / 1e3
+                    ck.samples as f64 / ck.seconds.max(1e-9) / 1e3
                 ));
                 if last_checkpoint.elapsed().as_secs_f64() > opts.checkpoint_secs {
                     write_checkpoint(out, &mut ck, &net, &optim, set)?;
@@ -421,10 +425,16 @@ pub fn train(
         });
         (row_sum, row_n) = (0.0, 0);
         if opts.progress {
-            bar.println(format!(
-                "epoch {:>4}: train loss {:.5}, validation loss {val:.5}",
-                ck.epoch, ck.history.iter().rev().find_map(|r| r.train).unwrap_or(last_train)
-            ));
+            // Also when the bar is hidden (output not a terminal), so logs show progress.
+            bar.suspend(|| {
+                eprintln!(
+                    "epoch {:>4}/{}: train loss {:.5}, validation loss {val:.5}, {:.0} K samples/s",
+                    ck.epoch,
+                    opts.epochs,
+                    ck.history.iter().rev().find_map(|r| r.train).unwrap_or(last_train),
+                    ck.samples as f64 / ck.seconds.max(1e-9) / 1e3
+                )
+            });
         }
         write_checkpoint(out, &mut ck, &net, &optim, set)?;
         last_checkpoint = Instant::now();

@@ -91,7 +91,7 @@ pub struct BenchTrainArgs {
     /// Timed steps per design, after 2 untimed ones.
     #[arg(long, default_value_t = 10)]
     steps: usize,
-    /// Python with PyTorch for the side-by-side peer (bench/train-vs-pytorch.sh installs one).
+    /// Python with PyTorch for the side-by-side peer (bench/train_vs_pytorch.sh installs one).
     #[arg(long)]
     python: Option<PathBuf>,
 }
@@ -210,7 +210,7 @@ pub fn bench(cmd: BenchCommand) -> Result<()> {
     let peer = match &a.python {
         Some(py) => run_pytorch(py, &a, threads)?,
         None => {
-            println!("(no --python given: PyTorch peer skipped; bench/train-vs-pytorch.sh sets one up)");
+            println!("(no --python given: PyTorch peer skipped; bench/train_vs_pytorch.sh sets one up)");
             Vec::new()
         }
     };
