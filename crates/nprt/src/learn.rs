@@ -42,7 +42,8 @@ pub struct TrainArgs {
     /// larger --epochs continues a finished one.
     #[arg(long)]
     out: PathBuf,
-    /// Passes over all foreground pixels of the training views (the paper: 500).
+    /// Passes over all foreground pixels of the training views (the paper: 500). On 2 CPU
+    /// cores one epoch of the default 400-view 128² dataset takes about 4 minutes (dsep).
     #[arg(long, default_value_t = 20)]
     epochs: usize,
     /// Samples per batch.
