@@ -298,6 +298,16 @@ pub fn prepare(dir: &Path, manifest: &Manifest) -> Result<()> {
 /// Checks that a view file reads back complete: right size, every channel, finite values.
 pub fn check_view(path: &Path, view: &ViewRecord) -> Result<()> {
     let (w, h, ch) = read_channels(path)?;
+    check_channels(w, h, &ch, view)
+}
+
+/// Checks the channels of a view file already read: right size, every channel, finite values.
+pub fn check_channels(
+    w: usize,
+    h: usize,
+    ch: &std::collections::HashMap<String, Vec<f32>>,
+    view: &ViewRecord,
+) -> Result<()> {
     if (w, h) != (view.width as usize, view.height as usize) {
         bail!("is {w}×{h}, expected {}×{}", view.width, view.height);
     }

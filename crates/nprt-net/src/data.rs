@@ -125,9 +125,9 @@ fn load_view(
     encoder_width: usize,
 ) -> Result<ViewSamples> {
     let path = dir.join(&view.file);
-    nprt_data::dataset::check_view(&path, view)
+    let (w, h, ch) = nprt_trace::exr_io::read_channels(&path)?;
+    nprt_data::dataset::check_channels(w, h, &ch, view)
         .with_context(|| format!("dataset view '{}' is unusable (run `nprt generate` again to redo it)", path.display()))?;
-    let (_, _, ch) = nprt_trace::exr_io::read_channels(&path)?;
     let vec3 = |name: &str, i: usize| {
         let c = |k: &str| ch[&format!("{name}.{k}")][i];
         match name {

@@ -94,6 +94,8 @@ pub struct LightInput {
     pub pixels: Vec<f32>,
     /// The map's mean over texels and channels.
     pub scale: f32,
+    /// W: the encoder input width.
+    pub width: usize,
 }
 
 impl LightInput {
@@ -123,6 +125,10 @@ impl LightInput {
                 pixels[k * width * height + i] = (c[k] / scale).ln_1p();
             }
         }
-        LightInput { pixels, scale }
+        LightInput {
+            pixels,
+            scale,
+            width,
+        }
     }
 }

@@ -161,7 +161,8 @@ pub struct Batch {
     pub scale: Vec<f32>,
     /// [V, 3, W/2, W] pre-processed maps.
     pub lights: Vec<f32>,
-    pub light_count: usize,
+    /// W of the maps.
+    pub light_width: usize,
 }
 
 impl Batch {
@@ -173,7 +174,7 @@ impl Batch {
             view: Vec::with_capacity(samples.len()),
             scale: Vec::with_capacity(samples.len()),
             lights: views.iter().flat_map(|v| v.light.pixels.iter().copied()).collect(),
-            light_count: views.len(),
+            light_width: views.first().map_or(0, |v| v.light.width),
         };
         for &(v, p) in samples {
             let (view, p) = (views[v as usize], p as usize);
@@ -197,13 +198,13 @@ impl Batch {
     /// Predicted radiance [B, 3] and the reference [B, 3] on `device`.
     pub fn forward(&self, net: &NprtNet, device: &Device) -> (Tensor<2>, Tensor<2>) {
         let n = self.len();
-        let side = ((self.lights.len() / self.light_count / 3 * 2) as f64).sqrt() as usize;
+        let w = self.light_width;
         let f = Tensor::from_data(TensorData::new(self.features.clone(), [n, FEATURES]), device);
         let r = Tensor::from_data(TensorData::new(self.radiance.clone(), [n, 3]), device);
         let v = Tensor::<1, Int>::from_data(TensorData::new(self.view.clone(), [n]), device);
         let s = Tensor::from_data(TensorData::new(self.scale.clone(), [n, 1]), device);
         let l = Tensor::from_data(
-            TensorData::new(self.lights.clone(), [self.light_count, 3, side / 2, side]),
+            TensorData::new(self.lights.clone(), [self.lights.len() / (3 * w * w / 2), 3, w / 2, w]),
             device,
         );
         (net.forward(f, l, v, s), r)
@@ -550,7 +551,7 @@ pub fn measure_throughput(
         view: (0..batch_size).map(|i| (i % views) as i64).collect(),
         scale: random(batch_size, 1.0).into_iter().map(|s| s + 0.5).collect(),
         lights: random(views * 3 * w * w / 2, 1.0),
-        light_count: views,
+        light_width: w,
     };
     let mut timed = Instant::now();
     for step in 0..warmup + steps {
