@@ -129,6 +129,30 @@ impl ViewRecord {
     }
 }
 
+/// Source bytes that identify a scene: the file's bytes, or the built-in name.
+pub fn scene_source(spec: &str) -> Result<Vec<u8>> {
+    if spec.starts_with("builtin:") {
+        Ok(spec.as_bytes().to_vec())
+    } else {
+        std::fs::read(spec).with_context(|| format!("cannot read scene '{spec}'"))
+    }
+}
+
+/// Loads the scene `spec` and checks it is the one with hash `expected` (that a dataset was
+/// rendered from, or a model trained on, as `what` says).
+pub fn load_checked_scene(spec: &str, expected: &str, what: &str) -> Result<Scene> {
+    let scene = nprt_scene::load_scene(spec, &nprt_scene::SceneOptions::default())?;
+    let hash = scene_hash(&scene, &scene_source(spec)?);
+    if hash != expected {
+        bail!(
+            "scene '{spec}' is not the scene {what} (hash {} ≠ {})",
+            &hash[..12],
+            &expected[..12.min(expected.len())]
+        );
+    }
+    Ok(scene)
+}
+
 /// Hash of what the network will learn: geometry, material parameters at vertices, and the
 /// scene's source text (file bytes, or the built-in name).
 pub fn scene_hash(scene: &Scene, source: &[u8]) -> String {

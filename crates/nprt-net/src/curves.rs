@@ -39,49 +39,80 @@ fn register_font() {
 
 /// Training and validation loss against epochs, log-scaled.
 pub fn plot(path: &Path, rows: &[LossRow], title: &str) -> Result<()> {
+    let train: Vec<(f64, f64)> = rows.iter().filter_map(|r| Some((r.epoch, r.train?))).collect();
+    let val: Vec<(f64, f64)> = rows.iter().filter_map(|r| Some((r.epoch, r.val?))).collect();
+    plot_lines(
+        path,
+        &format!("nprt training: {title}"),
+        ("epoch", "log-L1 loss"),
+        &[("training".into(), train), ("validation (held-out lighting)".into(), val)],
+    )
+}
+
+/// Named series as lines with markers on a log-scaled y axis, as a PNG.
+pub fn plot_lines(
+    path: &Path,
+    title: &str,
+    (x_desc, y_desc): (&str, &str),
+    series: &[(String, Vec<(f64, f64)>)],
+) -> Result<()> {
     register_font();
     let (w, h) = (800u32, 500u32);
     let mut buf = vec![0u8; (w * h * 3) as usize];
-    let train: Vec<(f64, f64)> = rows.iter().filter_map(|r| Some((r.epoch, r.train?))).collect();
-    let val: Vec<(f64, f64)> = rows.iter().filter_map(|r| Some((r.epoch, r.val?))).collect();
-    let values = || train.iter().chain(&val).map(|p| p.1).filter(|v| v.is_finite() && *v > 0.0);
+    let values = || {
+        series
+            .iter()
+            .flat_map(|s| s.1.iter().map(|p| p.1))
+            .filter(|v| v.is_finite() && *v > 0.0)
+    };
     let lo = values().fold(f64::INFINITY, f64::min);
     let hi = values().fold(0.0, f64::max);
     let (lo, hi) = if lo < hi { (lo * 0.9, hi * 1.1) } else { (1e-3, 1.0) };
-    let x_max = rows.iter().map(|r| r.epoch).fold(1e-3, f64::max);
+    let xs = || series.iter().flat_map(|s| s.1.iter().map(|p| p.0));
+    let x_min = xs().fold(0.0, f64::min);
+    let x_max = xs().fold(1e-3, f64::max);
+    const PALETTE: [RGBColor; 8] = [
+        RGBColor(31, 119, 180),
+        RGBColor(214, 39, 40),
+        RGBColor(44, 160, 44),
+        RGBColor(255, 127, 14),
+        RGBColor(148, 103, 189),
+        RGBColor(140, 86, 75),
+        RGBColor(227, 119, 194),
+        RGBColor(127, 127, 127),
+    ];
     {
         let root = BitMapBackend::with_buffer(&mut buf, (w, h)).into_drawing_area();
-        let err = |e: DrawingAreaErrorKind<_>| anyhow!("cannot draw loss plot: {e:?}");
+        let err = |e: DrawingAreaErrorKind<_>| anyhow!("cannot draw plot '{title}': {e:?}");
         root.fill(&WHITE).map_err(err)?;
         let mut chart = ChartBuilder::on(&root)
-            .caption(format!("nprt training: {title}"), ("sans-serif", 22))
+            .caption(title, ("sans-serif", 22))
             .margin(12)
             .x_label_area_size(40)
             .y_label_area_size(70)
-            .build_cartesian_2d(0f64..x_max, (lo..hi).log_scale())
+            .build_cartesian_2d(x_min..x_max, (lo..hi).log_scale())
             .map_err(err)?;
         chart
             .configure_mesh()
-            .x_desc("epoch")
-            .y_desc("log-L1 loss")
+            .x_desc(x_desc)
+            .y_desc(y_desc)
+            .y_label_formatter(&|v| format!("{v:.3}"))
             .label_style(("sans-serif", 14))
             .draw()
             .map_err(err)?;
-        let blue = RGBColor(31, 119, 180);
-        let red = RGBColor(214, 39, 40);
-        chart
-            .draw_series(LineSeries::new(train.iter().copied(), blue.stroke_width(2)))
-            .map_err(err)?
-            .label("training")
-            .legend(move |(x, y)| PathElement::new([(x, y), (x + 20, y)], blue.stroke_width(2)));
-        chart
-            .draw_series(LineSeries::new(val.iter().copied(), red.stroke_width(2)))
-            .map_err(err)?
-            .label("validation (held-out lighting)")
-            .legend(move |(x, y)| PathElement::new([(x, y), (x + 20, y)], red.stroke_width(2)));
-        chart
-            .draw_series(val.iter().map(|&p| Circle::new(p, 3, red.filled())))
-            .map_err(err)?;
+        for (i, (name, points)) in series.iter().enumerate() {
+            let colour = PALETTE[i % PALETTE.len()];
+            let points: Vec<(f64, f64)> =
+                points.iter().copied().filter(|p| p.1.is_finite() && p.1 > 0.0).collect();
+            chart
+                .draw_series(LineSeries::new(points.iter().copied(), colour.stroke_width(2)))
+                .map_err(err)?
+                .label(name.as_str())
+                .legend(move |(x, y)| PathElement::new([(x, y), (x + 20, y)], colour.stroke_width(2)));
+            chart
+                .draw_series(points.iter().map(|&p| Circle::new(p, 3, colour.filled())))
+                .map_err(err)?;
+        }
         chart
             .configure_series_labels()
             .background_style(WHITE.mix(0.8))

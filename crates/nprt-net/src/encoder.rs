@@ -3,13 +3,13 @@
 use burn::module::Module;
 use burn::nn::conv::Conv2d;
 use burn::nn::pool::{MaxPool2d, MaxPool2dConfig};
-use burn::nn::{Linear, PaddingConfig2d};
+use burn::nn::Linear;
 use burn::tensor::activation::relu;
 use burn::tensor::Tensor;
 use glam::Vec2;
 use nprt_scene::envmap::{uv_to_direction, EnvMap};
 
-use crate::layers::{Activation, Init, Mlp};
+use crate::layers::{conv2d, Activation, Init, Mlp};
 
 /// Convolution blocks of the paper's encoder.
 pub const BLOCKS: usize = 5;
@@ -43,20 +43,7 @@ pub struct LightEncoder {
 impl LightEncoder {
     pub fn new(init: &mut Init, width: usize) -> Self {
         let convs = (0..BLOCKS)
-            .map(|i| {
-                let c_in = if i == 0 { 3 } else { CHANNELS };
-                // PyTorch's default Conv2d initialisation: U(±1/√fan_in) for weight and bias.
-                let bound = 1.0 / ((c_in * 9) as f32).sqrt();
-                Conv2d {
-                    weight: init.uniform([CHANNELS, c_in, 3, 3], bound),
-                    bias: Some(init.uniform([CHANNELS], bound)),
-                    stride: [1, 1],
-                    kernel_size: [3, 3],
-                    dilation: [1, 1],
-                    groups: 1,
-                    padding: PaddingConfig2d::Same,
-                }
-            })
+            .map(|i| conv2d(init, if i == 0 { 3 } else { CHANNELS }, CHANNELS, 3))
             .collect();
         let flat = CHANNELS * (width >> BLOCKS) * (width >> (BLOCKS + 1));
         let mut to_code = Mlp::new(init, &[flat, CODE_SIZE], Activation::Relu);

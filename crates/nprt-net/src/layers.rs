@@ -1,7 +1,8 @@
 //! Dense layers, the two activations of the paper and their initialisations.
 
 use burn::module::{Module, Param, ParamId};
-use burn::nn::Linear;
+use burn::nn::conv::Conv2d;
+use burn::nn::{Linear, PaddingConfig2d};
 use burn::tensor::activation::relu;
 use burn::tensor::{DType, Device, Tensor, TensorData};
 use rand::{RngExt, SeedableRng};
@@ -95,6 +96,21 @@ fn dense(init: &mut Init, d_in: usize, d_out: usize, weight_bound: f32) -> Linea
     Linear {
         weight: init.uniform([d_in, d_out], weight_bound),
         bias: Some(init.uniform([d_out], bias_bound)),
+    }
+}
+
+/// A k×k convolution with "same" padding and PyTorch's default initialisation
+/// (U(±1/√fan_in) for weight and bias).
+pub fn conv2d(init: &mut Init, c_in: usize, c_out: usize, k: usize) -> Conv2d {
+    let bound = 1.0 / ((c_in * k * k) as f32).sqrt();
+    Conv2d {
+        weight: init.uniform([c_out, c_in, k, k], bound),
+        bias: Some(init.uniform([c_out], bound)),
+        stride: [1, 1],
+        kernel_size: [k, k],
+        dilation: [1, 1],
+        groups: 1,
+        padding: PaddingConfig2d::Same,
     }
 }
 

@@ -14,6 +14,7 @@ pub mod layers;
 pub mod model;
 pub mod train;
 
+pub use burn;
 pub use burn::tensor::Device;
 pub use design::{log_l1, Design, NprtNet, FEATURES};
 pub use encoder::{LightEncoder, LightInput};

@@ -58,7 +58,10 @@ pub struct ModelFile {
     pub config: ModelConfig,
     /// Scene bounds that normalise positions to [−1, 1].
     pub bounds: [[f32; 3]; 2],
-    /// The scene the model was trained for (BLAKE3, as in the dataset manifest).
+    /// The scene the model was trained for, as the dataset names it (a file path or a
+    /// built-in name), and its BLAKE3 hash as in the dataset manifest.
+    #[serde(default)]
+    pub scene: String,
     pub scene_hash: String,
     /// BLAKE3 of the training dataset's manifest.json.
     pub dataset_hash: String,
@@ -70,17 +73,17 @@ pub struct ModelFile {
 
 /// Writes `model.json` and the weights of `net` into `dir`, each file atomically.
 pub fn save_model(dir: &Path, file: &ModelFile, net: &NprtNet) -> Result<()> {
-    save_weights(&dir.join(WEIGHTS_FILE), net, file.config.design)?;
+    save_weights(&dir.join(WEIGHTS_FILE), net, file.config.design.name())?;
     let json = serde_json::to_vec_pretty(file)?;
     write_atomically(&dir.join(CONFIG_FILE), |tmp| Ok(std::fs::write(tmp, &json)?))
 }
 
-/// Weights as safetensors, tagged with the design that produced them.
-pub fn save_weights(path: &Path, net: &NprtNet, design: Design) -> Result<()> {
+/// Weights as safetensors, tagged with the design (or other network kind) that produced them.
+pub fn save_weights<M: Module>(path: &Path, net: &M, tag: &str) -> Result<()> {
     // One metadata key only: the header is then byte-for-byte reproducible.
     let mut store = SafetensorsStore::from_bytes(None)
         .clear_metadata()
-        .metadata("nprt_design", design.name());
+        .metadata("nprt_design", tag);
     net.save_into(&mut store)
         .map_err(|e| anyhow::anyhow!("cannot serialise weights: {e}"))?;
     let bytes = store
@@ -90,16 +93,15 @@ pub fn save_weights(path: &Path, net: &NprtNet, design: Design) -> Result<()> {
 }
 
 /// Loads weights saved by [`save_weights`] into `net`, which must be of the same design.
-pub fn load_weights(path: &Path, net: &mut NprtNet, design: Design) -> Result<()> {
+pub fn load_weights<M: Module>(path: &Path, net: &mut M, tag: &str) -> Result<()> {
     let bytes =
         std::fs::read(path).with_context(|| format!("cannot read weights '{}'", path.display()))?;
     let saved_design = read_design_tag(&bytes)
         .with_context(|| format!("'{}' is not an nprt weights file", path.display()))?;
-    if saved_design != design.name() {
+    if saved_design != tag {
         bail!(
-            "weights '{}' belong to design '{saved_design}', not '{}'",
-            path.display(),
-            design.name()
+            "weights '{}' belong to design '{saved_design}', not '{tag}'",
+            path.display()
         );
     }
     let mut store = SafetensorsStore::from_bytes(Some(bytes)).validate(true);
@@ -108,9 +110,8 @@ pub fn load_weights(path: &Path, net: &mut NprtNet, design: Design) -> Result<()
         .map_err(|e| anyhow::anyhow!("cannot load weights '{}': {e}", path.display()))?;
     if !result.errors.is_empty() || !result.missing.is_empty() || !result.unused.is_empty() {
         bail!(
-            "weights '{}' do not fit the '{}' network: {} missing, {} unexpected, {} bad tensors (first: {})",
+            "weights '{}' do not fit the '{tag}' network: {} missing, {} unexpected, {} bad tensors (first: {})",
             path.display(),
-            design.name(),
             result.missing.len(),
             result.unused.len(),
             result.errors.len(),
@@ -162,7 +163,7 @@ pub fn read_model_file(dir: &Path) -> Result<ModelFile> {
 pub fn load_model(dir: &Path, device: &Device) -> Result<(ModelFile, NprtNet)> {
     let file = read_model_file(dir)?;
     let mut net = file.config.build(&mut Init::new(0, device));
-    load_weights(&dir.join(WEIGHTS_FILE), &mut net, file.config.design)?;
+    load_weights(&dir.join(WEIGHTS_FILE), &mut net, file.config.design.name())?;
     Ok((file, net))
 }
 

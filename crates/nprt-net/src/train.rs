@@ -316,7 +316,7 @@ pub fn train(
             );
         }
         let dir = checkpoint_dir(out);
-        load_weights(&dir.join(&saved.weights), &mut net, config.design)?;
+        load_weights(&dir.join(&saved.weights), &mut net, config.design.name())?;
         optim = optim.load(dir.join(&saved.optimizer)).map_err(|e| {
             anyhow::anyhow!("cannot read optimiser state in '{}': {e:?}", dir.display())
         })?;
@@ -465,7 +465,7 @@ fn write_checkpoint(
     let dir = checkpoint_dir(out);
     let weights = format!("weights-{:09}.safetensors", ck.step);
     let optimizer = format!("optimizer-{:09}.bpk", ck.step);
-    save_weights(&dir.join(&weights), net, ck.config.design)?;
+    save_weights(&dir.join(&weights), net, ck.config.design.name())?;
     optim
         .save(dir.join(&optimizer))
         .map_err(|e| anyhow::anyhow!("cannot write optimiser state: {e:?}"))?;
@@ -489,6 +489,7 @@ fn write_checkpoint(
         version: MODEL_VERSION,
         config: ck.config.clone(),
         bounds: set.manifest.bounds,
+        scene: set.manifest.settings.scene.clone(),
         scene_hash: set.manifest.settings.scene_hash.clone(),
         dataset_hash: set.dataset_hash.clone(),
         transport_params,

@@ -154,17 +154,17 @@ fn saved_weights_load_into_a_fresh_network_exactly() {
         let batch = tiny_batch(&init, 16, 2);
         let net = config.build(&mut Init::new(1, &device));
         let path = dir.join(format!("{}.safetensors", design.name()));
-        save_weights(&path, &net, design).unwrap();
+        save_weights(&path, &net, design.name()).unwrap();
         let mut other = config.build(&mut Init::new(2, &device));
         let before = value(loss(&other, &batch));
-        load_weights(&path, &mut other, design).unwrap();
+        load_weights(&path, &mut other, design.name()).unwrap();
         assert_eq!(value(loss(&other, &batch)), value(loss(&net, &batch)));
         assert_ne!(before, value(loss(&net, &batch)), "different seeds give different nets");
         // Weights of one design refuse to load into another, naming both.
         let wrong = if design == Design::Dsep { Design::Prt } else { Design::Dsep };
         let mut wrong_net = ModelConfig { encoder_width: 64, ..ModelConfig::new(wrong, None) }
             .build(&mut Init::new(1, &device));
-        let err = load_weights(&path, &mut wrong_net, wrong).unwrap_err().to_string();
+        let err = load_weights(&path, &mut wrong_net, wrong.name()).unwrap_err().to_string();
         assert!(err.contains(design.name()) && err.contains(wrong.name()), "{err}");
     }
     std::fs::remove_dir_all(&dir).ok();

@@ -171,3 +171,45 @@ pub fn trace_path(
     }
     out
 }
+
+/// Follows one path by BSDF sampling alone until it leaves the scene; returns the escape
+/// direction and the path throughput, or `None` when the path ends on a surface (absorbed,
+/// Russian roulette, `max_depth`) or misses the scene from the start (no scattered light).
+pub fn trace_escape(
+    scene: &Scene,
+    accel: &Accel,
+    mut origin: Vec3,
+    mut dir: Vec3,
+    s: &PathSettings,
+    rng: &mut Pcg64Mcg,
+) -> Option<(Vec3, Vec3)> {
+    let mut beta = Vec3::ONE;
+    let mut depth = 0u32;
+    loop {
+        let Some(hit) = accel.intersect(origin, dir, f32::INFINITY) else {
+            return (depth > 0).then_some((dir, beta));
+        };
+        if depth + 1 >= s.max_depth {
+            return None;
+        }
+        let sp = surface_point(scene, &hit, dir);
+        let frame = Frame3::new(sp.ns);
+        let wo = frame.to_local(-dir);
+        let bsdf = Bsdf::new(sp.params);
+        if wo.z <= 0.0 || bsdf.is_black() {
+            return None;
+        }
+        let bs = bsdf.sample(wo, Vec2::new(rng.random(), rng.random()), rng.random())?;
+        dir = frame.to_world(bs.wi);
+        origin = offset_origin(sp.p, sp.ng, dir);
+        beta *= bs.weight;
+        depth += 1;
+        if depth >= s.rr_depth {
+            let q = beta.max_element().min(0.95);
+            if rng.random::<f32>() >= q {
+                return None;
+            }
+            beta /= q;
+        }
+    }
+}

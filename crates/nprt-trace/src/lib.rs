@@ -16,4 +16,7 @@ pub mod render;
 pub use accel::{Accel, Hit};
 pub use bsdf::Bsdf;
 pub use frame::{Frame, GBuffer, GSample};
-pub use render::{render, PixelFilter, RenderSettings, TraceScene};
+pub use render::{
+    primary_sample, render, render_gbuffer, render_transport, PixelFilter, RenderSettings,
+    TraceScene,
+};

@@ -10,7 +10,7 @@ use rayon::prelude::*;
 
 use crate::accel::Accel;
 use crate::frame::{Frame, GBuffer, GSample};
-use crate::integrator::{surface_point, trace_path, PathRadiance, PathSettings};
+use crate::integrator::{surface_point, trace_escape, trace_path, PathRadiance, PathSettings};
 
 /// Where a pixel's samples go through the film.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -133,8 +133,18 @@ fn pixel(
         sum.direct += r.direct;
     }
     let n = s.spp.max(1) as f32;
-    let (o, d) = camera.ray(centre);
-    let gb = match ts.accel.intersect(o, d, f32::INFINITY) {
+    let gb = primary_sample(ts, camera, x, y);
+    PixelOut {
+        radiance: sum.total / n,
+        direct: sum.direct / n,
+        gb,
+    }
+}
+
+/// The G-buffer of the ray through the centre of pixel (x, y).
+pub fn primary_sample(ts: &TraceScene, camera: &Camera, x: usize, y: usize) -> GSample {
+    let (o, d) = camera.ray(Vec2::new(x as f32 + 0.5, y as f32 + 0.5));
+    match ts.accel.intersect(o, d, f32::INFINITY) {
         Some(hit) => {
             let sp = surface_point(ts.scene, &hit, d);
             GSample {
@@ -148,10 +158,59 @@ fn pixel(
             }
         }
         None => GSample::default(),
-    };
-    PixelOut {
-        radiance: sum.total / n,
-        direct: sum.direct / n,
-        gb,
     }
+}
+
+/// Primary rays only: the G-buffer of a whole frame (what a rasteriser would give), in parallel.
+pub fn render_gbuffer(ts: &TraceScene, camera: &Camera) -> GBuffer {
+    let (w, h) = (camera.width as usize, camera.height as usize);
+    let samples: Vec<GSample> = (0..w * h)
+        .into_par_iter()
+        .map(|i| primary_sample(ts, camera, i % w, i / w))
+        .collect();
+    let mut g = GBuffer::default();
+    for s in samples {
+        g.push(s);
+    }
+    g
+}
+
+/// Per-pixel transport of a frame onto a basis of the distant lighting: for each pixel, an
+/// estimate of E[path throughput × basis(escape direction)] (one RGB value per basis function),
+/// so that radiance under lighting with basis coefficients c is Σ_k T_k ⊙ c_k. Paths sample the
+/// BSDF only (the lighting is unknown here); the same seed gives the same transport.
+pub fn render_transport(
+    ts: &TraceScene,
+    camera: &Camera,
+    s: &RenderSettings,
+    basis_len: usize,
+    basis: &(dyn Fn(Vec3, &mut [f32]) + Sync),
+) -> Vec<Vec<Vec3>> {
+    let w = camera.width as usize;
+    let ps = PathSettings {
+        max_depth: s.max_depth.unwrap_or(u32::MAX),
+        rr_depth: s.rr_depth,
+    };
+    (0..w * camera.height as usize)
+        .into_par_iter()
+        .map(|i| {
+            let mut rng = Pcg64Mcg::seed_from_u64(mix(
+                s.seed.wrapping_mul(0x9e37_79b9_7f4a_7c15) ^ mix(i as u64),
+            ));
+            let mut t = vec![Vec3::ZERO; basis_len];
+            let mut y_k = vec![0.0; basis_len];
+            let (o, d) = camera.ray(Vec2::new((i % w) as f32 + 0.5, (i / w) as f32 + 0.5));
+            for _ in 0..s.spp {
+                if let Some((dir, beta)) = trace_escape(ts.scene, &ts.accel, o, d, &ps, &mut rng) {
+                    basis(dir, &mut y_k);
+                    for (tk, yk) in t.iter_mut().zip(&y_k) {
+                        *tk += beta * *yk;
+                    }
+                }
+            }
+            let n = s.spp.max(1) as f32;
+            t.iter_mut().for_each(|v| *v /= n);
+            t
+        })
+        .collect()
 }

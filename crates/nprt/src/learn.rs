@@ -14,59 +14,59 @@ pub struct ModelInfoArgs {
     /// Transport design: baseline, prt (PRT-inspired), albedo (albedo factorisation) or dsep
     /// (diffuse/specular separation).
     #[arg(long, required_unless_present = "model", conflicts_with = "model")]
-    arch: Option<Design>,
+    pub arch: Option<Design>,
     /// A trained model folder: load it (checking its config and weights) and describe it.
     #[arg(long)]
     model: Option<PathBuf>,
     /// Activation of the layers that read the pixel inputs (siren or relu). Default: the
     /// paper's (relu for baseline, siren for the others).
     #[arg(long)]
-    activation: Option<Activation>,
+    pub activation: Option<Activation>,
     /// Width W of the encoder's W × W/2 input map (a multiple of 64).
     #[arg(long, default_value_t = 128)]
-    encoder_width: usize,
+    pub encoder_width: usize,
 }
 
 #[derive(clap::Args)]
 pub struct TrainArgs {
     /// Dataset folder made by `nprt generate` (holding manifest.json).
     #[arg(long)]
-    data: PathBuf,
+    pub data: PathBuf,
     /// Transport design: baseline, prt, albedo or dsep.
     #[arg(long)]
-    arch: Design,
+    pub arch: Design,
     /// siren or relu for the layers that read the pixel inputs (default: the paper's choice).
     #[arg(long)]
-    activation: Option<Activation>,
+    pub activation: Option<Activation>,
     /// Model folder to write; re-running with the same settings resumes the run in it, and a
     /// larger --epochs continues a finished one.
     #[arg(long)]
-    out: PathBuf,
+    pub out: PathBuf,
     /// Passes over all foreground pixels of the training views (the paper: 500). On 2 CPU
     /// cores one epoch of the default 400-view 128² dataset takes about 4 minutes (dsep).
     #[arg(long, default_value_t = 20)]
-    epochs: usize,
+    pub epochs: usize,
     /// Samples per batch.
     #[arg(long, default_value_t = 16_384)]
-    batch_size: usize,
+    pub batch_size: usize,
     /// Adam learning rate (the paper: 1e-4).
     #[arg(long, default_value_t = 1e-4)]
-    lr: f64,
+    pub lr: f64,
     /// Seed of the initial weights and of the batch order.
     #[arg(long, default_value_t = 0)]
-    seed: u64,
+    pub seed: u64,
     /// Views whose pixels are mixed in each batch, each lit by its own rotated map.
     #[arg(long, default_value_t = 8)]
-    views_per_batch: usize,
+    pub views_per_batch: usize,
     /// Test-view pixels (held-out lighting) used for the validation loss after each epoch.
     #[arg(long, default_value_t = 65_536)]
-    val_samples: usize,
+    pub val_samples: usize,
     /// Width W of the encoder's W × W/2 input map (a multiple of 64).
     #[arg(long, default_value_t = 128)]
-    encoder_width: usize,
+    pub encoder_width: usize,
     /// Minutes between checkpoints within an epoch (one is always written at an epoch's end).
     #[arg(long, default_value_t = 5.0)]
-    checkpoint_minutes: f64,
+    pub checkpoint_minutes: f64,
 }
 
 #[derive(clap::Subcommand)]
@@ -80,12 +80,12 @@ pub enum BenchCommand {
 pub struct BenchTrainArgs {
     /// Designs to measure, comma-separated.
     #[arg(long, default_value = "baseline,prt,albedo,dsep", value_delimiter = ',')]
-    arch: Vec<Design>,
+    pub arch: Vec<Design>,
     /// siren or relu (default: each design's own).
     #[arg(long)]
-    activation: Option<Activation>,
+    pub activation: Option<Activation>,
     #[arg(long, default_value_t = 16_384)]
-    batch_size: usize,
+    pub batch_size: usize,
     /// Maps (views) per batch.
     #[arg(long, default_value_t = 8)]
     views: usize,

@@ -10,7 +10,10 @@ use glam::Vec3;
 use nprt_scene::{load_scene, procedural, SceneOptions};
 use nprt_trace::{render, Frame, PixelFilter, RenderSettings, TraceScene};
 
+mod demo;
+mod evaluation;
 mod learn;
+mod relight;
 
 // Training allocates and frees large tensors every step; glibc's allocator returns that memory
 // to the OS and page-faults it back each time (measured: 8% of a training step).
@@ -37,9 +40,10 @@ enum Command {
     /// Path-trace a scene through its own sensor and film (box pixel filter, the integrator's
     /// max_depth) and write every layer to one OpenEXR file; prints time and samples/s.
     Reference(ReferenceArgs),
-    /// Run the pipeline on the built-in scene and lighting, writing images and a summary.
-    /// Today: reference renders of builtin:room under the built-in sky and an indoor map.
-    Demo(DemoArgs),
+    /// The whole pipeline on the built-in scene and lighting: generate a dataset, train the four
+    /// designs and Deep Shading, evaluate them against the baselines, relight a camera path
+    /// under held-out lighting. About 20 minutes on 2 cores; --quick about 3.
+    Demo(demo::DemoArgs),
     /// Render a training dataset: G-buffers and radiance of many views under many lightings
     /// (documented in docs/dataset.md). Resumable; shards may run at once into one folder.
     Generate(GenerateArgs),
@@ -55,6 +59,18 @@ enum Command {
     /// Benchmarks.
     #[command(subcommand)]
     Bench(learn::BenchCommand),
+    /// Relight a camera path with a trained model under a lighting schedule: primary rays for
+    /// the G-buffer, the encoder once per lighting change, the network on foreground pixels.
+    /// Writes PNG frames (EXR on request), an animation and per-frame timings.
+    Render(relight::RenderArgs),
+    /// Evaluate trained designs against the paper's baselines (path tracing at 5 spp and at
+    /// equal time, denoised when Open Image Denoise is installed, SH PRT with 9 and 25
+    /// coefficients, Deep Shading) on a dataset's test views: metrics, error analysis, timings,
+    /// images; writes a Markdown and a self-contained HTML report.
+    Eval(evaluation::EvalArgs),
+    /// Train the Deep Shading baseline (a per-scene U-Net on G-buffer images, with the light
+    /// code at its bottleneck) on a dataset.
+    TrainDeepShading(evaluation::DeepShadingArgs),
 }
 
 #[derive(Subcommand)]
@@ -74,58 +90,58 @@ enum DatasetCommand {
 }
 
 #[derive(clap::Args)]
-struct GenerateArgs {
+pub(crate) struct GenerateArgs {
     /// Scene: builtin:room, or a Mitsuba .xml / glTF / mesh file (then give the camera volume).
     #[arg(long)]
-    scene: String,
+    pub(crate) scene: String,
     /// Environment maps: a folder of .exr/.hdr lat-long maps, or `builtin` (16 skies, 8 indoor).
     #[arg(long)]
-    envmaps: String,
+    pub(crate) envmaps: String,
     /// Dataset folder; re-running with the same settings resumes it.
     #[arg(long)]
-    out: PathBuf,
+    pub(crate) out: PathBuf,
     /// Training views (the paper: 3000). Defaults take ~7 min for builtin:room on a 2-core CPU.
     #[arg(long, default_value_t = 400)]
-    train_views: u64,
+    pub(crate) train_views: u64,
     /// Test views, lit only by held-out maps (the paper: 200).
     #[arg(long, default_value_t = 40)]
-    test_views: u64,
+    pub(crate) test_views: u64,
     /// Training view resolution, N or WxH (the paper: 256).
     #[arg(long, default_value = "128", value_parser = parse_resolution)]
-    train_res: [u32; 2],
+    pub(crate) train_res: [u32; 2],
     /// Test view resolution, N or WxH (the paper: 400).
     #[arg(long, default_value = "128", value_parser = parse_resolution)]
-    test_res: [u32; 2],
+    pub(crate) test_res: [u32; 2],
     /// Samples per pixel, every one through the pixel centre.
     #[arg(long, default_value_t = 64)]
-    spp: u32,
+    pub(crate) spp: u32,
     /// Seed of every random choice (cameras, split, rotations, pixels).
     #[arg(long, default_value_t = 0)]
-    seed: u64,
+    pub(crate) seed: u64,
     /// Maps held out for testing (default: a fifth, at least one).
     #[arg(long)]
-    test_maps: Option<usize>,
+    pub(crate) test_maps: Option<usize>,
     /// Render only views with index ≡ K (mod N), e.g. 0/4 … 3/4 on four machines.
     #[arg(long, default_value = "0/1", value_parser = parse_shard)]
-    shard: (u64, u64),
+    pub(crate) shard: (u64, u64),
     /// Camera active volume, min corner x,y,z (overrides the scene's).
     #[arg(long, value_parser = parse_vec3, requires_all = ["volume_max", "look"], allow_hyphen_values = true)]
-    volume_min: Option<glam::Vec3>,
+    pub(crate) volume_min: Option<glam::Vec3>,
     /// Camera active volume, max corner x,y,z.
     #[arg(long, value_parser = parse_vec3, allow_hyphen_values = true)]
-    volume_max: Option<glam::Vec3>,
+    pub(crate) volume_max: Option<glam::Vec3>,
     /// Main view direction x,y,z.
     #[arg(long, value_parser = parse_vec3, allow_hyphen_values = true)]
-    look: Option<glam::Vec3>,
+    pub(crate) look: Option<glam::Vec3>,
     /// Half-angle of the pyramid of view directions, degrees.
     #[arg(long, default_value_t = 30.0)]
-    spread: f32,
+    pub(crate) spread: f32,
     /// Horizontal field of view of dataset cameras, degrees.
     #[arg(long, default_value_t = 60.0)]
-    fov: f32,
+    pub(crate) fov: f32,
 }
 
-fn parse_resolution(s: &str) -> Result<[u32; 2], String> {
+pub(crate) fn parse_resolution(s: &str) -> Result<[u32; 2], String> {
     let parse = |t: &str| {
         t.parse::<u32>()
             .ok()
@@ -204,16 +220,6 @@ struct ReferenceArgs {
     centre: bool,
 }
 
-#[derive(clap::Args)]
-struct DemoArgs {
-    /// Output folder.
-    #[arg(long, default_value = "nprt-demo")]
-    out: PathBuf,
-    /// Samples per pixel of the demo renders.
-    #[arg(long, default_value_t = 64)]
-    spp: u32,
-}
-
 fn main() {
     let cli = Cli::parse();
     if let Err(e) = run(cli) {
@@ -231,12 +237,15 @@ fn run(cli: Cli) -> Result<()> {
     }
     match cli.command {
         Command::Reference(a) => reference(a),
-        Command::Demo(a) => demo(a),
+        Command::Demo(a) => demo::demo(a),
         Command::Generate(a) => generate(a),
         Command::Dataset(DatasetCommand::Verify { dir }) => verify(&dir),
         Command::Model(ModelCommand::Info(a)) => learn::model_info(a),
         Command::Train(a) => learn::train(a),
         Command::Bench(c) => learn::bench(c),
+        Command::Render(a) => relight::render(a),
+        Command::Eval(a) => evaluation::eval(a).map(|_| ()),
+        Command::TrainDeepShading(a) => evaluation::train_deep_shading(a),
     }
 }
 
@@ -334,7 +343,7 @@ fn reference(a: ReferenceArgs) -> Result<()> {
 }
 
 /// Fails early, before a long render, if `path` cannot be written.
-fn check_writable(path: &Path) -> Result<()> {
+pub(crate) fn check_writable(path: &Path) -> Result<()> {
     let dir = nprt_trace::exr_io::create_parent_dir(path)?;
     let probe = dir.join(format!(".nprt-write-test-{}", std::process::id()));
     std::fs::write(&probe, b"")
@@ -363,50 +372,7 @@ fn write_png(frame: &Frame, path: &Path) -> Result<()> {
     })
 }
 
-fn demo(a: DemoArgs) -> Result<()> {
-    let scene = load_scene("builtin:room", &SceneOptions::default())?;
-    let camera = scene
-        .camera
-        .clone()
-        .context("built-in scene has a camera")?;
-    check_writable(&a.out.join("x"))?;
-    let ts = TraceScene::new(&scene);
-    println!(
-        "nprt demo: builtin:room ({} triangles), {}×{}, {} spp",
-        scene.triangle_count(),
-        camera.width,
-        camera.height,
-        a.spp
-    );
-    for (name, spec) in [("sky", "builtin:sky"), ("indoor", "builtin:indoor:1")] {
-        let env = procedural::open_envmap(spec)?;
-        let settings = RenderSettings {
-            spp: a.spp,
-            max_depth: scene.max_depth,
-            rr_depth: scene.rr_depth,
-            seed: 1,
-            filter: PixelFilter::Box,
-            progress: true,
-        };
-        let t = Instant::now();
-        let frame = render(&ts, &camera, &env, &settings);
-        let secs = t.elapsed().as_secs_f64();
-        let exr = a.out.join(format!("room-{name}.exr"));
-        let png = a.out.join(format!("room-{name}.png"));
-        frame.write_exr(&exr)?;
-        write_png(&frame, &png)?;
-        let samples = camera.width as f64 * camera.height as f64 * a.spp as f64;
-        println!(
-            "  {spec:<18} {secs:6.2} s, {:.3} Msamples/s -> {}",
-            samples / secs / 1e6,
-            png.display()
-        );
-    }
-    println!("demo images in {}", a.out.display());
-    Ok(())
-}
-
-fn generate(a: GenerateArgs) -> Result<()> {
+pub(crate) fn generate(a: GenerateArgs) -> Result<()> {
     use nprt_data::{dataset, lighting};
     let scene = load_scene(&a.scene, &SceneOptions::default())?;
     let volume = match (a.volume_min, a.volume_max, a.look) {
@@ -442,11 +408,7 @@ fn generate(a: GenerateArgs) -> Result<()> {
             m.clamped_negative()
         );
     }
-    let source = if a.scene.starts_with("builtin:") {
-        a.scene.clone().into_bytes()
-    } else {
-        std::fs::read(&a.scene)?
-    };
+    let source = nprt_data::dataset::scene_source(&a.scene)?;
     let request = nprt_data::Request {
         scene_spec: a.scene.clone(),
         scene: &scene,

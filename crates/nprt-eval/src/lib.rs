@@ -1,0 +1,19 @@
+//! nprt-eval: how good and how fast the trained models are. It owns the error metrics, the
+//! paper's baselines (path tracing at 5 spp and at equal time, optionally denoised with Open
+//! Image Denoise; per-pixel SH PRT with 9 and 25 coefficients; Deep Shading, a per-scene U-Net),
+//! the error analysis, the timing tables and the Markdown/HTML report. It renders neural frames
+//! through nprt-render and reference-style frames through nprt-trace; it must not write
+//! datasets or train the Neural PRT designs (nprt-net does).
+
+pub mod deep_shading;
+pub mod evaluate;
+pub mod metrics;
+pub mod oidn;
+pub mod progress;
+pub mod report;
+pub mod sh;
+pub mod views;
+
+pub use evaluate::{evaluate, EvalOptions, Evaluation, MethodResult};
+pub use metrics::Metrics;
+pub use report::write_report;

@@ -1,0 +1,107 @@
+//! Lighting over time: a sequence of environment maps, each held for a share of the frames
+//! while it turns about +Y.
+
+use std::path::Path;
+
+use anyhow::{bail, Context, Result};
+use nprt_scene::procedural::open_envmap;
+use nprt_scene::EnvMap;
+use serde::{Deserialize, Serialize};
+
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Segment {
+    /// A map file or a built-in spec (`builtin:sky:ELEV:AZIM:TURB`, `builtin:indoor:SEED`).
+    pub map: String,
+    /// Relative length of the segment (frames are shared out in proportion).
+    #[serde(default = "one")]
+    pub weight: f32,
+    /// Rotation about +Y at the segment's start and end, degrees.
+    #[serde(default)]
+    pub rotation_deg: [f32; 2],
+}
+
+fn one() -> f32 {
+    1.0
+}
+
+/// The maps of a schedule, opened, and which one lights each frame at what rotation.
+pub struct LightingSchedule {
+    pub segments: Vec<Segment>,
+    pub maps: Vec<EnvMap>,
+}
+
+impl LightingSchedule {
+    /// `spec` is a JSON file (`{"segments": [{"map": …, "weight": 1, "rotation_deg": [0, 90]}]}`)
+    /// or a comma-separated list of maps, each turning by `spin_deg` over its segment.
+    pub fn parse(spec: &str, spin_deg: f32) -> Result<Self> {
+        let segments = if spec.ends_with(".json") {
+            #[derive(Deserialize)]
+            struct File {
+                segments: Vec<Segment>,
+            }
+            let text = std::fs::read_to_string(Path::new(spec))
+                .with_context(|| format!("cannot read lighting schedule '{spec}'"))?;
+            serde_json::from_str::<File>(&text)
+                .with_context(|| format!("lighting schedule '{spec}' is not {{\"segments\": [{{\"map\": …, \"weight\": w, \"rotation_deg\": [from, to]}}]}}"))?
+                .segments
+        } else {
+            spec.split(',')
+                .filter(|s| !s.trim().is_empty())
+                .map(|m| Segment {
+                    map: m.trim().to_string(),
+                    weight: 1.0,
+                    rotation_deg: [0.0, spin_deg],
+                })
+                .collect()
+        };
+        if segments.is_empty() {
+            bail!("lighting schedule '{spec}' names no map");
+        }
+        if let Some(s) = segments.iter().find(|s| !(s.weight > 0.0 && s.weight.is_finite())) {
+            bail!("lighting schedule '{spec}': segment '{}' has weight {}, must be > 0", s.map, s.weight);
+        }
+        let maps = segments
+            .iter()
+            .map(|s| open_envmap(&s.map))
+            .collect::<Result<_>>()?;
+        Ok(LightingSchedule { segments, maps })
+    }
+
+    /// The map index and rotation lighting frame `i` of `frames`.
+    pub fn at(&self, i: usize, frames: usize) -> (usize, f32) {
+        let total: f32 = self.segments.iter().map(|s| s.weight).sum();
+        let t = if frames > 1 {
+            i as f32 / (frames - 1) as f32
+        } else {
+            0.0
+        } * total;
+        let mut start = 0.0;
+        for (k, s) in self.segments.iter().enumerate() {
+            let end = start + s.weight;
+            if t < end || k + 1 == self.segments.len() {
+                let f = ((t - start) / s.weight).clamp(0.0, 1.0);
+                let [a, b] = s.rotation_deg;
+                return (k, a + (b - a) * f);
+            }
+            start = end;
+        }
+        unreachable!("a schedule has at least one segment")
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn frames_share_segments() {
+        let s = LightingSchedule::parse("builtin:indoor:1,builtin:indoor:2", 90.0).unwrap();
+        assert_eq!(s.at(0, 11), (0, 0.0));
+        assert_eq!(s.at(10, 11), (1, 90.0));
+        let (k, r) = s.at(2, 11);
+        assert_eq!(k, 0);
+        assert!((r - 36.0).abs() < 1e-3);
+        assert!(LightingSchedule::parse("builtin:moon", 0.0).is_err());
+        assert!(LightingSchedule::parse(" , ", 0.0).is_err());
+    }
+}

@@ -1,0 +1,172 @@
+//! `nprt demo`: the whole pipeline on the built-in scene and lighting, sized for a laptop CPU.
+
+use std::path::PathBuf;
+use std::time::Instant;
+
+use anyhow::Result;
+use nprt_net::Design;
+
+use crate::evaluation::{eval, train_deep_shading, DeepShadingArgs, EvalArgs};
+use crate::learn::{train, TrainArgs};
+use crate::relight::{render, RenderArgs};
+use crate::GenerateArgs;
+
+#[derive(clap::Args)]
+pub struct DemoArgs {
+    /// Output folder (dataset, models, report, relit frames). Re-running resumes what is done.
+    #[arg(long, default_value = "nprt-demo")]
+    pub out: PathBuf,
+    /// Tiny sizes (about 3 minutes on 2 cores): checks the pipeline, not the method.
+    #[arg(long)]
+    pub quick: bool,
+}
+
+/// The demo's sizes.
+struct Plan {
+    train_views: u64,
+    test_views: u64,
+    train_res: u32,
+    test_res: u32,
+    spp: u32,
+    epochs: usize,
+    deep_shading_epochs: usize,
+    sh_spp: u32,
+    timing_res: u32,
+    frames: usize,
+    frame_res: u32,
+}
+
+const FULL: Plan = Plan {
+    train_views: 200,
+    test_views: 16,
+    train_res: 64,
+    test_res: 96,
+    spp: 64,
+    epochs: 6,
+    deep_shading_epochs: 15,
+    sh_spp: 256,
+    timing_res: 512,
+    frames: 48,
+    frame_res: 128,
+};
+
+const QUICK: Plan = Plan {
+    train_views: 24,
+    test_views: 4,
+    train_res: 32,
+    test_res: 32,
+    spp: 16,
+    epochs: 2,
+    deep_shading_epochs: 2,
+    sh_spp: 16,
+    timing_res: 64,
+    frames: 4,
+    frame_res: 48,
+};
+
+/// The encoder input width of the demo's models: the smallest the encoder takes, for speed.
+const ENCODER_WIDTH: usize = 64;
+
+pub fn demo(a: DemoArgs) -> Result<()> {
+    let p = if a.quick { QUICK } else { FULL };
+    let start = Instant::now();
+    let step = |what: &str| println!("\n== {what} ({:.0} s so far)", start.elapsed().as_secs_f64());
+    let data = a.out.join("dataset");
+    step("1/5 generating the dataset: builtin:room under the built-in skies and indoor maps");
+    crate::generate(GenerateArgs {
+        scene: "builtin:room".into(),
+        envmaps: "builtin".into(),
+        out: data.clone(),
+        train_views: p.train_views,
+        test_views: p.test_views,
+        train_res: [p.train_res; 2],
+        test_res: [p.test_res; 2],
+        spp: p.spp,
+        seed: 0,
+        test_maps: None,
+        shard: (0, 1),
+        volume_min: None,
+        volume_max: None,
+        look: None,
+        spread: 30.0,
+        fov: 60.0,
+    })?;
+    let mut models = Vec::new();
+    for (i, design) in Design::ALL.into_iter().enumerate() {
+        step(&format!("2/5 training design {} of 4: {}", i + 1, design.name()));
+        let out = a.out.join("models").join(design.name());
+        train(TrainArgs {
+            data: data.clone(),
+            arch: design,
+            activation: None,
+            out: out.clone(),
+            epochs: p.epochs,
+            batch_size: 16_384,
+            lr: 1e-4,
+            seed: 0,
+            views_per_batch: 8,
+            val_samples: 65_536,
+            encoder_width: ENCODER_WIDTH,
+            checkpoint_minutes: 5.0,
+        })?;
+        models.push(out);
+    }
+    step("3/5 training the Deep Shading baseline");
+    let deep = a.out.join("models").join("deep-shading");
+    train_deep_shading(DeepShadingArgs {
+        data: data.clone(),
+        out: deep.clone(),
+        epochs: p.deep_shading_epochs,
+        batch_views: 4,
+        lr: 1e-3,
+        seed: 0,
+        encoder_width: ENCODER_WIDTH,
+    })?;
+    step("4/5 evaluating against the baselines");
+    let report = a.out.join("report");
+    let e = eval(EvalArgs {
+        model: models.clone(),
+        data: data.clone(),
+        out: report.clone(),
+        deep_shading: Some(deep),
+        sh_spp: p.sh_spp,
+        timing_res: p.timing_res,
+        views: None,
+        shown_views: 3,
+        seed: 0,
+    })?;
+    step("5/5 relighting a camera path under held-out lighting");
+    let manifest = nprt_data::dataset::load_manifest(&data)?;
+    let s = &manifest.settings;
+    let held_out: Vec<String> = s.test_maps.iter().map(|&k| s.envmaps[k].spec.clone()).collect();
+    let frames = a.out.join("relit");
+    render(RenderArgs {
+        model: models.last().expect("four models").clone(),
+        out: frames.clone(),
+        scene: None,
+        camera_path: None,
+        lighting: held_out.join(","),
+        spin: 120.0,
+        frames: p.frames,
+        res: [p.frame_res; 2],
+        fps: 24,
+        exposure: 0.0,
+        exr: false,
+    })?;
+    println!("\n== nprt demo done in {:.0} s", start.elapsed().as_secs_f64());
+    println!("report: {}", report.join("report.html").display());
+    println!("relit frames: {}", frames.display());
+    let l1 = |name: &str| e.method(name).map(|m| m.mean.l1);
+    if let (Some(d), Some(b)) = (e.method("nprt-dsep"), e.method("nprt-baseline")) {
+        println!("headline: RMSE D/S {:.4} vs baseline design {:.4}", d.mean.rmse, b.mean.rmse);
+    }
+    if let (Some(d), Some(sh)) = (l1("nprt-dsep"), l1("sh-prt-9")) {
+        println!("headline: L1 D/S {d:.4} vs SH PRT (9) {sh:.4}, equal-time path tracing at {} spp {:.4}",
+            e.equal_time_spp,
+            e.methods.iter().find(|m| m.name.starts_with("pt-equal-time")).map_or(f64::NAN, |m| m.mean.l1));
+    }
+    let failed = e.checks().into_iter().filter(|c| !c.1).count();
+    println!("{} of the paper's claims hold here{}", e.checks().len() - failed,
+        if failed > 0 { format!(", {failed} do not (see the report)") } else { String::new() });
+    Ok(())
+}

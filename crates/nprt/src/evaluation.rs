@@ -1,0 +1,139 @@
+//! `nprt eval` and `nprt train-deep-shading`.
+
+use std::path::PathBuf;
+
+use anyhow::{bail, Result};
+use nprt_data::dataset::{load_manifest, MANIFEST};
+use nprt_eval::deep_shading::{self, DeepShadingFile, DeepShadingOptions};
+use nprt_eval::views::load_views;
+use nprt_eval::{evaluate, write_report, EvalOptions, Evaluation};
+use nprt_net::data::open_recorded_maps;
+use nprt_net::encoder::check_input_width;
+use nprt_net::Device;
+
+#[derive(clap::Args)]
+pub struct EvalArgs {
+    /// Trained model folders (repeat the flag or separate with commas).
+    #[arg(long, required = true, value_delimiter = ',')]
+    pub model: Vec<PathBuf>,
+    /// Dataset folder; its test views (held-out lighting) are evaluated.
+    #[arg(long)]
+    pub data: PathBuf,
+    /// Report folder: report.md, report.html (self-contained), results.json, images/.
+    #[arg(long)]
+    pub out: PathBuf,
+    /// A Deep Shading model folder (from `nprt train-deep-shading`) to compare too.
+    #[arg(long)]
+    pub deep_shading: Option<PathBuf>,
+    /// Paths per pixel of the SH PRT transport precomputation.
+    #[arg(long, default_value_t = 256)]
+    pub sh_spp: u32,
+    /// Side of the square frames of the timing table (the paper: 512).
+    #[arg(long, default_value_t = 512)]
+    pub timing_res: u32,
+    /// Evaluate only the first N test views.
+    #[arg(long)]
+    pub views: Option<usize>,
+    /// Test views shown as images (frames, crops, heat maps) in the report.
+    #[arg(long, default_value_t = 3)]
+    pub shown_views: usize,
+    /// Seed of the baselines' path-traced samples.
+    #[arg(long, default_value_t = 0)]
+    pub seed: u64,
+}
+
+#[derive(clap::Args)]
+pub struct DeepShadingArgs {
+    /// Dataset folder made by `nprt generate`.
+    #[arg(long)]
+    pub data: PathBuf,
+    /// Model folder; re-running resumes from the last finished epoch (Adam's moments restart).
+    #[arg(long)]
+    pub out: PathBuf,
+    /// Passes over the training views.
+    #[arg(long, default_value_t = 20)]
+    pub epochs: usize,
+    /// Whole views per step.
+    #[arg(long, default_value_t = 4)]
+    pub batch_views: usize,
+    /// Adam learning rate.
+    #[arg(long, default_value_t = 1e-3)]
+    pub lr: f64,
+    #[arg(long, default_value_t = 0)]
+    pub seed: u64,
+    /// Width W of the light encoder's W × W/2 input (a multiple of 64).
+    #[arg(long, default_value_t = 128)]
+    pub encoder_width: usize,
+}
+
+/// Runs the evaluation and writes the report; prints where it is and the headline figures.
+pub fn eval(a: EvalArgs) -> Result<Evaluation> {
+    if a.sh_spp == 0 || a.timing_res < 8 {
+        bail!("--sh-spp must be at least 1 and --timing-res at least 8");
+    }
+    let opts = EvalOptions {
+        data: a.data.clone(),
+        models: a.model.clone(),
+        deep_shading: a.deep_shading.clone(),
+        sh_spp: a.sh_spp,
+        timing_res: a.timing_res,
+        max_views: a.views,
+        shown_views: a.shown_views,
+        seed: a.seed,
+        progress: true,
+    };
+    let e = evaluate(&opts, &Device::flex())?;
+    let (md, html) = write_report(&e, &a.out)?;
+    println!("{:<32} {:>10} {:>10} {:>10} {:>12}", "method", "L1", "RMSE", "dSSIM", "ms / view");
+    for m in &e.methods {
+        println!("{:<32} {:>10.5} {:>10.5} {:>10.5} {:>12.1}", m.name, m.mean.l1, m.mean.rmse, m.mean.dssim, m.ms_per_view);
+    }
+    for (claim, ok) in e.checks() {
+        println!("{} {claim}", if ok { "holds: " } else { "FAILS: " });
+    }
+    println!("report: {} and {}", md.display(), html.display());
+    Ok(e)
+}
+
+pub fn train_deep_shading(a: DeepShadingArgs) -> Result<()> {
+    check_input_width(a.encoder_width)?;
+    if a.epochs == 0 || a.batch_views == 0 || !(a.lr > 0.0 && a.lr.is_finite()) {
+        bail!("--epochs and --batch-views must be positive, and --lr a positive number");
+    }
+    let manifest = load_manifest(&a.data)?;
+    let hash = blake3::hash(&std::fs::read(a.data.join(MANIFEST))?).to_hex().to_string();
+    let maps = open_recorded_maps(&manifest)?;
+    let train = load_views(&a.data, &manifest, "train")?;
+    let test = load_views(&a.data, &manifest, "test")?;
+    let s = &manifest.settings;
+    let base = DeepShadingFile {
+        format: deep_shading::TAG.into(),
+        version: 1,
+        encoder_width: a.encoder_width,
+        bounds: manifest.bounds,
+        scene: s.scene.clone(),
+        scene_hash: s.scene_hash.clone(),
+        dataset_hash: hash,
+        unet_params: 0,
+        encoder_params: 0,
+        options: DeepShadingOptions {
+            epochs: a.epochs,
+            batch_views: a.batch_views,
+            learning_rate: a.lr,
+            seed: a.seed,
+            encoder_width: a.encoder_width,
+        },
+        epochs_done: 0,
+        seconds: 0.0,
+    };
+    let f = deep_shading::train(&train, &test, &maps, base, &a.out, &Device::flex(), true)?;
+    println!(
+        "trained Deep Shading ({} U-Net parameters + {} encoder) for {} epochs in {:.1} s; model in '{}'",
+        f.unet_params,
+        f.encoder_params,
+        f.epochs_done,
+        f.seconds,
+        a.out.display()
+    );
+    Ok(())
+}
