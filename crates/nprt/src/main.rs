@@ -6,9 +6,8 @@ use std::time::Instant;
 
 use anyhow::{bail, Context, Result};
 use clap::{Parser, Subcommand};
-use glam::Vec3;
 use nprt_scene::{load_scene, procedural, SceneOptions};
-use nprt_trace::{render, Frame, PixelFilter, RenderSettings, TraceScene};
+use nprt_trace::{render, PixelFilter, RenderSettings, TraceScene};
 
 mod demo;
 mod evaluation;
@@ -319,7 +318,7 @@ fn reference(a: ReferenceArgs) -> Result<()> {
     let secs = t1.elapsed().as_secs_f64();
     frame.write_exr(&a.out)?;
     if let Some(png) = &a.png {
-        write_png(&frame, png)?;
+        nprt_render::write_png(&frame.radiance, frame.width, frame.height, 0.0, png)?;
     }
     let samples = camera.width as f64 * camera.height as f64 * settings.spp as f64;
     let m = frame.mean();
@@ -350,26 +349,6 @@ pub(crate) fn check_writable(path: &Path) -> Result<()> {
         .with_context(|| format!("output folder '{}' is not writable", dir.display()))?;
     std::fs::remove_file(&probe).ok();
     Ok(())
-}
-
-/// Clamped sRGB preview of the radiance.
-fn write_png(frame: &Frame, path: &Path) -> Result<()> {
-    let encode = |c: f32| {
-        let c = c.clamp(0.0, 1.0);
-        let s = if c <= 0.0031308 {
-            12.92 * c
-        } else {
-            1.055 * c.powf(1.0 / 2.4) - 0.055
-        };
-        (s * 255.0 + 0.5) as u8
-    };
-    let img = image::RgbImage::from_fn(frame.width as u32, frame.height as u32, |x, y| {
-        let v: Vec3 = frame.radiance[y as usize * frame.width + x as usize];
-        image::Rgb([encode(v.x), encode(v.y), encode(v.z)])
-    });
-    nprt_trace::exr_io::write_atomically(path, |tmp| {
-        Ok(img.save_with_format(tmp, image::ImageFormat::Png)?)
-    })
 }
 
 pub(crate) fn generate(a: GenerateArgs) -> Result<()> {
