@@ -5,7 +5,7 @@
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
-use anyhow::{bail, Context, Result};
+use anyhow::{bail, Result};
 use glam::Vec3;
 use nprt_data::dataset::{load_checked_scene, load_manifest, Manifest, MANIFEST};
 use nprt_net::data::open_recorded_maps;
@@ -509,9 +509,4 @@ impl Evaluation {
         }
         out
     }
-}
-
-/// Used by `nprt eval` to refuse a report folder that is a file.
-pub fn check_out(dir: &Path) -> Result<()> {
-    std::fs::create_dir_all(dir).with_context(|| format!("cannot create report folder '{}'", dir.display()))
 }

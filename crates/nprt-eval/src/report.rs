@@ -86,6 +86,11 @@ fn save(dir: &Path, name: &str, rgb: &[Vec3], w: usize, h: usize, exposure: f32)
     Ok(file)
 }
 
+/// A method name as a file-name part.
+fn slug(name: &str) -> String {
+    name.chars().map(|c| if c.is_ascii_alphanumeric() { c } else { '-' }).collect()
+}
+
 fn fmt(v: f64) -> String {
     if !v.is_finite() {
         "–".into()
@@ -178,8 +183,7 @@ pub fn write_report(e: &Evaluation, dir: &Path) -> Result<(PathBuf, PathBuf)> {
         writeln!(md, "### Test view {}\n", v.index)?;
         writeln!(md, "| method | frame | crop | error |\n|---|---|---|---|")?;
         for (name, rgb) in all {
-            let slug: String = name.chars().map(|c| if c.is_ascii_alphanumeric() { c } else { '-' }).collect();
-            let stem = format!("view{}-{slug}", v.index);
+            let stem = format!("view{}-{}", v.index, slug(&name));
             let full = save(dir, &stem, rgb, v.width, v.height, exposure)?;
             let side = window.2 * ZOOM;
             let cr = save(dir, &format!("{stem}-crop"), &crop(rgb, v.width, window), side, side, exposure)?;
@@ -195,7 +199,7 @@ pub fn write_report(e: &Evaluation, dir: &Path) -> Result<(PathBuf, PathBuf)> {
     }
     writeln!(md, "## Training curves\n")?;
     for m in e.methods.iter().filter(|m| m.loss_png.is_some()) {
-        let rel = format!("images/loss-{}.png", m.name);
+        let rel = format!("images/loss-{}.png", slug(&m.name));
         std::fs::copy(m.loss_png.as_ref().unwrap(), dir.join(&rel)).with_context(|| format!("cannot copy the training curve of {}", m.name))?;
         writeln!(md, "![{}]({rel})\n", m.name)?;
     }

@@ -52,14 +52,6 @@ impl Relighter {
         })
     }
 
-    pub fn from_parts(file: ModelFile, net: NprtNet, device: &Device) -> Self {
-        Relighter {
-            file,
-            net,
-            device: device.clone(),
-        }
-    }
-
     /// Encodes `map` rotated by `rotation_deg` about +Y.
     pub fn light_code(&self, map: &EnvMap, rotation_deg: f32) -> LightCode {
         let input = LightInput::new(map, rotation_deg, self.file.config.encoder_width);
