@@ -12,7 +12,10 @@ fi
 wheels="$root/target/oidn/wheel"
 mkdir -p "$wheels" "$lib"
 echo "oidn: downloading the oidn 0.2.1 wheel (OIDN 1.4.3) into $wheels" >&2
-python3 -m pip download -q --disable-pip-version-check --no-deps --only-binary=:all: \
+pip=(python3 -m pip)
+# The Mitsuba peer's venv has a pip even where the system Python ships none.
+[ -x "$root/target/peer-venv/bin/pip" ] && pip=("$root/target/peer-venv/bin/pip")
+"${pip[@]}" download -q --disable-pip-version-check --no-deps --only-binary=:all: \
   --platform manylinux1_x86_64 -d "$wheels" oidn==0.2.1 >&2
 python3 - "$wheels" "$lib" <<'PY'
 import pathlib, sys, zipfile

@@ -64,8 +64,9 @@ const QUICK: Plan = Plan {
     frame_res: 48,
 };
 
-/// The encoder input width of the demo's models: the smallest the encoder takes, for speed.
-const ENCODER_WIDTH: usize = 64;
+/// The encoder input width of the demo's models (the default): 64 was measured 10% worse in L1
+/// for 10% less training time.
+const ENCODER_WIDTH: usize = 128;
 
 pub fn demo(a: DemoArgs) -> Result<()> {
     let p = if a.quick { QUICK } else { FULL };
