@@ -119,7 +119,7 @@ pub fn demo(a: DemoArgs) -> Result<()> {
         out: deep.clone(),
         epochs: p.deep_shading_epochs,
         batch_views: 4,
-        lr: 1e-3,
+        lr: 1e-4,
         seed: 0,
         encoder_width: ENCODER_WIDTH,
     })?;

@@ -56,8 +56,9 @@ pub struct DeepShadingArgs {
     /// Whole views per step.
     #[arg(long, default_value_t = 4)]
     pub batch_views: usize,
-    /// Adam learning rate.
-    #[arg(long, default_value_t = 1e-3)]
+    /// Adam learning rate (1e-3 was measured to kill this ReLU U-Net: every activation dead,
+    /// the output a constant).
+    #[arg(long, default_value_t = 1e-4)]
     pub lr: f64,
     #[arg(long, default_value_t = 0)]
     pub seed: u64,

@@ -43,6 +43,11 @@ fn quick_demo_then_render_and_eval() {
     let html = std::fs::read_to_string(report.join("report.html")).unwrap();
     assert!(!html.contains("src=\"images/") && html.matches("data:image/png;base64,").count() > 20, "report.html must embed its images");
 
+    // Deep Shading learns: a collapsed U-Net (all activations dead) repeats one validation loss.
+    let csv = std::fs::read_to_string(dir.join("models/deep-shading/loss.csv")).unwrap();
+    let val: Vec<&str> = csv.lines().skip(1).map(|l| l.rsplit(',').next().unwrap()).collect();
+    assert!(val.len() == 2 && val[0] != val[1], "Deep Shading validation losses {val:?}");
+
     // The relit path: frames and an animation.
     let relit = dir.join("relit");
     assert_eq!(std::fs::read_dir(relit.join("frames")).unwrap().count(), 4);
