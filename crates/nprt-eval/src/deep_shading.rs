@@ -16,7 +16,7 @@ use burn::nn::Linear;
 use burn::optim::{AdamConfig, GradientsParams};
 use burn::tensor::activation::relu;
 use burn::tensor::{Tensor, TensorData};
-use nprt_net::curves::{plot, write_csv};
+use nprt_net::curves::{plot, read_csv, write_csv};
 use nprt_net::data::pixel_features;
 use nprt_net::encoder::CODE_SIZE;
 use nprt_net::layers::conv2d;
@@ -292,7 +292,7 @@ pub fn train(
         load_weights(&out.join(WEIGHTS_FILE), &mut net, TAG)?;
         file.epochs_done = prev.epochs_done;
         file.seconds = prev.seconds;
-        rows = read_rows(&out.join("loss.csv"));
+        rows = read_csv(&out.join("loss.csv"));
     }
     let (train_s, pw, ph) = prepare(train_views, maps, &file.bounds, opts.encoder_width)?;
     let (test_s, tpw, tph) = prepare(test_views, maps, &file.bounds, opts.encoder_width)?;
@@ -350,23 +350,4 @@ pub fn train(
     }
     bar.finish_and_clear();
     Ok(file)
-}
-
-fn read_rows(path: &Path) -> Vec<LossRow> {
-    let Ok(text) = std::fs::read_to_string(path) else { return vec![] };
-    text.lines()
-        .skip(1)
-        .filter_map(|l| {
-            let f: Vec<&str> = l.split(',').collect();
-            let num = |i: usize| f.get(i).and_then(|s| s.parse::<f64>().ok());
-            Some(LossRow {
-                step: num(0)? as u64,
-                epoch: num(1)?,
-                samples: num(2)? as u64,
-                seconds: num(3)?,
-                train: num(4),
-                val: num(5),
-            })
-        })
-        .collect()
 }

@@ -340,34 +340,29 @@ pub fn evaluate(o: &EvalOptions, device: &Device) -> Result<Evaluation> {
     let pool = if designs.is_empty() { results.iter().collect() } else { designs };
     let slowest_ms = pool.iter().map(|r| r.ms_per_view).fold(0.0, f64::max);
 
-    // Path tracing at 5 spp, timed per view; its cost per sample sets the equal-time count.
-    let mut pt5 = Accumulator::new("pt-5spp", Kind::Baseline, None);
-    let mut pt5_frames = Vec::new();
-    for v in &views {
-        bar.set_message("path tracing 5 spp");
-        let t = Instant::now();
-        let f = render(&ts, &v.camera, &maps[v.record.map].rotated_y(v.record.rotation_deg), &pt_settings(5, v.record.seed ^ o.seed ^ 0x5eed_0005));
-        let t_ms = ms(t);
-        pt5.add(v, &f.radiance, t_ms);
-        pt5_frames.push(f.radiance);
-        bar.inc(1);
-    }
-    let pt5 = pt5.finish();
+    // Path tracing of every view at `spp`, timed per view; `salt` keeps the seeds apart.
+    let trace_all = |name: &str, spp: u32, salt: u64| {
+        let mut acc = Accumulator::new(name, Kind::Baseline, None);
+        let mut frames = Vec::new();
+        for v in &views {
+            bar.set_message(format!("path tracing {spp} spp"));
+            let map = maps[v.record.map].rotated_y(v.record.rotation_deg);
+            let t = Instant::now();
+            let f = render(&ts, &v.camera, &map, &pt_settings(spp, v.record.seed ^ o.seed ^ salt));
+            acc.add(v, &f.radiance, ms(t));
+            frames.push(f.radiance);
+            bar.inc(1);
+        }
+        (acc.finish(), frames)
+    };
+    // 5 spp first: its cost per sample sets the equal-time count.
+    let (pt5, pt5_frames) = trace_all("pt-5spp", 5, 0x5eed_0005);
     let equal_time_spp = ((slowest_ms / (pt5.ms_per_view / 5.0)).round() as u32).max(1);
-    let mut pteq = Accumulator::new(&format!("pt-equal-time ({equal_time_spp} spp)"), Kind::Baseline, None);
-    let mut pteq_frames = Vec::new();
-    for v in &views {
-        bar.set_message(format!("path tracing {equal_time_spp} spp"));
-        let t = Instant::now();
-        let f = render(&ts, &v.camera, &maps[v.record.map].rotated_y(v.record.rotation_deg), &pt_settings(equal_time_spp, v.record.seed ^ o.seed ^ 0x5eed_e9a1));
-        pteq.add(v, &f.radiance, ms(t));
-        pteq_frames.push(f.radiance);
-        bar.inc(1);
-    }
-    let mut pteq = pteq.finish();
+    let (mut pteq, pteq_frames) =
+        trace_all(&format!("pt-equal-time ({equal_time_spp} spp)"), equal_time_spp, 0x5eed_e9a1);
     pteq.note = format!("{equal_time_spp} spp: the time of the slowest design ({slowest_ms:.0} ms per view)");
     for (k, (a, b)) in pt5_frames.iter().zip(&pteq_frames).take(shown_n).enumerate() {
-        shown[k].methods.push(("pt-5spp".into(), a.clone()));
+        shown[k].methods.push((pt5.name.clone(), a.clone()));
         shown[k].methods.push((pteq.name.clone(), b.clone()));
     }
     let mut baselines = vec![pt5, pteq];

@@ -28,6 +28,28 @@ pub fn write_csv(path: &Path, rows: &[LossRow]) -> Result<()> {
     write_atomically(path, |tmp| Ok(std::fs::write(tmp, text)?))
 }
 
+/// Rows of a loss.csv written by [`write_csv`]; none when it is missing, unreadable rows skipped.
+pub fn read_csv(path: &Path) -> Vec<LossRow> {
+    let Ok(text) = std::fs::read_to_string(path) else {
+        return vec![];
+    };
+    text.lines()
+        .skip(1)
+        .filter_map(|l| {
+            let f: Vec<&str> = l.split(',').collect();
+            let num = |i: usize| f.get(i).and_then(|s| s.parse::<f64>().ok());
+            Some(LossRow {
+                step: num(0)? as u64,
+                epoch: num(1)?,
+                samples: num(2)? as u64,
+                seconds: num(3)?,
+                train: num(4),
+                val: num(5),
+            })
+        })
+        .collect()
+}
+
 fn register_font() {
     static FONT: Once = Once::new();
     FONT.call_once(|| {
