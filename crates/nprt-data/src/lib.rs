@@ -6,6 +6,7 @@
 pub mod cameras;
 pub mod dataset;
 pub mod lighting;
+pub mod views;
 
 pub use cameras::{place_camera, PlacementError};
 pub use dataset::{Manifest, Request};

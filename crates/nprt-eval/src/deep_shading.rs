@@ -17,7 +17,7 @@ use burn::optim::{AdamConfig, GradientsParams};
 use burn::tensor::activation::relu;
 use burn::tensor::{Tensor, TensorData};
 use nprt_net::curves::{plot, read_csv, write_csv};
-use nprt_net::data::pixel_features;
+use nprt_net::data::gbuffer_features;
 use nprt_net::encoder::CODE_SIZE;
 use nprt_net::layers::conv2d;
 use nprt_net::model::{load_weights, save_weights};
@@ -31,7 +31,7 @@ use rand::SeedableRng;
 use rand_pcg::Pcg64Mcg;
 use serde::{Deserialize, Serialize};
 
-use crate::views::ImageView;
+use nprt_data::views::ImageView;
 
 pub const TAG: &str = "deep-shading";
 pub const CONFIG_FILE: &str = "deep-shading.json";
@@ -124,7 +124,7 @@ pub fn feature_image(bounds: &[[f32; 3]; 2], g: &GBuffer, width: usize, height: 
     let (pw, ph) = (width.div_ceil(8) * 8, height.div_ceil(8) * 8);
     let mut img = vec![0.0; FEATURES * pw * ph];
     for i in (0..g.mask.len()).filter(|&i| g.mask[i] > 0.5) {
-        let f = pixel_features(bounds, g.position[i], g.normal[i], g.view[i], g.kd[i], g.ks[i], g.alpha[i]);
+        let f = gbuffer_features(bounds, g, i);
         let (x, y) = (i % width, i / width);
         for (k, v) in f.iter().enumerate() {
             img[k * pw * ph + y * pw + x] = *v;

@@ -19,7 +19,7 @@ use crate::deep_shading::DeepShadingModel;
 use crate::metrics::{correlation, Metrics};
 use crate::oidn::Oidn;
 use crate::sh::ShTransport;
-use crate::views::{load_views, ImageView};
+use nprt_data::views::{load_views, ImageView};
 
 #[derive(Clone, Debug)]
 pub struct EvalOptions {

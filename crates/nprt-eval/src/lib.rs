@@ -12,7 +12,6 @@ pub mod oidn;
 pub mod progress;
 pub mod report;
 pub mod sh;
-pub mod views;
 
 pub use evaluate::{evaluate, EvalOptions, Evaluation, MethodResult};
 pub use metrics::Metrics;

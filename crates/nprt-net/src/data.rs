@@ -7,6 +7,7 @@ use anyhow::{bail, Context, Result};
 use glam::Vec3;
 use nprt_data::dataset::{load_manifest, Manifest, ViewRecord, MANIFEST};
 use nprt_scene::envmap::EnvMap;
+use nprt_trace::GBuffer;
 use rayon::prelude::*;
 
 use crate::design::FEATURES;
@@ -32,6 +33,11 @@ pub fn pixel_features(
     }
     f[18] = alpha;
     f
+}
+
+/// The 19 inputs of pixel `i` of a G-buffer.
+pub fn gbuffer_features(bounds: &[[f32; 3]; 2], g: &GBuffer, i: usize) -> [f32; FEATURES] {
+    pixel_features(bounds, g.position[i], g.normal[i], g.view[i], g.kd[i], g.ks[i], g.alpha[i])
 }
 
 /// The foreground pixels of one view.
@@ -124,30 +130,13 @@ fn load_view(
     view: &ViewRecord,
     encoder_width: usize,
 ) -> Result<ViewSamples> {
-    let path = dir.join(&view.file);
-    let (w, h, ch) = nprt_trace::exr_io::read_channels(&path)?;
-    nprt_data::dataset::check_channels(w, h, &ch, view)
-        .with_context(|| format!("dataset view '{}' is unusable (run `nprt generate` again to redo it)", path.display()))?;
-    let vec3 = |name: &str, i: usize| {
-        let c = |k: &str| ch[&format!("{name}.{k}")][i];
-        match name {
-            "kd" | "ks" => Vec3::new(c("R"), c("G"), c("B")),
-            _ => Vec3::new(c("X"), c("Y"), c("Z")),
-        }
-    };
+    let image = nprt_data::views::load_view(dir, view)?;
+    let g = &image.gbuffer;
     let mut features = Vec::new();
     let mut radiance = Vec::new();
-    for i in (0..ch["mask"].len()).filter(|&i| ch["mask"][i] > 0.5) {
-        features.extend(pixel_features(
-            &manifest.bounds,
-            vec3("position", i),
-            vec3("normal", i),
-            vec3("view", i),
-            vec3("kd", i),
-            vec3("ks", i),
-            ch["alpha"][i],
-        ));
-        radiance.extend([ch["R"][i], ch["G"][i], ch["B"][i]]);
+    for i in (0..g.mask.len()).filter(|&i| g.mask[i] > 0.5) {
+        features.extend(gbuffer_features(&manifest.bounds, g, i));
+        radiance.extend(image.radiance[i].to_array());
     }
     let map = maps
         .get(view.map)

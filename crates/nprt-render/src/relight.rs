@@ -5,7 +5,7 @@ use std::path::Path;
 use anyhow::Result;
 use glam::{Vec2, Vec3};
 use nprt_net::burn::tensor::{Tensor, TensorData};
-use nprt_net::data::pixel_features;
+use nprt_net::data::gbuffer_features;
 use nprt_net::{load_model, Device, LightInput, ModelFile, NprtNet, FEATURES};
 use nprt_scene::{Camera, EnvMap};
 use nprt_trace::GBuffer;
@@ -71,17 +71,7 @@ impl Relighter {
         for chunk in fg.chunks(CHUNK) {
             let features: Vec<f32> = chunk
                 .par_iter()
-                .flat_map_iter(|&i| {
-                    pixel_features(
-                        &self.file.bounds,
-                        g.position[i],
-                        g.normal[i],
-                        g.view[i],
-                        g.kd[i],
-                        g.ks[i],
-                        g.alpha[i],
-                    )
-                })
+                .flat_map_iter(|&i| gbuffer_features(&self.file.bounds, g, i))
                 .collect();
             let n = chunk.len();
             let f = Tensor::from_data(TensorData::new(features, [n, FEATURES]), &self.device);

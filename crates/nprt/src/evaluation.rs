@@ -5,7 +5,7 @@ use std::path::PathBuf;
 use anyhow::{bail, Result};
 use nprt_data::dataset::{load_manifest, MANIFEST};
 use nprt_eval::deep_shading::{self, DeepShadingFile, DeepShadingOptions};
-use nprt_eval::views::load_views;
+use nprt_data::views::load_views;
 use nprt_eval::{evaluate, write_report, EvalOptions, Evaluation};
 use nprt_net::data::open_recorded_maps;
 use nprt_net::encoder::check_input_width;

@@ -1,10 +1,11 @@
-//! Dataset views as whole images: reference radiance, its direct part, and the G-buffer.
+//! Dataset views as whole images: reference radiance, its direct part, and the G-buffer, read
+//! and checked against the manifest (for training and evaluation alike).
 
 use std::path::Path;
 
 use anyhow::{Context, Result};
 use glam::Vec3;
-use nprt_data::dataset::{check_channels, Manifest, ViewRecord};
+use crate::dataset::{check_channels, Manifest, ViewRecord};
 use nprt_scene::Camera;
 use nprt_trace::exr_io::read_channels;
 use nprt_trace::GBuffer;
@@ -36,7 +37,8 @@ pub fn load_views(dir: &Path, manifest: &Manifest, split: &str) -> Result<Vec<Im
         .collect()
 }
 
-fn load_view(dir: &Path, view: &ViewRecord) -> Result<ImageView> {
+/// Reads one view, refusing a file whose channels or size disagree with the manifest.
+pub fn load_view(dir: &Path, view: &ViewRecord) -> Result<ImageView> {
     let path = dir.join(&view.file);
     let (w, h, ch) = read_channels(&path)?;
     check_channels(w, h, &ch, view).with_context(|| {
