@@ -8,9 +8,8 @@ use std::time::Instant;
 
 use anyhow::{bail, Context, Result};
 use glam::Mat4;
-use indicatif::{ProgressBar, ProgressStyle};
 use nprt_scene::{Camera, CameraVolume, EnvMap, FovAxis, Scene};
-use nprt_trace::exr_io::{read_channels, write_atomically};
+use nprt_trace::exr_io::read_channels;
 use nprt_trace::{render, PixelFilter, RenderSettings, TraceScene};
 use rand::{RngExt, SeedableRng};
 use rand_pcg::Pcg64Mcg;
@@ -316,7 +315,7 @@ pub fn prepare(dir: &Path, manifest: &Manifest) -> Result<()> {
         return Ok(());
     }
     let text = serde_json::to_string_pretty(manifest)?;
-    write_atomically(&dir.join(MANIFEST), |tmp| Ok(std::fs::write(tmp, &text)?))
+    nprt_io::write_file(&dir.join(MANIFEST), &text)
 }
 
 /// Checks that a view file reads back complete: right size, every channel, finite values.
@@ -404,18 +403,7 @@ pub fn run(
             None => todo.push(v),
         }
     }
-    let bar = if progress {
-        ProgressBar::new(todo.len() as u64)
-    } else {
-        ProgressBar::hidden()
-    };
-    bar.set_style(
-        ProgressStyle::with_template(
-            "generating [{bar:40}] {pos}/{len} views, {per_sec}, ETA {eta}",
-        )
-        .expect("valid template")
-        .progress_chars("=> "),
-    );
+    let bar = nprt_io::progress_bar(progress, todo.len() as u64, "generating", "views");
     let t0 = Instant::now();
     for v in todo {
         render_view(ts, maps, manifest, v, dir)

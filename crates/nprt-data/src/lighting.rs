@@ -63,7 +63,8 @@ pub fn map_hash(spec: &str) -> Result<String> {
         blake3::hash(spec.as_bytes())
     } else {
         blake3::hash(
-            &std::fs::read(spec).with_context(|| format!("cannot read environment map '{spec}'"))?,
+            &std::fs::read(spec)
+                .with_context(|| format!("cannot read environment map '{spec}'"))?,
         )
     };
     Ok(hash.to_hex().to_string())

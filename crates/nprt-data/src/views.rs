@@ -3,9 +3,9 @@
 
 use std::path::Path;
 
+use crate::dataset::{check_channels, Manifest, ViewRecord};
 use anyhow::{Context, Result};
 use glam::Vec3;
-use crate::dataset::{check_channels, Manifest, ViewRecord};
 use nprt_scene::Camera;
 use nprt_trace::exr_io::read_channels;
 use nprt_trace::GBuffer;
@@ -42,14 +42,23 @@ pub fn load_view(dir: &Path, view: &ViewRecord) -> Result<ImageView> {
     let path = dir.join(&view.file);
     let (w, h, ch) = read_channels(&path)?;
     check_channels(w, h, &ch, view).with_context(|| {
-        format!("dataset view '{}' is unusable (run `nprt generate` again to redo it)", path.display())
+        format!(
+            "dataset view '{}' is unusable (run `nprt generate` again to redo it)",
+            path.display()
+        )
     })?;
     let vec3 = |prefix: &str, names: [&str; 3]| -> Vec<Vec3> {
         let c = names.map(|n| {
-            let key = if prefix.is_empty() { n.to_string() } else { format!("{prefix}.{n}") };
+            let key = if prefix.is_empty() {
+                n.to_string()
+            } else {
+                format!("{prefix}.{n}")
+            };
             &ch[&key]
         });
-        (0..w * h).map(|i| Vec3::new(c[0][i], c[1][i], c[2][i])).collect()
+        (0..w * h)
+            .map(|i| Vec3::new(c[0][i], c[1][i], c[2][i]))
+            .collect()
     };
     const RGB: [&str; 3] = ["R", "G", "B"];
     const XYZ: [&str; 3] = ["X", "Y", "Z"];

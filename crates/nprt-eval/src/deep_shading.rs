@@ -8,7 +8,6 @@ use std::path::Path;
 use std::time::Instant;
 
 use anyhow::{bail, Context, Result};
-use glam::Vec3;
 use burn::module::Module;
 use burn::nn::conv::Conv2d;
 use burn::nn::pool::{MaxPool2d, MaxPool2dConfig};
@@ -16,13 +15,14 @@ use burn::nn::Linear;
 use burn::optim::{AdamConfig, GradientsParams};
 use burn::tensor::activation::relu;
 use burn::tensor::{Tensor, TensorData};
+use glam::Vec3;
 use nprt_net::curves::{plot, read_csv, write_csv};
 use nprt_net::data::gbuffer_features;
 use nprt_net::encoder::CODE_SIZE;
 use nprt_net::layers::conv2d;
+use nprt_net::layers::Mlp;
 use nprt_net::model::{load_weights, save_weights};
 use nprt_net::train::LossRow;
-use nprt_net::layers::Mlp;
 use nprt_net::{Activation, Device, Init, LightEncoder, LightInput, FEATURES};
 use nprt_scene::EnvMap;
 use nprt_trace::GBuffer;
@@ -72,7 +72,9 @@ impl DeepShading {
         }
         let b = WIDTHS[3];
         let bottleneck = vec![conv2d(init, WIDTHS[2], b, 3), conv2d(init, b, b, 3)];
-        let code = Mlp::new(init, &[CODE_SIZE, b], Activation::Relu).layers.remove(0);
+        let code = Mlp::new(init, &[CODE_SIZE, b], Activation::Relu)
+            .layers
+            .remove(0);
         let up = vec![
             conv2d(init, b + WIDTHS[2], WIDTHS[1], 3),
             conv2d(init, WIDTHS[1] + WIDTHS[1], WIDTHS[0], 3),
@@ -107,7 +109,11 @@ impl DeepShading {
         }
         x = relu(self.bottleneck[0].forward(x));
         let [b, c, h, w] = x.dims();
-        x = x + self.code.forward(code).reshape([b, c, 1, 1]).expand([b, c, h, w]);
+        x = x + self
+            .code
+            .forward(code)
+            .reshape([b, c, 1, 1])
+            .expand([b, c, h, w]);
         x = relu(self.bottleneck[1].forward(x));
         for conv in &self.up {
             let skip = skips.pop().expect("one skip per level");
@@ -120,7 +126,12 @@ impl DeepShading {
 
 /// A view's G-buffer as a [19, H', W'] feature image, zero on the background and padded to
 /// multiples of 8; returns the padded size too.
-pub fn feature_image(bounds: &[[f32; 3]; 2], g: &GBuffer, width: usize, height: usize) -> (Vec<f32>, usize, usize) {
+pub fn feature_image(
+    bounds: &[[f32; 3]; 2],
+    g: &GBuffer,
+    width: usize,
+    height: usize,
+) -> (Vec<f32>, usize, usize) {
     let (pw, ph) = (width.div_ceil(8) * 8, height.div_ceil(8) * 8);
     let mut img = vec![0.0; FEATURES * pw * ph];
     for i in (0..g.mask.len()).filter(|&i| g.mask[i] > 0.5) {
@@ -169,11 +180,19 @@ pub struct DeepShadingModel {
 
 pub fn read_file(dir: &Path) -> Result<DeepShadingFile> {
     let path = dir.join(CONFIG_FILE);
-    let text = std::fs::read_to_string(&path)
-        .with_context(|| format!("'{}' is not a Deep Shading model folder (no readable {CONFIG_FILE})", dir.display()))?;
-    let f: DeepShadingFile = serde_json::from_str(&text).with_context(|| format!("'{}' is malformed", path.display()))?;
+    let text = std::fs::read_to_string(&path).with_context(|| {
+        format!(
+            "'{}' is not a Deep Shading model folder (no readable {CONFIG_FILE})",
+            dir.display()
+        )
+    })?;
+    let f: DeepShadingFile = serde_json::from_str(&text)
+        .with_context(|| format!("'{}' is malformed", path.display()))?;
     if f.format != TAG || f.version != 1 {
-        bail!("'{}' is not a version-1 Deep Shading config", path.display());
+        bail!(
+            "'{}' is not a version-1 Deep Shading config",
+            path.display()
+        );
     }
     Ok(f)
 }
@@ -183,18 +202,32 @@ impl DeepShadingModel {
         let file = read_file(dir)?;
         let mut net = DeepShading::new(&mut Init::new(0, device), file.encoder_width);
         load_weights(&dir.join(WEIGHTS_FILE), &mut net, TAG)?;
-        Ok(DeepShadingModel { file, net, device: device.clone() })
+        Ok(DeepShadingModel {
+            file,
+            net,
+            device: device.clone(),
+        })
     }
 
     /// Radiance of every pixel of a `width`×`height` G-buffer under `map` rotated by
     /// `rotation_deg` (background pixels 0).
-    pub fn shade(&self, g: &GBuffer, width: usize, height: usize, map: &EnvMap, rotation_deg: f32) -> Vec<Vec3> {
+    pub fn shade(
+        &self,
+        g: &GBuffer,
+        width: usize,
+        height: usize,
+        map: &EnvMap,
+        rotation_deg: f32,
+    ) -> Vec<Vec3> {
         let (img, pw, ph) = feature_image(&self.file.bounds, g, width, height);
         let light = LightInput::new(map, rotation_deg, self.file.encoder_width);
         let lw = light.width;
         let out = self.net.forward(
             Tensor::from_data(TensorData::new(img, [1, FEATURES, ph, pw]), &self.device),
-            Tensor::from_data(TensorData::new(light.pixels, [1, 3, lw / 2, lw]), &self.device),
+            Tensor::from_data(
+                TensorData::new(light.pixels, [1, 3, lw / 2, lw]),
+                &self.device,
+            ),
             Tensor::from_data(TensorData::new(vec![light.scale], [1]), &self.device),
         );
         let data = out.into_data();
@@ -203,7 +236,11 @@ impl DeepShadingModel {
             .map(|i| {
                 let (x, y) = (i % width, i / width);
                 if g.mask[i] > 0.5 {
-                    Vec3::new(v[y * pw + x], v[pw * ph + y * pw + x], v[2 * pw * ph + y * pw + x])
+                    Vec3::new(
+                        v[y * pw + x],
+                        v[pw * ph + y * pw + x],
+                        v[2 * pw * ph + y * pw + x],
+                    )
                 } else {
                     Vec3::ZERO
                 }
@@ -220,7 +257,12 @@ struct Sample {
     light: LightInput,
 }
 
-fn prepare(views: &[ImageView], maps: &[EnvMap], bounds: &[[f32; 3]; 2], encoder_width: usize) -> Result<(Vec<Sample>, usize, usize)> {
+fn prepare(
+    views: &[ImageView],
+    maps: &[EnvMap],
+    bounds: &[[f32; 3]; 2],
+    encoder_width: usize,
+) -> Result<(Vec<Sample>, usize, usize)> {
     let (w, h) = (views[0].width, views[0].height);
     if views.iter().any(|v| (v.width, v.height) != (w, h)) {
         bail!("Deep Shading trains on views of one resolution");
@@ -238,22 +280,50 @@ fn prepare(views: &[ImageView], maps: &[EnvMap], bounds: &[[f32; 3]; 2], encoder
                     radiance[c * pw * ph + j] = v.radiance[i][c] * mask[j];
                 }
             }
-            Sample { features, radiance, mask, light: LightInput::new(&maps[v.record.map], v.record.rotation_deg, encoder_width) }
+            Sample {
+                features,
+                radiance,
+                mask,
+                light: LightInput::new(&maps[v.record.map], v.record.rotation_deg, encoder_width),
+            }
         })
         .collect();
     Ok((samples, w.div_ceil(8) * 8, h.div_ceil(8) * 8))
 }
 
 /// The masked log-L1 loss and the tensors of a batch of views.
-fn batch_loss(net: &DeepShading, batch: &[&Sample], pw: usize, ph: usize, device: &Device) -> Tensor<1> {
+fn batch_loss(
+    net: &DeepShading,
+    batch: &[&Sample],
+    pw: usize,
+    ph: usize,
+    device: &Device,
+) -> Tensor<1> {
     let b = batch.len();
-    let cat = |f: fn(&Sample) -> &Vec<f32>| batch.iter().flat_map(|s| f(s).iter().copied()).collect::<Vec<f32>>();
+    let cat = |f: fn(&Sample) -> &Vec<f32>| {
+        batch
+            .iter()
+            .flat_map(|s| f(s).iter().copied())
+            .collect::<Vec<f32>>()
+    };
     let lw = batch[0].light.width;
-    let features = Tensor::from_data(TensorData::new(cat(|s| &s.features), [b, FEATURES, ph, pw]), device);
-    let reference = Tensor::from_data(TensorData::new(cat(|s| &s.radiance), [b, 3, ph, pw]), device);
+    let features = Tensor::from_data(
+        TensorData::new(cat(|s| &s.features), [b, FEATURES, ph, pw]),
+        device,
+    );
+    let reference = Tensor::from_data(
+        TensorData::new(cat(|s| &s.radiance), [b, 3, ph, pw]),
+        device,
+    );
     let mask = Tensor::<4>::from_data(TensorData::new(cat(|s| &s.mask), [b, 1, ph, pw]), device);
-    let light = Tensor::from_data(TensorData::new(cat(|s| &s.light.pixels), [b, 3, lw / 2, lw]), device);
-    let scale = Tensor::from_data(TensorData::new(batch.iter().map(|s| s.light.scale).collect::<Vec<_>>(), [b]), device);
+    let light = Tensor::from_data(
+        TensorData::new(cat(|s| &s.light.pixels), [b, 3, lw / 2, lw]),
+        device,
+    );
+    let scale = Tensor::from_data(
+        TensorData::new(batch.iter().map(|s| s.light.scale).collect::<Vec<_>>(), [b]),
+        device,
+    );
     let pred = net.forward(features, light, scale);
     let mask3 = mask.clone().expand([b, 3, ph, pw]);
     let err = (pred.log1p() - reference.log1p()).abs() * mask3;
@@ -284,10 +354,15 @@ pub fn train(
     file.encoder_params = net.light.num_params();
     let mut rows: Vec<LossRow> = Vec::new();
     if let Ok(prev) = read_file(out) {
-        if prev.options.seed != opts.seed || prev.options.batch_views != opts.batch_views
-            || prev.options.learning_rate != opts.learning_rate || prev.dataset_hash != file.dataset_hash
+        if prev.options.seed != opts.seed
+            || prev.options.batch_views != opts.batch_views
+            || prev.options.learning_rate != opts.learning_rate
+            || prev.dataset_hash != file.dataset_hash
         {
-            bail!("'{}' holds a Deep Shading model of other settings or data; choose another folder", out.display());
+            bail!(
+                "'{}' holds a Deep Shading model of other settings or data; choose another folder",
+                out.display()
+            );
         }
         load_weights(&out.join(WEIGHTS_FILE), &mut net, TAG)?;
         file.epochs_done = prev.epochs_done;
@@ -299,25 +374,41 @@ pub fn train(
     // Adam restarts on resume (its moments are not saved); the weights carry over.
     let mut optim = AdamConfig::new().with_epsilon(1e-8).init();
     let steps_per_epoch = train_s.len().div_ceil(opts.batch_views);
-    let bar = crate::progress::bar(progress, ((opts.epochs.saturating_sub(file.epochs_done)) * steps_per_epoch) as u64, "Deep Shading");
+    let bar = nprt_io::progress_bar(
+        progress,
+        ((opts.epochs.saturating_sub(file.epochs_done)) * steps_per_epoch) as u64,
+        "Deep Shading",
+        "steps",
+    );
     let start = Instant::now();
     let seconds_before = file.seconds;
     for epoch in file.epochs_done..opts.epochs {
         let mut order: Vec<usize> = (0..train_s.len()).collect();
-        order.shuffle(&mut Pcg64Mcg::seed_from_u64(opts.seed ^ (epoch as u64).wrapping_mul(0x9e37_79b9)));
+        order.shuffle(&mut Pcg64Mcg::seed_from_u64(
+            opts.seed ^ (epoch as u64).wrapping_mul(0x9e37_79b9),
+        ));
         let mut sum = 0.0;
         for (step, chunk) in order.chunks(opts.batch_views).enumerate() {
             let batch: Vec<&Sample> = chunk.iter().map(|&i| &train_s[i]).collect();
             let loss = batch_loss(&net, &batch, pw, ph, &ad);
             let value = loss.clone().into_scalar::<f32>() as f64;
             if !value.is_finite() {
-                bail!("Deep Shading training diverged (loss {value}) in epoch {}", epoch + 1);
+                bail!(
+                    "Deep Shading training diverged (loss {value}) in epoch {}",
+                    epoch + 1
+                );
             }
             sum += value;
             let grads = GradientsParams::from_grads(loss.backward(), &net);
             net = optim.step(opts.learning_rate, net, grads);
             bar.inc(1);
-            bar.set_message(format!("epoch {}/{} step {}/{steps_per_epoch} loss {:.4}", epoch + 1, opts.epochs, step + 1, sum / (step + 1) as f64));
+            bar.set_message(format!(
+                "epoch {}/{} step {}/{steps_per_epoch} loss {:.4}",
+                epoch + 1,
+                opts.epochs,
+                step + 1,
+                sum / (step + 1) as f64
+            ));
         }
         let valid = net.valid();
         let val = if test_s.is_empty() {
@@ -325,7 +416,11 @@ pub fn train(
         } else {
             test_s
                 .chunks(opts.batch_views)
-                .map(|c| batch_loss(&valid, &c.iter().collect::<Vec<_>>(), tpw, tph, device).into_scalar::<f32>() as f64 * c.len() as f64)
+                .map(|c| {
+                    batch_loss(&valid, &c.iter().collect::<Vec<_>>(), tpw, tph, device)
+                        .into_scalar::<f32>() as f64
+                        * c.len() as f64
+                })
                 .sum::<f64>()
                 / test_s.len() as f64
         };
@@ -343,9 +438,14 @@ pub fn train(
         write_csv(&out.join("loss.csv"), &rows)?;
         plot(&out.join("loss.png"), &rows, "Deep Shading (U-Net)")?;
         let json = serde_json::to_vec_pretty(&file)?;
-        nprt_trace::exr_io::write_atomically(&out.join(CONFIG_FILE), |tmp| Ok(std::fs::write(tmp, &json)?))?;
+        nprt_io::write_file(&out.join(CONFIG_FILE), &json)?;
         if !progress {
-            eprintln!("Deep Shading epoch {}/{}: train {:.4}, val {val:.4}", epoch + 1, opts.epochs, sum / steps_per_epoch as f64);
+            eprintln!(
+                "Deep Shading epoch {}/{}: train {:.4}, val {val:.4}",
+                epoch + 1,
+                opts.epochs,
+                sum / steps_per_epoch as f64
+            );
         }
     }
     bar.finish_and_clear();

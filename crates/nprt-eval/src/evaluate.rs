@@ -149,12 +149,16 @@ impl Accumulator {
 
     fn add(&mut self, view: &ImageView, pred: &[Vec3], ms: f64) {
         let g = &view.gbuffer;
-        self.result.per_view.push(Metrics::compute(pred, &view.radiance, &g.mask, view.width));
+        self.result
+            .per_view
+            .push(Metrics::compute(pred, &view.radiance, &g.mask, view.width));
         self.ms.push(ms);
         for i in (0..g.mask.len()).filter(|&i| g.mask[i] > 0.5) {
             let r = view.radiance[i];
-            self.err.push(((pred[i] - r).abs().element_sum() / 3.0) as f64);
-            self.direct.push((luminance(view.direct[i]) / luminance(r).max(1e-6)).clamp(0.0, 1.0) as f64);
+            self.err
+                .push(((pred[i] - r).abs().element_sum() / 3.0) as f64);
+            self.direct
+                .push((luminance(view.direct[i]) / luminance(r).max(1e-6)).clamp(0.0, 1.0) as f64);
             let (kd, ks) = (g.kd[i].element_sum(), g.ks[i].element_sum());
             self.spec.push((ks / (kd + ks).max(1e-6)) as f64);
         }
@@ -181,7 +185,10 @@ fn binned(x: &[f64], y: &[f64]) -> Vec<f64> {
         sum[k] += b;
         n[k] += 1;
     }
-    sum.iter().zip(&n).map(|(s, &c)| if c > 0 { s / c as f64 } else { f64::NAN }).collect()
+    sum.iter()
+        .zip(&n)
+        .map(|(s, &c)| if c > 0 { s / c as f64 } else { f64::NAN })
+        .collect()
 }
 
 fn ms(t: Instant) -> f64 {
@@ -209,7 +216,14 @@ impl Net {
     }
 
     /// Radiance of a G-buffer under a map, and (encoder, network) milliseconds.
-    fn shade(&self, g: &GBuffer, w: usize, h: usize, map: &EnvMap, rotation: f32) -> (Vec<Vec3>, f64, f64) {
+    fn shade(
+        &self,
+        g: &GBuffer,
+        w: usize,
+        h: usize,
+        map: &EnvMap,
+        rotation: f32,
+    ) -> (Vec<Vec3>, f64, f64) {
         match self {
             Net::Nprt(r, _) => {
                 let t = Instant::now();
@@ -228,9 +242,18 @@ impl Net {
     }
 }
 
-fn check_model(dir: &Path, dataset_hash: &str, scene_hash: &str, model_scene: &str, model_data: &str) -> Result<()> {
+fn check_model(
+    dir: &Path,
+    dataset_hash: &str,
+    scene_hash: &str,
+    model_scene: &str,
+    model_data: &str,
+) -> Result<()> {
     if model_scene != scene_hash {
-        bail!("model '{}' was trained on another scene than the dataset's", dir.display());
+        bail!(
+            "model '{}' was trained on another scene than the dataset's",
+            dir.display()
+        );
     }
     if model_data != dataset_hash {
         eprintln!(
@@ -247,7 +270,11 @@ pub fn evaluate(o: &EvalOptions, device: &Device) -> Result<Evaluation> {
     let manifest_bytes = std::fs::read(o.data.join(MANIFEST))?;
     let dataset_hash = blake3::hash(&manifest_bytes).to_hex().to_string();
     let s = &manifest.settings;
-    let scene = load_checked_scene(&s.scene, &s.scene_hash, &format!("dataset '{}' was rendered from", o.data.display()))?;
+    let scene = load_checked_scene(
+        &s.scene,
+        &s.scene_hash,
+        &format!("dataset '{}' was rendered from", o.data.display()),
+    )?;
     let maps = open_recorded_maps(&manifest)?;
     let mut views = load_views(&o.data, &manifest, "test")?;
     views.sort_by_key(|v| v.record.index);
@@ -260,12 +287,24 @@ pub fn evaluate(o: &EvalOptions, device: &Device) -> Result<Evaluation> {
     let mut nets = Vec::new();
     for dir in &o.models {
         let r = Relighter::load(dir, device)?;
-        check_model(dir, &dataset_hash, &s.scene_hash, &r.file.scene_hash, &r.file.dataset_hash)?;
+        check_model(
+            dir,
+            &dataset_hash,
+            &s.scene_hash,
+            &r.file.scene_hash,
+            &r.file.dataset_hash,
+        )?;
         nets.push(Net::Nprt(Box::new(r), dir.clone()));
     }
     if let Some(dir) = &o.deep_shading {
         let d = DeepShadingModel::load(dir, device)?;
-        check_model(dir, &dataset_hash, &s.scene_hash, &d.file.scene_hash, &d.file.dataset_hash)?;
+        check_model(
+            dir,
+            &dataset_hash,
+            &s.scene_hash,
+            &d.file.scene_hash,
+            &d.file.dataset_hash,
+        )?;
         nets.push(Net::DeepShading(Box::new(d), dir.clone()));
     }
     if nets.is_empty() {
@@ -275,7 +314,10 @@ pub fn evaluate(o: &EvalOptions, device: &Device) -> Result<Evaluation> {
     let names: Vec<String> = nets
         .iter()
         .map(|n| {
-            let same = nets.iter().filter(|m| m.kind_name() == n.kind_name()).count();
+            let same = nets
+                .iter()
+                .filter(|m| m.kind_name() == n.kind_name())
+                .count();
             match same {
                 1 => n.kind_name(),
                 _ => format!("{} ({})", n.kind_name(), n.dir().display()),
@@ -293,7 +335,8 @@ pub fn evaluate(o: &EvalOptions, device: &Device) -> Result<Evaluation> {
     };
     let oidn = Oidn::open();
     let denoiser = match &oidn {
-        Ok(_) => "Intel Open Image Denoise 1.4.3 (RT filter, HDR, albedo and normal auxiliaries)".to_string(),
+        Ok(_) => "Intel Open Image Denoise 1.4.3 (RT filter, HDR, albedo and normal auxiliaries)"
+            .to_string(),
         Err(e) => format!("unavailable: {e:#}"),
     };
     let shown_n = o.shown_views.min(views.len());
@@ -309,7 +352,7 @@ pub fn evaluate(o: &EvalOptions, device: &Device) -> Result<Evaluation> {
         })
         .collect();
     let total_steps = (views.len() * (nets.len() + 3)) as u64;
-    let bar = crate::progress::bar(o.progress, total_steps, "evaluating");
+    let bar = nprt_io::progress_bar(o.progress, total_steps, "evaluating", "steps");
 
     // Networks first: the slowest one sets the equal-time sample count.
     let mut results = Vec::new();
@@ -325,7 +368,13 @@ pub fn evaluate(o: &EvalOptions, device: &Device) -> Result<Evaluation> {
             let t = Instant::now();
             let g = render_gbuffer(&ts, &v.camera);
             let g_ms = ms(t);
-            let (rgb, enc, netms) = net.shade(&g, v.width, v.height, &maps[v.record.map], v.record.rotation_deg);
+            let (rgb, enc, netms) = net.shade(
+                &g,
+                v.width,
+                v.height,
+                &maps[v.record.map],
+                v.record.rotation_deg,
+            );
             acc.add(v, &rgb, g_ms + enc + netms);
             if k < shown_n {
                 shown[k].methods.push((name.clone(), rgb));
@@ -336,8 +385,15 @@ pub fn evaluate(o: &EvalOptions, device: &Device) -> Result<Evaluation> {
     }
     // Equal time is set by the Neural PRT designs (Deep Shading is a baseline); with none, by
     // whatever network was given.
-    let designs: Vec<&MethodResult> = results.iter().filter(|r| r.name.starts_with("nprt-")).collect();
-    let pool = if designs.is_empty() { results.iter().collect() } else { designs };
+    let designs: Vec<&MethodResult> = results
+        .iter()
+        .filter(|r| r.name.starts_with("nprt-"))
+        .collect();
+    let pool = if designs.is_empty() {
+        results.iter().collect()
+    } else {
+        designs
+    };
     let slowest_ms = pool.iter().map(|r| r.ms_per_view).fold(0.0, f64::max);
 
     // Path tracing of every view at `spp`, timed per view; `salt` keeps the seeds apart.
@@ -348,7 +404,12 @@ pub fn evaluate(o: &EvalOptions, device: &Device) -> Result<Evaluation> {
             bar.set_message(format!("path tracing {spp} spp"));
             let map = maps[v.record.map].rotated_y(v.record.rotation_deg);
             let t = Instant::now();
-            let f = render(&ts, &v.camera, &map, &pt_settings(spp, v.record.seed ^ o.seed ^ salt));
+            let f = render(
+                &ts,
+                &v.camera,
+                &map,
+                &pt_settings(spp, v.record.seed ^ o.seed ^ salt),
+            );
             acc.add(v, &f.radiance, ms(t));
             frames.push(f.radiance);
             bar.inc(1);
@@ -358,10 +419,20 @@ pub fn evaluate(o: &EvalOptions, device: &Device) -> Result<Evaluation> {
     // 5 spp first: its cost per sample sets the equal-time count.
     let (pt5, pt5_frames) = trace_all("pt-5spp", 5, 0x5eed_0005);
     let equal_time_spp = ((slowest_ms / (pt5.ms_per_view / 5.0)).round() as u32).max(1);
-    let (mut pteq, pteq_frames) =
-        trace_all(&format!("pt-equal-time ({equal_time_spp} spp)"), equal_time_spp, 0x5eed_e9a1);
-    pteq.note = format!("{equal_time_spp} spp: the time of the slowest design ({slowest_ms:.0} ms per view)");
-    for (k, (a, b)) in pt5_frames.iter().zip(&pteq_frames).take(shown_n).enumerate() {
+    let (mut pteq, pteq_frames) = trace_all(
+        &format!("pt-equal-time ({equal_time_spp} spp)"),
+        equal_time_spp,
+        0x5eed_e9a1,
+    );
+    pteq.note = format!(
+        "{equal_time_spp} spp: the time of the slowest design ({slowest_ms:.0} ms per view)"
+    );
+    for (k, (a, b)) in pt5_frames
+        .iter()
+        .zip(&pteq_frames)
+        .take(shown_n)
+        .enumerate()
+    {
         shown[k].methods.push((pt5.name.clone(), a.clone()));
         shown[k].methods.push((pteq.name.clone(), b.clone()));
     }
@@ -369,11 +440,19 @@ pub fn evaluate(o: &EvalOptions, device: &Device) -> Result<Evaluation> {
 
     // The same, denoised.
     if let Ok(oidn) = oidn {
-        for (frames, base) in [(&pt5_frames, baselines[0].name.clone()), (&pteq_frames, baselines[1].name.clone())] {
+        for (frames, base) in [
+            (&pt5_frames, baselines[0].name.clone()),
+            (&pteq_frames, baselines[1].name.clone()),
+        ] {
             let mut acc = Accumulator::new(&format!("{base} + OIDN"), Kind::Baseline, None);
-            let base_ms = baselines.iter().find(|b| b.name == base).map_or(0.0, |b| b.ms_per_view);
+            let base_ms = baselines
+                .iter()
+                .find(|b| b.name == base)
+                .map_or(0.0, |b| b.ms_per_view);
             for (k, (v, f)) in views.iter().zip(frames.iter()).enumerate() {
-                let albedo: Vec<Vec3> = (0..f.len()).map(|i| (v.gbuffer.kd[i] + v.gbuffer.ks[i]).min(Vec3::ONE)).collect();
+                let albedo: Vec<Vec3> = (0..f.len())
+                    .map(|i| (v.gbuffer.kd[i] + v.gbuffer.ks[i]).min(Vec3::ONE))
+                    .collect();
                 let t = Instant::now();
                 let d = oidn.denoise(f, &albedo, &v.gbuffer.normal, v.width, v.height)?;
                 acc.add(v, &d, base_ms + ms(t));
@@ -386,12 +465,20 @@ pub fn evaluate(o: &EvalOptions, device: &Device) -> Result<Evaluation> {
     }
 
     // SH PRT with 25 and 9 coefficients per channel: one transport precomputation per view.
-    let mut sh = [Accumulator::new("sh-prt-9", Kind::Baseline, None), Accumulator::new("sh-prt-25", Kind::Baseline, None)];
+    let mut sh = [
+        Accumulator::new("sh-prt-9", Kind::Baseline, None),
+        Accumulator::new("sh-prt-25", Kind::Baseline, None),
+    ];
     let mut pre_ms = 0.0;
     for (k, v) in views.iter().enumerate() {
         bar.set_message(format!("SH transport, {} paths per pixel", o.sh_spp));
         let t = Instant::now();
-        let t25 = ShTransport::precompute(&ts, &v.camera, 5, &pt_settings(o.sh_spp, v.record.seed ^ o.seed ^ 0x5eed_0525));
+        let t25 = ShTransport::precompute(
+            &ts,
+            &v.camera,
+            5,
+            &pt_settings(o.sh_spp, v.record.seed ^ o.seed ^ 0x5eed_0525),
+        );
         pre_ms += ms(t);
         let map = maps[v.record.map].rotated_y(v.record.rotation_deg);
         for (acc, transport) in sh.iter_mut().zip([t25.truncated(3), t25]) {
@@ -408,12 +495,23 @@ pub fn evaluate(o: &EvalOptions, device: &Device) -> Result<Evaluation> {
     for acc in sh {
         let mut r = acc.finish();
         r.precompute_ms = Some(pre_ms / views.len() as f64);
-        r.note = format!("transport path-traced at {} paths per pixel per view (fixed view)", o.sh_spp);
+        r.note = format!(
+            "transport path-traced at {} paths per pixel per view (fixed view)",
+            o.sh_spp
+        );
         baselines.push(r);
     }
     results.extend(baselines);
 
-    let timings = time_table(o, &ts, &views[0].camera, &maps[views[0].record.map], &nets, &names, &pt_settings(5, o.seed))?;
+    let timings = time_table(
+        o,
+        &ts,
+        &views[0].camera,
+        &maps[views[0].record.map],
+        &nets,
+        &names,
+        &pt_settings(5, o.seed),
+    )?;
     let fg = views.iter().map(|v| v.foreground()).sum();
     Ok(Evaluation {
         data: o.data.clone(),
@@ -450,28 +548,50 @@ fn time_table(
     };
     let mut rows = Vec::new();
     let mut g = GBuffer::default();
-    let gb = median((0..3).map(|_| {
-        let t = Instant::now();
-        g = render_gbuffer(ts, &camera);
-        ms(t)
-    }).collect());
-    rows.push(Timing { what: "G-buffer (primary rays)".into(), ms: gb });
+    let gb = median(
+        (0..3)
+            .map(|_| {
+                let t = Instant::now();
+                g = render_gbuffer(ts, &camera);
+                ms(t)
+            })
+            .collect(),
+    );
+    rows.push(Timing {
+        what: "G-buffer (primary rays)".into(),
+        ms: gb,
+    });
     for (net, name) in nets.iter().zip(names) {
-        let runs: Vec<(f64, f64)> = (0..3).map(|_| {
-            let (_, e, m) = net.shade(&g, n, n, map, 0.0);
-            (e, m)
-        }).collect();
+        let runs: Vec<(f64, f64)> = (0..3)
+            .map(|_| {
+                let (_, e, m) = net.shade(&g, n, n, map, 0.0);
+                (e, m)
+            })
+            .collect();
         if let Net::Nprt(..) = net {
-            rows.push(Timing { what: format!("{name}: encoder"), ms: median(runs.iter().map(|r| r.0).collect()) });
+            rows.push(Timing {
+                what: format!("{name}: encoder"),
+                ms: median(runs.iter().map(|r| r.0).collect()),
+            });
         }
-        rows.push(Timing { what: format!("{name}: network"), ms: median(runs.iter().map(|r| r.1).collect()) });
+        rows.push(Timing {
+            what: format!("{name}: network"),
+            ms: median(runs.iter().map(|r| r.1).collect()),
+        });
     }
-    let pt_ms = median((0..3).map(|_| {
-        let t = Instant::now();
-        render(ts, &camera, map, pt);
-        ms(t)
-    }).collect());
-    rows.push(Timing { what: "path tracing, 5 spp".into(), ms: pt_ms });
+    let pt_ms = median(
+        (0..3)
+            .map(|_| {
+                let t = Instant::now();
+                render(ts, &camera, map, pt);
+                ms(t)
+            })
+            .collect(),
+    );
+    rows.push(Timing {
+        what: "path tracing, 5 spp".into(),
+        ms: pt_ms,
+    });
     if rows.iter().any(|r| !r.ms.is_finite()) {
         bail!("a timing was not finite");
     }
@@ -488,16 +608,25 @@ impl Evaluation {
         let mut out = Vec::new();
         if let (Some(d), Some(b)) = (self.method("nprt-dsep"), self.method("nprt-baseline")) {
             out.push((
-                format!("D/S beats the baseline design in RMSE ({:.4} < {:.4})", d.mean.rmse, b.mean.rmse),
+                format!(
+                    "D/S beats the baseline design in RMSE ({:.4} < {:.4})",
+                    d.mean.rmse, b.mean.rmse
+                ),
                 d.mean.rmse < b.mean.rmse,
             ));
         }
         let sh9 = self.method("sh-prt-9");
-        let pteq = self.methods.iter().find(|m| m.name.starts_with("pt-equal-time") && !m.name.ends_with("OIDN"));
+        let pteq = self
+            .methods
+            .iter()
+            .find(|m| m.name.starts_with("pt-equal-time") && !m.name.ends_with("OIDN"));
         for m in self.methods.iter().filter(|m| m.name.starts_with("nprt-")) {
             for other in [sh9, pteq].into_iter().flatten() {
                 out.push((
-                    format!("{} beats {} in L1 ({:.4} < {:.4})", m.name, other.name, m.mean.l1, other.mean.l1),
+                    format!(
+                        "{} beats {} in L1 ({:.4} < {:.4})",
+                        m.name, other.name, m.mean.l1, other.mean.l1
+                    ),
                     m.mean.l1 < other.mean.l1,
                 ));
             }

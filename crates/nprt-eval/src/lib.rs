@@ -9,7 +9,6 @@ pub mod deep_shading;
 pub mod evaluate;
 pub mod metrics;
 pub mod oidn;
-pub mod progress;
 pub mod report;
 pub mod sh;
 

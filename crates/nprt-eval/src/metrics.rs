@@ -24,7 +24,15 @@ impl Metrics {
     pub const NAMES: [&'static str; 7] = ["L1", "L2", "RMSE", "dSSIM", "MAPE", "MRSE", "log-L1"];
 
     pub fn values(&self) -> [f64; 7] {
-        [self.l1, self.l2, self.rmse, self.dssim, self.mape, self.mrse, self.log_l1]
+        [
+            self.l1,
+            self.l2,
+            self.rmse,
+            self.dssim,
+            self.mape,
+            self.mrse,
+            self.log_l1,
+        ]
     }
 
     /// Errors of `pred` against `reference` (row-major `width` wide) where `mask` > 0.5.
@@ -46,7 +54,13 @@ impl Metrics {
             return Metrics::default();
         }
         let n = n as f64;
-        for v in [&mut m.l1, &mut m.l2, &mut m.mape, &mut m.mrse, &mut m.log_l1] {
+        for v in [
+            &mut m.l1,
+            &mut m.l2,
+            &mut m.mape,
+            &mut m.mrse,
+            &mut m.log_l1,
+        ] {
             *v /= n;
         }
         m.rmse = m.l2.sqrt();
@@ -76,7 +90,9 @@ impl Metrics {
 pub fn ssim(pred: &[Vec3], reference: &[Vec3], mask: &[f32], width: usize) -> f64 {
     const R: i64 = 5;
     let (c1, c2) = (0.01f64.powi(2), 0.03f64.powi(2));
-    let g: Vec<f64> = (-R..=R).map(|k| (-(k * k) as f64 / (2.0 * 1.5 * 1.5)).exp()).collect();
+    let g: Vec<f64> = (-R..=R)
+        .map(|k| (-(k * k) as f64 / (2.0 * 1.5 * 1.5)).exp())
+        .collect();
     let height = mask.len() / width.max(1);
     let fg = |i: usize| mask[i] > 0.5;
     let (mut total, mut count) = (0.0, 0usize);
@@ -159,10 +175,16 @@ mod tests {
         assert!(same.dssim.abs() < 1e-12, "{same:?}");
         let p: Vec<Vec3> = r.iter().map(|v| *v + 0.1).collect();
         let m = Metrics::compute(&p, &r, &mask, w);
-        assert!((m.l1 - 0.1).abs() < 1e-6 && (m.l2 - 0.01).abs() < 1e-6 && (m.rmse - 0.1).abs() < 1e-6);
+        assert!(
+            (m.l1 - 0.1).abs() < 1e-6 && (m.l2 - 0.01).abs() < 1e-6 && (m.rmse - 0.1).abs() < 1e-6
+        );
         let mape: f64 = r.iter().map(|v| 0.1 / (v.x as f64 + 0.01)).sum::<f64>() / r.len() as f64;
         assert!((m.mape - mape).abs() < 1e-6, "{} vs {mape}", m.mape);
-        let log: f64 = r.iter().map(|v| ((1.1 + v.x as f64) / (1.0 + v.x as f64)).ln()).sum::<f64>() / r.len() as f64;
+        let log: f64 = r
+            .iter()
+            .map(|v| ((1.1 + v.x as f64) / (1.0 + v.x as f64)).ln())
+            .sum::<f64>()
+            / r.len() as f64;
         assert!((m.log_l1 - log).abs() < 1e-6);
         assert!(m.dssim > 0.0);
         // Background pixels carry no error, whatever they hold.
@@ -178,7 +200,9 @@ mod tests {
     #[test]
     fn ssim_drops_with_structure_loss() {
         let (w, h) = (24, 24);
-        let r = image(w, h, |x, y| Vec3::splat(((x / 3 + y / 3) % 2) as f32 * 0.8 + 0.1));
+        let r = image(w, h, |x, y| {
+            Vec3::splat(((x / 3 + y / 3) % 2) as f32 * 0.8 + 0.1)
+        });
         let flat = vec![Vec3::splat(0.5); w * h];
         let mask = vec![1.0; w * h];
         let s = ssim(&flat, &r, &mask, w);

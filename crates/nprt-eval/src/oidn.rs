@@ -39,7 +39,17 @@ pub fn search_dirs() -> Vec<PathBuf> {
 type NewDevice = unsafe extern "C" fn(i32) -> *mut c_void;
 type Handle = unsafe extern "C" fn(*mut c_void);
 type NewFilter = unsafe extern "C" fn(*mut c_void, *const c_char) -> *mut c_void;
-type SetImage = unsafe extern "C" fn(*mut c_void, *const c_char, *mut c_void, i32, usize, usize, usize, usize, usize);
+type SetImage = unsafe extern "C" fn(
+    *mut c_void,
+    *const c_char,
+    *mut c_void,
+    i32,
+    usize,
+    usize,
+    usize,
+    usize,
+    usize,
+);
 type SetBool = unsafe extern "C" fn(*mut c_void, *const c_char, bool);
 type GetError = unsafe extern "C" fn(*mut c_void, *mut *const c_char) -> i32;
 
@@ -68,13 +78,22 @@ impl Oidn {
     fn open_in(dir: &Path) -> Result<Self> {
         // SAFETY: these are OIDN's own libraries; loading runs only their initialisers. TBB
         // first, so that OIDN's dependency on it resolves to this copy.
-        let tbb = unsafe { Library::new(dir.join(TBB)) }.with_context(|| format!("cannot load {}", dir.join(TBB).display()))?;
-        let lib = unsafe { Library::new(dir.join(LIB)) }.with_context(|| format!("cannot load {}", dir.join(LIB).display()))?;
+        let tbb = unsafe { Library::new(dir.join(TBB)) }
+            .with_context(|| format!("cannot load {}", dir.join(TBB).display()))?;
+        let lib = unsafe { Library::new(dir.join(LIB)) }
+            .with_context(|| format!("cannot load {}", dir.join(LIB).display()))?;
         Ok(Oidn { lib, _tbb: tbb })
     }
 
     /// Denoises HDR `color` with `albedo` and `normal` auxiliary images (the "RT" filter).
-    pub fn denoise(&self, color: &[Vec3], albedo: &[Vec3], normal: &[Vec3], width: usize, height: usize) -> Result<Vec<Vec3>> {
+    pub fn denoise(
+        &self,
+        color: &[Vec3],
+        albedo: &[Vec3],
+        normal: &[Vec3],
+        width: usize,
+        height: usize,
+    ) -> Result<Vec<Vec3>> {
         let n = width * height;
         if color.len() != n || albedo.len() != n || normal.len() != n {
             bail!("denoiser inputs of mismatched sizes");
@@ -84,7 +103,10 @@ impl Oidn {
         // that outlive the filter's execution, and both handles are released before returning.
         unsafe {
             let sym = |name: &str| -> Result<*const ()> {
-                let s: Symbol<*const ()> = self.lib.get(name.as_bytes()).with_context(|| format!("OIDN lacks {name}"))?;
+                let s: Symbol<*const ()> = self
+                    .lib
+                    .get(name.as_bytes())
+                    .with_context(|| format!("OIDN lacks {name}"))?;
                 Ok(*s)
             };
             let new_device: NewDevice = std::mem::transmute(sym("oidnNewDevice")?);
@@ -112,7 +134,17 @@ impl Oidn {
             ];
             for (name, ptr) in images {
                 let name = CString::new(name).expect("no NUL");
-                set_image(filter, name.as_ptr(), ptr, FLOAT3, width, height, 0, 12, 12 * width);
+                set_image(
+                    filter,
+                    name.as_ptr(),
+                    ptr,
+                    FLOAT3,
+                    width,
+                    height,
+                    0,
+                    12,
+                    12 * width,
+                );
             }
             set_bool(filter, c"hdr".as_ptr(), true);
             commit_filter(filter);
@@ -122,7 +154,11 @@ impl Oidn {
             release_filter(filter);
             release_device(device);
             if code != 0 {
-                let text = if msg.is_null() { String::new() } else { CStr::from_ptr(msg).to_string_lossy().into_owned() };
+                let text = if msg.is_null() {
+                    String::new()
+                } else {
+                    CStr::from_ptr(msg).to_string_lossy().into_owned()
+                };
                 bail!("OIDN failed (error {code}): {text}");
             }
         }

@@ -7,10 +7,10 @@ use std::path::{Path, PathBuf};
 use anyhow::{Context, Result};
 use base64::Engine;
 use glam::Vec3;
+use nprt_io::{write_atomically, write_file};
 use nprt_net::curves::plot_lines;
 use nprt_render::video::to_image;
 use nprt_scene::luminance;
-use nprt_trace::exr_io::write_atomically;
 
 use crate::evaluate::{Evaluation, ShownView, BINS};
 use crate::metrics::{Metrics, RELATIVE_EPS};
@@ -22,7 +22,10 @@ const ZOOM: usize = 3;
 
 /// Exposure (stops) putting the 90th percentile of the foreground's luminance at 0.7.
 fn auto_exposure(v: &ShownView) -> f32 {
-    let mut l: Vec<f32> = (0..v.mask.len()).filter(|&i| v.mask[i] > 0.5).map(|i| luminance(v.reference[i])).collect();
+    let mut l: Vec<f32> = (0..v.mask.len())
+        .filter(|&i| v.mask[i] > 0.5)
+        .map(|i| luminance(v.reference[i]))
+        .collect();
     if l.is_empty() {
         return 0.0;
     }
@@ -32,7 +35,12 @@ fn auto_exposure(v: &ShownView) -> f32 {
 
 /// Black → purple → orange → pale yellow.
 fn heat(t: f32) -> Vec3 {
-    const STOPS: [Vec3; 4] = [Vec3::new(0.0, 0.0, 0.02), Vec3::new(0.45, 0.07, 0.5), Vec3::new(0.95, 0.45, 0.1), Vec3::new(1.0, 1.0, 0.75)];
+    const STOPS: [Vec3; 4] = [
+        Vec3::new(0.0, 0.0, 0.02),
+        Vec3::new(0.45, 0.07, 0.5),
+        Vec3::new(0.95, 0.45, 0.1),
+        Vec3::new(1.0, 1.0, 0.75),
+    ];
     let x = t.clamp(0.0, 1.0) * 3.0;
     let i = (x as usize).min(2);
     STOPS[i].lerp(STOPS[i + 1], x - i as f32)
@@ -56,15 +64,26 @@ fn heat_map(pred: &[Vec3], v: &ShownView) -> Vec<Vec3> {
 /// The square window (x0, y0, side) around the largest error of `pred`, smoothed over the
 /// window.
 fn crop_window(pred: &[Vec3], v: &ShownView) -> (usize, usize, usize) {
-    let side = (v.width.min(v.height) / 3).max(8).min(v.width.min(v.height));
+    let side = (v.width.min(v.height) / 3)
+        .max(8)
+        .min(v.width.min(v.height));
     let err: Vec<f32> = (0..v.mask.len())
-        .map(|i| if v.mask[i] > 0.5 { (pred[i] - v.reference[i]).abs().element_sum() } else { 0.0 })
+        .map(|i| {
+            if v.mask[i] > 0.5 {
+                (pred[i] - v.reference[i]).abs().element_sum()
+            } else {
+                0.0
+            }
+        })
         .collect();
     let mut best = (0.0, 0, 0);
     let step = (side / 4).max(1);
     for y0 in (0..=v.height - side).step_by(step) {
         for x0 in (0..=v.width - side).step_by(step) {
-            let s: f32 = (y0..y0 + side).flat_map(|y| (x0..x0 + side).map(move |x| (x, y))).map(|(x, y)| err[y * v.width + x]).sum();
+            let s: f32 = (y0..y0 + side)
+                .flat_map(|y| (x0..x0 + side).map(move |x| (x, y)))
+                .map(|(x, y)| err[y * v.width + x])
+                .sum();
             if s > best.0 {
                 best = (s, x0, y0);
             }
@@ -75,20 +94,26 @@ fn crop_window(pred: &[Vec3], v: &ShownView) -> (usize, usize, usize) {
 
 fn crop(img: &[Vec3], width: usize, (x0, y0, side): (usize, usize, usize)) -> Vec<Vec3> {
     let n = side * ZOOM;
-    (0..n * n).map(|i| img[(y0 + (i / n) / ZOOM) * width + x0 + (i % n) / ZOOM]).collect()
+    (0..n * n)
+        .map(|i| img[(y0 + (i / n) / ZOOM) * width + x0 + (i % n) / ZOOM])
+        .collect()
 }
 
 fn save(dir: &Path, name: &str, rgb: &[Vec3], w: usize, h: usize, exposure: f32) -> Result<String> {
     let file = format!("images/{name}.png");
     let img = to_image(rgb, w, h, exposure);
     let path = dir.join(&file);
-    write_atomically(&path, |tmp| Ok(img.save_with_format(tmp, image::ImageFormat::Png)?))?;
+    write_atomically(&path, |tmp| {
+        Ok(img.save_with_format(tmp, image::ImageFormat::Png)?)
+    })?;
     Ok(file)
 }
 
 /// A method name as a file-name part.
 fn slug(name: &str) -> String {
-    name.chars().map(|c| if c.is_ascii_alphanumeric() { c } else { '-' }).collect()
+    name.chars()
+        .map(|c| if c.is_ascii_alphanumeric() { c } else { '-' })
+        .collect()
 }
 
 fn fmt(v: f64) -> String {
@@ -103,7 +128,8 @@ fn fmt(v: f64) -> String {
 
 /// Writes the report folder; returns the paths of report.md and report.html.
 pub fn write_report(e: &Evaluation, dir: &Path) -> Result<(PathBuf, PathBuf)> {
-    std::fs::create_dir_all(dir.join("images")).with_context(|| format!("cannot create report folder '{}'", dir.display()))?;
+    std::fs::create_dir_all(dir.join("images"))
+        .with_context(|| format!("cannot create report folder '{}'", dir.display()))?;
     let mut md = String::new();
     writeln!(md, "# nprt evaluation\n")?;
     writeln!(
@@ -124,9 +150,18 @@ pub fn write_report(e: &Evaluation, dir: &Path) -> Result<(PathBuf, PathBuf)> {
     for n in Metrics::NAMES {
         write!(md, " {n} |")?;
     }
-    writeln!(md, " ms / view |\n|---|---|{}---|", "---|".repeat(Metrics::NAMES.len()))?;
+    writeln!(
+        md,
+        " ms / view |\n|---|---|{}---|",
+        "---|".repeat(Metrics::NAMES.len())
+    )?;
     for m in &e.methods {
-        write!(md, "| {} | {} |", m.name, m.params.map_or("–".into(), |p| p.to_string()))?;
+        write!(
+            md,
+            "| {} | {} |",
+            m.name,
+            m.params.map_or("–".into(), |p| p.to_string())
+        )?;
         for v in m.mean.values() {
             write!(md, " {} |", fmt(v))?;
         }
@@ -137,14 +172,22 @@ pub fn write_report(e: &Evaluation, dir: &Path) -> Result<(PathBuf, PathBuf)> {
         writeln!(md, "- {}: {}", m.name, m.note)?;
     }
     if let Some(p) = e.methods.iter().find_map(|m| m.precompute_ms) {
-        writeln!(md, "- SH transport precomputation: {:.0} ms per view (not counted in ms / view).", p)?;
+        writeln!(
+            md,
+            "- SH transport precomputation: {:.0} ms per view (not counted in ms / view).",
+            p
+        )?;
     }
     writeln!(md, "- Denoiser: {}.\n", e.denoiser)?;
     writeln!(md, "## The paper's claims, here\n")?;
     for (claim, ok) in e.checks() {
         writeln!(md, "- {} {claim}", if ok { "✅" } else { "❌" })?;
     }
-    writeln!(md, "\n## Timings at {0}×{0} (the paper's Tables 3 and 4)\n", e.timing_res)?;
+    writeln!(
+        md,
+        "\n## Timings at {0}×{0} (the paper's Tables 3 and 4)\n",
+        e.timing_res
+    )?;
     writeln!(md, "Median of three runs on this machine's CPU (the paper: an RTX 3090).\n\n| stage | ms |\n|---|---|")?;
     for t in &e.timings {
         writeln!(md, "| {} | {:.1} |", t.what, t.ms)?;
@@ -152,20 +195,47 @@ pub fn write_report(e: &Evaluation, dir: &Path) -> Result<(PathBuf, PathBuf)> {
     writeln!(md, "\n## Error analysis\n")?;
     writeln!(md, "Pearson correlation, over foreground pixels of all test views, of the per-pixel L1 error with the \
         directness (share of direct light in the reference) and with the specularity (|ks| / (|kd| + |ks|)).\n")?;
-    writeln!(md, "| method | corr(error, directness) | corr(error, specularity) |\n|---|---|---|")?;
+    writeln!(
+        md,
+        "| method | corr(error, directness) | corr(error, specularity) |\n|---|---|---|"
+    )?;
     for m in &e.methods {
-        writeln!(md, "| {} | {:.3} | {:.3} |", m.name, m.corr_directness, m.corr_specularity)?;
+        writeln!(
+            md,
+            "| {} | {:.3} | {:.3} |",
+            m.name, m.corr_directness, m.corr_specularity
+        )?;
     }
     for (file, title, x, pick) in [
-        ("error-vs-directness", "mean L1 error against directness", "share of direct light", 0),
-        ("error-vs-specularity", "mean L1 error against specularity", "specularity", 1),
+        (
+            "error-vs-directness",
+            "mean L1 error against directness",
+            "share of direct light",
+            0,
+        ),
+        (
+            "error-vs-specularity",
+            "mean L1 error against specularity",
+            "specularity",
+            1,
+        ),
     ] {
         let series: Vec<(String, Vec<(f64, f64)>)> = e
             .methods
             .iter()
             .map(|m| {
-                let v = if pick == 0 { &m.error_by_directness } else { &m.error_by_specularity };
-                (m.name.clone(), v.iter().enumerate().map(|(k, &y)| ((k as f64 + 0.5) / BINS as f64, y)).collect())
+                let v = if pick == 0 {
+                    &m.error_by_directness
+                } else {
+                    &m.error_by_specularity
+                };
+                (
+                    m.name.clone(),
+                    v.iter()
+                        .enumerate()
+                        .map(|(k, &y)| ((k as f64 + 0.5) / BINS as f64, y))
+                        .collect(),
+                )
             })
             .collect();
         let rel = format!("images/{file}.png");
@@ -177,20 +247,39 @@ pub fn write_report(e: &Evaluation, dir: &Path) -> Result<(PathBuf, PathBuf)> {
         (|error| / (reference + {RELATIVE_EPS}), black 0 → pale yellow ≥ {HEAT_MAX}). Exposure set per view from the reference.\n")?;
     for v in &e.shown {
         let exposure = auto_exposure(v);
-        let first = v.methods.first().map(|m| m.1.as_slice()).unwrap_or(&v.reference);
+        let first = v
+            .methods
+            .first()
+            .map(|m| m.1.as_slice())
+            .unwrap_or(&v.reference);
         let window = crop_window(first, v);
-        let all = std::iter::once(("reference".to_string(), &v.reference)).chain(v.methods.iter().map(|(n, r)| (n.clone(), r)));
+        let all = std::iter::once(("reference".to_string(), &v.reference))
+            .chain(v.methods.iter().map(|(n, r)| (n.clone(), r)));
         writeln!(md, "### Test view {}\n", v.index)?;
         writeln!(md, "| method | frame | crop | error |\n|---|---|---|---|")?;
         for (name, rgb) in all {
             let stem = format!("view{}-{}", v.index, slug(&name));
             let full = save(dir, &stem, rgb, v.width, v.height, exposure)?;
             let side = window.2 * ZOOM;
-            let cr = save(dir, &format!("{stem}-crop"), &crop(rgb, v.width, window), side, side, exposure)?;
+            let cr = save(
+                dir,
+                &format!("{stem}-crop"),
+                &crop(rgb, v.width, window),
+                side,
+                side,
+                exposure,
+            )?;
             let err = if name == "reference" {
                 String::new()
             } else {
-                let f = save(dir, &format!("{stem}-error"), &heat_map(rgb, v), v.width, v.height, 0.0)?;
+                let f = save(
+                    dir,
+                    &format!("{stem}-error"),
+                    &heat_map(rgb, v),
+                    v.width,
+                    v.height,
+                    0.0,
+                )?;
                 format!("![]({f})")
             };
             writeln!(md, "| {name} | ![]({full}) | ![]({cr}) | {err} |")?;
@@ -200,48 +289,66 @@ pub fn write_report(e: &Evaluation, dir: &Path) -> Result<(PathBuf, PathBuf)> {
     writeln!(md, "## Training curves\n")?;
     for m in e.methods.iter().filter(|m| m.loss_png.is_some()) {
         let rel = format!("images/loss-{}.png", slug(&m.name));
-        std::fs::copy(m.loss_png.as_ref().unwrap(), dir.join(&rel)).with_context(|| format!("cannot copy the training curve of {}", m.name))?;
+        std::fs::copy(m.loss_png.as_ref().unwrap(), dir.join(&rel))
+            .with_context(|| format!("cannot copy the training curve of {}", m.name))?;
         writeln!(md, "![{}]({rel})\n", m.name)?;
     }
     let md_path = dir.join("report.md");
-    write_atomically(&md_path, |tmp| Ok(std::fs::write(tmp, &md)?))?;
+    write_file(&md_path, &md)?;
     let html_path = dir.join("report.html");
     let html = to_html(&md, dir)?;
-    write_atomically(&html_path, |tmp| Ok(std::fs::write(tmp, html)?))?;
+    write_file(&html_path, html)?;
     let json = serde_json::to_vec_pretty(e)?;
-    write_atomically(&dir.join("results.json"), |tmp| Ok(std::fs::write(tmp, &json)?))?;
+    write_file(&dir.join("results.json"), &json)?;
     Ok((md_path, html_path))
 }
 
 /// Renders the report's Markdown subset (headings, lists, pipe tables, images) as one HTML page
 /// with every image embedded as a data URI.
 fn to_html(md: &str, dir: &Path) -> Result<String> {
-    let esc = |s: &str| s.replace('&', "&amp;").replace('<', "&lt;").replace('>', "&gt;");
+    let esc = |s: &str| {
+        s.replace('&', "&amp;")
+            .replace('<', "&lt;")
+            .replace('>', "&gt;")
+    };
     let inline = |s: &str| -> Result<String> {
         // Images `![alt](file)` become embedded <img>; `code` spans become <code>.
         let mut out = String::new();
         let mut rest = s;
         while let Some(i) = rest.find("![") {
             out += &esc(&rest[..i]);
-            let close = rest[i..].find("](").map(|k| i + k).context("malformed image")?;
-            let end = rest[close..].find(')').map(|k| close + k).context("malformed image")?;
+            let close = rest[i..]
+                .find("](")
+                .map(|k| i + k)
+                .context("malformed image")?;
+            let end = rest[close..]
+                .find(')')
+                .map(|k| close + k)
+                .context("malformed image")?;
             let alt = &rest[i + 2..close];
             let file = &rest[close + 2..end];
-            let bytes = std::fs::read(dir.join(file)).with_context(|| format!("cannot read '{file}'"))?;
+            let bytes =
+                std::fs::read(dir.join(file)).with_context(|| format!("cannot read '{file}'"))?;
             let b64 = base64::engine::general_purpose::STANDARD.encode(bytes);
-            out += &format!("<img alt=\"{}\" src=\"data:image/png;base64,{b64}\">", esc(alt));
+            out += &format!(
+                "<img alt=\"{}\" src=\"data:image/png;base64,{b64}\">",
+                esc(alt)
+            );
             rest = &rest[end + 1..];
         }
         out += &esc(rest);
         let mut code = false;
-        Ok(out.split('`').enumerate().fold(String::new(), |mut acc, (k, part)| {
-            if k > 0 {
-                acc += if code { "</code>" } else { "<code>" };
-                code = !code;
-            }
-            acc += part;
-            acc
-        }))
+        Ok(out
+            .split('`')
+            .enumerate()
+            .fold(String::new(), |mut acc, (k, part)| {
+                if k > 0 {
+                    acc += if code { "</code>" } else { "<code>" };
+                    code = !code;
+                }
+                acc += part;
+                acc
+            }))
     };
     let mut html = String::from(
         "<!DOCTYPE html><html><head><meta charset=\"utf-8\"><title>nprt evaluation</title><style>\

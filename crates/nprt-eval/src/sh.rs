@@ -56,10 +56,12 @@ pub fn project(map: &EnvMap, bands: usize) -> Vec<Vec3> {
             let mut acc = vec![Vec3::ZERO; bands * bands];
             let mut y = [0.0; 25];
             let v = (row as f32 + 0.5) / h as f32;
-            let band = (pi * row as f32 / h as f32).cos() - (pi * (row + 1) as f32 / h as f32).cos();
+            let band =
+                (pi * row as f32 / h as f32).cos() - (pi * (row + 1) as f32 / h as f32).cos();
             let d_omega = 2.0 * pi / w as f32 * band;
             for col in 0..w {
-                let d = map.to_world() * uv_to_direction(Vec2::new((col as f32 + 0.5) / w as f32, v));
+                let d =
+                    map.to_world() * uv_to_direction(Vec2::new((col as f32 + 0.5) / w as f32, v));
                 basis(bands, d, &mut y);
                 let l = map.eval(d) * d_omega;
                 for (a, yk) in acc.iter_mut().zip(&y) {
@@ -83,8 +85,15 @@ pub struct ShTransport {
 
 impl ShTransport {
     /// Path-traces the transport of `camera`'s view at `settings.spp` paths per pixel.
-    pub fn precompute(ts: &TraceScene, camera: &Camera, bands: usize, settings: &RenderSettings) -> Self {
-        let transport = render_transport(ts, camera, settings, bands * bands, &|d, out| basis(bands, d, out));
+    pub fn precompute(
+        ts: &TraceScene,
+        camera: &Camera,
+        bands: usize,
+        settings: &RenderSettings,
+    ) -> Self {
+        let transport = render_transport(ts, camera, settings, bands * bands, &|d, out| {
+            basis(bands, d, out)
+        });
         ShTransport { bands, transport }
     }
 
@@ -92,7 +101,11 @@ impl ShTransport {
     pub fn truncated(&self, bands: usize) -> Self {
         ShTransport {
             bands,
-            transport: self.transport.iter().map(|t| t[..bands * bands].to_vec()).collect(),
+            transport: self
+                .transport
+                .iter()
+                .map(|t| t[..bands * bands].to_vec())
+                .collect(),
         }
     }
 
@@ -114,7 +127,10 @@ mod tests {
         let (w, h) = (256, 128);
         let texels = (0..w * h)
             .map(|i| {
-                let uv = Vec2::new(((i % w) as f32 + 0.5) / w as f32, ((i / w) as f32 + 0.5) / h as f32);
+                let uv = Vec2::new(
+                    ((i % w) as f32 + 0.5) / w as f32,
+                    ((i / w) as f32 + 0.5) / h as f32,
+                );
                 f(uv_to_direction(uv))
             })
             .collect();
@@ -129,9 +145,15 @@ mod tests {
         let mut y = [0.0; 25];
         for row in 0..h {
             let v = (row as f32 + 0.5) / h as f32;
-            let dw = (2.0 * std::f64::consts::PI / w as f64) * (std::f64::consts::PI / h as f64) * ((v as f64) * std::f64::consts::PI).sin();
+            let dw = (2.0 * std::f64::consts::PI / w as f64)
+                * (std::f64::consts::PI / h as f64)
+                * ((v as f64) * std::f64::consts::PI).sin();
             for col in 0..w {
-                basis(5, uv_to_direction(Vec2::new((col as f32 + 0.5) / w as f32, v)), &mut y);
+                basis(
+                    5,
+                    uv_to_direction(Vec2::new((col as f32 + 0.5) / w as f32, v)),
+                    &mut y,
+                );
                 for i in 0..25 {
                     for j in 0..25 {
                         gram[i * 25 + j] += (y[i] * y[j]) as f64 * dw;
@@ -142,7 +164,11 @@ mod tests {
         for i in 0..25 {
             for j in 0..25 {
                 let want = if i == j { 1.0 } else { 0.0 };
-                assert!((gram[i * 25 + j] - want).abs() < 2e-3, "<Y{i}, Y{j}> = {}", gram[i * 25 + j]);
+                assert!(
+                    (gram[i * 25 + j] - want).abs() < 2e-3,
+                    "<Y{i}, Y{j}> = {}",
+                    gram[i * 25 + j]
+                );
             }
         }
     }
@@ -151,8 +177,16 @@ mod tests {
     fn projects_known_functions() {
         // L(d) = 2 + d.y: c0 = 2·√(4π), the band-1 y coefficient = 0.4886·4π/3, rest 0.
         let c = project(&map_from(|d| Vec3::splat(2.0 + d.y)), 3);
-        assert!((c[0].x - 2.0 * (4.0 * std::f32::consts::PI).sqrt()).abs() < 2e-2, "{:?}", c[0]);
-        assert!((c[1].x - 0.488_602_5 * 4.0 * std::f32::consts::PI / 3.0).abs() < 2e-2, "{:?}", c[1]);
+        assert!(
+            (c[0].x - 2.0 * (4.0 * std::f32::consts::PI).sqrt()).abs() < 2e-2,
+            "{:?}",
+            c[0]
+        );
+        assert!(
+            (c[1].x - 0.488_602_5 * 4.0 * std::f32::consts::PI / 3.0).abs() < 2e-2,
+            "{:?}",
+            c[1]
+        );
         for k in 2..9 {
             assert!(c[k].abs().max_element() < 1e-2, "c{k} = {:?}", c[k]);
         }
@@ -160,6 +194,9 @@ mod tests {
         let rotated = project(&map_from(|d| Vec3::splat(1.0 + d.x)).rotated_y(90.0), 2);
         let plain = project(&map_from(|d| Vec3::splat(1.0 + d.x)), 2);
         assert!((rotated[0] - plain[0]).length() < 1e-2);
-        assert!((rotated[3].x.abs() + rotated[2].x.abs() - plain[3].x.abs()).abs() < 2e-2, "{rotated:?}");
+        assert!(
+            (rotated[3].x.abs() + rotated[2].x.abs() - plain[3].x.abs()).abs() < 2e-2,
+            "{rotated:?}"
+        );
     }
 }

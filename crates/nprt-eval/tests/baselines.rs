@@ -13,7 +13,12 @@ fn plane(kd: f32) -> (Scene, Camera) {
     let mut s = Scene::empty("plane");
     let mesh = Mesh {
         name: "plane".into(),
-        positions: vec![Vec3::new(-5.0, 0.0, -5.0), Vec3::new(5.0, 0.0, -5.0), Vec3::new(5.0, 0.0, 5.0), Vec3::new(-5.0, 0.0, 5.0)],
+        positions: vec![
+            Vec3::new(-5.0, 0.0, -5.0),
+            Vec3::new(5.0, 0.0, -5.0),
+            Vec3::new(5.0, 0.0, 5.0),
+            Vec3::new(-5.0, 0.0, 5.0),
+        ],
         normals: vec![],
         uvs: vec![],
         indices: vec![[0, 2, 1], [0, 3, 2]],
@@ -25,7 +30,14 @@ fn plane(kd: f32) -> (Scene, Camera) {
 }
 
 fn settings(spp: u32) -> RenderSettings {
-    RenderSettings { spp, max_depth: None, rr_depth: 5, seed: 7, filter: PixelFilter::Centre, progress: false }
+    RenderSettings {
+        spp,
+        max_depth: None,
+        rr_depth: 5,
+        seed: 7,
+        filter: PixelFilter::Centre,
+        progress: false,
+    }
 }
 
 #[test]
@@ -34,10 +46,15 @@ fn sh_prt_of_a_diffuse_plane_under_a_constant_sky_is_kd_times_l() {
     let ts = TraceScene::new(&scene);
     let t = ShTransport::precompute(&ts, &cam, 5, &settings(512));
     for bands in [3, 5] {
-        let rgb = t.truncated(bands).shade(&EnvMap::constant(Vec3::new(1.0, 2.0, 0.5)));
+        let rgb = t
+            .truncated(bands)
+            .shade(&EnvMap::constant(Vec3::new(1.0, 2.0, 0.5)));
         for px in &rgb {
             // Cosine-weighted sampling of a diffuse plane gives throughput kd exactly: no noise.
-            assert!((*px - Vec3::new(0.6, 1.2, 0.3)).abs().max_element() < 1e-3, "{bands} bands: {px}");
+            assert!(
+                (*px - Vec3::new(0.6, 1.2, 0.3)).abs().max_element() < 1e-3,
+                "{bands} bands: {px}"
+            );
         }
     }
 }
@@ -48,7 +65,10 @@ fn sh_prt_25_approaches_path_tracing_under_a_smooth_sky() {
     let (w, h) = (128, 64);
     let texels = (0..w * h)
         .map(|i| {
-            let d = uv_to_direction(Vec2::new(((i % w) as f32 + 0.5) / w as f32, ((i / w) as f32 + 0.5) / h as f32));
+            let d = uv_to_direction(Vec2::new(
+                ((i % w) as f32 + 0.5) / w as f32,
+                ((i / w) as f32 + 0.5) / h as f32,
+            ));
             Vec3::new(1.0 + 0.8 * d.y, 1.0 + 0.5 * d.x, 1.0 + 0.6 * d.y * d.y)
         })
         .collect();

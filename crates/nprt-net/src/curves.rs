@@ -4,7 +4,7 @@ use std::path::Path;
 use std::sync::Once;
 
 use anyhow::{anyhow, Result};
-use nprt_trace::exr_io::write_atomically;
+use nprt_io::write_atomically;
 use plotters::prelude::*;
 use plotters::style::FontStyle;
 
@@ -25,7 +25,7 @@ pub fn write_csv(path: &Path, rows: &[LossRow]) -> Result<()> {
             cell(r.val)
         );
     }
-    write_atomically(path, |tmp| Ok(std::fs::write(tmp, text)?))
+    nprt_io::write_file(path, text)
 }
 
 /// Rows of a loss.csv written by [`write_csv`]; none when it is missing, unreadable rows skipped.
@@ -61,13 +61,22 @@ fn register_font() {
 
 /// Training and validation loss against epochs, log-scaled.
 pub fn plot(path: &Path, rows: &[LossRow], title: &str) -> Result<()> {
-    let train: Vec<(f64, f64)> = rows.iter().filter_map(|r| Some((r.epoch, r.train?))).collect();
-    let val: Vec<(f64, f64)> = rows.iter().filter_map(|r| Some((r.epoch, r.val?))).collect();
+    let train: Vec<(f64, f64)> = rows
+        .iter()
+        .filter_map(|r| Some((r.epoch, r.train?)))
+        .collect();
+    let val: Vec<(f64, f64)> = rows
+        .iter()
+        .filter_map(|r| Some((r.epoch, r.val?)))
+        .collect();
     plot_lines(
         path,
         &format!("nprt training: {title}"),
         ("epoch", "log-L1 loss"),
-        &[("training".into(), train), ("validation (held-out lighting)".into(), val)],
+        &[
+            ("training".into(), train),
+            ("validation (held-out lighting)".into(), val),
+        ],
     )
 }
 
@@ -89,7 +98,11 @@ pub fn plot_lines(
     };
     let lo = values().fold(f64::INFINITY, f64::min);
     let hi = values().fold(0.0, f64::max);
-    let (lo, hi) = if lo < hi { (lo * 0.9, hi * 1.1) } else { (1e-3, 1.0) };
+    let (lo, hi) = if lo < hi {
+        (lo * 0.9, hi * 1.1)
+    } else {
+        (1e-3, 1.0)
+    };
     let xs = || series.iter().flat_map(|s| s.1.iter().map(|p| p.0));
     let x_min = xs().fold(0.0, f64::min);
     let x_max = xs().fold(1e-3, f64::max);
@@ -124,13 +137,21 @@ pub fn plot_lines(
             .map_err(err)?;
         for (i, (name, points)) in series.iter().enumerate() {
             let colour = PALETTE[i % PALETTE.len()];
-            let points: Vec<(f64, f64)> =
-                points.iter().copied().filter(|p| p.1.is_finite() && p.1 > 0.0).collect();
+            let points: Vec<(f64, f64)> = points
+                .iter()
+                .copied()
+                .filter(|p| p.1.is_finite() && p.1 > 0.0)
+                .collect();
             chart
-                .draw_series(LineSeries::new(points.iter().copied(), colour.stroke_width(2)))
+                .draw_series(LineSeries::new(
+                    points.iter().copied(),
+                    colour.stroke_width(2),
+                ))
                 .map_err(err)?
                 .label(name.as_str())
-                .legend(move |(x, y)| PathElement::new([(x, y), (x + 20, y)], colour.stroke_width(2)));
+                .legend(move |(x, y)| {
+                    PathElement::new([(x, y), (x + 20, y)], colour.stroke_width(2))
+                });
             chart
                 .draw_series(points.iter().map(|&p| Circle::new(p, 3, colour.filled())))
                 .map_err(err)?;
@@ -145,7 +166,14 @@ pub fn plot_lines(
         root.present().map_err(err)?;
     }
     write_atomically(path, |tmp| {
-        image::save_buffer_with_format(tmp, &buf, w, h, image::ExtendedColorType::Rgb8, image::ImageFormat::Png)?;
+        image::save_buffer_with_format(
+            tmp,
+            &buf,
+            w,
+            h,
+            image::ExtendedColorType::Rgb8,
+            image::ImageFormat::Png,
+        )?;
         Ok(())
     })
 }

@@ -37,7 +37,15 @@ pub fn pixel_features(
 
 /// The 19 inputs of pixel `i` of a G-buffer.
 pub fn gbuffer_features(bounds: &[[f32; 3]; 2], g: &GBuffer, i: usize) -> [f32; FEATURES] {
-    pixel_features(bounds, g.position[i], g.normal[i], g.view[i], g.kd[i], g.ks[i], g.alpha[i])
+    pixel_features(
+        bounds,
+        g.position[i],
+        g.normal[i],
+        g.view[i],
+        g.kd[i],
+        g.ks[i],
+        g.alpha[i],
+    )
 }
 
 /// The foreground pixels of one view.
@@ -138,9 +146,14 @@ fn load_view(
         features.extend(gbuffer_features(&manifest.bounds, g, i));
         radiance.extend(image.radiance[i].to_array());
     }
-    let map = maps
-        .get(view.map)
-        .with_context(|| format!("view '{}' names map {} of {}", view.file, view.map, maps.len()))?;
+    let map = maps.get(view.map).with_context(|| {
+        format!(
+            "view '{}' names map {} of {}",
+            view.file,
+            view.map,
+            maps.len()
+        )
+    })?;
     Ok(ViewSamples {
         features,
         radiance,

@@ -155,7 +155,9 @@ impl Track {
             features.clone().select(1, idx)
         };
         let out = match &self.transfer {
-            None => self.shading.forward(Tensor::cat(vec![code.clone(), inputs], 1)),
+            None => self
+                .shading
+                .forward(Tensor::cat(vec![code.clone(), inputs], 1)),
             Some(ft) => {
                 let s = ft.forward(inputs);
                 self.shading.forward(Tensor::cat(vec![s, code.clone()], 1))
@@ -183,7 +185,12 @@ pub struct NprtNet {
 }
 
 impl NprtNet {
-    pub fn new(init: &mut Init, design: Design, activation: Activation, encoder_width: usize) -> Self {
+    pub fn new(
+        init: &mut Init,
+        design: Design,
+        activation: Activation,
+        encoder_width: usize,
+    ) -> Self {
         let encoder = LightEncoder::new(init, encoder_width);
         let kinds: &[TrackKind] = match design {
             Design::Baseline | Design::Prt => &[TrackKind::Full],

@@ -79,7 +79,11 @@ impl Init {
         let id = ParamId::from(self.next_id);
         self.next_id += 1;
         let tensor = Tensor::from_data(data, (&self.device, self.dtype));
-        let tensor = if self.device.is_autodiff() { tensor.require_grad() } else { tensor };
+        let tensor = if self.device.is_autodiff() {
+            tensor.require_grad()
+        } else {
+            tensor
+        };
         Param::initialized(id, tensor)
     }
 

@@ -6,7 +6,6 @@ use anyhow::{bail, Context, Result};
 use burn::module::Module;
 use burn::store::{ModuleSnapshot, SafetensorsStore};
 use burn::tensor::Device;
-use nprt_trace::exr_io::write_atomically;
 use serde::{Deserialize, Serialize};
 
 use crate::design::{Design, NprtNet};
@@ -75,7 +74,7 @@ pub struct ModelFile {
 pub fn save_model(dir: &Path, file: &ModelFile, net: &NprtNet) -> Result<()> {
     save_weights(&dir.join(WEIGHTS_FILE), net, file.config.design.name())?;
     let json = serde_json::to_vec_pretty(file)?;
-    write_atomically(&dir.join(CONFIG_FILE), |tmp| Ok(std::fs::write(tmp, &json)?))
+    nprt_io::write_file(&dir.join(CONFIG_FILE), &json)
 }
 
 /// Weights as safetensors, tagged with the design (or other network kind) that produced them.
@@ -89,7 +88,7 @@ pub fn save_weights<M: Module>(path: &Path, net: &M, tag: &str) -> Result<()> {
     let bytes = store
         .get_bytes()
         .map_err(|e| anyhow::anyhow!("cannot serialise weights: {e}"))?;
-    write_atomically(path, |tmp| Ok(std::fs::write(tmp, &bytes)?))
+    nprt_io::write_file(path, &bytes)
 }
 
 /// Loads weights saved by [`save_weights`] into `net`, which must be of the same design.
@@ -142,7 +141,10 @@ fn read_design_tag(bytes: &[u8]) -> Result<String> {
 pub fn read_model_file(dir: &Path) -> Result<ModelFile> {
     let path = dir.join(CONFIG_FILE);
     let text = std::fs::read_to_string(&path).with_context(|| {
-        format!("'{}' is not a model folder (no readable {CONFIG_FILE})", dir.display())
+        format!(
+            "'{}' is not a model folder (no readable {CONFIG_FILE})",
+            dir.display()
+        )
     })?;
     let value: serde_json::Value = serde_json::from_str(&text)
         .with_context(|| format!("'{}' is not valid JSON", path.display()))?;
@@ -189,12 +191,19 @@ pub fn layer_table(net: &NprtNet) -> Vec<LayerRow> {
             1 => String::new(),
             _ => format!("{:?}.", track.kind).to_lowercase(),
         };
-        let parts = [("transfer", track.transfer.as_ref()), ("shading", Some(&track.shading))];
+        let parts = [
+            ("transfer", track.transfer.as_ref()),
+            ("shading", Some(&track.shading)),
+        ];
         for (part, mlp) in parts {
             let Some(mlp) = mlp else { continue };
             for (l, ([i, o], layer)) in mlp.shapes().into_iter().zip(&mlp.layers).enumerate() {
                 let last = l + 1 == mlp.layers.len();
-                let act = if last { "linear" } else { mlp.activation.name() };
+                let act = if last {
+                    "linear"
+                } else {
+                    mlp.activation.name()
+                };
                 rows.push(LayerRow {
                     name: format!("{track_name}{part}.{l}"),
                     shape: format!("{i}→{o} {act}"),

@@ -13,7 +13,6 @@ use anyhow::{bail, Context, Result};
 use burn::module::Module;
 use burn::optim::{AdamConfig, GradientsParams, ModuleOptimizer};
 use burn::tensor::{Device, Int, Tensor, TensorData};
-use indicatif::{ProgressBar, ProgressStyle};
 use rand::seq::SliceRandom;
 use rand::SeedableRng;
 use rand_pcg::Pcg64Mcg;
@@ -64,7 +63,13 @@ impl TrainOptions {
     /// that shapes the run must match; epochs may grow, reporting options may change.
     fn same_run(&self, other: &TrainOptions) -> bool {
         let key = |o: &TrainOptions| {
-            (o.batch_size, o.learning_rate.to_bits(), o.seed, o.views_per_batch, o.val_samples)
+            (
+                o.batch_size,
+                o.learning_rate.to_bits(),
+                o.seed,
+                o.views_per_batch,
+                o.val_samples,
+            )
         };
         key(self) == key(other)
     }
@@ -173,14 +178,18 @@ impl Batch {
             radiance: Vec::with_capacity(samples.len() * 3),
             view: Vec::with_capacity(samples.len()),
             scale: Vec::with_capacity(samples.len()),
-            lights: views.iter().flat_map(|v| v.light.pixels.iter().copied()).collect(),
+            lights: views
+                .iter()
+                .flat_map(|v| v.light.pixels.iter().copied())
+                .collect(),
             light_width: views.first().map_or(0, |v| v.light.width),
         };
         for &(v, p) in samples {
             let (view, p) = (views[v as usize], p as usize);
             b.features
                 .extend_from_slice(&view.features[p * FEATURES..(p + 1) * FEATURES]);
-            b.radiance.extend_from_slice(&view.radiance[p * 3..p * 3 + 3]);
+            b.radiance
+                .extend_from_slice(&view.radiance[p * 3..p * 3 + 3]);
             b.view.push(v as i64);
             b.scale.push(view.light.scale);
         }
@@ -199,12 +208,18 @@ impl Batch {
     pub fn forward(&self, net: &NprtNet, device: &Device) -> (Tensor<2>, Tensor<2>) {
         let n = self.len();
         let w = self.light_width;
-        let f = Tensor::from_data(TensorData::new(self.features.clone(), [n, FEATURES]), device);
+        let f = Tensor::from_data(
+            TensorData::new(self.features.clone(), [n, FEATURES]),
+            device,
+        );
         let r = Tensor::from_data(TensorData::new(self.radiance.clone(), [n, 3]), device);
         let v = Tensor::<1, Int>::from_data(TensorData::new(self.view.clone(), [n]), device);
         let s = Tensor::from_data(TensorData::new(self.scale.clone(), [n, 1]), device);
         let l = Tensor::from_data(
-            TensorData::new(self.lights.clone(), [self.lights.len() / (3 * w * w / 2), 3, w / 2, w]),
+            TensorData::new(
+                self.lights.clone(),
+                [self.lights.len() / (3 * w * w / 2), 3, w / 2, w],
+            ),
             device,
         );
         (net.forward(f, l, v, s), r)
@@ -226,7 +241,12 @@ fn group_batches(views: &[&ViewSamples], count: usize, rng: &mut Pcg64Mcg) -> Ve
 }
 
 /// Mean log-L1 loss over a fixed, evenly strided subset of the test views' pixels.
-pub fn validation_loss(net: &NprtNet, set: &TrainingSet, opts: &TrainOptions, device: &Device) -> f64 {
+pub fn validation_loss(
+    net: &NprtNet,
+    set: &TrainingSet,
+    opts: &TrainOptions,
+    device: &Device,
+) -> f64 {
     let views: Vec<&ViewSamples> = set.test.iter().filter(|v| !v.is_empty()).collect();
     let total: usize = views.iter().map(|v| v.len()).sum();
     if total == 0 {
@@ -326,7 +346,10 @@ pub fn train(
             eprintln!("resuming '{}' from epoch {at:.2}", out.display());
         }
         resumed_from_epoch = Some(at);
-        ck = Checkpoint { options: opts.clone(), ..saved };
+        ck = Checkpoint {
+            options: opts.clone(),
+            ..saved
+        };
     }
 
     let per_epoch: Vec<usize> = (0..opts.epochs)
@@ -334,7 +357,9 @@ pub fn train(
         .collect();
     let total_batches: usize = per_epoch.iter().sum();
     let done_batches: usize = per_epoch.iter().take(ck.epoch).sum::<usize>() + ck.batch;
-    let bar = progress_bar(opts.progress, total_batches as u64, done_batches as u64);
+    let bar = nprt_io::progress_bar(opts.progress, total_batches as u64, "training", "batches");
+    bar.set_position(done_batches as u64);
+    bar.reset_eta();
     let started = Instant::now();
     let seconds_before = ck.seconds;
     let mut last_checkpoint = Instant::now();
@@ -355,20 +380,31 @@ pub fn train(
                 continue;
             }
             let views: Vec<&ViewSamples> = group.iter().map(|&v| &set.train[v]).collect();
-            let batches = group_batches(&views, count, &mut rng_for(opts.seed, ck.epoch as u64, g as u64));
+            let batches = group_batches(
+                &views,
+                count,
+                &mut rng_for(opts.seed, ck.epoch as u64, g as u64),
+            );
             for (i, samples) in batches.iter().enumerate().skip(ck.batch - first) {
                 let batch = Batch::gather(&views, samples);
                 let (pred, reference) = batch.forward(&net, &device);
                 let loss = log_l1(pred, reference);
                 let value = loss.clone().into_scalar::<f32>() as f64;
-                ema = if ema.is_nan() { value } else { 0.98 * ema + 0.02 * value };
+                ema = if ema.is_nan() {
+                    value
+                } else {
+                    0.98 * ema + 0.02 * value
+                };
                 if ck.step > 200 {
                     best_ema = best_ema.min(ema);
                 }
                 if !value.is_finite() || ema > 10.0 * best_ema {
                     bar.abandon();
                     let kept = if checkpoint_dir(out).join(STATE_FILE).exists() {
-                        format!("the last good checkpoint in '{}' is kept", checkpoint_dir(out).display())
+                        format!(
+                            "the last good checkpoint in '{}' is kept",
+                            checkpoint_dir(out).display()
+                        )
                     } else {
                         "no checkpoint had been written yet".to_string()
                     };
@@ -432,7 +468,11 @@ pub fn train(
                     "epoch {:>4}/{}: train loss {:.5}, validation loss {val:.5}, {:.0} K samples/s",
                     ck.epoch,
                     opts.epochs,
-                    ck.history.iter().rev().find_map(|r| r.train).unwrap_or(last_train),
+                    ck.history
+                        .iter()
+                        .rev()
+                        .find_map(|r| r.train)
+                        .unwrap_or(last_train),
                     ck.samples as f64 / ck.seconds.max(1e-9) / 1e3
                 )
             });
@@ -441,8 +481,18 @@ pub fn train(
         last_checkpoint = Instant::now();
     }
     bar.finish_and_clear();
-    let final_val = ck.history.iter().rev().find_map(|r| r.val).unwrap_or(f64::NAN);
-    let final_train = ck.history.iter().rev().find_map(|r| r.train).unwrap_or(last_train);
+    let final_val = ck
+        .history
+        .iter()
+        .rev()
+        .find_map(|r| r.val)
+        .unwrap_or(f64::NAN);
+    let final_train = ck
+        .history
+        .iter()
+        .rev()
+        .find_map(|r| r.train)
+        .unwrap_or(last_train);
     Ok(TrainSummary {
         steps: ck.step,
         samples: ck.samples,
@@ -472,7 +522,7 @@ fn write_checkpoint(
     ck.weights = weights;
     ck.optimizer = optimizer;
     let json = serde_json::to_vec_pretty(ck)?;
-    nprt_trace::exr_io::write_atomically(&dir.join(STATE_FILE), |tmp| Ok(std::fs::write(tmp, &json)?))?;
+    nprt_io::write_file(&dir.join(STATE_FILE), &json)?;
     for entry in std::fs::read_dir(&dir)?.flatten() {
         let name = entry.file_name().to_string_lossy().to_string();
         if (name.starts_with("weights-") || name.starts_with("optimizer-"))
@@ -506,27 +556,15 @@ fn write_checkpoint(
     };
     save_model(out, &file, net)?;
     crate::curves::write_csv(&out.join("loss.csv"), &ck.history)?;
-    crate::curves::plot(&out.join("loss.png"), &ck.history, &format!(
-        "{} ({})",
-        ck.config.design.name(),
-        ck.config.activation.name()
-    ))
-}
-
-fn progress_bar(show: bool, total: u64, done: u64) -> ProgressBar {
-    if !show {
-        return ProgressBar::hidden();
-    }
-    let bar = ProgressBar::new(total);
-    bar.set_style(
-        ProgressStyle::with_template(
-            "{spinner} [{elapsed_precise}] {bar:30} {pos}/{len} batches, {msg}, ETA {eta}",
-        )
-        .expect("valid template"),
-    );
-    bar.set_position(done);
-    bar.reset_eta();
-    bar
+    crate::curves::plot(
+        &out.join("loss.png"),
+        &ck.history,
+        &format!(
+            "{} ({})",
+            ck.config.design.name(),
+            ck.config.activation.name()
+        ),
+    )
 }
 
 /// Training throughput in samples/s: `steps` full steps (forward, backward, Adam) on one
@@ -545,12 +583,17 @@ pub fn measure_throughput(
     let mut optim = AdamConfig::new().with_epsilon(1e-8).init();
     let mut rng = Pcg64Mcg::seed_from_u64(0);
     let w = config.encoder_width;
-    let mut random = |n: usize, scale: f32| -> Vec<f32> { (0..n).map(|_| rng.random::<f32>() * scale).collect() };
+    let mut random = |n: usize, scale: f32| -> Vec<f32> {
+        (0..n).map(|_| rng.random::<f32>() * scale).collect()
+    };
     let batch = Batch {
         features: random(batch_size * FEATURES, 1.0),
         radiance: random(batch_size * 3, 4.0),
         view: (0..batch_size).map(|i| (i % views) as i64).collect(),
-        scale: random(batch_size, 1.0).into_iter().map(|s| s + 0.5).collect(),
+        scale: random(batch_size, 1.0)
+            .into_iter()
+            .map(|s| s + 0.5)
+            .collect(),
         lights: random(views * 3 * w * w / 2, 1.0),
         light_width: w,
     };

@@ -13,7 +13,8 @@ use rand_pcg::Pcg64Mcg;
 fn transport_parameter_counts_are_the_papers() {
     for design in Design::ALL {
         for activation in [Activation::Siren, Activation::Relu] {
-            let net = ModelConfig::new(design, Some(activation)).build(&mut Init::new(0, &Device::flex()));
+            let net = ModelConfig::new(design, Some(activation))
+                .build(&mut Init::new(0, &Device::flex()));
             let (ours, paper) = (net.transport_params(), design.paper_params());
             match design {
                 Design::Dsep => assert!(
@@ -54,7 +55,12 @@ fn tiny_batch(init: &Init, n: usize, seed: u64) -> Tiny {
 }
 
 fn loss(net: &NprtNet, b: &Tiny) -> Tensor<1> {
-    let pred = net.forward(b.features.clone(), b.light.clone(), b.view.clone(), b.scale.clone());
+    let pred = net.forward(
+        b.features.clone(),
+        b.light.clone(),
+        b.view.clone(),
+        b.scale.clone(),
+    );
     log_l1(pred, b.reference.clone())
 }
 
@@ -159,13 +165,29 @@ fn saved_weights_load_into_a_fresh_network_exactly() {
         let before = value(loss(&other, &batch));
         load_weights(&path, &mut other, design.name()).unwrap();
         assert_eq!(value(loss(&other, &batch)), value(loss(&net, &batch)));
-        assert_ne!(before, value(loss(&net, &batch)), "different seeds give different nets");
+        assert_ne!(
+            before,
+            value(loss(&net, &batch)),
+            "different seeds give different nets"
+        );
         // Weights of one design refuse to load into another, naming both.
-        let wrong = if design == Design::Dsep { Design::Prt } else { Design::Dsep };
-        let mut wrong_net = ModelConfig { encoder_width: 64, ..ModelConfig::new(wrong, None) }
-            .build(&mut Init::new(1, &device));
-        let err = load_weights(&path, &mut wrong_net, wrong.name()).unwrap_err().to_string();
-        assert!(err.contains(design.name()) && err.contains(wrong.name()), "{err}");
+        let wrong = if design == Design::Dsep {
+            Design::Prt
+        } else {
+            Design::Dsep
+        };
+        let mut wrong_net = ModelConfig {
+            encoder_width: 64,
+            ..ModelConfig::new(wrong, None)
+        }
+        .build(&mut Init::new(1, &device));
+        let err = load_weights(&path, &mut wrong_net, wrong.name())
+            .unwrap_err()
+            .to_string();
+        assert!(
+            err.contains(design.name()) && err.contains(wrong.name()),
+            "{err}"
+        );
     }
     std::fs::remove_dir_all(&dir).ok();
 }

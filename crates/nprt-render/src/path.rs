@@ -47,7 +47,8 @@ impl CameraPath {
                 path.display()
             )
         })?;
-        p.check().with_context(|| format!("camera path '{}'", path.display()))?;
+        p.check()
+            .with_context(|| format!("camera path '{}'", path.display()))?;
         Ok(p)
     }
 
@@ -61,7 +62,10 @@ impl CameraPath {
                 bail!("keyframe {i} has a non-finite value or looks at its own position");
             }
             if !(1.0..179.0).contains(&k.fov_x_deg) {
-                bail!("keyframe {i} has a field of view of {}°, outside 1–179°", k.fov_x_deg);
+                bail!(
+                    "keyframe {i} has a field of view of {}°, outside 1–179°",
+                    k.fov_x_deg
+                );
             }
         }
         Ok(())
@@ -76,19 +80,24 @@ impl CameraPath {
         let half = (v.max - v.min) * 0.5;
         let reach = half.max_element().max(1e-3) * 4.0;
         let pan = v.spread_deg.to_radians().tan() * 0.6;
-        let keyframes = [(-0.8, 0.3, -1.0), (0.0, -0.3, 0.0), (0.8, 0.3, 1.0), (0.0, 0.6, 0.0)]
-            .iter()
-            .chain(std::iter::once(&(-0.8, 0.3, -1.0)))
-            .map(|&(a, b, turn): &(f32, f32, f32)| {
-                let position = centre + half * (side * a + Vec3::Y * b * 0.5 + look * b * 0.5);
-                let dir = (look + side * (pan * -turn)).normalize();
-                Keyframe {
-                    position: position.to_array(),
-                    target: (position + dir * reach).to_array(),
-                    fov_x_deg: v.fov_deg,
-                }
-            })
-            .collect();
+        let keyframes = [
+            (-0.8, 0.3, -1.0),
+            (0.0, -0.3, 0.0),
+            (0.8, 0.3, 1.0),
+            (0.0, 0.6, 0.0),
+        ]
+        .iter()
+        .chain(std::iter::once(&(-0.8, 0.3, -1.0)))
+        .map(|&(a, b, turn): &(f32, f32, f32)| {
+            let position = centre + half * (side * a + Vec3::Y * b * 0.5 + look * b * 0.5);
+            let dir = (look + side * (pan * -turn)).normalize();
+            Keyframe {
+                position: position.to_array(),
+                target: (position + dir * reach).to_array(),
+                fov_x_deg: v.fov_deg,
+            }
+        })
+        .collect();
         CameraPath { keyframes }
     }
 
@@ -97,7 +106,11 @@ impl CameraPath {
         let k = &self.keyframes;
         let n = k.len();
         let (pos, target, fov) = if n == 1 {
-            (Vec3::from(k[0].position), Vec3::from(k[0].target), k[0].fov_x_deg)
+            (
+                Vec3::from(k[0].position),
+                Vec3::from(k[0].target),
+                k[0].fov_x_deg,
+            )
         } else {
             let x = t.clamp(0.0, 1.0) * (n - 1) as f32;
             let i = (x.floor() as usize).min(n - 2);
@@ -131,7 +144,10 @@ mod tests {
         };
         for (t, x) in [(0.0, 0.0), (0.5, 1.0), (1.0, 3.0)] {
             let c = p.camera(t, 8, 8);
-            assert!((c.origin() - Vec3::new(x, 1.0, 0.0)).length() < 1e-5, "t={t}");
+            assert!(
+                (c.origin() - Vec3::new(x, 1.0, 0.0)).length() < 1e-5,
+                "t={t}"
+            );
             assert!((c.fov_deg - (40.0 + x)).abs() < 1e-4);
         }
     }
@@ -149,7 +165,10 @@ mod tests {
         p.check().unwrap();
         for i in 0..=20 {
             let o = p.camera(i as f32 / 20.0, 4, 4).origin();
-            assert!(o.cmpge(v.min - 1e-4).all() && o.cmple(v.max + 1e-4).all(), "{o}");
+            assert!(
+                o.cmpge(v.min - 1e-4).all() && o.cmple(v.max + 1e-4).all(),
+                "{o}"
+            );
         }
     }
 }

@@ -56,7 +56,10 @@ impl Relighter {
     pub fn light_code(&self, map: &EnvMap, rotation_deg: f32) -> LightCode {
         let input = LightInput::new(map, rotation_deg, self.file.config.encoder_width);
         let w = input.width;
-        let pixels = Tensor::from_data(TensorData::new(input.pixels, [1, 3, w / 2, w]), &self.device);
+        let pixels = Tensor::from_data(
+            TensorData::new(input.pixels, [1, 3, w / 2, w]),
+            &self.device,
+        );
         LightCode {
             code: self.net.encoder.forward(pixels),
             scale: input.scale,

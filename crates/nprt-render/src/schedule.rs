@@ -57,8 +57,15 @@ impl LightingSchedule {
         if segments.is_empty() {
             bail!("lighting schedule '{spec}' names no map");
         }
-        if let Some(s) = segments.iter().find(|s| !(s.weight > 0.0 && s.weight.is_finite())) {
-            bail!("lighting schedule '{spec}': segment '{}' has weight {}, must be > 0", s.map, s.weight);
+        if let Some(s) = segments
+            .iter()
+            .find(|s| !(s.weight > 0.0 && s.weight.is_finite()))
+        {
+            bail!(
+                "lighting schedule '{spec}': segment '{}' has weight {}, must be > 0",
+                s.map,
+                s.weight
+            );
         }
         let maps = segments
             .iter()

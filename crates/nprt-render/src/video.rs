@@ -8,7 +8,7 @@ use anyhow::{Context, Result};
 use glam::Vec3;
 use image::codecs::gif::{GifEncoder, Repeat};
 use image::{Delay, Frame, RgbImage, RgbaImage};
-use nprt_trace::exr_io::write_atomically;
+use nprt_io::write_atomically;
 
 /// Linear radiance scaled by 2^exposure, clamped, sRGB-encoded.
 pub fn srgb8(c: Vec3, exposure: f32) -> [u8; 3] {
@@ -32,9 +32,17 @@ pub fn to_image(rgb: &[Vec3], width: usize, height: usize, exposure: f32) -> Rgb
 }
 
 /// Writes a tone-mapped PNG atomically.
-pub fn write_png(rgb: &[Vec3], width: usize, height: usize, exposure: f32, path: &Path) -> Result<()> {
+pub fn write_png(
+    rgb: &[Vec3],
+    width: usize,
+    height: usize,
+    exposure: f32,
+    path: &Path,
+) -> Result<()> {
     let img = to_image(rgb, width, height, exposure);
-    write_atomically(path, |tmp| Ok(img.save_with_format(tmp, image::ImageFormat::Png)?))
+    write_atomically(path, |tmp| {
+        Ok(img.save_with_format(tmp, image::ImageFormat::Png)?)
+    })
 }
 
 /// Which animation was written.
@@ -59,13 +67,36 @@ pub fn write_animation(frames: &[PathBuf], fps: u32, stem: &Path) -> Result<Anim
         let list = dir.join("ffmpeg-frames.txt");
         let body: String = frames
             .iter()
-            .map(|f| format!("file '{}'\nduration {}\n", f.file_name().unwrap().to_string_lossy(), 1.0 / fps as f64))
+            .map(|f| {
+                format!(
+                    "file '{}'\nduration {}\n",
+                    f.file_name().unwrap().to_string_lossy(),
+                    1.0 / fps as f64
+                )
+            })
             .collect();
-        std::fs::write(&list, body).with_context(|| format!("cannot write '{}'", list.display()))?;
+        std::fs::write(&list, body)
+            .with_context(|| format!("cannot write '{}'", list.display()))?;
         let ok = Command::new("ffmpeg")
-            .args(["-y", "-loglevel", "error", "-f", "concat", "-safe", "0", "-i"])
+            .args([
+                "-y",
+                "-loglevel",
+                "error",
+                "-f",
+                "concat",
+                "-safe",
+                "0",
+                "-i",
+            ])
             .arg(&list)
-            .args(["-r", &fps.to_string(), "-pix_fmt", "yuv420p", "-vf", "pad=ceil(iw/2)*2:ceil(ih/2)*2"])
+            .args([
+                "-r",
+                &fps.to_string(),
+                "-pix_fmt",
+                "yuv420p",
+                "-vf",
+                "pad=ceil(iw/2)*2:ceil(ih/2)*2",
+            ])
             .arg(&mp4)
             .stdout(Stdio::null())
             .stderr(Stdio::null())
@@ -85,7 +116,12 @@ pub fn write_animation(frames: &[PathBuf], fps: u32, stem: &Path) -> Result<Anim
             let img: RgbaImage = image::open(f)
                 .with_context(|| format!("cannot read frame '{}'", f.display()))?
                 .to_rgba8();
-            enc.encode_frame(Frame::from_parts(img, 0, 0, Delay::from_numer_denom_ms(1000, fps)))?;
+            enc.encode_frame(Frame::from_parts(
+                img,
+                0,
+                0,
+                Delay::from_numer_denom_ms(1000, fps),
+            ))?;
         }
         Ok(())
     })?;

@@ -6,6 +6,7 @@ use std::path::Path;
 
 use anyhow::{bail, Context, Result};
 use exr::prelude::*;
+use nprt_io::write_atomically;
 
 /// Writes `channels` (name, row-major data of `width × height`) to `path`.
 pub fn write_channels(
@@ -36,37 +37,6 @@ pub fn write_channels(
         Image::from_layer(layer).write().to_file(tmp)?;
         Ok(())
     })
-}
-
-/// Creates the folder `path` goes in (the current one for a bare file name) and returns it.
-pub fn create_parent_dir(path: &Path) -> Result<&Path> {
-    let dir = path
-        .parent()
-        .filter(|p| !p.as_os_str().is_empty())
-        .unwrap_or(Path::new("."));
-    std::fs::create_dir_all(dir)
-        .with_context(|| format!("cannot create folder '{}'", dir.display()))?;
-    Ok(dir)
-}
-
-/// Creates `path`'s folder, lets `write` fill a temporary file beside `path`, then renames it
-/// into place, so readers never see a partial file and a killed run leaves none behind.
-pub fn write_atomically(path: &Path, write: impl FnOnce(&Path) -> Result<()>) -> Result<()> {
-    let dir = create_parent_dir(path)?;
-    let name = path
-        .file_name()
-        .with_context(|| format!("output path '{}' has no file name", path.display()))?;
-    let tmp = dir.join(format!(
-        ".{}.{}.tmp",
-        name.to_string_lossy(),
-        std::process::id()
-    ));
-    if let Err(e) = write(&tmp) {
-        let _ = std::fs::remove_file(&tmp);
-        return Err(e.context(format!("cannot write '{}'", path.display())));
-    }
-    std::fs::rename(&tmp, path)
-        .with_context(|| format!("cannot move '{}' into place", path.display()))
 }
 
 /// Reads every f32/f16 channel of the first layer: (width, height, name → data).

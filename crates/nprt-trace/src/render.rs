@@ -2,7 +2,6 @@
 //! same image whatever the thread count), a progress bar with ETA.
 
 use glam::{Vec2, Vec3};
-use indicatif::{ProgressBar, ProgressStyle};
 use nprt_scene::{Camera, EnvMap, Scene};
 use rand::{RngExt, SeedableRng};
 use rand_pcg::Pcg64Mcg;
@@ -63,18 +62,7 @@ struct PixelOut {
 
 pub fn render(ts: &TraceScene, camera: &Camera, env: &EnvMap, s: &RenderSettings) -> Frame {
     let (w, h) = (camera.width as usize, camera.height as usize);
-    let bar = if s.progress {
-        ProgressBar::new(h as u64)
-    } else {
-        ProgressBar::hidden()
-    };
-    bar.set_style(
-        ProgressStyle::with_template(
-            "{spinner} rendering [{bar:40}] {pos}/{len} rows, {elapsed} elapsed, ETA {eta}",
-        )
-        .expect("valid template")
-        .progress_chars("=> "),
-    );
+    let bar = nprt_io::progress_bar(s.progress, h as u64, "rendering", "rows");
     let path_settings = PathSettings {
         max_depth: s.max_depth.unwrap_or(u32::MAX),
         rr_depth: s.rr_depth,
@@ -195,7 +183,7 @@ pub fn render_transport(
         .into_par_iter()
         .map(|i| {
             let mut rng = Pcg64Mcg::seed_from_u64(mix(
-                s.seed.wrapping_mul(0x9e37_79b9_7f4a_7c15) ^ mix(i as u64),
+                s.seed.wrapping_mul(0x9e37_79b9_7f4a_7c15) ^ mix(i as u64)
             ));
             let mut t = vec![Vec3::ZERO; basis_len];
             let mut y_k = vec![0.0; basis_len];

@@ -71,7 +71,12 @@ const ENCODER_WIDTH: usize = 128;
 pub fn demo(a: DemoArgs) -> Result<()> {
     let p = if a.quick { QUICK } else { FULL };
     let start = Instant::now();
-    let step = |what: &str| println!("\n== {what} ({:.0} s so far)", start.elapsed().as_secs_f64());
+    let step = |what: &str| {
+        println!(
+            "\n== {what} ({:.0} s so far)",
+            start.elapsed().as_secs_f64()
+        )
+    };
     let data = a.out.join("dataset");
     step("1/5 generating the dataset: builtin:room under the built-in skies and indoor maps");
     crate::generate(GenerateArgs {
@@ -94,7 +99,11 @@ pub fn demo(a: DemoArgs) -> Result<()> {
     })?;
     let mut models = Vec::new();
     for (i, design) in Design::ALL.into_iter().enumerate() {
-        step(&format!("2/5 training design {} of 4: {}", i + 1, design.name()));
+        step(&format!(
+            "2/5 training design {} of 4: {}",
+            i + 1,
+            design.name()
+        ));
         let out = a.out.join("models").join(design.name());
         train(TrainArgs {
             data: data.clone(),
@@ -139,7 +148,11 @@ pub fn demo(a: DemoArgs) -> Result<()> {
     step("5/5 relighting a camera path under held-out lighting");
     let manifest = nprt_data::dataset::load_manifest(&data)?;
     let s = &manifest.settings;
-    let held_out: Vec<String> = s.test_maps.iter().map(|&k| s.envmaps[k].spec.clone()).collect();
+    let held_out: Vec<String> = s
+        .test_maps
+        .iter()
+        .map(|&k| s.envmaps[k].spec.clone())
+        .collect();
     let frames = a.out.join("relit");
     render(RenderArgs {
         model: models.last().expect("four models").clone(),
@@ -154,12 +167,18 @@ pub fn demo(a: DemoArgs) -> Result<()> {
         exposure: 0.0,
         exr: false,
     })?;
-    println!("\n== nprt demo done in {:.0} s", start.elapsed().as_secs_f64());
+    println!(
+        "\n== nprt demo done in {:.0} s",
+        start.elapsed().as_secs_f64()
+    );
     println!("report: {}", report.join("report.html").display());
     println!("relit frames: {}", frames.display());
     let l1 = |name: &str| e.method(name).map(|m| m.mean.l1);
     if let (Some(d), Some(b)) = (e.method("nprt-dsep"), e.method("nprt-baseline")) {
-        println!("headline: RMSE D/S {:.4} vs baseline design {:.4}", d.mean.rmse, b.mean.rmse);
+        println!(
+            "headline: RMSE D/S {:.4} vs baseline design {:.4}",
+            d.mean.rmse, b.mean.rmse
+        );
     }
     if let (Some(d), Some(sh)) = (l1("nprt-dsep"), l1("sh-prt-9")) {
         println!("headline: L1 D/S {d:.4} vs SH PRT (9) {sh:.4}, equal-time path tracing at {} spp {:.4}",
@@ -167,7 +186,14 @@ pub fn demo(a: DemoArgs) -> Result<()> {
             e.methods.iter().find(|m| m.name.starts_with("pt-equal-time")).map_or(f64::NAN, |m| m.mean.l1));
     }
     let failed = e.checks().into_iter().filter(|c| !c.1).count();
-    println!("{} of the paper's claims hold here{}", e.checks().len() - failed,
-        if failed > 0 { format!(", {failed} do not (see the report)") } else { String::new() });
+    println!(
+        "{} of the paper's claims hold here{}",
+        e.checks().len() - failed,
+        if failed > 0 {
+            format!(", {failed} do not (see the report)")
+        } else {
+            String::new()
+        }
+    );
     Ok(())
 }

@@ -4,8 +4,8 @@ use std::path::PathBuf;
 
 use anyhow::{bail, Result};
 use nprt_data::dataset::{load_manifest, MANIFEST};
-use nprt_eval::deep_shading::{self, DeepShadingFile, DeepShadingOptions};
 use nprt_data::views::load_views;
+use nprt_eval::deep_shading::{self, DeepShadingFile, DeepShadingOptions};
 use nprt_eval::{evaluate, write_report, EvalOptions, Evaluation};
 use nprt_net::data::open_recorded_maps;
 use nprt_net::encoder::check_input_width;
@@ -85,9 +85,15 @@ pub fn eval(a: EvalArgs) -> Result<Evaluation> {
     };
     let e = evaluate(&opts, &Device::flex())?;
     let (md, html) = write_report(&e, &a.out)?;
-    println!("{:<32} {:>10} {:>10} {:>10} {:>12}", "method", "L1", "RMSE", "dSSIM", "ms / view");
+    println!(
+        "{:<32} {:>10} {:>10} {:>10} {:>12}",
+        "method", "L1", "RMSE", "dSSIM", "ms / view"
+    );
     for m in &e.methods {
-        println!("{:<32} {:>10.5} {:>10.5} {:>10.5} {:>12.1}", m.name, m.mean.l1, m.mean.rmse, m.mean.dssim, m.ms_per_view);
+        println!(
+            "{:<32} {:>10.5} {:>10.5} {:>10.5} {:>12.1}",
+            m.name, m.mean.l1, m.mean.rmse, m.mean.dssim, m.ms_per_view
+        );
     }
     for (claim, ok) in e.checks() {
         println!("{} {claim}", if ok { "holds: " } else { "FAILS: " });
@@ -102,7 +108,9 @@ pub fn train_deep_shading(a: DeepShadingArgs) -> Result<()> {
         bail!("--epochs and --batch-views must be positive, and --lr a positive number");
     }
     let manifest = load_manifest(&a.data)?;
-    let hash = blake3::hash(&std::fs::read(a.data.join(MANIFEST))?).to_hex().to_string();
+    let hash = blake3::hash(&std::fs::read(a.data.join(MANIFEST))?)
+        .to_hex()
+        .to_string();
     let maps = open_recorded_maps(&manifest)?;
     let train = load_views(&a.data, &manifest, "train")?;
     let test = load_views(&a.data, &manifest, "test")?;

@@ -4,10 +4,12 @@ use std::path::PathBuf;
 use std::process::Command as Process;
 
 use anyhow::{bail, Context, Result};
-use nprt_net::Device;
 use nprt_net::data::TrainingSet;
 use nprt_net::encoder::check_input_width;
-use nprt_net::{layer_table, measure_throughput, Activation, Design, Init, ModelConfig, TrainOptions};
+use nprt_net::Device;
+use nprt_net::{
+    layer_table, measure_throughput, Activation, Design, Init, ModelConfig, TrainOptions,
+};
 
 #[derive(clap::Args)]
 pub struct ModelInfoArgs {
@@ -79,7 +81,11 @@ pub enum BenchCommand {
 #[derive(clap::Args)]
 pub struct BenchTrainArgs {
     /// Designs to measure, comma-separated.
-    #[arg(long, default_value = "baseline,prt,albedo,dsep", value_delimiter = ',')]
+    #[arg(
+        long,
+        default_value = "baseline,prt,albedo,dsep",
+        value_delimiter = ','
+    )]
     pub arch: Vec<Design>,
     /// siren or relu (default: each design's own).
     #[arg(long)]
@@ -97,7 +103,11 @@ pub struct BenchTrainArgs {
     python: Option<PathBuf>,
 }
 
-fn config(arch: Design, activation: Option<Activation>, encoder_width: usize) -> Result<ModelConfig> {
+fn config(
+    arch: Design,
+    activation: Option<Activation>,
+    encoder_width: usize,
+) -> Result<ModelConfig> {
     check_input_width(encoder_width)?;
     Ok(ModelConfig {
         encoder_width,
@@ -211,7 +221,9 @@ pub fn bench(cmd: BenchCommand) -> Result<()> {
     let peer = match &a.python {
         Some(py) => run_pytorch(py, &a, threads)?,
         None => {
-            println!("(no --python given: PyTorch peer skipped; bench/train_vs_pytorch.sh sets one up)");
+            println!(
+                "(no --python given: PyTorch peer skipped; bench/train_vs_pytorch.sh sets one up)"
+            );
             Vec::new()
         }
     };
@@ -256,13 +268,17 @@ fn run_pytorch(python: &PathBuf, a: &BenchTrainArgs, threads: usize) -> Result<V
     if !out.status.success() {
         bail!(
             "PyTorch peer failed: {}",
-            String::from_utf8_lossy(&out.stderr).lines().last().unwrap_or("")
+            String::from_utf8_lossy(&out.stderr)
+                .lines()
+                .last()
+                .unwrap_or("")
         );
     }
     String::from_utf8_lossy(&out.stdout)
         .lines()
         .map(|l| {
-            let v: serde_json::Value = serde_json::from_str(l).context("PyTorch peer printed non-JSON")?;
+            let v: serde_json::Value =
+                serde_json::from_str(l).context("PyTorch peer printed non-JSON")?;
             Ok((
                 v["design"].as_str().unwrap_or_default().to_string(),
                 v["samples_per_s"].as_f64().unwrap_or(f64::NAN),

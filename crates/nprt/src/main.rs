@@ -310,7 +310,7 @@ fn reference(a: ReferenceArgs) -> Result<()> {
         },
         progress: true,
     };
-    check_writable(&a.out)?;
+    nprt_io::check_writable(&a.out)?;
     let ts = TraceScene::new(&scene);
     let setup = t0.elapsed().as_secs_f64();
     let t1 = Instant::now();
@@ -338,16 +338,6 @@ fn reference(a: ReferenceArgs) -> Result<()> {
         m.z,
         a.out.display()
     );
-    Ok(())
-}
-
-/// Fails early, before a long render, if `path` cannot be written.
-pub(crate) fn check_writable(path: &Path) -> Result<()> {
-    let dir = nprt_trace::exr_io::create_parent_dir(path)?;
-    let probe = dir.join(format!(".nprt-write-test-{}", std::process::id()));
-    std::fs::write(&probe, b"")
-        .with_context(|| format!("output folder '{}' is not writable", dir.display()))?;
-    std::fs::remove_file(&probe).ok();
     Ok(())
 }
 

@@ -1,14 +1,14 @@
-//! `nprt render`: a trained model relighting a camera path under a lighting schedule.
+//! `nprt render`: flags for relighting a camera path under a lighting schedule; the work is
+//! `nprt_render::render_sequence`.
 
 use std::path::PathBuf;
-use std::time::Instant;
 
 use anyhow::{bail, Context, Result};
 use nprt_net::Device;
-use nprt_render::{background, write_animation, write_png, Animation, CameraPath, FrameTimings, LightingSchedule, Relighter};
-use nprt_trace::{render_gbuffer, TraceScene};
+use nprt_render::{render_sequence, Animation, CameraPath, LightingSchedule, Relighter, Sequence};
+use nprt_trace::TraceScene;
 
-use crate::{check_writable, parse_resolution};
+use crate::parse_resolution;
 
 /// Lighting when none is given: maps outside the built-in training set (`builtin` maps).
 pub const DEFAULT_LIGHTING: &str = "builtin:sky:30:250:3,builtin:indoor:9";
@@ -60,7 +60,10 @@ pub fn render(a: RenderArgs) -> Result<()> {
     let model = Relighter::load(&a.model, &device)?;
     let spec = match (&a.scene, model.file.scene.as_str()) {
         (Some(s), _) => s.clone(),
-        (None, "") => bail!("model '{}' does not record its scene; give --scene", a.model.display()),
+        (None, "") => bail!(
+            "model '{}' does not record its scene; give --scene",
+            a.model.display()
+        ),
         (None, s) => s.to_string(),
     };
     let scene = nprt_data::dataset::load_checked_scene(
@@ -70,92 +73,66 @@ pub fn render(a: RenderArgs) -> Result<()> {
     )?;
     let path = match &a.camera_path {
         Some(p) => CameraPath::load(p)?,
-        None => CameraPath::through_volume(scene.camera_volume.as_ref().with_context(|| {
-            format!("scene '{spec}' has no camera volume; give --camera-path")
-        })?),
+        None => {
+            CameraPath::through_volume(scene.camera_volume.as_ref().with_context(|| {
+                format!("scene '{spec}' has no camera volume; give --camera-path")
+            })?)
+        }
     };
-    let schedule = LightingSchedule::parse(&a.lighting, a.spin)?;
-    let frames_dir = a.out.join("frames");
-    check_writable(&frames_dir.join("x"))?;
-    let ts = TraceScene::new(&scene);
+    let lighting = LightingSchedule::parse(&a.lighting, a.spin)?;
+    let seq = Sequence {
+        path: &path,
+        lighting: &lighting,
+        frames: a.frames,
+        resolution: a.res,
+        fps: a.fps,
+        exposure: a.exposure,
+        exr: a.exr,
+        out: &a.out,
+    };
     let [w, h] = a.res;
     println!(
         "nprt render: {} ({}) on {spec}, {} frames at {w}×{h}, lighting {}",
         a.model.display(),
         model.file.config.design.name(),
         a.frames,
-        schedule.segments.iter().map(|s| s.map.as_str()).collect::<Vec<_>>().join(" → ")
+        lighting
+            .segments
+            .iter()
+            .map(|s| s.map.as_str())
+            .collect::<Vec<_>>()
+            .join(" → ")
     );
-    let mut csv = String::from("frame,map,rotation_deg,gbuffer_ms,encoder_ms,network_ms,total_ms\n");
-    let mut pngs = Vec::new();
-    let mut sum = FrameTimings::default();
-    let mut last: Option<(usize, f32)> = None;
-    let mut code = None;
-    let start = Instant::now();
-    for i in 0..a.frames {
-        let camera = path.camera(i as f32 / (a.frames.max(2) - 1) as f32, w, h);
-        let mut t = FrameTimings::default();
-        let clock = Instant::now();
-        let g = render_gbuffer(&ts, &camera);
-        t.gbuffer_ms = clock.elapsed().as_secs_f64() * 1e3;
-        let (k, rot) = schedule.at(i, a.frames);
-        if last != Some((k, rot)) {
-            // The encoder runs only when the lighting changes.
-            let clock = Instant::now();
-            code = Some(model.light_code(&schedule.maps[k], rot));
-            t.encoder_ms = clock.elapsed().as_secs_f64() * 1e3;
-            last = Some((k, rot));
-        }
-        let clock = Instant::now();
-        let mut rgb = model.shade(&g, code.as_ref().expect("code computed on the first frame"));
-        t.network_ms = clock.elapsed().as_secs_f64() * 1e3;
-        let map = schedule.maps[k].rotated_y(rot);
-        background(&camera, &map, &g.mask, &mut rgb);
-        let png = frames_dir.join(format!("{i:04}.png"));
-        write_png(&rgb, w as usize, h as usize, a.exposure, &png)?;
-        if a.exr {
-            let ch = (0..3)
-                .map(|c| (["R", "G", "B"][c].to_string(), rgb.iter().map(|v| v[c]).collect()))
-                .collect::<Vec<_>>();
-            nprt_trace::exr_io::write_channels(&png.with_extension("exr"), w as usize, h as usize, &ch)?;
-        }
-        pngs.push(png);
-        let eta = start.elapsed().as_secs_f64() / (i + 1) as f64 * (a.frames - i - 1) as f64;
+    let done = render_sequence(&model, &TraceScene::new(&scene), &seq, |f| {
+        let t = &f.timings;
         println!(
-            "frame {:>4}/{}: G-buffer {:7.1} ms, encoder {:6.1} ms, network {:8.1} ms (ETA {eta:.0} s)",
-            i + 1,
+            "frame {:>4}/{}: G-buffer {:7.1} ms, encoder {:6.1} ms, network {:8.1} ms (ETA {:.0} s)",
+            f.index + 1,
             a.frames,
             t.gbuffer_ms,
             t.encoder_ms,
-            t.network_ms
-        );
-        csv += &format!(
-            "{i},{},{rot:.3},{:.3},{:.3},{:.3},{:.3}\n",
-            schedule.segments[k].map,
-            t.gbuffer_ms,
-            t.encoder_ms,
             t.network_ms,
-            t.total_ms()
+            f.eta_s
         );
-        sum.gbuffer_ms += t.gbuffer_ms;
-        sum.encoder_ms += t.encoder_ms;
-        sum.network_ms += t.network_ms;
-    }
-    nprt_trace::exr_io::write_atomically(&a.out.join("timings.csv"), |tmp| Ok(std::fs::write(tmp, &csv)?))?;
-    let anim = write_animation(&pngs, a.fps, &a.out.join("animation"))?;
-    let n = a.frames as f64;
+    })?;
+    let m = done.mean;
     println!(
         "mean per frame: G-buffer {:.1} ms, encoder {:.1} ms (once per lighting change), network {:.1} ms; total {:.1} ms ({:.2} fps)",
-        sum.gbuffer_ms / n,
-        sum.encoder_ms / n,
-        sum.network_ms / n,
-        sum.total_ms() / n,
-        1e3 * n / sum.total_ms()
+        m.gbuffer_ms,
+        m.encoder_ms,
+        m.network_ms,
+        m.total_ms(),
+        1e3 / m.total_ms()
     );
-    let kind = match anim {
+    let kind = match done.animation {
         Animation::Mp4(_) => "MP4 (ffmpeg)",
         Animation::Gif(_) => "GIF (ffmpeg not on PATH or failed)",
     };
-    println!("wrote {} frames to {}, animation {} [{kind}]", a.frames, frames_dir.display(), anim.path().display());
+    println!(
+        "wrote {} frames to {}, animation {} [{kind}]",
+        a.frames,
+        done.frames_dir.display(),
+        done.animation.path().display()
+    );
     Ok(())
 }

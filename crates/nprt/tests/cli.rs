@@ -3,7 +3,7 @@
 
 mod common;
 
-use common::{fails, fresh_dir, nprt, shared};
+use common::{assets, fails, fresh_dir, nprt};
 use nprt_trace::exr_io::{read_channels, write_channels};
 
 /// A created scratch folder.
@@ -18,7 +18,7 @@ fn reference_renders_a_gltf_and_reports_speed() {
     let out_dir = tmp("ok");
     let exr = out_dir.join("bunny.exr");
     let png = out_dir.join("bunny.png");
-    let bunny = shared().join("models/bunny_plain.glb");
+    let bunny = assets().join("models/bunny_plain.glb");
     let o = nprt(&[
         "reference",
         bunny.to_str().unwrap(),
@@ -71,7 +71,7 @@ fn reference_renders_a_gltf_and_reports_speed() {
 #[test]
 fn draco_gltf_is_refused_by_name() {
     let out = tmp("draco").join("x.exr");
-    let bunny = shared().join("models/bunny.glb");
+    let bunny = assets().join("models/bunny.glb");
     fails(
         &[
             "reference",

@@ -9,18 +9,44 @@ use serde_json::Value;
 fn quick_demo_then_render_and_eval() {
     let dir = fresh_dir("demo");
     let out = ok(&["demo", "--quick", "--out", dir.to_str().unwrap()]);
-    assert!(out.contains("report: ") && out.contains("headline: RMSE D/S"), "{out}");
+    assert!(
+        out.contains("report: ") && out.contains("headline: RMSE D/S"),
+        "{out}"
+    );
 
     // The report: every design, every baseline, self-contained HTML, finite figures.
     let report = dir.join("report");
-    let results: Value = serde_json::from_str(&std::fs::read_to_string(report.join("results.json")).unwrap()).unwrap();
-    let names: Vec<&str> = results["methods"].as_array().unwrap().iter().map(|m| m["name"].as_str().unwrap()).collect();
-    for want in ["nprt-baseline", "nprt-prt", "nprt-albedo", "nprt-dsep", "deep-shading", "pt-5spp", "sh-prt-9", "sh-prt-25"] {
+    let results: Value =
+        serde_json::from_str(&std::fs::read_to_string(report.join("results.json")).unwrap())
+            .unwrap();
+    let names: Vec<&str> = results["methods"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|m| m["name"].as_str().unwrap())
+        .collect();
+    for want in [
+        "nprt-baseline",
+        "nprt-prt",
+        "nprt-albedo",
+        "nprt-dsep",
+        "deep-shading",
+        "pt-5spp",
+        "sh-prt-9",
+        "sh-prt-25",
+    ] {
         assert!(names.contains(&want), "{want} missing from {names:?}");
     }
-    assert!(names.iter().any(|n| n.starts_with("pt-equal-time")), "{names:?}");
+    assert!(
+        names.iter().any(|n| n.starts_with("pt-equal-time")),
+        "{names:?}"
+    );
     if std::env::var_os("NPRT_REQUIRE_OIDN").is_some() {
-        assert_eq!(names.iter().filter(|n| n.ends_with("+ OIDN")).count(), 2, "{names:?}");
+        assert_eq!(
+            names.iter().filter(|n| n.ends_with("+ OIDN")).count(),
+            2,
+            "{names:?}"
+        );
     }
     for m in results["methods"].as_array().unwrap() {
         for k in ["l1", "l2", "rmse", "dssim", "mape", "mrse", "log_l1"] {
@@ -29,24 +55,61 @@ fn quick_demo_then_render_and_eval() {
         }
     }
     // The parameter counts are the paper's (D/S within 2%) and Deep Shading's is comparable.
-    let params = |n: &str| results["methods"].as_array().unwrap().iter().find(|m| m["name"] == n).unwrap()["params"].as_u64().unwrap();
+    let params = |n: &str| {
+        results["methods"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .find(|m| m["name"] == n)
+            .unwrap()["params"]
+            .as_u64()
+            .unwrap()
+    };
     assert_eq!(params("nprt-baseline"), 219_651);
     assert!((180_000..230_000).contains(&params("deep-shading")));
-    let timings: Vec<&str> = results["timings"].as_array().unwrap().iter().map(|t| t["what"].as_str().unwrap()).collect();
-    for want in ["G-buffer (primary rays)", "nprt-dsep: encoder", "nprt-dsep: network", "deep-shading: network", "path tracing, 5 spp"] {
+    let timings: Vec<&str> = results["timings"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|t| t["what"].as_str().unwrap())
+        .collect();
+    for want in [
+        "G-buffer (primary rays)",
+        "nprt-dsep: encoder",
+        "nprt-dsep: network",
+        "deep-shading: network",
+        "path tracing, 5 spp",
+    ] {
         assert!(timings.contains(&want), "{want} missing from {timings:?}");
     }
     let md = std::fs::read_to_string(report.join("report.md")).unwrap();
-    for want in ["| nprt-dsep | 191226 |", "## Timings at", "## Error analysis", "corr(error, directness)", "images/error-vs-directness.png", "images/loss-nprt-dsep.png"] {
+    for want in [
+        "| nprt-dsep | 191226 |",
+        "## Timings at",
+        "## Error analysis",
+        "corr(error, directness)",
+        "images/error-vs-directness.png",
+        "images/loss-nprt-dsep.png",
+    ] {
         assert!(md.contains(want), "report.md lacks {want}");
     }
     let html = std::fs::read_to_string(report.join("report.html")).unwrap();
-    assert!(!html.contains("src=\"images/") && html.matches("data:image/png;base64,").count() > 20, "report.html must embed its images");
+    assert!(
+        !html.contains("src=\"images/") && html.matches("data:image/png;base64,").count() > 20,
+        "report.html must embed its images"
+    );
 
     // Deep Shading learns: a collapsed U-Net (all activations dead) repeats one validation loss.
     let csv = std::fs::read_to_string(dir.join("models/deep-shading/loss.csv")).unwrap();
-    let val: Vec<&str> = csv.lines().skip(1).map(|l| l.rsplit(',').next().unwrap()).collect();
-    assert!(val.len() == 2 && val[0] != val[1], "Deep Shading validation losses {val:?}");
+    let val: Vec<&str> = csv
+        .lines()
+        .skip(1)
+        .map(|l| l.rsplit(',').next().unwrap())
+        .collect();
+    assert!(
+        val.len() == 2 && val[0] != val[1],
+        "Deep Shading validation losses {val:?}"
+    );
 
     // The relit path: frames and an animation.
     let relit = dir.join("relit");
@@ -63,8 +126,26 @@ fn quick_demo_then_render_and_eval() {
     std::fs::write(&sched, r#"{"segments": [{"map": "builtin:indoor:12", "rotation_deg": [0, 90]}, {"map": "builtin:sky:50:10:3", "weight": 2}]}"#).unwrap();
     let r = dir.join("r");
     let m = model.to_str().unwrap();
-    let out = ok(&["render", "--model", m, "--out", r.to_str().unwrap(), "--camera-path", path.to_str().unwrap(), "--lighting", sched.to_str().unwrap(), "--frames", "3", "--res", "24x16", "--exr"]);
-    assert!(out.contains("frame    3/3: G-buffer") && out.contains("mean per frame"), "{out}");
+    let out = ok(&[
+        "render",
+        "--model",
+        m,
+        "--out",
+        r.to_str().unwrap(),
+        "--camera-path",
+        path.to_str().unwrap(),
+        "--lighting",
+        sched.to_str().unwrap(),
+        "--frames",
+        "3",
+        "--res",
+        "24x16",
+        "--exr",
+    ]);
+    assert!(
+        out.contains("frame    3/3: G-buffer") && out.contains("mean per frame"),
+        "{out}"
+    );
     assert!(r.join("frames/0002.exr").is_file() && r.join("frames/0002.png").is_file());
     let img = image::open(r.join("frames/0000.png")).unwrap();
     assert_eq!((img.width(), img.height()), (24, 16));
@@ -72,14 +153,65 @@ fn quick_demo_then_render_and_eval() {
     // Refusals, each naming what is wrong.
     let rr = dir.join("rr");
     let rr = rr.to_str().unwrap();
-    fails(&["render", "--model", m, "--out", rr, "--lighting", "builtin:moon"], &["builtin:moon"]);
-    fails(&["render", "--model", m, "--out", rr, "--frames", "0"], &["--frames"]);
+    fails(
+        &[
+            "render",
+            "--model",
+            m,
+            "--out",
+            rr,
+            "--lighting",
+            "builtin:moon",
+        ],
+        &["builtin:moon"],
+    );
+    fails(
+        &["render", "--model", m, "--out", rr, "--frames", "0"],
+        &["--frames"],
+    );
     std::fs::write(&path, "{\"keyframes\": []}").unwrap();
-    fails(&["render", "--model", m, "--out", rr, "--camera-path", path.to_str().unwrap()], &["path.json", "no keyframes"]);
-    let other_scene = concat!(env!("CARGO_MANIFEST_DIR"), "/../../tests/mitsuba/diffuse_room.xml");
-    fails(&["render", "--model", m, "--out", rr, "--scene", other_scene], &["is not the scene model"]);
-    fails(&["render", "--model", dir.join("nowhere").to_str().unwrap(), "--out", rr], &["nowhere", "not a model folder"]);
-    fails(&["eval", "--model", dir.join("nowhere").to_str().unwrap(), "--data", dir.join("dataset").to_str().unwrap(), "--out", rr], &["nowhere"]);
+    fails(
+        &[
+            "render",
+            "--model",
+            m,
+            "--out",
+            rr,
+            "--camera-path",
+            path.to_str().unwrap(),
+        ],
+        &["path.json", "no keyframes"],
+    );
+    let other_scene = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../../tests/mitsuba/diffuse_room.xml"
+    );
+    fails(
+        &["render", "--model", m, "--out", rr, "--scene", other_scene],
+        &["is not the scene model"],
+    );
+    fails(
+        &[
+            "render",
+            "--model",
+            dir.join("nowhere").to_str().unwrap(),
+            "--out",
+            rr,
+        ],
+        &["nowhere", "not a model folder"],
+    );
+    fails(
+        &[
+            "eval",
+            "--model",
+            dir.join("nowhere").to_str().unwrap(),
+            "--data",
+            dir.join("dataset").to_str().unwrap(),
+            "--out",
+            rr,
+        ],
+        &["nowhere"],
+    );
     let o = nprt(&["eval", "--help"]);
     assert!(String::from_utf8_lossy(&o.stdout).contains("--sh-spp"));
     std::fs::remove_dir_all(&dir).ok();

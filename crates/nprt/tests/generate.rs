@@ -5,7 +5,7 @@ mod common;
 
 use std::path::Path;
 
-use common::{fails, fresh_dir as tmp, nprt, ok, shared};
+use common::{assets, fails, fresh_dir as tmp, nprt, ok};
 
 const SMALL: &[&str] = &[
     "--scene",
@@ -206,12 +206,12 @@ fn bad_input_is_refused_before_anything_is_written() {
         maps.to_str().unwrap(),
         &["no .exr or .hdr"],
     );
-    std::fs::copy(shared().join("envmaps/sky.exr"), maps.join("sky.exr")).unwrap();
+    std::fs::copy(assets().join("envmaps/sky.exr"), maps.join("sky.exr")).unwrap();
     refused(o, "builtin:room", maps.to_str().unwrap(), &["at least 2"]);
     std::fs::write(maps.join("broken.exr"), b"not an exr").unwrap();
     refused(o, "builtin:room", maps.to_str().unwrap(), &["broken.exr"]);
     // A file scene without a camera volume; an unwritable folder; a bad shard.
-    let mesh = shared().join("models/bunny.ply");
+    let mesh = assets().join("models/bunny.ply");
     refused(
         o,
         mesh.to_str().unwrap(),
@@ -250,7 +250,7 @@ fn real_maps_and_a_file_scene_with_flags_work() {
         "--scene",
         xml.to_str().unwrap(),
         "--envmaps",
-        shared().join("envmaps").to_str().unwrap(),
+        assets().join("envmaps").to_str().unwrap(),
         "--volume-min",
         "-1,1,2",
         "--volume-max",
@@ -269,7 +269,7 @@ fn real_maps_and_a_file_scene_with_flags_work() {
         "2",
     ]);
     assert!(
-        out.contains("under 10 maps") && out.contains("under 3 held-out maps"),
+        out.contains("under 2 maps") && out.contains("under 1 held-out maps"),
         "{out}"
     );
     assert!(ok(&["dataset", "verify", dir.to_str().unwrap()]).contains("3 of 3"));

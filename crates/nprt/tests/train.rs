@@ -13,9 +13,23 @@ fn dataset() -> &'static Path {
     DIR.get_or_init(|| {
         let dir = fresh_dir("train-data");
         ok(&[
-            "generate", "--scene", "builtin:room", "--envmaps", "builtin", "--out",
-            dir.to_str().unwrap(), "--train-views", "3", "--test-views", "1", "--train-res",
-            "12", "--test-res", "12", "--spp", "16",
+            "generate",
+            "--scene",
+            "builtin:room",
+            "--envmaps",
+            "builtin",
+            "--out",
+            dir.to_str().unwrap(),
+            "--train-views",
+            "3",
+            "--test-views",
+            "1",
+            "--train-res",
+            "12",
+            "--test-res",
+            "12",
+            "--spp",
+            "16",
         ]);
         dir
     })
@@ -25,9 +39,21 @@ fn dataset() -> &'static Path {
 fn train(out: &Path, arch: &str, extra: &[&str]) -> String {
     let data = dataset().to_str().unwrap();
     let mut args = vec![
-        "train", "--data", data, "--arch", arch, "--out", out.to_str().unwrap(),
-        "--encoder-width", "64", "--batch-size", "64", "--views-per-batch", "3",
-        "--val-samples", "256",
+        "train",
+        "--data",
+        data,
+        "--arch",
+        arch,
+        "--out",
+        out.to_str().unwrap(),
+        "--encoder-width",
+        "64",
+        "--batch-size",
+        "64",
+        "--views-per-batch",
+        "3",
+        "--val-samples",
+        "256",
     ];
     args.extend_from_slice(extra);
     ok(&args)
@@ -54,7 +80,11 @@ fn a_tiny_dataset_is_overfit() {
     for arch in ["prt", "dsep"] {
         let out = fresh_dir(&format!("overfit-{arch}"));
         // One full batch per epoch.
-        train(&out, arch, &["--epochs", "300", "--lr", "1e-3", "--batch-size", "4096"]);
+        train(
+            &out,
+            arch,
+            &["--epochs", "300", "--lr", "1e-3", "--batch-size", "4096"],
+        );
         let rows = losses(&out);
         let train: Vec<f64> = rows.iter().filter_map(|r| r.0).collect();
         let first = train[..3].iter().sum::<f64>() / 3.0;
@@ -63,7 +93,10 @@ fn a_tiny_dataset_is_overfit() {
             last < 0.03 && last < first / 8.0,
             "{arch}: training loss {first:.4} → {last:.4}"
         );
-        assert!(rows.iter().filter(|r| r.1.is_some()).count() == 300, "a validation loss per epoch");
+        assert!(
+            rows.iter().filter(|r| r.1.is_some()).count() == 300,
+            "a validation loss per epoch"
+        );
         let png = std::fs::read(out.join("loss.png")).unwrap();
         assert_eq!(&png[1..4], b"PNG");
         let info = ok(&["model", "info", "--model", out.to_str().unwrap()]);
@@ -80,7 +113,10 @@ fn resumed_training_equals_an_uninterrupted_run() {
     let out = train(&resumed, "albedo", &["--epochs", "3"]);
     assert!(out.contains("resumed from epoch 1.00"), "{out}");
     let weights = |d: &Path| std::fs::read(d.join("weights.safetensors")).unwrap();
-    assert!(weights(&straight) == weights(&resumed), "resumed weights differ");
+    assert!(
+        weights(&straight) == weights(&resumed),
+        "resumed weights differ"
+    );
     let val = |d: &Path| losses(d).iter().filter_map(|r| r.1).collect::<Vec<_>>();
     assert_eq!(val(&straight), val(&resumed));
     // The same seed gives the same model; another seed another one.
@@ -103,34 +139,89 @@ fn bad_runs_stop_clearly_and_keep_the_last_good_checkpoint() {
     let state = std::fs::read(out.join("checkpoint/state.json")).unwrap();
     // Another design (or dataset, or hyper-parameters) in the same folder is refused.
     fails(
-        &["train", "--data", data, "--arch", "prt", "--out", o, "--encoder-width", "64"],
+        &[
+            "train",
+            "--data",
+            data,
+            "--arch",
+            "prt",
+            "--out",
+            o,
+            "--encoder-width",
+            "64",
+        ],
         &["holds a run with other settings"],
     );
     // A learning rate that blows up stops with a clear message; the checkpoint is untouched.
     let boom = fresh_dir("diverge");
     let b = boom.to_str().unwrap();
     fails(
-        &["train", "--data", data, "--arch", "baseline", "--out", b, "--encoder-width", "64",
-          "--lr", "1e4", "--epochs", "5"],
+        &[
+            "train",
+            "--data",
+            data,
+            "--arch",
+            "baseline",
+            "--out",
+            b,
+            "--encoder-width",
+            "64",
+            "--lr",
+            "1e4",
+            "--epochs",
+            "5",
+        ],
         &["training diverged"],
     );
-    assert_eq!(std::fs::read(out.join("checkpoint/state.json")).unwrap(), state);
+    assert_eq!(
+        std::fs::read(out.join("checkpoint/state.json")).unwrap(),
+        state
+    );
     // Bad arguments and inputs.
     let bad = common::nprt(&["train", "--data", data, "--arch", "mlp", "--out", o]);
     assert!(!bad.status.success());
     assert!(String::from_utf8_lossy(&bad.stderr).contains("unknown design 'mlp'"));
     fails(
-        &["train", "--data", data, "--arch", "prt", "--out", o, "--encoder-width", "100"],
+        &[
+            "train",
+            "--data",
+            data,
+            "--arch",
+            "prt",
+            "--out",
+            o,
+            "--encoder-width",
+            "100",
+        ],
         &["multiple of 64"],
     );
     fails(
-        &["train", "--data", "/nonexistent/ds", "--arch", "prt", "--out", o],
+        &[
+            "train",
+            "--data",
+            "/nonexistent/ds",
+            "--arch",
+            "prt",
+            "--out",
+            o,
+        ],
         &["/nonexistent/ds"],
     );
     // A model of another version or whose weights belong to another design is refused.
     let json = std::fs::read_to_string(out.join("model.json")).unwrap();
-    std::fs::write(out.join("model.json"), json.replace("\"version\": 1", "\"version\": 99")).unwrap();
+    std::fs::write(
+        out.join("model.json"),
+        json.replace("\"version\": 1", "\"version\": 99"),
+    )
+    .unwrap();
     fails(&["model", "info", "--model", o], &["format version 99"]);
-    std::fs::write(out.join("model.json"), json.replace("\"design\": \"baseline\"", "\"design\": \"prt\"")).unwrap();
-    fails(&["model", "info", "--model", o], &["belong to design 'baseline', not 'prt'"]);
+    std::fs::write(
+        out.join("model.json"),
+        json.replace("\"design\": \"baseline\"", "\"design\": \"prt\""),
+    )
+    .unwrap();
+    fails(
+        &["model", "info", "--model", o],
+        &["belong to design 'baseline', not 'prt'"],
+    );
 }

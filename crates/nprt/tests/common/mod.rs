@@ -44,10 +44,7 @@ pub fn fresh_dir(name: &str) -> PathBuf {
     d
 }
 
-/// The shared data folder beside the checkout (env maps, meshes).
-pub fn shared() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("../../../shared")
-        .canonicalize()
-        .expect("../shared beside the checkout")
+/// The repository's small test assets (env maps, meshes; see tests/assets/README.md).
+pub fn assets() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("../../tests/assets")
 }
