@@ -10,7 +10,7 @@ use anyhow::{bail, Context, Result};
 use glam::Mat4;
 use nprt_scene::{Camera, CameraVolume, EnvMap, FovAxis, Scene};
 use nprt_trace::exr_io::read_channels;
-use nprt_trace::{render, PixelFilter, RenderSettings, TraceScene};
+use nprt_trace::{render, Frame, PixelFilter, RenderSettings, TraceScene};
 use rand::{RngExt, SeedableRng};
 use rand_pcg::Pcg64Mcg;
 use serde::{Deserialize, Serialize};
@@ -20,32 +20,6 @@ use crate::cameras::place_camera;
 pub const FORMAT_VERSION: u32 = 1;
 pub const MANIFEST: &str = "manifest.json";
 
-/// Channels every view file must hold (see nprt-trace's frame docs).
-pub const CHANNELS: &[&str] = &[
-    "R",
-    "G",
-    "B",
-    "direct.R",
-    "direct.G",
-    "direct.B",
-    "position.X",
-    "position.Y",
-    "position.Z",
-    "normal.X",
-    "normal.Y",
-    "normal.Z",
-    "view.X",
-    "view.Y",
-    "view.Z",
-    "kd.R",
-    "kd.G",
-    "kd.B",
-    "ks.R",
-    "ks.G",
-    "ks.B",
-    "alpha",
-    "mask",
-];
 
 /// Everything that determines a dataset's content; two runs agree on it or must not share a folder.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -286,11 +260,17 @@ pub fn plan(req: &Request, ts: &TraceScene) -> Result<Manifest> {
 }
 
 pub fn load_manifest(dir: &Path) -> Result<Manifest> {
+    Ok(load_manifest_hashed(dir)?.0)
+}
+
+/// The manifest of the dataset in `dir` and the dataset's hash (of the manifest's bytes, which
+/// fix every view's camera, map, rotation and seed); models record it to refuse other data.
+pub fn load_manifest_hashed(dir: &Path) -> Result<(Manifest, String)> {
     let path = dir.join(MANIFEST);
-    let text = std::fs::read_to_string(&path)
-        .with_context(|| format!("cannot read '{}'", path.display()))?;
-    serde_json::from_str(&text)
-        .with_context(|| format!("'{}' is not a valid nprt dataset manifest", path.display()))
+    let bytes = std::fs::read(&path).with_context(|| format!("cannot read '{}'", path.display()))?;
+    let manifest = serde_json::from_slice(&bytes)
+        .with_context(|| format!("'{}' is not a valid nprt dataset manifest", path.display()))?;
+    Ok((manifest, blake3::hash(&bytes).to_hex().to_string()))
 }
 
 /// Creates the dataset folder and its manifest, or checks that an existing one was made with
@@ -320,29 +300,17 @@ pub fn prepare(dir: &Path, manifest: &Manifest) -> Result<()> {
 
 /// Checks that a view file reads back complete: right size, every channel, finite values.
 pub fn check_view(path: &Path, view: &ViewRecord) -> Result<()> {
-    let (w, h, ch) = read_channels(path)?;
-    check_channels(w, h, &ch, view)
+    read_view(path, view).map(|_| ())
 }
 
-/// Checks the channels of a view file already read: right size, every channel, finite values.
-pub fn check_channels(
-    w: usize,
-    h: usize,
-    ch: &std::collections::HashMap<String, Vec<f32>>,
-    view: &ViewRecord,
-) -> Result<()> {
+/// Reads a view file, refusing one whose size disagrees with its record, that lacks a channel
+/// or that holds non-finite values.
+pub fn read_view(path: &Path, view: &ViewRecord) -> Result<Frame> {
+    let (w, h, ch) = read_channels(path)?;
     if (w, h) != (view.width as usize, view.height as usize) {
         bail!("is {w}×{h}, expected {}×{}", view.width, view.height);
     }
-    for name in CHANNELS {
-        let data = ch
-            .get(*name)
-            .with_context(|| format!("lacks channel '{name}'"))?;
-        if data.iter().any(|v| !v.is_finite()) {
-            bail!("channel '{name}' holds non-finite values");
-        }
-    }
-    Ok(())
+    Frame::from_channels(w, h, &ch)
 }
 
 /// Renders one view to its file.

@@ -326,7 +326,7 @@ fn batch_loss(
     );
     let pred = net.forward(features, light, scale);
     let mask3 = mask.clone().expand([b, 3, ph, pw]);
-    let err = (pred.log1p() - reference.log1p()).abs() * mask3;
+    let err = nprt_net::loss::log_l1_map(pred, reference) * mask3;
     err.sum() / (mask.sum() * 3.0).clamp_min(1.0)
 }
 

@@ -7,7 +7,7 @@ use std::time::Instant;
 
 use anyhow::{bail, Result};
 use glam::Vec3;
-use nprt_data::dataset::{load_checked_scene, load_manifest, Manifest, MANIFEST};
+use nprt_data::dataset::{load_checked_scene, load_manifest_hashed, Manifest};
 use nprt_net::data::open_recorded_maps;
 use nprt_net::Device;
 use nprt_render::{LightCode, Relighter};
@@ -266,9 +266,7 @@ fn check_model(
 
 /// Runs the whole evaluation.
 pub fn evaluate(o: &EvalOptions, device: &Device) -> Result<Evaluation> {
-    let manifest: Manifest = load_manifest(&o.data)?;
-    let manifest_bytes = std::fs::read(o.data.join(MANIFEST))?;
-    let dataset_hash = blake3::hash(&manifest_bytes).to_hex().to_string();
+    let (manifest, dataset_hash): (Manifest, _) = load_manifest_hashed(&o.data)?;
     let s = &manifest.settings;
     let scene = load_checked_scene(
         &s.scene,

@@ -46,7 +46,7 @@ impl Metrics {
                 m.l2 += d * d;
                 m.mape += d.abs() / (r.abs() + RELATIVE_EPS as f64);
                 m.mrse += d * d / (r * r + RELATIVE_EPS as f64);
-                m.log_l1 += (p.max(0.0).ln_1p() - r.max(0.0).ln_1p()).abs();
+                m.log_l1 += nprt_net::loss::log_l1_error(p, r);
             }
             n += 3;
         }

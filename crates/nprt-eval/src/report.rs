@@ -10,7 +10,7 @@ use glam::Vec3;
 use nprt_io::{write_atomically, write_file};
 use nprt_net::curves::plot_lines;
 use nprt_render::video::to_image;
-use nprt_scene::luminance;
+use nprt_scene::{luminance, srgb_to_linear};
 
 use crate::evaluate::{Evaluation, ShownView, BINS};
 use crate::metrics::{Metrics, RELATIVE_EPS};
@@ -56,7 +56,7 @@ fn heat_map(pred: &[Vec3], v: &ShownView) -> Vec<Vec3> {
             let r = v.reference[i];
             let e = (pred[i] - r).abs().element_sum() / (r.element_sum() + 3.0 * RELATIVE_EPS);
             // The PNG writer sRGB-encodes; decode so the colour map is what shows.
-            heat(e / HEAT_MAX).powf(2.2)
+            heat(e / HEAT_MAX).map(srgb_to_linear)
         })
         .collect()
 }

@@ -5,7 +5,7 @@ use std::path::Path;
 
 use anyhow::{bail, Context, Result};
 use glam::Vec3;
-use nprt_data::dataset::{load_manifest, Manifest, ViewRecord, MANIFEST};
+use nprt_data::dataset::{load_manifest_hashed, Manifest, ViewRecord};
 use nprt_scene::envmap::EnvMap;
 use nprt_trace::GBuffer;
 use rayon::prelude::*;
@@ -81,9 +81,7 @@ impl TrainingSet {
     /// Reads every view of the dataset in `dir` (in parallel) and prepares its map for an
     /// encoder of input width `encoder_width`.
     pub fn load(dir: &Path, encoder_width: usize) -> Result<Self> {
-        let manifest = load_manifest(dir)?;
-        let bytes = std::fs::read(dir.join(MANIFEST))
-            .with_context(|| format!("cannot read '{}'", dir.join(MANIFEST).display()))?;
+        let (manifest, dataset_hash) = load_manifest_hashed(dir)?;
         let maps = open_recorded_maps(&manifest)?;
         let load = |split: &str| -> Result<Vec<ViewSamples>> {
             manifest
@@ -103,7 +101,7 @@ impl TrainingSet {
         }
         Ok(TrainingSet {
             manifest,
-            dataset_hash: blake3::hash(&bytes).to_hex().to_string(),
+            dataset_hash,
             train,
             test,
         })

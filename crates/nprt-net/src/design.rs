@@ -238,8 +238,3 @@ impl NprtNet {
         self.tracks.iter().map(|t| t.num_params()).sum()
     }
 }
-
-/// The paper's training loss: mean L1 distance between log(1 + x) of prediction and reference.
-pub fn log_l1(prediction: Tensor<2>, reference: Tensor<2>) -> Tensor<1> {
-    (prediction.log1p() - reference.log1p()).abs().mean()
-}

@@ -11,12 +11,14 @@ pub mod data;
 pub mod design;
 pub mod encoder;
 pub mod layers;
+pub mod loss;
 pub mod model;
 pub mod train;
 
 pub use burn;
 pub use burn::tensor::Device;
-pub use design::{log_l1, Design, NprtNet, FEATURES};
+pub use design::{Design, NprtNet, FEATURES};
+pub use loss::log_l1;
 pub use encoder::{LightEncoder, LightInput};
 pub use layers::{Activation, Init};
 pub use model::{layer_table, load_model, ModelConfig, ModelFile};

@@ -19,7 +19,8 @@ use rand_pcg::Pcg64Mcg;
 use serde::{Deserialize, Serialize};
 
 use crate::data::{TrainingSet, ViewSamples};
-use crate::design::{log_l1, NprtNet, FEATURES};
+use crate::design::{NprtNet, FEATURES};
+use crate::loss::log_l1;
 use crate::layers::Init;
 use crate::model::{
     load_weights, save_model, save_weights, ModelConfig, ModelFile, MODEL_FORMAT, MODEL_VERSION,

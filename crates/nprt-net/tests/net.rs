@@ -3,7 +3,8 @@
 use burn::module::{Module, ModuleMapper, ModuleVisitor, Param, ParamId};
 use burn::optim::GradientsParams;
 use burn::tensor::{DType, Int, Tensor, TensorData};
-use nprt_net::design::{log_l1, FEATURES};
+use nprt_net::design::FEATURES;
+use nprt_net::log_l1;
 use nprt_net::model::{load_weights, save_weights};
 use nprt_net::{Activation, Design, Device, Init, ModelConfig, NprtNet};
 use rand::{RngExt, SeedableRng};

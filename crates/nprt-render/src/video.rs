@@ -9,19 +9,12 @@ use glam::Vec3;
 use image::codecs::gif::{GifEncoder, Repeat};
 use image::{Delay, Frame, RgbImage, RgbaImage};
 use nprt_io::write_atomically;
+use nprt_scene::linear_to_srgb;
 
 /// Linear radiance scaled by 2^exposure, clamped, sRGB-encoded.
 pub fn srgb8(c: Vec3, exposure: f32) -> [u8; 3] {
     let scale = exposure.exp2();
-    let encode = |c: f32| {
-        let c = (c * scale).clamp(0.0, 1.0);
-        let s = if c <= 0.003_130_8 {
-            12.92 * c
-        } else {
-            1.055 * c.powf(1.0 / 2.4) - 0.055
-        };
-        (s * 255.0 + 0.5) as u8
-    };
+    let encode = |c: f32| (linear_to_srgb(c * scale) * 255.0 + 0.5) as u8;
     [encode(c.x), encode(c.y), encode(c.z)]
 }
 

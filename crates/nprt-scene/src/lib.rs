@@ -9,6 +9,7 @@
 
 pub mod builtin;
 pub mod camera;
+pub mod color;
 pub mod distribution;
 pub mod envmap;
 pub mod gltf_scene;
@@ -21,13 +22,9 @@ pub mod scene;
 pub mod texture;
 
 pub use camera::{Camera, CameraVolume, FovAxis};
+pub use color::{linear_to_srgb, luminance, srgb_to_linear};
 pub use envmap::EnvMap;
 pub use material::{BsdfParams, Material, Surface};
 pub use mesh::Mesh;
 pub use scene::{load_scene, Scene, SceneOptions};
 pub use texture::{Bitmap, Texture};
-
-/// Linear Rec.709 luminance, the weights Mitsuba 3 uses for importance sampling.
-pub fn luminance(c: glam::Vec3) -> f32 {
-    0.212671 * c.x + 0.715160 * c.y + 0.072169 * c.z
-}

@@ -6,6 +6,8 @@ use std::sync::Arc;
 use anyhow::{Context, Result};
 use glam::{Affine2, Vec2, Vec3};
 
+use crate::srgb_to_linear;
+
 /// A linear-RGB image sampled with bilinear filtering and repeat wrapping (Mitsuba's and glTF's
 /// defaults).
 #[derive(Debug)]
@@ -14,15 +16,6 @@ pub struct Bitmap {
     pub height: usize,
     /// Row-major, top row first, linear RGB.
     pub texels: Vec<Vec3>,
-}
-
-/// sRGB transfer function to linear.
-pub fn srgb_to_linear(c: f32) -> f32 {
-    if c <= 0.04045 {
-        c / 12.92
-    } else {
-        ((c + 0.055) / 1.055).powf(2.4)
-    }
 }
 
 impl Bitmap {

@@ -6,9 +6,10 @@
 //! `kd.R/G/B`, `ks.R/G/B`; `alpha` (GGX α); `mask` (1 where the pixel-centre ray hits geometry).
 //! G-buffer layers are those of the ray through the pixel centre; background pixels hold zeros.
 
+use std::collections::HashMap;
 use std::path::Path;
 
-use anyhow::Result;
+use anyhow::{bail, Context, Result};
 use glam::Vec3;
 
 #[derive(Clone, Debug, Default)]
@@ -55,35 +56,94 @@ pub struct Frame {
     pub gbuffer: GBuffer,
 }
 
-fn split(prefix: &str, names: [&str; 3], data: &[Vec3]) -> Vec<(String, Vec<f32>)> {
-    (0..3)
-        .map(|k| {
-            let name = if prefix.is_empty() {
-                names[k].to_string()
-            } else {
-                format!("{prefix}.{}", names[k])
-            };
-            (name, data.iter().map(|v| v[k]).collect())
-        })
-        .collect()
+const RGB: [&str; 3] = ["R", "G", "B"];
+const XYZ: [&str; 3] = ["X", "Y", "Z"];
+
+/// The three-component layers in file order: (channel prefix, component names).
+const VECTOR_LAYERS: [(&str, [&str; 3]); 7] = [
+    ("", RGB),
+    ("direct", RGB),
+    ("position", XYZ),
+    ("normal", XYZ),
+    ("view", XYZ),
+    ("kd", RGB),
+    ("ks", RGB),
+];
+/// The one-component layers, after the vector layers.
+const SCALAR_LAYERS: [&str; 2] = ["alpha", "mask"];
+
+fn channel_name(prefix: &str, component: &str) -> String {
+    if prefix.is_empty() {
+        component.to_string()
+    } else {
+        format!("{prefix}.{component}")
+    }
 }
 
 impl Frame {
+    /// Every channel name, in the order documented above.
+    pub fn channel_names() -> Vec<String> {
+        VECTOR_LAYERS
+            .iter()
+            .flat_map(|(p, names)| names.map(|n| channel_name(p, n)))
+            .chain(SCALAR_LAYERS.map(String::from))
+            .collect()
+    }
+
+    fn vector_layers(&self) -> [&Vec<Vec3>; 7] {
+        let g = &self.gbuffer;
+        [&self.radiance, &self.direct, &g.position, &g.normal, &g.view, &g.kd, &g.ks]
+    }
+
     /// Every layer as (channel name, data), in the order documented above.
     pub fn channels(&self) -> Vec<(String, Vec<f32>)> {
-        const RGB: [&str; 3] = ["R", "G", "B"];
-        const XYZ: [&str; 3] = ["X", "Y", "Z"];
-        let g = &self.gbuffer;
-        let mut out = split("", RGB, &self.radiance);
-        out.extend(split("direct", RGB, &self.direct));
-        out.extend(split("position", XYZ, &g.position));
-        out.extend(split("normal", XYZ, &g.normal));
-        out.extend(split("view", XYZ, &g.view));
-        out.extend(split("kd", RGB, &g.kd));
-        out.extend(split("ks", RGB, &g.ks));
-        out.push(("alpha".into(), g.alpha.clone()));
-        out.push(("mask".into(), g.mask.clone()));
+        let mut out: Vec<(String, Vec<f32>)> = VECTOR_LAYERS
+            .iter()
+            .zip(self.vector_layers())
+            .flat_map(|((p, names), data)| {
+                (0..3).map(move |k| (channel_name(p, names[k]), data.iter().map(|v| v[k]).collect()))
+            })
+            .collect();
+        out.push(("alpha".into(), self.gbuffer.alpha.clone()));
+        out.push(("mask".into(), self.gbuffer.mask.clone()));
         out
+    }
+
+    /// The frame held by named channels (as [`crate::exr_io::read_channels`] returns them),
+    /// refusing a missing or wrongly sized channel and non-finite values.
+    pub fn from_channels(width: usize, height: usize, ch: &HashMap<String, Vec<f32>>) -> Result<Frame> {
+        let get = |name: &str| -> Result<&Vec<f32>> {
+            let data = ch.get(name).with_context(|| format!("lacks channel '{name}'"))?;
+            if data.len() != width * height {
+                bail!("channel '{name}' has {} values for {width}×{height} pixels", data.len());
+            }
+            if data.iter().any(|v| !v.is_finite()) {
+                bail!("channel '{name}' holds non-finite values");
+            }
+            Ok(data)
+        };
+        let mut layers = Vec::with_capacity(VECTOR_LAYERS.len());
+        for (prefix, names) in VECTOR_LAYERS {
+            let c = [get(&channel_name(prefix, names[0]))?, get(&channel_name(prefix, names[1]))?, get(&channel_name(prefix, names[2]))?];
+            layers.push((0..width * height).map(|i| Vec3::new(c[0][i], c[1][i], c[2][i])).collect::<Vec<_>>());
+        }
+        let [radiance, direct, position, normal, view, kd, ks]: [Vec<Vec3>; 7] =
+            layers.try_into().expect("one entry per vector layer");
+        Ok(Frame {
+            width,
+            height,
+            radiance,
+            direct,
+            gbuffer: GBuffer {
+                position,
+                normal,
+                view,
+                kd,
+                ks,
+                alpha: get("alpha")?.clone(),
+                mask: get("mask")?.clone(),
+            },
+        })
     }
 
     pub fn write_exr(&self, path: &Path) -> Result<()> {

@@ -54,6 +54,12 @@ fn mix(mut z: u64) -> u64 {
     z ^ (z >> 31)
 }
 
+/// The random stream of pixel `index` under `seed`: independent of thread count and order, so
+/// the same seed gives the same image.
+fn pixel_rng(seed: u64, index: u64) -> Pcg64Mcg {
+    Pcg64Mcg::seed_from_u64(mix(seed.wrapping_mul(0x9e37_79b9_7f4a_7c15) ^ mix(index)))
+}
+
 struct PixelOut {
     radiance: Vec3,
     direct: Vec3,
@@ -103,8 +109,7 @@ fn pixel(
     y: usize,
 ) -> PixelOut {
     let index = (y * camera.width as usize + x) as u64;
-    let mut rng =
-        Pcg64Mcg::seed_from_u64(mix(s.seed.wrapping_mul(0x9e37_79b9_7f4a_7c15) ^ mix(index)));
+    let mut rng = pixel_rng(s.seed, index);
     let centre = Vec2::new(x as f32 + 0.5, y as f32 + 0.5);
     let mut sum = PathRadiance::default();
     for _ in 0..s.spp {
@@ -182,9 +187,7 @@ pub fn render_transport(
     (0..w * camera.height as usize)
         .into_par_iter()
         .map(|i| {
-            let mut rng = Pcg64Mcg::seed_from_u64(mix(
-                s.seed.wrapping_mul(0x9e37_79b9_7f4a_7c15) ^ mix(i as u64)
-            ));
+            let mut rng = pixel_rng(s.seed, i as u64);
             let mut t = vec![Vec3::ZERO; basis_len];
             let mut y_k = vec![0.0; basis_len];
             let (o, d) = camera.ray(Vec2::new((i % w) as f32 + 0.5, (i / w) as f32 + 0.5));

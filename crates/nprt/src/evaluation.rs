@@ -3,7 +3,7 @@
 use std::path::PathBuf;
 
 use anyhow::{bail, Result};
-use nprt_data::dataset::{load_manifest, MANIFEST};
+use nprt_data::dataset::load_manifest_hashed;
 use nprt_data::views::load_views;
 use nprt_eval::deep_shading::{self, DeepShadingFile, DeepShadingOptions};
 use nprt_eval::{evaluate, write_report, EvalOptions, Evaluation};
@@ -107,10 +107,7 @@ pub fn train_deep_shading(a: DeepShadingArgs) -> Result<()> {
     if a.epochs == 0 || a.batch_views == 0 || !(a.lr > 0.0 && a.lr.is_finite()) {
         bail!("--epochs and --batch-views must be positive, and --lr a positive number");
     }
-    let manifest = load_manifest(&a.data)?;
-    let hash = blake3::hash(&std::fs::read(a.data.join(MANIFEST))?)
-        .to_hex()
-        .to_string();
+    let (manifest, hash) = load_manifest_hashed(&a.data)?;
     let maps = open_recorded_maps(&manifest)?;
     let train = load_views(&a.data, &manifest, "train")?;
     let test = load_views(&a.data, &manifest, "test")?;
