@@ -21,5 +21,5 @@ pub use design::{Design, NprtNet, FEATURES};
 pub use loss::log_l1;
 pub use encoder::{LightEncoder, LightInput};
 pub use layers::{Activation, Init};
-pub use model::{layer_table, load_model, ModelConfig, ModelFile};
+pub use model::{layer_table, load_model, ModelConfig, ModelFile, DEFAULT_ENCODER_WIDTH};
 pub use train::{measure_throughput, train, TrainOptions, TrainSummary};

@@ -34,12 +34,16 @@ pub struct ModelConfig {
     pub encoder_width: usize,
 }
 
+/// Encoder input width when none is asked for: on the demo, 64 measured 10% worse in L1 than
+/// 128 for 10% less training time.
+pub const DEFAULT_ENCODER_WIDTH: usize = 128;
+
 impl ModelConfig {
     pub fn new(design: Design, activation: Option<Activation>) -> Self {
         ModelConfig {
             design,
             activation: activation.unwrap_or(design.default_activation()),
-            encoder_width: 128,
+            encoder_width: DEFAULT_ENCODER_WIDTH,
         }
     }
 

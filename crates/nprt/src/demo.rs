@@ -4,7 +4,7 @@ use std::path::PathBuf;
 use std::time::Instant;
 
 use anyhow::Result;
-use nprt_net::Design;
+use nprt_net::{Design, TrainOptions, DEFAULT_ENCODER_WIDTH};
 
 use crate::evaluation::{eval, train_deep_shading, DeepShadingArgs, EvalArgs};
 use crate::learn::{train, TrainArgs};
@@ -16,7 +16,7 @@ pub struct DemoArgs {
     /// Output folder (dataset, models, report, relit frames). Re-running resumes what is done.
     #[arg(long, default_value = "nprt-demo")]
     pub out: PathBuf,
-    /// Tiny sizes (about 3 minutes on 2 cores): checks the pipeline, not the method.
+    /// Tiny sizes (under a minute on 2 cores): checks the pipeline, not the method.
     #[arg(long)]
     pub quick: bool,
 }
@@ -64,10 +64,6 @@ const QUICK: Plan = Plan {
     frame_res: 48,
 };
 
-/// The encoder input width of the demo's models (the default): 64 was measured 10% worse in L1
-/// for 10% less training time.
-const ENCODER_WIDTH: usize = 128;
-
 pub fn demo(a: DemoArgs) -> Result<()> {
     let p = if a.quick { QUICK } else { FULL };
     let start = Instant::now();
@@ -98,6 +94,7 @@ pub fn demo(a: DemoArgs) -> Result<()> {
         fov: 60.0,
     })?;
     let mut models = Vec::new();
+    let defaults = TrainOptions::default();
     for (i, design) in Design::ALL.into_iter().enumerate() {
         step(&format!(
             "2/5 training design {} of 4: {}",
@@ -111,13 +108,13 @@ pub fn demo(a: DemoArgs) -> Result<()> {
             activation: None,
             out: out.clone(),
             epochs: p.epochs,
-            batch_size: 16_384,
-            lr: 1e-4,
-            seed: 0,
-            views_per_batch: 8,
-            val_samples: 65_536,
-            encoder_width: ENCODER_WIDTH,
-            checkpoint_minutes: 5.0,
+            batch_size: defaults.batch_size,
+            lr: defaults.learning_rate,
+            seed: defaults.seed,
+            views_per_batch: defaults.views_per_batch,
+            val_samples: defaults.val_samples,
+            encoder_width: DEFAULT_ENCODER_WIDTH,
+            checkpoint_minutes: defaults.checkpoint_secs / 60.0,
         })?;
         models.push(out);
     }
@@ -130,7 +127,7 @@ pub fn demo(a: DemoArgs) -> Result<()> {
         batch_views: 4,
         lr: 1e-4,
         seed: 0,
-        encoder_width: ENCODER_WIDTH,
+        encoder_width: DEFAULT_ENCODER_WIDTH,
     })?;
     step("4/5 evaluating against the baselines");
     let report = a.out.join("report");

@@ -63,7 +63,7 @@ pub struct DeepShadingArgs {
     #[arg(long, default_value_t = 0)]
     pub seed: u64,
     /// Width W of the light encoder's W × W/2 input (a multiple of 64).
-    #[arg(long, default_value_t = 128)]
+    #[arg(long, default_value_t = nprt_net::DEFAULT_ENCODER_WIDTH)]
     pub encoder_width: usize,
 }
 

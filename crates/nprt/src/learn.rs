@@ -9,6 +9,7 @@ use nprt_net::encoder::check_input_width;
 use nprt_net::Device;
 use nprt_net::{
     layer_table, measure_throughput, Activation, Design, Init, ModelConfig, TrainOptions,
+    DEFAULT_ENCODER_WIDTH,
 };
 
 #[derive(clap::Args)]
@@ -25,7 +26,7 @@ pub struct ModelInfoArgs {
     #[arg(long)]
     pub activation: Option<Activation>,
     /// Width W of the encoder's W × W/2 input map (a multiple of 64).
-    #[arg(long, default_value_t = 128)]
+    #[arg(long, default_value_t = DEFAULT_ENCODER_WIDTH)]
     pub encoder_width: usize,
 }
 
@@ -46,28 +47,28 @@ pub struct TrainArgs {
     pub out: PathBuf,
     /// Passes over all foreground pixels of the training views (the paper: 500). On 2 CPU
     /// cores one epoch of the default 400-view 128² dataset takes about 4 minutes (dsep).
-    #[arg(long, default_value_t = 20)]
+    #[arg(long, default_value_t = TrainOptions::default().epochs)]
     pub epochs: usize,
     /// Samples per batch.
-    #[arg(long, default_value_t = 16_384)]
+    #[arg(long, default_value_t = TrainOptions::default().batch_size)]
     pub batch_size: usize,
     /// Adam learning rate (the paper: 1e-4).
-    #[arg(long, default_value_t = 1e-4)]
+    #[arg(long, default_value_t = TrainOptions::default().learning_rate)]
     pub lr: f64,
     /// Seed of the initial weights and of the batch order.
-    #[arg(long, default_value_t = 0)]
+    #[arg(long, default_value_t = TrainOptions::default().seed)]
     pub seed: u64,
     /// Views whose pixels are mixed in each batch, each lit by its own rotated map.
-    #[arg(long, default_value_t = 8)]
+    #[arg(long, default_value_t = TrainOptions::default().views_per_batch)]
     pub views_per_batch: usize,
     /// Test-view pixels (held-out lighting) used for the validation loss after each epoch.
-    #[arg(long, default_value_t = 65_536)]
+    #[arg(long, default_value_t = TrainOptions::default().val_samples)]
     pub val_samples: usize,
     /// Width W of the encoder's W × W/2 input map (a multiple of 64).
-    #[arg(long, default_value_t = 128)]
+    #[arg(long, default_value_t = DEFAULT_ENCODER_WIDTH)]
     pub encoder_width: usize,
     /// Minutes between checkpoints within an epoch (one is always written at an epoch's end).
-    #[arg(long, default_value_t = 5.0)]
+    #[arg(long, default_value_t = TrainOptions::default().checkpoint_secs / 60.0)]
     pub checkpoint_minutes: f64,
 }
 

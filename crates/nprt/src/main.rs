@@ -41,7 +41,7 @@ enum Command {
     Reference(ReferenceArgs),
     /// The whole pipeline on the built-in scene and lighting: generate a dataset, train the four
     /// designs and Deep Shading, evaluate them against the baselines, relight a camera path
-    /// under held-out lighting. About 20 minutes on 2 cores; --quick about 3.
+    /// under held-out lighting. About 14 minutes on 2 cores; --quick under a minute.
     Demo(demo::DemoArgs),
     /// Render a training dataset: G-buffers and radiance of many views under many lightings
     /// (documented in docs/dataset.md). Resumable; shards may run at once into one folder.
