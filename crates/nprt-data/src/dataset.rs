@@ -90,6 +90,54 @@ pub struct Manifest {
     pub views: Vec<ViewRecord>,
 }
 
+impl Manifest {
+    /// Refuses a manifest that a hand edit or another tool made inconsistent, so that every
+    /// later use (map indices, image sizes, cameras, file names) can trust it.
+    pub fn check(&self) -> Result<()> {
+        let s = &self.settings;
+        if s.format_version != FORMAT_VERSION {
+            bail!("format_version is {}, this nprt reads {FORMAT_VERSION}", s.format_version);
+        }
+        let maps = s.envmaps.len();
+        if let Some(&i) = s.train_maps.iter().chain(&s.test_maps).find(|&&i| i >= maps) {
+            bail!("map index {i} is out of range: settings.envmaps lists {maps} maps");
+        }
+        if s.train_maps.is_empty() || s.test_maps.is_empty() {
+            bail!("settings.train_maps and settings.test_maps must each name at least one map");
+        }
+        if !self.bounds.iter().flatten().all(|v| v.is_finite())
+            || (0..3).any(|k| self.bounds[0][k] > self.bounds[1][k])
+        {
+            bail!("bounds {:?} are not a finite box (min ≤ max)", self.bounds);
+        }
+        for v in &self.views {
+            let what = format!("view {} ('{}')", v.index, v.file);
+            let allowed = match v.split.as_str() {
+                "train" => &s.train_maps,
+                "test" => &s.test_maps,
+                other => bail!("{what}: split '{other}' is neither 'train' nor 'test'"),
+            };
+            if !allowed.contains(&v.map) {
+                bail!("{what}: map {} is not one of its split's maps {allowed:?}", v.map);
+            }
+            if v.width == 0 || v.height == 0 || v.width as u64 * v.height as u64 > 1 << 28 {
+                bail!("{what}: size {}×{} is empty or implausibly large", v.width, v.height);
+            }
+            if !(v.fov_x_deg > 0.0 && v.fov_x_deg < 180.0) {
+                bail!("{what}: fov_x_deg {} is not in (0, 180)", v.fov_x_deg);
+            }
+            if !v.camera_to_world.iter().all(|x| x.is_finite()) || !v.rotation_deg.is_finite() {
+                bail!("{what}: camera_to_world or rotation_deg holds a non-finite number");
+            }
+            let file = Path::new(&v.file);
+            if file.is_absolute() || file.components().any(|c| matches!(c, std::path::Component::ParentDir)) {
+                bail!("{what}: file must be a path inside the dataset folder");
+            }
+        }
+        Ok(())
+    }
+}
+
 impl ViewRecord {
     pub fn camera(&self) -> Camera {
         Camera {
@@ -252,11 +300,15 @@ pub fn plan(req: &Request, ts: &TraceScene) -> Result<Manifest> {
         });
     }
     let (lo, hi) = req.scene.bounds();
-    Ok(Manifest {
+    let manifest = Manifest {
         settings,
         bounds: [lo.into(), hi.into()],
         views,
-    })
+    };
+    manifest
+        .check()
+        .with_context(|| format!("cannot plan a dataset for scene '{}'", req.scene_spec))?;
+    Ok(manifest)
 }
 
 pub fn load_manifest(dir: &Path) -> Result<Manifest> {
@@ -268,8 +320,11 @@ pub fn load_manifest(dir: &Path) -> Result<Manifest> {
 pub fn load_manifest_hashed(dir: &Path) -> Result<(Manifest, String)> {
     let path = dir.join(MANIFEST);
     let bytes = std::fs::read(&path).with_context(|| format!("cannot read '{}'", path.display()))?;
-    let manifest = serde_json::from_slice(&bytes)
+    let manifest: Manifest = serde_json::from_slice(&bytes)
         .with_context(|| format!("'{}' is not a valid nprt dataset manifest", path.display()))?;
+    manifest
+        .check()
+        .with_context(|| format!("'{}' is not a consistent nprt dataset manifest", path.display()))?;
     Ok((manifest, blake3::hash(&bytes).to_hex().to_string()))
 }
 

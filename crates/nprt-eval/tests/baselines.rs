@@ -48,7 +48,7 @@ fn sh_prt_of_a_diffuse_plane_under_a_constant_sky_is_kd_times_l() {
     for bands in [3, 5] {
         let rgb = t
             .truncated(bands)
-            .shade(&EnvMap::constant(Vec3::new(1.0, 2.0, 0.5)));
+            .shade(&EnvMap::constant(Vec3::new(1.0, 2.0, 0.5)).unwrap());
         for px in &rgb {
             // Cosine-weighted sampling of a diffuse plane gives throughput kd exactly: no noise.
             assert!(

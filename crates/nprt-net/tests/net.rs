@@ -197,7 +197,7 @@ fn saved_weights_load_into_a_fresh_network_exactly() {
 fn encoder_input_is_mean_normalised_log_of_the_rotated_map() {
     use nprt_scene::envmap::EnvMap;
     // A constant map: every texel is log(1 + 1) after dividing by the mean; scale is the mean.
-    let map = EnvMap::constant(glam::Vec3::new(2.0, 4.0, 6.0));
+    let map = EnvMap::constant(glam::Vec3::new(2.0, 4.0, 6.0)).unwrap();
     let input = nprt_net::LightInput::new(&map, 37.0, 64);
     assert!((input.scale - 4.0).abs() < 1e-5);
     let expect = [0.5f32.ln_1p(), 1.0f32.ln_1p(), 1.5f32.ln_1p()];

@@ -116,8 +116,8 @@ impl EnvMap {
     }
 
     /// A uniform map: a white furnace when `radiance` is 1.
-    pub fn constant(radiance: Vec3) -> Self {
-        Self::from_texels("constant", 8, 4, vec![radiance; 32]).expect("valid constant map")
+    pub fn constant(radiance: Vec3) -> Result<Self> {
+        Self::from_texels("constant", 8, 4, vec![radiance; 32])
     }
 
     /// Reads an OpenEXR (.exr) or Radiance (.hdr) lat-long map, scaled by `scale`.

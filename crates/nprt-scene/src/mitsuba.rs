@@ -153,8 +153,12 @@ impl<'a> Ctx<'a> {
         s.split(|c: char| c == ',' || c.is_whitespace())
             .filter(|t| !t.is_empty())
             .map(|t| {
-                t.parse::<f32>()
-                    .or_else(|_| self.fail(node, format!("'{t}' is not a number")))
+                match t.parse::<f32>() {
+                    Ok(x) if x.is_finite() => Ok(x),
+                    // 1e40 parses as infinity in f32: as unusable as "inf" or "nan".
+                    Ok(_) => self.fail(node, format!("'{t}' is not a finite number")),
+                    Err(_) => self.fail(node, format!("'{t}' is not a number")),
+                }
             })
             .collect()
     }
@@ -482,7 +486,7 @@ impl<'a> Ctx<'a> {
                 EnvMap::load(&path, scale).with_context(|| self.at(node))?
             }
             "constant" => match self.texture_prop(node, "radiance", Vec3::ONE)? {
-                Texture::Constant(c) => EnvMap::constant(c),
+                Texture::Constant(c) => EnvMap::constant(c).with_context(|| self.at(node))?,
                 _ => return self.fail(node, "constant emitter radiance must be a colour"),
             },
             other => {
@@ -794,5 +798,14 @@ mod tests {
         let p = write(&dir, "unset.xml", &SCENE.replace("$spp", "$nosuch"));
         let err = format!("{:#}", load(&p, &SceneOptions::default()).unwrap_err());
         assert!(err.contains("$nosuch"), "{err}");
+        // Values that are not finite numbers (1e40 overflows f32) stop at the file and line.
+        for v in ["nan", "inf", "-inf", "1e40", "1, nan, 1"] {
+            let bad = SCENE.replace(
+                r#"<rgb name="radiance" value="2"/>"#,
+                &format!(r#"<rgb name="radiance" value="{v}"/>"#),
+            );
+            let err = format!("{:#}", load(&write(&dir, "nonfinite.xml", &bad), &SceneOptions::default()).unwrap_err());
+            assert!(err.contains("nonfinite.xml:19:") && err.contains("not a finite number"), "{v}: {err}");
+        }
     }
 }

@@ -48,7 +48,7 @@ fn white_furnace_returns_the_environment() {
     let f = render(
         &ts,
         &camera(),
-        &EnvMap::constant(Vec3::ONE),
+        &EnvMap::constant(Vec3::ONE).unwrap(),
         &settings(64, None),
     );
     let m = foreground_mean(&f);
@@ -72,7 +72,7 @@ fn convex_diffuse_object_reflects_albedo_times_sky() {
     let s = sphere_scene(Material::diffuse("d", kd));
     let ts = TraceScene::new(&s);
     let sky = Vec3::new(2.0, 1.0, 0.5);
-    let f = render(&ts, &camera(), &EnvMap::constant(sky), &settings(64, None));
+    let f = render(&ts, &camera(), &EnvMap::constant(sky).unwrap(), &settings(64, None));
     let m = foreground_mean(&f);
     let expected = kd * sky;
     assert!(
@@ -110,7 +110,7 @@ fn diffuse_plane_under_constant_map() {
         let f = render(
             &ts,
             &cam,
-            &EnvMap::constant(Vec3::splat(1.5)),
+            &EnvMap::constant(Vec3::splat(1.5)).unwrap(),
             &settings(64, depth),
         );
         let m = foreground_mean(&f);
@@ -122,7 +122,7 @@ fn diffuse_plane_under_constant_map() {
 fn max_depth_follows_mitsuba() {
     let s = sphere_scene(Material::diffuse("d", Vec3::splat(0.5)));
     let ts = TraceScene::new(&s);
-    let env = EnvMap::constant(Vec3::ONE);
+    let env = EnvMap::constant(Vec3::ONE).unwrap();
     // max_depth 1: only the emitter seen directly; surfaces are black. Through pixel centres
     // every pixel is exactly the sky (1) or a surface (0).
     let centre = RenderSettings {
@@ -192,7 +192,7 @@ fn gbuffer_holds_the_centre_hit() {
     let f = render(
         &ts,
         &cam,
-        &EnvMap::constant(Vec3::ONE),
+        &EnvMap::constant(Vec3::ONE).unwrap(),
         &RenderSettings {
             filter: PixelFilter::Centre,
             ..settings(1, Some(3))

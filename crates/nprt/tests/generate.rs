@@ -274,3 +274,30 @@ fn real_maps_and_a_file_scene_with_flags_work() {
     );
     assert!(ok(&["dataset", "verify", dir.to_str().unwrap()]).contains("3 of 3"));
 }
+
+#[test]
+fn hand_edited_manifests_are_refused_by_name_in_every_command() {
+    let dir = tmp("edited");
+    generate(&dir, &[]);
+    let path = dir.join("manifest.json");
+    let good: serde_json::Value = serde_json::from_slice(&std::fs::read(&path).unwrap()).unwrap();
+    let edits: [(&str, fn(&mut serde_json::Value)); 5] = [
+        ("map index 99 is out of range", |m| m["settings"]["test_maps"][0] = 99.into()),
+        ("not one of its split's maps", |m| m["views"][0]["map"] = 10_000.into()),
+        ("neither 'train' nor 'test'", |m| m["views"][1]["split"] = "valid".into()),
+        ("inside the dataset folder", |m| m["views"][2]["file"] = "../../etc/passwd".into()),
+        ("fov_x_deg", |m| m["views"][3]["fov_x_deg"] = 0.into()),
+    ];
+    let model = dir.join("model");
+    for (needle, edit) in edits {
+        let mut m = good.clone();
+        edit(&mut m);
+        std::fs::write(&path, serde_json::to_vec(&m).unwrap()).unwrap();
+        let d = dir.to_str().unwrap();
+        let expected = ["manifest.json", needle];
+        fails(&["dataset", "verify", d], &expected);
+        fails(&["train", "--data", d, "--arch", "prt", "--out", model.to_str().unwrap()], &expected);
+        fails(&["train-deep-shading", "--data", d, "--out", model.to_str().unwrap()], &expected);
+        assert!(!model.exists(), "nothing may be written from a refused dataset");
+    }
+}
