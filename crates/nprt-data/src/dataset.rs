@@ -20,7 +20,6 @@ use crate::cameras::place_camera;
 pub const FORMAT_VERSION: u32 = 1;
 pub const MANIFEST: &str = "manifest.json";
 
-
 /// Everything that determines a dataset's content; two runs agree on it or must not share a folder.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Settings {
@@ -96,10 +95,18 @@ impl Manifest {
     pub fn check(&self) -> Result<()> {
         let s = &self.settings;
         if s.format_version != FORMAT_VERSION {
-            bail!("format_version is {}, this nprt reads {FORMAT_VERSION}", s.format_version);
+            bail!(
+                "format_version is {}, this nprt reads {FORMAT_VERSION}",
+                s.format_version
+            );
         }
         let maps = s.envmaps.len();
-        if let Some(&i) = s.train_maps.iter().chain(&s.test_maps).find(|&&i| i >= maps) {
+        if let Some(&i) = s
+            .train_maps
+            .iter()
+            .chain(&s.test_maps)
+            .find(|&&i| i >= maps)
+        {
             bail!("map index {i} is out of range: settings.envmaps lists {maps} maps");
         }
         if s.train_maps.is_empty() || s.test_maps.is_empty() {
@@ -118,10 +125,17 @@ impl Manifest {
                 other => bail!("{what}: split '{other}' is neither 'train' nor 'test'"),
             };
             if !allowed.contains(&v.map) {
-                bail!("{what}: map {} is not one of its split's maps {allowed:?}", v.map);
+                bail!(
+                    "{what}: map {} is not one of its split's maps {allowed:?}",
+                    v.map
+                );
             }
             if v.width == 0 || v.height == 0 || v.width as u64 * v.height as u64 > 1 << 28 {
-                bail!("{what}: size {}×{} is empty or implausibly large", v.width, v.height);
+                bail!(
+                    "{what}: size {}×{} is empty or implausibly large",
+                    v.width,
+                    v.height
+                );
             }
             if !(v.fov_x_deg > 0.0 && v.fov_x_deg < 180.0) {
                 bail!("{what}: fov_x_deg {} is not in (0, 180)", v.fov_x_deg);
@@ -130,7 +144,11 @@ impl Manifest {
                 bail!("{what}: camera_to_world or rotation_deg holds a non-finite number");
             }
             let file = Path::new(&v.file);
-            if file.is_absolute() || file.components().any(|c| matches!(c, std::path::Component::ParentDir)) {
+            if file.is_absolute()
+                || file
+                    .components()
+                    .any(|c| matches!(c, std::path::Component::ParentDir))
+            {
                 bail!("{what}: file must be a path inside the dataset folder");
             }
         }
@@ -319,12 +337,16 @@ pub fn load_manifest(dir: &Path) -> Result<Manifest> {
 /// fix every view's camera, map, rotation and seed); models record it to refuse other data.
 pub fn load_manifest_hashed(dir: &Path) -> Result<(Manifest, String)> {
     let path = dir.join(MANIFEST);
-    let bytes = std::fs::read(&path).with_context(|| format!("cannot read '{}'", path.display()))?;
+    let bytes =
+        std::fs::read(&path).with_context(|| format!("cannot read '{}'", path.display()))?;
     let manifest: Manifest = serde_json::from_slice(&bytes)
         .with_context(|| format!("'{}' is not a valid nprt dataset manifest", path.display()))?;
-    manifest
-        .check()
-        .with_context(|| format!("'{}' is not a consistent nprt dataset manifest", path.display()))?;
+    manifest.check().with_context(|| {
+        format!(
+            "'{}' is not a consistent nprt dataset manifest",
+            path.display()
+        )
+    })?;
     Ok((manifest, blake3::hash(&bytes).to_hex().to_string()))
 }
 

@@ -367,7 +367,7 @@ pub fn train(
         load_weights(&out.join(WEIGHTS_FILE), &mut net, TAG)?;
         file.epochs_done = prev.epochs_done;
         file.seconds = prev.seconds;
-        rows = read_csv(&out.join("loss.csv"));
+        rows = read_csv(&out.join("loss.csv"))?;
     }
     let (train_s, pw, ph) = prepare(train_views, maps, &file.bounds, opts.encoder_width)?;
     let (test_s, tpw, tph) = prepare(test_views, maps, &file.bounds, opts.encoder_width)?;

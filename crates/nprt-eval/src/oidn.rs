@@ -102,23 +102,19 @@ impl Oidn {
         // SAFETY: the signatures are OIDN 1.4's C API; images are tightly packed float3 buffers
         // that outlive the filter's execution, and both handles are released before returning.
         unsafe {
-            let sym = |name: &str| -> Result<*const ()> {
-                let s: Symbol<*const ()> = self
-                    .lib
-                    .get(name.as_bytes())
-                    .with_context(|| format!("OIDN lacks {name}"))?;
-                Ok(*s)
-            };
-            let new_device: NewDevice = std::mem::transmute(sym("oidnNewDevice")?);
-            let commit_device: Handle = std::mem::transmute(sym("oidnCommitDevice")?);
-            let release_device: Handle = std::mem::transmute(sym("oidnReleaseDevice")?);
-            let get_error: GetError = std::mem::transmute(sym("oidnGetDeviceError")?);
-            let new_filter: NewFilter = std::mem::transmute(sym("oidnNewFilter")?);
-            let set_image: SetImage = std::mem::transmute(sym("oidnSetSharedFilterImage")?);
-            let set_bool: SetBool = std::mem::transmute(sym("oidnSetFilter1b")?);
-            let commit_filter: Handle = std::mem::transmute(sym("oidnCommitFilter")?);
-            let execute: Handle = std::mem::transmute(sym("oidnExecuteFilter")?);
-            let release_filter: Handle = std::mem::transmute(sym("oidnReleaseFilter")?);
+            // libloading's typed `get` checks nothing about the signature either; the types
+            // above are the contract.
+            let lib = &self.lib;
+            let new_device: NewDevice = symbol(lib, "oidnNewDevice")?;
+            let commit_device: Handle = symbol(lib, "oidnCommitDevice")?;
+            let release_device: Handle = symbol(lib, "oidnReleaseDevice")?;
+            let get_error: GetError = symbol(lib, "oidnGetDeviceError")?;
+            let new_filter: NewFilter = symbol(lib, "oidnNewFilter")?;
+            let set_image: SetImage = symbol(lib, "oidnSetSharedFilterImage")?;
+            let set_bool: SetBool = symbol(lib, "oidnSetFilter1b")?;
+            let commit_filter: Handle = symbol(lib, "oidnCommitFilter")?;
+            let execute: Handle = symbol(lib, "oidnExecuteFilter")?;
+            let release_filter: Handle = symbol(lib, "oidnReleaseFilter")?;
 
             let device = new_device(0);
             if device.is_null() {
@@ -164,4 +160,14 @@ impl Oidn {
         }
         Ok(output)
     }
+}
+
+/// The function `name` of `lib` as the function-pointer type `F`.
+///
+/// # Safety
+/// `F` must be the symbol's true C signature.
+unsafe fn symbol<F: Copy>(lib: &Library, name: &str) -> Result<F> {
+    let s: Symbol<F> =
+        unsafe { lib.get(name.as_bytes()) }.with_context(|| format!("OIDN lacks {name}"))?;
+    Ok(*s)
 }

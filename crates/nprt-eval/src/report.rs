@@ -303,53 +303,33 @@ pub fn write_report(e: &Evaluation, dir: &Path) -> Result<(PathBuf, PathBuf)> {
     Ok((md_path, html_path))
 }
 
-/// Renders the report's Markdown subset (headings, lists, pipe tables, images) as one HTML page
-/// with every image embedded as a data URI.
+/// Renders the report's Markdown as one HTML page (pulldown-cmark, with tables) with every
+/// image embedded as a data URI, so the page can be mailed or moved alone.
 fn to_html(md: &str, dir: &Path) -> Result<String> {
-    let esc = |s: &str| {
-        s.replace('&', "&amp;")
-            .replace('<', "&lt;")
-            .replace('>', "&gt;")
-    };
-    let inline = |s: &str| -> Result<String> {
-        // Images `![alt](file)` become embedded <img>; `code` spans become <code>.
-        let mut out = String::new();
-        let mut rest = s;
-        while let Some(i) = rest.find("![") {
-            out += &esc(&rest[..i]);
-            let close = rest[i..]
-                .find("](")
-                .map(|k| i + k)
-                .context("malformed image")?;
-            let end = rest[close..]
-                .find(')')
-                .map(|k| close + k)
-                .context("malformed image")?;
-            let alt = &rest[i + 2..close];
-            let file = &rest[close + 2..end];
-            let bytes =
-                std::fs::read(dir.join(file)).with_context(|| format!("cannot read '{file}'"))?;
-            let b64 = base64::engine::general_purpose::STANDARD.encode(bytes);
-            out += &format!(
-                "<img alt=\"{}\" src=\"data:image/png;base64,{b64}\">",
-                esc(alt)
-            );
-            rest = &rest[end + 1..];
-        }
-        out += &esc(rest);
-        let mut code = false;
-        Ok(out
-            .split('`')
-            .enumerate()
-            .fold(String::new(), |mut acc, (k, part)| {
-                if k > 0 {
-                    acc += if code { "</code>" } else { "<code>" };
-                    code = !code;
-                }
-                acc += part;
-                acc
-            }))
-    };
+    use pulldown_cmark::{Event, Options, Parser, Tag};
+    let mut events = Vec::new();
+    for event in Parser::new_ext(md, Options::ENABLE_TABLES) {
+        events.push(match event {
+            Event::Start(Tag::Image {
+                link_type,
+                dest_url,
+                title,
+                id,
+            }) => {
+                let file = dir.join(dest_url.as_ref());
+                let bytes = std::fs::read(&file)
+                    .with_context(|| format!("cannot read report image '{}'", file.display()))?;
+                let b64 = base64::engine::general_purpose::STANDARD.encode(bytes);
+                Event::Start(Tag::Image {
+                    link_type,
+                    dest_url: format!("data:image/png;base64,{b64}").into(),
+                    title,
+                    id,
+                })
+            }
+            other => other,
+        });
+    }
     let mut html = String::from(
         "<!DOCTYPE html><html><head><meta charset=\"utf-8\"><title>nprt evaluation</title><style>\
          body{font-family:sans-serif;max-width:1400px;margin:2em auto;padding:0 1em}\
@@ -357,55 +337,7 @@ fn to_html(md: &str, dir: &Path) -> Result<String> {
          td:first-child,th:first-child{text-align:left}img{image-rendering:pixelated;max-width:100%}\
          td img{width:192px}</style></head><body>\n",
     );
-    let mut in_table = false;
-    let mut in_list = false;
-    for line in md.lines() {
-        let t = line.trim();
-        if in_table && !t.starts_with('|') {
-            html += "</table>\n";
-            in_table = false;
-        }
-        if in_list && !t.starts_with("- ") {
-            html += "</ul>\n";
-            in_list = false;
-        }
-        if let Some(h) = t.strip_prefix("### ") {
-            html += &format!("<h3>{}</h3>\n", inline(h)?);
-        } else if let Some(h) = t.strip_prefix("## ") {
-            html += &format!("<h2>{}</h2>\n", inline(h)?);
-        } else if let Some(h) = t.strip_prefix("# ") {
-            html += &format!("<h1>{}</h1>\n", inline(h)?);
-        } else if let Some(item) = t.strip_prefix("- ") {
-            if !in_list {
-                html += "<ul>\n";
-                in_list = true;
-            }
-            html += &format!("<li>{}</li>\n", inline(item)?);
-        } else if t.starts_with('|') {
-            let cells: Vec<&str> = t.trim_matches('|').split('|').map(str::trim).collect();
-            if cells.iter().all(|c| c.chars().all(|ch| ch == '-')) {
-                continue;
-            }
-            let tag = if in_table { "td" } else { "th" };
-            if !in_table {
-                html += "<table>\n";
-                in_table = true;
-            }
-            html += "<tr>";
-            for c in cells {
-                html += &format!("<{tag}>{}</{tag}>", inline(c)?);
-            }
-            html += "</tr>\n";
-        } else if !t.is_empty() {
-            html += &format!("<p>{}</p>\n", inline(t)?);
-        }
-    }
-    if in_table {
-        html += "</table>\n";
-    }
-    if in_list {
-        html += "</ul>\n";
-    }
+    pulldown_cmark::html::push_html(&mut html, events.into_iter());
     html += "</body></html>\n";
     Ok(html)
 }

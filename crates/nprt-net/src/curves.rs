@@ -3,48 +3,62 @@
 use std::path::Path;
 use std::sync::Once;
 
-use anyhow::{anyhow, Result};
+use anyhow::{anyhow, Context, Result};
 use nprt_io::write_atomically;
 use plotters::prelude::*;
 use plotters::style::FontStyle;
+use serde::{Deserialize, Serialize};
 
 use crate::train::LossRow;
 
-/// `step,epoch,samples,seconds,train_loss,val_loss`; empty cells where a row has no value.
-pub fn write_csv(path: &Path, rows: &[LossRow]) -> Result<()> {
-    let cell = |v: Option<f64>| v.map_or(String::new(), |v| format!("{v:.6}"));
-    let mut text = String::from("step,epoch,samples,seconds,train_loss,val_loss\n");
-    for r in rows {
-        text += &format!(
-            "{},{:.4},{},{:.2},{},{}\n",
-            r.step,
-            r.epoch,
-            r.samples,
-            r.seconds,
-            cell(r.train),
-            cell(r.val)
-        );
-    }
-    nprt_io::write_file(path, text)
+/// One loss.csv row: `step,epoch,samples,seconds,train_loss,val_loss`, empty cells where a
+/// row has no value.
+#[derive(Serialize, Deserialize)]
+struct CsvRow {
+    step: u64,
+    epoch: f64,
+    samples: u64,
+    seconds: f64,
+    train_loss: Option<f64>,
+    val_loss: Option<f64>,
 }
 
-/// Rows of a loss.csv written by [`write_csv`]; none when it is missing, unreadable rows skipped.
-pub fn read_csv(path: &Path) -> Vec<LossRow> {
-    let Ok(text) = std::fs::read_to_string(path) else {
-        return vec![];
-    };
-    text.lines()
-        .skip(1)
-        .filter_map(|l| {
-            let f: Vec<&str> = l.split(',').collect();
-            let num = |i: usize| f.get(i).and_then(|s| s.parse::<f64>().ok());
-            Some(LossRow {
-                step: num(0)? as u64,
-                epoch: num(1)?,
-                samples: num(2)? as u64,
-                seconds: num(3)?,
-                train: num(4),
-                val: num(5),
+pub fn write_csv(path: &Path, rows: &[LossRow]) -> Result<()> {
+    let mut w = csv::Writer::from_writer(Vec::new());
+    for r in rows {
+        w.serialize(CsvRow {
+            step: r.step,
+            epoch: r.epoch,
+            samples: r.samples,
+            seconds: r.seconds,
+            train_loss: r.train,
+            val_loss: r.val,
+        })?;
+    }
+    nprt_io::write_file(path, w.into_inner().context("cannot finish loss.csv")?)
+}
+
+/// Rows of a loss.csv written by [`write_csv`]; none when the file does not exist. A row that
+/// does not parse is an error naming the file and the row.
+pub fn read_csv(path: &Path) -> Result<Vec<LossRow>> {
+    if !path.exists() {
+        return Ok(vec![]);
+    }
+    let mut r = csv::Reader::from_path(path)
+        .with_context(|| format!("cannot read '{}'", path.display()))?;
+    r.deserialize::<CsvRow>()
+        .enumerate()
+        .map(|(i, row)| {
+            let row = row.with_context(|| {
+                format!("'{}': row {} is not a loss row", path.display(), i + 1)
+            })?;
+            Ok(LossRow {
+                step: row.step,
+                epoch: row.epoch,
+                samples: row.samples,
+                seconds: row.seconds,
+                train: row.train_loss,
+                val: row.val_loss,
             })
         })
         .collect()

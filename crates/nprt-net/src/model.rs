@@ -132,12 +132,13 @@ pub fn load_weights<M: Module>(path: &Path, net: &mut M, tag: &str) -> Result<()
 
 /// The `nprt_design` entry of a safetensors header.
 fn read_design_tag(bytes: &[u8]) -> Result<String> {
-    let len = u64::from_le_bytes(bytes.get(..8).context("file too short")?.try_into()?) as usize;
-    let header: serde_json::Value =
-        serde_json::from_slice(bytes.get(8..8 + len).context("truncated header")?)?;
-    header["__metadata__"]["nprt_design"]
-        .as_str()
-        .map(str::to_string)
+    let (_, metadata) = safetensors::SafeTensors::read_metadata(bytes)
+        .map_err(|e| anyhow::anyhow!("not a safetensors file: {e}"))?;
+    metadata
+        .metadata()
+        .as_ref()
+        .and_then(|m| m.get("nprt_design"))
+        .cloned()
         .context("no nprt_design tag in its metadata")
 }
 

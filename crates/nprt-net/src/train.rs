@@ -20,8 +20,8 @@ use serde::{Deserialize, Serialize};
 
 use crate::data::{TrainingSet, ViewSamples};
 use crate::design::{NprtNet, FEATURES};
-use crate::loss::log_l1;
 use crate::layers::Init;
+use crate::loss::log_l1;
 use crate::model::{
     load_weights, save_model, save_weights, ModelConfig, ModelFile, MODEL_FORMAT, MODEL_VERSION,
 };

@@ -804,8 +804,18 @@ mod tests {
                 r#"<rgb name="radiance" value="2"/>"#,
                 &format!(r#"<rgb name="radiance" value="{v}"/>"#),
             );
-            let err = format!("{:#}", load(&write(&dir, "nonfinite.xml", &bad), &SceneOptions::default()).unwrap_err());
-            assert!(err.contains("nonfinite.xml:19:") && err.contains("not a finite number"), "{v}: {err}");
+            let err = format!(
+                "{:#}",
+                load(
+                    &write(&dir, "nonfinite.xml", &bad),
+                    &SceneOptions::default()
+                )
+                .unwrap_err()
+            );
+            assert!(
+                err.contains("nonfinite.xml:19:") && err.contains("not a finite number"),
+                "{v}: {err}"
+            );
         }
     }
 }

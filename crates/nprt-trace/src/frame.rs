@@ -92,7 +92,15 @@ impl Frame {
 
     fn vector_layers(&self) -> [&Vec<Vec3>; 7] {
         let g = &self.gbuffer;
-        [&self.radiance, &self.direct, &g.position, &g.normal, &g.view, &g.kd, &g.ks]
+        [
+            &self.radiance,
+            &self.direct,
+            &g.position,
+            &g.normal,
+            &g.view,
+            &g.kd,
+            &g.ks,
+        ]
     }
 
     /// Every layer as (channel name, data), in the order documented above.
@@ -101,7 +109,12 @@ impl Frame {
             .iter()
             .zip(self.vector_layers())
             .flat_map(|((p, names), data)| {
-                (0..3).map(move |k| (channel_name(p, names[k]), data.iter().map(|v| v[k]).collect()))
+                (0..3).map(move |k| {
+                    (
+                        channel_name(p, names[k]),
+                        data.iter().map(|v| v[k]).collect(),
+                    )
+                })
             })
             .collect();
         out.push(("alpha".into(), self.gbuffer.alpha.clone()));
@@ -111,11 +124,20 @@ impl Frame {
 
     /// The frame held by named channels (as [`crate::exr_io::read_channels`] returns them),
     /// refusing a missing or wrongly sized channel and non-finite values.
-    pub fn from_channels(width: usize, height: usize, ch: &HashMap<String, Vec<f32>>) -> Result<Frame> {
+    pub fn from_channels(
+        width: usize,
+        height: usize,
+        ch: &HashMap<String, Vec<f32>>,
+    ) -> Result<Frame> {
         let get = |name: &str| -> Result<&Vec<f32>> {
-            let data = ch.get(name).with_context(|| format!("lacks channel '{name}'"))?;
+            let data = ch
+                .get(name)
+                .with_context(|| format!("lacks channel '{name}'"))?;
             if data.len() != width * height {
-                bail!("channel '{name}' has {} values for {width}×{height} pixels", data.len());
+                bail!(
+                    "channel '{name}' has {} values for {width}×{height} pixels",
+                    data.len()
+                );
             }
             if data.iter().any(|v| !v.is_finite()) {
                 bail!("channel '{name}' holds non-finite values");
@@ -124,8 +146,16 @@ impl Frame {
         };
         let mut layers = Vec::with_capacity(VECTOR_LAYERS.len());
         for (prefix, names) in VECTOR_LAYERS {
-            let c = [get(&channel_name(prefix, names[0]))?, get(&channel_name(prefix, names[1]))?, get(&channel_name(prefix, names[2]))?];
-            layers.push((0..width * height).map(|i| Vec3::new(c[0][i], c[1][i], c[2][i])).collect::<Vec<_>>());
+            let c = [
+                get(&channel_name(prefix, names[0]))?,
+                get(&channel_name(prefix, names[1]))?,
+                get(&channel_name(prefix, names[2]))?,
+            ];
+            layers.push(
+                (0..width * height)
+                    .map(|i| Vec3::new(c[0][i], c[1][i], c[2][i]))
+                    .collect::<Vec<_>>(),
+            );
         }
         let [radiance, direct, position, normal, view, kd, ks]: [Vec<Vec3>; 7] =
             layers.try_into().expect("one entry per vector layer");

@@ -72,7 +72,12 @@ fn convex_diffuse_object_reflects_albedo_times_sky() {
     let s = sphere_scene(Material::diffuse("d", kd));
     let ts = TraceScene::new(&s);
     let sky = Vec3::new(2.0, 1.0, 0.5);
-    let f = render(&ts, &camera(), &EnvMap::constant(sky).unwrap(), &settings(64, None));
+    let f = render(
+        &ts,
+        &camera(),
+        &EnvMap::constant(sky).unwrap(),
+        &settings(64, None),
+    );
     let m = foreground_mean(&f);
     let expected = kd * sky;
     assert!(

@@ -282,10 +282,18 @@ fn hand_edited_manifests_are_refused_by_name_in_every_command() {
     let path = dir.join("manifest.json");
     let good: serde_json::Value = serde_json::from_slice(&std::fs::read(&path).unwrap()).unwrap();
     let edits: [(&str, fn(&mut serde_json::Value)); 5] = [
-        ("map index 99 is out of range", |m| m["settings"]["test_maps"][0] = 99.into()),
-        ("not one of its split's maps", |m| m["views"][0]["map"] = 10_000.into()),
-        ("neither 'train' nor 'test'", |m| m["views"][1]["split"] = "valid".into()),
-        ("inside the dataset folder", |m| m["views"][2]["file"] = "../../etc/passwd".into()),
+        ("map index 99 is out of range", |m| {
+            m["settings"]["test_maps"][0] = 99.into()
+        }),
+        ("not one of its split's maps", |m| {
+            m["views"][0]["map"] = 10_000.into()
+        }),
+        ("neither 'train' nor 'test'", |m| {
+            m["views"][1]["split"] = "valid".into()
+        }),
+        ("inside the dataset folder", |m| {
+            m["views"][2]["file"] = "../../etc/passwd".into()
+        }),
         ("fov_x_deg", |m| m["views"][3]["fov_x_deg"] = 0.into()),
     ];
     let model = dir.join("model");
@@ -296,8 +304,31 @@ fn hand_edited_manifests_are_refused_by_name_in_every_command() {
         let d = dir.to_str().unwrap();
         let expected = ["manifest.json", needle];
         fails(&["dataset", "verify", d], &expected);
-        fails(&["train", "--data", d, "--arch", "prt", "--out", model.to_str().unwrap()], &expected);
-        fails(&["train-deep-shading", "--data", d, "--out", model.to_str().unwrap()], &expected);
-        assert!(!model.exists(), "nothing may be written from a refused dataset");
+        fails(
+            &[
+                "train",
+                "--data",
+                d,
+                "--arch",
+                "prt",
+                "--out",
+                model.to_str().unwrap(),
+            ],
+            &expected,
+        );
+        fails(
+            &[
+                "train-deep-shading",
+                "--data",
+                d,
+                "--out",
+                model.to_str().unwrap(),
+            ],
+            &expected,
+        );
+        assert!(
+            !model.exists(),
+            "nothing may be written from a refused dataset"
+        );
     }
 }
