@@ -90,6 +90,13 @@ pub struct Manifest {
 }
 
 impl Manifest {
+    /// Parses and [checks](Manifest::check) a manifest's JSON.
+    pub fn from_json(bytes: &[u8]) -> Result<Manifest> {
+        let manifest: Manifest = serde_json::from_slice(bytes).context("not a valid manifest")?;
+        manifest.check()?;
+        Ok(manifest)
+    }
+
     /// Refuses a manifest that a hand edit or another tool made inconsistent, so that every
     /// later use (map indices, image sizes, cameras, file names) can trust it.
     pub fn check(&self) -> Result<()> {
@@ -339,14 +346,8 @@ pub fn load_manifest_hashed(dir: &Path) -> Result<(Manifest, String)> {
     let path = dir.join(MANIFEST);
     let bytes =
         std::fs::read(&path).with_context(|| format!("cannot read '{}'", path.display()))?;
-    let manifest: Manifest = serde_json::from_slice(&bytes)
-        .with_context(|| format!("'{}' is not a valid nprt dataset manifest", path.display()))?;
-    manifest.check().with_context(|| {
-        format!(
-            "'{}' is not a consistent nprt dataset manifest",
-            path.display()
-        )
-    })?;
+    let manifest = Manifest::from_json(&bytes)
+        .with_context(|| format!("'{}' is not a usable nprt dataset manifest", path.display()))?;
     Ok((manifest, blake3::hash(&bytes).to_hex().to_string()))
 }
 

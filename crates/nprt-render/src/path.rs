@@ -41,14 +41,15 @@ impl CameraPath {
     pub fn load(path: &Path) -> Result<Self> {
         let text = std::fs::read_to_string(path)
             .with_context(|| format!("cannot read camera path '{}'", path.display()))?;
-        let p: CameraPath = serde_json::from_str(&text).with_context(|| {
-            format!(
-                "camera path '{}' is not {{\"keyframes\": [{{\"position\": [x,y,z], \"target\": [x,y,z], \"fov_x_deg\": deg}}, …]}}",
-                path.display()
-            )
-        })?;
-        p.check()
-            .with_context(|| format!("camera path '{}'", path.display()))?;
+        Self::from_json(&text).with_context(|| format!("camera path '{}'", path.display()))
+    }
+
+    /// Parses and checks a camera path's JSON.
+    pub fn from_json(text: &str) -> Result<Self> {
+        let p: CameraPath = serde_json::from_str(text).context(
+            "is not {\"keyframes\": [{\"position\": [x,y,z], \"target\": [x,y,z], \"fov_x_deg\": deg}, …]}",
+        )?;
+        p.check()?;
         Ok(p)
     }
 

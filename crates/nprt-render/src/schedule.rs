@@ -30,43 +30,81 @@ pub struct LightingSchedule {
     pub maps: Vec<EnvMap>,
 }
 
+/// Parses and checks a lighting schedule's JSON:
+/// `{"segments": [{"map": …, "weight": 1, "rotation_deg": [0, 90]}]}`.
+pub fn parse_segments(text: &str) -> Result<Vec<Segment>> {
+    #[derive(Deserialize)]
+    struct File {
+        segments: Vec<Segment>,
+    }
+    let segments = serde_json::from_str::<File>(text)
+        .context("is not {\"segments\": [{\"map\": …, \"weight\": w, \"rotation_deg\": [from, to]}]}")?
+        .segments;
+    check_segments(&segments)?;
+    Ok(segments)
+}
+
+fn check_segments(segments: &[Segment]) -> Result<()> {
+    if segments.is_empty() {
+        bail!("names no map");
+    }
+    for s in segments {
+        if !(s.weight > 0.0 && s.weight.is_finite()) {
+            bail!("segment '{}' has weight {}, must be > 0", s.map, s.weight);
+        }
+        if !s.rotation_deg.iter().all(|r| r.is_finite()) {
+            bail!("segment '{}' has a non-finite rotation", s.map);
+        }
+    }
+    if !segments.iter().map(|s| s.weight).sum::<f32>().is_finite() {
+        bail!("the segments' weights add up to more than a 32-bit float holds");
+    }
+    Ok(())
+}
+
+/// The segment index and rotation (degrees) lighting frame `i` of `frames` under `segments`
+/// (checked by [`parse_segments`]): frames are shared out in proportion to the weights.
+pub fn segment_at(segments: &[Segment], i: usize, frames: usize) -> (usize, f32) {
+    let total: f32 = segments.iter().map(|s| s.weight).sum();
+    let t = if frames > 1 {
+        i as f32 / (frames - 1) as f32
+    } else {
+        0.0
+    } * total;
+    let mut start = 0.0;
+    for (k, s) in segments.iter().enumerate() {
+        let end = start + s.weight;
+        if t < end || k + 1 == segments.len() {
+            let f = ((t - start) / s.weight).clamp(0.0, 1.0);
+            let [a, b] = s.rotation_deg;
+            return (k, a + (b - a) * f);
+        }
+        start = end;
+    }
+    (0, 0.0)
+}
+
 impl LightingSchedule {
-    /// `spec` is a JSON file (`{"segments": [{"map": …, "weight": 1, "rotation_deg": [0, 90]}]}`)
-    /// or a comma-separated list of maps, each turning by `spin_deg` over its segment.
+    /// `spec` is a JSON file (see [`parse_segments`]) or a comma-separated list of maps, each
+    /// turning by `spin_deg` over its segment.
     pub fn parse(spec: &str, spin_deg: f32) -> Result<Self> {
         let segments = if spec.ends_with(".json") {
-            #[derive(Deserialize)]
-            struct File {
-                segments: Vec<Segment>,
-            }
             let text = std::fs::read_to_string(Path::new(spec))
                 .with_context(|| format!("cannot read lighting schedule '{spec}'"))?;
-            serde_json::from_str::<File>(&text)
-                .with_context(|| format!("lighting schedule '{spec}' is not {{\"segments\": [{{\"map\": …, \"weight\": w, \"rotation_deg\": [from, to]}}]}}"))?
-                .segments
+            parse_segments(&text).with_context(|| format!("lighting schedule '{spec}'"))?
         } else {
-            spec.split(',')
+            let segments: Vec<Segment> = spec
+                .split(',')
                 .filter(|s| !s.trim().is_empty())
                 .map(|m| Segment {
                     map: m.trim().to_string(),
                     weight: 1.0,
                     rotation_deg: [0.0, spin_deg],
                 })
-                .collect()
+                .collect();
+            check_segments(&segments).with_context(|| format!("lighting schedule '{spec}'"))?;
+            segments
         };
-        if segments.is_empty() {
-            bail!("lighting schedule '{spec}' names no map");
-        }
-        if let Some(s) = segments
-            .iter()
-            .find(|s| !(s.weight > 0.0 && s.weight.is_finite()))
-        {
-            bail!(
-                "lighting schedule '{spec}': segment '{}' has weight {}, must be > 0",
-                s.map,
-                s.weight
-            );
-        }
         let maps = segments
             .iter()
             .map(|s| open_envmap(&s.map))
@@ -76,23 +114,7 @@ impl LightingSchedule {
 
     /// The map index and rotation lighting frame `i` of `frames`.
     pub fn at(&self, i: usize, frames: usize) -> (usize, f32) {
-        let total: f32 = self.segments.iter().map(|s| s.weight).sum();
-        let t = if frames > 1 {
-            i as f32 / (frames - 1) as f32
-        } else {
-            0.0
-        } * total;
-        let mut start = 0.0;
-        for (k, s) in self.segments.iter().enumerate() {
-            let end = start + s.weight;
-            if t < end || k + 1 == self.segments.len() {
-                let f = ((t - start) / s.weight).clamp(0.0, 1.0);
-                let [a, b] = s.rotation_deg;
-                return (k, a + (b - a) * f);
-            }
-            start = end;
-        }
-        unreachable!("a schedule has at least one segment")
+        segment_at(&self.segments, i, frames)
     }
 }
 

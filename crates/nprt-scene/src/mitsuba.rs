@@ -26,11 +26,17 @@ use crate::texture::{Bitmap, Texture};
 const SPHERE_SEGMENTS: u32 = 96;
 
 pub fn load(path: &Path, opts: &SceneOptions) -> Result<Scene> {
-    let file = path.display().to_string();
     let text = std::fs::read_to_string(path)
-        .with_context(|| format!("cannot read scene file '{file}'"))?;
+        .with_context(|| format!("cannot read scene file '{}'", path.display()))?;
+    parse(&text, path, opts)
+}
+
+/// Parses the Mitsuba scene `text` of the file `path` (which names it in errors and anchors
+/// its relative file references).
+pub fn parse(text: &str, path: &Path, opts: &SceneOptions) -> Result<Scene> {
+    let file = path.display().to_string();
     let doc =
-        Document::parse(&text).map_err(|e| anyhow!("scene file '{file}' is not valid XML: {e}"))?;
+        Document::parse(text).map_err(|e| anyhow!("scene file '{file}' is not valid XML: {e}"))?;
     let root = doc.root_element();
     if root.tag_name().name() != "scene" {
         bail!(
