@@ -7,11 +7,14 @@ use glam::{Vec2, Vec3};
 use nprt_scene::{luminance, BsdfParams};
 use std::f32::consts::PI;
 
+use crate::microfacet::GgxDistribution;
+
 #[derive(Clone, Copy, Debug)]
 pub struct Bsdf {
     pub kd: Vec3,
     pub ks: Vec3,
     pub alpha: f32,
+    ggx: GgxDistribution,
     /// Probability of sampling the specular lobe.
     p_spec: f32,
 }
@@ -23,42 +26,6 @@ pub struct BsdfSample {
     pub pdf: f32,
 }
 
-fn ggx_d(alpha: f32, m: Vec3) -> f32 {
-    let a2 = alpha * alpha;
-    let c2 = m.z * m.z;
-    let denom = c2 * (a2 - 1.0) + 1.0;
-    a2 / (PI * denom * denom)
-}
-
-/// Smith's G1 for GGX, zero when the microfacet is seen from its back.
-fn smith_g1(alpha: f32, v: Vec3, m: Vec3) -> f32 {
-    if v.dot(m) * v.z <= 0.0 {
-        return 0.0;
-    }
-    let c2 = v.z * v.z;
-    let tan2 = ((1.0 - c2) / c2).max(0.0);
-    2.0 / (1.0 + (1.0 + alpha * alpha * tan2).sqrt())
-}
-
-/// Samples a GGX visible normal for a view direction in the upper hemisphere (Heitz 2018).
-fn sample_vndf(alpha: f32, wo: Vec3, u: Vec2) -> Vec3 {
-    let vh = Vec3::new(alpha * wo.x, alpha * wo.y, wo.z).normalize();
-    let len2 = vh.x * vh.x + vh.y * vh.y;
-    let t1 = if len2 > 0.0 {
-        Vec3::new(-vh.y, vh.x, 0.0) / len2.sqrt()
-    } else {
-        Vec3::X
-    };
-    let t2 = vh.cross(t1);
-    let r = u.x.sqrt();
-    let phi = 2.0 * PI * u.y;
-    let p1 = r * phi.cos();
-    let s = 0.5 * (1.0 + vh.z);
-    let p2 = (1.0 - s) * (1.0 - p1 * p1).max(0.0).sqrt() + s * r * phi.sin();
-    let nh = t1 * p1 + t2 * p2 + vh * (1.0 - p1 * p1 - p2 * p2).max(0.0).sqrt();
-    Vec3::new(alpha * nh.x, alpha * nh.y, nh.z.max(1e-6)).normalize()
-}
-
 impl Bsdf {
     pub fn new(p: BsdfParams) -> Self {
         let (ld, ls) = (luminance(p.kd), luminance(p.ks));
@@ -67,6 +34,7 @@ impl Bsdf {
             kd: p.kd,
             ks: p.ks,
             alpha: p.alpha,
+            ggx: GgxDistribution::new(p.alpha),
             p_spec,
         }
     }
@@ -83,8 +51,8 @@ impl Bsdf {
         let mut f = self.kd * (wi.z / PI);
         if self.p_spec > 0.0 {
             let m = (wo + wi).normalize();
-            let g = smith_g1(self.alpha, wo, m) * smith_g1(self.alpha, wi, m);
-            f += self.ks * (ggx_d(self.alpha, m) * g / (4.0 * wo.z));
+            let g = self.ggx.g1(wo, m) * self.ggx.g1(wi, m);
+            f += self.ks * (self.ggx.d(m) * g / (4.0 * wo.z));
         }
         f
     }
@@ -97,7 +65,7 @@ impl Bsdf {
         if self.p_spec > 0.0 {
             let m = (wo + wi).normalize();
             // Visible-normal density G1(ωo)·D(m)·(ωo·m)/cos θo, times the reflection Jacobian.
-            pdf += self.p_spec * smith_g1(self.alpha, wo, m) * ggx_d(self.alpha, m) / (4.0 * wo.z);
+            pdf += self.p_spec * self.ggx.g1(wo, m) * self.ggx.d(m) / (4.0 * wo.z);
         }
         pdf
     }
@@ -107,7 +75,7 @@ impl Bsdf {
             return None;
         }
         let wi = if u_lobe < self.p_spec {
-            let m = sample_vndf(self.alpha, wo, u);
+            let m = self.ggx.sample_visible_normal(wo, u);
             2.0 * wo.dot(m) * m - wo
         } else {
             let r = u.x.sqrt();
@@ -126,34 +94,10 @@ impl Bsdf {
     }
 }
 
-/// An orthonormal frame around a unit normal (Duff et al. 2017).
-#[derive(Clone, Copy, Debug)]
-pub struct Frame3 {
-    pub s: Vec3,
-    pub t: Vec3,
-    pub n: Vec3,
-}
-
-impl Frame3 {
-    pub fn new(n: Vec3) -> Self {
-        let sign = 1.0f32.copysign(n.z);
-        let a = -1.0 / (sign + n.z);
-        let b = n.x * n.y * a;
-        let s = Vec3::new(1.0 + sign * n.x * n.x * a, sign * b, -sign * n.x);
-        let t = Vec3::new(b, sign + n.y * n.y * a, -n.y);
-        Frame3 { s, t, n }
-    }
-    pub fn to_local(&self, v: Vec3) -> Vec3 {
-        Vec3::new(v.dot(self.s), v.dot(self.t), v.dot(self.n))
-    }
-    pub fn to_world(&self, v: Vec3) -> Vec3 {
-        self.s * v.x + self.t * v.y + self.n * v.z
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::shading_frame::Frame3;
     use rand::{RngExt, SeedableRng};
 
     fn params(kd: f32, ks: f32, alpha: f32) -> BsdfParams {

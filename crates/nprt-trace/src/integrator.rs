@@ -8,7 +8,8 @@ use rand::RngExt;
 use rand_pcg::Pcg64Mcg;
 
 use crate::accel::{Accel, Hit};
-use crate::bsdf::{Bsdf, Frame3};
+use crate::bsdf::Bsdf;
+use crate::shading_frame::Frame3;
 
 /// A surface point seen along a ray, oriented for shading.
 #[derive(Clone, Copy, Debug)]

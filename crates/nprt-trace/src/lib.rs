@@ -11,7 +11,9 @@ pub mod bsdf;
 pub mod exr_io;
 pub mod frame;
 pub mod integrator;
+pub mod microfacet;
 pub mod render;
+pub mod shading_frame;
 
 pub use accel::{Accel, Hit};
 pub use bsdf::Bsdf;
