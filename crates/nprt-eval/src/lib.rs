@@ -6,12 +6,21 @@
 //! datasets or train the Neural PRT designs (nprt-net does).
 
 pub mod deep_shading;
+mod error_analysis;
 pub mod evaluate;
+pub mod method;
 pub mod metrics;
+mod networks;
 pub mod oidn;
+mod path_tracing;
 pub mod report;
 pub mod sh;
+mod sh_prt;
+mod test_bench;
+mod timing;
 
-pub use evaluate::{evaluate, EvalOptions, Evaluation, MethodResult};
+pub use evaluate::{evaluate, EvalOptions, Evaluation};
+pub use method::{Family, MethodResult, BINS};
 pub use metrics::Metrics;
 pub use report::write_report;
+pub use timing::Timing;

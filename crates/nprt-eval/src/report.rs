@@ -12,7 +12,8 @@ use nprt_net::curves::plot_lines;
 use nprt_render::video::to_image;
 use nprt_scene::{luminance, srgb_to_linear};
 
-use crate::evaluate::{Evaluation, ShownView, BINS};
+use crate::evaluate::{Evaluation, ShownView};
+use crate::method::BINS;
 use crate::metrics::{Metrics, RELATIVE_EPS};
 
 /// Relative error at which the heat map saturates.

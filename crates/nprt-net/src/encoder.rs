@@ -22,7 +22,7 @@ pub const CODE_SIZE: usize = 64;
 /// the width.
 pub fn check_input_width(width: usize) -> anyhow::Result<()> {
     let step = 2usize.pow(BLOCKS as u32 + 1);
-    if width < step || width % step != 0 {
+    if width < step || !width.is_multiple_of(step) {
         anyhow::bail!(
             "encoder input width {width} must be a positive multiple of {step} (the map is W×W/2 and {BLOCKS} blocks halve it)"
         );

@@ -425,7 +425,7 @@ pub fn train(
                 last_train = value;
                 let elapsed = started.elapsed().as_secs_f64();
                 ck.seconds = seconds_before + elapsed;
-                if ck.step % row_every == 0 {
+                if ck.step.is_multiple_of(row_every) {
                     ck.history.push(LossRow {
                         step: ck.step,
                         epoch: ck.epoch as f64 + ck.batch as f64 / total as f64,

@@ -1,0 +1,88 @@
+//! Per-method error bookkeeping over the test views: metrics per view, and each foreground
+//! pixel's error against its share of direct light and its specularity (the paper's error
+//! analysis), binned and correlated.
+
+use glam::Vec3;
+use nprt_data::views::ImageView;
+use nprt_scene::luminance;
+
+use crate::method::{Family, MethodResult, BINS};
+use crate::metrics::{correlation, Metrics};
+
+/// Accumulates one method's per-view metrics and per-pixel error statistics.
+pub struct Accumulator {
+    pub result: MethodResult,
+    err: Vec<f64>,
+    direct: Vec<f64>,
+    spec: Vec<f64>,
+    ms: Vec<f64>,
+}
+
+impl Accumulator {
+    pub fn new(name: &str, family: Family, params: Option<usize>) -> Self {
+        Accumulator {
+            result: MethodResult {
+                name: name.into(),
+                family,
+                params,
+                mean: Metrics::default(),
+                per_view: vec![],
+                ms_per_view: 0.0,
+                precompute_ms: None,
+                corr_directness: 0.0,
+                corr_specularity: 0.0,
+                error_by_directness: vec![],
+                error_by_specularity: vec![],
+                note: String::new(),
+                loss_png: None,
+            },
+            err: vec![],
+            direct: vec![],
+            spec: vec![],
+            ms: vec![],
+        }
+    }
+
+    pub fn add(&mut self, view: &ImageView, pred: &[Vec3], ms: f64) {
+        let g = &view.gbuffer;
+        self.result
+            .per_view
+            .push(Metrics::compute(pred, &view.radiance, &g.mask, view.width));
+        self.ms.push(ms);
+        for i in (0..g.mask.len()).filter(|&i| g.mask[i] > 0.5) {
+            let r = view.radiance[i];
+            self.err
+                .push(((pred[i] - r).abs().element_sum() / 3.0) as f64);
+            self.direct
+                .push((luminance(view.direct[i]) / luminance(r).max(1e-6)).clamp(0.0, 1.0) as f64);
+            let (kd, ks) = (g.kd[i].element_sum(), g.ks[i].element_sum());
+            self.spec.push((ks / (kd + ks).max(1e-6)) as f64);
+        }
+    }
+
+    pub fn finish(mut self) -> MethodResult {
+        let r = &mut self.result;
+        r.mean = Metrics::mean(&r.per_view);
+        r.ms_per_view = self.ms.iter().sum::<f64>() / self.ms.len().max(1) as f64;
+        r.corr_directness = correlation(&self.err, &self.direct);
+        r.corr_specularity = correlation(&self.err, &self.spec);
+        r.error_by_directness = binned(&self.direct, &self.err);
+        r.error_by_specularity = binned(&self.spec, &self.err);
+        self.result
+    }
+}
+
+/// Mean of `y` in `BINS` equal bins of `x` ∈ [0, 1] (NaN where a bin is empty).
+fn binned(x: &[f64], y: &[f64]) -> Vec<f64> {
+    let mut sum = [0.0; BINS];
+    let mut n = vec![0usize; BINS];
+    for (a, b) in x.iter().zip(y) {
+        let k = ((a * BINS as f64) as usize).min(BINS - 1);
+        sum[k] += b;
+        n[k] += 1;
+    }
+    sum.iter()
+        .zip(&n)
+        .map(|(s, &c)| if c > 0 { s / c as f64 } else { f64::NAN })
+        .collect()
+}

@@ -1,0 +1,61 @@
+//! One evaluated method's results: its family, metrics over the test views, cost and error
+//! analysis.
+
+use std::path::PathBuf;
+
+use serde::{Deserialize, Serialize};
+
+use crate::metrics::Metrics;
+
+/// Which family of method a row is: what it is compared as, and how it is run.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum Family {
+    /// One of the paper's Neural PRT designs.
+    NeuralPrt,
+    /// The Deep Shading U-Net baseline.
+    DeepShading,
+    /// Path tracing at a fixed sample count.
+    PathTracing,
+    /// Path tracing denoised by Open Image Denoise.
+    Denoised,
+    /// Per-pixel spherical-harmonics PRT in a fixed view.
+    ShPrt,
+}
+
+impl Family {
+    /// A trained network (Neural PRT design or Deep Shading).
+    pub fn is_network(self) -> bool {
+        matches!(self, Family::NeuralPrt | Family::DeepShading)
+    }
+}
+
+/// Bins of the error analysis (directness and specularity in [0, 1]).
+pub const BINS: usize = 10;
+
+/// One method's results over the test views.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct MethodResult {
+    pub name: String,
+    pub family: Family,
+    /// Transport parameters (networks only).
+    pub params: Option<usize>,
+    pub mean: Metrics,
+    pub per_view: Vec<Metrics>,
+    /// Mean milliseconds per test view at the test resolution (what the method costs at run
+    /// time: G-buffer + encoder + network for networks, tracing for path tracing, projection +
+    /// dot products for SH).
+    pub ms_per_view: f64,
+    /// One-off precomputation per view (SH transport), milliseconds.
+    pub precompute_ms: Option<f64>,
+    /// Pearson correlation over foreground pixels of the per-pixel L1 error with the share of
+    /// direct light, and with specularity.
+    pub corr_directness: f64,
+    pub corr_specularity: f64,
+    /// Mean per-pixel L1 error in each directness / specularity bin.
+    pub error_by_directness: Vec<f64>,
+    pub error_by_specularity: Vec<f64>,
+    pub note: String,
+    /// Training curve, for networks.
+    pub loss_png: Option<PathBuf>,
+}
