@@ -4,7 +4,7 @@
 use std::path::Path;
 
 use anyhow::{bail, Context, Result};
-use nprt_scene::procedural::open_envmap;
+use nprt_scene::open_envmap;
 use nprt_scene::EnvMap;
 use rand::seq::SliceRandom;
 use rand::SeedableRng;

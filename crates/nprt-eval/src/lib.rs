@@ -5,7 +5,6 @@
 //! through nprt-render and reference-style frames through nprt-trace; it must not write
 //! datasets or train the Neural PRT designs (nprt-net does).
 
-pub mod deep_shading;
 mod error_analysis;
 pub mod evaluate;
 pub mod method;

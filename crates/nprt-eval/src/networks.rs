@@ -11,11 +11,11 @@ use nprt_render::Relighter;
 use nprt_scene::EnvMap;
 use nprt_trace::{render_gbuffer, GBuffer};
 
-use crate::deep_shading::DeepShadingModel;
 use crate::error_analysis::Accumulator;
 use crate::evaluate::{ms, EvalOptions};
 use crate::method::{Family, MethodResult};
 use crate::test_bench::TestBench;
+use nprt_net::deep_shading::DeepShadingModel;
 
 /// A network under evaluation and its folder.
 pub enum Net {

@@ -9,7 +9,19 @@ use plotters::prelude::*;
 use plotters::style::FontStyle;
 use serde::{Deserialize, Serialize};
 
-use crate::train::LossRow;
+/// One row of a run's loss history.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct LossRow {
+    pub step: u64,
+    /// Epochs done, fractional.
+    pub epoch: f64,
+    pub samples: u64,
+    pub seconds: f64,
+    /// Mean training loss since the previous row.
+    pub train: Option<f64>,
+    /// Validation loss (at epoch ends).
+    pub val: Option<f64>,
+}
 
 /// One loss.csv row: `step,epoch,samples,seconds,train_loss,val_loss`, empty cells where a
 /// row has no value.

@@ -4,49 +4,12 @@
 use std::path::Path;
 
 use anyhow::{bail, Context, Result};
-use glam::Vec3;
 use nprt_data::dataset::{load_manifest_hashed, Manifest, ViewRecord};
 use nprt_scene::envmap::EnvMap;
-use nprt_trace::GBuffer;
 use rayon::prelude::*;
 
-use crate::design::FEATURES;
 use crate::encoder::LightInput;
-
-/// The 19 network inputs of one surface point, in the order of [`crate::design::feature`].
-/// `bounds` normalises the position to [−1, 1]; ωr is ωo mirrored about n.
-pub fn pixel_features(
-    bounds: &[[f32; 3]; 2],
-    position: Vec3,
-    normal: Vec3,
-    view: Vec3,
-    kd: Vec3,
-    ks: Vec3,
-    alpha: f32,
-) -> [f32; FEATURES] {
-    let (lo, hi) = (Vec3::from(bounds[0]), Vec3::from(bounds[1]));
-    let x = (position - lo) / (hi - lo).max(Vec3::splat(1e-6)) * 2.0 - 1.0;
-    let mirror = 2.0 * normal.dot(view) * normal - view;
-    let mut f = [0.0; FEATURES];
-    for (i, v) in [x, view, mirror, normal, kd, ks].iter().enumerate() {
-        f[3 * i..3 * i + 3].copy_from_slice(&v.to_array());
-    }
-    f[18] = alpha;
-    f
-}
-
-/// The 19 inputs of pixel `i` of a G-buffer.
-pub fn gbuffer_features(bounds: &[[f32; 3]; 2], g: &GBuffer, i: usize) -> [f32; FEATURES] {
-    pixel_features(
-        bounds,
-        g.position[i],
-        g.normal[i],
-        g.view[i],
-        g.kd[i],
-        g.ks[i],
-        g.alpha[i],
-    )
-}
+use crate::features::gbuffer_features;
 
 /// The foreground pixels of one view.
 pub struct ViewSamples {
@@ -124,7 +87,7 @@ pub fn open_recorded_maps(manifest: &Manifest) -> Result<Vec<EnvMap>> {
                     &rec.hash[..12.min(rec.hash.len())]
                 );
             }
-            nprt_scene::procedural::open_envmap(&rec.spec)
+            nprt_scene::open_envmap(&rec.spec)
         })
         .collect()
 }

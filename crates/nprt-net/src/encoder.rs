@@ -9,7 +9,9 @@ use burn::tensor::Tensor;
 use glam::Vec2;
 use nprt_scene::envmap::{uv_to_direction, EnvMap};
 
-use crate::layers::{conv2d, Activation, Init, Mlp};
+use crate::activation::Activation;
+use crate::init::{conv2d, Init};
+use crate::mlp::Mlp;
 
 /// Convolution blocks of the paper's encoder.
 pub const BLOCKS: usize = 5;

@@ -1,25 +1,48 @@
 //! nprt-net: the learned part of Neural PRT. It owns the light encoder, the four transport
-//! designs, the model folder format (weights plus config) and training on a dataset folder.
+//! designs, the Deep Shading baseline network, the model folder format (weights plus config)
+//! and the one training loop every network goes through (checkpoints, exact resume).
 //! It reads datasets through nprt-data and environment maps through nprt-scene; it must not
 //! trace rays or write datasets, and it knows nothing of evaluation or frame rendering.
 //!
 //! Network code is device-generic: it runs on whatever burn `Device` its tensors live on
 //! (the flex CPU backend here; a GPU backend by enabling its burn feature).
 
+mod activation;
+mod batch;
+mod checkpoint;
 pub mod curves;
 pub mod data;
-pub mod design;
+pub mod deep_shading;
+mod design;
 pub mod encoder;
-pub mod layers;
+mod epoch_plan;
+mod features;
+mod init;
 pub mod loss;
+mod mlp;
 pub mod model;
-pub mod train;
+mod options;
+mod throughput;
+mod track;
+mod train;
+pub mod trainer;
+mod validation;
 
+pub use activation::{Activation, OMEGA_0};
+pub use batch::Batch;
 pub use burn;
 pub use burn::tensor::Device;
-pub use design::{Design, NprtNet, FEATURES};
+pub use checkpoint::RunState;
+pub use design::{Design, NprtNet, TRANSPORT_CODE};
 pub use encoder::{LightEncoder, LightInput};
-pub use layers::{Activation, Init};
+pub use features::{feature, gbuffer_features, pixel_features, FEATURES};
+pub use init::{conv2d, Init};
 pub use loss::log_l1;
+pub use mlp::Mlp;
 pub use model::{layer_table, load_model, ModelConfig, ModelFile, DEFAULT_ENCODER_WIDTH};
-pub use train::{measure_throughput, train, TrainOptions, TrainSummary};
+pub use options::TrainOptions;
+pub use throughput::measure_throughput;
+pub use track::{Track, TrackKind};
+pub use train::train;
+pub use trainer::{Objective, Schedule, TrainSummary};
+pub use validation::validation_loss;

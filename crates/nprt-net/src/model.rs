@@ -8,8 +8,9 @@ use burn::store::{ModuleSnapshot, SafetensorsStore};
 use burn::tensor::Device;
 use serde::{Deserialize, Serialize};
 
+use crate::activation::Activation;
 use crate::design::{Design, NprtNet};
-use crate::layers::{Activation, Init};
+use crate::init::Init;
 
 /// Identifies a model folder's config file.
 pub const MODEL_FORMAT: &str = "nprt-model";

@@ -3,9 +3,9 @@
 use burn::module::{Module, ModuleMapper, ModuleVisitor, Param, ParamId};
 use burn::optim::GradientsParams;
 use burn::tensor::{DType, Int, Tensor, TensorData};
-use nprt_net::design::FEATURES;
 use nprt_net::log_l1;
 use nprt_net::model::{load_weights, save_weights};
+use nprt_net::FEATURES;
 use nprt_net::{Activation, Design, Device, Init, ModelConfig, NprtNet};
 use rand::{RngExt, SeedableRng};
 use rand_pcg::Pcg64Mcg;

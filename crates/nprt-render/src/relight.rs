@@ -5,7 +5,7 @@ use std::path::Path;
 use anyhow::Result;
 use glam::{Vec2, Vec3};
 use nprt_net::burn::tensor::{Tensor, TensorData};
-use nprt_net::data::gbuffer_features;
+use nprt_net::gbuffer_features;
 use nprt_net::{load_model, Device, LightInput, ModelFile, NprtNet, FEATURES};
 use nprt_scene::{Camera, EnvMap};
 use nprt_trace::GBuffer;

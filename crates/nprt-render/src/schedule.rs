@@ -4,7 +4,7 @@
 use std::path::Path;
 
 use anyhow::{bail, Context, Result};
-use nprt_scene::procedural::open_envmap;
+use nprt_scene::open_envmap;
 use nprt_scene::EnvMap;
 use serde::{Deserialize, Serialize};
 
@@ -38,7 +38,9 @@ pub fn parse_segments(text: &str) -> Result<Vec<Segment>> {
         segments: Vec<Segment>,
     }
     let segments = serde_json::from_str::<File>(text)
-        .context("is not {\"segments\": [{\"map\": …, \"weight\": w, \"rotation_deg\": [from, to]}]}")?
+        .context(
+            "is not {\"segments\": [{\"map\": …, \"weight\": w, \"rotation_deg\": [from, to]}]}",
+        )?
         .segments;
     check_segments(&segments)?;
     Ok(segments)

@@ -8,6 +8,7 @@ use anyhow::{bail, Context, Result};
 use glam::{Mat3, Vec2, Vec3};
 
 use crate::distribution::Distribution2D;
+use crate::image_file::read_linear_rgb;
 use crate::luminance;
 
 use std::f32::consts::PI;
@@ -120,26 +121,15 @@ impl EnvMap {
         Self::from_texels("constant", 8, 4, vec![radiance; 32])
     }
 
-    /// Reads an OpenEXR (.exr) or Radiance (.hdr) lat-long map, scaled by `scale`.
+    /// Reads a lat-long map (OpenEXR, Radiance HDR, or an 8-bit image taken as sRGB), scaled
+    /// by `scale`.
     pub fn load(path: &Path, scale: f32) -> Result<Self> {
         let name = path.display().to_string();
-        let ext = path
-            .extension()
-            .and_then(|e| e.to_str())
-            .unwrap_or("")
-            .to_ascii_lowercase();
-        let (w, h, texels) =
-            match ext.as_str() {
-                "exr" => read_exr(path)
-                    .with_context(|| format!("cannot read environment map '{name}'"))?,
-                "hdr" => read_hdr(path)
-                    .with_context(|| format!("cannot read environment map '{name}'"))?,
-                _ => bail!(
-                "environment map '{name}': unsupported extension '.{ext}' (expected .exr or .hdr)"
-            ),
-            };
-        let texels = texels.into_iter().map(|t| t * scale).collect();
-        Self::from_texels(&name, w, h, texels).with_context(|| format!("environment map '{name}'"))
+        let img = read_linear_rgb(path, false)
+            .with_context(|| format!("cannot read environment map '{name}'"))?;
+        let texels = img.texels.into_iter().map(|t| t * scale).collect();
+        Self::from_texels(&name, img.width, img.height, texels)
+            .with_context(|| format!("environment map '{name}'"))
     }
 
     pub fn name(&self) -> &str {
@@ -254,35 +244,6 @@ impl EnvMap {
         }
         sum / wsum
     }
-}
-
-fn read_exr(path: &Path) -> Result<(usize, usize, Vec<Vec3>)> {
-    use exr::prelude::*;
-    let image = read_first_rgba_layer_from_file(
-        path,
-        |res, _| {
-            (
-                res.width(),
-                res.height(),
-                vec![Vec3::ZERO; res.width() * res.height()],
-            )
-        },
-        |(w, _, px), pos, (r, g, b, _a): (f32, f32, f32, f32)| {
-            px[pos.y() * *w + pos.x()] = Vec3::new(r, g, b);
-        },
-    )?;
-    let (w, h, texels) = image.layer_data.channel_data.pixels;
-    Ok((w, h, texels))
-}
-
-fn read_hdr(path: &Path) -> Result<(usize, usize, Vec<Vec3>)> {
-    let img = image::ImageReader::open(path)?
-        .with_guessed_format()?
-        .decode()?
-        .into_rgb32f();
-    let (w, h) = (img.width() as usize, img.height() as usize);
-    let texels = img.pixels().map(|p| Vec3::new(p[0], p[1], p[2])).collect();
-    Ok((w, h, texels))
 }
 
 #[cfg(test)]

@@ -9,6 +9,7 @@ use anyhow::{anyhow, bail, Context, Result};
 use glam::{Affine2, Mat4, Vec2, Vec3};
 
 use crate::camera::{Camera, FovAxis};
+use crate::image_file::linear_rgb;
 use crate::material::{Material, Surface};
 use crate::mesh::Mesh;
 use crate::scene::Scene;
@@ -252,10 +253,10 @@ fn bitmap_from_gltf(data: &gltf::image::Data, srgb: bool) -> Result<Bitmap> {
             _ => image::Rgb([p[0], p[1], p[2]]),
         }
     });
-    Ok(Bitmap::from_rgb8_or_f32(
+    Ok(Bitmap::from(linear_rgb(
         image::DynamicImage::ImageRgb8(buf),
         !srgb,
-    ))
+    )))
 }
 
 #[cfg(test)]

@@ -6,7 +6,7 @@ use std::sync::Arc;
 use anyhow::{Context, Result};
 use glam::{Affine2, Vec2, Vec3};
 
-use crate::srgb_to_linear;
+use crate::image_file::{read_linear_rgb, LinearImage};
 
 /// A linear-RGB image sampled with bilinear filtering and repeat wrapping (Mitsuba's and glTF's
 /// defaults).
@@ -18,44 +18,21 @@ pub struct Bitmap {
     pub texels: Vec<Vec3>,
 }
 
+impl From<LinearImage> for Bitmap {
+    fn from(img: LinearImage) -> Self {
+        Bitmap {
+            width: img.width,
+            height: img.height,
+            texels: img.texels,
+        }
+    }
+}
+
 impl Bitmap {
     /// Reads a PNG/JPEG (sRGB-decoded unless `raw`) or an EXR/HDR (always linear) image.
     pub fn load(path: &Path, raw: bool) -> Result<Self> {
-        let img = image::ImageReader::open(path)
-            .and_then(|r| r.with_guessed_format())
-            .with_context(|| format!("cannot open texture '{}'", path.display()))?
-            .decode()
-            .with_context(|| format!("cannot decode texture '{}'", path.display()))?;
-        let float_source = matches!(
-            img,
-            image::DynamicImage::ImageRgb32F(_) | image::DynamicImage::ImageRgba32F(_)
-        );
-        Ok(Self::from_rgb8_or_f32(img, raw || float_source))
-    }
-
-    /// Converts a decoded image, applying the sRGB curve unless `linear`.
-    pub fn from_rgb8_or_f32(img: image::DynamicImage, linear: bool) -> Self {
-        let rgb = img.into_rgb32f();
-        let texels = rgb
-            .pixels()
-            .map(|p| {
-                let c = Vec3::new(p[0], p[1], p[2]);
-                if linear {
-                    c
-                } else {
-                    Vec3::new(
-                        srgb_to_linear(c.x),
-                        srgb_to_linear(c.y),
-                        srgb_to_linear(c.z),
-                    )
-                }
-            })
-            .collect();
-        Self {
-            width: rgb.width() as usize,
-            height: rgb.height() as usize,
-            texels,
-        }
+        let img = read_linear_rgb(path, raw).context("cannot read texture")?;
+        Ok(Self::from(img))
     }
 
     fn texel(&self, x: i64, y: i64) -> Vec3 {
@@ -157,12 +134,5 @@ mod tests {
         assert_eq!(t.eval(Vec2::new(0.25, 0.25)), Vec3::ONE);
         assert_eq!(t.eval(Vec2::new(0.75, 0.25)), Vec3::ZERO);
         assert_eq!(t.eval(Vec2::new(0.75, 0.75)), Vec3::ONE);
-    }
-
-    #[test]
-    fn srgb_curve_endpoints() {
-        assert_eq!(srgb_to_linear(0.0), 0.0);
-        assert!((srgb_to_linear(1.0) - 1.0).abs() < 1e-6);
-        assert!((srgb_to_linear(0.5) - 0.214).abs() < 1e-3);
     }
 }

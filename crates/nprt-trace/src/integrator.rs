@@ -93,12 +93,95 @@ pub struct PathSettings {
     pub rr_depth: u32,
 }
 
+/// A surface vertex of a path, ready to shade.
+struct Vertex {
+    sp: SurfacePoint,
+    frame: Frame3,
+    wo: Vec3,
+    bsdf: Bsdf,
+    /// Throughput up to this vertex.
+    beta: Vec3,
+    /// Surface bounces before this vertex.
+    depth: u32,
+}
+
+/// How a path left the scene.
+struct Escape {
+    dir: Vec3,
+    beta: Vec3,
+    /// Surface bounces before leaving (0: the camera ray missed).
+    depth: u32,
+    /// Density of the BSDF sample that left (0 when `depth` is 0).
+    pdf: f32,
+}
+
+/// Follows a path by BSDF sampling, calling `at_surface` at each vertex before it scatters,
+/// until it leaves the scene (`Some`) or ends on a surface (absorbed, Russian roulette from
+/// `rr_depth`, or `max_depth` reached: `None`). The one walk behind both integrators.
+fn walk(
+    scene: &Scene,
+    accel: &Accel,
+    mut origin: Vec3,
+    mut dir: Vec3,
+    s: &PathSettings,
+    rng: &mut Pcg64Mcg,
+    mut at_surface: impl FnMut(&Vertex, &mut Pcg64Mcg),
+) -> Option<Escape> {
+    let (mut beta, mut pdf, mut depth) = (Vec3::ONE, 0.0f32, 0u32);
+    loop {
+        let Some(hit) = accel.intersect(origin, dir, f32::INFINITY) else {
+            return Some(Escape {
+                dir,
+                beta,
+                depth,
+                pdf,
+            });
+        };
+        if depth + 1 >= s.max_depth {
+            return None;
+        }
+        let sp = surface_point(scene, &hit, dir);
+        let frame = Frame3::new(sp.ns);
+        let wo = frame.to_local(-dir);
+        let bsdf = Bsdf::new(sp.params);
+        if wo.z <= 0.0 || bsdf.is_black() {
+            return None;
+        }
+        let v = Vertex {
+            sp,
+            frame,
+            wo,
+            bsdf,
+            beta,
+            depth,
+        };
+        at_surface(&v, rng);
+        let bs = v
+            .bsdf
+            .sample(wo, Vec2::new(rng.random(), rng.random()), rng.random())?;
+        dir = frame.to_world(bs.wi);
+        origin = offset_origin(v.sp.p, v.sp.ng, dir);
+        beta *= bs.weight;
+        pdf = bs.pdf;
+        depth += 1;
+        if depth >= s.rr_depth {
+            let q = beta.max_element().min(0.95);
+            if rng.random::<f32>() >= q {
+                return None;
+            }
+            beta /= q;
+        }
+    }
+}
+
+/// Radiance along one camera ray: BSDF sampling and next-event estimation towards the
+/// environment at every vertex, combined by multiple importance sampling.
 pub fn trace_path(
     scene: &Scene,
     accel: &Accel,
     env: &EnvMap,
-    mut origin: Vec3,
-    mut dir: Vec3,
+    origin: Vec3,
+    dir: Vec3,
     s: &PathSettings,
     rng: &mut Pcg64Mcg,
 ) -> PathRadiance {
@@ -106,68 +189,39 @@ pub fn trace_path(
     if s.max_depth == 0 {
         return out;
     }
-    let mut beta = Vec3::ONE;
-    let mut prev_pdf = 0.0f32;
-    let mut depth = 0u32;
-    loop {
-        let Some(hit) = accel.intersect(origin, dir, f32::INFINITY) else {
-            let (le, light_pdf) = env.eval_pdf(dir);
-            let weight = if depth == 0 {
-                1.0
-            } else {
-                mis(prev_pdf, light_pdf)
-            };
-            let c = beta * le * weight;
-            out.total += c;
-            if depth <= 1 {
-                out.direct += c;
-            }
-            break;
-        };
-        if depth + 1 >= s.max_depth {
-            break;
-        }
-        let sp = surface_point(scene, &hit, dir);
-        let frame = Frame3::new(sp.ns);
-        let wo = frame.to_local(-dir);
-        let bsdf = Bsdf::new(sp.params);
-        if wo.z <= 0.0 || bsdf.is_black() {
-            break;
-        }
-        // Next-event estimation towards the environment.
+    let escape = walk(scene, accel, origin, dir, s, rng, |v, rng| {
         let (wi_world, le, light_pdf) =
             env.sample(Vec3::new(rng.random(), rng.random(), rng.random()));
-        if light_pdf > 0.0 {
-            let wi = frame.to_local(wi_world);
-            let f = bsdf.eval(wo, wi);
-            if f != Vec3::ZERO
-                && !accel.occluded(
-                    offset_origin(sp.p, sp.ng, wi_world),
-                    wi_world,
-                    f32::INFINITY,
-                )
-            {
-                let c = beta * f * le * (mis(light_pdf, bsdf.pdf(wo, wi)) / light_pdf);
-                out.total += c;
-                if depth == 0 {
-                    out.direct += c;
-                }
+        if light_pdf <= 0.0 {
+            return;
+        }
+        let wi = v.frame.to_local(wi_world);
+        let f = v.bsdf.eval(v.wo, wi);
+        if f != Vec3::ZERO
+            && !accel.occluded(
+                offset_origin(v.sp.p, v.sp.ng, wi_world),
+                wi_world,
+                f32::INFINITY,
+            )
+        {
+            let c = v.beta * f * le * (mis(light_pdf, v.bsdf.pdf(v.wo, wi)) / light_pdf);
+            out.total += c;
+            if v.depth == 0 {
+                out.direct += c;
             }
         }
-        let Some(bs) = bsdf.sample(wo, Vec2::new(rng.random(), rng.random()), rng.random()) else {
-            break;
+    });
+    if let Some(e) = escape {
+        let (le, light_pdf) = env.eval_pdf(e.dir);
+        let weight = if e.depth == 0 {
+            1.0
+        } else {
+            mis(e.pdf, light_pdf)
         };
-        dir = frame.to_world(bs.wi);
-        origin = offset_origin(sp.p, sp.ng, dir);
-        beta *= bs.weight;
-        prev_pdf = bs.pdf;
-        depth += 1;
-        if depth >= s.rr_depth {
-            let q = beta.max_element().min(0.95);
-            if rng.random::<f32>() >= q {
-                break;
-            }
-            beta /= q;
+        let c = e.beta * le * weight;
+        out.total += c;
+        if e.depth <= 1 {
+            out.direct += c;
         }
     }
     out
@@ -179,38 +233,12 @@ pub fn trace_path(
 pub fn trace_escape(
     scene: &Scene,
     accel: &Accel,
-    mut origin: Vec3,
-    mut dir: Vec3,
+    origin: Vec3,
+    dir: Vec3,
     s: &PathSettings,
     rng: &mut Pcg64Mcg,
 ) -> Option<(Vec3, Vec3)> {
-    let mut beta = Vec3::ONE;
-    let mut depth = 0u32;
-    loop {
-        let Some(hit) = accel.intersect(origin, dir, f32::INFINITY) else {
-            return (depth > 0).then_some((dir, beta));
-        };
-        if depth + 1 >= s.max_depth {
-            return None;
-        }
-        let sp = surface_point(scene, &hit, dir);
-        let frame = Frame3::new(sp.ns);
-        let wo = frame.to_local(-dir);
-        let bsdf = Bsdf::new(sp.params);
-        if wo.z <= 0.0 || bsdf.is_black() {
-            return None;
-        }
-        let bs = bsdf.sample(wo, Vec2::new(rng.random(), rng.random()), rng.random())?;
-        dir = frame.to_world(bs.wi);
-        origin = offset_origin(sp.p, sp.ng, dir);
-        beta *= bs.weight;
-        depth += 1;
-        if depth >= s.rr_depth {
-            let q = beta.max_element().min(0.95);
-            if rng.random::<f32>() >= q {
-                return None;
-            }
-            beta /= q;
-        }
-    }
+    walk(scene, accel, origin, dir, s, rng, |_, _| {})
+        .filter(|e| e.depth > 0)
+        .map(|e| (e.dir, e.beta))
 }

@@ -81,7 +81,10 @@ mod tests {
         for alpha in [0.1, 0.3, 0.8] {
             let g = GgxDistribution::new(alpha);
             let projected = integrate(|m| (g.d(m) * m.z) as f64);
-            assert!((projected - 1.0).abs() < 2e-3, "α {alpha}: ∫D cos = {projected}");
+            assert!(
+                (projected - 1.0).abs() < 2e-3,
+                "α {alpha}: ∫D cos = {projected}"
+            );
             let wo = Vec3::new(0.6, -0.2, 0.5).normalize();
             let visible = integrate(|m| (g.g1(wo, m) * g.d(m) * wo.dot(m).max(0.0) / wo.z) as f64);
             assert!((visible - 1.0).abs() < 2e-3, "α {alpha}: ∫D_wo = {visible}");
@@ -93,9 +96,15 @@ mod tests {
         let g = GgxDistribution::new(0.4);
         let wo = Vec3::new(0.8, 0.1, 0.3).normalize();
         for k in 0..1000 {
-            let u = Vec2::new(((k as f32 + 0.5) * 0.618_034).fract(), (k as f32 + 0.5) / 1000.0);
+            let u = Vec2::new(
+                ((k as f32 + 0.5) * 0.618_034).fract(),
+                (k as f32 + 0.5) / 1000.0,
+            );
             let m = g.sample_visible_normal(wo, u);
-            assert!((m.length() - 1.0).abs() < 1e-5 && m.z > 0.0 && m.dot(wo) >= -1e-4, "{m}");
+            assert!(
+                (m.length() - 1.0).abs() < 1e-5 && m.z > 0.0 && m.dot(wo) >= -1e-4,
+                "{m}"
+            );
         }
     }
 }

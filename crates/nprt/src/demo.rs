@@ -4,6 +4,7 @@ use std::path::PathBuf;
 use std::time::Instant;
 
 use anyhow::Result;
+use nprt_net::deep_shading::DeepShadingOptions;
 use nprt_net::{Design, TrainOptions, DEFAULT_ENCODER_WIDTH};
 
 use crate::evaluation::{eval, train_deep_shading, DeepShadingArgs, EvalArgs};
@@ -109,25 +110,26 @@ pub fn demo(a: DemoArgs) -> Result<()> {
             out: out.clone(),
             epochs: p.epochs,
             batch_size: defaults.batch_size,
-            lr: defaults.learning_rate,
-            seed: defaults.seed,
+            lr: defaults.schedule.learning_rate,
+            seed: defaults.schedule.seed,
             views_per_batch: defaults.views_per_batch,
             val_samples: defaults.val_samples,
             encoder_width: DEFAULT_ENCODER_WIDTH,
-            checkpoint_minutes: defaults.checkpoint_secs / 60.0,
+            checkpoint_minutes: defaults.schedule.checkpoint_secs / 60.0,
         })?;
         models.push(out);
     }
     step("3/5 training the Deep Shading baseline");
     let deep = a.out.join("models").join("deep-shading");
+    let deep_defaults = DeepShadingOptions::default();
     train_deep_shading(DeepShadingArgs {
         data: data.clone(),
         out: deep.clone(),
         epochs: p.deep_shading_epochs,
-        batch_views: 4,
-        lr: 1e-4,
-        seed: 0,
-        encoder_width: DEFAULT_ENCODER_WIDTH,
+        batch_views: deep_defaults.batch_views,
+        lr: deep_defaults.schedule.learning_rate,
+        seed: deep_defaults.schedule.seed,
+        encoder_width: deep_defaults.encoder_width,
     })?;
     step("4/5 evaluating against the baselines");
     let report = a.out.join("report");

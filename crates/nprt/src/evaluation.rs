@@ -3,13 +3,9 @@
 use std::path::PathBuf;
 
 use anyhow::{bail, Result};
-use nprt_data::dataset::load_manifest_hashed;
-use nprt_data::views::load_views;
-use nprt_eval::deep_shading::{self, DeepShadingFile, DeepShadingOptions};
 use nprt_eval::{evaluate, write_report, EvalOptions, Evaluation};
-use nprt_net::data::open_recorded_maps;
-use nprt_net::encoder::check_input_width;
-use nprt_net::Device;
+use nprt_net::deep_shading::{self, DeepShadingOptions};
+use nprt_net::{Device, Schedule};
 
 #[derive(clap::Args)]
 pub struct EvalArgs {
@@ -47,23 +43,25 @@ pub struct DeepShadingArgs {
     /// Dataset folder made by `nprt generate`.
     #[arg(long)]
     pub data: PathBuf,
-    /// Model folder; re-running resumes from the last finished epoch (Adam's moments restart).
+    /// Model folder; re-running with the same settings resumes exactly where the last run
+    /// stopped (weights and Adam's moments), and a larger --epochs continues a finished one.
     #[arg(long)]
     pub out: PathBuf,
     /// Passes over the training views.
-    #[arg(long, default_value_t = 20)]
+    #[arg(long, default_value_t = DeepShadingOptions::default().schedule.epochs)]
     pub epochs: usize,
     /// Whole views per step.
-    #[arg(long, default_value_t = 4)]
+    #[arg(long, default_value_t = DeepShadingOptions::default().batch_views)]
     pub batch_views: usize,
     /// Adam learning rate (1e-3 was measured to kill this ReLU U-Net: every activation dead,
     /// the output a constant).
-    #[arg(long, default_value_t = 1e-4)]
+    #[arg(long, default_value_t = DeepShadingOptions::default().schedule.learning_rate)]
     pub lr: f64,
-    #[arg(long, default_value_t = 0)]
+    /// Seed of the initial weights and of the batch order.
+    #[arg(long, default_value_t = DeepShadingOptions::default().schedule.seed)]
     pub seed: u64,
     /// Width W of the light encoder's W × W/2 input (a multiple of 64).
-    #[arg(long, default_value_t = nprt_net::DEFAULT_ENCODER_WIDTH)]
+    #[arg(long, default_value_t = DeepShadingOptions::default().encoder_width)]
     pub encoder_width: usize,
 }
 
@@ -103,42 +101,29 @@ pub fn eval(a: EvalArgs) -> Result<Evaluation> {
 }
 
 pub fn train_deep_shading(a: DeepShadingArgs) -> Result<()> {
-    check_input_width(a.encoder_width)?;
-    if a.epochs == 0 || a.batch_views == 0 || !(a.lr > 0.0 && a.lr.is_finite()) {
-        bail!("--epochs and --batch-views must be positive, and --lr a positive number");
-    }
-    let (manifest, hash) = load_manifest_hashed(&a.data)?;
-    let maps = open_recorded_maps(&manifest)?;
-    let train = load_views(&a.data, &manifest, "train")?;
-    let test = load_views(&a.data, &manifest, "test")?;
-    let s = &manifest.settings;
-    let base = DeepShadingFile {
-        format: deep_shading::TAG.into(),
-        version: 1,
-        encoder_width: a.encoder_width,
-        bounds: manifest.bounds,
-        scene: s.scene.clone(),
-        scene_hash: s.scene_hash.clone(),
-        dataset_hash: hash,
-        unet_params: 0,
-        encoder_params: 0,
-        options: DeepShadingOptions {
+    let defaults = DeepShadingOptions::default();
+    let opts = DeepShadingOptions {
+        schedule: Schedule {
             epochs: a.epochs,
-            batch_views: a.batch_views,
             learning_rate: a.lr,
             seed: a.seed,
-            encoder_width: a.encoder_width,
+            ..defaults.schedule
         },
-        epochs_done: 0,
-        seconds: 0.0,
+        batch_views: a.batch_views,
+        encoder_width: a.encoder_width,
     };
-    let f = deep_shading::train(&train, &test, &maps, base, &a.out, &Device::flex(), true)?;
+    let (s, f) = deep_shading::train(&a.data, &opts, &a.out, &Device::flex())?;
+    if let Some(e) = s.resumed_from_epoch {
+        println!("resumed from epoch {e:.2}");
+    }
     println!(
-        "trained Deep Shading ({} U-Net parameters + {} encoder) for {} epochs in {:.1} s; model in '{}'",
+        "trained Deep Shading ({} U-Net parameters + {} encoder) for {} epochs in {:.1} s; training loss {:.5}, validation loss {:.5}; model in '{}'",
         f.unet_params,
         f.encoder_params,
         f.epochs_done,
         f.seconds,
+        s.final_train,
+        s.final_val,
         a.out.display()
     );
     Ok(())

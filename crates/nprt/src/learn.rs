@@ -8,7 +8,7 @@ use nprt_net::data::TrainingSet;
 use nprt_net::encoder::check_input_width;
 use nprt_net::Device;
 use nprt_net::{
-    layer_table, measure_throughput, Activation, Design, Init, ModelConfig, TrainOptions,
+    layer_table, measure_throughput, Activation, Design, Init, ModelConfig, Schedule, TrainOptions,
     DEFAULT_ENCODER_WIDTH,
 };
 
@@ -47,16 +47,16 @@ pub struct TrainArgs {
     pub out: PathBuf,
     /// Passes over all foreground pixels of the training views (the paper: 500). On 2 CPU
     /// cores one epoch of the default 400-view 128² dataset takes about 4 minutes (dsep).
-    #[arg(long, default_value_t = TrainOptions::default().epochs)]
+    #[arg(long, default_value_t = TrainOptions::default().schedule.epochs)]
     pub epochs: usize,
     /// Samples per batch.
     #[arg(long, default_value_t = TrainOptions::default().batch_size)]
     pub batch_size: usize,
     /// Adam learning rate (the paper: 1e-4).
-    #[arg(long, default_value_t = TrainOptions::default().learning_rate)]
+    #[arg(long, default_value_t = TrainOptions::default().schedule.learning_rate)]
     pub lr: f64,
     /// Seed of the initial weights and of the batch order.
-    #[arg(long, default_value_t = TrainOptions::default().seed)]
+    #[arg(long, default_value_t = TrainOptions::default().schedule.seed)]
     pub seed: u64,
     /// Views whose pixels are mixed in each batch, each lit by its own rotated map.
     #[arg(long, default_value_t = TrainOptions::default().views_per_batch)]
@@ -68,7 +68,7 @@ pub struct TrainArgs {
     #[arg(long, default_value_t = DEFAULT_ENCODER_WIDTH)]
     pub encoder_width: usize,
     /// Minutes between checkpoints within an epoch (one is always written at an epoch's end).
-    #[arg(long, default_value_t = TrainOptions::default().checkpoint_secs / 60.0)]
+    #[arg(long, default_value_t = TrainOptions::default().schedule.checkpoint_secs / 60.0)]
     pub checkpoint_minutes: f64,
 }
 
@@ -161,12 +161,6 @@ pub fn model_info(a: ModelInfoArgs) -> Result<()> {
 
 pub fn train(a: TrainArgs) -> Result<()> {
     let config = config(a.arch, a.activation, a.encoder_width)?;
-    if a.batch_size == 0 || a.epochs == 0 || a.views_per_batch == 0 {
-        bail!("--epochs, --batch-size and --views-per-batch must be positive");
-    }
-    if !(a.lr > 0.0 && a.lr.is_finite()) {
-        bail!("--lr must be a positive number, got {}", a.lr);
-    }
     let t0 = std::time::Instant::now();
     let set = TrainingSet::load(&a.data, config.encoder_width)?;
     let count = |v: &[nprt_net::data::ViewSamples]| v.iter().map(|s| s.len()).sum::<usize>();
@@ -180,15 +174,18 @@ pub fn train(a: TrainArgs) -> Result<()> {
         t0.elapsed().as_secs_f64()
     );
     let opts = TrainOptions {
-        epochs: a.epochs,
+        schedule: Schedule {
+            epochs: a.epochs,
+            learning_rate: a.lr,
+            seed: a.seed,
+            checkpoint_secs: a.checkpoint_minutes * 60.0,
+            progress: true,
+        },
         batch_size: a.batch_size,
-        learning_rate: a.lr,
-        seed: a.seed,
         views_per_batch: a.views_per_batch,
         val_samples: a.val_samples,
-        checkpoint_secs: a.checkpoint_minutes * 60.0,
-        progress: true,
     };
+    opts.check().context("bad training options")?;
     let s = nprt_net::train(&set, &config, &opts, &a.out, &Device::flex())?;
     if let Some(e) = s.resumed_from_epoch {
         println!("resumed from epoch {e:.2}");

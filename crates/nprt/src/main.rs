@@ -6,7 +6,7 @@ use std::time::Instant;
 
 use anyhow::{bail, Context, Result};
 use clap::{Parser, Subcommand};
-use nprt_scene::{load_scene, procedural, SceneOptions};
+use nprt_scene::{load_scene, SceneOptions};
 use nprt_trace::{render, PixelFilter, RenderSettings, TraceScene};
 
 mod demo;
@@ -268,7 +268,7 @@ fn reference(a: ReferenceArgs) -> Result<()> {
         eprintln!("warning: {w}");
     }
     let env = match (&a.envmap, &scene.envmap) {
-        (Some(spec), _) => procedural::open_envmap(spec)?,
+        (Some(spec), _) => nprt_scene::open_envmap(spec)?,
         (None, Some(env)) => env.clone(),
         (None, None) => bail!(
             "scene '{}' has no environment emitter; give one with --envmap",

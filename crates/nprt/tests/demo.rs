@@ -105,6 +105,7 @@ fn quick_demo_then_render_and_eval() {
         .lines()
         .skip(1)
         .map(|l| l.rsplit(',').next().unwrap())
+        .filter(|v| !v.is_empty())
         .collect();
     assert!(
         val.len() == 2 && val[0] != val[1],

@@ -130,6 +130,63 @@ fn resumed_training_equals_an_uninterrupted_run() {
     assert!(weights(&other) != weights(&one));
 }
 
+/// Deep Shading trains through the same loop: exact resume (Adam's moments included), the
+/// same loss files, and a refusal to resume other settings.
+#[test]
+fn deep_shading_resumes_exactly_through_the_shared_loop() {
+    let data = dataset().to_str().unwrap();
+    let run = |out: &Path, extra: &[&str]| {
+        let mut args = vec![
+            "train-deep-shading",
+            "--data",
+            data,
+            "--out",
+            out.to_str().unwrap(),
+            "--encoder-width",
+            "64",
+            "--batch-views",
+            "2",
+        ];
+        args.extend_from_slice(extra);
+        ok(&args)
+    };
+    let straight = fresh_dir("deep-straight");
+    let resumed = fresh_dir("deep-parts");
+    run(&straight, &["--epochs", "3"]);
+    run(&resumed, &["--epochs", "1"]);
+    let out = run(&resumed, &["--epochs", "3"]);
+    assert!(out.contains("resumed from epoch 1.00"), "{out}");
+    let weights = |d: &Path| std::fs::read(d.join("weights.safetensors")).unwrap();
+    assert!(
+        weights(&straight) == weights(&resumed),
+        "resumed Deep Shading weights differ"
+    );
+    let val = |d: &Path| losses(d).iter().filter_map(|r| r.1).collect::<Vec<_>>();
+    assert_eq!(val(&straight).len(), 3);
+    assert_eq!(val(&straight), val(&resumed));
+    assert!(straight.join("checkpoint/state.json").exists());
+    let config: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(straight.join("deep-shading.json")).unwrap())
+            .unwrap();
+    assert_eq!(config["epochs_done"], 3);
+    fails(
+        &[
+            "train-deep-shading",
+            "--data",
+            data,
+            "--out",
+            straight.to_str().unwrap(),
+            "--encoder-width",
+            "64",
+            "--batch-views",
+            "3",
+            "--epochs",
+            "4",
+        ],
+        &["holds a run with other settings"],
+    );
+}
+
 #[test]
 fn bad_runs_stop_clearly_and_keep_the_last_good_checkpoint() {
     let data = dataset().to_str().unwrap();

@@ -1,11 +1,8 @@
-//! Built-in environment maps, for when no map files are given: an outdoor sky with sun from the
-//! Preetham et al. 1999 analytic daylight model, and an indoor-style generator (bright window
-//! and lamp regions over a dim surround). Every choice is driven by explicit parameters or a seed.
+//! The outdoor sky with sun from the Preetham et al. 1999 analytic daylight model (kept by
+//! hand: no maintained crate implements it).
 
-use anyhow::{bail, Context, Result};
+use anyhow::{bail, Result};
 use glam::{Vec2, Vec3};
-use rand::{RngExt, SeedableRng};
-use rand_pcg::Pcg64Mcg;
 
 use crate::envmap::{direction_to_uv, uv_to_direction, EnvMap};
 use crate::luminance;
@@ -185,90 +182,6 @@ pub fn sky(p: SkyParams) -> Result<EnvMap> {
     EnvMap::from_texels(&name, w, h, texels)
 }
 
-/// An indoor-style map: a dim, slightly graded surround with 1–3 bright rectangular windows or
-/// lamps of random size, place, colour and strength, all drawn from `seed`.
-pub fn indoor(seed: u64, width: usize) -> Result<EnvMap> {
-    if width < 8 || !width.is_multiple_of(2) {
-        bail!("indoor map width {width} must be even and at least 8");
-    }
-    let mut rng = Pcg64Mcg::seed_from_u64(seed ^ 0x1d00_2d00);
-    let (w, h) = (width, width / 2);
-    let wall = Vec3::new(
-        rng.random_range(0.7..1.0),
-        rng.random_range(0.7..1.0),
-        rng.random_range(0.7..1.0),
-    ) * rng.random_range(0.04..0.12);
-    struct Light {
-        centre: Vec2,
-        half: Vec2,
-        radiance: Vec3,
-    }
-    let n = rng.random_range(1..=3);
-    let lights: Vec<Light> = (0..n)
-        .map(|_| {
-            let lamp = rng.random_bool(0.4);
-            let warm = rng.random_range(0.0..1.0f32);
-            let tint = Vec3::new(1.0, 0.85 + 0.15 * (1.0 - warm), 0.6 + 0.4 * (1.0 - warm));
-            if lamp {
-                // Small ceiling lamp, high up.
-                Light {
-                    centre: Vec2::new(rng.random_range(0.0..1.0), rng.random_range(0.05..0.25)),
-                    half: Vec2::new(rng.random_range(0.01..0.03), rng.random_range(0.01..0.03)),
-                    radiance: tint * rng.random_range(20.0..60.0),
-                }
-            } else {
-                // Window: wide, around the horizon or above it.
-                Light {
-                    centre: Vec2::new(rng.random_range(0.0..1.0), rng.random_range(0.3..0.48)),
-                    half: Vec2::new(rng.random_range(0.03..0.09), rng.random_range(0.05..0.12)),
-                    radiance: tint * rng.random_range(3.0..12.0),
-                }
-            }
-        })
-        .collect();
-    let mut texels = Vec::with_capacity(w * h);
-    for y in 0..h {
-        for x in 0..w {
-            let uv = Vec2::new((x as f32 + 0.5) / w as f32, y as f32 / (h - 1) as f32);
-            // Ceiling a little brighter than the floor.
-            let mut c = wall * (1.3 - 0.8 * uv.y);
-            for l in &lights {
-                let du = (uv.x - l.centre.x + 0.5).rem_euclid(1.0) - 0.5;
-                if du.abs() < l.half.x && (uv.y - l.centre.y).abs() < l.half.y {
-                    c += l.radiance;
-                }
-            }
-            texels.push(c);
-        }
-    }
-    EnvMap::from_texels(&format!("builtin:indoor:{seed}"), w, h, texels)
-}
-
-/// Opens an environment map from a file path or a built-in spec:
-/// `builtin:sky[:ELEVATION[:AZIMUTH[:TURBIDITY]]]` or `builtin:indoor[:SEED]`.
-pub fn open_envmap(spec: &str) -> Result<EnvMap> {
-    let Some(rest) = spec.strip_prefix("builtin:") else {
-        return EnvMap::load(std::path::Path::new(spec), 1.0);
-    };
-    let mut parts = rest.split(':');
-    let kind = parts.next().unwrap_or("");
-    let nums: Vec<f32> = parts
-        .map(|s| {
-            s.parse::<f32>()
-                .with_context(|| format!("environment map '{spec}': '{s}' is not a number"))
-        })
-        .collect::<Result<_>>()?;
-    match kind {
-        "sky" => {
-            let d = SkyParams::default();
-            let get = |i: usize, v: f32| nums.get(i).copied().unwrap_or(v);
-            sky(SkyParams { elevation: get(0, d.elevation), azimuth: get(1, d.azimuth), turbidity: get(2, d.turbidity), width: d.width })
-        }
-        "indoor" => indoor(nums.first().copied().unwrap_or(0.0) as u64, 256),
-        _ => bail!("unknown built-in environment map '{spec}' (expected builtin:sky[:ELEV[:AZIM[:TURB]]] or builtin:indoor[:SEED])"),
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -300,26 +213,5 @@ mod tests {
             })
             .count();
         assert!(hits > 500, "{hits}");
-    }
-
-    #[test]
-    fn indoor_maps_depend_on_seed_only() {
-        let a = indoor(7, 64).unwrap();
-        let b = indoor(7, 64).unwrap();
-        let c = indoor(8, 64).unwrap();
-        assert_eq!(a.texels(), b.texels());
-        assert_ne!(a.texels(), c.texels());
-        let peak = a.texels().iter().map(|&t| luminance(t)).fold(0.0, f32::max);
-        assert!(
-            peak > 20.0 * luminance(a.mean_radiance()) / 2.0,
-            "lights should stand out"
-        );
-    }
-
-    #[test]
-    fn specs_parse_and_fail_clearly() {
-        assert!(open_envmap("builtin:sky:20:45:4").is_ok());
-        let err = open_envmap("builtin:moon").unwrap_err().to_string();
-        assert!(err.contains("builtin:moon"), "{err}");
     }
 }

@@ -1,0 +1,182 @@
+//! The dataset's manifest (docs/dataset.md): the settings, maps, volume and views a dataset
+//! was made from, checked once where it is read.
+
+use std::path::Path;
+
+use anyhow::{bail, Context, Result};
+use glam::Mat4;
+use nprt_scene::{Camera, FovAxis};
+use serde::{Deserialize, Serialize};
+
+pub const FORMAT_VERSION: u32 = 1;
+pub const MANIFEST: &str = "manifest.json";
+
+/// Everything that determines a dataset's content; two runs agree on it or must not share a folder.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Settings {
+    pub format_version: u32,
+    pub scene: String,
+    /// BLAKE3 of the loaded geometry and the scene source (see [`super::scene_hash`]).
+    pub scene_hash: String,
+    pub envmaps: Vec<MapRecord>,
+    pub train_maps: Vec<usize>,
+    pub test_maps: Vec<usize>,
+    pub train_views: u64,
+    pub test_views: u64,
+    pub train_resolution: [u32; 2],
+    pub test_resolution: [u32; 2],
+    pub spp: u32,
+    pub max_depth: Option<u32>,
+    pub rr_depth: u32,
+    pub seed: u64,
+    pub camera_volume: VolumeRecord,
+}
+
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct MapRecord {
+    /// File path or built-in spec, as given.
+    pub spec: String,
+    /// BLAKE3 of the file's bytes (of the spec for built-in maps).
+    pub hash: String,
+    pub width: usize,
+    pub height: usize,
+}
+
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct VolumeRecord {
+    pub min: [f32; 3],
+    pub max: [f32; 3],
+    pub look: [f32; 3],
+    pub spread_deg: f32,
+    pub fov_deg: f32,
+}
+
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct ViewRecord {
+    pub index: u64,
+    /// "train" or "test".
+    pub split: String,
+    /// Relative to the dataset folder.
+    pub file: String,
+    /// Camera-to-world, column-major, Mitsuba's camera convention (+Z forward, +Y up, +X left).
+    pub camera_to_world: [f32; 16],
+    /// Horizontal field of view, degrees.
+    pub fov_x_deg: f32,
+    pub width: u32,
+    pub height: u32,
+    /// Index into `settings.envmaps`.
+    pub map: usize,
+    /// Rotation of the map about +Y, degrees.
+    pub rotation_deg: f32,
+    /// Seed of the view's per-pixel random streams.
+    pub seed: u64,
+}
+
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Manifest {
+    pub settings: Settings,
+    /// Scene bounds (min, max) for normalising positions to [-1, 1].
+    pub bounds: [[f32; 3]; 2],
+    pub views: Vec<ViewRecord>,
+}
+
+impl Manifest {
+    /// Parses and [checks](Manifest::check) a manifest's JSON.
+    pub fn from_json(bytes: &[u8]) -> Result<Manifest> {
+        let manifest: Manifest = serde_json::from_slice(bytes).context("not a valid manifest")?;
+        manifest.check()?;
+        Ok(manifest)
+    }
+
+    /// Refuses a manifest that a hand edit or another tool made inconsistent, so that every
+    /// later use (map indices, image sizes, cameras, file names) can trust it.
+    pub fn check(&self) -> Result<()> {
+        let s = &self.settings;
+        if s.format_version != FORMAT_VERSION {
+            bail!(
+                "format_version is {}, this nprt reads {FORMAT_VERSION}",
+                s.format_version
+            );
+        }
+        let maps = s.envmaps.len();
+        if let Some(&i) = s
+            .train_maps
+            .iter()
+            .chain(&s.test_maps)
+            .find(|&&i| i >= maps)
+        {
+            bail!("map index {i} is out of range: settings.envmaps lists {maps} maps");
+        }
+        if s.train_maps.is_empty() || s.test_maps.is_empty() {
+            bail!("settings.train_maps and settings.test_maps must each name at least one map");
+        }
+        if !self.bounds.iter().flatten().all(|v| v.is_finite())
+            || (0..3).any(|k| self.bounds[0][k] > self.bounds[1][k])
+        {
+            bail!("bounds {:?} are not a finite box (min ≤ max)", self.bounds);
+        }
+        for v in &self.views {
+            let what = format!("view {} ('{}')", v.index, v.file);
+            let allowed = match v.split.as_str() {
+                "train" => &s.train_maps,
+                "test" => &s.test_maps,
+                other => bail!("{what}: split '{other}' is neither 'train' nor 'test'"),
+            };
+            if !allowed.contains(&v.map) {
+                bail!(
+                    "{what}: map {} is not one of its split's maps {allowed:?}",
+                    v.map
+                );
+            }
+            if v.width == 0 || v.height == 0 || v.width as u64 * v.height as u64 > 1 << 28 {
+                bail!(
+                    "{what}: size {}×{} is empty or implausibly large",
+                    v.width,
+                    v.height
+                );
+            }
+            if !(v.fov_x_deg > 0.0 && v.fov_x_deg < 180.0) {
+                bail!("{what}: fov_x_deg {} is not in (0, 180)", v.fov_x_deg);
+            }
+            if !v.camera_to_world.iter().all(|x| x.is_finite()) || !v.rotation_deg.is_finite() {
+                bail!("{what}: camera_to_world or rotation_deg holds a non-finite number");
+            }
+            let file = Path::new(&v.file);
+            if file.is_absolute()
+                || file
+                    .components()
+                    .any(|c| matches!(c, std::path::Component::ParentDir))
+            {
+                bail!("{what}: file must be a path inside the dataset folder");
+            }
+        }
+        Ok(())
+    }
+}
+
+impl ViewRecord {
+    pub fn camera(&self) -> Camera {
+        Camera {
+            to_world: Mat4::from_cols_array(&self.camera_to_world),
+            fov_deg: self.fov_x_deg,
+            fov_axis: FovAxis::X,
+            width: self.width,
+            height: self.height,
+        }
+    }
+}
+
+pub fn load_manifest(dir: &Path) -> Result<Manifest> {
+    Ok(load_manifest_hashed(dir)?.0)
+}
+
+/// The manifest of the dataset in `dir` and the dataset's hash (of the manifest's bytes, which
+/// fix every view's camera, map, rotation and seed); models record it to refuse other data.
+pub fn load_manifest_hashed(dir: &Path) -> Result<(Manifest, String)> {
+    let path = dir.join(MANIFEST);
+    let bytes =
+        std::fs::read(&path).with_context(|| format!("cannot read '{}'", path.display()))?;
+    let manifest = Manifest::from_json(&bytes)
+        .with_context(|| format!("'{}' is not a usable nprt dataset manifest", path.display()))?;
+    Ok((manifest, blake3::hash(&bytes).to_hex().to_string()))
+}

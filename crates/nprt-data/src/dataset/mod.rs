@@ -1,0 +1,21 @@
+//! The dataset on disk (format documented in docs/dataset.md): `manifest.json` and one OpenEXR
+//! per view under `views/`. The manifest is a pure function of the settings, so every shard
+//! computes the same one; views are rendered by whichever shard owns them (index mod N), written
+//! atomically, and skipped on resume once they read back complete.
+
+mod generation;
+mod manifest;
+mod plan;
+mod scene_identity;
+mod verify;
+mod view_file;
+
+pub use generation::{prepare, render_view, run, Summary};
+pub use manifest::{
+    load_manifest, load_manifest_hashed, Manifest, MapRecord, Settings, ViewRecord, VolumeRecord,
+    FORMAT_VERSION, MANIFEST,
+};
+pub use plan::{plan, Request};
+pub use scene_identity::{load_checked_scene, scene_hash, scene_source};
+pub use verify::{verify, Report};
+pub use view_file::{check_view, read_view};

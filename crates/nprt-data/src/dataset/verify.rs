@@ -1,0 +1,46 @@
+//! Verifying a dataset folder: every view present, complete and of the planned size.
+
+use std::path::{Path, PathBuf};
+
+use anyhow::Result;
+
+use super::manifest::load_manifest;
+use super::view_file::check_view;
+
+/// Completeness of a dataset folder.
+#[derive(Debug, Default)]
+pub struct Report {
+    pub views: usize,
+    pub complete: usize,
+    pub missing: Vec<String>,
+    pub corrupt: Vec<String>,
+}
+
+/// Reads every view back fully (in parallel: this is also how fast a trainer can load them).
+pub fn verify(dir: &Path) -> Result<Report> {
+    use rayon::prelude::*;
+    let manifest = load_manifest(dir)?;
+    let states: Vec<Result<(), String>> = manifest
+        .views
+        .par_iter()
+        .map(|v| {
+            let path: PathBuf = dir.join(&v.file);
+            if !path.exists() {
+                return Err(String::new());
+            }
+            check_view(&path, v).map_err(|e| format!("{e:#}"))
+        })
+        .collect();
+    let mut report = Report {
+        views: manifest.views.len(),
+        ..Default::default()
+    };
+    for (v, state) in manifest.views.iter().zip(states) {
+        match state {
+            Ok(()) => report.complete += 1,
+            Err(e) if e.is_empty() => report.missing.push(v.file.clone()),
+            Err(e) => report.corrupt.push(format!("{}: {e}", v.file)),
+        }
+    }
+    Ok(report)
+}

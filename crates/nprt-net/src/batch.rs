@@ -1,0 +1,76 @@
+//! A batch of pixel samples in host memory and its forward pass.
+
+use burn::tensor::{Device, Int, Tensor, TensorData};
+
+use crate::data::ViewSamples;
+use crate::design::NprtNet;
+use crate::features::FEATURES;
+
+/// Samples drawn from several views, and those views' maps.
+pub struct Batch {
+    pub features: Vec<f32>,
+    pub radiance: Vec<f32>,
+    /// Index into `lights` of each sample.
+    pub view: Vec<i64>,
+    pub scale: Vec<f32>,
+    /// [V, 3, W/2, W] pre-processed maps.
+    pub lights: Vec<f32>,
+    /// W of the maps.
+    pub light_width: usize,
+}
+
+impl Batch {
+    /// Gathers `samples` ((view position in `views`, pixel) pairs) from `views`.
+    pub fn gather(views: &[&ViewSamples], samples: &[(u32, u32)]) -> Self {
+        let mut b = Batch {
+            features: Vec::with_capacity(samples.len() * FEATURES),
+            radiance: Vec::with_capacity(samples.len() * 3),
+            view: Vec::with_capacity(samples.len()),
+            scale: Vec::with_capacity(samples.len()),
+            lights: views
+                .iter()
+                .flat_map(|v| v.light.pixels.iter().copied())
+                .collect(),
+            light_width: views.first().map_or(0, |v| v.light.width),
+        };
+        for &(v, p) in samples {
+            let (view, p) = (views[v as usize], p as usize);
+            b.features
+                .extend_from_slice(&view.features[p * FEATURES..(p + 1) * FEATURES]);
+            b.radiance
+                .extend_from_slice(&view.radiance[p * 3..p * 3 + 3]);
+            b.view.push(v as i64);
+            b.scale.push(view.light.scale);
+        }
+        b
+    }
+
+    pub fn len(&self) -> usize {
+        self.view.len()
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.view.is_empty()
+    }
+
+    /// Predicted radiance [B, 3] and the reference [B, 3] on `device`.
+    pub fn forward(&self, net: &NprtNet, device: &Device) -> (Tensor<2>, Tensor<2>) {
+        let n = self.len();
+        let w = self.light_width;
+        let f = Tensor::from_data(
+            TensorData::new(self.features.clone(), [n, FEATURES]),
+            device,
+        );
+        let r = Tensor::from_data(TensorData::new(self.radiance.clone(), [n, 3]), device);
+        let v = Tensor::<1, Int>::from_data(TensorData::new(self.view.clone(), [n]), device);
+        let s = Tensor::from_data(TensorData::new(self.scale.clone(), [n, 1]), device);
+        let l = Tensor::from_data(
+            TensorData::new(
+                self.lights.clone(),
+                [self.lights.len() / (3 * w * w / 2), 3, w / 2, w],
+            ),
+            device,
+        );
+        (net.forward(f, l, v, s), r)
+    }
+}

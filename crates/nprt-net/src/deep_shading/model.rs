@@ -1,0 +1,115 @@
+//! A Deep Shading model folder: `deep-shading.json`, the weights, and shading with them.
+
+use std::path::Path;
+
+use anyhow::{bail, Context, Result};
+use burn::tensor::{Device, Tensor, TensorData};
+use glam::Vec3;
+use nprt_scene::EnvMap;
+use nprt_trace::GBuffer;
+use serde::{Deserialize, Serialize};
+
+use super::train::DeepShadingOptions;
+use super::unet::{feature_image, DeepShading};
+use crate::encoder::LightInput;
+use crate::features::FEATURES;
+use crate::init::Init;
+use crate::model::{load_weights, WEIGHTS_FILE};
+
+pub const TAG: &str = "deep-shading";
+pub const CONFIG_FILE: &str = "deep-shading.json";
+
+/// The model folder's config.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct DeepShadingFile {
+    pub format: String,
+    pub version: u32,
+    pub encoder_width: usize,
+    pub bounds: [[f32; 3]; 2],
+    pub scene: String,
+    pub scene_hash: String,
+    pub dataset_hash: String,
+    pub unet_params: usize,
+    pub encoder_params: usize,
+    pub options: DeepShadingOptions,
+    pub epochs_done: usize,
+    pub seconds: f64,
+}
+
+/// A trained Deep Shading network, ready to shade.
+pub struct DeepShadingModel {
+    pub file: DeepShadingFile,
+    net: DeepShading,
+    device: Device,
+}
+
+pub fn read_file(dir: &Path) -> Result<DeepShadingFile> {
+    let path = dir.join(CONFIG_FILE);
+    let text = std::fs::read_to_string(&path).with_context(|| {
+        format!(
+            "'{}' is not a Deep Shading model folder (no readable {CONFIG_FILE})",
+            dir.display()
+        )
+    })?;
+    let f: DeepShadingFile = serde_json::from_str(&text)
+        .with_context(|| format!("'{}' is malformed", path.display()))?;
+    if f.format != TAG || f.version != 1 {
+        bail!(
+            "'{}' is not a version-1 Deep Shading config",
+            path.display()
+        );
+    }
+    Ok(f)
+}
+
+impl DeepShadingModel {
+    pub fn load(dir: &Path, device: &Device) -> Result<Self> {
+        let file = read_file(dir)?;
+        let mut net = DeepShading::new(&mut Init::new(0, device), file.encoder_width);
+        load_weights(&dir.join(WEIGHTS_FILE), &mut net, TAG)?;
+        Ok(DeepShadingModel {
+            file,
+            net,
+            device: device.clone(),
+        })
+    }
+
+    /// Radiance of every pixel of a `width`×`height` G-buffer under `map` rotated by
+    /// `rotation_deg` (background pixels 0).
+    pub fn shade(
+        &self,
+        g: &GBuffer,
+        width: usize,
+        height: usize,
+        map: &EnvMap,
+        rotation_deg: f32,
+    ) -> Vec<Vec3> {
+        let (img, pw, ph) = feature_image(&self.file.bounds, g, width, height);
+        let light = LightInput::new(map, rotation_deg, self.file.encoder_width);
+        let lw = light.width;
+        let out = self.net.forward(
+            Tensor::from_data(TensorData::new(img, [1, FEATURES, ph, pw]), &self.device),
+            Tensor::from_data(
+                TensorData::new(light.pixels, [1, 3, lw / 2, lw]),
+                &self.device,
+            ),
+            Tensor::from_data(TensorData::new(vec![light.scale], [1]), &self.device),
+        );
+        let data = out.into_data();
+        let v = data.as_slice::<f32>().expect("f32 output");
+        (0..width * height)
+            .map(|i| {
+                let (x, y) = (i % width, i / width);
+                if g.mask[i] > 0.5 {
+                    Vec3::new(
+                        v[y * pw + x],
+                        v[pw * ph + y * pw + x],
+                        v[2 * pw * ph + y * pw + x],
+                    )
+                } else {
+                    Vec3::ZERO
+                }
+            })
+            .collect()
+    }
+}

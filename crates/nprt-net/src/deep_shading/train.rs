@@ -1,0 +1,283 @@
+//! Training the Deep Shading U-Net on a dataset folder: whole training views per step, the
+//! masked log-L1 loss, validation on the test views.
+
+use std::path::Path;
+
+use anyhow::{bail, Result};
+use burn::module::Module;
+use burn::tensor::{Device, Tensor, TensorData};
+use nprt_data::dataset::load_manifest_hashed;
+use nprt_data::views::{load_views, ImageView};
+use nprt_scene::EnvMap;
+use rand::seq::SliceRandom;
+use serde::{Deserialize, Serialize};
+
+use super::model::{DeepShadingFile, CONFIG_FILE, TAG};
+use super::unet::{feature_image, DeepShading};
+use crate::checkpoint::{self, RunState};
+use crate::data::open_recorded_maps;
+use crate::encoder::{check_input_width, LightInput};
+use crate::features::FEATURES;
+use crate::init::Init;
+use crate::loss::log_l1_map;
+use crate::model::{save_weights, WEIGHTS_FILE};
+use crate::trainer::{self, epoch_rng, Objective, Schedule, TrainSummary};
+
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct DeepShadingOptions {
+    #[serde(flatten)]
+    pub schedule: Schedule,
+    /// Whole views per step.
+    pub batch_views: usize,
+    /// Width W of the light encoder's W × W/2 input.
+    pub encoder_width: usize,
+}
+
+impl Default for DeepShadingOptions {
+    fn default() -> Self {
+        DeepShadingOptions {
+            schedule: Schedule {
+                epochs: 20,
+                // 1e-3 was measured to kill this ReLU U-Net: every activation dead, the output
+                // a constant.
+                learning_rate: 1e-4,
+                seed: 0,
+                checkpoint_secs: 300.0,
+                progress: true,
+            },
+            batch_views: 4,
+            encoder_width: crate::model::DEFAULT_ENCODER_WIDTH,
+        }
+    }
+}
+
+/// What training needs of each view, padded to multiples of 8.
+struct Sample {
+    features: Vec<f32>,
+    radiance: Vec<f32>,
+    mask: Vec<f32>,
+    light: LightInput,
+    foreground: u64,
+}
+
+/// Views of one split, all of one padded size.
+struct Split {
+    samples: Vec<Sample>,
+    width: usize,
+    height: usize,
+}
+
+impl Split {
+    fn new(
+        views: &[ImageView],
+        maps: &[EnvMap],
+        bounds: &[[f32; 3]; 2],
+        encoder_width: usize,
+    ) -> Result<Self> {
+        let Some(first) = views.first() else {
+            return Ok(Split {
+                samples: Vec::new(),
+                width: 0,
+                height: 0,
+            });
+        };
+        let (w, h) = (first.width, first.height);
+        if views.iter().any(|v| (v.width, v.height) != (w, h)) {
+            bail!("Deep Shading trains on views of one resolution per split");
+        }
+        let samples = views
+            .iter()
+            .map(|v| {
+                let (features, pw, ph) = feature_image(bounds, &v.gbuffer, w, h);
+                let mut radiance = vec![0.0; 3 * pw * ph];
+                let mut mask = vec![0.0; pw * ph];
+                for i in 0..w * h {
+                    let j = (i / w) * pw + i % w;
+                    mask[j] = v.gbuffer.mask[i];
+                    for c in 0..3 {
+                        radiance[c * pw * ph + j] = v.radiance[i][c] * mask[j];
+                    }
+                }
+                Sample {
+                    foreground: mask.iter().filter(|&&m| m > 0.5).count() as u64,
+                    features,
+                    radiance,
+                    mask,
+                    light: LightInput::new(
+                        &maps[v.record.map],
+                        v.record.rotation_deg,
+                        encoder_width,
+                    ),
+                }
+            })
+            .collect();
+        Ok(Split {
+            samples,
+            width: w.div_ceil(8) * 8,
+            height: h.div_ceil(8) * 8,
+        })
+    }
+
+    /// The masked log-L1 loss of the views `batch`, and their foreground pixels.
+    fn loss(&self, net: &DeepShading, batch: &[usize], device: &Device) -> (Tensor<1>, u64) {
+        let (b, pw, ph) = (batch.len(), self.width, self.height);
+        let views: Vec<&Sample> = batch.iter().map(|&i| &self.samples[i]).collect();
+        let cat = |f: fn(&Sample) -> &Vec<f32>| {
+            views
+                .iter()
+                .flat_map(|s| f(s).iter().copied())
+                .collect::<Vec<f32>>()
+        };
+        let tensor = |data: Vec<f32>, shape: [usize; 4]| {
+            Tensor::<4>::from_data(TensorData::new(data, shape), device)
+        };
+        let lw = views[0].light.width;
+        let features = tensor(cat(|s| &s.features), [b, FEATURES, ph, pw]);
+        let reference = tensor(cat(|s| &s.radiance), [b, 3, ph, pw]);
+        let mask = tensor(cat(|s| &s.mask), [b, 1, ph, pw]);
+        let light = tensor(cat(|s| &s.light.pixels), [b, 3, lw / 2, lw]);
+        let scale = Tensor::from_data(
+            TensorData::new(views.iter().map(|s| s.light.scale).collect::<Vec<_>>(), [b]),
+            device,
+        );
+        let pred = net.forward(features, light, scale);
+        let err = log_l1_map(pred, reference) * mask.clone().expand([b, 3, ph, pw]);
+        let loss = err.sum() / (mask.sum() * 3.0).clamp_min(1.0);
+        (loss, views.iter().map(|s| s.foreground).sum())
+    }
+}
+
+struct UnetObjective {
+    train: Split,
+    test: Split,
+    /// The model file as it will be saved, less the run's progress.
+    file: DeepShadingFile,
+}
+
+impl Objective for UnetObjective {
+    type Net = DeepShading;
+    type Batch = Vec<usize>;
+
+    fn tag(&self) -> String {
+        TAG.into()
+    }
+
+    fn title(&self) -> String {
+        "Deep Shading (U-Net)".into()
+    }
+
+    fn run_key(&self) -> serde_json::Value {
+        serde_json::json!({
+            "network": TAG,
+            "dataset_hash": self.file.dataset_hash,
+            "batch_views": self.file.options.batch_views,
+            "encoder_width": self.file.encoder_width,
+        })
+    }
+
+    fn build(&self, init: &mut Init) -> DeepShading {
+        DeepShading::new(init, self.file.encoder_width)
+    }
+
+    fn steps(&self, _seed: u64, _epoch: usize) -> usize {
+        self.train
+            .samples
+            .len()
+            .div_ceil(self.file.options.batch_views)
+    }
+
+    fn batches(&self, seed: u64, epoch: usize, from: usize) -> impl Iterator<Item = Vec<usize>> {
+        let mut order: Vec<usize> = (0..self.train.samples.len()).collect();
+        order.shuffle(&mut epoch_rng(seed, epoch as u64, 0));
+        order
+            .chunks(self.file.options.batch_views)
+            .skip(from)
+            .map(<[usize]>::to_vec)
+            .collect::<Vec<_>>()
+            .into_iter()
+    }
+
+    fn loss(&self, net: &DeepShading, batch: &Vec<usize>, device: &Device) -> (Tensor<1>, u64) {
+        self.train.loss(net, batch, device)
+    }
+
+    fn validation_loss(&self, net: &DeepShading, device: &Device) -> f64 {
+        let n = self.test.samples.len();
+        let views: Vec<usize> = (0..n).collect();
+        views
+            .chunks(self.file.options.batch_views)
+            .map(|c| self.test.loss(net, c, device).0.into_scalar::<f32>() as f64 * c.len() as f64)
+            .sum::<f64>()
+            / n as f64
+    }
+
+    fn save_model(
+        &self,
+        out: &Path,
+        net: &DeepShading,
+        schedule: &Schedule,
+        state: &RunState,
+    ) -> Result<()> {
+        save_weights(&out.join(WEIGHTS_FILE), net, TAG)?;
+        let mut file = self.file.clone();
+        file.options.schedule = schedule.clone();
+        file.epochs_done = state.epoch;
+        file.seconds = state.seconds;
+        nprt_io::write_file(&out.join(CONFIG_FILE), serde_json::to_vec_pretty(&file)?)
+    }
+}
+
+/// Trains (or resumes exactly, Adam's moments included) a Deep Shading network on the dataset
+/// in `data`, with the validation loss on its test views after every epoch. Returns the run's
+/// summary and the model's config as saved.
+pub fn train(
+    data: &Path,
+    opts: &DeepShadingOptions,
+    out: &Path,
+    device: &Device,
+) -> Result<(TrainSummary, DeepShadingFile)> {
+    opts.schedule.check()?;
+    check_input_width(opts.encoder_width)?;
+    if opts.batch_views == 0 {
+        bail!("the views per Deep Shading step must be positive");
+    }
+    if out.join(CONFIG_FILE).exists() && !checkpoint::exists(out) {
+        bail!(
+            "'{}' holds a Deep Shading model without a checkpoint (from an older nprt); choose another folder or delete it",
+            out.display()
+        );
+    }
+    let (manifest, dataset_hash) = load_manifest_hashed(data)?;
+    let maps = open_recorded_maps(&manifest)?;
+    let split = |name: &str| -> Result<Split> {
+        let views = load_views(data, &manifest, name)?;
+        Split::new(&views, &maps, &manifest.bounds, opts.encoder_width)
+    };
+    let train = split("train")?;
+    if train.samples.is_empty() {
+        bail!("dataset '{}' has no training views", data.display());
+    }
+    let test = split("test")?;
+    let net = DeepShading::new(&mut Init::new(0, device), opts.encoder_width);
+    let s = &manifest.settings;
+    let file = DeepShadingFile {
+        format: TAG.into(),
+        version: 1,
+        encoder_width: opts.encoder_width,
+        bounds: manifest.bounds,
+        scene: s.scene.clone(),
+        scene_hash: s.scene_hash.clone(),
+        dataset_hash,
+        unet_params: net.unet_params(),
+        encoder_params: net.light.num_params(),
+        options: opts.clone(),
+        epochs_done: 0,
+        seconds: 0.0,
+    };
+    let objective = UnetObjective { train, test, file };
+    let summary = trainer::train(&objective, &opts.schedule, out, device)?;
+    let mut file = objective.file;
+    file.epochs_done = opts.schedule.epochs;
+    file.seconds = summary.seconds;
+    Ok((summary, file))
+}

@@ -1,0 +1,297 @@
+//! The one training loop, whatever the network: Adam as the paper (ε = 1e-8), checkpoints
+//! with the optimiser's moments, exact resume, a divergence stop that keeps the last good
+//! checkpoint, per-epoch validation, `loss.csv` and `loss.png`. What is trained, on which
+//! batches and with which loss is an [`Objective`]: the Neural PRT designs and the Deep
+//! Shading U-Net are two.
+//!
+//! Resume is exact because a batch is a function of the seed, the epoch and its index only,
+//! and parameter ids (which key Adam's state) are stable.
+
+use std::path::Path;
+use std::time::Instant;
+
+use anyhow::{bail, Context, Result};
+use burn::module::Module;
+use burn::optim::{AdamConfig, GradientsParams};
+use burn::tensor::{Device, Tensor};
+use rand::SeedableRng;
+use rand_pcg::Pcg64Mcg;
+use serde::{Deserialize, Serialize};
+
+use crate::checkpoint::{self, Checkpoint, RunState};
+use crate::curves::{self, LossRow};
+use crate::init::Init;
+
+pub const ADAM_EPSILON: f32 = 1e-8;
+/// Training-loss rows per epoch in loss.csv.
+const TRAIN_ROWS_PER_EPOCH: u64 = 20;
+
+/// The loop's own settings, shared by every network.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Schedule {
+    pub epochs: usize,
+    pub learning_rate: f64,
+    /// Seed of the initial weights and of the batch order.
+    pub seed: u64,
+    /// Seconds between checkpoints inside an epoch (one is always written at each epoch end).
+    #[serde(skip)]
+    pub checkpoint_secs: f64,
+    #[serde(skip)]
+    pub progress: bool,
+}
+
+impl Schedule {
+    /// Refuses settings no run can use.
+    pub fn check(&self) -> Result<()> {
+        if self.epochs == 0 {
+            bail!("the number of epochs must be positive");
+        }
+        if !(self.learning_rate > 0.0 && self.learning_rate.is_finite()) {
+            bail!(
+                "the learning rate must be a positive number, got {}",
+                self.learning_rate
+            );
+        }
+        Ok(())
+    }
+}
+
+/// What one network's training is: its construction, its batches and its loss.
+pub trait Objective {
+    type Net: Module;
+    type Batch;
+    /// Names the network in its weights' metadata and in messages.
+    fn tag(&self) -> String;
+    /// Title of the loss plot.
+    fn title(&self) -> String;
+    /// All that shapes the run besides the schedule (network, data, batching): a checkpoint
+    /// resumes only under an equal key.
+    fn run_key(&self) -> serde_json::Value;
+    fn build(&self, init: &mut Init) -> Self::Net;
+    /// Batches in `epoch`.
+    fn steps(&self, seed: u64, epoch: usize) -> usize;
+    /// The batches of `epoch` from index `from` on; a function of `seed` and `epoch` only.
+    fn batches(
+        &self,
+        seed: u64,
+        epoch: usize,
+        from: usize,
+    ) -> impl Iterator<Item = Self::Batch> + '_;
+    /// The batch's mean loss and how many samples (pixels) it holds.
+    fn loss(&self, net: &Self::Net, batch: &Self::Batch, device: &Device) -> (Tensor<1>, u64);
+    /// Loss on held-out data with a network off the autodiff device; NaN where there is none.
+    fn validation_loss(&self, net: &Self::Net, device: &Device) -> f64;
+    /// Writes the model folder's own files (config and weights) for the network as it stands.
+    fn save_model(
+        &self,
+        out: &Path,
+        net: &Self::Net,
+        schedule: &Schedule,
+        state: &RunState,
+    ) -> Result<()>;
+}
+
+/// What a finished (or resumed and finished) run reports.
+pub struct TrainSummary {
+    pub steps: u64,
+    pub samples: u64,
+    pub seconds: f64,
+    pub final_train: f64,
+    pub final_val: f64,
+    pub resumed_from_epoch: Option<f64>,
+}
+
+/// The random stream of one part (`stream`) of one epoch: shuffles depend on nothing else.
+pub fn epoch_rng(seed: u64, epoch: u64, stream: u64) -> Pcg64Mcg {
+    let key = [seed, epoch, stream].map(u64::to_le_bytes).concat();
+    let h = blake3::hash(&key);
+    let mut first = [0; 8];
+    first.copy_from_slice(&h.as_bytes()[..8]);
+    Pcg64Mcg::seed_from_u64(u64::from_le_bytes(first))
+}
+
+/// Trains (or resumes training of) `objective`'s network in the model folder `out`.
+pub fn train<O: Objective>(
+    objective: &O,
+    schedule: &Schedule,
+    out: &Path,
+    device: &Device,
+) -> Result<TrainSummary> {
+    schedule.check()?;
+    let tag = objective.tag();
+    let device = device.clone().autodiff();
+    let mut net = objective.build(&mut Init::new(schedule.seed, &device));
+    let mut optim = AdamConfig::new().with_epsilon(ADAM_EPSILON).init();
+    std::fs::create_dir_all(checkpoint::dir(out))
+        .with_context(|| format!("cannot create model folder '{}'", out.display()))?;
+
+    let mut ck = Checkpoint {
+        run: serde_json::json!({
+            "network": objective.run_key(),
+            "learning_rate": schedule.learning_rate,
+            "seed": schedule.seed,
+        }),
+        state: RunState::default(),
+        history: Vec::new(),
+        weights: String::new(),
+        optimizer: String::new(),
+    };
+    let mut resumed_from_epoch = None;
+    if let Some(saved) = checkpoint::read(out)? {
+        if saved.run != ck.run {
+            bail!(
+                "model folder '{}' holds a run with other settings (network, dataset or hyper-parameters); choose another --out or delete it",
+                out.display()
+            );
+        }
+        optim = checkpoint::restore(out, &saved, &mut net, optim, &tag)?;
+        let s = saved.state;
+        let at =
+            s.epoch as f64 + s.batch as f64 / objective.steps(schedule.seed, s.epoch).max(1) as f64;
+        if schedule.progress {
+            eprintln!("resuming '{}' from epoch {at:.2}", out.display());
+        }
+        resumed_from_epoch = Some(at);
+        ck = saved;
+    }
+
+    let per_epoch: Vec<usize> = (0..schedule.epochs)
+        .map(|e| objective.steps(schedule.seed, e))
+        .collect();
+    let total_batches: usize = per_epoch.iter().sum();
+    let done_batches = per_epoch.iter().take(ck.state.epoch).sum::<usize>() + ck.state.batch;
+    let bar = nprt_io::progress_bar(
+        schedule.progress,
+        total_batches as u64,
+        &format!("training {tag}"),
+        "batches",
+    );
+    bar.set_position(done_batches as u64);
+    bar.reset_eta();
+    let started = Instant::now();
+    let seconds_before = ck.state.seconds;
+    let mut last_checkpoint = Instant::now();
+    let (mut row_sum, mut row_n) = (0.0f64, 0u64);
+    let mut last_train = f64::NAN;
+    let mut best_ema = f64::INFINITY;
+    let mut ema = f64::NAN;
+
+    while ck.state.epoch < schedule.epochs {
+        let epoch = ck.state.epoch;
+        let total = per_epoch[epoch];
+        let row_every = (total as u64).div_ceil(TRAIN_ROWS_PER_EPOCH).max(1);
+        for batch in objective.batches(schedule.seed, epoch, ck.state.batch) {
+            let (loss, samples) = objective.loss(&net, &batch, &device);
+            let value = loss.clone().into_scalar::<f32>() as f64;
+            ema = if ema.is_nan() {
+                value
+            } else {
+                0.98 * ema + 0.02 * value
+            };
+            if ck.state.step > 200 {
+                best_ema = best_ema.min(ema);
+            }
+            if !value.is_finite() || ema > 10.0 * best_ema {
+                bar.abandon();
+                let kept = if checkpoint::exists(out) {
+                    format!(
+                        "the last good checkpoint in '{}' is kept",
+                        checkpoint::dir(out).display()
+                    )
+                } else {
+                    "no checkpoint had been written yet".to_string()
+                };
+                bail!(
+                    "training diverged at epoch {} step {} (loss {value}, running mean {ema:.4}, best {best_ema:.4}); {kept}; lower --lr and use another --out",
+                    epoch + 1,
+                    ck.state.step
+                );
+            }
+            let grads = GradientsParams::from_grads(loss.backward(), &net);
+            net = optim.step(schedule.learning_rate, net, grads);
+            let s = &mut ck.state;
+            s.batch += 1;
+            s.step += 1;
+            s.samples += samples;
+            s.seconds = seconds_before + started.elapsed().as_secs_f64();
+            row_sum += value;
+            row_n += 1;
+            last_train = value;
+            if s.step.is_multiple_of(row_every) {
+                ck.history.push(LossRow {
+                    step: s.step,
+                    epoch: epoch as f64 + s.batch as f64 / total as f64,
+                    samples: s.samples,
+                    seconds: s.seconds,
+                    train: Some(row_sum / row_n as f64),
+                    val: None,
+                });
+                (row_sum, row_n) = (0.0, 0);
+            }
+            bar.inc(1);
+            bar.set_message(format!(
+                "epoch {}/{} loss {ema:.4} {:.0}K samples/s",
+                epoch + 1,
+                schedule.epochs,
+                s.samples as f64 / s.seconds.max(1e-9) / 1e3
+            ));
+            if last_checkpoint.elapsed().as_secs_f64() > schedule.checkpoint_secs {
+                save(objective, schedule, out, &mut ck, &net, &optim)?;
+                last_checkpoint = Instant::now();
+            }
+        }
+        let val = objective.validation_loss(&net.valid(), &device.clone().inner());
+        let s = &mut ck.state;
+        s.epoch += 1;
+        s.batch = 0;
+        ck.history.push(LossRow {
+            step: s.step,
+            epoch: s.epoch as f64,
+            samples: s.samples,
+            seconds: s.seconds,
+            train: (row_n > 0).then(|| row_sum / row_n as f64),
+            val: Some(val),
+        });
+        (row_sum, row_n) = (0.0, 0);
+        if schedule.progress {
+            // Also when the bar is hidden (output not a terminal), so logs show progress.
+            let train = ck.history.iter().rev().find_map(|r| r.train);
+            bar.suspend(|| {
+                eprintln!(
+                    "epoch {:>4}/{}: train loss {:.5}, validation loss {val:.5}, {:.0} K samples/s",
+                    s.epoch,
+                    schedule.epochs,
+                    train.unwrap_or(last_train),
+                    s.samples as f64 / s.seconds.max(1e-9) / 1e3
+                )
+            });
+        }
+        save(objective, schedule, out, &mut ck, &net, &optim)?;
+        last_checkpoint = Instant::now();
+    }
+    bar.finish_and_clear();
+    let last = |f: fn(&LossRow) -> Option<f64>| ck.history.iter().rev().find_map(f);
+    Ok(TrainSummary {
+        steps: ck.state.step,
+        samples: ck.state.samples,
+        seconds: ck.state.seconds,
+        final_train: last(|r| r.train).unwrap_or(last_train),
+        final_val: last(|r| r.val).unwrap_or(f64::NAN),
+        resumed_from_epoch,
+    })
+}
+
+/// The checkpoint, then the model folder's own files, loss.csv and loss.png.
+fn save<O: Objective>(
+    objective: &O,
+    schedule: &Schedule,
+    out: &Path,
+    ck: &mut Checkpoint,
+    net: &O::Net,
+    optim: &burn::optim::ModuleOptimizer,
+) -> Result<()> {
+    checkpoint::write(out, ck, net, optim, &objective.tag())?;
+    objective.save_model(out, net, schedule, &ck.state)?;
+    curves::write_csv(&out.join("loss.csv"), &ck.history)?;
+    curves::plot(&out.join("loss.png"), &ck.history, &objective.title())
+}
