@@ -2,6 +2,39 @@
 //! views are stored and verified. It owns placement and dataset bookkeeping, and renders only
 //! through `nprt-trace`; it must not parse scene files, trace paths itself or know about
 //! networks.
+//!
+//! ```
+//! use nprt_data::dataset::{self, Request};
+//! use nprt_scene::{load_scene, open_envmap, SceneOptions};
+//! use nprt_trace::TraceScene;
+//!
+//! let scene = load_scene("builtin:room", &SceneOptions::default())?;
+//! let map_specs = vec!["builtin:sky".to_string(), "builtin:indoor:1".to_string()];
+//! let maps = map_specs.iter().map(|s| open_envmap(s)).collect::<anyhow::Result<Vec<_>>>()?;
+//! let ts = TraceScene::new(&scene);
+//! let request = Request {
+//!     scene_spec: "builtin:room".into(),
+//!     scene: &scene,
+//!     scene_source: dataset::scene_source("builtin:room")?,
+//!     volume: scene.camera_volume.clone().unwrap(),
+//!     map_specs,
+//!     maps,
+//!     test_maps: 1,
+//!     train_views: 2,
+//!     test_views: 1,
+//!     train_resolution: [8, 8],
+//!     test_resolution: [8, 8],
+//!     spp: 2,
+//!     seed: 0,
+//! };
+//! let manifest = dataset::plan(&request, &ts)?;
+//! let dir = std::env::temp_dir().join(format!("nprt-data-doc-{}", std::process::id()));
+//! dataset::prepare(&dir, &manifest)?;
+//! dataset::run(&ts, &request.maps, &manifest, &dir, (0, 1), false)?;
+//! assert_eq!(dataset::verify(&dir)?.complete, 3);
+//! # std::fs::remove_dir_all(&dir)?;
+//! # Ok::<(), anyhow::Error>(())
+//! ```
 
 pub mod cameras;
 pub mod dataset;

@@ -4,6 +4,17 @@
 //! the error analysis, the timing tables and the Markdown/HTML report. It renders neural frames
 //! through nprt-render and reference-style frames through nprt-trace; it must not write
 //! datasets or train the Neural PRT designs (nprt-net does).
+//!
+//! ```
+//! use glam::Vec3;
+//! use nprt_eval::metrics::Metrics;
+//!
+//! // The paper's image errors of a prediction against its reference, on foreground pixels.
+//! let reference = vec![Vec3::splat(0.5); 64];
+//! let prediction = vec![Vec3::splat(0.6); 64];
+//! let m = Metrics::compute(&prediction, &reference, &[1.0; 64], 8);
+//! assert!((m.l1 - 0.1).abs() < 1e-6);
+//! ```
 
 mod error_analysis;
 pub mod evaluate;

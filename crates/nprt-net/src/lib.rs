@@ -6,6 +6,15 @@
 //!
 //! Network code is device-generic: it runs on whatever burn `Device` its tensors live on
 //! (the flex CPU backend here; a GPU backend by enabling its burn feature).
+//!
+//! ```
+//! use nprt_net::{Design, Device, Init, ModelConfig};
+//!
+//! // The paper's diffuse/specular design, with its own default activation (SIREN).
+//! let net = ModelConfig::new(Design::Dsep, None).build(&mut Init::new(0, &Device::flex()));
+//! let paper = Design::Dsep.paper_params() as f64;
+//! assert!((net.transport_params() as f64 / paper - 1.0).abs() < 0.05);
+//! ```
 
 mod activation;
 mod batch;

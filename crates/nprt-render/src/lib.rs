@@ -3,6 +3,22 @@
 //! time, and writing frames and animations. It reads models through nprt-net and traces only
 //! primary rays (for the G-buffer) through nprt-trace; it must not train networks, write
 //! datasets or compute error metrics.
+//!
+//! ```
+//! use nprt_render::{CameraPath, LightingSchedule};
+//! use nprt_scene::{load_scene, SceneOptions};
+//!
+//! // A sequence's camera and lighting: a path through the scene's camera volume, and two
+//! // maps, the first spinning for half the frames.
+//! let scene = load_scene("builtin:room", &SceneOptions::default())?;
+//! let path = CameraPath::through_volume(scene.camera_volume.as_ref().unwrap());
+//! let camera = path.camera(0.5, 64, 48);
+//! assert_eq!((camera.width, camera.height), (64, 48));
+//! let schedule = LightingSchedule::parse("builtin:sky,builtin:indoor:1", 90.0)?;
+//! let (map, _rotation_deg) = schedule.at(0, 10);
+//! assert_eq!(map, 0);
+//! # Ok::<(), anyhow::Error>(())
+//! ```
 
 pub mod path;
 pub mod relight;

@@ -6,6 +6,16 @@
 //! (lat-long, Mitsuba 3's mapping, importance sampling) and the procedural built-in content, plus
 //! the loaders for glTF 2.0, Mitsuba 3 XML, PLY and OBJ. It must not trace rays, sample paths or
 //! know about datasets and networks: those belong to `nprt-trace` and later stages.
+//!
+//! ```
+//! use nprt_scene::{load_scene, open_envmap, SceneOptions};
+//!
+//! let scene = load_scene("builtin:room", &SceneOptions::default())?;
+//! let sky = open_envmap("builtin:sky:30:120")?;
+//! assert!(scene.triangle_count() > 0 && scene.camera_volume.is_some());
+//! assert!(sky.mean_radiance().max_element() > 0.0);
+//! # Ok::<(), anyhow::Error>(())
+//! ```
 
 pub mod builtin;
 pub mod camera;

@@ -5,6 +5,26 @@
 //!
 //! It owns everything about light transport and pixels, and reads scenes only through
 //! `nprt-scene`; it must not parse files, place dataset cameras or know about networks.
+//!
+//! ```
+//! use nprt_scene::{load_scene, open_envmap, SceneOptions};
+//! use nprt_trace::{render, PixelFilter, RenderSettings, TraceScene};
+//!
+//! let scene = load_scene("builtin:room", &SceneOptions::default())?;
+//! let camera = scene.framing_camera().with_resolution(16, 12);
+//! let settings = RenderSettings {
+//!     spp: 4,
+//!     max_depth: None,
+//!     rr_depth: scene.rr_depth,
+//!     seed: 0,
+//!     filter: PixelFilter::Box,
+//!     progress: false,
+//! };
+//! let frame = render(&TraceScene::new(&scene), &camera, &open_envmap("builtin:sky")?, &settings);
+//! assert_eq!(frame.radiance.len(), 16 * 12);
+//! assert!(frame.radiance.iter().all(|c| c.is_finite()));
+//! # Ok::<(), anyhow::Error>(())
+//! ```
 
 pub mod accel;
 pub mod bsdf;
