@@ -17,13 +17,13 @@
 //! ```
 
 mod error_analysis;
-pub mod evaluate;
-pub mod method;
+mod evaluate;
+mod method;
 pub mod metrics;
 mod networks;
 pub mod oidn;
 mod path_tracing;
-pub mod report;
+mod report;
 pub mod sh;
 mod sh_prt;
 mod test_bench;

@@ -20,10 +20,10 @@
 //! # Ok::<(), anyhow::Error>(())
 //! ```
 
-pub mod path;
-pub mod relight;
+mod path;
+mod relight;
 pub mod schedule;
-pub mod sequence;
+mod sequence;
 pub mod video;
 
 pub use path::CameraPath;

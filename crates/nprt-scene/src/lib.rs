@@ -18,20 +18,20 @@
 //! ```
 
 pub mod builtin;
-pub mod camera;
-pub mod color;
-pub mod distribution;
+mod camera;
+mod color;
+mod distribution;
 pub mod envmap;
 mod envmap_spec;
-pub mod gltf_scene;
+mod gltf_scene;
 mod image_file;
-pub mod material;
-pub mod mesh;
-pub mod mesh_io;
+mod material;
+mod mesh;
+mod mesh_io;
 pub mod mitsuba;
-pub mod procedural;
-pub mod scene;
-pub mod texture;
+mod procedural;
+mod scene;
+mod texture;
 
 pub use camera::{Camera, CameraVolume, FovAxis};
 pub use color::{linear_to_srgb, luminance, srgb_to_linear};

@@ -26,14 +26,14 @@
 //! # Ok::<(), anyhow::Error>(())
 //! ```
 
-pub mod accel;
-pub mod bsdf;
+mod accel;
+mod bsdf;
 pub mod exr_io;
-pub mod frame;
-pub mod integrator;
-pub mod microfacet;
-pub mod render;
-pub mod shading_frame;
+mod frame;
+mod integrator;
+mod microfacet;
+mod render;
+mod shading_frame;
 
 pub use accel::{Accel, Hit};
 pub use bsdf::Bsdf;
