@@ -146,6 +146,24 @@ pub fn write_report(e: &Evaluation, dir: &Path) -> Result<(PathBuf, PathBuf)> {
         e.foreground_pixels,
         e.cpu_threads
     )?;
+    errors(&mut md, e)?;
+    claims(&mut md, e)?;
+    timings(&mut md, e)?;
+    error_analysis(&mut md, e, dir)?;
+    images(&mut md, e, dir)?;
+    training_curves(&mut md, e, dir)?;
+    let md_path = dir.join("report.md");
+    write_file(&md_path, &md)?;
+    let html_path = dir.join("report.html");
+    let html = to_html(&md, dir)?;
+    write_file(&html_path, html)?;
+    let json = serde_json::to_vec_pretty(e)?;
+    write_file(&dir.join("results.json"), &json)?;
+    Ok((md_path, html_path))
+}
+
+/// The error table (the paper's Tables 5 and 6) and the notes under it.
+fn errors(md: &mut String, e: &Evaluation) -> Result<()> {
     writeln!(md, "## Errors (the paper's Tables 5 and 6)\n")?;
     write!(md, "| method | params |")?;
     for n in Metrics::NAMES {
@@ -180,10 +198,20 @@ pub fn write_report(e: &Evaluation, dir: &Path) -> Result<(PathBuf, PathBuf)> {
         )?;
     }
     writeln!(md, "- Denoiser: {}.\n", e.denoiser)?;
+    Ok(())
+}
+
+/// Which of the paper's claims hold on this evaluation.
+fn claims(md: &mut String, e: &Evaluation) -> Result<()> {
     writeln!(md, "## The paper's claims, here\n")?;
     for (claim, ok) in e.checks() {
         writeln!(md, "- {} {claim}", if ok { "✅" } else { "❌" })?;
     }
+    Ok(())
+}
+
+/// Per-stage timings (the paper's Tables 3 and 4).
+fn timings(md: &mut String, e: &Evaluation) -> Result<()> {
     writeln!(
         md,
         "\n## Timings at {0}×{0} (the paper's Tables 3 and 4)\n",
@@ -193,6 +221,11 @@ pub fn write_report(e: &Evaluation, dir: &Path) -> Result<(PathBuf, PathBuf)> {
     for t in &e.timings {
         writeln!(md, "| {} | {:.1} |", t.what, t.ms)?;
     }
+    Ok(())
+}
+
+/// Correlations of the error with directness and specularity, and the binned plots.
+fn error_analysis(md: &mut String, e: &Evaluation, dir: &Path) -> Result<()> {
     writeln!(md, "\n## Error analysis\n")?;
     writeln!(md, "Pearson correlation, over foreground pixels of all test views, of the per-pixel L1 error with the \
         directness (share of direct light in the reference) and with the specularity (|ks| / (|kd| + |ks|)).\n")?;
@@ -243,7 +276,11 @@ pub fn write_report(e: &Evaluation, dir: &Path) -> Result<(PathBuf, PathBuf)> {
         plot_lines(&dir.join(&rel), title, (x, "mean L1 error"), &series)?;
         writeln!(md, "\n![{title}]({rel})")?;
     }
+    Ok(())
+}
 
+/// Frames, crops and heat maps of the shown views.
+fn images(md: &mut String, e: &Evaluation, dir: &Path) -> Result<()> {
     writeln!(md, "\n## Images\n\nPer view: full frames, a {ZOOM}× crop where the first network errs most, and relative-error heat maps \
         (|error| / (reference + {RELATIVE_EPS}), black 0 → pale yellow ≥ {HEAT_MAX}). Exposure set per view from the reference.\n")?;
     for v in &e.shown {
@@ -287,6 +324,11 @@ pub fn write_report(e: &Evaluation, dir: &Path) -> Result<(PathBuf, PathBuf)> {
         }
         writeln!(md)?;
     }
+    Ok(())
+}
+
+/// The networks' loss curves.
+fn training_curves(md: &mut String, e: &Evaluation, dir: &Path) -> Result<()> {
     writeln!(md, "## Training curves\n")?;
     for m in e.methods.iter().filter(|m| m.loss_png.is_some()) {
         let rel = format!("images/loss-{}.png", slug(&m.name));
@@ -294,14 +336,7 @@ pub fn write_report(e: &Evaluation, dir: &Path) -> Result<(PathBuf, PathBuf)> {
             .with_context(|| format!("cannot copy the training curve of {}", m.name))?;
         writeln!(md, "![{}]({rel})\n", m.name)?;
     }
-    let md_path = dir.join("report.md");
-    write_file(&md_path, &md)?;
-    let html_path = dir.join("report.html");
-    let html = to_html(&md, dir)?;
-    write_file(&html_path, html)?;
-    let json = serde_json::to_vec_pretty(e)?;
-    write_file(&dir.join("results.json"), &json)?;
-    Ok((md_path, html_path))
+    Ok(())
 }
 
 /// Renders the report's Markdown as one HTML page (pulldown-cmark, with tables) with every

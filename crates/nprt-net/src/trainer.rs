@@ -12,7 +12,7 @@ use std::time::Instant;
 
 use anyhow::{bail, Context, Result};
 use burn::module::Module;
-use burn::optim::{AdamConfig, GradientsParams};
+use burn::optim::{AdamConfig, GradientsParams, ModuleOptimizer};
 use burn::tensor::{Device, Tensor};
 use rand::SeedableRng;
 use rand_pcg::Pcg64Mcg;
@@ -125,35 +125,28 @@ pub fn train<O: Objective>(
     std::fs::create_dir_all(checkpoint::dir(out))
         .with_context(|| format!("cannot create model folder '{}'", out.display()))?;
 
-    let mut ck = Checkpoint {
-        run: serde_json::json!({
-            "network": objective.run_key(),
-            "learning_rate": schedule.learning_rate,
-            "seed": schedule.seed,
-        }),
-        state: RunState::default(),
-        history: Vec::new(),
-        weights: String::new(),
-        optimizer: String::new(),
+    let (mut ck, resumed_from_epoch) = match checkpoint::read(out)? {
+        Some(saved) => {
+            optim = resume(objective, schedule, out, &saved, &mut net, optim)?;
+            let s = saved.state;
+            let at = s.epoch as f64
+                + s.batch as f64 / objective.steps(schedule.seed, s.epoch).max(1) as f64;
+            if schedule.progress {
+                eprintln!("resuming '{}' from epoch {at:.2}", out.display());
+            }
+            (saved, Some(at))
+        }
+        None => (
+            Checkpoint {
+                run: run_key(objective, schedule),
+                state: RunState::default(),
+                history: Vec::new(),
+                weights: String::new(),
+                optimizer: String::new(),
+            },
+            None,
+        ),
     };
-    let mut resumed_from_epoch = None;
-    if let Some(saved) = checkpoint::read(out)? {
-        if saved.run != ck.run {
-            bail!(
-                "model folder '{}' holds a run with other settings (network, dataset or hyper-parameters); choose another --out or delete it",
-                out.display()
-            );
-        }
-        optim = checkpoint::restore(out, &saved, &mut net, optim, &tag)?;
-        let s = saved.state;
-        let at =
-            s.epoch as f64 + s.batch as f64 / objective.steps(schedule.seed, s.epoch).max(1) as f64;
-        if schedule.progress {
-            eprintln!("resuming '{}' from epoch {at:.2}", out.display());
-        }
-        resumed_from_epoch = Some(at);
-        ck = saved;
-    }
 
     let per_epoch: Vec<usize> = (0..schedule.epochs)
         .map(|e| objective.steps(schedule.seed, e))
@@ -173,8 +166,7 @@ pub fn train<O: Objective>(
     let mut last_checkpoint = Instant::now();
     let (mut row_sum, mut row_n) = (0.0f64, 0u64);
     let mut last_train = f64::NAN;
-    let mut best_ema = f64::INFINITY;
-    let mut ema = f64::NAN;
+    let mut guard = DivergenceGuard::default();
 
     while ck.state.epoch < schedule.epochs {
         let epoch = ck.state.epoch;
@@ -183,15 +175,7 @@ pub fn train<O: Objective>(
         for batch in objective.batches(schedule.seed, epoch, ck.state.batch) {
             let (loss, samples) = objective.loss(&net, &batch, &device);
             let value = loss.clone().into_scalar::<f32>() as f64;
-            ema = if ema.is_nan() {
-                value
-            } else {
-                0.98 * ema + 0.02 * value
-            };
-            if ck.state.step > 200 {
-                best_ema = best_ema.min(ema);
-            }
-            if !value.is_finite() || ema > 10.0 * best_ema {
+            if let Some(why) = guard.check(value, ck.state.step) {
                 bar.abandon();
                 let kept = if checkpoint::exists(out) {
                     format!(
@@ -202,7 +186,7 @@ pub fn train<O: Objective>(
                     "no checkpoint had been written yet".to_string()
                 };
                 bail!(
-                    "training diverged at epoch {} step {} (loss {value}, running mean {ema:.4}, best {best_ema:.4}); {kept}; lower --lr and use another --out",
+                    "training diverged at epoch {} step {} ({why}); {kept}; lower --lr and use another --out",
                     epoch + 1,
                     ck.state.step
                 );
@@ -230,9 +214,10 @@ pub fn train<O: Objective>(
             }
             bar.inc(1);
             bar.set_message(format!(
-                "epoch {}/{} loss {ema:.4} {:.0}K samples/s",
+                "epoch {}/{} loss {:.4} {:.0}K samples/s",
                 epoch + 1,
                 schedule.epochs,
+                guard.ema,
                 s.samples as f64 / s.seconds.max(1e-9) / 1e3
             ));
             if last_checkpoint.elapsed().as_secs_f64() > schedule.checkpoint_secs {
@@ -281,6 +266,70 @@ pub fn train<O: Objective>(
     })
 }
 
+/// All that must match for a checkpoint to resume: the network's key, the learning rate and
+/// the seed.
+fn run_key<O: Objective>(objective: &O, schedule: &Schedule) -> serde_json::Value {
+    serde_json::json!({
+        "network": objective.run_key(),
+        "learning_rate": schedule.learning_rate,
+        "seed": schedule.seed,
+    })
+}
+
+/// Checks that `saved` belongs to this run and loads its weights and optimiser state.
+fn resume<O: Objective>(
+    objective: &O,
+    schedule: &Schedule,
+    out: &Path,
+    saved: &Checkpoint,
+    net: &mut O::Net,
+    optim: ModuleOptimizer,
+) -> Result<ModuleOptimizer> {
+    if saved.run != run_key(objective, schedule) {
+        bail!(
+            "model folder '{}' holds a run with other settings (network, dataset or hyper-parameters); choose another --out or delete it",
+            out.display()
+        );
+    }
+    checkpoint::restore(out, saved, net, optim, &objective.tag())
+}
+
+/// Stops a run whose loss is not finite or whose running mean rose ten times above its best
+/// (measured after 200 steps, once the start's transient is over).
+struct DivergenceGuard {
+    ema: f64,
+    best: f64,
+}
+
+impl Default for DivergenceGuard {
+    fn default() -> Self {
+        DivergenceGuard {
+            ema: f64::NAN,
+            best: f64::INFINITY,
+        }
+    }
+}
+
+impl DivergenceGuard {
+    /// Takes the loss of step `step`; says why the run diverged, if it did.
+    fn check(&mut self, loss: f64, step: u64) -> Option<String> {
+        self.ema = if self.ema.is_nan() {
+            loss
+        } else {
+            0.98 * self.ema + 0.02 * loss
+        };
+        if step > 200 {
+            self.best = self.best.min(self.ema);
+        }
+        (!loss.is_finite() || self.ema > 10.0 * self.best).then(|| {
+            format!(
+                "loss {loss}, running mean {:.4}, best {:.4}",
+                self.ema, self.best
+            )
+        })
+    }
+}
+
 /// The checkpoint, then the model folder's own files, loss.csv and loss.png.
 fn save<O: Objective>(
     objective: &O,
@@ -288,7 +337,7 @@ fn save<O: Objective>(
     out: &Path,
     ck: &mut Checkpoint,
     net: &O::Net,
-    optim: &burn::optim::ModuleOptimizer,
+    optim: &ModuleOptimizer,
 ) -> Result<()> {
     checkpoint::write(out, ck, net, optim, &objective.tag())?;
     objective.save_model(out, net, schedule, &ck.state)?;
