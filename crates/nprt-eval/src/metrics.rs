@@ -86,7 +86,8 @@ impl Metrics {
 
 /// Mean SSIM (Wang et al. 2004: 11×11 Gaussian window, σ 1.5, K1 0.01, K2 0.03, dynamic range 1)
 /// per colour channel, over windows centred on foreground pixels; background pixels count as
-/// black in both images so they add no difference.
+/// black in both images so they add no difference. Hand-written: the SSIM crates work on whole
+/// 8-bit images, without a foreground mask or linear HDR values.
 pub fn ssim(pred: &[Vec3], reference: &[Vec3], mask: &[f32], width: usize) -> f64 {
     const R: i64 = 5;
     let (c1, c2) = (0.01f64.powi(2), 0.03f64.powi(2));

@@ -1,7 +1,8 @@
 //! The spherical-harmonics PRT baseline (Sloan et al. 2002), per pixel in a fixed view: each
 //! pixel's transport onto the real SH basis is precomputed by path tracing (full global
 //! illumination, BSDF sampling only), the lighting is projected onto the same basis, and
-//! radiance is their per-channel dot product.
+//! radiance is their per-channel dot product. The 25 real SH basis functions up to band 4 are
+//! written out in closed form (a few lines each) rather than taken from a crate.
 
 use glam::{Vec2, Vec3};
 use nprt_scene::envmap::uv_to_direction;
