@@ -20,13 +20,7 @@ pub struct TrainOptions {
 impl Default for TrainOptions {
     fn default() -> Self {
         TrainOptions {
-            schedule: Schedule {
-                epochs: 20,
-                learning_rate: 1e-4,
-                seed: 0,
-                checkpoint_secs: 300.0,
-                progress: true,
-            },
+            schedule: Schedule::default(),
             batch_size: 16_384,
             views_per_batch: 8,
             val_samples: 65_536,

@@ -40,6 +40,19 @@ pub struct Schedule {
     pub progress: bool,
 }
 
+impl Default for Schedule {
+    /// The paper's learning rate; a checkpoint every 5 minutes within an epoch.
+    fn default() -> Self {
+        Schedule {
+            epochs: 20,
+            learning_rate: 1e-4,
+            seed: 0,
+            checkpoint_secs: 300.0,
+            progress: true,
+        }
+    }
+}
+
 impl Schedule {
     /// Refuses settings no run can use.
     pub fn check(&self) -> Result<()> {

@@ -19,10 +19,10 @@ impl Frame3 {
         let t = Vec3::new(b, sign + n.y * n.y * a, -n.y);
         Frame3 { s, t, n }
     }
-    pub fn to_local(&self, v: Vec3) -> Vec3 {
+    pub fn to_local(self, v: Vec3) -> Vec3 {
         Vec3::new(v.dot(self.s), v.dot(self.t), v.dot(self.n))
     }
-    pub fn to_world(&self, v: Vec3) -> Vec3 {
+    pub fn to_world(self, v: Vec3) -> Vec3 {
         self.s * v.x + self.t * v.y + self.n * v.z
     }
 }

@@ -12,7 +12,7 @@ use nprt_scene::EnvMap;
 use rand::seq::SliceRandom;
 use serde::{Deserialize, Serialize};
 
-use super::model::{DeepShadingFile, CONFIG_FILE, TAG};
+use super::model::{read_file, DeepShadingFile, CONFIG_FILE, TAG};
 use super::unet::{feature_image, DeepShading};
 use crate::checkpoint::{self, RunState};
 use crate::data::open_recorded_maps;
@@ -36,15 +36,9 @@ pub struct DeepShadingOptions {
 impl Default for DeepShadingOptions {
     fn default() -> Self {
         DeepShadingOptions {
-            schedule: Schedule {
-                epochs: 20,
-                // 1e-3 was measured to kill this ReLU U-Net: every activation dead, the output
-                // a constant.
-                learning_rate: 1e-4,
-                seed: 0,
-                checkpoint_secs: 300.0,
-                progress: true,
-            },
+            // Its learning rate too: 1e-3 was measured to kill this ReLU U-Net (every
+            // activation dead, the output a constant).
+            schedule: Schedule::default(),
             batch_views: 4,
             encoder_width: crate::model::DEFAULT_ENCODER_WIDTH,
         }
@@ -150,7 +144,8 @@ impl Split {
 struct UnetObjective {
     train: Split,
     test: Split,
-    /// The model file as it will be saved, less the run's progress.
+    /// The model file as it will be saved, less what `save_model` fills in from the network
+    /// and the run (parameter counts, progress).
     file: DeepShadingFile,
 }
 
@@ -221,6 +216,8 @@ impl Objective for UnetObjective {
         save_weights(&out.join(WEIGHTS_FILE), net, TAG)?;
         let mut file = self.file.clone();
         file.options.schedule = schedule.clone();
+        file.unet_params = net.unet_params();
+        file.encoder_params = net.light.num_params();
         file.epochs_done = state.epoch;
         file.seconds = state.seconds;
         nprt_io::write_file(&out.join(CONFIG_FILE), serde_json::to_vec_pretty(&file)?)
@@ -258,7 +255,6 @@ pub fn train(
         bail!("dataset '{}' has no training views", data.display());
     }
     let test = split("test")?;
-    let net = DeepShading::new(&mut Init::new(0, device), opts.encoder_width);
     let s = &manifest.settings;
     let file = DeepShadingFile {
         format: TAG.into(),
@@ -268,16 +264,13 @@ pub fn train(
         scene: s.scene.clone(),
         scene_hash: s.scene_hash.clone(),
         dataset_hash,
-        unet_params: net.unet_params(),
-        encoder_params: net.light.num_params(),
+        unet_params: 0,
+        encoder_params: 0,
         options: opts.clone(),
         epochs_done: 0,
         seconds: 0.0,
     };
     let objective = UnetObjective { train, test, file };
     let summary = trainer::train(&objective, &opts.schedule, out, device)?;
-    let mut file = objective.file;
-    file.epochs_done = opts.schedule.epochs;
-    file.seconds = summary.seconds;
-    Ok((summary, file))
+    Ok((summary, read_file(out)?))
 }
