@@ -50,6 +50,9 @@ pub struct Evaluation {
     pub methods: Vec<MethodResult>,
     pub timing_res: u32,
     pub timings: Vec<Timing>,
+    /// f32 peak of `cpu_threads` threads, measured beside the timings.
+    #[serde(default)]
+    pub peak_gflops: f64,
     pub denoiser: String,
     pub cpu_threads: usize,
     /// Images of the shown views, per method (reference first), in the report's images folder.
@@ -179,6 +182,7 @@ pub fn evaluate(o: &EvalOptions, device: &Device) -> Result<Evaluation> {
         methods: results,
         timing_res: o.timing_res,
         timings,
+        peak_gflops: nprt_net::cpu::measured_peak(rayon::current_num_threads()).gflops,
         denoiser,
         cpu_threads: rayon::current_num_threads(),
         shown: bench.shown,

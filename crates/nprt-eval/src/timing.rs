@@ -15,10 +15,14 @@ use crate::networks::Net;
 pub struct Timing {
     pub what: String,
     pub ms: f64,
+    /// Achieved f32 GFLOP/s of the dense layers, for the networks on the CPU engine.
+    #[serde(default)]
+    pub gflops: Option<f64>,
 }
 
 /// The paper's Tables 3 and 4 on this machine: per-stage times of one frame at
-/// `timing_res`², the median of three runs each.
+/// `timing_res`², the median of three runs each; for Neural PRT designs also a lighting change
+/// under a still camera, which runs only the shading networks.
 pub fn time_table(
     timing_res: u32,
     ts: &TraceScene,
@@ -47,6 +51,7 @@ pub fn time_table(
     rows.push(Timing {
         what: "G-buffer (primary rays)".into(),
         ms: gb,
+        gflops: None,
     });
     for (net, name) in nets {
         let runs: Vec<(f64, f64)> = (0..3)
@@ -55,16 +60,51 @@ pub fn time_table(
                 (e, m)
             })
             .collect();
-        if let Net::Nprt(..) = net {
+        let network_ms = median(runs.iter().map(|r| r.1).collect());
+        let Net::Nprt(r, _) = net else {
             rows.push(Timing {
-                what: format!("{name}: encoder"),
-                ms: median(runs.iter().map(|r| r.0).collect()),
+                what: format!("{name}: network"),
+                ms: network_ms,
+                gflops: None,
             });
-        }
+            continue;
+        };
+        let foreground = g.mask.iter().filter(|&&m| m > 0.5).count() as f64;
+        let gflops = |transfer_known, ms: f64| {
+            r.flops_per_pixel(transfer_known)
+                .map(|f| f * foreground / (ms * 1e6))
+        };
+        rows.push(Timing {
+            what: format!("{name}: encoder"),
+            ms: median(runs.iter().map(|r| r.0).collect()),
+            gflops: None,
+        });
         rows.push(Timing {
             what: format!("{name}: network"),
-            ms: median(runs.iter().map(|r| r.1).collect()),
+            ms: network_ms,
+            gflops: gflops(false, network_ms),
         });
+        if r.file.config.design != nprt_net::Design::Baseline {
+            let px = r.pixels(&g);
+            let code = r.light_code(map, 0.0);
+            let relight_ms = median(
+                (0..3)
+                    .map(|_| {
+                        let t = Instant::now();
+                        r.relight(&px, &code);
+                        ms(t)
+                    })
+                    .collect(),
+            );
+            rows.push(Timing {
+                what: format!(
+                    "{name}: network, lighting change under a still camera ({:.1}× faster)",
+                    network_ms / relight_ms
+                ),
+                ms: relight_ms,
+                gflops: gflops(true, relight_ms),
+            });
+        }
     }
     let pt_ms = median(
         (0..3)
@@ -78,6 +118,7 @@ pub fn time_table(
     rows.push(Timing {
         what: "path tracing, 5 spp".into(),
         ms: pt_ms,
+        gflops: None,
     });
     if rows.iter().any(|r| !r.ms.is_finite()) {
         bail!("a timing was not finite");

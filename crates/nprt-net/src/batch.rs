@@ -1,10 +1,21 @@
 //! A batch of pixel samples in host memory and its forward pass.
 
+use burn::optim::GradientsParams;
 use burn::tensor::{Device, Int, Tensor, TensorData};
 
 use crate::data::ViewSamples;
 use crate::design::NprtNet;
 use crate::features::FEATURES;
+use crate::loss::log_l1;
+
+/// Which code computes a batch's gradients.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Engine {
+    /// The CPU engine where it applies (burn's CPU backend, f32), else burn's autodiff.
+    Auto,
+    /// burn's autodiff graph on any device: the reference the CPU engine is held to.
+    Autodiff,
+}
 
 /// Samples drawn from several views, and those views' maps.
 pub struct Batch {
@@ -53,10 +64,16 @@ impl Batch {
         self.view.is_empty()
     }
 
+    /// The views' maps [V, 3, W/2, W] on `device`.
+    pub fn light_tensor(&self, device: &Device) -> Tensor<4> {
+        let w = self.light_width;
+        let shape = [self.lights.len() / (3 * w * w / 2), 3, w / 2, w];
+        Tensor::from_data(TensorData::new(self.lights.clone(), shape), device)
+    }
+
     /// Predicted radiance [B, 3] and the reference [B, 3] on `device`.
     pub fn forward(&self, net: &NprtNet, device: &Device) -> (Tensor<2>, Tensor<2>) {
         let n = self.len();
-        let w = self.light_width;
         let f = Tensor::from_data(
             TensorData::new(self.features.clone(), [n, FEATURES]),
             device,
@@ -64,13 +81,23 @@ impl Batch {
         let r = Tensor::from_data(TensorData::new(self.radiance.clone(), [n, 3]), device);
         let v = Tensor::<1, Int>::from_data(TensorData::new(self.view.clone(), [n]), device);
         let s = Tensor::from_data(TensorData::new(self.scale.clone(), [n, 1]), device);
-        let l = Tensor::from_data(
-            TensorData::new(
-                self.lights.clone(),
-                [self.lights.len() / (3 * w * w / 2), 3, w / 2, w],
-            ),
-            device,
-        );
-        (net.forward(f, l, v, s), r)
+        (net.forward(f, self.light_tensor(device), v, s), r)
+    }
+
+    /// The paper's loss on this batch and every parameter's gradient (`device` is an autodiff
+    /// device), computed by `engine`.
+    pub fn gradients(
+        &self,
+        net: &NprtNet,
+        device: &Device,
+        engine: Engine,
+    ) -> (f64, GradientsParams) {
+        if engine == Engine::Auto && crate::cpu::applies(net, device) {
+            return crate::cpu::gradients(net, self, device);
+        }
+        let (pred, reference) = self.forward(net, device);
+        let loss = log_l1(pred, reference);
+        let value = loss.clone().into_scalar::<f64>();
+        (value, GradientsParams::from_grads(loss.backward(), net))
     }
 }

@@ -5,7 +5,9 @@
 //! trace rays or write datasets, and it knows nothing of evaluation or frame rendering.
 //!
 //! Network code is device-generic: it runs on whatever burn `Device` its tensors live on
-//! (the flex CPU backend here; a GPU backend by enabling its burn feature).
+//! (the flex CPU backend here; a GPU backend by enabling its burn feature). On the CPU in f32
+//! the transport networks train and infer through [`cpu`], a hand-written engine held to
+//! burn's autodiff by tests, because burn's graph was slower than PyTorch on SIREN layers.
 //!
 //! ```
 //! use nprt_net::{Design, Device, Init, ModelConfig};
@@ -19,6 +21,7 @@
 mod activation;
 mod batch;
 mod checkpoint;
+pub mod cpu;
 pub mod curves;
 pub mod data;
 pub mod deep_shading;
@@ -38,7 +41,7 @@ pub mod trainer;
 mod validation;
 
 pub use activation::{Activation, OMEGA_0};
-pub use batch::Batch;
+pub use batch::{Batch, Engine};
 pub use burn;
 pub use burn::tensor::Device;
 pub use checkpoint::RunState;
@@ -50,7 +53,7 @@ pub use loss::log_l1;
 pub use mlp::Mlp;
 pub use model::{layer_table, load_model, ModelConfig, ModelFile, DEFAULT_ENCODER_WIDTH};
 pub use options::TrainOptions;
-pub use throughput::measure_throughput;
+pub use throughput::{measure_inference, measure_throughput, InferenceSpeed};
 pub use track::{Track, TrackKind};
 pub use train::train;
 pub use trainer::{Objective, Schedule, TrainSummary};

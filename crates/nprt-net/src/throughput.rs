@@ -1,23 +1,25 @@
-//! Training throughput of a design on synthetic data, for `nprt bench train`.
+//! Training throughput and inference speed of a design on synthetic data, for `nprt bench`.
 
 use std::time::Instant;
 
-use burn::optim::{AdamConfig, GradientsParams};
+use burn::optim::AdamConfig;
 use burn::tensor::Device;
 use rand::{RngExt, SeedableRng};
 use rand_pcg::Pcg64Mcg;
 
-use crate::batch::Batch;
+use crate::batch::{Batch, Engine};
+use crate::encoder::CODE_SIZE;
 use crate::features::FEATURES;
 use crate::init::Init;
-use crate::loss::log_l1;
 use crate::model::ModelConfig;
 use crate::trainer::ADAM_EPSILON;
 
 /// Samples/s of `steps` full steps (forward, backward, Adam) on one synthetic batch of
-/// `batch_size` samples over `views` maps, after `warmup` untimed steps.
+/// `batch_size` samples over `views` maps, after `warmup` untimed steps, gradients computed by
+/// `engine`.
 pub fn measure_throughput(
     config: &ModelConfig,
+    engine: Engine,
     batch_size: usize,
     views: usize,
     steps: usize,
@@ -49,10 +51,59 @@ pub fn measure_throughput(
             device.sync().ok();
             timed = Instant::now();
         }
-        let (pred, reference) = batch.forward(&net, &device);
-        let grads = GradientsParams::from_grads(log_l1(pred, reference).backward(), &net);
+        let (_, grads) = batch.gradients(&net, &device, engine);
         net = optim.step(1e-4, net, grads);
     }
     device.sync().ok();
     (batch_size * steps) as f64 / timed.elapsed().as_secs_f64()
+}
+
+/// Inference speed of a design's transport networks on the CPU engine.
+pub struct InferenceSpeed {
+    pub pixels: usize,
+    /// A frame from a new viewpoint: transfer and shading networks.
+    pub frame_ms: f64,
+    /// A lighting change under a still camera: shading networks only (the transfer networks'
+    /// outputs kept); equal to `frame_ms` for the baseline, which has none.
+    pub relight_ms: f64,
+    pub frame_gflops: f64,
+    pub relight_gflops: f64,
+}
+
+/// Median over `repeats` runs of the transport networks on `pixels` synthetic foreground
+/// pixels (the encoder, once per lighting, is not counted).
+pub fn measure_inference(config: &ModelConfig, pixels: usize, repeats: usize) -> InferenceSpeed {
+    let net = config.build(&mut Init::new(0, &Device::flex()));
+    let host = crate::cpu::HostTransport::from_net(&net);
+    let mut rng = Pcg64Mcg::seed_from_u64(1);
+    let features: Vec<f32> = (0..pixels * FEATURES)
+        .map(|_| rng.random::<f32>())
+        .collect();
+    let code: Vec<f32> = (0..CODE_SIZE).map(|_| rng.random::<f32>() - 0.5).collect();
+    let kept = host.transfer_codes(&features);
+    let median_ms = |run: &dyn Fn()| {
+        let mut ms: Vec<f64> = (0..repeats.max(1))
+            .map(|_| {
+                let t = Instant::now();
+                run();
+                t.elapsed().as_secs_f64() * 1e3
+            })
+            .collect();
+        ms.sort_by(f64::total_cmp);
+        ms[ms.len() / 2]
+    };
+    let frame_ms = median_ms(&|| {
+        host.radiance(&features, &code, 1.0, None);
+    });
+    let relight_ms = median_ms(&|| {
+        host.radiance(&features, &code, 1.0, Some(&kept));
+    });
+    let gflops = |flops: f64, ms: f64| flops * pixels as f64 / (ms * 1e6);
+    InferenceSpeed {
+        pixels,
+        frame_ms,
+        relight_ms,
+        frame_gflops: gflops(host.flops_per_pixel(false), frame_ms),
+        relight_gflops: gflops(host.flops_per_pixel(true), relight_ms),
+    }
 }

@@ -9,15 +9,15 @@ use std::path::Path;
 
 use anyhow::Result;
 use burn::module::Module;
-use burn::tensor::{Device, Tensor};
+use burn::optim::GradientsParams;
+use burn::tensor::Device;
 
-use crate::batch::Batch;
+use crate::batch::{Batch, Engine};
 use crate::checkpoint::RunState;
 use crate::data::{TrainingSet, ViewSamples};
 use crate::design::NprtNet;
 use crate::epoch_plan::{group_batches, EpochPlan};
 use crate::init::Init;
-use crate::loss::log_l1;
 use crate::model::{save_model, ModelConfig, ModelFile, MODEL_FORMAT, MODEL_VERSION};
 use crate::options::TrainOptions;
 use crate::trainer::{self, Objective, Schedule, TrainSummary, ADAM_EPSILON};
@@ -90,9 +90,14 @@ impl Objective for PixelObjective<'_> {
             })
     }
 
-    fn loss(&self, net: &NprtNet, batch: &Batch, device: &Device) -> (Tensor<1>, u64) {
-        let (pred, reference) = batch.forward(net, device);
-        (log_l1(pred, reference), batch.len() as u64)
+    fn gradients(
+        &self,
+        net: &NprtNet,
+        batch: &Batch,
+        device: &Device,
+    ) -> (f64, GradientsParams, u64) {
+        let (loss, grads) = batch.gradients(net, device, Engine::Auto);
+        (loss, grads, batch.len() as u64)
     }
 
     fn validation_loss(&self, net: &NprtNet, device: &Device) -> f64 {

@@ -13,7 +13,7 @@ use std::time::Instant;
 use anyhow::{bail, Context, Result};
 use burn::module::Module;
 use burn::optim::{AdamConfig, GradientsParams, ModuleOptimizer};
-use burn::tensor::{Device, Tensor};
+use burn::tensor::Device;
 use rand::SeedableRng;
 use rand_pcg::Pcg64Mcg;
 use serde::{Deserialize, Serialize};
@@ -90,8 +90,14 @@ pub trait Objective {
         epoch: usize,
         from: usize,
     ) -> impl Iterator<Item = Self::Batch> + '_;
-    /// The batch's mean loss and how many samples (pixels) it holds.
-    fn loss(&self, net: &Self::Net, batch: &Self::Batch, device: &Device) -> (Tensor<1>, u64);
+    /// The batch's mean loss, every parameter's gradient, and how many samples (pixels) the
+    /// batch holds; `device` is an autodiff device.
+    fn gradients(
+        &self,
+        net: &Self::Net,
+        batch: &Self::Batch,
+        device: &Device,
+    ) -> (f64, GradientsParams, u64);
     /// Loss on held-out data with a network off the autodiff device; NaN where there is none.
     fn validation_loss(&self, net: &Self::Net, device: &Device) -> f64;
     /// Writes the model folder's own files (config and weights) for the network as it stands.
@@ -186,8 +192,7 @@ pub fn train<O: Objective>(
         let total = per_epoch[epoch];
         let row_every = (total as u64).div_ceil(TRAIN_ROWS_PER_EPOCH).max(1);
         for batch in objective.batches(schedule.seed, epoch, ck.state.batch) {
-            let (loss, samples) = objective.loss(&net, &batch, &device);
-            let value = loss.clone().into_scalar::<f32>() as f64;
+            let (value, grads, samples) = objective.gradients(&net, &batch, &device);
             if let Some(why) = guard.check(value, ck.state.step) {
                 bar.abandon();
                 let kept = if checkpoint::exists(out) {
@@ -204,7 +209,6 @@ pub fn train<O: Objective>(
                     ck.state.step
                 );
             }
-            let grads = GradientsParams::from_grads(loss.backward(), &net);
             net = optim.step(schedule.learning_rate, net, grads);
             let s = &mut ck.state;
             s.batch += 1;

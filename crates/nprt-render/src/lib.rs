@@ -27,7 +27,7 @@ mod sequence;
 pub mod video;
 
 pub use path::CameraPath;
-pub use relight::{background, FrameTimings, LightCode, Relighter};
+pub use relight::{background, FrameTimings, LightCode, Pixels, Relighter};
 pub use schedule::LightingSchedule;
 pub use sequence::{render_sequence, FrameReport, Sequence, SequenceSummary};
 pub use video::{srgb8, write_animation, write_png, Animation};

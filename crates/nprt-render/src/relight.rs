@@ -1,10 +1,13 @@
-//! The run-time network: light code once per lighting change, transport on foreground pixels.
+//! The run-time network: light code once per lighting change, transport on foreground pixels,
+//! and for a still camera the light-independent part (the transfer networks' ŝ) kept between
+//! lighting changes.
 
 use std::path::Path;
 
 use anyhow::Result;
 use glam::{Vec2, Vec3};
 use nprt_net::burn::tensor::{Tensor, TensorData};
+use nprt_net::cpu::{self, HostTransport, TransferCodes};
 use nprt_net::gbuffer_features;
 use nprt_net::{load_model, Device, LightInput, ModelFile, NprtNet, FEATURES};
 use nprt_scene::{Camera, EnvMap};
@@ -19,6 +22,8 @@ pub struct Relighter {
     pub file: ModelFile,
     net: NprtNet,
     device: Device,
+    /// The transport networks on the CPU engine, where it applies.
+    host: Option<HostTransport>,
 }
 
 /// What the encoder made of one lighting: the 64-d code ê and the map's mean.
@@ -26,6 +31,15 @@ pub struct Relighter {
 pub struct LightCode {
     code: Tensor<2>,
     scale: f32,
+}
+
+/// A G-buffer's foreground pixels as network inputs, and what of the network does not depend
+/// on the lighting: all a still camera needs to relight.
+pub struct Pixels {
+    count: usize,
+    foreground: Vec<usize>,
+    features: Vec<f32>,
+    transfer: Option<TransferCodes>,
 }
 
 /// Milliseconds spent in each stage of one frame.
@@ -45,10 +59,12 @@ impl FrameTimings {
 impl Relighter {
     pub fn load(dir: &Path, device: &Device) -> Result<Self> {
         let (file, net) = load_model(dir, device)?;
+        let host = cpu::applies(&net, device).then(|| HostTransport::from_net(&net));
         Ok(Relighter {
             file,
             net,
             device: device.clone(),
+            host,
         })
     }
 
@@ -69,24 +85,63 @@ impl Relighter {
     /// Radiance of every pixel of `g` under `light`; background pixels are zero (see
     /// [`background`]).
     pub fn shade(&self, g: &GBuffer, light: &LightCode) -> Vec<Vec3> {
-        let fg: Vec<usize> = (0..g.mask.len()).filter(|&i| g.mask[i] > 0.5).collect();
-        let mut out = vec![Vec3::ZERO; g.mask.len()];
-        for chunk in fg.chunks(CHUNK) {
-            let features: Vec<f32> = chunk
-                .par_iter()
-                .flat_map_iter(|&i| gbuffer_features(&self.file.bounds, g, i))
-                .collect();
-            let n = chunk.len();
-            let f = Tensor::from_data(TensorData::new(features, [n, FEATURES]), &self.device);
-            let code = light.code.clone().expand([n, light.code.dims()[1]]);
-            let scale = Tensor::full([n, 1], light.scale, &self.device);
-            let rgb = self.net.shade(f, code, scale).into_data();
-            let rgb = rgb.as_slice::<f32>().expect("f32 network output");
-            for (k, &i) in chunk.iter().enumerate() {
-                out[i] = Vec3::from_slice(&rgb[3 * k..3 * k + 3]);
+        self.relight(&self.pixels(g), light)
+    }
+
+    /// The network inputs of `g`'s foreground pixels and, on the CPU engine, the transfer
+    /// networks' outputs (same work as running them inline), so that [`Self::relight`] under
+    /// each further lighting runs only the shading networks.
+    pub fn pixels(&self, g: &GBuffer) -> Pixels {
+        let foreground: Vec<usize> = (0..g.mask.len()).filter(|&i| g.mask[i] > 0.5).collect();
+        let features: Vec<f32> = foreground
+            .par_iter()
+            .flat_map_iter(|&i| gbuffer_features(&self.file.bounds, g, i))
+            .collect();
+        let transfer = self.host.as_ref().map(|h| h.transfer_codes(&features));
+        Pixels {
+            count: g.mask.len(),
+            foreground,
+            features,
+            transfer,
+        }
+    }
+
+    /// Floating-point operations of the dense layers per foreground pixel, for a frame from a
+    /// new viewpoint or (`transfer_known`) a lighting change under a still camera; None off the
+    /// CPU engine.
+    pub fn flops_per_pixel(&self, transfer_known: bool) -> Option<f64> {
+        self.host
+            .as_ref()
+            .map(|h| h.flops_per_pixel(transfer_known))
+    }
+
+    /// Radiance of every pixel under `light`; background pixels are zero.
+    pub fn relight(&self, px: &Pixels, light: &LightCode) -> Vec<Vec3> {
+        let rgb = match &self.host {
+            Some(host) => {
+                let code = cpu::host_values(light.code.clone().into_data());
+                host.radiance(&px.features, &code, light.scale, px.transfer.as_ref())
             }
+            None => self.burn_radiance(&px.features, light),
+        };
+        let mut out = vec![Vec3::ZERO; px.count];
+        for (k, &i) in px.foreground.iter().enumerate() {
+            out[i] = Vec3::from_slice(&rgb[3 * k..3 * k + 3]);
         }
         out
+    }
+
+    /// Radiance (`n × 3`) of feature rows through burn, chunk by chunk.
+    fn burn_radiance(&self, features: &[f32], light: &LightCode) -> Vec<f32> {
+        let mut rgb = Vec::with_capacity(features.len() / FEATURES * 3);
+        for chunk in features.chunks(CHUNK * FEATURES) {
+            let n = chunk.len() / FEATURES;
+            let f = Tensor::from_data(TensorData::new(chunk.to_vec(), [n, FEATURES]), &self.device);
+            let code = light.code.clone().expand([n, light.code.dims()[1]]);
+            let scale = Tensor::full([n, 1], light.scale, &self.device);
+            rgb.extend(cpu::host_values(self.net.shade(f, code, scale).into_data()));
+        }
+        rgb
     }
 }
 

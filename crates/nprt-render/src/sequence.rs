@@ -59,7 +59,9 @@ struct TimingRow<'a> {
 
 /// Renders `seq` with `model` on `scene` (already checked to be the model's scene): the
 /// G-buffer from primary rays, the encoder only when the lighting changes, the network on
-/// foreground pixels, the map as background. Calls `on_frame` after each frame.
+/// foreground pixels, the map as background. While the camera stands still, the G-buffer and
+/// the transfer networks' outputs are kept and only the shading networks run again. Calls
+/// `on_frame` after each frame.
 pub fn render_sequence(
     model: &Relighter,
     scene: &TraceScene,
@@ -76,15 +78,25 @@ pub fn render_sequence(
     let mut pngs = Vec::new();
     let mut sum = FrameTimings::default();
     let mut light: Option<((usize, f32), crate::LightCode)> = None;
+    let mut still: Option<(nprt_scene::Camera, Vec<f32>, crate::Pixels)> = None;
     let start = Instant::now();
     for i in 0..seq.frames {
         let camera = seq
             .path
             .camera(i as f32 / (seq.frames.max(2) - 1) as f32, w, h);
         let mut t = FrameTimings::default();
-        let clock = Instant::now();
-        let g = render_gbuffer(scene, &camera);
-        t.gbuffer_ms = clock.elapsed().as_secs_f64() * 1e3;
+        let (mask, px) = match still.take() {
+            Some((c, mask, px)) if c == camera => (mask, px),
+            _ => {
+                let clock = Instant::now();
+                let g = render_gbuffer(scene, &camera);
+                t.gbuffer_ms = clock.elapsed().as_secs_f64() * 1e3;
+                let clock = Instant::now();
+                let px = model.pixels(&g);
+                t.network_ms = clock.elapsed().as_secs_f64() * 1e3;
+                (g.mask, px)
+            }
+        };
         let (k, rot) = seq.lighting.at(i, seq.frames);
         let code = match light.take() {
             Some((key, code)) if key == (k, rot) => code,
@@ -96,13 +108,13 @@ pub fn render_sequence(
             }
         };
         let clock = Instant::now();
-        let mut rgb = model.shade(&g, &code);
-        t.network_ms = clock.elapsed().as_secs_f64() * 1e3;
+        let mut rgb = model.relight(&px, &code);
+        t.network_ms += clock.elapsed().as_secs_f64() * 1e3;
         light = Some(((k, rot), code));
         background(
             &camera,
             &seq.lighting.maps[k].rotated_y(rot),
-            &g.mask,
+            &mask,
             &mut rgb,
         );
         let png = frames_dir.join(format!("{i:04}.png"));
@@ -121,6 +133,7 @@ pub fn render_sequence(
             )?;
         }
         pngs.push(png);
+        still = Some((camera, mask, px));
         csv.serialize(TimingRow {
             frame: i,
             map: &seq.lighting.segments[k].map,

@@ -27,7 +27,7 @@ pub struct CameraVolume {
     pub fov_deg: f32,
 }
 
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, PartialEq)]
 pub struct Camera {
     pub to_world: Mat4,
     pub fov_deg: f32,

@@ -8,8 +8,8 @@ use nprt_net::data::TrainingSet;
 use nprt_net::encoder::check_input_width;
 use nprt_net::Device;
 use nprt_net::{
-    layer_table, measure_throughput, Activation, Design, Init, ModelConfig, Schedule, TrainOptions,
-    DEFAULT_ENCODER_WIDTH,
+    layer_table, measure_throughput, Activation, Design, Engine, Init, ModelConfig, Schedule,
+    TrainOptions, DEFAULT_ENCODER_WIDTH,
 };
 
 #[derive(clap::Args)]
@@ -74,13 +74,20 @@ pub struct TrainArgs {
 
 #[derive(clap::Subcommand)]
 pub enum BenchCommand {
-    /// Training samples/s of each design (forward, backward and Adam on one batch), beside
-    /// bench/train_pytorch.py running the same networks, batch and loss when --python is given.
+    /// Training samples/s of each design (forward, backward and Adam on one batch) with the CPU
+    /// engine and with burn's autodiff graph, beside bench/train_pytorch.py running the same
+    /// networks, batch and loss when --python is given; the ratio is the engine's to PyTorch's.
     Train(BenchTrainArgs),
+    /// Inference speed of each design's transport networks on the CPU engine at a square
+    /// resolution, every pixel foreground: a frame from a new viewpoint, and a lighting change
+    /// under a still camera (transfer outputs kept), with achieved GFLOP/s beside the machine's
+    /// f32 peak (measured with register-resident FMA chains on as many threads).
+    Infer(BenchInferArgs),
 }
 
+/// The designs a benchmark measures.
 #[derive(clap::Args)]
-pub struct BenchTrainArgs {
+pub struct BenchDesigns {
     /// Designs to measure, comma-separated.
     #[arg(
         long,
@@ -88,6 +95,24 @@ pub struct BenchTrainArgs {
         value_delimiter = ','
     )]
     pub arch: Vec<Design>,
+}
+
+#[derive(clap::Args)]
+pub struct BenchInferArgs {
+    #[command(flatten)]
+    designs: BenchDesigns,
+    /// Width and height of the frame in pixels (the paper's Table 3: 512).
+    #[arg(long, default_value_t = 512)]
+    resolution: usize,
+    /// Runs per measurement; the median is reported.
+    #[arg(long, default_value_t = 5)]
+    repeats: usize,
+}
+
+#[derive(clap::Args)]
+pub struct BenchTrainArgs {
+    #[command(flatten)]
+    designs: BenchDesigns,
     /// siren or relu (default: each design's own).
     #[arg(long)]
     pub activation: Option<Activation>,
@@ -210,7 +235,46 @@ pub fn train(a: TrainArgs) -> Result<()> {
 }
 
 pub fn bench(cmd: BenchCommand) -> Result<()> {
-    let BenchCommand::Train(a) = cmd;
+    match cmd {
+        BenchCommand::Train(a) => bench_train(a),
+        BenchCommand::Infer(a) => bench_infer(a),
+    }
+}
+
+fn bench_infer(a: BenchInferArgs) -> Result<()> {
+    let peak = nprt_net::cpu::measured_peak(rayon::current_num_threads());
+    println!(
+        "inference at {r}×{r}, every pixel foreground, encoder not counted; f32 peak {:.0} \
+         GFLOP/s ({} threads, {}-lane FMA chains, measured)",
+        peak.gflops,
+        peak.threads,
+        peak.lanes,
+        r = a.resolution
+    );
+    println!(
+        "{:<10} {:>9} {:>8} {:>6} {:>11} {:>8} {:>6} {:>8}",
+        "design", "frame ms", "GFLOP/s", "peak", "relight ms", "GFLOP/s", "peak", "speed-up"
+    );
+    for &arch in &a.designs.arch {
+        let config = ModelConfig::new(arch, None);
+        let s = nprt_net::measure_inference(&config, a.resolution * a.resolution, a.repeats);
+        let pct = |g: f64| format!("{:.0}%", 100.0 * g / peak.gflops);
+        println!(
+            "{:<10} {:>9.1} {:>8.1} {:>6} {:>11.1} {:>8.1} {:>6} {:>7.2}×",
+            arch.name(),
+            s.frame_ms,
+            s.frame_gflops,
+            pct(s.frame_gflops),
+            s.relight_ms,
+            s.relight_gflops,
+            pct(s.relight_gflops),
+            s.frame_ms / s.relight_ms
+        );
+    }
+    Ok(())
+}
+
+fn bench_train(a: BenchTrainArgs) -> Result<()> {
     let threads = rayon::current_num_threads();
     println!(
         "training throughput, batch {}, {} maps per batch, {} timed steps, {threads} threads",
@@ -226,18 +290,31 @@ pub fn bench(cmd: BenchCommand) -> Result<()> {
         }
     };
     println!(
-        "{:<10} {:<6} {:>14} {:>16} {:>8}",
-        "design", "act", "nprt samples/s", "PyTorch samples/s", "ratio"
+        "{:<10} {:<6} {:>14} {:>18} {:>17} {:>8}",
+        "design", "act", "nprt samples/s", "autodiff samples/s", "PyTorch samples/s", "ratio"
     );
-    for &arch in &a.arch {
+    for &arch in &a.designs.arch {
         let config = ModelConfig::new(arch, a.activation);
-        let ours = measure_throughput(&config, a.batch_size, a.views, a.steps, 2, &Device::flex());
+        let measure = |engine| {
+            measure_throughput(
+                &config,
+                engine,
+                a.batch_size,
+                a.views,
+                a.steps,
+                2,
+                &Device::flex(),
+            )
+        };
+        let ours = measure(Engine::Auto);
+        let autodiff = measure(Engine::Autodiff);
         let theirs = peer.iter().find(|p| p.0 == arch.name()).map(|p| p.1);
         println!(
-            "{:<10} {:<6} {:>14.0} {:>16} {:>8}",
+            "{:<10} {:<6} {:>14.0} {:>18.0} {:>17} {:>8}",
             arch.name(),
             config.activation.name(),
             ours,
+            autodiff,
             theirs.map_or("-".into(), |t| format!("{t:.0}")),
             theirs.map_or("-".into(), |t| format!("{:.2}×", ours / t))
         );
@@ -249,7 +326,7 @@ pub fn bench(cmd: BenchCommand) -> Result<()> {
 /// returns (design, samples/s) pairs.
 fn run_pytorch(python: &PathBuf, a: &BenchTrainArgs, threads: usize) -> Result<Vec<(String, f64)>> {
     let script = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../bench/train_pytorch.py");
-    let designs: Vec<&str> = a.arch.iter().map(|d| d.name()).collect();
+    let designs: Vec<&str> = a.designs.arch.iter().map(|d| d.name()).collect();
     let mut cmd = Process::new(python);
     cmd.arg(&script)
         .args(["--designs", &designs.join(",")])

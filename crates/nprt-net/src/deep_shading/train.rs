@@ -5,6 +5,7 @@ use std::path::Path;
 
 use anyhow::{bail, Result};
 use burn::module::Module;
+use burn::optim::GradientsParams;
 use burn::tensor::{Device, Tensor, TensorData};
 use nprt_data::dataset::load_manifest_hashed;
 use nprt_data::views::{load_views, ImageView};
@@ -192,8 +193,19 @@ impl Objective for UnetObjective {
             .into_iter()
     }
 
-    fn loss(&self, net: &DeepShading, batch: &Vec<usize>, device: &Device) -> (Tensor<1>, u64) {
-        self.train.loss(net, batch, device)
+    fn gradients(
+        &self,
+        net: &DeepShading,
+        batch: &Vec<usize>,
+        device: &Device,
+    ) -> (f64, GradientsParams, u64) {
+        let (loss, samples) = self.train.loss(net, batch, device);
+        let value = loss.clone().into_scalar::<f64>();
+        (
+            value,
+            GradientsParams::from_grads(loss.backward(), net),
+            samples,
+        )
     }
 
     fn validation_loss(&self, net: &DeepShading, device: &Device) -> f64 {

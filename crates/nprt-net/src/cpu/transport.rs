@@ -1,0 +1,451 @@
+//! The transport tracks of a design on the host: forward, the paper's log-L1 loss and backward
+//! for a whole batch, block by block on all cores, given the light codes the encoder made.
+//!
+//! Computes exactly what [`crate::design::NprtNet::shade`] and [`crate::loss::log_l1`] compute
+//! (same operations in f32), so that burn's autodiff and this path agree to rounding; a test
+//! holds them to that.
+
+use rayon::prelude::*;
+
+use super::dense::{DenseStack, SharedInput, Tape};
+use super::matmul::MatRef;
+use crate::batch::Batch;
+use crate::design::{NprtNet, TRANSPORT_CODE};
+use crate::encoder::CODE_SIZE;
+use crate::features::{feature, FEATURES};
+use crate::track::TrackKind;
+
+/// Rows per block: small enough that a block's activations stay in the caches, large enough
+/// for efficient matrix products.
+const BLOCK: usize = 512;
+/// A batch's blocks are cut into this many runs of consecutive blocks, one gradient sum each,
+/// added in order: the result does not depend on the number of threads.
+const RUNS: usize = 8;
+/// The group of every row when one light code lights them all.
+const ONE_GROUP: [u32; BLOCK] = [0; BLOCK];
+
+/// One track's networks on the host.
+#[derive(Clone)]
+pub struct HostTrack {
+    pub kind: TrackKind,
+    inputs: Vec<usize>,
+    pub transfer: Option<DenseStack>,
+    pub shading: DenseStack,
+}
+
+/// The transport part of a network (every track) on the host.
+#[derive(Clone)]
+pub struct HostTransport {
+    pub tracks: Vec<HostTrack>,
+}
+
+/// Loss and gradients of one batch.
+pub struct TransportGradients {
+    /// Mean log-L1 over the batch's values.
+    pub loss: f64,
+    /// Per track, gradients of the transfer and shading networks.
+    pub tracks: Vec<HostTrack>,
+    /// Gradient at each view's light code, `views × CODE_SIZE`.
+    pub codes: Vec<f32>,
+}
+
+/// Each track's transfer output ŝ (`rows × TRANSPORT_CODE`, empty without a transfer network)
+/// for a set of rows, such as a still camera's pixels.
+pub struct TransferCodes {
+    tracks: Vec<Vec<f32>>,
+}
+
+/// A track's state over one block; its buffers are reused from block to block.
+#[derive(Default)]
+struct TrackPass {
+    /// Gathered inputs (empty when the track reads all features).
+    x: Vec<f32>,
+    transfer: Tape,
+    shading: Tape,
+    /// exp of the shading network's outputs.
+    exps: Vec<f32>,
+    /// Gradients at the shading network's outputs and at ŝ.
+    d_out: Vec<f32>,
+    d_transfer: Vec<f32>,
+}
+
+/// The light codes of a block: each view's code, and each row's view.
+#[derive(Clone, Copy)]
+struct Lighting<'a> {
+    codes: &'a [f32],
+    view: &'a [u32],
+}
+
+impl HostTrack {
+    fn reads_all(&self) -> bool {
+        self.inputs.len() == FEATURES
+    }
+
+    /// The shading network's first-layer weight rows that multiply ê: after ŝ, or first for
+    /// the baseline (whose input is [ê, inputs]).
+    fn code_rows(&self) -> std::ops::Range<usize> {
+        match self.transfer {
+            Some(_) => TRANSPORT_CODE..TRANSPORT_CODE + CODE_SIZE,
+            None => 0..CODE_SIZE,
+        }
+    }
+
+    fn shared<'a>(&self, light: Lighting<'a>) -> SharedInput<'a> {
+        SharedInput {
+            weight_rows: self.code_rows(),
+            values: light.codes,
+            group: light.view,
+        }
+    }
+
+    fn zeros_like(&self) -> Self {
+        HostTrack {
+            transfer: self.transfer.as_ref().map(DenseStack::zeros_like),
+            shading: self.shading.zeros_like(),
+            ..self.clone()
+        }
+    }
+
+    fn add(&mut self, other: &Self) {
+        if let (Some(a), Some(b)) = (&mut self.transfer, &other.transfer) {
+            a.add(b);
+        }
+        self.shading.add(&other.shading);
+    }
+
+    /// This track's inputs of each row, gathered into `x` when it reads only some of the
+    /// features; the rows as a matrix.
+    fn inputs<'a>(&self, features: &'a [f32], x: &'a mut Vec<f32>, n: usize) -> MatRef<'a> {
+        if self.reads_all() {
+            return MatRef::new(features, n, FEATURES);
+        }
+        x.clear();
+        x.extend(
+            features
+                .chunks_exact(FEATURES)
+                .flat_map(|f| self.inputs.iter().map(|&i| f[i])),
+        );
+        MatRef::new(x, n, self.inputs.len())
+    }
+
+    /// Forward over `n` rows of `features` under `light`. `known` holds the transfer
+    /// network's outputs ŝ for these rows when they are known already (they do not depend on
+    /// the lighting).
+    fn forward(
+        &self,
+        features: &[f32],
+        light: Lighting,
+        n: usize,
+        known: Option<&[f32]>,
+        pass: &mut TrackPass,
+    ) {
+        let shared = self.shared(light);
+        let x = self.inputs(features, &mut pass.x, n);
+        match (&self.transfer, known) {
+            (Some(_), Some(s)) => {
+                let s = MatRef::new(s, n, TRANSPORT_CODE);
+                self.shading.forward(s, Some(&shared), &mut pass.shading);
+            }
+            (Some(ft), None) => {
+                ft.forward(x, None, &mut pass.transfer);
+                let s = MatRef::new(pass.transfer.output(), n, TRANSPORT_CODE);
+                self.shading.forward(s, Some(&shared), &mut pass.shading);
+            }
+            (None, _) => self.shading.forward(x, Some(&shared), &mut pass.shading),
+        }
+        pass.exps.clear();
+        pass.exps
+            .extend(pass.shading.output().iter().map(|o| o.exp()));
+    }
+
+    /// ŝ of `n` rows of `features` (empty for a track without a transfer network).
+    fn transfer_code(&self, features: &[f32], n: usize) -> Vec<f32> {
+        let Some(ft) = &self.transfer else {
+            return Vec::new();
+        };
+        let mut pass = TrackPass::default();
+        let x = self.inputs(features, &mut pass.x, n);
+        ft.forward(x, None, &mut pass.transfer);
+        pass.transfer.output().to_vec()
+    }
+
+    /// Radiance of row `r` before the map's scale.
+    fn radiance(&self, pass: &TrackPass, features: &[f32], r: usize) -> [f32; 3] {
+        let f = &features[r * FEATURES..];
+        let e = &pass.exps[r * self.shading.d_out()..];
+        std::array::from_fn(|c| match self.kind {
+            TrackKind::Full => e[c],
+            TrackKind::Albedo => {
+                f[feature::KD.start + c] * e[c] + f[feature::KS.start + c] * e[3 + c]
+            }
+            TrackKind::Diffuse => f[feature::KD.start + c] * e[c],
+            TrackKind::Specular => f[feature::KS.start + c] * e[c],
+        })
+    }
+
+    /// The gradient at the shading network's outputs, into `pass.d_out`, from the gradient
+    /// `dr` at this track's radiance (before the scale).
+    fn d_outputs(&self, pass: &mut TrackPass, features: &[f32], dr: &[f32]) {
+        let outs = self.shading.d_out();
+        pass.d_out.resize(pass.exps.len(), 0.0);
+        for (r, (d, e)) in pass
+            .d_out
+            .chunks_exact_mut(outs)
+            .zip(pass.exps.chunks_exact(outs))
+            .enumerate()
+        {
+            let f = &features[r * FEATURES..];
+            for c in 0..3 {
+                let g = dr[r * 3 + c];
+                match self.kind {
+                    TrackKind::Full => d[c] = g * e[c],
+                    TrackKind::Albedo => {
+                        d[c] = g * f[feature::KD.start + c] * e[c];
+                        d[3 + c] = g * f[feature::KS.start + c] * e[3 + c];
+                    }
+                    TrackKind::Diffuse => d[c] = g * f[feature::KD.start + c] * e[c],
+                    TrackKind::Specular => d[c] = g * f[feature::KS.start + c] * e[c],
+                }
+            }
+        }
+    }
+
+    /// Backward of [`Self::forward`]: adds parameter gradients to `grads` and the gradient at
+    /// each view's light code to `d_codes` (`views × CODE_SIZE`).
+    fn backward(
+        &self,
+        pass: &mut TrackPass,
+        features: &[f32],
+        light: Lighting,
+        dr: &[f32],
+        grads: &mut HostTrack,
+        d_codes: &mut [f32],
+    ) {
+        let n = dr.len() / 3;
+        let shared = self.shared(light);
+        self.d_outputs(pass, features, dr);
+        let TrackPass {
+            x,
+            transfer,
+            shading,
+            d_out,
+            d_transfer,
+            ..
+        } = pass;
+        match (&self.transfer, &mut grads.transfer) {
+            (Some(ft), Some(g)) => {
+                d_transfer.resize(n * TRANSPORT_CODE, 0.0);
+                let s = MatRef::new(transfer.output(), n, TRANSPORT_CODE);
+                self.shading.backward(
+                    s,
+                    Some(&shared),
+                    shading,
+                    d_out,
+                    &mut grads.shading,
+                    Some(d_transfer),
+                    Some(d_codes),
+                );
+                let x = self.inputs(features, x, n);
+                ft.backward(x, None, transfer, d_transfer, g, None, None);
+            }
+            _ => {
+                let x = self.inputs(features, x, n);
+                self.shading.backward(
+                    x,
+                    Some(&shared),
+                    shading,
+                    d_out,
+                    &mut grads.shading,
+                    None,
+                    Some(d_codes),
+                );
+            }
+        }
+    }
+}
+
+impl HostTransport {
+    pub fn from_net(net: &NprtNet) -> Self {
+        let tracks = net
+            .tracks
+            .iter()
+            .map(|t| HostTrack {
+                kind: t.kind,
+                inputs: t.kind.inputs(),
+                transfer: t.transfer.as_ref().map(DenseStack::from_mlp),
+                shading: DenseStack::from_mlp(&t.shading),
+            })
+            .collect();
+        HostTransport { tracks }
+    }
+
+    /// The batch's mean log-L1 loss and its gradients, for the light codes `codes`
+    /// (`views × CODE_SIZE`, the encoder's output for the batch's maps).
+    pub fn gradients(&self, batch: &Batch, codes: &[f32]) -> TransportGradients {
+        let n = batch.len();
+        let views = codes.len() / CODE_SIZE;
+        let view: Vec<u32> = batch.view.iter().map(|&v| v as u32).collect();
+        let blocks = n.div_ceil(BLOCK);
+        let per_run = blocks.div_ceil(RUNS).max(1);
+        let runs: Vec<TransportGradients> = (0..blocks.div_ceil(per_run))
+            .into_par_iter()
+            .map(|run| {
+                let mut g = self.zero_gradients(views);
+                let mut passes: Vec<TrackPass> =
+                    self.tracks.iter().map(|_| TrackPass::default()).collect();
+                for b in run * per_run..((run + 1) * per_run).min(blocks) {
+                    let rows = b * BLOCK..((b + 1) * BLOCK).min(n);
+                    let light = Lighting {
+                        codes,
+                        view: &view[rows.clone()],
+                    };
+                    self.block(batch, rows, light, &mut passes, &mut g);
+                }
+                g
+            })
+            .collect();
+        let mut total = runs
+            .into_iter()
+            .reduce(|mut a, b| {
+                a.loss += b.loss;
+                a.codes.iter_mut().zip(&b.codes).for_each(|(x, y)| *x += y);
+                a.tracks
+                    .iter_mut()
+                    .zip(&b.tracks)
+                    .for_each(|(x, y)| x.add(y));
+                a
+            })
+            .unwrap_or_else(|| self.zero_gradients(views));
+        total.loss /= (3 * n.max(1)) as f64;
+        total
+    }
+
+    /// Multiply-adds × 2 of the dense layers per pixel: all of them, or (`transfer_known`) only
+    /// those a lighting change runs again. The light code's share of each shading network's
+    /// first layer, made once per lighting, is not counted.
+    pub fn flops_per_pixel(&self, transfer_known: bool) -> f64 {
+        let dense = |s: &DenseStack| -> f64 {
+            s.layers
+                .iter()
+                .map(|l| 2.0 * (l.d_in * l.d_out) as f64)
+                .sum()
+        };
+        self.tracks
+            .iter()
+            .map(|t| {
+                let transfer = t.transfer.as_ref().map_or(0.0, dense);
+                let code = 2.0 * (CODE_SIZE * t.shading.layers[0].d_out) as f64;
+                dense(&t.shading) - code + if transfer_known { 0.0 } else { transfer }
+            })
+            .sum()
+    }
+
+    /// Each track's ŝ for the rows of `features`: the part of the network a lighting change
+    /// leaves as it is (empty for the baseline, whose every layer sees the light code).
+    pub fn transfer_codes(&self, features: &[f32]) -> TransferCodes {
+        let tracks = self
+            .tracks
+            .iter()
+            .map(|t| {
+                features
+                    .par_chunks(BLOCK * FEATURES)
+                    .flat_map_iter(|f| t.transfer_code(f, f.len() / FEATURES))
+                    .collect()
+            })
+            .collect();
+        TransferCodes { tracks }
+    }
+
+    /// Radiance (`n × 3`) of the rows of `features` lit by one light `code` of a map whose mean
+    /// is `scale`. With `known`, made by [`Self::transfer_codes`] from the same features, the
+    /// transfer networks are not run again.
+    pub fn radiance(
+        &self,
+        features: &[f32],
+        code: &[f32],
+        scale: f32,
+        known: Option<&TransferCodes>,
+    ) -> Vec<f32> {
+        assert_eq!(code.len(), CODE_SIZE);
+        let n = features.len() / FEATURES;
+        let mut out = vec![0.0; n * 3];
+        out.par_chunks_mut(BLOCK * 3)
+            .zip(features.par_chunks(BLOCK * FEATURES))
+            .enumerate()
+            .for_each_init(
+                || -> Vec<TrackPass> { self.tracks.iter().map(|_| TrackPass::default()).collect() },
+                |passes, (b, (out, f))| {
+                    let rows = f.len() / FEATURES;
+                    let light = Lighting {
+                        codes: code,
+                        view: &ONE_GROUP[..rows],
+                    };
+                    for (k, (t, pass)) in self.tracks.iter().zip(passes.iter_mut()).enumerate() {
+                        let s = known.filter(|_| t.transfer.is_some()).map(|c| {
+                            &c.tracks[k][b * BLOCK * TRANSPORT_CODE..][..rows * TRANSPORT_CODE]
+                        });
+                        t.forward(f, light, rows, s, pass);
+                        for r in 0..rows {
+                            let c = t.radiance(pass, f, r);
+                            (0..3).for_each(|i| out[r * 3 + i] += c[i]);
+                        }
+                    }
+                    out.iter_mut().for_each(|v| *v *= scale);
+                },
+            );
+        out
+    }
+
+    fn zero_gradients(&self, views: usize) -> TransportGradients {
+        TransportGradients {
+            loss: 0.0,
+            tracks: self.tracks.iter().map(HostTrack::zeros_like).collect(),
+            codes: vec![0.0; views * CODE_SIZE],
+        }
+    }
+
+    /// Adds the loss and gradients of the batch's rows `rows` to `g`.
+    fn block(
+        &self,
+        batch: &Batch,
+        rows: std::ops::Range<usize>,
+        light: Lighting,
+        passes: &mut [TrackPass],
+        g: &mut TransportGradients,
+    ) {
+        let n = rows.len();
+        let features = &batch.features[rows.start * FEATURES..rows.end * FEATURES];
+        let reference = &batch.radiance[rows.start * 3..rows.end * 3];
+        let scale = &batch.scale[rows];
+        for (t, pass) in self.tracks.iter().zip(passes.iter_mut()) {
+            t.forward(features, light, n, None, pass);
+        }
+        // d mean / d value.
+        let norm = 1.0 / batch.len() as f32 / 3.0;
+        // Loss, and its gradient at each track's radiance (the same for every track).
+        let mut dr = vec![0.0f32; n * 3];
+        for r in 0..n {
+            let mut p = [0.0f32; 3];
+            for (t, pass) in self.tracks.iter().zip(passes.iter()) {
+                let c = t.radiance(pass, features, r);
+                (0..3).for_each(|i| p[i] += c[i]);
+            }
+            for c in 0..3 {
+                let pred = p[c] * scale[r];
+                let d = pred.ln_1p() - reference[r * 3 + c].ln_1p();
+                g.loss += d.abs() as f64;
+                let sign = if d > 0.0 {
+                    1.0
+                } else if d < 0.0 {
+                    -1.0
+                } else {
+                    0.0
+                };
+                dr[r * 3 + c] = sign * norm / (1.0 + pred) * scale[r];
+            }
+        }
+        for ((t, pass), grads) in self.tracks.iter().zip(passes).zip(&mut g.tracks) {
+            t.backward(pass, features, light, &dr, grads, &mut g.codes);
+        }
+    }
+}
