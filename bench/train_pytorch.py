@@ -3,7 +3,8 @@
 Layers mirror crates/nprt-net (encoder: 5 x [3x3 conv 32, ReLU, zero-padded skip, 2x2 max-pool]
 then a dense layer to 64; the four transport designs with SIREN or ReLU layers; log-radiance
 outputs through exp, scaled by the map mean; L1 on log(1 + x); Adam lr 1e-4, eps 1e-8).
-Prints one JSON line per design.
+Prints one JSON line per design. `--device cuda` runs it on the GPU, in f32 without TF32 (as
+nprt computes), synchronising before the clock is read.
 """
 
 import argparse
@@ -104,20 +105,25 @@ def main():
     p.add_argument("--steps", type=int, default=10)
     p.add_argument("--warmup", type=int, default=2)
     p.add_argument("--threads", type=int, default=0)
+    p.add_argument("--device", default="cpu", help="cpu or cuda")
     a = p.parse_args()
+    dev = torch.device(a.device)
+    torch.backends.cuda.matmul.allow_tf32 = False
+    torch.backends.cudnn.allow_tf32 = False
+    sync = torch.cuda.synchronize if dev.type == "cuda" else (lambda: None)
     if a.threads:
         torch.set_num_threads(a.threads)
     torch.manual_seed(0)
     for design in a.designs.split(","):
         act = a.activation or ("relu" if design == "baseline" else "siren")
-        net = Net(design, act, a.encoder_width)
+        net = Net(design, act, a.encoder_width).to(dev)
         opt = torch.optim.Adam(net.parameters(), lr=1e-4, eps=1e-8)
         b, w = a.batch_size, a.encoder_width
-        f = torch.rand(b, FEAT)
-        ref = torch.rand(b, 3) * 4
-        light = torch.rand(a.views, 3, w // 2, w)
-        view = torch.randint(0, a.views, (b,))
-        scale = torch.rand(b, 1) + 0.5
+        f = torch.rand(b, FEAT, device=dev)
+        ref = torch.rand(b, 3, device=dev) * 4
+        light = torch.rand(a.views, 3, w // 2, w, device=dev)
+        view = torch.randint(0, a.views, (b,), device=dev)
+        scale = torch.rand(b, 1, device=dev) + 0.5
 
         def step():
             opt.zero_grad(set_to_none=True)
@@ -127,9 +133,11 @@ def main():
 
         for _ in range(a.warmup):
             step()
+        sync()
         t = time.perf_counter()
         for _ in range(a.steps):
             step()
+        sync()
         secs = time.perf_counter() - t
         transport = sum(p.numel() for p in net.tracks.parameters())
         print(json.dumps({
@@ -139,6 +147,7 @@ def main():
             "samples_per_s": b * a.steps / secs,
             "torch": torch.__version__,
             "threads": torch.get_num_threads(),
+            "device": str(dev),
         }), flush=True)
 
 

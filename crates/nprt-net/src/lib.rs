@@ -21,6 +21,7 @@
 mod activation;
 mod batch;
 mod checkpoint;
+mod compute;
 pub mod cpu;
 pub mod curves;
 pub mod data;
@@ -45,6 +46,7 @@ pub use batch::{Batch, Engine};
 pub use burn;
 pub use burn::tensor::Device;
 pub use checkpoint::RunState;
+pub use compute::{device_name, is_cpu, Compute};
 pub use design::{Design, NprtNet, TRANSPORT_CODE};
 pub use encoder::{LightEncoder, LightInput};
 pub use features::{feature, gbuffer_features, pixel_features, FEATURES};

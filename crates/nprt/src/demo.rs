@@ -10,7 +10,7 @@ use nprt_net::{Design, TrainOptions, DEFAULT_ENCODER_WIDTH};
 use crate::evaluation::{eval, train_deep_shading, DeepShadingArgs, EvalArgs};
 use crate::learn::{train, TrainArgs};
 use crate::relight::{render, RenderArgs};
-use crate::GenerateArgs;
+use crate::{DeviceArg, GenerateArgs};
 
 #[derive(clap::Args)]
 pub struct DemoArgs {
@@ -20,6 +20,8 @@ pub struct DemoArgs {
     /// Tiny sizes (under a minute on 2 cores): checks the pipeline, not the method.
     #[arg(long)]
     pub quick: bool,
+    #[command(flatten)]
+    pub device: DeviceArg,
 }
 
 /// The demo's sizes.
@@ -116,6 +118,7 @@ pub fn demo(a: DemoArgs) -> Result<()> {
             val_samples: defaults.val_samples,
             encoder_width: DEFAULT_ENCODER_WIDTH,
             checkpoint_minutes: defaults.schedule.checkpoint_secs / 60.0,
+            device: a.device,
         })?;
         models.push(out);
     }
@@ -130,6 +133,7 @@ pub fn demo(a: DemoArgs) -> Result<()> {
         lr: deep_defaults.schedule.learning_rate,
         seed: deep_defaults.schedule.seed,
         encoder_width: deep_defaults.encoder_width,
+        device: a.device,
     })?;
     step("4/5 evaluating against the baselines");
     let report = a.out.join("report");
@@ -143,6 +147,7 @@ pub fn demo(a: DemoArgs) -> Result<()> {
         views: None,
         shown_views: 3,
         seed: 0,
+        device: a.device,
     })?;
     step("5/5 relighting a camera path under held-out lighting");
     let manifest = nprt_data::dataset::load_manifest(&data)?;
@@ -165,6 +170,7 @@ pub fn demo(a: DemoArgs) -> Result<()> {
         fps: 24,
         exposure: 0.0,
         exr: false,
+        device: a.device,
     })?;
     println!(
         "\n== nprt demo done in {:.0} s",

@@ -5,7 +5,9 @@ use std::path::PathBuf;
 use anyhow::{bail, Result};
 use nprt_eval::{evaluate, write_report, EvalOptions, Evaluation};
 use nprt_net::deep_shading::{self, DeepShadingOptions};
-use nprt_net::{Device, Schedule};
+use nprt_net::Schedule;
+
+use crate::DeviceArg;
 
 #[derive(clap::Args)]
 pub struct EvalArgs {
@@ -36,6 +38,8 @@ pub struct EvalArgs {
     /// Seed of the baselines' path-traced samples.
     #[arg(long, default_value_t = 0)]
     pub seed: u64,
+    #[command(flatten)]
+    pub device: DeviceArg,
 }
 
 #[derive(clap::Args)]
@@ -63,6 +67,8 @@ pub struct DeepShadingArgs {
     /// Width W of the light encoder's W × W/2 input (a multiple of 64).
     #[arg(long, default_value_t = DeepShadingOptions::default().encoder_width)]
     pub encoder_width: usize,
+    #[command(flatten)]
+    pub device: DeviceArg,
 }
 
 /// Runs the evaluation and writes the report; prints where it is and the headline figures.
@@ -81,7 +87,7 @@ pub fn eval(a: EvalArgs) -> Result<Evaluation> {
         seed: a.seed,
         progress: true,
     };
-    let e = evaluate(&opts, &Device::flex())?;
+    let e = evaluate(&opts, &a.device.device()?)?;
     let (md, html) = write_report(&e, &a.out)?;
     println!(
         "{:<32} {:>10} {:>10} {:>10} {:>12}",
@@ -112,7 +118,7 @@ pub fn train_deep_shading(a: DeepShadingArgs) -> Result<()> {
         batch_views: a.batch_views,
         encoder_width: a.encoder_width,
     };
-    let (s, f) = deep_shading::train(&a.data, &opts, &a.out, &Device::flex())?;
+    let (s, f) = deep_shading::train(&a.data, &opts, &a.out, &a.device.device()?)?;
     if let Some(e) = s.resumed_from_epoch {
         println!("resumed from epoch {e:.2}");
     }

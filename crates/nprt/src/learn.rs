@@ -6,7 +6,9 @@ use std::process::Command as Process;
 use anyhow::{bail, Context, Result};
 use nprt_net::data::TrainingSet;
 use nprt_net::encoder::check_input_width;
-use nprt_net::Device;
+use nprt_net::{device_name, is_cpu, Device};
+
+use crate::DeviceArg;
 use nprt_net::{
     layer_table, measure_throughput, Activation, Design, Engine, Init, ModelConfig, Schedule,
     TrainOptions, DEFAULT_ENCODER_WIDTH,
@@ -70,6 +72,8 @@ pub struct TrainArgs {
     /// Minutes between checkpoints within an epoch (one is always written at an epoch's end).
     #[arg(long, default_value_t = TrainOptions::default().schedule.checkpoint_secs / 60.0)]
     pub checkpoint_minutes: f64,
+    #[command(flatten)]
+    pub device: DeviceArg,
 }
 
 #[derive(clap::Subcommand)]
@@ -107,6 +111,8 @@ pub struct BenchInferArgs {
     /// Runs per measurement; the median is reported.
     #[arg(long, default_value_t = 5)]
     repeats: usize,
+    #[command(flatten)]
+    device: DeviceArg,
 }
 
 #[derive(clap::Args)]
@@ -121,12 +127,18 @@ pub struct BenchTrainArgs {
     /// Maps (views) per batch.
     #[arg(long, default_value_t = 8)]
     views: usize,
-    /// Timed steps per design, after 2 untimed ones.
+    /// Timed steps per design.
     #[arg(long, default_value_t = 10)]
     steps: usize,
-    /// Python with PyTorch for the side-by-side peer (bench/train_vs_pytorch.sh installs one).
+    /// Untimed steps before them (a GPU compiles and tunes its kernels in the first steps).
+    #[arg(long, default_value_t = 2)]
+    warmup: usize,
+    /// Python with PyTorch for the side-by-side peer (bench/train_vs_pytorch.sh installs one);
+    /// it runs on the same device (CUDA for a GPU).
     #[arg(long)]
     python: Option<PathBuf>,
+    #[command(flatten)]
+    device: DeviceArg,
 }
 
 fn config(
@@ -211,7 +223,7 @@ pub fn train(a: TrainArgs) -> Result<()> {
         val_samples: a.val_samples,
     };
     opts.check().context("bad training options")?;
-    let s = nprt_net::train(&set, &config, &opts, &a.out, &Device::flex())?;
+    let s = nprt_net::train(&set, &config, &opts, &a.out, &a.device.device()?)?;
     if let Some(e) = s.resumed_from_epoch {
         println!("resumed from epoch {e:.2}");
     }
@@ -242,13 +254,16 @@ pub fn bench(cmd: BenchCommand) -> Result<()> {
 }
 
 fn bench_infer(a: BenchInferArgs) -> Result<()> {
-    let peak = nprt_net::cpu::measured_peak(rayon::current_num_threads());
+    let device = a.device.device()?;
+    // A peak is measured only for the CPU; on a GPU the column is left empty.
+    let peak = is_cpu(&device).then(|| nprt_net::cpu::measured_peak(rayon::current_num_threads()));
     println!(
-        "inference at {r}×{r}, every pixel foreground, encoder not counted; f32 peak {:.0} \
-         GFLOP/s ({} threads, {}-lane FMA chains, measured)",
-        peak.gflops,
-        peak.threads,
-        peak.lanes,
+        "inference at {r}×{r} on {}, every pixel foreground, encoder not counted{}",
+        device_name(&device),
+        peak.as_ref().map_or(String::new(), |p| format!(
+            "; f32 peak {:.0} GFLOP/s ({} threads, {}-lane FMA chains, measured)",
+            p.gflops, p.threads, p.lanes
+        )),
         r = a.resolution
     );
     println!(
@@ -257,8 +272,12 @@ fn bench_infer(a: BenchInferArgs) -> Result<()> {
     );
     for &arch in &a.designs.arch {
         let config = ModelConfig::new(arch, None);
-        let s = nprt_net::measure_inference(&config, a.resolution * a.resolution, a.repeats);
-        let pct = |g: f64| format!("{:.0}%", 100.0 * g / peak.gflops);
+        let s =
+            nprt_net::measure_inference(&config, a.resolution * a.resolution, a.repeats, &device);
+        let pct = |g: f64| {
+            peak.as_ref()
+                .map_or("-".into(), |p| format!("{:.0}%", 100.0 * g / p.gflops))
+        };
         println!(
             "{:<10} {:>9.1} {:>8.1} {:>6} {:>11.1} {:>8.1} {:>6} {:>7.2}×",
             arch.name(),
@@ -276,12 +295,17 @@ fn bench_infer(a: BenchInferArgs) -> Result<()> {
 
 fn bench_train(a: BenchTrainArgs) -> Result<()> {
     let threads = rayon::current_num_threads();
+    let device = a.device.device()?;
+    let cpu = is_cpu(&device);
     println!(
-        "training throughput, batch {}, {} maps per batch, {} timed steps, {threads} threads",
-        a.batch_size, a.views, a.steps
+        "training throughput on {}, batch {}, {} maps per batch, {} timed steps, {threads} threads",
+        device_name(&device),
+        a.batch_size,
+        a.views,
+        a.steps
     );
     let peer = match &a.python {
-        Some(py) => run_pytorch(py, &a, threads)?,
+        Some(py) => run_pytorch(py, &a, threads, cpu)?,
         None => {
             println!(
                 "(no --python given: PyTorch peer skipped; bench/train_vs_pytorch.sh sets one up)"
@@ -302,19 +326,20 @@ fn bench_train(a: BenchTrainArgs) -> Result<()> {
                 a.batch_size,
                 a.views,
                 a.steps,
-                2,
-                &Device::flex(),
+                a.warmup,
+                &device,
             )
         };
         let ours = measure(Engine::Auto);
-        let autodiff = measure(Engine::Autodiff);
+        // Off the CPU burn's autodiff is the only path, so the column would repeat the first.
+        let autodiff = cpu.then(|| measure(Engine::Autodiff));
         let theirs = peer.iter().find(|p| p.0 == arch.name()).map(|p| p.1);
         println!(
-            "{:<10} {:<6} {:>14.0} {:>18.0} {:>17} {:>8}",
+            "{:<10} {:<6} {:>14.0} {:>18} {:>17} {:>8}",
             arch.name(),
             config.activation.name(),
             ours,
-            autodiff,
+            autodiff.map_or("-".into(), |t| format!("{t:.0}")),
             theirs.map_or("-".into(), |t| format!("{t:.0}")),
             theirs.map_or("-".into(), |t| format!("{:.2}×", ours / t))
         );
@@ -324,7 +349,12 @@ fn bench_train(a: BenchTrainArgs) -> Result<()> {
 
 /// Runs bench/train_pytorch.py first (so both see the same idle machine state in turn) and
 /// returns (design, samples/s) pairs.
-fn run_pytorch(python: &PathBuf, a: &BenchTrainArgs, threads: usize) -> Result<Vec<(String, f64)>> {
+fn run_pytorch(
+    python: &PathBuf,
+    a: &BenchTrainArgs,
+    threads: usize,
+    cpu: bool,
+) -> Result<Vec<(String, f64)>> {
     let script = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../bench/train_pytorch.py");
     let designs: Vec<&str> = a.designs.arch.iter().map(|d| d.name()).collect();
     let mut cmd = Process::new(python);
@@ -333,7 +363,9 @@ fn run_pytorch(python: &PathBuf, a: &BenchTrainArgs, threads: usize) -> Result<V
         .args(["--batch-size", &a.batch_size.to_string()])
         .args(["--views", &a.views.to_string()])
         .args(["--steps", &a.steps.to_string()])
-        .args(["--threads", &threads.to_string()]);
+        .args(["--warmup", &a.warmup.to_string()])
+        .args(["--threads", &threads.to_string()])
+        .args(["--device", if cpu { "cpu" } else { "cuda" }]);
     if let Some(act) = a.activation {
         cmd.args(["--activation", act.name()]);
     }

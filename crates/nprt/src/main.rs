@@ -34,6 +34,22 @@ struct Cli {
     command: Command,
 }
 
+/// `--device`, shared by every command that runs the networks.
+#[derive(clap::Args, Clone, Copy)]
+pub(crate) struct DeviceArg {
+    /// Where the networks run: cpu, gpu (an NVIDIA GPU through CUDA; an error if none is found)
+    /// or auto (the GPU when one is found, else the CPU). A model folder is the same whichever
+    /// trained it.
+    #[arg(long = "device", default_value = "auto")]
+    pub(crate) compute: nprt_net::Compute,
+}
+
+impl DeviceArg {
+    pub(crate) fn device(self) -> Result<nprt_net::Device> {
+        self.compute.device()
+    }
+}
+
 #[derive(Subcommand)]
 enum Command {
     /// Path-trace a scene through its own sensor and film (box pixel filter, the integrator's

@@ -4,11 +4,10 @@
 use std::path::PathBuf;
 
 use anyhow::{bail, Context, Result};
-use nprt_net::Device;
 use nprt_render::{render_sequence, Animation, CameraPath, LightingSchedule, Relighter, Sequence};
 use nprt_trace::TraceScene;
 
-use crate::parse_resolution;
+use crate::{parse_resolution, DeviceArg};
 
 /// Lighting when none is given: maps outside the built-in training set (`builtin` maps).
 pub const DEFAULT_LIGHTING: &str = "builtin:sky:30:250:3,builtin:indoor:9";
@@ -50,13 +49,15 @@ pub struct RenderArgs {
     /// Also write each frame's linear radiance as OpenEXR.
     #[arg(long)]
     pub exr: bool,
+    #[command(flatten)]
+    pub device: DeviceArg,
 }
 
 pub fn render(a: RenderArgs) -> Result<()> {
     if a.frames == 0 || a.fps == 0 {
         bail!("--frames and --fps must be at least 1");
     }
-    let device = Device::flex();
+    let device = a.device.device()?;
     let model = Relighter::load(&a.model, &device)?;
     let spec = match (&a.scene, model.file.scene.as_str()) {
         (Some(s), _) => s.clone(),

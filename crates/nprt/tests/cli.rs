@@ -207,3 +207,35 @@ fn help_explains_every_flag() {
         assert!(text.contains(flag), "reference --help lacks {flag}");
     }
 }
+
+#[test]
+fn device_gpu_without_one_fails_clearly_and_auto_falls_back() {
+    let run = |device: &str| {
+        nprt(&[
+            "bench",
+            "infer",
+            "--arch",
+            "baseline",
+            "--resolution",
+            "8",
+            "--repeats",
+            "1",
+            "--device",
+            device,
+        ])
+    };
+    let gpu = run("gpu");
+    if gpu.status.success() {
+        // A machine with a CUDA GPU: the frame ran on it.
+        assert!(String::from_utf8_lossy(&gpu.stdout).contains("Cuda"));
+    } else {
+        let err = String::from_utf8_lossy(&gpu.stderr);
+        assert!(err.contains("--device gpu: no CUDA GPU found"), "{err}");
+        let auto = run("auto");
+        assert!(auto.status.success());
+        assert!(String::from_utf8_lossy(&auto.stdout).contains(" on cpu,"));
+    }
+    let bad = run("tpu");
+    assert!(!bad.status.success());
+    assert!(String::from_utf8_lossy(&bad.stderr).contains("expected cpu, gpu or auto"));
+}

@@ -27,7 +27,7 @@ pub use transport::{HostTransport, TransferCodes, TransportGradients};
 /// Whether the CPU engine can run `net` on `device`.
 pub fn applies(net: &NprtNet, device: &Device) -> bool {
     let weight = &net.tracks[0].shading.layers[0].weight;
-    device.clone().inner() == Device::flex() && weight.val().dtype() == DType::F32
+    crate::compute::is_cpu(device) && weight.val().dtype() == DType::F32
 }
 
 /// The batch's loss and every parameter's gradient, with the transport networks on the CPU
