@@ -73,6 +73,9 @@ pub(crate) fn restore<M: Module>(
 ) -> Result<ModuleOptimizer> {
     let dir = dir(out);
     load_weights(&dir.join(&ck.weights), net, tag)?;
+    if let Some(device) = net.devices().into_iter().next() {
+        crate::compute::make_default(&device);
+    }
     optim
         .load(dir.join(&ck.optimizer))
         .map_err(|e| anyhow::anyhow!("cannot read optimiser state in '{}': {e:?}", dir.display()))

@@ -25,11 +25,12 @@ impl Compute {
 
     /// The device to run on. `gpu` without a usable CUDA device is an error naming what is
     /// missing; `auto` then falls back to the CPU.
+    /// The chosen device also becomes burn's default (see [`make_default`]).
     pub fn device(self) -> Result<Device> {
-        match self {
-            Compute::Cpu => Ok(Device::flex()),
+        let device = match self {
+            Compute::Cpu => Device::flex(),
             Compute::Gpu => match first_gpu() {
-                Some(device) => Ok(device),
+                Some(device) => device,
                 None => bail!(
                     "--device gpu: no CUDA GPU found (nprt loads the NVIDIA driver's libcuda at \
                      run time; this machine has {}); use --device cpu or auto",
@@ -40,8 +41,30 @@ impl Compute {
                     }
                 ),
             },
-            Compute::Auto => Ok(first_gpu().unwrap_or_else(Device::flex)),
-        }
+            Compute::Auto => first_gpu().unwrap_or_else(Device::flex),
+        };
+        make_default(&device);
+        Ok(device)
+    }
+}
+
+/// Makes `device` burn's default device. burn materialises some state on its default device
+/// (the optimiser's moments when a checkpoint is loaded), and that default is CUDA whenever
+/// the CUDA backend is compiled in, GPU or not: without this a resumed CPU run on a machine
+/// with no NVIDIA driver panicked. burn reads the choice from `BURN_DEVICE` on every use.
+pub(crate) fn make_default(device: &Device) {
+    let name = if is_cpu(device) { "flex" } else { "cuda" };
+    if std::env::var("BURN_DEVICE").ok().as_deref() != Some(name) {
+        std::env::set_var("BURN_DEVICE", name);
+    }
+}
+
+/// Waits for the work queued on burn's default device when that is a GPU. Called once a
+/// command is done: work still queued at exit ran after the CUDA driver had shut down and
+/// panicked in burn's device thread (seen after resuming a run on an H100).
+pub fn finish() {
+    if std::env::var("BURN_DEVICE").ok().as_deref() == Some("cuda") {
+        Device::default().sync().ok();
     }
 }
 

@@ -46,7 +46,7 @@ pub use batch::{Batch, Engine};
 pub use burn;
 pub use burn::tensor::Device;
 pub use checkpoint::RunState;
-pub use compute::{device_name, is_cpu, Compute};
+pub use compute::{device_name, finish, is_cpu, Compute};
 pub use design::{Design, NprtNet, TRANSPORT_CODE};
 pub use encoder::{LightEncoder, LightInput};
 pub use features::{feature, gbuffer_features, pixel_features, FEATURES};
