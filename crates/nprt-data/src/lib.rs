@@ -19,13 +19,15 @@
 //!     volume: scene.camera_volume.clone().unwrap(),
 //!     map_specs,
 //!     maps,
-//!     test_maps: 1,
+//!     lighting: dataset::MapAssignment::Pool { test_maps: 1 },
 //!     train_views: 2,
 //!     test_views: 1,
 //!     train_resolution: [8, 8],
 //!     test_resolution: [8, 8],
 //!     spp: 2,
+//!     test_spp: 4,
 //!     seed: 0,
+//!     jitter: dataset::Jitter::default(),
 //! };
 //! let manifest = dataset::plan(&request, &ts)?;
 //! let dir = std::env::temp_dir().join(format!("nprt-data-doc-{}", std::process::id()));

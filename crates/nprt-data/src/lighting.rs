@@ -6,22 +6,56 @@ use std::path::Path;
 use anyhow::{bail, Context, Result};
 use nprt_scene::open_envmap;
 use nprt_scene::EnvMap;
+
+use crate::dataset::MapAssignment;
 use rand::seq::SliceRandom;
-use rand::SeedableRng;
+use rand::{RngExt, SeedableRng};
 use rand_pcg::Pcg64Mcg;
 
-/// Built-in maps for when no files are given: 16 skies (4 sun elevations × 4 azimuths,
-/// turbidity 2–5) and 8 indoor maps.
-pub fn builtin_specs() -> Vec<String> {
-    let mut specs = vec![];
-    for (i, elevation) in [8.0, 20.0, 40.0, 65.0].iter().enumerate() {
-        for (j, azimuth) in [20.0, 110.0, 200.0, 290.0].iter().enumerate() {
-            let turbidity = 2.0 + ((i + j) % 4) as f32;
-            specs.push(format!("builtin:sky:{elevation}:{azimuth}:{turbidity}"));
+/// The maps of a dataset and how its views take them, from `--envmaps`: `builtin` draws one
+/// fresh procedural lighting per view ([`builtin_per_view`]); a folder's maps form a pool
+/// with `test_maps` of them (default: a fifth) held out for testing.
+pub fn choose(
+    envmaps: &str,
+    train_views: u64,
+    test_views: u64,
+    test_maps: Option<usize>,
+    seed: u64,
+) -> Result<(Vec<String>, MapAssignment)> {
+    if envmaps == "builtin" {
+        if test_maps.is_some() {
+            bail!("--test-maps applies to a folder of maps; --envmaps builtin gives every view its own lighting");
         }
+        return Ok((
+            builtin_per_view(train_views, test_views, seed),
+            MapAssignment::PerView,
+        ));
     }
-    specs.extend((0..8).map(|s| format!("builtin:indoor:{s}")));
-    specs
+    let specs = specs_in_dir(Path::new(envmaps))?;
+    let test_maps = test_maps.unwrap_or_else(|| default_test_count(specs.len()));
+    Ok((specs, MapAssignment::Pool { test_maps }))
+}
+
+/// One built-in lighting per view, drawn from `seed`, training views first: two in three are
+/// skies (sun elevation 3–70°, azimuth 0–360°, turbidity 2–6), the others indoor layouts.
+/// Test lightings never repeat a training one: sky parameters are drawn from continuous
+/// ranges, and indoor layouts from even seeds for training and odd ones for testing.
+pub fn builtin_per_view(train_views: u64, test_views: u64, seed: u64) -> Vec<String> {
+    let mut rng = Pcg64Mcg::seed_from_u64(seed ^ 0x11d1_5ca9_e000);
+    (0..train_views + test_views)
+        .map(|i| {
+            if rng.random::<f32>() < 2.0 / 3.0 {
+                let elevation = rng.random_range(3.0..70.0f32);
+                let azimuth = rng.random_range(0.0..360.0f32);
+                let turbidity = rng.random_range(2.0..6.0f32);
+                format!("builtin:sky:{elevation:.3}:{azimuth:.3}:{turbidity:.3}")
+            } else {
+                // Seeds stay below 2^21, exact in the spec's f32.
+                let layout = rng.random_range(0..1u64 << 20) * 2 + u64::from(i >= train_views);
+                format!("builtin:indoor:{layout}")
+            }
+        })
+        .collect()
 }
 
 /// The .exr and .hdr files of `dir`, sorted by name.
@@ -118,6 +152,36 @@ mod tests {
     }
 
     #[test]
+    fn builtin_lighting_is_one_fresh_map_per_view_and_seeded() {
+        let specs = builtin_per_view(300, 40, 5);
+        assert_eq!(specs.len(), 340);
+        assert_eq!(specs, builtin_per_view(300, 40, 5));
+        assert_ne!(specs, builtin_per_view(300, 40, 6));
+        let (train, test) = specs.split_at(300);
+        assert!(
+            test.iter().all(|t| !train.contains(t)),
+            "a test lighting repeats a training one"
+        );
+        let indoor_parity = |s: &[String]| -> Vec<u64> {
+            s.iter()
+                .filter_map(|x| x.strip_prefix("builtin:indoor:"))
+                .map(|n| n.parse::<u64>().unwrap() % 2)
+                .collect()
+        };
+        assert!(indoor_parity(train).iter().all(|&p| p == 0));
+        assert!(indoor_parity(test).iter().all(|&p| p == 1));
+        let skies = specs
+            .iter()
+            .filter(|s| s.starts_with("builtin:sky:"))
+            .count();
+        assert!((200..260).contains(&skies), "{skies} skies of 340");
+        assert!(load_all(&specs[..6]).is_ok());
+        let (specs, how) = choose("builtin", 3, 2, None, 0).unwrap();
+        assert_eq!((specs.len(), how), (5, MapAssignment::PerView));
+        assert!(choose("builtin", 3, 2, Some(1), 0).is_err());
+    }
+
+    #[test]
     fn folders_without_maps_are_refused() {
         let dir = std::env::temp_dir().join(format!("nprt-nomaps-{}", std::process::id()));
         std::fs::create_dir_all(&dir).unwrap();
@@ -125,6 +189,5 @@ mod tests {
         let err = specs_in_dir(&dir).unwrap_err().to_string();
         assert!(err.contains("no .exr or .hdr"), "{err}");
         assert!(specs_in_dir(&dir.join("missing")).is_err());
-        assert_eq!(builtin_specs().len(), 24);
     }
 }

@@ -18,6 +18,8 @@ pub struct ImageView {
     pub radiance: Vec<Vec3>,
     pub direct: Vec<Vec3>,
     pub gbuffer: GBuffer,
+    /// Radiance of the first half of the samples, for a test view rendered in halves.
+    pub half: Option<Vec<Vec3>>,
 }
 
 impl ImageView {
@@ -32,19 +34,20 @@ pub fn load_views(dir: &Path, manifest: &Manifest, split: &str) -> Result<Vec<Im
         .views
         .par_iter()
         .filter(|v| v.split == split)
-        .map(|v| load_view(dir, v))
+        .map(|v| load_view(dir, manifest, v))
         .collect()
 }
 
 /// Reads one view, refusing a file whose channels or size disagree with the manifest.
-pub fn load_view(dir: &Path, view: &ViewRecord) -> Result<ImageView> {
+pub fn load_view(dir: &Path, manifest: &Manifest, view: &ViewRecord) -> Result<ImageView> {
     let path = dir.join(&view.file);
-    let frame = read_view(&path, view).with_context(|| {
+    let image = read_view(&path, view, manifest.settings.in_halves(view)).with_context(|| {
         format!(
             "dataset view '{}' is unusable (run `nprt generate` again to redo it)",
             path.display()
         )
     })?;
+    let frame = image.frame;
     Ok(ImageView {
         record: view.clone(),
         camera: view.camera(),
@@ -53,5 +56,6 @@ pub fn load_view(dir: &Path, view: &ViewRecord) -> Result<ImageView> {
         radiance: frame.radiance,
         direct: frame.direct,
         gbuffer: frame.gbuffer,
+        half: image.half,
     })
 }

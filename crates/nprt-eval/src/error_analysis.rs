@@ -2,7 +2,7 @@
 //! pixel's error against its share of direct light and its specularity (the paper's error
 //! analysis), binned and correlated.
 
-use glam::Vec3;
+use glam::{DVec3, Vec3};
 use nprt_data::views::ImageView;
 use nprt_scene::luminance;
 
@@ -16,6 +16,8 @@ pub struct Accumulator {
     direct: Vec<f64>,
     spec: Vec<f64>,
     ms: Vec<f64>,
+    /// Foreground sums of prediction and reference, per channel.
+    sums: [DVec3; 2],
 }
 
 impl Accumulator {
@@ -35,11 +37,13 @@ impl Accumulator {
                 error_by_specularity: vec![],
                 note: String::new(),
                 loss_png: None,
+                level: [f64::NAN; 3],
             },
             err: vec![],
             direct: vec![],
             spec: vec![],
             ms: vec![],
+            sums: [DVec3::ZERO; 2],
         }
     }
 
@@ -51,6 +55,8 @@ impl Accumulator {
         self.ms.push(ms);
         for i in (0..g.mask.len()).filter(|&i| g.mask[i] > 0.5) {
             let r = view.radiance[i];
+            self.sums[0] += pred[i].as_dvec3();
+            self.sums[1] += r.as_dvec3();
             self.err
                 .push(((pred[i] - r).abs().element_sum() / 3.0) as f64);
             self.direct
@@ -68,6 +74,7 @@ impl Accumulator {
         r.corr_specularity = correlation(&self.err, &self.spec);
         r.error_by_directness = binned(&self.direct, &self.err);
         r.error_by_specularity = binned(&self.spec, &self.err);
+        r.level = (self.sums[0] / self.sums[1]).to_array();
         self.result
     }
 }

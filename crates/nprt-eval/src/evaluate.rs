@@ -15,6 +15,7 @@ use nprt_trace::TraceScene;
 use serde::{Deserialize, Serialize};
 
 use crate::method::{Family, MethodResult};
+use crate::metrics::Metrics;
 use crate::networks::{load_networks, run_networks};
 use crate::oidn::Oidn;
 use crate::path_tracing::{equal_time_spp, run_denoised, run_path_tracing};
@@ -47,6 +48,14 @@ pub struct Evaluation {
     pub resolution: [usize; 2],
     pub foreground_pixels: usize,
     pub equal_time_spp: u32,
+    /// Samples per pixel of the references (the test views).
+    #[serde(default)]
+    pub reference_spp: u32,
+    /// The references' own error: the first half of each reference's samples against the
+    /// whole, which differs from it by noise of the reference's own size (None for a dataset
+    /// whose test views were not rendered in halves).
+    #[serde(default)]
+    pub noise_floor: Option<Metrics>,
     pub methods: Vec<MethodResult>,
     pub timing_res: u32,
     pub timings: Vec<Timing>,
@@ -172,6 +181,19 @@ pub fn evaluate(o: &EvalOptions, device: &Device) -> Result<Evaluation> {
         &bench.path_tracer(5, o.seed),
     )?;
     let fg = views.iter().map(|v| v.foreground()).sum();
+    let noise_floor = views
+        .iter()
+        .map(|v| {
+            let half = v.half.as_ref()?;
+            Some(Metrics::compute(
+                half,
+                &v.radiance,
+                &v.gbuffer.mask,
+                v.width,
+            ))
+        })
+        .collect::<Option<Vec<_>>>()
+        .map(|per_view| Metrics::mean(&per_view));
     Ok(Evaluation {
         data: o.data.clone(),
         scene: s.scene.clone(),
@@ -179,6 +201,8 @@ pub fn evaluate(o: &EvalOptions, device: &Device) -> Result<Evaluation> {
         resolution: [views[0].width, views[0].height],
         foreground_pixels: fg,
         equal_time_spp,
+        reference_spp: s.spp_of(&views[0].record),
+        noise_floor,
         methods: results,
         timing_res: o.timing_res,
         timings,

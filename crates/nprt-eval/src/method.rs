@@ -58,4 +58,9 @@ pub struct MethodResult {
     pub note: String,
     /// Training curve, for networks.
     pub loss_png: Option<PathBuf>,
+    /// Level and tint: the prediction's foreground sum over the reference's, per channel (1 is
+    /// right; a uniformly dark prediction is below 1 in all three, a wrong tint differs among
+    /// them).
+    #[serde(default)]
+    pub level: [f64; 3],
 }

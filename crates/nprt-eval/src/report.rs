@@ -171,7 +171,7 @@ fn errors(md: &mut String, e: &Evaluation) -> Result<()> {
     }
     writeln!(
         md,
-        " ms / view |\n|---|---|{}---|",
+        " ms / view | level R / G / B |\n|---|---|{}---|---|",
         "---|".repeat(Metrics::NAMES.len())
     )?;
     for m in &e.methods {
@@ -184,9 +184,18 @@ fn errors(md: &mut String, e: &Evaluation) -> Result<()> {
         for v in m.mean.values() {
             write!(md, " {} |", fmt(v))?;
         }
-        writeln!(md, " {:.1} |", m.ms_per_view)?;
+        let [r, g, b] = m.level;
+        writeln!(md, " {:.1} | {r:.3} / {g:.3} / {b:.3} |", m.ms_per_view)?;
+    }
+    if let Some(floor) = &e.noise_floor {
+        write!(md, "| *reference noise floor* | – |")?;
+        for v in floor.values() {
+            write!(md, " {} |", fmt(v))?;
+        }
+        writeln!(md, " – | – |")?;
     }
     writeln!(md)?;
+    noise_floor_note(md, e)?;
     for m in e.methods.iter().filter(|m| !m.note.is_empty()) {
         writeln!(md, "- {}: {}", m.name, m.note)?;
     }
@@ -197,7 +206,40 @@ fn errors(md: &mut String, e: &Evaluation) -> Result<()> {
             p
         )?;
     }
+    writeln!(
+        md,
+        "- Level R / G / B: each channel's sum of the prediction over the reference's, on the \
+         foreground of every test view; 1 is right, below 1 in all three is too dark, unequal \
+         values are a wrong tint."
+    )?;
     writeln!(md, "- Denoiser: {}.\n", e.denoiser)?;
+    Ok(())
+}
+
+/// What the references' noise floor means here, or why it is unknown.
+fn noise_floor_note(md: &mut String, e: &Evaluation) -> Result<()> {
+    let Some(floor) = &e.noise_floor else {
+        return Ok(writeln!(
+            md,
+            "- Reference noise floor: unknown; the test views ({} spp) were not rendered in two halves \
+             (a dataset from before `nprt generate --test-spp`).",
+            e.reference_spp
+        )?);
+    };
+    let best = e
+        .methods
+        .iter()
+        .map(|m| m.mean.l1)
+        .fold(f64::INFINITY, f64::min);
+    writeln!(
+        md,
+        "- Reference noise floor: the references ({} spp) have noise of their own; the first half of \
+         each reference's samples differs from the whole by noise of the same size, and its error is \
+         the row above. A method's measured error mixes its own with this floor (in L2, they add). \
+         The floor's L1 is {:.1}% of the best method's L1.",
+        e.reference_spp,
+        100.0 * floor.l1 / best
+    )?;
     Ok(())
 }
 

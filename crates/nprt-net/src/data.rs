@@ -3,7 +3,7 @@
 
 use std::path::Path;
 
-use anyhow::{bail, Context, Result};
+use anyhow::{bail, Result};
 use nprt_data::dataset::{load_manifest_hashed, Manifest, ViewRecord};
 use nprt_scene::envmap::EnvMap;
 use rayon::prelude::*;
@@ -99,7 +99,7 @@ fn load_view(
     view: &ViewRecord,
     encoder_width: usize,
 ) -> Result<ViewSamples> {
-    let image = nprt_data::views::load_view(dir, view)?;
+    let image = nprt_data::views::load_view(dir, manifest, view)?;
     let g = &image.gbuffer;
     let mut features = Vec::new();
     let mut radiance = Vec::new();
@@ -107,17 +107,9 @@ fn load_view(
         features.extend(gbuffer_features(&manifest.bounds, g, i));
         radiance.extend(image.radiance[i].to_array());
     }
-    let map = maps.get(view.map).with_context(|| {
-        format!(
-            "view '{}' names map {} of {}",
-            view.file,
-            view.map,
-            maps.len()
-        )
-    })?;
     Ok(ViewSamples {
         features,
         radiance,
-        light: LightInput::new(map, view.rotation_deg, encoder_width),
+        light: LightInput::new(&view.lighting(maps)?, 0.0, encoder_width),
     })
 }

@@ -25,8 +25,13 @@ impl Mlp {
             .enumerate()
             .map(|(i, w)| {
                 let fan_in = w[0] as f32;
+                let last = i + 2 == widths.len();
                 let bound = match activation {
-                    // PyTorch's kaiming_uniform(a=√5) for nn.Linear reduces to 1/√fan_in.
+                    // He et al.'s uniform bound keeps the signal's variance through ReLU
+                    // layers; PyTorch's nn.Linear default (1/√fan_in, kept for the linear
+                    // output layer) shrinks it sixfold per layer, which left the deep baseline
+                    // a near-constant function of its inputs (docs/model.md).
+                    Activation::Relu if !last => (6.0 / fan_in).sqrt(),
                     Activation::Relu => 1.0 / fan_in.sqrt(),
                     Activation::Siren if i == 0 => 1.0 / fan_in,
                     Activation::Siren => (6.0 / fan_in).sqrt() / OMEGA_0,

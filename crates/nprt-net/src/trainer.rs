@@ -21,6 +21,7 @@ use serde::{Deserialize, Serialize};
 use crate::checkpoint::{self, Checkpoint, RunState};
 use crate::curves::{self, LossRow};
 use crate::init::Init;
+use crate::lr_schedule::LrSchedule;
 
 pub const ADAM_EPSILON: f32 = 1e-8;
 /// Training-loss rows per epoch in loss.csv.
@@ -29,8 +30,18 @@ const TRAIN_ROWS_PER_EPOCH: u64 = 20;
 /// The loop's own settings, shared by every network.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Schedule {
+    /// Passes over the data; with a time budget, the most the run may do.
     pub epochs: usize,
+    /// The peak learning rate.
     pub learning_rate: f64,
+    /// How the rate moves over the run (the paper: constant).
+    #[serde(default)]
+    pub lr_schedule: LrSchedule,
+    /// Wall-clock budget of training time, minutes: the run stops when its accumulated time
+    /// reaches it (or after `epochs`, whichever comes first), and a decaying schedule decays
+    /// over it instead of over the epochs.
+    #[serde(default)]
+    pub minutes: Option<f64>,
     /// Seed of the initial weights and of the batch order.
     pub seed: u64,
     /// Seconds between checkpoints inside an epoch (one is always written at each epoch end).
@@ -46,6 +57,8 @@ impl Default for Schedule {
         Schedule {
             epochs: 20,
             learning_rate: 1e-4,
+            lr_schedule: LrSchedule::Paper,
+            minutes: None,
             seed: 0,
             checkpoint_secs: 300.0,
             progress: true,
@@ -65,7 +78,26 @@ impl Schedule {
                 self.learning_rate
             );
         }
+        if let Some(m) = self.minutes {
+            if !(m > 0.0 && m.is_finite()) {
+                bail!("the time budget must be a positive number of minutes, got {m}");
+            }
+        }
         Ok(())
+    }
+
+    /// The budget in seconds, if the run has one.
+    fn budget_secs(&self) -> Option<f64> {
+        self.minutes.map(|m| m * 60.0)
+    }
+
+    /// "epoch 3/20", or "epoch 3" for a run bounded by its time budget alone.
+    fn epoch_label(&self, epoch: usize) -> String {
+        if self.epochs == usize::MAX {
+            format!("epoch {epoch}")
+        } else {
+            format!("epoch {epoch}/{}", self.epochs)
+        }
     }
 }
 
@@ -112,6 +144,8 @@ pub trait Objective {
 
 /// What a finished (or resumed and finished) run reports.
 pub struct TrainSummary {
+    /// Epochs done, counting a part-done one by its share of batches.
+    pub epochs: f64,
     pub steps: u64,
     pub samples: u64,
     pub seconds: f64,
@@ -167,19 +201,34 @@ pub fn train<O: Objective>(
         ),
     };
 
-    let per_epoch: Vec<usize> = (0..schedule.epochs)
-        .map(|e| objective.steps(schedule.seed, e))
-        .collect();
-    let total_batches: usize = per_epoch.iter().sum();
-    let done_batches = per_epoch.iter().take(ck.state.epoch).sum::<usize>() + ck.state.batch;
-    let bar = nprt_io::progress_bar(
-        schedule.progress,
-        total_batches as u64,
-        &format!("training {tag}"),
-        "batches",
-    );
-    bar.set_position(done_batches as u64);
+    // A time budget sets the run's length (and the bar's, in seconds); otherwise its batches do.
+    let budget = schedule.budget_secs();
+    let steps_in = |epoch: usize| objective.steps(schedule.seed, epoch);
+    let total_batches: usize = match budget {
+        Some(_) => 0,
+        None => (0..schedule.epochs).map(steps_in).sum(),
+    };
+    let mut done_batches = (0..ck.state.epoch).map(steps_in).sum::<usize>() + ck.state.batch;
+    let bar = match budget {
+        Some(b) => nprt_io::progress_bar(
+            schedule.progress,
+            b.ceil() as u64,
+            &format!("training {tag}"),
+            "s",
+        ),
+        None => nprt_io::progress_bar(
+            schedule.progress,
+            total_batches as u64,
+            &format!("training {tag}"),
+            "batches",
+        ),
+    };
+    bar.set_position(match budget {
+        Some(_) => ck.state.seconds as u64,
+        None => done_batches as u64,
+    });
     bar.reset_eta();
+    let out_of_time = |seconds: f64| budget.is_some_and(|b| seconds >= b);
     let started = Instant::now();
     let seconds_before = ck.state.seconds;
     let mut last_checkpoint = Instant::now();
@@ -187,11 +236,16 @@ pub fn train<O: Objective>(
     let mut last_train = f64::NAN;
     let mut guard = DivergenceGuard::default();
 
-    while ck.state.epoch < schedule.epochs {
+    while ck.state.epoch < schedule.epochs && !out_of_time(ck.state.seconds) {
         let epoch = ck.state.epoch;
-        let total = per_epoch[epoch];
+        let total = steps_in(epoch);
         let row_every = (total as u64).div_ceil(TRAIN_ROWS_PER_EPOCH).max(1);
         for batch in objective.batches(schedule.seed, epoch, ck.state.batch) {
+            let progress = match budget {
+                Some(b) => ck.state.seconds / b,
+                None => done_batches as f64 / total_batches.max(1) as f64,
+            };
+            let lr = schedule.learning_rate * schedule.lr_schedule.factor(progress);
             let (value, grads, samples) = objective.gradients(&net, &batch, &device);
             if let Some(why) = guard.check(value, ck.state.step) {
                 bar.abandon();
@@ -209,7 +263,8 @@ pub fn train<O: Objective>(
                     ck.state.step
                 );
             }
-            net = optim.step(schedule.learning_rate, net, grads);
+            net = optim.step(lr, net, grads);
+            done_batches += 1;
             let s = &mut ck.state;
             s.batch += 1;
             s.step += 1;
@@ -229,26 +284,34 @@ pub fn train<O: Objective>(
                 });
                 (row_sum, row_n) = (0.0, 0);
             }
-            bar.inc(1);
+            match budget {
+                Some(_) => bar.set_position(s.seconds as u64),
+                None => bar.inc(1),
+            }
             bar.set_message(format!(
-                "epoch {}/{} loss {:.4} {:.0}K samples/s",
-                epoch + 1,
-                schedule.epochs,
+                "{} loss {:.4} {:.0}K samples/s",
+                schedule.epoch_label(epoch + 1),
                 guard.ema,
                 s.samples as f64 / s.seconds.max(1e-9) / 1e3
             ));
+            if out_of_time(s.seconds) {
+                break;
+            }
             if last_checkpoint.elapsed().as_secs_f64() > schedule.checkpoint_secs {
                 save(objective, schedule, out, &mut ck, &net, &optim)?;
                 last_checkpoint = Instant::now();
             }
         }
+        // The epoch ended, or the budget ran out within it: validate and save either way.
         let val = objective.validation_loss(&net.valid(), &device.clone().inner());
         let s = &mut ck.state;
-        s.epoch += 1;
-        s.batch = 0;
+        if s.batch >= total {
+            s.epoch += 1;
+            s.batch = 0;
+        }
         ck.history.push(LossRow {
             step: s.step,
-            epoch: s.epoch as f64,
+            epoch: s.epoch as f64 + s.batch as f64 / total.max(1) as f64,
             samples: s.samples,
             seconds: s.seconds,
             train: (row_n > 0).then(|| row_sum / row_n as f64),
@@ -260,11 +323,11 @@ pub fn train<O: Objective>(
             let train = ck.history.iter().rev().find_map(|r| r.train);
             bar.suspend(|| {
                 eprintln!(
-                    "epoch {:>4}/{}: train loss {:.5}, validation loss {val:.5}, {:.0} K samples/s",
-                    s.epoch,
-                    schedule.epochs,
+                    "{}: train loss {:.5}, validation loss {val:.5}, {:.0} K samples/s, {:.0} s",
+                    schedule.epoch_label(s.epoch),
                     train.unwrap_or(last_train),
-                    s.samples as f64 / s.seconds.max(1e-9) / 1e3
+                    s.samples as f64 / s.seconds.max(1e-9) / 1e3,
+                    s.seconds
                 )
             });
         }
@@ -274,6 +337,8 @@ pub fn train<O: Objective>(
     bar.finish_and_clear();
     let last = |f: fn(&LossRow) -> Option<f64>| ck.history.iter().rev().find_map(f);
     Ok(TrainSummary {
+        epochs: ck.state.epoch as f64
+            + ck.state.batch as f64 / steps_in(ck.state.epoch).max(1) as f64,
         steps: ck.state.step,
         samples: ck.state.samples,
         seconds: ck.state.seconds,
@@ -284,13 +349,22 @@ pub fn train<O: Objective>(
 }
 
 /// All that must match for a checkpoint to resume: the network's key, the learning rate and
-/// the seed.
+/// the seed; for a decaying rate also its schedule and the run's length it decays over, so
+/// that a finished run is not lengthened (the paper's constant rate may be).
 fn run_key<O: Objective>(objective: &O, schedule: &Schedule) -> serde_json::Value {
-    serde_json::json!({
+    let mut key = serde_json::json!({
         "network": objective.run_key(),
         "learning_rate": schedule.learning_rate,
         "seed": schedule.seed,
-    })
+    });
+    if schedule.lr_schedule.needs_horizon() {
+        key["lr_schedule"] = serde_json::json!({
+            "name": schedule.lr_schedule.name(),
+            "epochs": (schedule.epochs != usize::MAX).then_some(schedule.epochs),
+            "minutes": schedule.minutes,
+        });
+    }
+    key
 }
 
 /// Checks that `saved` belongs to this run and loads its weights and optimiser state.
@@ -304,7 +378,7 @@ fn resume<O: Objective>(
 ) -> Result<ModuleOptimizer> {
     if saved.run != run_key(objective, schedule) {
         bail!(
-            "model folder '{}' holds a run with other settings (network, dataset or hyper-parameters); choose another --out or delete it",
+            "model folder '{}' holds a run with other settings (network, dataset or hyper-parameters; a run with a decaying --schedule also keeps its --epochs and --minutes); choose another --out or delete it",
             out.display()
         );
     }

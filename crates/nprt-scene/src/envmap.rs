@@ -162,6 +162,17 @@ impl EnvMap {
         }
     }
 
+    /// The map with every texel multiplied by `gain` (an exposure and white-balance change),
+    /// in the same placement.
+    pub fn scaled(&self, gain: Vec3) -> Result<Self> {
+        if gain == Vec3::ONE {
+            return Ok(self.clone());
+        }
+        let texels = self.data.texels.iter().map(|&t| t * gain).collect();
+        let (w, h) = (self.data.width, self.data.height);
+        Ok(Self::from_texels(&self.data.name, w, h, texels)?.with_to_world(self.to_world))
+    }
+
     /// The map rotated by `degrees` about +Y, on top of its current placement.
     pub fn rotated_y(&self, degrees: f32) -> Self {
         self.with_to_world(Mat3::from_rotation_y(degrees.to_radians()) * self.to_world)
@@ -290,6 +301,17 @@ mod tests {
         // Wrap-around between the last and first column.
         let v = m.eval_uv(Vec2::new(0.0, 0.0));
         assert!((v.x - 16.5).abs() < 1e-3, "{v}");
+    }
+
+    #[test]
+    fn scaling_multiplies_radiance_and_keeps_the_placement() {
+        let m = gradient_map().rotated_y(37.0);
+        let gain = Vec3::new(2.0, 0.5, 1.0);
+        let s = m.scaled(gain).unwrap();
+        for d in [Vec3::X, Vec3::new(0.3, 0.5, -0.8).normalize(), -Vec3::Y] {
+            assert!((s.eval(d) - m.eval(d) * gain).length() < 1e-4 * m.eval(d).length());
+        }
+        assert_eq!(s.to_world(), m.to_world());
     }
 
     #[test]

@@ -10,7 +10,7 @@ use nprt_net::{Design, TrainOptions, DEFAULT_ENCODER_WIDTH};
 use crate::evaluation::{eval, train_deep_shading, DeepShadingArgs, EvalArgs};
 use crate::learn::{train, TrainArgs};
 use crate::relight::{render, RenderArgs};
-use crate::{DeviceArg, GenerateArgs};
+use crate::{DeviceArg, GenerateArgs, RunLength};
 
 #[derive(clap::Args)]
 pub struct DemoArgs {
@@ -31,8 +31,10 @@ struct Plan {
     train_res: u32,
     test_res: u32,
     spp: u32,
-    epochs: usize,
-    deep_shading_epochs: usize,
+    test_spp: u32,
+    /// Each design's training (the measured recipe, unless it says otherwise).
+    training: RunLength,
+    deep_shading: RunLength,
     sh_spp: u32,
     timing_res: u32,
     frames: usize,
@@ -45,8 +47,9 @@ const FULL: Plan = Plan {
     train_res: 64,
     test_res: 96,
     spp: 64,
-    epochs: 6,
-    deep_shading_epochs: 15,
+    test_spp: 1024,
+    training: minutes(2.0),
+    deep_shading: minutes(2.0),
     sh_spp: 256,
     timing_res: 512,
     frames: 48,
@@ -59,13 +62,32 @@ const QUICK: Plan = Plan {
     train_res: 32,
     test_res: 32,
     spp: 16,
-    epochs: 2,
-    deep_shading_epochs: 2,
+    test_spp: 32,
+    training: epochs(2),
+    deep_shading: epochs(2),
     sh_spp: 16,
     timing_res: 64,
     frames: 4,
     frame_res: 48,
 };
+
+/// A training budget of wall-clock minutes: what a faster machine gets is a better model.
+const fn minutes(m: f64) -> RunLength {
+    RunLength {
+        epochs: None,
+        minutes: Some(m),
+        schedule: None,
+    }
+}
+
+/// A fixed number of epochs, for a reproducible quick run.
+const fn epochs(e: usize) -> RunLength {
+    RunLength {
+        epochs: Some(e),
+        minutes: None,
+        schedule: None,
+    }
+}
 
 pub fn demo(a: DemoArgs) -> Result<()> {
     let p = if a.quick { QUICK } else { FULL };
@@ -87,7 +109,10 @@ pub fn demo(a: DemoArgs) -> Result<()> {
         train_res: [p.train_res; 2],
         test_res: [p.test_res; 2],
         spp: p.spp,
+        test_spp: p.test_spp,
         seed: 0,
+        jitter_exposure: 1.0,
+        jitter_tint: 0.3,
         test_maps: None,
         shard: (0, 1),
         volume_min: None,
@@ -110,9 +135,9 @@ pub fn demo(a: DemoArgs) -> Result<()> {
             arch: design,
             activation: None,
             out: out.clone(),
-            epochs: p.epochs,
+            run: p.training,
             batch_size: defaults.batch_size,
-            lr: defaults.schedule.learning_rate,
+            lr: None,
             seed: defaults.schedule.seed,
             views_per_batch: defaults.views_per_batch,
             val_samples: defaults.val_samples,
@@ -128,7 +153,7 @@ pub fn demo(a: DemoArgs) -> Result<()> {
     train_deep_shading(DeepShadingArgs {
         data: data.clone(),
         out: deep.clone(),
-        epochs: p.deep_shading_epochs,
+        run: p.deep_shading,
         batch_views: deep_defaults.batch_views,
         lr: deep_defaults.schedule.learning_rate,
         seed: deep_defaults.schedule.seed,

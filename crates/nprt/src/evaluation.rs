@@ -7,7 +7,7 @@ use nprt_eval::{evaluate, write_report, EvalOptions, Evaluation};
 use nprt_net::deep_shading::{self, DeepShadingOptions};
 use nprt_net::Schedule;
 
-use crate::DeviceArg;
+use crate::{DeviceArg, RunLength};
 
 #[derive(clap::Args)]
 pub struct EvalArgs {
@@ -48,12 +48,13 @@ pub struct DeepShadingArgs {
     #[arg(long)]
     pub data: PathBuf,
     /// Model folder; re-running with the same settings resumes exactly where the last run
-    /// stopped (weights and Adam's moments), and a larger --epochs continues a finished one.
+    /// stopped (weights and Adam's moments), and a larger --epochs or --minutes continues a
+    /// finished one (with --schedule paper).
     #[arg(long)]
     pub out: PathBuf,
-    /// Passes over the training views.
-    #[arg(long, default_value_t = DeepShadingOptions::default().schedule.epochs)]
-    pub epochs: usize,
+    /// The run's length (--epochs: passes over the training views) and learning-rate schedule.
+    #[command(flatten)]
+    pub run: RunLength,
     /// Whole views per step.
     #[arg(long, default_value_t = DeepShadingOptions::default().batch_views)]
     pub batch_views: usize,
@@ -99,6 +100,16 @@ pub fn eval(a: EvalArgs) -> Result<Evaluation> {
             m.name, m.mean.l1, m.mean.rmse, m.mean.dssim, m.ms_per_view
         );
     }
+    if let Some(f) = &e.noise_floor {
+        println!(
+            "{:<32} {:>10.5} {:>10.5} {:>10.5} {:>12}",
+            format!("reference noise ({} spp)", e.reference_spp),
+            f.l1,
+            f.rmse,
+            f.dssim,
+            "–"
+        );
+    }
     for (claim, ok) in e.checks() {
         println!("{} {claim}", if ok { "holds: " } else { "FAILS: " });
     }
@@ -109,12 +120,11 @@ pub fn eval(a: EvalArgs) -> Result<Evaluation> {
 pub fn train_deep_shading(a: DeepShadingArgs) -> Result<()> {
     let defaults = DeepShadingOptions::default();
     let opts = DeepShadingOptions {
-        schedule: Schedule {
-            epochs: a.epochs,
+        schedule: a.run.apply(Schedule {
             learning_rate: a.lr,
             seed: a.seed,
             ..defaults.schedule
-        },
+        }),
         batch_views: a.batch_views,
         encoder_width: a.encoder_width,
     };

@@ -8,10 +8,10 @@ use nprt_net::data::TrainingSet;
 use nprt_net::encoder::check_input_width;
 use nprt_net::{device_name, is_cpu, Device};
 
-use crate::DeviceArg;
+use crate::{DeviceArg, RunLength};
 use nprt_net::{
-    layer_table, measure_throughput, Activation, Design, Engine, Init, ModelConfig, Schedule,
-    TrainOptions, DEFAULT_ENCODER_WIDTH,
+    layer_table, measure_throughput, recipe_rate, Activation, Design, Engine, Init, ModelConfig,
+    Schedule, TrainOptions, DEFAULT_ENCODER_WIDTH,
 };
 
 #[derive(clap::Args)]
@@ -44,19 +44,22 @@ pub struct TrainArgs {
     #[arg(long)]
     pub activation: Option<Activation>,
     /// Model folder to write; re-running with the same settings resumes the run in it, and a
-    /// larger --epochs continues a finished one.
+    /// larger --epochs or --minutes continues a finished one (with --schedule paper).
     #[arg(long)]
     pub out: PathBuf,
-    /// Passes over all foreground pixels of the training views (the paper: 500). On 2 CPU
-    /// cores one epoch of the default 400-view 128² dataset takes about 4 minutes (dsep).
-    #[arg(long, default_value_t = TrainOptions::default().schedule.epochs)]
-    pub epochs: usize,
+    /// The run's length (--epochs: passes over all foreground pixels of the training views,
+    /// the paper: 500; on 2 CPU cores one epoch of the default 400-view 128² dataset takes
+    /// about 4 minutes with dsep) and learning-rate schedule.
+    #[command(flatten)]
+    pub run: RunLength,
     /// Samples per batch.
     #[arg(long, default_value_t = TrainOptions::default().batch_size)]
     pub batch_size: usize,
-    /// Adam learning rate (the paper: 1e-4).
-    #[arg(long, default_value_t = TrainOptions::default().schedule.learning_rate)]
-    pub lr: f64,
+    /// Adam's (peak) learning rate [default with --schedule cosine: 1e-3 for albedo and dsep,
+    /// 5e-4 for prt, 3e-4 for baseline, measured on the demo's data (docs/model.md); with
+    /// --schedule paper, the paper's 1e-4].
+    #[arg(long)]
+    pub lr: Option<f64>,
     /// Seed of the initial weights and of the batch order.
     #[arg(long, default_value_t = TrainOptions::default().schedule.seed)]
     pub seed: u64,
@@ -196,6 +199,20 @@ pub fn model_info(a: ModelInfoArgs) -> Result<()> {
     Ok(())
 }
 
+/// The run's schedule: the measured recipe unless flags say otherwise.
+fn training_schedule(a: &TrainArgs) -> Schedule {
+    let s = a.run.apply(Schedule {
+        seed: a.seed,
+        checkpoint_secs: a.checkpoint_minutes * 60.0,
+        progress: true,
+        ..TrainOptions::default().schedule
+    });
+    Schedule {
+        learning_rate: a.lr.unwrap_or_else(|| recipe_rate(a.arch, s.lr_schedule)),
+        ..s
+    }
+}
+
 pub fn train(a: TrainArgs) -> Result<()> {
     let config = config(a.arch, a.activation, a.encoder_width)?;
     let t0 = std::time::Instant::now();
@@ -211,13 +228,7 @@ pub fn train(a: TrainArgs) -> Result<()> {
         t0.elapsed().as_secs_f64()
     );
     let opts = TrainOptions {
-        schedule: Schedule {
-            epochs: a.epochs,
-            learning_rate: a.lr,
-            seed: a.seed,
-            checkpoint_secs: a.checkpoint_minutes * 60.0,
-            progress: true,
-        },
+        schedule: training_schedule(&a),
         batch_size: a.batch_size,
         views_per_batch: a.views_per_batch,
         val_samples: a.val_samples,
@@ -228,10 +239,10 @@ pub fn train(a: TrainArgs) -> Result<()> {
         println!("resumed from epoch {e:.2}");
     }
     println!(
-        "trained {} ({}) for {} epochs: {} steps, {:.2} M samples in {:.1} s ({:.0} K samples/s); training loss {:.5}, validation loss {:.5}",
+        "trained {} ({}) for {:.2} epochs: {} steps, {:.2} M samples in {:.1} s ({:.0} K samples/s); training loss {:.5}, validation loss {:.5}",
         a.arch.name(),
         config.activation.name(),
-        a.epochs,
+        s.epochs,
         s.steps,
         s.samples as f64 / 1e6,
         s.seconds,

@@ -50,6 +50,42 @@ impl DeviceArg {
     }
 }
 
+/// How long a training run lasts and how its learning rate moves, shared by both trainings.
+#[derive(clap::Args, Clone, Copy)]
+pub(crate) struct RunLength {
+    /// Passes over the training data [default: 20, or as many as fit with --minutes].
+    #[arg(long)]
+    pub(crate) epochs: Option<usize>,
+    /// Wall-clock budget: stop when the run's training time reaches this many minutes (or
+    /// after --epochs if given, whichever comes first). The same command continues a stopped
+    /// run up to the budget.
+    #[arg(long)]
+    pub(crate) minutes: Option<f64>,
+    /// Learning-rate schedule: paper (--lr throughout, as the paper) or cosine (warm-up over
+    /// the first 2% of the run, then a cosine decay to 5% of --lr at its end: the last epoch,
+    /// or the end of --minutes). A cosine run keeps its length: it cannot be lengthened later.
+    /// [default: cosine for train, paper for train-deep-shading]
+    #[arg(long)]
+    pub(crate) schedule: Option<nprt_net::LrSchedule>,
+}
+
+impl RunLength {
+    /// `defaults` with this run's length and schedule.
+    pub(crate) fn apply(self, defaults: nprt_net::Schedule) -> nprt_net::Schedule {
+        let epochs = match (self.epochs, self.minutes) {
+            (Some(e), _) => e,
+            (None, Some(_)) => usize::MAX,
+            (None, None) => defaults.epochs,
+        };
+        nprt_net::Schedule {
+            epochs,
+            minutes: self.minutes,
+            lr_schedule: self.schedule.unwrap_or(defaults.lr_schedule),
+            ..defaults
+        }
+    }
+}
+
 #[derive(Subcommand)]
 enum Command {
     /// Path-trace a scene through its own sensor and film (box pixel filter, the integrator's
@@ -57,7 +93,7 @@ enum Command {
     Reference(ReferenceArgs),
     /// The whole pipeline on the built-in scene and lighting: generate a dataset, train the four
     /// designs and Deep Shading, evaluate them against the baselines, relight a camera path
-    /// under held-out lighting. About 14 minutes on 2 cores; --quick under a minute.
+    /// under held-out lighting. About 15 minutes on 2 cores; --quick under a minute.
     Demo(demo::DemoArgs),
     /// Render a training dataset: G-buffers and radiance of many views under many lightings
     /// (documented in docs/dataset.md). Resumable; shards may run at once into one folder.
@@ -109,7 +145,9 @@ pub(crate) struct GenerateArgs {
     /// Scene: builtin:room, or a Mitsuba .xml / glTF / mesh file (then give the camera volume).
     #[arg(long)]
     pub(crate) scene: String,
-    /// Environment maps: a folder of .exr/.hdr lat-long maps, or `builtin` (16 skies, 8 indoor).
+    /// Environment maps: a folder of .exr/.hdr lat-long maps (a fifth held out for the test
+    /// views), or `builtin`: a fresh procedural lighting for every view (random sun and sky,
+    /// or indoor windows and lamps), the test views' never seen in training.
     #[arg(long)]
     pub(crate) envmaps: String,
     /// Dataset folder; re-running with the same settings resumes it.
@@ -127,13 +165,26 @@ pub(crate) struct GenerateArgs {
     /// Test view resolution, N or WxH (the paper: 400).
     #[arg(long, default_value = "128", value_parser = parse_resolution)]
     pub(crate) test_res: [u32; 2],
-    /// Samples per pixel, every one through the pixel centre.
+    /// Samples per pixel of the training views, every one through the pixel centre.
     #[arg(long, default_value_t = 64)]
     pub(crate) spp: u32,
+    /// Samples per pixel of the test views, the references every method is scored against:
+    /// rendered as two independent halves (so even), from which `nprt eval` measures the
+    /// references' own noise.
+    #[arg(long, default_value_t = 1024)]
+    pub(crate) test_spp: u32,
+    /// Exposure jitter of the training views' maps, in stops: each view's map is scaled by 2^e,
+    /// e uniform in ±this (recorded per view in the manifest; test views are never jittered).
+    #[arg(long, default_value_t = 1.0)]
+    pub(crate) jitter_exposure: f32,
+    /// White-balance jitter of the training views' maps, in stops: red and blue scaled by
+    /// 2^r, 2^b (r, b uniform in ±this) against green, at unchanged luminance.
+    #[arg(long, default_value_t = 0.3)]
+    pub(crate) jitter_tint: f32,
     /// Seed of every random choice (cameras, split, rotations, pixels).
     #[arg(long, default_value_t = 0)]
     pub(crate) seed: u64,
-    /// Maps held out for testing (default: a fifth, at least one).
+    /// Maps of the folder held out for testing (default: a fifth, at least one).
     #[arg(long)]
     pub(crate) test_maps: Option<usize>,
     /// Render only views with index ≡ K (mod N), e.g. 0/4 … 3/4 on four machines.
@@ -382,11 +433,8 @@ pub(crate) fn generate(a: GenerateArgs) -> Result<()> {
             )
         })?,
     };
-    let specs = if a.envmaps == "builtin" {
-        lighting::builtin_specs()
-    } else {
-        lighting::specs_in_dir(Path::new(&a.envmaps))?
-    };
+    let (specs, assignment) =
+        lighting::choose(&a.envmaps, a.train_views, a.test_views, a.test_maps, a.seed)?;
     let maps = lighting::load_all(&specs)?;
     for m in maps.iter().filter(|m| m.clamped_negative() > 0) {
         eprintln!(
@@ -401,9 +449,7 @@ pub(crate) fn generate(a: GenerateArgs) -> Result<()> {
         scene: &scene,
         scene_source: source,
         volume,
-        test_maps: a
-            .test_maps
-            .unwrap_or_else(|| lighting::default_test_count(maps.len())),
+        lighting: assignment,
         map_specs: specs,
         maps,
         train_views: a.train_views,
@@ -411,7 +457,12 @@ pub(crate) fn generate(a: GenerateArgs) -> Result<()> {
         train_resolution: a.train_res,
         test_resolution: a.test_res,
         spp: a.spp,
+        test_spp: a.test_spp,
         seed: a.seed,
+        jitter: nprt_data::dataset::Jitter {
+            exposure: a.jitter_exposure,
+            tint: a.jitter_tint,
+        },
     };
     let ts = TraceScene::new(&scene);
     // Planning validates the split and places cameras; only then is anything written.
@@ -419,9 +470,9 @@ pub(crate) fn generate(a: GenerateArgs) -> Result<()> {
     dataset::prepare(&a.out, &manifest)?;
     let s = &manifest.settings;
     println!(
-        "dataset {}: {} train views ({}×{}) under {} maps, {} test views ({}×{}) under {} held-out maps, {} spp; shard {}/{}",
-        a.out.display(), s.train_views, s.train_resolution[0], s.train_resolution[1], s.train_maps.len(),
-        s.test_views, s.test_resolution[0], s.test_resolution[1], s.test_maps.len(), s.spp, a.shard.0, a.shard.1
+        "dataset {}: {} train views ({}×{}, {} spp) under {} maps, {} test views ({}×{}, {} spp) under {} held-out maps; shard {}/{}",
+        a.out.display(), s.train_views, s.train_resolution[0], s.train_resolution[1], s.spp, s.train_maps.len(),
+        s.test_views, s.test_resolution[0], s.test_resolution[1], a.test_spp, s.test_maps.len(), a.shard.0, a.shard.1
     );
     let summary = dataset::run(&ts, &request.maps, &manifest, &a.out, a.shard, true)?;
     for r in &summary.redone {

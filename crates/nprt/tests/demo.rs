@@ -53,6 +53,10 @@ fn quick_demo_then_render_and_eval() {
             let v = m["mean"][k].as_f64().unwrap();
             assert!(v.is_finite() && v >= 0.0, "{} {k} = {v}", m["name"]);
         }
+        for c in m["level"].as_array().unwrap() {
+            let l = c.as_f64().unwrap();
+            assert!(l > 0.0 && l.is_finite(), "{} level {l}", m["name"]);
+        }
     }
     // The parameter counts are the paper's (D/S within 2%) and Deep Shading's is comparable.
     let params = |n: &str| {
@@ -90,9 +94,24 @@ fn quick_demo_then_render_and_eval() {
         "corr(error, directness)",
         "images/error-vs-directness.png",
         "images/loss-nprt-dsep.png",
+        "| *reference noise floor* |",
+        "of the best method's L1",
     ] {
         assert!(md.contains(want), "report.md lacks {want}");
     }
+    let floor = results["noise_floor"]["l1"].as_f64().unwrap();
+    let best = results["methods"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|m| m["mean"]["l1"].as_f64().unwrap())
+        .fold(f64::INFINITY, f64::min);
+    // No method can do much better than a perfect prediction (the floor's own estimate is noisy).
+    assert!(
+        floor > 0.0 && floor < 2.0 * best,
+        "noise floor {floor}, best L1 {best}"
+    );
+    assert_eq!(results["reference_spp"], 32);
     let html = std::fs::read_to_string(report.join("report.html")).unwrap();
     assert!(
         !html.contains("src=\"images/") && html.matches("data:image/png;base64,").count() > 20,

@@ -22,6 +22,8 @@ const SMALL: &[&str] = &[
     "32x16",
     "--spp",
     "4",
+    "--test-spp",
+    "8",
     "--seed",
     "3",
 ];
@@ -106,7 +108,7 @@ fn resume_redoes_only_missing_and_corrupt_views() {
 #[test]
 fn manifest_records_split_rotations_and_cameras() {
     let dir = tmp("manifest");
-    generate(&dir, &["--test-maps", "4"]);
+    generate(&dir, &[]);
     let m: serde_json::Value =
         serde_json::from_slice(&std::fs::read(dir.join("manifest.json")).unwrap()).unwrap();
     let s = &m["settings"];
@@ -122,19 +124,32 @@ fn manifest_records_split_rotations_and_cameras() {
         .iter()
         .map(|v| v.as_u64().unwrap())
         .collect();
-    assert_eq!((train.len(), test.len()), (20, 4));
+    // builtin lighting: one fresh map per view, training views' maps jittered, test views' not.
+    assert_eq!((train, test), ((0..5).collect(), vec![5, 6]));
+    let specs: Vec<&str> = s["envmaps"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|e| e["spec"].as_str().unwrap())
+        .collect();
+    assert!(specs.iter().all(|x| x.starts_with("builtin:")));
     assert!(
-        train.iter().all(|t| !test.contains(t)),
-        "test maps never appear in training"
+        (1..specs.len()).all(|i| !specs[..i].contains(&specs[i])),
+        "{specs:?}"
     );
+    assert_eq!(s["test_spp"], 8);
     for v in m["views"].as_array().unwrap() {
-        let map = v["map"].as_u64().unwrap();
-        let pool = if v["split"] == "train" { &train } else { &test };
-        assert!(
-            pool.contains(&map),
-            "view {} uses map {map} from the wrong split",
-            v["index"]
-        );
+        assert_eq!(v["map"], v["index"]);
+        let gain = v["gain"].as_array();
+        if v["split"] == "train" {
+            let g: Vec<f64> = gain.unwrap().iter().map(|x| x.as_f64().unwrap()).collect();
+            assert!(
+                g.iter().all(|x| (0.2..5.0).contains(x)) && g[0] != g[2],
+                "{g:?}"
+            );
+        } else {
+            assert!(gain.is_none(), "a test view is jittered: {v}");
+        }
         let r = v["rotation_deg"].as_f64().unwrap();
         assert!((0.0..360.0).contains(&r));
         assert_eq!(v["camera_to_world"].as_array().unwrap().len(), 16);
@@ -267,6 +282,8 @@ fn real_maps_and_a_file_scene_with_flags_work() {
         "16",
         "--spp",
         "2",
+        "--test-spp",
+        "4",
     ]);
     assert!(
         out.contains("under 2 maps") && out.contains("under 1 held-out maps"),

@@ -30,6 +30,8 @@ fn dataset() -> &'static Path {
             "12",
             "--spp",
             "16",
+            "--test-spp",
+            "32",
         ]);
         dir
     })
@@ -37,11 +39,15 @@ fn dataset() -> &'static Path {
 
 /// Small-run settings: 64-wide encoder input, batches of 64 mixing all 3 views.
 fn train(out: &Path, arch: &str, extra: &[&str]) -> String {
-    let data = dataset().to_str().unwrap();
+    ok(&train_args(out, arch, extra))
+}
+
+/// The arguments of [`train`].
+fn train_args<'a>(out: &'a Path, arch: &'a str, extra: &[&'a str]) -> Vec<&'a str> {
     let mut args = vec![
         "train",
         "--data",
-        data,
+        dataset().to_str().unwrap(),
         "--arch",
         arch,
         "--out",
@@ -56,7 +62,7 @@ fn train(out: &Path, arch: &str, extra: &[&str]) -> String {
         "256",
     ];
     args.extend_from_slice(extra);
-    ok(&args)
+    args
 }
 
 /// (train, val) columns of loss.csv, empty cells as None.
@@ -108,9 +114,11 @@ fn a_tiny_dataset_is_overfit() {
 fn resumed_training_equals_an_uninterrupted_run() {
     let straight = fresh_dir("resume-straight");
     let resumed = fresh_dir("resume-parts");
-    train(&straight, "albedo", &["--epochs", "3"]);
-    train(&resumed, "albedo", &["--epochs", "1"]);
-    let out = train(&resumed, "albedo", &["--epochs", "3"]);
+    // The paper's constant rate lets a finished run be lengthened.
+    let paper = |epochs| ["--epochs", epochs, "--schedule", "paper"];
+    train(&straight, "albedo", &paper("3"));
+    train(&resumed, "albedo", &paper("1"));
+    let out = train(&resumed, "albedo", &paper("3"));
     assert!(out.contains("resumed from epoch 1.00"), "{out}");
     let weights = |d: &Path| std::fs::read(d.join("weights.safetensors")).unwrap();
     assert!(
@@ -121,7 +129,7 @@ fn resumed_training_equals_an_uninterrupted_run() {
     assert_eq!(val(&straight), val(&resumed));
     // The same seed gives the same model; another seed another one.
     let again = fresh_dir("resume-again");
-    train(&again, "albedo", &["--epochs", "3"]);
+    train(&again, "albedo", &paper("3"));
     assert!(weights(&again) == weights(&straight));
     let other = fresh_dir("resume-seed");
     train(&other, "albedo", &["--epochs", "1", "--seed", "7"]);
@@ -280,5 +288,52 @@ fn bad_runs_stop_clearly_and_keep_the_last_good_checkpoint() {
     fails(
         &["model", "info", "--model", o],
         &["belong to design 'baseline', not 'prt'"],
+    );
+}
+
+/// `--minutes` stops a run at its budget (validated and saved there), and the same command
+/// then has nothing left to do; a cosine run keeps its length and differs from the paper's.
+#[test]
+fn a_time_budget_stops_the_run_and_a_cosine_run_keeps_its_length() {
+    let timed = fresh_dir("budget");
+    let out = train(&timed, "prt", &["--minutes", "0.005"]);
+    let state: serde_json::Value = serde_json::from_str(
+        &std::fs::read_to_string(timed.join("checkpoint/state.json")).unwrap(),
+    )
+    .unwrap();
+    let seconds = state["seconds"].as_f64().unwrap();
+    let steps = state["step"].as_u64().unwrap();
+    assert!(
+        (0.3..5.0).contains(&seconds) && steps > 0,
+        "{seconds} s, {steps} steps: {out}"
+    );
+    assert!(
+        losses(&timed).last().unwrap().1.is_some(),
+        "validated at the budget"
+    );
+    let again = train(&timed, "prt", &["--minutes", "0.005"]);
+    assert!(again.contains(&format!(" {steps} steps")), "{again}");
+
+    let cosine = fresh_dir("cosine");
+    let paper = fresh_dir("cosine-paper");
+    train(
+        &cosine,
+        "prt",
+        &["--epochs", "2", "--schedule", "cosine", "--lr", "1e-3"],
+    );
+    train(
+        &paper,
+        "prt",
+        &["--epochs", "2", "--lr", "1e-3", "--schedule", "paper"],
+    );
+    let weights = |d: &Path| std::fs::read(d.join("weights.safetensors")).unwrap();
+    assert!(weights(&cosine) != weights(&paper));
+    fails(
+        &train_args(
+            &cosine,
+            "prt",
+            &["--epochs", "3", "--schedule", "cosine", "--lr", "1e-3"],
+        ),
+        &["decaying --schedule"],
     );
 }

@@ -5,11 +5,12 @@ use std::path::Path;
 use std::time::Instant;
 
 use anyhow::{bail, Context, Result};
+use glam::Vec3;
 use nprt_scene::EnvMap;
-use nprt_trace::{render, PixelFilter, RenderSettings, TraceScene};
+use nprt_trace::{render, Frame, PixelFilter, RenderSettings, TraceScene};
 
 use super::manifest::{load_manifest, Manifest, ViewRecord, MANIFEST};
-use super::view_file::check_view;
+use super::view_file::{check_view, write_view, ViewImage};
 
 /// Creates the dataset folder and its manifest, or checks that an existing one was made with
 /// the same settings.
@@ -36,7 +37,11 @@ pub fn prepare(dir: &Path, manifest: &Manifest) -> Result<()> {
     nprt_io::write_file(&dir.join(MANIFEST), &text)
 }
 
-/// Renders one view to its file.
+/// Salt of the second half's random streams of a view rendered in halves.
+const SECOND_HALF: u64 = 0x9e37_79b9_7f4a_7c15;
+
+/// Renders one view to its file: a test view of a dataset with `test_spp` as two independent
+/// halves, averaged, the first kept apart.
 pub fn render_view(
     ts: &TraceScene,
     maps: &[EnvMap],
@@ -45,17 +50,48 @@ pub fn render_view(
     dir: &Path,
 ) -> Result<()> {
     let s = &manifest.settings;
-    let env = maps[view.map].rotated_y(view.rotation_deg);
+    let env = view.lighting(maps)?;
     let settings = RenderSettings {
-        spp: s.spp,
+        spp: s.spp_of(view),
         max_depth: s.max_depth,
         rr_depth: s.rr_depth,
         seed: view.seed,
         filter: PixelFilter::Centre,
         progress: false,
     };
-    let frame = render(ts, &view.camera(), &env, &settings);
-    frame.write_exr(&dir.join(&view.file))
+    let image = if s.in_halves(view) {
+        let half = |seed| {
+            render(
+                ts,
+                &view.camera(),
+                &env,
+                &RenderSettings {
+                    spp: settings.spp / 2,
+                    seed,
+                    ..settings.clone()
+                },
+            )
+        };
+        let (first, second) = (half(view.seed), half(view.seed ^ SECOND_HALF));
+        let mean = |a: &[Vec3], b: &[Vec3]| a.iter().zip(b).map(|(x, y)| (*x + *y) * 0.5).collect();
+        let frame = Frame {
+            width: first.width,
+            height: first.height,
+            radiance: mean(&first.radiance, &second.radiance),
+            direct: mean(&first.direct, &second.direct),
+            gbuffer: first.gbuffer,
+        };
+        ViewImage {
+            frame,
+            half: Some(first.radiance),
+        }
+    } else {
+        ViewImage {
+            frame: render(ts, &view.camera(), &env, &settings),
+            half: None,
+        }
+    };
+    write_view(&dir.join(&view.file), &image)
 }
 
 #[derive(Debug, Default)]
@@ -85,7 +121,10 @@ pub fn run(
     let mut summary = Summary::default();
     for v in mine {
         let path = dir.join(&v.file);
-        match path.exists().then(|| check_view(&path, v)) {
+        match path
+            .exists()
+            .then(|| check_view(&path, v, manifest.settings.in_halves(v)))
+        {
             Some(Ok(())) => summary.skipped += 1,
             Some(Err(e)) => {
                 summary.redone.push(format!("{}: {e:#}", v.file));
@@ -100,10 +139,92 @@ pub fn run(
         render_view(ts, maps, manifest, v, dir)
             .with_context(|| format!("view {} ({})", v.index, v.file))?;
         summary.rendered += 1;
-        summary.samples += v.width as f64 * v.height as f64 * manifest.settings.spp as f64;
+        summary.samples += v.width as f64 * v.height as f64 * manifest.settings.spp_of(v) as f64;
         bar.inc(1);
     }
     bar.finish_and_clear();
     summary.seconds = t0.elapsed().as_secs_f64();
     Ok(summary)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::dataset::{plan, read_view, scene_source, Jitter, MapAssignment, Request};
+    use nprt_scene::{load_scene, SceneOptions};
+
+    fn mse(a: &[Vec3], b: &[Vec3]) -> f64 {
+        let sum: f64 = a
+            .iter()
+            .zip(b)
+            .map(|(x, y)| (*x - *y).length_squared() as f64)
+            .sum();
+        sum / (3 * a.len()) as f64
+    }
+
+    /// A test view rendered in halves holds their mean and the first half apart, and the first
+    /// half's distance to the whole is the whole's own noise (its distance to a converged image).
+    #[test]
+    fn test_views_in_halves_hold_their_own_noise() {
+        let scene = load_scene("builtin:room", &SceneOptions::default()).unwrap();
+        let ts = TraceScene::new(&scene);
+        let map_specs: Vec<String> = ["builtin:indoor:1", "builtin:indoor:2"]
+            .map(String::from)
+            .into();
+        let maps = crate::lighting::load_all(&map_specs).unwrap();
+        let request = Request {
+            scene_spec: "builtin:room".into(),
+            scene: &scene,
+            scene_source: scene_source("builtin:room").unwrap(),
+            volume: scene.camera_volume.clone().unwrap(),
+            map_specs,
+            maps,
+            lighting: MapAssignment::Pool { test_maps: 1 },
+            train_views: 1,
+            test_views: 1,
+            train_resolution: [8, 8],
+            test_resolution: [32, 32],
+            spp: 2,
+            test_spp: 8,
+            seed: 0,
+            jitter: Jitter::default(),
+        };
+        let manifest = plan(&request, &ts).unwrap();
+        let dir = std::env::temp_dir().join(format!("nprt-halves-{}", std::process::id()));
+        prepare(&dir, &manifest).unwrap();
+        run(&ts, &request.maps, &manifest, &dir, (0, 1), false).unwrap();
+        let view = |split: &str| manifest.views.iter().find(|v| v.split == split).unwrap();
+        let (train, test) = (view("train"), view("test"));
+        assert!(!manifest.settings.in_halves(train) && manifest.settings.in_halves(test));
+        let train_file = dir.join(&train.file);
+        assert!(read_view(&train_file, train, false).unwrap().half.is_none());
+        let err = read_view(&train_file, train, true)
+            .err()
+            .unwrap()
+            .to_string();
+        assert!(err.contains("half.R"), "{err}");
+
+        let image = read_view(&dir.join(&test.file), test, true).unwrap();
+        let (whole, half) = (&image.frame.radiance, image.half.unwrap());
+        let env = test.lighting(&request.maps).unwrap();
+        let at = |spp, seed| RenderSettings {
+            spp,
+            max_depth: scene.max_depth,
+            rr_depth: scene.rr_depth,
+            seed,
+            filter: PixelFilter::Centre,
+            progress: false,
+        };
+        let second = render(&ts, &test.camera(), &env, &at(4, test.seed ^ SECOND_HALF));
+        for ((w, a), b) in whole.iter().zip(&half).zip(&second.radiance) {
+            assert!((*w - (*a + *b) * 0.5).abs().max_element() <= 1e-6 * (1.0 + w.max_element()));
+        }
+        let converged = render(&ts, &test.camera(), &env, &at(2048, 99));
+        let (floor, actual) = (mse(&half, whole), mse(whole, &converged.radiance));
+        assert!(
+            actual > 0.0 && (floor / actual - 1.0).abs() < 0.35,
+            "floor {floor}, actual {actual}"
+        );
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
 }

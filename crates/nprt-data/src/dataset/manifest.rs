@@ -4,8 +4,8 @@
 use std::path::Path;
 
 use anyhow::{bail, Context, Result};
-use glam::Mat4;
-use nprt_scene::{Camera, FovAxis};
+use glam::{Mat4, Vec3};
+use nprt_scene::{Camera, EnvMap, FovAxis};
 use serde::{Deserialize, Serialize};
 
 pub const FORMAT_VERSION: u32 = 1;
@@ -25,11 +25,35 @@ pub struct Settings {
     pub test_views: u64,
     pub train_resolution: [u32; 2],
     pub test_resolution: [u32; 2],
+    /// Samples per pixel of the training views.
     pub spp: u32,
+    /// Samples per pixel of the test views (the references of evaluation), rendered as two
+    /// independent halves whose first is kept to measure the reference's own noise. Absent in
+    /// datasets made before it existed: their test views are at `spp`, in one piece.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub test_spp: Option<u32>,
     pub max_depth: Option<u32>,
     pub rr_depth: u32,
     pub seed: u64,
+    /// Random exposure and white-balance changes of the training views' maps.
+    #[serde(default, skip_serializing_if = "Jitter::is_none")]
+    pub jitter: Jitter,
     pub camera_volume: VolumeRecord,
+}
+
+/// How far a training view's map may be brightened, darkened and tinted, in stops: its gain
+/// is 2^e · (2^r, 1, 2^b) normalised to unit luminance, with e uniform in ±`exposure` and r, b
+/// in ±`tint`. Test views are never jittered.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct Jitter {
+    pub exposure: f32,
+    pub tint: f32,
+}
+
+impl Jitter {
+    pub fn is_none(&self) -> bool {
+        self.exposure == 0.0 && self.tint == 0.0
+    }
 }
 
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -68,8 +92,19 @@ pub struct ViewRecord {
     pub map: usize,
     /// Rotation of the map about +Y, degrees.
     pub rotation_deg: f32,
+    /// RGB factor of the map's radiance (exposure and white balance; see [`Jitter`]).
+    #[serde(default = "unit_gain", skip_serializing_if = "is_unit_gain")]
+    pub gain: [f32; 3],
     /// Seed of the view's per-pixel random streams.
     pub seed: u64,
+}
+
+fn unit_gain() -> [f32; 3] {
+    [1.0; 3]
+}
+
+fn is_unit_gain(g: &[f32; 3]) -> bool {
+    *g == unit_gain()
 }
 
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -97,6 +132,11 @@ impl Manifest {
                 "format_version is {}, this nprt reads {FORMAT_VERSION}",
                 s.format_version
             );
+        }
+        if let Some(n) = s.test_spp {
+            if n < 2 || n % 2 != 0 {
+                bail!("test_spp is {n}: it must be even and at least 2 (test views are rendered as two independent halves)");
+            }
         }
         let maps = s.envmaps.len();
         if let Some(&i) = s
@@ -141,6 +181,15 @@ impl Manifest {
             if !v.camera_to_world.iter().all(|x| x.is_finite()) || !v.rotation_deg.is_finite() {
                 bail!("{what}: camera_to_world or rotation_deg holds a non-finite number");
             }
+            if !v.gain.iter().all(|g| (1.0 / 64.0..=64.0).contains(g)) {
+                bail!("{what}: gain {:?} is not within [1/64, 64]", v.gain);
+            }
+            if v.split == "test" && !is_unit_gain(&v.gain) {
+                bail!(
+                    "{what}: a test view's map is never jittered, but its gain is {:?}",
+                    v.gain
+                );
+            }
             let file = Path::new(&v.file);
             if file.is_absolute()
                 || file
@@ -154,7 +203,37 @@ impl Manifest {
     }
 }
 
+impl Settings {
+    /// Whether `view`'s file holds the first half of its samples apart (see [`Settings::test_spp`]).
+    pub fn in_halves(&self, view: &ViewRecord) -> bool {
+        view.split == "test" && self.test_spp.is_some()
+    }
+
+    /// Samples per pixel of `view`.
+    pub fn spp_of(&self, view: &ViewRecord) -> u32 {
+        match (view.split.as_str(), self.test_spp) {
+            ("test", Some(n)) => n,
+            _ => self.spp,
+        }
+    }
+}
+
 impl ViewRecord {
+    /// The view's lighting: its map, scaled by its gain and rotated by its rotation.
+    pub fn lighting(&self, maps: &[EnvMap]) -> Result<EnvMap> {
+        let map = maps.get(self.map).with_context(|| {
+            format!(
+                "view '{}' names map {} of {}",
+                self.file,
+                self.map,
+                maps.len()
+            )
+        })?;
+        Ok(map
+            .scaled(Vec3::from_array(self.gain))?
+            .rotated_y(self.rotation_deg))
+    }
+
     pub fn camera(&self) -> Camera {
         Camera {
             to_world: Mat4::from_cols_array(&self.camera_to_world),

@@ -12,10 +12,10 @@ mod view_file;
 
 pub use generation::{prepare, render_view, run, Summary};
 pub use manifest::{
-    load_manifest, load_manifest_hashed, Manifest, MapRecord, Settings, ViewRecord, VolumeRecord,
-    FORMAT_VERSION, MANIFEST,
+    load_manifest, load_manifest_hashed, Jitter, Manifest, MapRecord, Settings, ViewRecord,
+    VolumeRecord, FORMAT_VERSION, MANIFEST,
 };
-pub use plan::{plan, Request};
+pub use plan::{plan, MapAssignment, Request};
 pub use scene_identity::{load_checked_scene, scene_hash, scene_source};
 pub use verify::{verify, Report};
-pub use view_file::{check_view, read_view};
+pub use view_file::{check_view, read_view, write_view, ViewImage};

@@ -1,24 +1,66 @@
-//! One view's OpenEXR file: read back and checked against its manifest record.
+//! One view's OpenEXR file: written from its render, read back and checked against its
+//! manifest record. A test view rendered in two halves also holds the first half's radiance
+//! (`half.R/G/B`), from which evaluation measures the reference's own noise.
 
 use std::path::Path;
 
-use anyhow::{bail, Result};
-use nprt_trace::exr_io::read_channels;
+use anyhow::{bail, Context, Result};
+use glam::Vec3;
+use nprt_trace::exr_io::{read_channels, write_channels};
 use nprt_trace::Frame;
 
 use super::manifest::ViewRecord;
 
+const HALF: [&str; 3] = ["half.R", "half.G", "half.B"];
+
+/// What a view file holds.
+pub struct ViewImage {
+    pub frame: Frame,
+    /// Radiance of the first half of the samples, for a view rendered in halves.
+    pub half: Option<Vec<Vec3>>,
+}
+
 /// Checks that a view file reads back complete: right size, every channel, finite values.
-pub fn check_view(path: &Path, view: &ViewRecord) -> Result<()> {
-    read_view(path, view).map(|_| ())
+pub fn check_view(path: &Path, view: &ViewRecord, in_halves: bool) -> Result<()> {
+    read_view(path, view, in_halves).map(|_| ())
+}
+
+/// Writes a view file atomically.
+pub fn write_view(path: &Path, image: &ViewImage) -> Result<()> {
+    let f = &image.frame;
+    let mut channels = f.channels();
+    if let Some(half) = &image.half {
+        for (k, name) in HALF.iter().enumerate() {
+            channels.push((name.to_string(), half.iter().map(|v| v[k]).collect()));
+        }
+    }
+    write_channels(path, f.width, f.height, &channels)
 }
 
 /// Reads a view file, refusing one whose size disagrees with its record, that lacks a channel
-/// or that holds non-finite values.
-pub fn read_view(path: &Path, view: &ViewRecord) -> Result<Frame> {
+/// (the half's too, when `in_halves`) or that holds non-finite values.
+pub fn read_view(path: &Path, view: &ViewRecord, in_halves: bool) -> Result<ViewImage> {
     let (w, h, ch) = read_channels(path)?;
     if (w, h) != (view.width as usize, view.height as usize) {
         bail!("is {w}×{h}, expected {}×{}", view.width, view.height);
     }
-    Frame::from_channels(w, h, &ch)
+    let frame = Frame::from_channels(w, h, &ch)?;
+    let half = if in_halves {
+        let [r, g, b] = HALF.map(|name| {
+            ch.get(name)
+                .with_context(|| format!("lacks channel '{name}'"))
+        });
+        let (r, g, b) = (r?, g?, b?);
+        if [r, g, b].iter().any(|c| c.len() != w * h) {
+            bail!("a half.* channel does not hold {w}×{h} values");
+        }
+        let half: Vec<Vec3> = (0..w * h).map(|i| Vec3::new(r[i], g[i], b[i])).collect();
+        if !half.iter().all(|v| v.is_finite()) {
+            bail!("channel half.* holds non-finite values");
+        }
+        Some(half)
+    } else {
+        None
+    };
+    Ok(ViewImage { frame, half })
 }

@@ -93,19 +93,15 @@ impl Split {
                         radiance[c * pw * ph + j] = v.radiance[i][c] * mask[j];
                     }
                 }
-                Sample {
+                Ok(Sample {
                     foreground: mask.iter().filter(|&&m| m > 0.5).count() as u64,
                     features,
                     radiance,
                     mask,
-                    light: LightInput::new(
-                        &maps[v.record.map],
-                        v.record.rotation_deg,
-                        encoder_width,
-                    ),
-                }
+                    light: LightInput::new(&v.record.lighting(maps)?, 0.0, encoder_width),
+                })
             })
-            .collect();
+            .collect::<Result<_>>()?;
         Ok(Split {
             samples,
             width: w.div_ceil(8) * 8,
