@@ -18,6 +18,8 @@ pub struct Accumulator {
     ms: Vec<f64>,
     /// Foreground sums of prediction and reference, per channel.
     sums: [DVec3; 2],
+    /// Each view's tint error.
+    tints: Vec<f64>,
 }
 
 impl Accumulator {
@@ -37,13 +39,16 @@ impl Accumulator {
                 error_by_specularity: vec![],
                 note: String::new(),
                 loss_png: None,
+                validation: vec![],
                 level: [f64::NAN; 3],
+                tint_error: f64::NAN,
             },
             err: vec![],
             direct: vec![],
             spec: vec![],
             ms: vec![],
             sums: [DVec3::ZERO; 2],
+            tints: vec![],
         }
     }
 
@@ -53,10 +58,11 @@ impl Accumulator {
             .per_view
             .push(Metrics::compute(pred, &view.radiance, &g.mask, view.width));
         self.ms.push(ms);
+        let mut sums = [DVec3::ZERO; 2];
         for i in (0..g.mask.len()).filter(|&i| g.mask[i] > 0.5) {
             let r = view.radiance[i];
-            self.sums[0] += pred[i].as_dvec3();
-            self.sums[1] += r.as_dvec3();
+            sums[0] += pred[i].as_dvec3();
+            sums[1] += r.as_dvec3();
             self.err
                 .push(((pred[i] - r).abs().element_sum() / 3.0) as f64);
             self.direct
@@ -64,6 +70,9 @@ impl Accumulator {
             let (kd, ks) = (g.kd[i].element_sum(), g.ks[i].element_sum());
             self.spec.push((ks / (kd + ks).max(1e-6)) as f64);
         }
+        self.sums[0] += sums[0];
+        self.sums[1] += sums[1];
+        self.tints.push(tint_error(sums[0] / sums[1]));
     }
 
     pub fn finish(mut self) -> MethodResult {
@@ -75,8 +84,15 @@ impl Accumulator {
         r.error_by_directness = binned(&self.direct, &self.err);
         r.error_by_specularity = binned(&self.spec, &self.err);
         r.level = (self.sums[0] / self.sums[1]).to_array();
+        r.tint_error = self.tints.iter().sum::<f64>() / self.tints.len().max(1) as f64;
         self.result
     }
+}
+
+/// The largest relative deviation of a channel's level from the mean of the three.
+fn tint_error(level: DVec3) -> f64 {
+    let mean = level.element_sum() / 3.0;
+    (level - DVec3::splat(mean)).abs().max_element() / mean.max(1e-12)
 }
 
 /// Mean of `y` in `BINS` equal bins of `x` ∈ [0, 1] (NaN where a bin is empty).
@@ -92,4 +108,18 @@ fn binned(x: &[f64], y: &[f64]) -> Vec<f64> {
         .zip(&n)
         .map(|(s, &c)| if c > 0 { s / c as f64 } else { f64::NAN })
         .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn tint_error_ignores_brightness_and_measures_colour_balance() {
+        assert!(tint_error(DVec3::splat(0.7)) < 1e-12);
+        assert!(tint_error(DVec3::splat(1.3)) < 1e-12);
+        // A warm map rendered neutral: red 20% under the mean, blue 20% over it.
+        assert!((tint_error(DVec3::new(0.8, 1.0, 1.2)) - 0.2).abs() < 1e-12);
+        assert!((tint_error(DVec3::new(0.4, 0.5, 0.6)) - 0.2).abs() < 1e-12);
+    }
 }

@@ -58,9 +58,17 @@ pub struct MethodResult {
     pub note: String,
     /// Training curve, for networks.
     pub loss_png: Option<PathBuf>,
+    /// Validation loss against seconds of training, for networks (from their loss.csv).
+    #[serde(default)]
+    pub validation: Vec<(f64, f64)>,
     /// Level and tint: the prediction's foreground sum over the reference's, per channel (1 is
     /// right; a uniformly dark prediction is below 1 in all three, a wrong tint differs among
     /// them).
     #[serde(default)]
     pub level: [f64; 3],
+    /// Tint error: per test view, the largest deviation of a channel's level from the view's
+    /// mean level, relative to it (0 is the reference's colour balance, whatever the
+    /// brightness); averaged over views. It tells a held-out map's colour rendered wrong.
+    #[serde(default)]
+    pub tint_error: f64,
 }

@@ -151,6 +151,21 @@ fn check_model(
     Ok(())
 }
 
+/// A model folder's validation loss against its training seconds; a loss.csv that cannot be
+/// read costs the report this curve only.
+fn validation_curve(dir: &Path, name: &str) -> Vec<(f64, f64)> {
+    match nprt_net::curves::read_csv(&dir.join("loss.csv")) {
+        Ok(rows) => rows
+            .iter()
+            .filter_map(|r| Some((r.seconds, r.val?)))
+            .collect(),
+        Err(e) => {
+            eprintln!("warning: {e:#}; the report leaves out {name}'s validation curve");
+            Vec::new()
+        }
+    }
+}
+
 /// Every network on every test view; its cost per view is the G-buffer, the encoder and the
 /// network, as at run time.
 pub fn run_networks(bench: &mut TestBench, nets: &[(Net, String)]) -> Vec<MethodResult> {
@@ -159,6 +174,7 @@ pub fn run_networks(bench: &mut TestBench, nets: &[(Net, String)]) -> Vec<Method
         let mut acc = Accumulator::new(name, net.family(), Some(net.params()));
         let loss_png = net.dir().join("loss.png");
         acc.result.loss_png = loss_png.is_file().then_some(loss_png);
+        acc.result.validation = validation_curve(net.dir(), name);
         for (k, v) in bench.views.iter().enumerate() {
             bench.bar.set_message(name.clone());
             let t = Instant::now();

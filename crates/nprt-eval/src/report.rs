@@ -171,7 +171,7 @@ fn errors(md: &mut String, e: &Evaluation) -> Result<()> {
     }
     writeln!(
         md,
-        " ms / view | level R / G / B |\n|---|---|{}---|---|",
+        " ms / view | level R / G / B | tint error |\n|---|---|{}---|---|---|",
         "---|".repeat(Metrics::NAMES.len())
     )?;
     for m in &e.methods {
@@ -185,14 +185,18 @@ fn errors(md: &mut String, e: &Evaluation) -> Result<()> {
             write!(md, " {} |", fmt(v))?;
         }
         let [r, g, b] = m.level;
-        writeln!(md, " {:.1} | {r:.3} / {g:.3} / {b:.3} |", m.ms_per_view)?;
+        writeln!(
+            md,
+            " {:.1} | {r:.3} / {g:.3} / {b:.3} | {:.3} |",
+            m.ms_per_view, m.tint_error
+        )?;
     }
     if let Some(floor) = &e.noise_floor {
         write!(md, "| *reference noise floor* | – |")?;
         for v in floor.values() {
             write!(md, " {} |", fmt(v))?;
         }
-        writeln!(md, " – | – |")?;
+        writeln!(md, " – | – | – |")?;
     }
     writeln!(md)?;
     noise_floor_note(md, e)?;
@@ -210,7 +214,9 @@ fn errors(md: &mut String, e: &Evaluation) -> Result<()> {
         md,
         "- Level R / G / B: each channel's sum of the prediction over the reference's, on the \
          foreground of every test view; 1 is right, below 1 in all three is too dark, unequal \
-         values are a wrong tint."
+         values are a wrong tint. Tint error: per view, the largest deviation of a channel's \
+         level from the mean of the three, relative to it, averaged over views (0 is the \
+         reference's colour balance at any brightness)."
     )?;
     writeln!(md, "- Denoiser: {}.\n", e.denoiser)?;
     Ok(())
@@ -378,9 +384,26 @@ fn images(md: &mut String, e: &Evaluation, dir: &Path) -> Result<()> {
     Ok(())
 }
 
-/// The networks' loss curves.
+/// The networks' validation loss against training time on one plot (recipes and designs
+/// compared at equal wall time), then each network's own loss curves.
 fn training_curves(md: &mut String, e: &Evaluation, dir: &Path) -> Result<()> {
     writeln!(md, "## Training curves\n")?;
+    let series: Vec<(String, Vec<(f64, f64)>)> = e
+        .methods
+        .iter()
+        .filter(|m| !m.validation.is_empty())
+        .map(|m| (m.name.clone(), m.validation.clone()))
+        .collect();
+    if !series.is_empty() {
+        let rel = "images/validation-vs-seconds.png";
+        plot_lines(
+            &dir.join(rel),
+            "validation loss (held-out lighting) against training time",
+            ("seconds of training", "validation log-L1"),
+            &series,
+        )?;
+        writeln!(md, "![validation loss against training time]({rel})\n")?;
+    }
     for m in e.methods.iter().filter(|m| m.loss_png.is_some()) {
         let rel = format!("images/loss-{}.png", slug(&m.name));
         std::fs::copy(m.loss_png.as_ref().unwrap(), dir.join(&rel))

@@ -6,7 +6,7 @@ use burn::tensor::{Device, Int, Tensor, TensorData};
 use crate::data::ViewSamples;
 use crate::design::NprtNet;
 use crate::features::FEATURES;
-use crate::loss::log_l1;
+use crate::loss::Loss;
 
 /// Which code computes a batch's gradients.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -84,19 +84,20 @@ impl Batch {
         (net.forward(f, self.light_tensor(device), v, s), r)
     }
 
-    /// The paper's loss on this batch and every parameter's gradient (`device` is an autodiff
-    /// device), computed by `engine`.
+    /// `loss` on this batch and every parameter's gradient (`device` is an autodiff device),
+    /// computed by `engine`.
     pub fn gradients(
         &self,
         net: &NprtNet,
         device: &Device,
         engine: Engine,
+        loss: Loss,
     ) -> (f64, GradientsParams) {
         if engine == Engine::Auto && crate::cpu::applies(net, device) {
-            return crate::cpu::gradients(net, self, device);
+            return crate::cpu::gradients(net, self, device, loss);
         }
         let (pred, reference) = self.forward(net, device);
-        let loss = log_l1(pred, reference);
+        let loss = loss.mean(pred, reference);
         let value = loss.clone().into_scalar::<f64>();
         (value, GradientsParams::from_grads(loss.backward(), net))
     }

@@ -52,7 +52,7 @@ pub use design::{Design, NprtNet, TRANSPORT_CODE};
 pub use encoder::{LightEncoder, LightInput};
 pub use features::{feature, gbuffer_features, pixel_features, FEATURES};
 pub use init::{conv2d, Init};
-pub use loss::log_l1;
+pub use loss::{log_l1, Loss};
 pub use lr_schedule::LrSchedule;
 pub use mlp::Mlp;
 pub use model::{layer_table, load_model, ModelConfig, ModelFile, DEFAULT_ENCODER_WIDTH};

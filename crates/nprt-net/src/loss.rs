@@ -1,14 +1,92 @@
-//! The paper's loss: L1 distance between log(1 + x) of predicted and reference radiance. One
-//! definition serves training (every network, Deep Shading included) and the log-L1 metric.
+//! The training losses: the paper's L1 distance between log(1 + x) of predicted and reference
+//! radiance, and a relative L2 whose minimiser on noisy targets is their mean. One definition
+//! serves training (burn and the CPU engine), validation and the log-L1 metric.
 
+use std::str::FromStr;
+
+use anyhow::{bail, Error};
 use burn::tensor::Tensor;
+use serde::{Deserialize, Serialize};
+
+/// ε of the relative L2 loss (the report's relative metrics use the same).
+pub const RELATIVE_L2_EPS: f32 = 0.01;
+
+/// What the Neural PRT designs are trained to minimise.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum Loss {
+    /// The paper's: mean |log(1 + p) − log(1 + r)|. On noisy targets it is minimised by their
+    /// median, below their mean for path-traced radiance.
+    #[default]
+    LogL1,
+    /// mean (p − r)² / (p̄² + ε) with p̄ the prediction held constant (Lehtinen et al. 2018,
+    /// Noise2Noise): on noisy targets its expected gradient vanishes at their mean.
+    RelL2,
+}
+
+impl Loss {
+    pub const ALL: [Loss; 2] = [Loss::LogL1, Loss::RelL2];
+
+    pub fn name(self) -> &'static str {
+        match self {
+            Loss::LogL1 => "log-l1",
+            Loss::RelL2 => "rel-l2",
+        }
+    }
+
+    /// The mean loss of `prediction` against `reference` ([B, 3]), differentiable.
+    pub fn mean(self, prediction: Tensor<2>, reference: Tensor<2>) -> Tensor<1> {
+        match self {
+            Loss::LogL1 => log_l1(prediction, reference),
+            Loss::RelL2 => {
+                let weight = prediction
+                    .clone()
+                    .detach()
+                    .square()
+                    .add_scalar(RELATIVE_L2_EPS);
+                ((prediction - reference).square() / weight).mean()
+            }
+        }
+    }
+
+    /// One element's loss and its derivative in the prediction `p` (for the CPU engine).
+    pub fn element(self, p: f32, r: f32) -> (f32, f32) {
+        match self {
+            Loss::LogL1 => {
+                let d = p.ln_1p() - r.ln_1p();
+                let sign = if d > 0.0 {
+                    1.0
+                } else if d < 0.0 {
+                    -1.0
+                } else {
+                    0.0
+                };
+                (d.abs(), sign / (1.0 + p))
+            }
+            Loss::RelL2 => {
+                let (d, w) = (p - r, 1.0 / (p * p + RELATIVE_L2_EPS));
+                (d * d * w, 2.0 * d * w)
+            }
+        }
+    }
+}
+
+impl FromStr for Loss {
+    type Err = Error;
+    fn from_str(s: &str) -> Result<Self, Error> {
+        match Loss::ALL.into_iter().find(|l| l.name() == s) {
+            Some(l) => Ok(l),
+            None => bail!("unknown loss '{s}' (expected log-l1 or rel-l2)"),
+        }
+    }
+}
 
 /// Per-element |log(1 + p) − log(1 + r)|, any tensor rank.
 pub fn log_l1_map<const D: usize>(prediction: Tensor<D>, reference: Tensor<D>) -> Tensor<D> {
     (prediction.log1p() - reference.log1p()).abs()
 }
 
-/// The mean of [`log_l1_map`]: the training loss of the Neural PRT designs.
+/// The mean of [`log_l1_map`]: the paper's training loss, and every run's validation loss.
 pub fn log_l1<const D: usize>(prediction: Tensor<D>, reference: Tensor<D>) -> Tensor<1> {
     log_l1_map(prediction, reference).mean()
 }

@@ -11,6 +11,7 @@ use crate::batch::{Batch, Engine};
 use crate::encoder::CODE_SIZE;
 use crate::features::FEATURES;
 use crate::init::Init;
+use crate::loss::Loss;
 use crate::model::ModelConfig;
 use crate::trainer::ADAM_EPSILON;
 
@@ -51,7 +52,7 @@ pub fn measure_throughput(
             device.sync().ok();
             timed = Instant::now();
         }
-        let (_, grads) = batch.gradients(&net, &device, engine);
+        let (_, grads) = batch.gradients(&net, &device, engine, Loss::LogL1);
         net = optim.step(1e-4, net, grads);
     }
     device.sync().ok();

@@ -53,6 +53,7 @@ impl Objective for PixelObjective<'_> {
             "batch_size": self.opts.batch_size,
             "views_per_batch": self.opts.views_per_batch,
             "val_samples": self.opts.val_samples,
+            "loss": self.opts.loss,
         })
     }
 
@@ -96,7 +97,7 @@ impl Objective for PixelObjective<'_> {
         batch: &Batch,
         device: &Device,
     ) -> (f64, GradientsParams, u64) {
-        let (loss, grads) = batch.gradients(net, device, Engine::Auto);
+        let (loss, grads) = batch.gradients(net, device, Engine::Auto, self.opts.loss);
         (loss, grads, batch.len() as u64)
     }
 
@@ -139,7 +140,7 @@ impl Objective for PixelObjective<'_> {
                 "samples": state.samples,
                 "seconds": state.seconds,
                 "adam_epsilon": ADAM_EPSILON,
-                "loss": "mean |log(1 + prediction) − log(1 + reference)|",
+                "loss": self.opts.loss.name(),
             }),
         };
         save_model(out, &file, net)

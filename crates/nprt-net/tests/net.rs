@@ -3,9 +3,9 @@
 use burn::module::{Module, ModuleMapper, ModuleVisitor, Param, ParamId};
 use burn::optim::GradientsParams;
 use burn::tensor::{DType, Int, Tensor, TensorData};
-use nprt_net::log_l1;
 use nprt_net::model::{load_weights, save_weights};
 use nprt_net::FEATURES;
+use nprt_net::{log_l1, Loss};
 use nprt_net::{Activation, Design, Device, Init, ModelConfig, NprtNet};
 use rand::{RngExt, SeedableRng};
 use rand_pcg::Pcg64Mcg;
@@ -256,43 +256,46 @@ fn cpu_engine_matches_autodiff() {
                 encoder_width: w,
                 ..ModelConfig::new(design, Some(activation))
             };
-            let net = config.build(&mut Init::new(4, &device));
-            assert!(nprt_net::cpu::applies(&net, &device));
-            let (burn_loss, burn) = batch.gradients(&net, &device, nprt_net::Engine::Autodiff);
-            let (loss, engine) = nprt_net::cpu::gradients(&net, &batch, &device);
-            assert!(
-                (loss - burn_loss).abs() <= 1e-6 * burn_loss,
-                "{design:?}/{activation:?}: loss {loss} vs {burn_loss}"
-            );
-            let mut init = Init::with_dtype(4, &device, DType::F64);
-            let exact_net = config.build(&mut init);
-            assert!(!nprt_net::cpu::applies(&exact_net, &device));
-            let pred = exact_net.forward(
-                init.tensor(batch.features.clone(), [n, FEATURES]),
-                init.tensor(batch.lights.clone(), [views, 3, w / 2, w]),
-                Tensor::from_data(TensorData::new(batch.view.clone(), [n]), &device),
-                init.tensor(batch.scale.clone(), [n, 1]),
-            );
-            let exact_loss = log_l1(pred, init.tensor(batch.radiance.clone(), [n, 3]));
-            let exact = GradientsParams::from_grads(exact_loss.backward(), &exact_net);
-            let mut shapes = Shapes(Vec::new());
-            net.visit(&mut shapes);
-            for (id, dims) in shapes.0 {
-                let truth = gradient_values(&exact, id, dims.len());
-                let error = |g: &GradientsParams| {
-                    let g = gradient_values(g, id, dims.len());
-                    g.iter()
-                        .zip(&truth)
-                        .map(|(x, y)| (x - y).powi(2))
-                        .sum::<f64>()
-                        .sqrt()
-                };
-                let norm = truth.iter().map(|v| v * v).sum::<f64>().sqrt();
-                let (ours, theirs) = (error(&engine), error(&burn));
+            for objective in Loss::ALL {
+                let net = config.build(&mut Init::new(4, &device));
+                assert!(nprt_net::cpu::applies(&net, &device));
+                let (burn_loss, burn) =
+                    batch.gradients(&net, &device, nprt_net::Engine::Autodiff, objective);
+                let (loss, engine) = nprt_net::cpu::gradients(&net, &batch, &device, objective);
                 assert!(
-                    ours <= 2.0 * theirs + 1e-6 * norm,
-                    "{design:?}/{activation:?} param {id} {dims:?}: engine error {ours:e}, burn f32 error {theirs:e}, gradient norm {norm:e}"
+                    (loss - burn_loss).abs() <= 1e-6 * burn_loss,
+                    "{design:?}/{activation:?}/{objective:?}: loss {loss} vs {burn_loss}"
                 );
+                let mut init = Init::with_dtype(4, &device, DType::F64);
+                let exact_net = config.build(&mut init);
+                assert!(!nprt_net::cpu::applies(&exact_net, &device));
+                let pred = exact_net.forward(
+                    init.tensor(batch.features.clone(), [n, FEATURES]),
+                    init.tensor(batch.lights.clone(), [views, 3, w / 2, w]),
+                    Tensor::from_data(TensorData::new(batch.view.clone(), [n]), &device),
+                    init.tensor(batch.scale.clone(), [n, 1]),
+                );
+                let exact_loss = objective.mean(pred, init.tensor(batch.radiance.clone(), [n, 3]));
+                let exact = GradientsParams::from_grads(exact_loss.backward(), &exact_net);
+                let mut shapes = Shapes(Vec::new());
+                net.visit(&mut shapes);
+                for (id, dims) in shapes.0 {
+                    let truth = gradient_values(&exact, id, dims.len());
+                    let error = |g: &GradientsParams| {
+                        let g = gradient_values(g, id, dims.len());
+                        g.iter()
+                            .zip(&truth)
+                            .map(|(x, y)| (x - y).powi(2))
+                            .sum::<f64>()
+                            .sqrt()
+                    };
+                    let norm = truth.iter().map(|v| v * v).sum::<f64>().sqrt();
+                    let (ours, theirs) = (error(&engine), error(&burn));
+                    assert!(
+                    ours <= 2.0 * theirs + 1e-6 * norm,
+                    "{design:?}/{activation:?}/{objective:?} param {id} {dims:?}: engine error {ours:e}, burn f32 error {theirs:e}, gradient norm {norm:e}"
+                );
+                }
             }
         }
     }

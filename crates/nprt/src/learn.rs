@@ -10,8 +10,8 @@ use nprt_net::{device_name, is_cpu, Device};
 
 use crate::{DeviceArg, RunLength};
 use nprt_net::{
-    layer_table, measure_throughput, recipe_rate, Activation, Design, Engine, Init, ModelConfig,
-    Schedule, TrainOptions, DEFAULT_ENCODER_WIDTH,
+    layer_table, measure_throughput, recipe_rate, Activation, Design, Engine, Init, Loss,
+    ModelConfig, Schedule, TrainOptions, DEFAULT_ENCODER_WIDTH,
 };
 
 #[derive(clap::Args)]
@@ -55,9 +55,9 @@ pub struct TrainArgs {
     /// Samples per batch.
     #[arg(long, default_value_t = TrainOptions::default().batch_size)]
     pub batch_size: usize,
-    /// Adam's (peak) learning rate [default with --schedule cosine: 1e-3 for albedo and dsep,
-    /// 5e-4 for prt, 3e-4 for baseline, measured on the demo's data (docs/model.md); with
-    /// --schedule paper, the paper's 1e-4].
+    /// Adam's (peak) learning rate [default with --schedule cosine: 5e-4 for prt, albedo and
+    /// dsep, 3e-4 for baseline, measured on demo-sized data (docs/model.md); with --schedule
+    /// paper, the paper's 1e-4].
     #[arg(long)]
     pub lr: Option<f64>,
     /// Seed of the initial weights and of the batch order.
@@ -66,6 +66,13 @@ pub struct TrainArgs {
     /// Views whose pixels are mixed in each batch, each lit by its own rotated map.
     #[arg(long, default_value_t = TrainOptions::default().views_per_batch)]
     pub views_per_batch: usize,
+    /// Training loss: log-l1 (the paper's L1 on log(1 + x): minimised by the median of what the
+    /// network cannot tell apart, target noise or detail not yet learnt, which is darker than
+    /// the mean) or rel-l2 ((p − r)² / (p² + 0.01) with p held constant in the denominator,
+    /// minimised by the mean: right in level, worse in detail at short budgets; see
+    /// docs/model.md). The validation loss is log-L1 either way.
+    #[arg(long, default_value = "log-l1")]
+    pub loss: Loss,
     /// Test-view pixels (held-out lighting) used for the validation loss after each epoch.
     #[arg(long, default_value_t = TrainOptions::default().val_samples)]
     pub val_samples: usize,
@@ -232,6 +239,7 @@ pub fn train(a: TrainArgs) -> Result<()> {
         batch_size: a.batch_size,
         views_per_batch: a.views_per_batch,
         val_samples: a.val_samples,
+        loss: a.loss,
     };
     opts.check().context("bad training options")?;
     let s = nprt_net::train(&set, &config, &opts, &a.out, &a.device.device()?)?;

@@ -57,6 +57,26 @@ fn quick_demo_then_render_and_eval() {
             let l = c.as_f64().unwrap();
             assert!(l > 0.0 && l.is_finite(), "{} level {l}", m["name"]);
         }
+        // Every network's validation curve, one point per epoch (2), in training seconds.
+        let name = m["name"].as_str().unwrap();
+        let curve = m["validation"].as_array().unwrap();
+        if name.starts_with("nprt-") || name == "deep-shading" {
+            let points: Vec<(f64, f64)> = curve
+                .iter()
+                .map(|p| (p[0].as_f64().unwrap(), p[1].as_f64().unwrap()))
+                .collect();
+            assert_eq!(points.len(), 2, "{name}: {points:?}");
+            assert!(
+                points[0].0 > 0.0 && points[1].0 > points[0].0,
+                "{name}: {points:?}"
+            );
+            assert!(
+                points.iter().all(|p| p.1 > 0.0 && p.1.is_finite()),
+                "{name}: {points:?}"
+            );
+        } else {
+            assert!(curve.is_empty(), "{name} is no network but has a curve");
+        }
     }
     // The parameter counts are the paper's (D/S within 2%) and Deep Shading's is comparable.
     let params = |n: &str| {
@@ -94,6 +114,7 @@ fn quick_demo_then_render_and_eval() {
         "corr(error, directness)",
         "images/error-vs-directness.png",
         "images/loss-nprt-dsep.png",
+        "images/validation-vs-seconds.png",
         "| *reference noise floor* |",
         "of the best method's L1",
     ] {

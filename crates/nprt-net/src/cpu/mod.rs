@@ -19,6 +19,7 @@ use burn::tensor::{DType, Device, Tensor, TensorData};
 use crate::batch::Batch;
 use crate::design::NprtNet;
 use crate::encoder::CODE_SIZE;
+use crate::loss::Loss;
 use crate::mlp::Mlp;
 pub use dense::DenseStack;
 pub use peak::{measured_peak, Peak};
@@ -32,10 +33,15 @@ pub fn applies(net: &NprtNet, device: &Device) -> bool {
 
 /// The batch's loss and every parameter's gradient, with the transport networks on the CPU
 /// engine and the encoder through burn's autodiff (`device` is an autodiff device).
-pub fn gradients(net: &NprtNet, batch: &Batch, device: &Device) -> (f64, GradientsParams) {
+pub fn gradients(
+    net: &NprtNet,
+    batch: &Batch,
+    device: &Device,
+    loss: Loss,
+) -> (f64, GradientsParams) {
     let codes = net.encoder.forward(batch.light_tensor(device));
     let host_codes = host_values(codes.clone().into_data());
-    let g = HostTransport::from_net(net).gradients(batch, &host_codes);
+    let g = HostTransport::from_net(net).gradients(batch, &host_codes, loss);
     // d loss / d encoder = d (Σ codes ⊙ g.codes) / d encoder, with g.codes held constant.
     let views = host_codes.len() / CODE_SIZE;
     let d_codes = Tensor::<2>::from_data(TensorData::new(g.codes, [views, CODE_SIZE]), device);

@@ -1,7 +1,7 @@
-//! The transport tracks of a design on the host: forward, the paper's log-L1 loss and backward
-//! for a whole batch, block by block on all cores, given the light codes the encoder made.
+//! The transport tracks of a design on the host: forward, the training loss and backward for a
+//! whole batch, block by block on all cores, given the light codes the encoder made.
 //!
-//! Computes exactly what [`crate::design::NprtNet::shade`] and [`crate::loss::log_l1`] compute
+//! Computes exactly what [`crate::design::NprtNet::shade`] and [`crate::loss::Loss::mean`] compute
 //! (same operations in f32), so that burn's autodiff and this path agree to rounding; a test
 //! holds them to that.
 
@@ -13,6 +13,7 @@ use crate::batch::Batch;
 use crate::design::{NprtNet, TRANSPORT_CODE};
 use crate::encoder::CODE_SIZE;
 use crate::features::{feature, FEATURES};
+use crate::loss::Loss;
 use crate::track::TrackKind;
 
 /// Rows per block: small enough that a block's activations stay in the caches, large enough
@@ -279,9 +280,9 @@ impl HostTransport {
         HostTransport { tracks }
     }
 
-    /// The batch's mean log-L1 loss and its gradients, for the light codes `codes`
+    /// The batch's mean `loss` and its gradients, for the light codes `codes`
     /// (`views × CODE_SIZE`, the encoder's output for the batch's maps).
-    pub fn gradients(&self, batch: &Batch, codes: &[f32]) -> TransportGradients {
+    pub fn gradients(&self, batch: &Batch, codes: &[f32], loss: Loss) -> TransportGradients {
         let n = batch.len();
         let views = codes.len() / CODE_SIZE;
         let view: Vec<u32> = batch.view.iter().map(|&v| v as u32).collect();
@@ -299,7 +300,7 @@ impl HostTransport {
                         codes,
                         view: &view[rows.clone()],
                     };
-                    self.block(batch, rows, light, &mut passes, &mut g);
+                    self.block(batch, rows, light, loss, &mut passes, &mut g);
                 }
                 g
             })
@@ -410,6 +411,7 @@ impl HostTransport {
         batch: &Batch,
         rows: std::ops::Range<usize>,
         light: Lighting,
+        loss: Loss,
         passes: &mut [TrackPass],
         g: &mut TransportGradients,
     ) {
@@ -432,16 +434,9 @@ impl HostTransport {
             }
             for c in 0..3 {
                 let pred = p[c] * scale[r];
-                let d = pred.ln_1p() - reference[r * 3 + c].ln_1p();
-                g.loss += d.abs() as f64;
-                let sign = if d > 0.0 {
-                    1.0
-                } else if d < 0.0 {
-                    -1.0
-                } else {
-                    0.0
-                };
-                dr[r * 3 + c] = sign * norm / (1.0 + pred) * scale[r];
+                let (value, slope) = loss.element(pred, reference[r * 3 + c]);
+                g.loss += value as f64;
+                dr[r * 3 + c] = slope * norm * scale[r];
             }
         }
         for ((t, pass), grads) in self.tracks.iter().zip(passes).zip(&mut g.tracks) {
