@@ -80,9 +80,9 @@ fn room() -> Result<Scene> {
     let down = Quat::from_rotation_x(std::f32::consts::FRAC_PI_2);
 
     // Floor with plank texture repeated twice per metre... over 6 m.
-    let floor = Material {
-        name: "floor".into(),
-        surface: Surface::Direct {
+    let floor = Material::new(
+        "floor",
+        Surface::Direct {
             kd: Texture::Bitmap {
                 image: Arc::new(plank_texture()),
                 to_uv: Affine2::from_scale(glam::Vec2::splat(2.0)),
@@ -91,8 +91,8 @@ fn room() -> Result<Scene> {
             ks: Texture::Constant(Vec3::splat(0.04)),
             alpha: Texture::constant(0.3),
         },
-        two_sided: true,
-    };
+        true,
+    );
     s.add(panel((2.0 * half, 2.0 * half), up, Vec3::ZERO), floor);
     // Ceiling around a 2 × 2 m skylight centred over x = 0.5, z = -1.
     let ceil_y = height;

@@ -192,14 +192,14 @@ impl Loader<'_> {
             Some(info) => self.texture(&info, false, mr_factor)?,
             None => Texture::Constant(mr_factor),
         };
-        let material = Material {
-            name: m.name().unwrap_or("default").to_string(),
-            surface: Surface::MetallicRoughness {
+        let material = Material::new(
+            m.name().unwrap_or("default"),
+            Surface::MetallicRoughness {
                 base,
                 metallic_roughness,
             },
-            two_sided: m.double_sided(),
-        };
+            m.double_sided(),
+        );
         self.scene.materials.push(material);
         let idx = self.scene.materials.len() - 1;
         self.materials.insert(m.index(), idx);

@@ -1,22 +1,26 @@
-//! Mitsuba 3 XML scenes, the subset DESIGN.md lists: obj/ply/rectangle/cube/sphere shapes;
-//! diffuse/conductor/roughconductor/plastic/roughplastic/twosided (and diffuse+conductor
-//! `blendbsdf`) BSDFs; bitmap/checkerboard textures; envmap/constant emitters; a perspective
-//! sensor with hdrfilm and sampler; the path integrator; `<default>`, `$name` and `<ref>`.
-//! Anything else stops with an error naming the file, line and element.
+//! Mitsuba XML scenes, the subset DESIGN.md lists: obj/ply/rectangle/cube/sphere shapes;
+//! diffuse/conductor/roughconductor/plastic/roughplastic/dielectric/thindielectric/twosided/mask
+//! (and diffuse+conductor `blendbsdf`) BSDFs; bitmap/checkerboard textures; envmap/constant
+//! emitters; a perspective sensor with hdrfilm and sampler; the path integrator; `<default>`,
+//! `$name` and `<ref>`. Files of format version 0.x (Mitsuba 0.5/0.6, e.g. Bitterli's scenes)
+//! are upgraded as Mitsuba 3 upgrades them: camelCase property names, a diffuse BSDF's
+//! `diffuseReflectance`, texture `uscale`/`uoffset`. Shapes carrying an area emitter are
+//! removed with a warning (the scene is lit by its environment only). Anything else stops
+//! with an error naming the file, line and element.
+
+use std::borrow::Cow;
 
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
 use anyhow::{anyhow, bail, Context, Result};
-#[cfg(test)]
-use glam::Vec2;
-use glam::{Affine2, Mat3, Mat4, Vec3};
+use glam::{Affine2, Mat3, Mat4, Vec2, Vec3};
 use roxmltree::{Document, Node};
 
 use crate::camera::{look_at, Camera, FovAxis};
 use crate::envmap::EnvMap;
-use crate::material::{Material, Surface, MIN_ALPHA};
+use crate::material::{Material, Scattering, Surface, MIN_ALPHA};
 use crate::mesh::Mesh;
 use crate::mesh_io::load_mesh;
 use crate::scene::{Scene, SceneOptions};
@@ -44,6 +48,14 @@ pub fn parse(text: &str, path: &Path, opts: &SceneOptions) -> Result<Scene> {
             root.tag_name().name()
         );
     }
+    let version = root.attribute("version").unwrap_or("3.0.0");
+    let major: u32 = version
+        .split('.')
+        .next()
+        .and_then(|m| m.trim().parse().ok())
+        .ok_or_else(|| {
+            anyhow!("scene file '{file}': version '{version}' is not a version number")
+        })?;
     let mut params: HashMap<String, String> = HashMap::new();
     for d in root.children().filter(|n| n.has_tag_name("default")) {
         let (Some(name), Some(value)) = (d.attribute("name"), d.attribute("value")) else {
@@ -66,6 +78,7 @@ pub fn parse(text: &str, path: &Path, opts: &SceneOptions) -> Result<Scene> {
         bitmaps: HashMap::new(),
         scene: Scene::empty(&file),
         rfilter_box: false,
+        legacy: major < 2,
     };
     for node in root.children().filter(Node::is_element) {
         ctx.top_level(node)?;
@@ -100,7 +113,64 @@ struct Ctx<'a> {
     bitmaps: HashMap<(PathBuf, bool), Arc<Bitmap>>,
     scene: Scene,
     rfilter_box: bool,
+    /// Format version 0.x: property names are camelCase.
+    legacy: bool,
 }
+
+/// Mitsuba 3's upgrade of a 0.x property name: `toWorld` → `to_world`, `intIOR` → `int_ior`
+/// (an upper-case letter after a lower-case one starts a word, and the capitals that follow
+/// belong to it).
+fn snake_case(name: &str) -> Cow<'_, str> {
+    let b = name.as_bytes();
+    if !b
+        .windows(2)
+        .any(|w| w[0].is_ascii_lowercase() && w[1].is_ascii_uppercase())
+    {
+        return Cow::Borrowed(name);
+    }
+    let mut out = String::with_capacity(name.len() + 4);
+    let mut i = 0;
+    while i < b.len() {
+        if i > 0 && b[i - 1].is_ascii_lowercase() && b[i].is_ascii_uppercase() {
+            out.push('_');
+            while i < b.len() && b[i].is_ascii_uppercase() {
+                out.push(b[i].to_ascii_lowercase() as char);
+                i += 1;
+            }
+        } else {
+            out.push(b[i] as char);
+            i += 1;
+        }
+    }
+    Cow::Owned(out)
+}
+
+/// Indices of refraction Mitsuba accepts by name (its documented table).
+const NAMED_IORS: [(&str, f32); 23] = [
+    ("vacuum", 1.0),
+    ("helium", 1.000036),
+    ("hydrogen", 1.000132),
+    ("air", 1.000277),
+    ("carbon dioxide", 1.00045),
+    ("water", 1.3330),
+    ("acetone", 1.36),
+    ("ethanol", 1.361),
+    ("carbon tetrachloride", 1.461),
+    ("glycerol", 1.4729),
+    ("benzene", 1.501),
+    ("silicone oil", 1.52045),
+    ("bromine", 1.661),
+    ("water ice", 1.31),
+    ("fused quartz", 1.458),
+    ("pyrex", 1.470),
+    ("acrylic glass", 1.49),
+    ("polypropylene", 1.49),
+    ("bk7", 1.5046),
+    ("sodium chloride", 1.544),
+    ("amber", 1.55),
+    ("pet", 1.5750),
+    ("diamond", 2.419),
+];
 
 #[derive(Clone)]
 enum Named {
@@ -203,10 +273,61 @@ impl<'a> Ctx<'a> {
         Ok(p)
     }
 
-    /// The child property element with `name="..."`.
+    /// The child property element with `name="..."` (in Mitsuba 3's spelling).
     fn prop(&self, node: Node<'a, 'a>, name: &str) -> Option<Node<'a, 'a>> {
-        node.children()
-            .find(|c| c.is_element() && c.attribute("name") == Some(name))
+        node.children().find(|c| {
+            c.is_element()
+                && c.attribute("name").is_some_and(|n| {
+                    if self.legacy {
+                        snake_case(n) == name
+                    } else {
+                        n == name
+                    }
+                })
+        })
+    }
+
+    /// An index of refraction given as a number or by material name.
+    fn ior_prop(&self, node: Node<'a, 'a>, name: &str, default: f32) -> Result<f32> {
+        let Some(p) = self.prop(node, name) else {
+            return Ok(default);
+        };
+        if p.has_tag_name("string") {
+            let v = self.req(p, "value")?.to_lowercase();
+            return match NAMED_IORS.iter().find(|(n, _)| *n == v) {
+                Some((_, ior)) => Ok(*ior),
+                None => self.fail(
+                    p,
+                    format!("unknown material '{v}' for an index of refraction; give a number"),
+                ),
+            };
+        }
+        let ior = self.float_value(p)?;
+        if ior <= 0.0 {
+            return self.fail(p, "an index of refraction must be positive");
+        }
+        Ok(ior)
+    }
+
+    /// The relative index int_ior / ext_ior of a dielectric interface.
+    fn relative_ior(&self, node: Node<'a, 'a>, int_default: f32) -> Result<f32> {
+        let eta = self.ior_prop(node, "int_ior", int_default)?
+            / self.ior_prop(node, "ext_ior", 1.000277)?;
+        if eta == 1.0 {
+            return self.fail(
+                node,
+                "int_ior and ext_ior are equal: the interface would be invisible",
+            );
+        }
+        Ok(eta)
+    }
+
+    /// A property that must be one colour (not a texture).
+    fn colour_prop(&mut self, node: Node<'a, 'a>, name: &str, default: Vec3) -> Result<Vec3> {
+        match self.texture_prop(node, name, default)? {
+            Texture::Constant(c) => Ok(c),
+            _ => self.fail(node, format!("'{name}' must be a colour, not a texture")),
+        }
     }
 
     fn float_prop(&self, node: Node<'a, 'a>, name: &str, default: f32) -> Result<f32> {
@@ -276,6 +397,20 @@ impl<'a> Ctx<'a> {
                 )
             }
             None => Affine2::IDENTITY,
+        };
+        // Mitsuba 0.x placed bitmaps by uoffset/voffset/uscale/vscale.
+        let to_uv = if self.legacy {
+            let scale = Vec2::new(
+                self.float_prop(node, "uscale", 1.0)?,
+                self.float_prop(node, "vscale", 1.0)?,
+            );
+            let offset = Vec2::new(
+                self.float_prop(node, "uoffset", 0.0)?,
+                self.float_prop(node, "voffset", 0.0)?,
+            );
+            Affine2::from_scale(scale) * Affine2::from_translation(offset) * to_uv
+        } else {
+            to_uv
         };
         match node.attribute("type").unwrap_or("") {
             "bitmap" => {
@@ -358,7 +493,7 @@ impl<'a> Ctx<'a> {
                         }
                     }
                 }
-                "lookat" => {
+                "lookat" | "lookAt" => {
                     let get = |k: &str| -> Result<Vec3> {
                         let v = self.numbers(t, &self.req(t, k)?)?;
                         if v.len() != 3 {
@@ -387,12 +522,21 @@ impl<'a> Ctx<'a> {
             "sensor" => self.sensor(node),
             "shape" => self.shape(node),
             "emitter" => self.emitter(node),
-            "bsdf" => {
-                let id = self.req(node, "id")?;
-                let m = self.bsdf(node)?;
-                self.named.insert(id, Named::Material(m));
-                Ok(())
-            }
+            "bsdf" => match self.attr(node, "id")? {
+                Some(_) => self.bsdf(node).map(|_| ()),
+                // Nothing can refer to it (Bitterli's scenes wrap bump maps this way), but BSDFs
+                // declared inside it with ids can be.
+                None => {
+                    for inner in node.children().filter(|c| c.has_tag_name("bsdf")) {
+                        self.nested_material(inner)?;
+                    }
+                    self.scene.warnings.push(format!(
+                        "{}: a top-level BSDF without an id is never used (as in Mitsuba); only BSDFs declared inside it with an id are",
+                        self.at(node)
+                    ));
+                    Ok(())
+                }
+            },
             "texture" => {
                 let id = self.req(node, "id")?;
                 let t = self.texture(node)?;
@@ -548,10 +692,11 @@ impl<'a> Ctx<'a> {
                     _ => return self.fail(child, "does not refer to a BSDF declared earlier"),
                 },
                 "emitter" => {
-                    return self.fail(
-                        child,
-                        "area emitters are not supported: light comes from the environment",
-                    )
+                    self.scene.warnings.push(format!(
+                        "{}: removed this shape: it carries an area emitter, and nprt lights scenes by the environment only (such shapes are usually light portals in a window)",
+                        self.at(node)
+                    ));
+                    return Ok(());
                 }
                 _ => {}
             }
@@ -575,24 +720,50 @@ impl<'a> Ctx<'a> {
     fn bsdf(&mut self, node: Node<'a, 'a>) -> Result<usize> {
         let material = self.bsdf_material(node)?;
         self.scene.materials.push(material);
-        Ok(self.scene.materials.len() - 1)
+        let index = self.scene.materials.len() - 1;
+        if let Some(id) = self.attr(node, "id")? {
+            self.named.insert(id, Named::Material(index));
+        }
+        Ok(index)
     }
 
-    fn nested_bsdfs(&self, node: Node<'a, 'a>) -> Result<Vec<Node<'a, 'a>>> {
+    /// A BSDF nested in another; one declared with an id is also registered for `<ref>`.
+    fn nested_material(&mut self, node: Node<'a, 'a>) -> Result<Material> {
+        let material = self.bsdf_material(node)?;
+        if let Some(id) = self.attr(node, "id")? {
+            self.scene.materials.push(material.clone());
+            self.named
+                .insert(id, Named::Material(self.scene.materials.len() - 1));
+        }
+        Ok(material)
+    }
+
+    /// The BSDFs a wrapper (twosided, mask, blendbsdf) holds, nested or referenced.
+    fn nested_materials(&mut self, node: Node<'a, 'a>) -> Result<Vec<Material>> {
         let mut out = vec![];
         for c in node.children().filter(Node::is_element) {
             match c.tag_name().name() {
-                "bsdf" => out.push(c),
-                "ref" => {
-                    return self.fail(
-                        c,
-                        "references inside twosided/blendbsdf are not supported; nest the BSDF",
-                    )
-                }
+                "bsdf" => out.push(self.nested_material(c)?),
+                "ref" => match self.named.get(&self.req(c, "id")?) {
+                    Some(Named::Material(m)) => out.push(self.scene.materials[*m].clone()),
+                    _ => return self.fail(c, "does not refer to a BSDF declared earlier"),
+                },
                 _ => {}
             }
         }
         Ok(out)
+    }
+
+    /// The one BSDF a wrapper holds.
+    fn single_nested(&mut self, node: Node<'a, 'a>) -> Result<Material> {
+        let mut inner = self.nested_materials(node)?;
+        if inner.len() != 1 {
+            return self.fail(
+                node,
+                format!("needs exactly one nested BSDF, has {}", inner.len()),
+            );
+        }
+        Ok(inner.remove(0))
     }
 
     fn bsdf_material(&mut self, node: Node<'a, 'a>) -> Result<Material> {
@@ -600,63 +771,100 @@ impl<'a> Ctx<'a> {
         let ty = node.attribute("type").unwrap_or("");
         let (kd, ks, alpha) = match ty {
             "twosided" => {
-                let inner = self.nested_bsdfs(node)?;
-                if inner.len() != 1 {
-                    return self.fail(node, "twosided with other than one nested BSDF is not supported");
+                let mut m = self.single_nested(node)?;
+                if matches!(m.scattering, Scattering::Dielectric { .. }) {
+                    return self.fail(node, "glass has no front and back: do not wrap it in twosided");
                 }
-                let mut m = self.bsdf_material(inner[0])?;
                 m.two_sided = true;
                 m.name = name;
                 return Ok(m);
             }
-            "diffuse" => (self.texture_prop(node, "reflectance", Vec3::splat(0.5))?, Texture::constant(0.0), Texture::constant(1.0)),
+            "mask" => {
+                let opacity = self.texture_prop(node, "opacity", Vec3::splat(0.5))?;
+                let mut m = self.single_nested(node)?;
+                if m.opacity.is_some() {
+                    return self.fail(node, "a mask inside a mask is not supported");
+                }
+                m.opacity = Some(opacity);
+                m.name = name;
+                return Ok(m);
+            }
+            "diffuse" => {
+                // Mitsuba 0.x also accepted diffuseReflectance here.
+                let key = if self.legacy && self.prop(node, "reflectance").is_none() { "diffuse_reflectance" } else { "reflectance" };
+                (self.texture_prop(node, key, Vec3::splat(0.5))?, Texture::constant(0.0), Texture::constant(1.0))
+            }
             "conductor" | "roughconductor" => {
                 let alpha = if ty == "conductor" { MIN_ALPHA } else { self.microfacet_alpha(node, 0.1)? };
                 let ks = self.texture_prop(node, "specular_reflectance", Vec3::ONE)?;
-                let material = self.string_prop(node, "material")?.unwrap_or_else(|| "none".into());
-                if material != "none" || self.prop(node, "eta").is_some() {
-                    return self.fail(node, "only material=\"none\" conductors match nprt's Fresnel-free model; use specular_reflectance for colour");
-                }
-                (Texture::constant(0.0), ks, Texture::constant(alpha))
+                let material = self.string_prop(node, "material")?;
+                let scattering = match (self.prop(node, "eta").is_some() || self.prop(node, "k").is_some(), material.as_deref()) {
+                    (false, None | Some("none")) => Scattering::FresnelFree,
+                    (true, None) => Scattering::Conductor {
+                        eta: self.colour_prop(node, "eta", Vec3::ZERO)?,
+                        k: self.colour_prop(node, "k", Vec3::ONE)?,
+                    },
+                    (true, Some(_)) => return self.fail(node, "give either a material or eta and k, not both"),
+                    (false, Some(other)) => return self.fail(node, format!("the named conductor '{other}' needs Mitsuba's spectral tables, which nprt does not ship; give its RGB eta and k instead")),
+                };
+                let mut m = Material::new(&name, Surface::Direct { kd: Texture::constant(0.0), ks, alpha: Texture::constant(alpha) }, false);
+                m.scattering = scattering;
+                return Ok(m);
+            }
+            "dielectric" | "thindielectric" => {
+                let eta = self.relative_ior(node, 1.5046)?;
+                let mut m = Material::new(
+                    &name,
+                    Surface::Direct {
+                        kd: Texture::constant(0.0),
+                        ks: self.texture_prop(node, "specular_reflectance", Vec3::ONE)?,
+                        alpha: Texture::constant(MIN_ALPHA),
+                    },
+                    false,
+                );
+                m.transmittance = self.texture_prop(node, "specular_transmittance", Vec3::ONE)?;
+                m.scattering = Scattering::Dielectric { eta, thin: ty == "thindielectric" };
+                return Ok(m);
             }
             "plastic" | "roughplastic" => {
                 let alpha = if ty == "plastic" { MIN_ALPHA } else { self.microfacet_alpha(node, 0.1)? };
-                let int_ior = self.float_prop(node, "int_ior", 1.49)?;
-                let ext_ior = self.float_prop(node, "ext_ior", 1.000277)?;
-                let f0 = ((int_ior - ext_ior) / (int_ior + ext_ior)).powi(2);
+                let eta = self.relative_ior(node, 1.49)?;
+                let f0 = ((eta - 1.0) / (eta + 1.0)).powi(2);
                 let spec = match self.texture_prop(node, "specular_reflectance", Vec3::ONE)? {
                     Texture::Constant(c) => c * f0,
                     _ => return self.fail(node, "textured specular_reflectance on plastic is not supported"),
                 };
+                let nonlinear = if self.bool_prop(node, "nonlinear", false)? { " (nonlinear ignored)" } else { "" };
                 self.scene.warnings.push(format!(
-                    "{}: plastic is approximated by diffuse + Fresnel-free GGX with ks = F0 = {f0:.4}",
+                    "{}: plastic is approximated by diffuse + Fresnel-free GGX with ks = F0 = {f0:.4}{nonlinear}",
                     self.at(node)
                 ));
                 (self.texture_prop(node, "diffuse_reflectance", Vec3::splat(0.5))?, Texture::Constant(spec), Texture::constant(alpha))
             }
             "blendbsdf" => return self.blend(node, name),
-            other => return self.fail(node, format!("unsupported BSDF plugin '{other}' (supported: diffuse, conductor, roughconductor, plastic, roughplastic, twosided, blendbsdf of diffuse + conductor)")),
+            "bumpmap" => return self.fail(node, "bump mapping is not supported yet: reference the BSDF nested inside it instead (scenes that declare it with an id and use that id render as in Mitsuba)"),
+            other => return self.fail(node, format!("unsupported BSDF plugin '{other}' (supported: diffuse, conductor, roughconductor, plastic, roughplastic, dielectric, thindielectric, twosided, mask, blendbsdf of diffuse + conductor)")),
         };
-        Ok(Material {
-            name,
-            surface: Surface::Direct { kd, ks, alpha },
-            two_sided: false,
-        })
+        Ok(Material::new(
+            &name,
+            Surface::Direct { kd, ks, alpha },
+            false,
+        ))
     }
 
     /// `blendbsdf` of one diffuse and one (rough)conductor is exactly DESIGN.md's model:
     /// kd = (1−w)·ρ, ks = w·ks with weight w on the second BSDF.
     fn blend(&mut self, node: Node<'a, 'a>, name: String) -> Result<Material> {
-        let inner = self.nested_bsdfs(node)?;
         let w = match self.texture_prop(node, "weight", Vec3::splat(0.5))? {
             Texture::Constant(c) => c.x,
             _ => return self.fail(node, "a textured blend weight is not supported"),
         };
-        if inner.len() != 2 {
+        let parts = self.nested_materials(node)?;
+        if parts.len() != 2 {
             return self.fail(node, "blendbsdf needs exactly two nested BSDFs");
         }
-        let parts = [self.bsdf_material(inner[0])?, self.bsdf_material(inner[1])?];
         let consts = |m: &Material| match &m.surface {
+            _ if m.scattering != Scattering::FresnelFree || m.opacity.is_some() => None,
             Surface::Direct {
                 kd: Texture::Constant(kd),
                 ks: Texture::Constant(ks),
@@ -767,16 +975,10 @@ mod tests {
     #[test]
     fn errors_name_file_line_and_element() {
         let dir = std::env::temp_dir().join(format!("nprt-mi-err-{}", std::process::id()));
-        let bad = SCENE.replace(
-            r#"<bsdf type="roughconductor">"#,
-            r#"<bsdf type="dielectric">"#,
-        );
+        let bad = SCENE.replace(r#"<bsdf type="roughconductor">"#, r#"<bsdf type="hair">"#);
         let p = write(&dir, "bad.xml", &bad);
         let err = format!("{:#}", load(&p, &SceneOptions::default()).unwrap_err());
-        assert!(
-            err.contains("bad.xml:17:") && err.contains("dielectric"),
-            "{err}"
-        );
+        assert!(err.contains("bad.xml:17:") && err.contains("hair"), "{err}");
 
         let p = write(
             &dir,
@@ -823,5 +1025,113 @@ mod tests {
                 "{v}: {err}"
             );
         }
+    }
+
+    #[test]
+    fn mitsuba_0x_property_names_upgrade_as_mitsuba_3() {
+        for (old, new) in [
+            ("toWorld", "to_world"),
+            ("maxDepth", "max_depth"),
+            ("intIOR", "int_ior"),
+            ("specularReflectance", "specular_reflectance"),
+            ("fovAxis", "fov_axis"),
+            ("uoffset", "uoffset"),
+            ("to_world", "to_world"),
+        ] {
+            assert_eq!(snake_case(old), new);
+        }
+    }
+
+    /// A scene in Bitterli's Mitsuba 0.5 style: camelCase names, glass, a mask over a nested
+    /// BSDF declared with an id, a bump-map wrapper nobody references, complex-index copper and
+    /// a light portal (a black rectangle carrying an area emitter).
+    #[test]
+    fn loads_mitsuba_0_5_scenes_with_glass_masks_and_portals() {
+        let text = r#"<scene version="0.5.0">
+  <integrator type="path"><integer name="maxDepth" value="7"/></integrator>
+  <sensor type="perspective"><float name="fov" value="50"/>
+    <transform name="toWorld"><lookAt origin="0, 1, 5" target="0, 1, 0" up="0, 1, 0"/></transform>
+    <sampler type="independent"><integer name="sampleCount" value="8"/></sampler>
+    <film type="hdrfilm"><integer name="width" value="32"/><integer name="height" value="16"/><rfilter type="box"/></film>
+  </sensor>
+  <bsdf type="dielectric" id="Glass"><float name="intIOR" value="1.5"/><float name="extIOR" value="1"/>
+    <rgb name="specularTransmittance" value="0, 0, 0"/></bsdf>
+  <bsdf type="thindielectric" id="Pane"><string name="intIOR" value="bk7"/></bsdf>
+  <bsdf type="mask" id="Blinds"><spectrum name="opacity" value="0.6"/>
+    <bsdf type="twosided"><bsdf type="diffuse"><rgb name="diffuseReflectance" value="0.6, 0.5, 0.4"/></bsdf></bsdf></bsdf>
+  <bsdf type="bumpmap"><float name="scale" value="1"/>
+    <bsdf type="twosided" id="Cushion"><bsdf type="diffuse"><rgb name="reflectance" value="0.5, 0.1, 0.1"/></bsdf></bsdf></bsdf>
+  <bsdf type="twosided" id="Copper"><bsdf type="roughconductor"><float name="alpha" value="0.1"/>
+    <string name="distribution" value="ggx"/>
+    <rgb name="eta" value="0.2, 0.92, 1.1"/><rgb name="k" value="3.9, 2.45, 2.14"/></bsdf></bsdf>
+  <shape type="rectangle"><ref id="Glass"/></shape>
+  <shape type="rectangle"><ref id="Pane"/></shape>
+  <shape type="rectangle"><ref id="Blinds"/></shape>
+  <shape type="rectangle"><ref id="Cushion"/></shape>
+  <shape type="rectangle"><ref id="Copper"/></shape>
+  <shape type="rectangle"><bsdf type="diffuse"><rgb name="reflectance" value="0"/></bsdf>
+    <emitter type="area"><spectrum name="radiance" value="16"/></emitter></shape>
+</scene>"#;
+        let s = parse(
+            text,
+            Path::new("kitchen-like.xml"),
+            &SceneOptions::default(),
+        )
+        .unwrap();
+        assert_eq!((s.max_depth, s.spp), (Some(7), Some(8)));
+        assert!((s.camera.as_ref().unwrap().origin() - Vec3::new(0.0, 1.0, 5.0)).length() < 1e-6);
+        assert_eq!(s.meshes.len(), 5, "the portal is removed");
+        let at = |i: usize| {
+            let m = &s.materials[s.meshes[i].material];
+            (m, m.eval(Vec2::ZERO))
+        };
+        let (glass, g) = at(0);
+        assert_eq!(
+            g.scattering,
+            Scattering::Dielectric {
+                eta: 1.5,
+                thin: false
+            }
+        );
+        assert!(!glass.two_sided && g.kt == Vec3::ZERO && g.ks == Vec3::ONE);
+        let (kd, ks, alpha) = g.gbuffer();
+        assert!(kd == Vec3::ZERO && (ks - Vec3::splat(0.04)).abs().max_element() < 1e-6);
+        assert_eq!(alpha, MIN_ALPHA);
+        let (_, pane) = at(1);
+        assert!(
+            matches!(pane.scattering, Scattering::Dielectric { eta, thin: true } if (eta - 1.5046 / 1.000277).abs() < 1e-6)
+        );
+        let (blinds, b) = at(2);
+        assert!(blinds.two_sided && (b.opacity - 0.6).abs() < 1e-6);
+        assert_eq!(b.kd, Vec3::new(0.6, 0.5, 0.4));
+        assert!((b.gbuffer().0 - Vec3::new(0.36, 0.3, 0.24)).length() < 1e-6);
+        assert_eq!(at(3).1.kd, Vec3::new(0.5, 0.1, 0.1));
+        let (copper, c) = at(4);
+        assert!(copper.two_sided && c.alpha == 0.1);
+        let f0 = c.gbuffer().1;
+        assert!(
+            f0.x > f0.y && f0.y > f0.z && f0.x < 1.0,
+            "copper's F0 is reddish: {f0}"
+        );
+        assert!(s.warnings.iter().any(|w| w.contains("area emitter")));
+        assert!(s.warnings.iter().any(|w| w.contains("without an id")));
+
+        // Used by a shape, a bump map is refused by name rather than rendered flat.
+        let bump = text.replace(
+            r#"<ref id="Cushion"/>"#,
+            r#"<bsdf type="bumpmap"><bsdf type="diffuse"/></bsdf>"#,
+        );
+        let err = parse(&bump, Path::new("k.xml"), &SceneOptions::default()).unwrap_err();
+        assert!(
+            format!("{err:#}").contains("bump mapping is not supported"),
+            "{err:#}"
+        );
+        // Mitsuba 3 names are not renamed in a 0.x file's camelCase world, nor the reverse.
+        let v3 = text.replace("0.5.0", "3.0.0");
+        let s3 = parse(&v3, Path::new("k.xml"), &SceneOptions::default()).unwrap();
+        assert_eq!(
+            s3.max_depth, None,
+            "maxDepth means nothing to a version-3 file"
+        );
     }
 }

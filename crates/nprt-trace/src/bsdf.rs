@@ -1,10 +1,12 @@
-//! DESIGN.md's BSDF in a local shading frame (z = normal): a Lambertian lobe kd/π plus a
-//! Fresnel-free GGX lobe ks·D·G1(ωo)·G1(ωi) / (4 cos θo cos θi), with Smith's separable
-//! shadowing as Mitsuba 3. The diffuse lobe is cosine-sampled, the specular one by GGX visible
-//! normals (Heitz 2018); a lobe is picked by the luminance of its albedo.
+//! DESIGN.md's BSDF in a local shading frame (z = normal): a Lambertian lobe kd/π plus a GGX
+//! lobe ks·F·D·G1(ωo)·G1(ωi) / (4 cos θo cos θi), with Smith's separable shadowing as Mitsuba 3
+//! and F = 1 (the model) or a conductor's Fresnel reflectance. The diffuse lobe is
+//! cosine-sampled, the specular one by GGX visible normals (Heitz 2018); a lobe is picked by
+//! the luminance of its albedo. Smooth glass (Mitsuba's `dielectric`, `thindielectric`) and
+//! opacity masks (`mask`) add delta lobes, sampled as Mitsuba 3 samples them.
 
 use glam::{Vec2, Vec3};
-use nprt_scene::{luminance, BsdfParams};
+use nprt_scene::{fresnel_conductor, fresnel_dielectric, luminance, BsdfParams, Scattering};
 use std::f32::consts::PI;
 
 use crate::microfacet::GgxDistribution;
@@ -14,16 +16,23 @@ pub struct Bsdf {
     pub kd: Vec3,
     pub ks: Vec3,
     pub alpha: f32,
+    kt: Vec3,
+    opacity: f32,
+    scattering: Scattering,
     ggx: GgxDistribution,
-    /// Probability of sampling the specular lobe.
+    /// Probability of sampling the specular lobe (of the reflecting part).
     p_spec: f32,
 }
 
-/// A sampled direction: ωi, f·cos θi / pdf, and the pdf.
+/// A sampled direction: ωi, f·cos θi / pdf, and the pdf (of the discrete choice for a delta
+/// lobe, whose sample no other strategy can produce).
 pub struct BsdfSample {
     pub wi: Vec3,
     pub weight: Vec3,
     pub pdf: f32,
+    pub delta: bool,
+    /// Relative index crossed (η for a refraction into glass, 1 otherwise), for Russian roulette.
+    pub eta: f32,
 }
 
 impl Bsdf {
@@ -34,31 +43,53 @@ impl Bsdf {
             kd: p.kd,
             ks: p.ks,
             alpha: p.alpha,
+            kt: p.kt,
+            opacity: p.opacity,
+            scattering: p.scattering,
             ggx: GgxDistribution::new(p.alpha),
             p_spec,
         }
     }
 
-    pub fn is_black(&self) -> bool {
-        self.kd == Vec3::ZERO && self.ks == Vec3::ZERO
+    fn is_glass(&self) -> bool {
+        matches!(self.scattering, Scattering::Dielectric { .. })
+    }
+
+    /// Whether light arriving along `wo` can leave in any direction.
+    pub fn scatters(&self, wo: Vec3) -> bool {
+        self.opacity < 1.0
+            || if self.is_glass() {
+                self.ks != Vec3::ZERO || self.kt != Vec3::ZERO
+            } else {
+                wo.z > 0.0 && (self.kd != Vec3::ZERO || self.ks != Vec3::ZERO)
+            }
+    }
+
+    /// Whether `eval` can be non-zero: next-event estimation is worth a shadow ray.
+    pub fn is_smooth(&self) -> bool {
+        !self.is_glass() && self.opacity > 0.0
     }
 
     /// f(ωo, ωi)·cos θi.
     pub fn eval(&self, wo: Vec3, wi: Vec3) -> Vec3 {
-        if wo.z <= 0.0 || wi.z <= 0.0 {
+        if wo.z <= 0.0 || wi.z <= 0.0 || !self.is_smooth() {
             return Vec3::ZERO;
         }
         let mut f = self.kd * (wi.z / PI);
         if self.p_spec > 0.0 {
             let m = (wo + wi).normalize();
             let g = self.ggx.g1(wo, m) * self.ggx.g1(wi, m);
-            f += self.ks * (self.ggx.d(m) * g / (4.0 * wo.z));
+            let fresnel = match self.scattering {
+                Scattering::Conductor { eta, k } => fresnel_conductor(wo.dot(m), eta, k),
+                _ => Vec3::ONE,
+            };
+            f += self.ks * fresnel * (self.ggx.d(m) * g / (4.0 * wo.z));
         }
-        f
+        f * self.opacity
     }
 
     pub fn pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
-        if wo.z <= 0.0 || wi.z <= 0.0 {
+        if wo.z <= 0.0 || wi.z <= 0.0 || !self.is_smooth() {
             return 0.0;
         }
         let mut pdf = (1.0 - self.p_spec) * wi.z / PI;
@@ -67,11 +98,34 @@ impl Bsdf {
             // Visible-normal density G1(ωo)·D(m)·(ωo·m)/cos θo, times the reflection Jacobian.
             pdf += self.p_spec * self.ggx.g1(wo, m) * self.ggx.d(m) / (4.0 * wo.z);
         }
-        pdf
+        pdf * self.opacity
     }
 
+    /// Samples ωi; `u_lobe` picks among lobes (pass-through, reflection, refraction) first.
     pub fn sample(&self, wo: Vec3, u: Vec2, u_lobe: f32) -> Option<BsdfSample> {
-        if wo.z <= 0.0 || self.is_black() {
+        if !self.scatters(wo) {
+            return None;
+        }
+        if u_lobe >= self.opacity {
+            return Some(BsdfSample {
+                wi: -wo,
+                weight: Vec3::ONE,
+                pdf: 1.0 - self.opacity,
+                delta: true,
+                eta: 1.0,
+            });
+        }
+        let u_lobe = u_lobe / self.opacity;
+        let mut s = match self.scattering {
+            Scattering::Dielectric { eta, thin } => self.sample_glass(wo, u_lobe, eta, thin),
+            _ => self.sample_reflection(wo, u, u_lobe),
+        }?;
+        s.pdf *= self.opacity;
+        Some(s)
+    }
+
+    fn sample_reflection(&self, wo: Vec3, u: Vec2, u_lobe: f32) -> Option<BsdfSample> {
+        if wo.z <= 0.0 {
             return None;
         }
         let wi = if u_lobe < self.p_spec {
@@ -82,14 +136,43 @@ impl Bsdf {
             let phi = 2.0 * PI * u.y;
             Vec3::new(r * phi.cos(), r * phi.sin(), (1.0 - u.x).max(0.0).sqrt())
         };
-        let pdf = self.pdf(wo, wi);
+        let pdf = self.pdf(wo, wi) / self.opacity;
         if pdf <= 0.0 {
             return None;
         }
         Some(BsdfSample {
             wi,
-            weight: self.eval(wo, wi) / pdf,
+            weight: self.eval(wo, wi) / self.opacity / pdf,
             pdf,
+            delta: false,
+            eta: 1.0,
+        })
+    }
+
+    /// Mitsuba 3's `dielectric` and `thindielectric`: reflection with the probability of the
+    /// Fresnel reflectance, weight ks; otherwise transmission with weight kt (times the
+    /// radiance compression 1/η² across a refracting interface).
+    fn sample_glass(&self, wo: Vec3, u_lobe: f32, eta: f32, thin: bool) -> Option<BsdfSample> {
+        let reflect = Vec3::new(-wo.x, -wo.y, wo.z);
+        let (r, wt, weight_t, eta_t) = if thin {
+            let r = fresnel_dielectric(wo.z.abs(), eta).r;
+            (r * 2.0 / (1.0 + r), -wo, self.kt, 1.0)
+        } else {
+            let f = fresnel_dielectric(wo.z, eta);
+            let wt = Vec3::new(-f.eta_ti * wo.x, -f.eta_ti * wo.y, f.cos_t);
+            (f.r, wt, self.kt * (f.eta_ti * f.eta_ti), f.eta_it)
+        };
+        let (wi, weight, pdf, eta) = if u_lobe <= r {
+            (reflect, self.ks, r, 1.0)
+        } else {
+            (wt, weight_t, 1.0 - r, eta_t)
+        };
+        (pdf > 0.0 && weight != Vec3::ZERO).then_some(BsdfSample {
+            wi,
+            weight,
+            pdf,
+            delta: true,
+            eta,
         })
     }
 }
@@ -98,14 +181,11 @@ impl Bsdf {
 mod tests {
     use super::*;
     use crate::shading_frame::Frame3;
+    use nprt_scene::{fresnel_conductor, fresnel_dielectric};
     use rand::{RngExt, SeedableRng};
 
     fn params(kd: f32, ks: f32, alpha: f32) -> BsdfParams {
-        BsdfParams {
-            kd: Vec3::splat(kd),
-            ks: Vec3::splat(ks),
-            alpha,
-        }
+        BsdfParams::new(Vec3::splat(kd), Vec3::splat(ks), alpha)
     }
 
     /// Albedo ∫ f cos dωi by uniform hemisphere sampling and by importance sampling must agree.
@@ -195,6 +275,128 @@ mod tests {
                     && f.s.dot(n).abs() < 1e-6
                     && (f.s.cross(f.t) - n).length() < 1e-5
             );
+        }
+    }
+
+    fn with(scattering: Scattering, opacity: f32) -> Bsdf {
+        Bsdf::new(BsdfParams {
+            kt: Vec3::ONE,
+            opacity,
+            scattering,
+            ..params(0.0, 1.0, 1e-3)
+        })
+    }
+
+    /// Glass reflects with the Fresnel probability and refracts by Snell's law with the
+    /// radiance compression 1/η², entering and leaving; a thin pane sums its inter-reflections.
+    #[test]
+    fn glass_follows_fresnel_and_snell() {
+        let eta = 1.5;
+        let glass = with(Scattering::Dielectric { eta, thin: false }, 1.0);
+        for wo in [Vec3::new(0.8, 0.0, 0.6), Vec3::new(0.0, -0.6, -0.8)] {
+            let f = fresnel_dielectric(wo.z, eta);
+            let n = 10_000;
+            let reflected = (0..n)
+                .filter(|k| {
+                    let s = glass
+                        .sample(wo, Vec2::ZERO, (*k as f32 + 0.5) / n as f32)
+                        .unwrap();
+                    assert!(s.delta && s.pdf > 0.0);
+                    if s.wi.z * wo.z > 0.0 {
+                        assert!((s.wi - Vec3::new(-wo.x, -wo.y, wo.z)).length() < 1e-6);
+                        assert_eq!((s.weight, s.eta), (Vec3::ONE, 1.0));
+                        true
+                    } else {
+                        let sin = |v: Vec3| (v.x * v.x + v.y * v.y).sqrt();
+                        assert!((sin(wo) - f.eta_it * sin(s.wi)).abs() < 1e-5);
+                        assert!((s.weight - Vec3::splat(f.eta_ti * f.eta_ti)).length() < 1e-5);
+                        assert_eq!(s.eta, f.eta_it);
+                        false
+                    }
+                })
+                .count();
+            assert!((reflected as f32 / n as f32 - f.r).abs() < 1e-3);
+            assert_eq!(glass.eval(wo, -wo), Vec3::ZERO);
+            assert!(!glass.is_smooth());
+        }
+        let thin = with(Scattering::Dielectric { eta, thin: true }, 1.0);
+        let wo = Vec3::new(0.6, 0.0, 0.8);
+        let r = fresnel_dielectric(0.8, eta).r;
+        let through = thin.sample(wo, Vec2::ZERO, 0.999).unwrap();
+        assert_eq!((through.wi, through.weight), (-wo, Vec3::ONE));
+        assert!((through.pdf - (1.0 - 2.0 * r / (1.0 + r))).abs() < 1e-6);
+    }
+
+    /// A mask lets light through unchanged with probability 1 − opacity and scales the
+    /// surface's own scattering by the opacity.
+    #[test]
+    fn mask_passes_light_with_probability_one_minus_opacity() {
+        let opaque = Bsdf::new(params(0.8, 0.0, 0.5));
+        let masked = Bsdf::new(BsdfParams {
+            opacity: 0.3,
+            ..params(0.8, 0.0, 0.5)
+        });
+        let (wo, wi) = (
+            Vec3::new(0.3, 0.1, 0.9).normalize(),
+            Vec3::new(-0.5, 0.2, 0.7).normalize(),
+        );
+        assert!((masked.eval(wo, wi) - 0.3 * opaque.eval(wo, wi)).length() < 1e-7);
+        assert!((masked.pdf(wo, wi) - 0.3 * opaque.pdf(wo, wi)).abs() < 1e-7);
+        let n = 20_000;
+        let mut through = 0;
+        let mut albedo = 0.0f64;
+        for k in 0..n {
+            let u = Vec2::new(
+                ((k as f32) * 0.618_034).fract(),
+                (k as f32 + 0.5) / n as f32,
+            );
+            let s = masked
+                .sample(wo, u, ((k as f32) * 0.414_213 + 0.1).fract())
+                .unwrap();
+            if s.delta {
+                assert_eq!((s.wi, s.weight), (-wo, Vec3::ONE));
+                through += 1;
+            } else {
+                albedo += s.weight.x as f64;
+            }
+        }
+        assert!((through as f64 / n as f64 - 0.7).abs() < 0.01);
+        assert!((albedo / (n - through) as f64 - 0.8).abs() < 0.01);
+    }
+
+    /// A conductor's specular lobe is the model's times its Fresnel reflectance at the
+    /// microfacet; η = 0, k = 1 (Mitsuba's material "none") is the model itself.
+    #[test]
+    fn conductor_lobe_carries_its_fresnel_term() {
+        let (eta, k) = (Vec3::new(0.2, 0.92, 1.1), Vec3::new(3.9, 2.45, 2.14));
+        let model = Bsdf::new(params(0.0, 1.0, 0.3));
+        let copper = Bsdf::new(BsdfParams {
+            scattering: Scattering::Conductor { eta, k },
+            ..params(0.0, 1.0, 0.3)
+        });
+        let none = Bsdf::new(BsdfParams {
+            scattering: Scattering::Conductor {
+                eta: Vec3::ZERO,
+                k: Vec3::ONE,
+            },
+            ..params(0.0, 1.0, 0.3)
+        });
+        for (wo, wi) in [
+            (Vec3::Z, Vec3::Z),
+            (
+                Vec3::new(0.6, 0.0, 0.8),
+                Vec3::new(-0.9, 0.1, 0.3).normalize(),
+            ),
+        ] {
+            let m = (wo + wi).normalize();
+            let ratio = copper.eval(wo, wi) / model.eval(wo, wi);
+            assert!(
+                (ratio - fresnel_conductor(wo.dot(m), eta, k))
+                    .abs()
+                    .max_element()
+                    < 1e-5
+            );
+            assert!((none.eval(wo, wi) - model.eval(wo, wi)).abs().max_element() < 1e-6);
         }
     }
 }

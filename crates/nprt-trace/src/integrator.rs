@@ -113,6 +113,9 @@ struct Escape {
     depth: u32,
     /// Density of the BSDF sample that left (0 when `depth` is 0).
     pdf: f32,
+    /// The last bounce was a delta lobe (glass, a mask's pass-through): no light sample could
+    /// have found this direction.
+    delta: bool,
 }
 
 /// Follows a path by BSDF sampling, calling `at_surface` at each vertex before it scatters,
@@ -127,7 +130,10 @@ fn walk(
     rng: &mut Pcg64Mcg,
     mut at_surface: impl FnMut(&Vertex, &mut Pcg64Mcg),
 ) -> Option<Escape> {
-    let (mut beta, mut pdf, mut depth) = (Vec3::ONE, 0.0f32, 0u32);
+    let (mut beta, mut pdf, mut depth, mut delta) = (Vec3::ONE, 0.0f32, 0u32, false);
+    // Product of the relative indices crossed: Russian roulette judges the throughput as if
+    // outside, as Mitsuba 3 does.
+    let mut eta = 1.0f32;
     loop {
         let Some(hit) = accel.intersect(origin, dir, f32::INFINITY) else {
             return Some(Escape {
@@ -135,6 +141,7 @@ fn walk(
                 beta,
                 depth,
                 pdf,
+                delta,
             });
         };
         if depth + 1 >= s.max_depth {
@@ -144,7 +151,7 @@ fn walk(
         let frame = Frame3::new(sp.ns);
         let wo = frame.to_local(-dir);
         let bsdf = Bsdf::new(sp.params);
-        if wo.z <= 0.0 || bsdf.is_black() {
+        if !bsdf.scatters(wo) {
             return None;
         }
         let v = Vertex {
@@ -163,9 +170,11 @@ fn walk(
         origin = offset_origin(v.sp.p, v.sp.ng, dir);
         beta *= bs.weight;
         pdf = bs.pdf;
+        delta = bs.delta;
+        eta *= bs.eta;
         depth += 1;
         if depth >= s.rr_depth {
-            let q = beta.max_element().min(0.95);
+            let q = (beta.max_element() * eta * eta).min(0.95);
             if rng.random::<f32>() >= q {
                 return None;
             }
@@ -190,6 +199,9 @@ pub fn trace_path(
         return out;
     }
     let escape = walk(scene, accel, origin, dir, s, rng, |v, rng| {
+        if !v.bsdf.is_smooth() {
+            return;
+        }
         let (wi_world, le, light_pdf) =
             env.sample(Vec3::new(rng.random(), rng.random(), rng.random()));
         if light_pdf <= 0.0 {
@@ -213,7 +225,7 @@ pub fn trace_path(
     });
     if let Some(e) = escape {
         let (le, light_pdf) = env.eval_pdf(e.dir);
-        let weight = if e.depth == 0 {
+        let weight = if e.depth == 0 || e.delta {
             1.0
         } else {
             mis(e.pdf, light_pdf)

@@ -140,13 +140,14 @@ pub fn primary_sample(ts: &TraceScene, camera: &Camera, x: usize, y: usize) -> G
     match ts.accel.intersect(o, d, f32::INFINITY) {
         Some(hit) => {
             let sp = surface_point(ts.scene, &hit, d);
+            let (kd, ks, alpha) = sp.params.gbuffer();
             GSample {
                 position: sp.p,
                 normal: sp.ns,
                 view: -d,
-                kd: sp.params.kd,
-                ks: sp.params.ks,
-                alpha: sp.params.alpha,
+                kd,
+                ks,
+                alpha,
                 mask: 1.0,
             }
         }
