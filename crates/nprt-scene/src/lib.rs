@@ -39,7 +39,7 @@ pub use color::{linear_to_srgb, luminance, srgb_to_linear};
 pub use envmap::EnvMap;
 pub use envmap_spec::open_envmap;
 pub use fresnel::{fresnel_conductor, fresnel_dielectric, DielectricFresnel};
-pub use material::{BsdfParams, Material, Scattering, Surface};
+pub use material::{BsdfParams, Material, Scattering, Surface, MIN_ALPHA};
 pub use mesh::Mesh;
 pub use scene::{load_scene, Scene, SceneOptions};
 pub use texture::{Bitmap, Texture};

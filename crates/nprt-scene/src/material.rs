@@ -1,7 +1,8 @@
 //! Materials in DESIGN.md's model: f = kd/π + ks·D(α)·G(α) / (4 |ωi·n| |ωo·n|), GGX with Smith
 //! shadowing, no Fresnel term (Mitsuba's `diffuse` plus `roughconductor` with
 //! `material="none"`), and what real scenes need beyond it: conductors with a complex index
-//! (the specular lobe times their Fresnel reflectance), smooth glass, and opacity masks.
+//! (the specular lobe times their Fresnel reflectance), plastics, smooth glass, and opacity
+//! masks.
 //! Formats with other parametrisations map onto it here. The G-buffer records every surface in
 //! the model's terms ([`BsdfParams::gbuffer`]).
 
@@ -28,6 +29,17 @@ pub enum Scattering {
     /// `thindielectric`: a slab whose inter-reflections are summed and whose transmission does
     /// not bend.
     Dielectric { eta: f32, thin: bool },
+    /// Mitsuba's `plastic` (`rough` = false: a smooth coat, delta reflection) and
+    /// `roughplastic`: a dielectric coat of relative index `eta` with a GGX lobe ks·F·D·G over
+    /// a diffuse base kd, seen through the coat's transmittance and inter-reflections
+    /// (`nonlinear`: the base's colour shifts with them). `sampling_weight` is Mitsuba's
+    /// share of specular samples, mean(ks) / (mean(kd) + mean(ks)) over the textures.
+    Plastic {
+        eta: f32,
+        rough: bool,
+        nonlinear: bool,
+        sampling_weight: f32,
+    },
 }
 
 /// The BSDF parameters at one surface point.
@@ -63,7 +75,9 @@ impl BsdfParams {
         match self.scattering {
             Scattering::FresnelFree => self.ks,
             Scattering::Conductor { eta, k } => self.ks * fresnel_conductor(1.0, eta, k),
-            Scattering::Dielectric { eta, .. } => self.ks * fresnel_dielectric(1.0, eta).r,
+            Scattering::Dielectric { eta, .. } | Scattering::Plastic { eta, .. } => {
+                self.ks * fresnel_dielectric(1.0, eta).r
+            }
         }
     }
 

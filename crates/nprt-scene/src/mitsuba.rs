@@ -827,19 +827,19 @@ impl<'a> Ctx<'a> {
                 return Ok(m);
             }
             "plastic" | "roughplastic" => {
-                let alpha = if ty == "plastic" { MIN_ALPHA } else { self.microfacet_alpha(node, 0.1)? };
-                let eta = self.relative_ior(node, 1.49)?;
-                let f0 = ((eta - 1.0) / (eta + 1.0)).powi(2);
-                let spec = match self.texture_prop(node, "specular_reflectance", Vec3::ONE)? {
-                    Texture::Constant(c) => c * f0,
-                    _ => return self.fail(node, "textured specular_reflectance on plastic is not supported"),
+                let rough = ty == "roughplastic";
+                let alpha = if rough { self.microfacet_alpha(node, 0.1)? } else { MIN_ALPHA };
+                let kd = self.texture_prop(node, "diffuse_reflectance", Vec3::splat(0.5))?;
+                let ks = self.texture_prop(node, "specular_reflectance", Vec3::ONE)?;
+                let (d_mean, s_mean) = (kd.mean(), ks.mean());
+                let mut m = Material::new(&name, Surface::Direct { kd, ks, alpha: Texture::constant(alpha) }, false);
+                m.scattering = Scattering::Plastic {
+                    eta: self.relative_ior(node, 1.49)?,
+                    rough,
+                    nonlinear: self.bool_prop(node, "nonlinear", false)?,
+                    sampling_weight: if d_mean + s_mean > 0.0 { s_mean / (d_mean + s_mean) } else { 0.5 },
                 };
-                let nonlinear = if self.bool_prop(node, "nonlinear", false)? { " (nonlinear ignored)" } else { "" };
-                self.scene.warnings.push(format!(
-                    "{}: plastic is approximated by diffuse + Fresnel-free GGX with ks = F0 = {f0:.4}{nonlinear}",
-                    self.at(node)
-                ));
-                (self.texture_prop(node, "diffuse_reflectance", Vec3::splat(0.5))?, Texture::Constant(spec), Texture::constant(alpha))
+                return Ok(m);
             }
             "blendbsdf" => return self.blend(node, name),
             "bumpmap" => return self.fail(node, "bump mapping is not supported yet: reference the BSDF nested inside it instead (scenes that declare it with an id and use that id render as in Mitsuba)"),

@@ -6,6 +6,7 @@ use std::sync::Arc;
 use anyhow::{Context, Result};
 use glam::{Affine2, Vec2, Vec3};
 
+use crate::color::luminance;
 use crate::image_file::{read_linear_rgb, LinearImage};
 
 /// A linear-RGB image sampled with bilinear filtering and repeat wrapping (Mitsuba's and glTF's
@@ -98,6 +99,22 @@ impl Texture {
                 } else {
                     *color1
                 }
+            }
+        }
+    }
+
+    /// Mean over the texture as Mitsuba 3's `mean()` in RGB mode: the channels' mean for a
+    /// colour, the texels' mean luminance for a bitmap (times its factor's mean).
+    pub fn mean(&self) -> f32 {
+        let channels = |c: Vec3| (c.x + c.y + c.z) / 3.0;
+        match self {
+            Texture::Constant(c) => channels(*c),
+            Texture::Bitmap { image, factor, .. } => {
+                let sum: f64 = image.texels.iter().map(|t| luminance(*t) as f64).sum();
+                channels(*factor) * (sum / image.texels.len().max(1) as f64) as f32
+            }
+            Texture::Checkerboard { color0, color1, .. } => {
+                0.5 * (channels(*color0) + channels(*color1))
             }
         }
     }

@@ -2,25 +2,30 @@
 //! lobe ks·F·D·G1(ωo)·G1(ωi) / (4 cos θo cos θi), with Smith's separable shadowing as Mitsuba 3
 //! and F = 1 (the model) or a conductor's Fresnel reflectance. The diffuse lobe is
 //! cosine-sampled, the specular one by GGX visible normals (Heitz 2018); a lobe is picked by
-//! the luminance of its albedo. Smooth glass (Mitsuba's `dielectric`, `thindielectric`) and
-//! opacity masks (`mask`) add delta lobes, sampled as Mitsuba 3 samples them.
+//! the luminance of its albedo. Beyond the model, as Mitsuba 3 evaluates and samples them:
+//! plastics (a dielectric coat over a diffuse base, [`Coating`]), smooth glass
+//! (`dielectric`, `thindielectric`) and opacity masks (`mask`), the last two with delta lobes.
 
 use glam::{Vec2, Vec3};
 use nprt_scene::{fresnel_conductor, fresnel_dielectric, luminance, BsdfParams, Scattering};
 use std::f32::consts::PI;
 
+use crate::coating::Coating;
 use crate::microfacet::GgxDistribution;
 
 #[derive(Clone, Copy, Debug)]
-pub struct Bsdf {
+pub struct Bsdf<'a> {
     pub kd: Vec3,
     pub ks: Vec3,
     pub alpha: f32,
     kt: Vec3,
     opacity: f32,
     scattering: Scattering,
+    /// The plastic's coat (`Scattering::Plastic` only).
+    coating: Option<&'a Coating>,
     ggx: GgxDistribution,
-    /// Probability of sampling the specular lobe (of the reflecting part).
+    /// Probability of sampling the specular lobe (of the reflecting part) for the model and
+    /// conductors; Mitsuba's specular sampling weight for plastics.
     p_spec: f32,
 }
 
@@ -35,10 +40,22 @@ pub struct BsdfSample {
     pub eta: f32,
 }
 
-impl Bsdf {
-    pub fn new(p: BsdfParams) -> Self {
-        let (ld, ls) = (luminance(p.kd), luminance(p.ks));
-        let p_spec = if ld + ls > 0.0 { ls / (ld + ls) } else { 0.0 };
+impl<'a> Bsdf<'a> {
+    /// `coating` must be given for plastics (the tracer builds one per material).
+    pub fn new(p: BsdfParams, coating: Option<&'a Coating>) -> Self {
+        let p_spec = match p.scattering {
+            Scattering::Plastic {
+                sampling_weight, ..
+            } => sampling_weight,
+            _ => {
+                let (ld, ls) = (luminance(p.kd), luminance(p.ks));
+                if ld + ls > 0.0 {
+                    ls / (ld + ls)
+                } else {
+                    0.0
+                }
+            }
+        };
         Bsdf {
             kd: p.kd,
             ks: p.ks,
@@ -46,6 +63,7 @@ impl Bsdf {
             kt: p.kt,
             opacity: p.opacity,
             scattering: p.scattering,
+            coating: coating.filter(|_| matches!(p.scattering, Scattering::Plastic { .. })),
             ggx: GgxDistribution::new(p.alpha),
             p_spec,
         }
@@ -72,33 +90,81 @@ impl Bsdf {
 
     /// f(ωo, ωi)·cos θi.
     pub fn eval(&self, wo: Vec3, wi: Vec3) -> Vec3 {
-        if wo.z <= 0.0 || wi.z <= 0.0 || !self.is_smooth() {
-            return Vec3::ZERO;
-        }
-        let mut f = self.kd * (wi.z / PI);
-        if self.p_spec > 0.0 {
-            let m = (wo + wi).normalize();
-            let g = self.ggx.g1(wo, m) * self.ggx.g1(wi, m);
-            let fresnel = match self.scattering {
-                Scattering::Conductor { eta, k } => fresnel_conductor(wo.dot(m), eta, k),
-                _ => Vec3::ONE,
-            };
-            f += self.ks * fresnel * (self.ggx.d(m) * g / (4.0 * wo.z));
-        }
-        f * self.opacity
+        self.eval_surface(wo, wi) * self.opacity
     }
 
     pub fn pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
-        if wo.z <= 0.0 || wi.z <= 0.0 || !self.is_smooth() {
+        self.pdf_surface(wo, wi) * self.opacity
+    }
+
+    /// Probability of the specular lobe for light leaving along `wo`: fixed for the model and
+    /// conductors; for a plastic, weighted by how much the coat reflects at this angle.
+    fn specular_probability(&self, wo: Vec3) -> f32 {
+        let Some(coat) = self.coating else {
+            return self.p_spec;
+        };
+        let reflected = 1.0 - coat.transmittance(wo.z);
+        let (s, d) = (
+            reflected * self.p_spec,
+            (1.0 - reflected) * (1.0 - self.p_spec),
+        );
+        if s + d > 0.0 {
+            s / (s + d)
+        } else {
+            0.0
+        }
+    }
+
+    /// The surface's own f·cos, before the mask's opacity (smooth lobes only).
+    fn eval_surface(&self, wo: Vec3, wi: Vec3) -> Vec3 {
+        if wo.z <= 0.0 || wi.z <= 0.0 || self.is_glass() {
+            return Vec3::ZERO;
+        }
+        let (diffuse, fresnel) = match (self.scattering, self.coating) {
+            (Scattering::Plastic { eta, nonlinear, .. }, Some(coat)) => {
+                let internal = if nonlinear {
+                    self.kd * coat.internal_reflectance
+                } else {
+                    Vec3::splat(coat.internal_reflectance)
+                };
+                let base = self.kd / (Vec3::ONE - internal);
+                let through = coat.transmittance(wo.z) * coat.transmittance(wi.z) / (eta * eta);
+                let m = (wo + wi).normalize();
+                let specular = if coat.is_rough() {
+                    fresnel_dielectric(wo.dot(m), eta).r
+                } else {
+                    0.0
+                };
+                (base * through, Vec3::splat(specular))
+            }
+            (Scattering::Conductor { eta, k }, _) => {
+                let m = (wo + wi).normalize();
+                (self.kd, fresnel_conductor(wo.dot(m), eta, k))
+            }
+            _ => (self.kd, Vec3::ONE),
+        };
+        let mut f = diffuse * (wi.z / PI);
+        if self.p_spec > 0.0 && fresnel != Vec3::ZERO {
+            let m = (wo + wi).normalize();
+            let g = self.ggx.g1(wo, m) * self.ggx.g1(wi, m);
+            f += self.ks * fresnel * (self.ggx.d(m) * g / (4.0 * wo.z));
+        }
+        f
+    }
+
+    /// Density of `sample` for the smooth lobes, before the mask's opacity.
+    fn pdf_surface(&self, wo: Vec3, wi: Vec3) -> f32 {
+        if wo.z <= 0.0 || wi.z <= 0.0 || self.is_glass() {
             return 0.0;
         }
-        let mut pdf = (1.0 - self.p_spec) * wi.z / PI;
-        if self.p_spec > 0.0 {
+        let p_spec = self.specular_probability(wo);
+        let mut pdf = (1.0 - p_spec) * wi.z / PI;
+        if p_spec > 0.0 && self.coating.is_none_or(Coating::is_rough) {
             let m = (wo + wi).normalize();
             // Visible-normal density G1(ωo)·D(m)·(ωo·m)/cos θo, times the reflection Jacobian.
-            pdf += self.p_spec * self.ggx.g1(wo, m) * self.ggx.d(m) / (4.0 * wo.z);
+            pdf += p_spec * self.ggx.g1(wo, m) * self.ggx.d(m) / (4.0 * wo.z);
         }
-        pdf * self.opacity
+        pdf
     }
 
     /// Samples ωi; `u_lobe` picks among lobes (pass-through, reflection, refraction) first.
@@ -128,21 +194,39 @@ impl Bsdf {
         if wo.z <= 0.0 {
             return None;
         }
-        let wi = if u_lobe < self.p_spec {
-            let m = self.ggx.sample_visible_normal(wo, u);
-            2.0 * wo.dot(m) * m - wo
-        } else {
+        let p_spec = self.specular_probability(wo);
+        let mirror = Vec3::new(-wo.x, -wo.y, wo.z);
+        let wi = if u_lobe >= p_spec {
             let r = u.x.sqrt();
             let phi = 2.0 * PI * u.y;
             Vec3::new(r * phi.cos(), r * phi.sin(), (1.0 - u.x).max(0.0).sqrt())
+        } else if let (Some(coat), Scattering::Plastic { eta, .. }) =
+            (self.coating, self.scattering)
+        {
+            if !coat.is_rough() {
+                // A smooth coat's delta reflection.
+                let weight = self.ks * (fresnel_dielectric(wo.z, eta).r / p_spec);
+                return Some(BsdfSample {
+                    wi: mirror,
+                    weight,
+                    pdf: p_spec,
+                    delta: true,
+                    eta: 1.0,
+                });
+            }
+            let m = self.ggx.sample_visible_normal(wo, u);
+            2.0 * wo.dot(m) * m - wo
+        } else {
+            let m = self.ggx.sample_visible_normal(wo, u);
+            2.0 * wo.dot(m) * m - wo
         };
-        let pdf = self.pdf(wo, wi) / self.opacity;
+        let pdf = self.pdf_surface(wo, wi);
         if pdf <= 0.0 {
             return None;
         }
         Some(BsdfSample {
             wi,
-            weight: self.eval(wo, wi) / self.opacity / pdf,
+            weight: self.eval_surface(wo, wi) / pdf,
             pdf,
             delta: false,
             eta: 1.0,
@@ -180,9 +264,13 @@ impl Bsdf {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::coating::Coating;
     use crate::shading_frame::Frame3;
-    use nprt_scene::{fresnel_conductor, fresnel_dielectric};
     use rand::{RngExt, SeedableRng};
+
+    fn plain(p: BsdfParams) -> Bsdf<'static> {
+        Bsdf::new(p, None)
+    }
 
     fn params(kd: f32, ks: f32, alpha: f32) -> BsdfParams {
         BsdfParams::new(Vec3::splat(kd), Vec3::splat(ks), alpha)
@@ -198,7 +286,7 @@ mod tests {
             (0.0, 1.0, 0.5),
             (0.5, 0.5, 0.2),
         ] {
-            let b = Bsdf::new(params(kd, ks, alpha));
+            let b = plain(params(kd, ks, alpha));
             let wo = Vec3::new(0.5, 0.1, 0.8).normalize();
             let n = 400_000;
             let (mut uni, mut imp) = (0.0f64, 0.0f64);
@@ -227,7 +315,7 @@ mod tests {
 
     #[test]
     fn pdf_integrates_to_one() {
-        let b = Bsdf::new(params(0.3, 0.7, 0.2));
+        let b = plain(params(0.3, 0.7, 0.2));
         let wo = Vec3::new(-0.3, 0.4, 0.6).normalize();
         let (nt, np) = (600, 600);
         let mut total = 0.0f64;
@@ -262,7 +350,7 @@ mod tests {
 
     #[test]
     fn reciprocal_and_frame_orthonormal() {
-        let b = Bsdf::new(params(0.2, 0.9, 0.3));
+        let b = plain(params(0.2, 0.9, 0.3));
         let (a, c) = (
             Vec3::new(0.3, 0.2, 0.9).normalize(),
             Vec3::new(-0.6, 0.1, 0.5).normalize(),
@@ -278,8 +366,8 @@ mod tests {
         }
     }
 
-    fn with(scattering: Scattering, opacity: f32) -> Bsdf {
-        Bsdf::new(BsdfParams {
+    fn with(scattering: Scattering, opacity: f32) -> Bsdf<'static> {
+        plain(BsdfParams {
             kt: Vec3::ONE,
             opacity,
             scattering,
@@ -331,8 +419,8 @@ mod tests {
     /// surface's own scattering by the opacity.
     #[test]
     fn mask_passes_light_with_probability_one_minus_opacity() {
-        let opaque = Bsdf::new(params(0.8, 0.0, 0.5));
-        let masked = Bsdf::new(BsdfParams {
+        let opaque = plain(params(0.8, 0.0, 0.5));
+        let masked = plain(BsdfParams {
             opacity: 0.3,
             ..params(0.8, 0.0, 0.5)
         });
@@ -369,12 +457,12 @@ mod tests {
     #[test]
     fn conductor_lobe_carries_its_fresnel_term() {
         let (eta, k) = (Vec3::new(0.2, 0.92, 1.1), Vec3::new(3.9, 2.45, 2.14));
-        let model = Bsdf::new(params(0.0, 1.0, 0.3));
-        let copper = Bsdf::new(BsdfParams {
+        let model = plain(params(0.0, 1.0, 0.3));
+        let copper = plain(BsdfParams {
             scattering: Scattering::Conductor { eta, k },
             ..params(0.0, 1.0, 0.3)
         });
-        let none = Bsdf::new(BsdfParams {
+        let none = plain(BsdfParams {
             scattering: Scattering::Conductor {
                 eta: Vec3::ZERO,
                 k: Vec3::ONE,
@@ -397,6 +485,63 @@ mod tests {
                     < 1e-5
             );
             assert!((none.eval(wo, wi) - model.eval(wo, wi)).abs().max_element() < 1e-6);
+        }
+    }
+
+    /// Plastics as Mitsuba 3: importance sampling reproduces the evaluated lobes (uniform
+    /// hemisphere integration), a smooth coat's delta reflection carries exactly F(θo)·ks, and
+    /// no plastic reflects more than it receives.
+    #[test]
+    fn plastic_sampling_matches_its_evaluation() {
+        let mut rng = rand_pcg::Pcg64Mcg::seed_from_u64(3);
+        let wo = Vec3::new(0.6, 0.2, 0.5).normalize();
+        for rough in [true, false] {
+            let alpha = if rough { 0.2 } else { 1e-3 };
+            let coat = Coating::new(1.5, alpha, rough);
+            let b = Bsdf::new(
+                BsdfParams {
+                    scattering: Scattering::Plastic {
+                        eta: 1.5,
+                        rough,
+                        nonlinear: true,
+                        sampling_weight: 0.4,
+                    },
+                    ..params(0.6, 1.0, alpha)
+                },
+                Some(&coat),
+            );
+            let n = 400_000;
+            let (mut uni, mut imp, mut mirror) = (0.0f64, 0.0f64, 0.0f64);
+            for _ in 0..n {
+                let (u1, u2): (f32, f32) = (rng.random(), rng.random());
+                let r = (1.0 - u1 * u1).sqrt();
+                let wi = Vec3::new(r * (2.0 * PI * u2).cos(), r * (2.0 * PI * u2).sin(), u1);
+                uni += (b.eval(wo, wi).x * 2.0 * PI) as f64;
+                if let Some(s) = b.sample(wo, Vec2::new(rng.random(), rng.random()), rng.random()) {
+                    if s.delta {
+                        assert_eq!(s.wi, Vec3::new(-wo.x, -wo.y, wo.z));
+                        mirror += s.weight.x as f64;
+                    } else {
+                        imp += s.weight.x as f64;
+                        assert!((b.pdf(wo, s.wi) - s.pdf).abs() < 1e-4 * s.pdf.max(1.0));
+                    }
+                }
+            }
+            let (uni, imp, mirror) = (uni / n as f64, imp / n as f64, mirror / n as f64);
+            assert!(
+                (uni - imp).abs() < 0.01 * uni,
+                "rough {rough}: uniform {uni} vs sampled {imp}"
+            );
+            let f = fresnel_dielectric(wo.z, 1.5).r as f64;
+            if rough {
+                assert_eq!(mirror, 0.0);
+            } else {
+                assert!(
+                    (mirror - f).abs() < 0.01 * f,
+                    "delta lobe {mirror} vs F {f}"
+                );
+            }
+            assert!(imp + mirror < 1.0 && imp > 0.3, "albedo {}", imp + mirror);
         }
     }
 }

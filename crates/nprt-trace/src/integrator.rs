@@ -7,8 +7,9 @@ use nprt_scene::{BsdfParams, EnvMap, Scene};
 use rand::RngExt;
 use rand_pcg::Pcg64Mcg;
 
-use crate::accel::{Accel, Hit};
+use crate::accel::Hit;
 use crate::bsdf::Bsdf;
+use crate::render::TraceScene;
 use crate::shading_frame::Frame3;
 
 /// A surface point seen along a ray, oriented for shading.
@@ -20,6 +21,8 @@ pub struct SurfacePoint {
     /// Shading normal; flipped towards the viewer on two-sided materials.
     pub ns: Vec3,
     pub params: BsdfParams,
+    /// Index into the scene's materials.
+    pub material: usize,
 }
 
 /// Power heuristic (β = 2) weight of the strategy with density `a` against `b`.
@@ -77,6 +80,7 @@ pub fn surface_point(scene: &Scene, hit: &Hit, dir: Vec3) -> SurfacePoint {
         ng,
         ns,
         params: material.eval(uv),
+        material: mesh.material,
     }
 }
 
@@ -94,11 +98,11 @@ pub struct PathSettings {
 }
 
 /// A surface vertex of a path, ready to shade.
-struct Vertex {
+struct Vertex<'a> {
     sp: SurfacePoint,
     frame: Frame3,
     wo: Vec3,
-    bsdf: Bsdf,
+    bsdf: Bsdf<'a>,
     /// Throughput up to this vertex.
     beta: Vec3,
     /// Surface bounces before this vertex.
@@ -122,8 +126,7 @@ struct Escape {
 /// until it leaves the scene (`Some`) or ends on a surface (absorbed, Russian roulette from
 /// `rr_depth`, or `max_depth` reached: `None`). The one walk behind both integrators.
 fn walk(
-    scene: &Scene,
-    accel: &Accel,
+    ts: &TraceScene,
     mut origin: Vec3,
     mut dir: Vec3,
     s: &PathSettings,
@@ -135,7 +138,7 @@ fn walk(
     // outside, as Mitsuba 3 does.
     let mut eta = 1.0f32;
     loop {
-        let Some(hit) = accel.intersect(origin, dir, f32::INFINITY) else {
+        let Some(hit) = ts.accel.intersect(origin, dir, f32::INFINITY) else {
             return Some(Escape {
                 dir,
                 beta,
@@ -147,10 +150,10 @@ fn walk(
         if depth + 1 >= s.max_depth {
             return None;
         }
-        let sp = surface_point(scene, &hit, dir);
+        let sp = surface_point(ts.scene, &hit, dir);
         let frame = Frame3::new(sp.ns);
         let wo = frame.to_local(-dir);
-        let bsdf = Bsdf::new(sp.params);
+        let bsdf = Bsdf::new(sp.params, ts.coatings[sp.material].as_ref());
         if !bsdf.scatters(wo) {
             return None;
         }
@@ -186,8 +189,7 @@ fn walk(
 /// Radiance along one camera ray: BSDF sampling and next-event estimation towards the
 /// environment at every vertex, combined by multiple importance sampling.
 pub fn trace_path(
-    scene: &Scene,
-    accel: &Accel,
+    ts: &TraceScene,
     env: &EnvMap,
     origin: Vec3,
     dir: Vec3,
@@ -198,7 +200,7 @@ pub fn trace_path(
     if s.max_depth == 0 {
         return out;
     }
-    let escape = walk(scene, accel, origin, dir, s, rng, |v, rng| {
+    let escape = walk(ts, origin, dir, s, rng, |v, rng| {
         if !v.bsdf.is_smooth() {
             return;
         }
@@ -210,7 +212,7 @@ pub fn trace_path(
         let wi = v.frame.to_local(wi_world);
         let f = v.bsdf.eval(v.wo, wi);
         if f != Vec3::ZERO
-            && !accel.occluded(
+            && !ts.accel.occluded(
                 offset_origin(v.sp.p, v.sp.ng, wi_world),
                 wi_world,
                 f32::INFINITY,
@@ -243,14 +245,13 @@ pub fn trace_path(
 /// direction and the path throughput, or `None` when the path ends on a surface (absorbed,
 /// Russian roulette, `max_depth`) or misses the scene from the start (no scattered light).
 pub fn trace_escape(
-    scene: &Scene,
-    accel: &Accel,
+    ts: &TraceScene,
     origin: Vec3,
     dir: Vec3,
     s: &PathSettings,
     rng: &mut Pcg64Mcg,
 ) -> Option<(Vec3, Vec3)> {
-    walk(scene, accel, origin, dir, s, rng, |_, _| {})
+    walk(ts, origin, dir, s, rng, |_, _| {})
         .filter(|e| e.depth > 0)
         .map(|e| (e.dir, e.beta))
 }

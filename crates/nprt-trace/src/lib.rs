@@ -28,6 +28,7 @@
 
 mod accel;
 mod bsdf;
+mod coating;
 pub mod exr_io;
 mod frame;
 mod integrator;
@@ -37,6 +38,7 @@ mod shading_frame;
 
 pub use accel::{Accel, Hit};
 pub use bsdf::Bsdf;
+pub use coating::Coating;
 pub use frame::{Frame, GBuffer, GSample};
 pub use render::{
     primary_sample, render, render_gbuffer, render_transport, PixelFilter, RenderSettings,

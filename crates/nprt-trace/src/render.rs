@@ -2,12 +2,13 @@
 //! same image whatever the thread count), a progress bar with ETA.
 
 use glam::{Vec2, Vec3};
-use nprt_scene::{Camera, EnvMap, Scene};
+use nprt_scene::{Camera, EnvMap, Scattering, Scene, Surface};
 use rand::{RngExt, SeedableRng};
 use rand_pcg::Pcg64Mcg;
 use rayon::prelude::*;
 
 use crate::accel::Accel;
+use crate::coating::Coating;
 use crate::frame::{Frame, GBuffer, GSample};
 use crate::integrator::{surface_point, trace_escape, trace_path, PathRadiance, PathSettings};
 
@@ -36,13 +37,26 @@ pub struct RenderSettings {
 pub struct TraceScene<'a> {
     pub scene: &'a Scene,
     pub accel: Accel,
+    /// Per material: the coat of a plastic, integrated once here (`None` for the others).
+    pub coatings: Vec<Option<Coating>>,
 }
 
 impl<'a> TraceScene<'a> {
     pub fn new(scene: &'a Scene) -> Self {
+        let coatings = scene
+            .materials
+            .iter()
+            .map(|m| match (m.scattering, &m.surface) {
+                (Scattering::Plastic { eta, rough, .. }, Surface::Direct { alpha, .. }) => {
+                    Some(Coating::new(eta, alpha.eval(Vec2::ZERO).x, rough))
+                }
+                _ => None,
+            })
+            .collect();
         TraceScene {
             scene,
             accel: Accel::new(scene),
+            coatings,
         }
     }
 }
@@ -121,7 +135,7 @@ fn pixel(
             PixelFilter::Centre => centre,
         };
         let (o, d) = camera.ray(film);
-        let r = trace_path(ts.scene, &ts.accel, env, o, d, ps, &mut rng);
+        let r = trace_path(ts, env, o, d, ps, &mut rng);
         sum.total += r.total;
         sum.direct += r.direct;
     }
@@ -193,7 +207,7 @@ pub fn render_transport(
             let mut y_k = vec![0.0; basis_len];
             let (o, d) = camera.ray(Vec2::new((i % w) as f32 + 0.5, (i / w) as f32 + 0.5));
             for _ in 0..s.spp {
-                if let Some((dir, beta)) = trace_escape(ts.scene, &ts.accel, o, d, &ps, &mut rng) {
+                if let Some((dir, beta)) = trace_escape(ts, o, d, &ps, &mut rng) {
                     basis(dir, &mut y_k);
                     for (tk, yk) in t.iter_mut().zip(&y_k) {
                         *tk += beta * *yk;

@@ -162,9 +162,9 @@ fn glossy_scene_matches_mitsuba_within_2_percent() {
     agree("glossy", 0.02);
 }
 
-/// A Mitsuba 0.5 file (camelCase names) with smooth glass, a thin pane, an opacity mask and a
-/// complex-index conductor: both renderers read the same file.
+/// A Mitsuba 0.5 file (camelCase names) with smooth glass, a thin pane, an opacity mask, a
+/// complex-index conductor and rough and smooth plastics: both renderers read the same file.
 #[test]
-fn legacy_glass_scene_matches_mitsuba_within_2_percent() {
-    agree("legacy_glass", 0.02);
+fn legacy_materials_scene_matches_mitsuba_within_2_percent() {
+    agree("legacy_materials", 0.02);
 }
