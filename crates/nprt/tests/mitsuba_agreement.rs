@@ -88,12 +88,21 @@ fn mitsuba(python: &str, scene: &Path, out: &Path, seed: u32, map: &Path) {
 }
 
 fn agree(name: &str, tolerance: f32) {
+    agree_on(
+        name,
+        &repo().join(format!("tests/mitsuba/{name}.xml")),
+        tolerance,
+    );
+}
+
+/// Renders `scene_path` twice with each renderer and compares them.
+fn agree_on(name: &str, scene_path: &Path, tolerance: f32) {
     if std::env::var("NPRT_SKIP_MITSUBA").as_deref() == Ok("1") {
         eprintln!("SKIPPED on request (NPRT_SKIP_MITSUBA=1): Mitsuba agreement for {name}");
         return;
     }
     let python = std::env::var("NPRT_PYTHON").expect("NPRT_PYTHON must name a Python with mitsuba installed (scripts/test sets it up); NPRT_SKIP_MITSUBA=1 skips on purpose");
-    let scene_path = repo().join(format!("tests/mitsuba/{name}.xml"));
+    let scene_path = scene_path.to_path_buf();
     let tmp = std::env::temp_dir().join(format!("nprt-mitsuba-{name}-{}", std::process::id()));
     std::fs::create_dir_all(&tmp).unwrap();
     let raw = load_scene(scene_path.to_str().unwrap(), &SceneOptions::default()).unwrap();
@@ -167,4 +176,75 @@ fn glossy_scene_matches_mitsuba_within_2_percent() {
 #[test]
 fn legacy_materials_scene_matches_mitsuba_within_2_percent() {
     agree("legacy_materials", 0.02);
+}
+
+/// The folder of large optional data beside the repository (`NPRT_SHARED`, else `../shared`)
+/// when it holds `sub`. Absent, the test is skipped, unless `NPRT_REQUIRE_SHARED=1` (CI) makes
+/// that a failure.
+fn shared(sub: &str) -> Option<PathBuf> {
+    let root = std::env::var_os("NPRT_SHARED")
+        .map(PathBuf::from)
+        .unwrap_or_else(|| repo().join("../shared"));
+    let path = root.join(sub);
+    if path.exists() {
+        return Some(path);
+    }
+    assert!(
+        std::env::var("NPRT_REQUIRE_SHARED").as_deref() != Ok("1"),
+        "NPRT_REQUIRE_SHARED=1 but {} is missing",
+        path.display()
+    );
+    eprintln!(
+        "SKIPPED: {} is absent (set NPRT_SHARED to the shared data folder)",
+        path.display()
+    );
+    None
+}
+
+/// The paper's KITCHEN (Bitterli's Mitsuba 0.5 release, a million triangles) as both renderers
+/// read it with its light portals removed, lit through the window by a real map: plastics,
+/// conductors, glass and the blinds' opacity mask at scale.
+#[test]
+fn kitchen_matches_mitsuba_within_2_percent() {
+    let (Some(kitchen), Some(map)) = (shared("scenes/kitchen"), shared("envmaps/sky.exr")) else {
+        return;
+    };
+    let dir = std::env::temp_dir().join(format!("nprt-kitchen-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    for sub in ["models", "textures"] {
+        let link = dir.join(sub);
+        let _ = std::fs::remove_file(&link);
+        std::os::unix::fs::symlink(kitchen.join(sub), &link).unwrap();
+    }
+    let text = std::fs::read_to_string(kitchen.join("scene.xml")).unwrap();
+    // Keep every shape but the portals (the ones carrying an area emitter).
+    let (mut xml, mut rest) = (String::new(), text.as_str());
+    while let Some(i) = rest.find("<shape") {
+        xml.push_str(&rest[..i]);
+        let end = i + rest[i..].find("</shape>").unwrap() + "</shape>".len();
+        if !rest[i..end].contains("<emitter") {
+            xml.push_str(&rest[i..end]);
+        }
+        rest = &rest[end..];
+    }
+    xml.push_str(rest);
+    let xml = xml
+        .replace(r#"value="1280""#, r#"value="160""#)
+        .replace(r#"value="720""#, r#"value="90""#)
+        .replace(r#"<rfilter name="rfilter" type="tent" />"#, r#"<rfilter type="box"/>"#)
+        .replace(
+            "</scene>",
+            &format!(
+                "<default name=\"envmap\" value=\"{}\"/>\n<emitter type=\"envmap\"><string name=\"filename\" value=\"$envmap\"/></emitter>\n</scene>",
+                map.display()
+            ),
+        );
+    assert_eq!(
+        xml.matches("<shape").count(),
+        289,
+        "the portals, and only they, are removed"
+    );
+    let scene = dir.join("kitchen.xml");
+    std::fs::write(&scene, xml).unwrap();
+    agree_on("kitchen", &scene, 0.02);
 }
