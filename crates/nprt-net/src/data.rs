@@ -71,6 +71,20 @@ impl TrainingSet {
     }
 }
 
+impl TrainingSet {
+    /// ln of the mean training radiance relative to its map's mean (what the networks predict
+    /// before the map's scale), over every foreground pixel and channel.
+    pub fn log_relative_level(&self) -> f32 {
+        let (mut sum, mut n) = (0.0f64, 0usize);
+        for v in &self.train {
+            let s = v.light.scale as f64;
+            sum += v.radiance.iter().map(|&r| r.max(0.0) as f64).sum::<f64>() / s;
+            n += v.radiance.len();
+        }
+        ((sum / n.max(1) as f64).max(1e-12) as f32).ln()
+    }
+}
+
 /// Opens the dataset's maps and checks each is the one the dataset was rendered with.
 pub fn open_recorded_maps(manifest: &Manifest) -> Result<Vec<EnvMap>> {
     manifest

@@ -122,6 +122,28 @@ impl NprtNet {
         self.shade(features, code, scale)
     }
 
+    /// Adds `log_level` to every track's output bias, so that an untrained network predicts
+    /// radiance of about exp(`log_level`) × the map's mean. Starting at the data's level
+    /// matters where it is far from the map's mean (a room lit through a window gets a small
+    /// fraction of its map): started orders of magnitude too bright, the exp output's first
+    /// steps overshoot to near zero, where log-L1's gradient (∝ the prediction) vanishes and
+    /// Adam, still scaled by the first steps' huge gradients, never brings it back. The
+    /// shifted bias is a fresh leaf, so autodiff trains it as any parameter.
+    pub fn shift_output_level(mut self, log_level: f32) -> Self {
+        for track in &mut self.tracks {
+            let last = track
+                .shading
+                .layers
+                .last_mut()
+                .expect("a network has layers");
+            last.bias = last
+                .bias
+                .take()
+                .map(|b| b.map(|t| t.add_scalar(log_level).detach().require_grad()));
+        }
+        self
+    }
+
     pub fn total_params(&self) -> usize {
         self.num_params()
     }

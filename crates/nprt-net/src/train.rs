@@ -58,7 +58,9 @@ impl Objective for PixelObjective<'_> {
     }
 
     fn build(&self, init: &mut Init) -> NprtNet {
-        self.config.build(init)
+        self.config
+            .build(init)
+            .shift_output_level(self.set.log_relative_level())
     }
 
     fn steps(&self, seed: u64, epoch: usize) -> usize {

@@ -333,3 +333,28 @@ fn cpu_engine_radiance_matches_burn() {
         }
     }
 }
+
+/// Starting a network at the data's level scales every design's untrained radiance by exactly
+/// exp(level), in burn and in the CPU engine alike (the shift lives in the output bias).
+#[test]
+fn output_level_shift_scales_the_untrained_prediction() {
+    let device = Device::flex();
+    let mut rng = Pcg64Mcg::seed_from_u64(9);
+    let n = 200;
+    let features: Vec<f32> = (0..n * FEATURES).map(|_| rng.random::<f32>()).collect();
+    let code: Vec<f32> = (0..64).map(|_| rng.random::<f32>() - 0.5).collect();
+    let level = (2e-3f32).ln();
+    for design in Design::ALL {
+        let net = ModelConfig::new(design, None).build(&mut Init::new(8, &device));
+        let shifted = net.clone().shift_output_level(level);
+        let radiance = |net: &NprtNet| {
+            nprt_net::cpu::HostTransport::from_net(net).radiance(&features, &code, 1.0, None)
+        };
+        for (a, b) in radiance(&shifted).iter().zip(radiance(&net)) {
+            assert!(
+                (a / b - 2e-3).abs() < 1e-3 * 2e-3,
+                "{design:?}: {a} is not 2e-3 × {b}"
+            );
+        }
+    }
+}

@@ -1,7 +1,11 @@
 //! Pinhole cameras with Mitsuba 3's `perspective` conventions: camera space looks along +Z
 //! with +Y up and +X to the image's left; `fov` is measured along `fov_axis`.
 
+use std::path::{Path, PathBuf};
+
+use anyhow::{bail, Context, Result};
 use glam::{Mat4, Vec2, Vec3};
+use serde::Deserialize;
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum FovAxis {
@@ -25,6 +29,56 @@ pub struct CameraVolume {
     pub spread_deg: f32,
     /// Horizontal field of view of the placed cameras, degrees.
     pub fov_deg: f32,
+}
+
+/// A camera volume as a file scene's sidecar states it (`NAME.camera.json` beside
+/// `NAME.xml`): `{"min": [x, y, z], "max": [x, y, z], "look": [x, y, z], "spread_deg": 30,
+/// "fov_deg": 60}`.
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct VolumeFile {
+    min: [f32; 3],
+    max: [f32; 3],
+    look: [f32; 3],
+    spread_deg: f32,
+    fov_deg: f32,
+}
+
+impl CameraVolume {
+    /// The sidecar that states the camera volume of the scene file `scene`.
+    pub fn sidecar_of(scene: &Path) -> PathBuf {
+        scene.with_extension("camera.json")
+    }
+
+    /// Reads and checks a camera-volume file; errors name the file and the reason.
+    pub fn load(path: &Path) -> Result<Self> {
+        let text = std::fs::read_to_string(path)
+            .with_context(|| format!("cannot read camera volume '{}'", path.display()))?;
+        let f: VolumeFile = serde_json::from_str(&text)
+            .with_context(|| format!("camera volume '{}'", path.display()))?;
+        let v = CameraVolume {
+            min: Vec3::from(f.min),
+            max: Vec3::from(f.max),
+            look: Vec3::from(f.look).normalize_or_zero(),
+            spread_deg: f.spread_deg,
+            fov_deg: f.fov_deg,
+        };
+        let problem = if !(v.min.is_finite() && v.max.is_finite() && v.min.cmple(v.max).all()) {
+            Some("\"min\" must not exceed \"max\" on any axis")
+        } else if v.look == Vec3::ZERO {
+            Some("\"look\" must be a non-zero direction")
+        } else if !(v.spread_deg >= 0.0 && v.spread_deg < 90.0) {
+            Some("\"spread_deg\" must be in [0, 90)")
+        } else if !(v.fov_deg > 0.0 && v.fov_deg < 180.0) {
+            Some("\"fov_deg\" must be in (0, 180)")
+        } else {
+            None
+        };
+        if let Some(p) = problem {
+            bail!("camera volume '{}': {p}", path.display());
+        }
+        Ok(v)
+    }
 }
 
 #[derive(Clone, Debug, PartialEq)]
@@ -139,5 +193,55 @@ mod tests {
         c.fov_axis = FovAxis::Y;
         let (_, top) = c.ray(Vec2::new(100.0, 0.0));
         assert!((top.y - top.z).abs() < 1e-5, "{top}");
+    }
+
+    /// A file scene picks up its sidecar volume; bad volumes are refused with the file named.
+    #[test]
+    fn camera_volume_sidecar_is_read_and_checked() {
+        let dir = std::env::temp_dir().join(format!("nprt-volume-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let scene = dir.join("room.xml");
+        std::fs::write(
+            &scene,
+            r#"<scene version="3.0.0"><shape type="cube"/></scene>"#,
+        )
+        .unwrap();
+        let spec = scene.to_str().unwrap();
+        let opts = crate::SceneOptions::default();
+        assert!(crate::load_scene(spec, &opts)
+            .unwrap()
+            .camera_volume
+            .is_none());
+        let sidecar = CameraVolume::sidecar_of(&scene);
+        assert_eq!(sidecar, dir.join("room.camera.json"));
+        let good = r#"{"min": [-1, 0.5, -1], "max": [1, 2, 1], "look": [0, 0, -2], "spread_deg": 20, "fov_deg": 50}"#;
+        std::fs::write(&sidecar, good).unwrap();
+        let v = crate::load_scene(spec, &opts)
+            .unwrap()
+            .camera_volume
+            .unwrap();
+        assert_eq!(
+            (v.min, v.look, v.spread_deg, v.fov_deg),
+            (Vec3::new(-1.0, 0.5, -1.0), -Vec3::Z, 20.0, 50.0)
+        );
+        for (bad, why) in [
+            (good.replace("[1, 2, 1]", "[1, 0, 1]"), "must not exceed"),
+            (good.replace("[0, 0, -2]", "[0, 0, 0]"), "non-zero"),
+            (
+                good.replace("\"fov_deg\": 50", "\"fov_deg\": 180"),
+                "fov_deg",
+            ),
+            (
+                good.replace("\"spread_deg\"", "\"spread\""),
+                "unknown field",
+            ),
+        ] {
+            std::fs::write(&sidecar, bad).unwrap();
+            let err = format!("{:#}", crate::load_scene(spec, &opts).unwrap_err());
+            assert!(
+                err.contains("room.camera.json") && err.contains(why),
+                "{err}"
+            );
+        }
     }
 }

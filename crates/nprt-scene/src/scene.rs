@@ -97,7 +97,8 @@ impl Scene {
     }
 }
 
-/// Loads `spec`: a file (.xml Mitsuba 3, .gltf/.glb, .ply/.obj) or `builtin:NAME`.
+/// Loads `spec`: a file (.xml Mitsuba 3, .gltf/.glb, .ply/.obj) or `builtin:NAME`. A file
+/// scene's camera volume comes from its sidecar `NAME.camera.json` when there is one.
 pub fn load_scene(spec: &str, opts: &SceneOptions) -> Result<Scene> {
     if let Some(name) = spec.strip_prefix("builtin:") {
         return crate::builtin::scene(name);
@@ -111,7 +112,7 @@ pub fn load_scene(spec: &str, opts: &SceneOptions) -> Result<Scene> {
         .and_then(|e| e.to_str())
         .unwrap_or("")
         .to_ascii_lowercase();
-    let scene = match ext.as_str() {
+    let mut scene = match ext.as_str() {
         "xml" => crate::mitsuba::load(path, opts)?,
         "gltf" | "glb" => crate::gltf_scene::load(path)?,
         "ply" | "obj" => {
@@ -127,6 +128,10 @@ pub fn load_scene(spec: &str, opts: &SceneOptions) -> Result<Scene> {
     };
     if scene.meshes.is_empty() {
         bail!("scene file '{spec}' contains no geometry");
+    }
+    let sidecar = CameraVolume::sidecar_of(path);
+    if sidecar.exists() {
+        scene.camera_volume = Some(CameraVolume::load(&sidecar)?);
     }
     Ok(scene)
 }

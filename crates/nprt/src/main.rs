@@ -190,6 +190,10 @@ pub(crate) struct GenerateArgs {
     /// Render only views with index ≡ K (mod N), e.g. 0/4 … 3/4 on four machines.
     #[arg(long, default_value = "0/1", value_parser = parse_shard)]
     pub(crate) shard: (u64, u64),
+    /// Camera active volume from a JSON file (as a scene's sidecar NAME.camera.json, which is
+    /// read by default: docs/dataset.md); overrides the scene's.
+    #[arg(long, conflicts_with = "volume_min")]
+    pub(crate) camera_volume: Option<std::path::PathBuf>,
     /// Camera active volume, min corner x,y,z (overrides the scene's).
     #[arg(long, value_parser = parse_vec3, requires_all = ["volume_max", "look"], allow_hyphen_values = true)]
     pub(crate) volume_min: Option<glam::Vec3>,
@@ -380,6 +384,7 @@ fn reference(a: ReferenceArgs) -> Result<()> {
         progress: true,
     };
     nprt_io::check_writable(&a.out)?;
+    let loaded = t0.elapsed().as_secs_f64();
     let ts = TraceScene::new(&scene);
     let setup = t0.elapsed().as_secs_f64();
     let t1 = Instant::now();
@@ -392,12 +397,13 @@ fn reference(a: ReferenceArgs) -> Result<()> {
     let samples = camera.width as f64 * camera.height as f64 * settings.spp as f64;
     let m = frame.mean();
     println!(
-        "rendered {}×{} at {} spp (max_depth {}) in {secs:.3} s ({:.3} Msamples/s; scene load + BVH {setup:.3} s), {} triangles",
+        "rendered {}×{} at {} spp (max_depth {}) in {secs:.3} s ({:.3} Msamples/s; scene load {loaded:.3} s + BVH {:.3} s), {} triangles",
         camera.width,
         camera.height,
         settings.spp,
         max_depth.map_or("unlimited".into(), |d| d.to_string()),
         samples / secs / 1e6,
+        setup - loaded,
         scene.triangle_count(),
     );
     println!(
@@ -426,12 +432,16 @@ pub(crate) fn generate(a: GenerateArgs) -> Result<()> {
                 fov_deg: a.fov,
             }
         }
-        _ => scene.camera_volume.clone().with_context(|| {
-            format!(
-                "scene '{}' carries no camera volume; give --volume-min, --volume-max and --look",
-                a.scene
-            )
-        })?,
+        _ => match &a.camera_volume {
+            Some(file) => nprt_scene::CameraVolume::load(file)?,
+            None => scene.camera_volume.clone().with_context(|| {
+                format!(
+                    "scene '{}' carries no camera volume (no sidecar '{}'); give --camera-volume FILE or --volume-min, --volume-max and --look",
+                    a.scene,
+                    nprt_scene::CameraVolume::sidecar_of(std::path::Path::new(&a.scene)).display()
+                )
+            })?,
+        },
     };
     let (specs, assignment) =
         lighting::choose(&a.envmaps, a.train_views, a.test_views, a.test_maps, a.seed)?;

@@ -27,6 +27,10 @@ pub struct RenderArgs {
     /// (Catmull-Rom through the keyframes). Default: a sweep through the scene's camera volume.
     #[arg(long)]
     pub camera_path: Option<PathBuf>,
+    /// Without --camera-path: sweep through the camera volume of this JSON file instead of the
+    /// scene's (its sidecar NAME.camera.json).
+    #[arg(long, conflicts_with = "camera_path")]
+    pub camera_volume: Option<PathBuf>,
     /// Lighting schedule: comma-separated maps (files or built-in specs), or a JSON file
     /// {"segments": [{"map": …, "weight": 1, "rotation_deg": [0, 90]}]}.
     #[arg(long, default_value = DEFAULT_LIGHTING)]
@@ -72,11 +76,12 @@ pub fn render(a: RenderArgs) -> Result<()> {
         &model.file.scene_hash,
         &format!("model '{}' was trained on", a.model.display()),
     )?;
-    let path = match &a.camera_path {
-        Some(p) => CameraPath::load(p)?,
-        None => {
+    let path = match (&a.camera_path, &a.camera_volume) {
+        (Some(p), _) => CameraPath::load(p)?,
+        (None, Some(v)) => CameraPath::through_volume(&nprt_scene::CameraVolume::load(v)?),
+        (None, None) => {
             CameraPath::through_volume(scene.camera_volume.as_ref().with_context(|| {
-                format!("scene '{spec}' has no camera volume; give --camera-path")
+                format!("scene '{spec}' has no camera volume (no sidecar NAME.camera.json); give --camera-path or --camera-volume")
             })?)
         }
     };

@@ -63,6 +63,19 @@ struct Split {
 }
 
 impl Split {
+    /// ln of the mean foreground radiance relative to its map's mean (as
+    /// `TrainingSet::log_relative_level`).
+    fn log_relative_level(&self) -> f32 {
+        let (mut sum, mut n) = (0.0f64, 0u64);
+        for s in &self.samples {
+            // Background pixels hold zero radiance here.
+            let fg: f64 = s.radiance.iter().map(|&r| r.max(0.0) as f64).sum();
+            sum += fg / s.light.scale as f64;
+            n += 3 * s.foreground;
+        }
+        ((sum / n.max(1) as f64).max(1e-12) as f32).ln()
+    }
+
     fn new(
         views: &[ImageView],
         maps: &[EnvMap],
@@ -169,6 +182,7 @@ impl Objective for UnetObjective {
 
     fn build(&self, init: &mut Init) -> DeepShading {
         DeepShading::new(init, self.file.encoder_width)
+            .shift_output_level(self.train.log_relative_level())
     }
 
     fn steps(&self, _seed: u64, _epoch: usize) -> usize {

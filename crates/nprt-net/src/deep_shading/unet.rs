@@ -78,6 +78,16 @@ impl DeepShading {
 
     /// Radiance [B, 3, H, W] from G-buffer features [B, 19, H, W] (H, W multiples of 8),
     /// pre-processed maps [B, 3, W/2, W] and map means [B].
+    /// Adds `log_level` to the output convolution's bias (see `NprtNet::shift_output_level`).
+    pub fn shift_output_level(mut self, log_level: f32) -> Self {
+        self.out.bias = self
+            .out
+            .bias
+            .take()
+            .map(|b| b.map(|t| t.add_scalar(log_level).detach().require_grad()));
+        self
+    }
+
     pub fn forward(&self, features: Tensor<4>, light: Tensor<4>, scale: Tensor<1>) -> Tensor<4> {
         let code = self.light.forward(light);
         let mut x = features;
