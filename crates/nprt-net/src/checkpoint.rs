@@ -111,3 +111,55 @@ pub(crate) fn write<M: Module>(
     }
     Ok(())
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use rand::{RngExt, SeedableRng};
+
+    /// A resumed run carries its history on, so every loss must come back bit for bit (the
+    /// default JSON float parser is off by an ulp on some values, such as the first below).
+    #[test]
+    fn the_history_survives_the_state_file_exactly() {
+        let mut rng = rand_pcg::Pcg64Mcg::seed_from_u64(3);
+        let mut values = vec![0.015105420413116612, 1e-300, 1e300, 5e-324];
+        values.extend(
+            (0..20_000).map(|_| rng.random::<f64>() * 10f64.powi(rng.random_range(-12..4))),
+        );
+        let history: Vec<LossRow> = values
+            .iter()
+            .enumerate()
+            .map(|(i, &v)| LossRow {
+                step: i as u64,
+                epoch: v * 3.0,
+                samples: i as u64,
+                seconds: v / 7.0,
+                train: Some(v),
+                val: (i % 2 == 0).then_some(v.sqrt()),
+            })
+            .collect();
+        let ck = Checkpoint {
+            run: serde_json::json!({ "lr": values[0] }),
+            state: RunState::default(),
+            history: history.clone(),
+            weights: "w".into(),
+            optimizer: "o".into(),
+        };
+        let out = std::env::temp_dir().join(format!("nprt-ck-{}", std::process::id()));
+        std::fs::create_dir_all(dir(&out)).unwrap();
+        nprt_io::write_file(
+            &dir(&out).join(STATE_FILE),
+            serde_json::to_vec_pretty(&ck).unwrap(),
+        )
+        .unwrap();
+        let back = read(&out).unwrap().unwrap();
+        std::fs::remove_dir_all(&out).ok();
+        assert_eq!(back.run, ck.run);
+        let bits = |r: &LossRow| {
+            [Some(r.epoch), Some(r.seconds), r.train, r.val].map(|v| v.map(f64::to_bits))
+        };
+        for (a, b) in history.iter().zip(&back.history) {
+            assert_eq!(bits(a), bits(b), "row {}", a.step);
+        }
+    }
+}
