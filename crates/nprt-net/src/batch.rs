@@ -23,6 +23,7 @@ pub struct Batch {
     pub radiance: Vec<f32>,
     /// Index into `lights` of each sample.
     pub view: Vec<i64>,
+    /// [n, 3] what the prediction's channels are multiplied by (the map's `LightInput::scale`).
     pub scale: Vec<f32>,
     /// [V, 3, W/2, W] pre-processed maps.
     pub lights: Vec<f32>,
@@ -37,7 +38,7 @@ impl Batch {
             features: Vec::with_capacity(samples.len() * FEATURES),
             radiance: Vec::with_capacity(samples.len() * 3),
             view: Vec::with_capacity(samples.len()),
-            scale: Vec::with_capacity(samples.len()),
+            scale: Vec::with_capacity(samples.len() * 3),
             lights: views
                 .iter()
                 .flat_map(|v| v.light.pixels.iter().copied())
@@ -51,7 +52,7 @@ impl Batch {
             b.radiance
                 .extend_from_slice(&view.radiance[p * 3..p * 3 + 3]);
             b.view.push(v as i64);
-            b.scale.push(view.light.scale);
+            b.scale.extend_from_slice(&view.light.scale);
         }
         b
     }
@@ -80,7 +81,7 @@ impl Batch {
         );
         let r = Tensor::from_data(TensorData::new(self.radiance.clone(), [n, 3]), device);
         let v = Tensor::<1, Int>::from_data(TensorData::new(self.view.clone(), [n]), device);
-        let s = Tensor::from_data(TensorData::new(self.scale.clone(), [n, 1]), device);
+        let s = Tensor::from_data(TensorData::new(self.scale.clone(), [n, 3]), device);
         (net.forward(f, self.light_tensor(device), v, s), r)
     }
 

@@ -10,6 +10,7 @@ use rayon::prelude::*;
 
 use crate::encoder::LightInput;
 use crate::features::gbuffer_features;
+use crate::map_norm::MapNorm;
 
 /// The foreground pixels of one view.
 pub struct ViewSamples {
@@ -42,8 +43,8 @@ pub struct TrainingSet {
 
 impl TrainingSet {
     /// Reads every view of the dataset in `dir` (in parallel) and prepares its map for an
-    /// encoder of input width `encoder_width`.
-    pub fn load(dir: &Path, encoder_width: usize) -> Result<Self> {
+    /// encoder of input width `encoder_width`, normalised by `norm`.
+    pub fn load(dir: &Path, encoder_width: usize, norm: MapNorm) -> Result<Self> {
         let (manifest, dataset_hash) = load_manifest_hashed(dir)?;
         let maps = open_recorded_maps(&manifest)?;
         let load = |split: &str| -> Result<Vec<ViewSamples>> {
@@ -51,7 +52,7 @@ impl TrainingSet {
                 .views
                 .par_iter()
                 .filter(|v| v.split == split)
-                .map(|v| load_view(dir, &manifest, &maps, v, encoder_width))
+                .map(|v| load_view(dir, &manifest, &maps, v, encoder_width, norm))
                 .collect()
         };
         let train = load("train")?;
@@ -72,17 +73,29 @@ impl TrainingSet {
 }
 
 impl TrainingSet {
-    /// ln of the mean training radiance relative to its map's mean (what the networks predict
-    /// before the map's scale), over every foreground pixel and channel.
+    /// ln of the mean training radiance relative to its map's scale (what the networks
+    /// predict before the scale), over every foreground pixel and channel.
     pub fn log_relative_level(&self) -> f32 {
         let (mut sum, mut n) = (0.0f64, 0usize);
         for v in &self.train {
-            let s = v.light.scale as f64;
-            sum += v.radiance.iter().map(|&r| r.max(0.0) as f64).sum::<f64>() / s;
+            sum += relative_radiance(&v.radiance, v.light.scale);
             n += v.radiance.len();
         }
         ((sum / n.max(1) as f64).max(1e-12) as f32).ln()
     }
+}
+
+/// The sum of `radiance` ([n, 3], negative values as zero) divided channel by channel by
+/// `scale`.
+pub(crate) fn relative_radiance(radiance: &[f32], scale: [f32; 3]) -> f64 {
+    radiance
+        .chunks_exact(3)
+        .map(|c| {
+            (0..3)
+                .map(|k| c[k].max(0.0) as f64 / scale[k] as f64)
+                .sum::<f64>()
+        })
+        .sum()
 }
 
 /// Opens the dataset's maps and checks each is the one the dataset was rendered with.
@@ -112,6 +125,7 @@ fn load_view(
     maps: &[EnvMap],
     view: &ViewRecord,
     encoder_width: usize,
+    norm: MapNorm,
 ) -> Result<ViewSamples> {
     let image = nprt_data::views::load_view(dir, manifest, view)?;
     let g = &image.gbuffer;
@@ -124,6 +138,6 @@ fn load_view(
     Ok(ViewSamples {
         features,
         radiance,
-        light: LightInput::new(&view.lighting(maps)?, 0.0, encoder_width),
+        light: LightInput::new(&view.lighting(maps)?, 0.0, encoder_width, norm),
     })
 }

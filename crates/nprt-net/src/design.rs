@@ -7,7 +7,7 @@ use serde::{Deserialize, Serialize};
 
 use crate::activation::Activation;
 use crate::encoder::LightEncoder;
-use crate::init::Init;
+use crate::init::{shifted_bias, Init};
 use crate::track::{Track, TrackKind};
 
 /// Size of the transport code ŝ.
@@ -97,8 +97,8 @@ impl NprtNet {
         NprtNet { encoder, tracks }
     }
 
-    /// Radiance [B, 3] for features [B, 19] lit by codes [B, 64] of maps whose means are
-    /// `scale` [B, 1].
+    /// Radiance [B, 3] for features [B, 19] lit by codes [B, 64] of maps normalised by
+    /// `scale` [B, 3].
     pub fn shade(&self, features: Tensor<2>, code: Tensor<2>, scale: Tensor<2>) -> Tensor<2> {
         let radiance = self
             .tracks
@@ -110,7 +110,8 @@ impl NprtNet {
     }
 
     /// Radiance for a batch mixing views: `light` holds the V pre-processed maps [V, 3, H, W],
-    /// `view` [B] says which map lights each sample and `scale` [B, 1] is that map's mean.
+    /// `view` [B] says which map lights each sample and `scale` [B, 3] is what that map was
+    /// divided by.
     pub fn forward(
         &self,
         features: Tensor<2>,
@@ -136,10 +137,7 @@ impl NprtNet {
                 .layers
                 .last_mut()
                 .expect("a network has layers");
-            last.bias = last
-                .bias
-                .take()
-                .map(|b| b.map(|t| t.add_scalar(log_level).detach().require_grad()));
+            last.bias = shifted_bias(last.bias.take(), log_level);
         }
         self
     }

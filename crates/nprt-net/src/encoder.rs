@@ -11,6 +11,7 @@ use nprt_scene::envmap::{uv_to_direction, EnvMap};
 
 use crate::activation::Activation;
 use crate::init::{conv2d, Init};
+use crate::map_norm::MapNorm;
 use crate::mlp::Mlp;
 
 /// Convolution blocks of the paper's encoder.
@@ -73,22 +74,23 @@ impl LightEncoder {
 }
 
 /// An environment map prepared for the encoder: box-filtered to W × W/2, divided by its mean
-/// and passed through log(1 + x), as the paper pre-processes it.
+/// (over channels or per channel, [`MapNorm`]) and passed through log(1 + x), as the paper
+/// pre-processes it.
 ///
-/// Radiance is linear in the lighting, so the network predicts radiance for the mean-normalised
-/// map and the model multiplies by `scale` (the mean) to restore the absolute level.
+/// Radiance is linear in the lighting, so the network predicts radiance for the normalised map
+/// and the model multiplies each channel by `scale` to restore the absolute level.
 #[derive(Clone, Debug)]
 pub struct LightInput {
     /// Channel-major [3, W/2, W] values.
     pub pixels: Vec<f32>,
-    /// The map's mean over texels and channels.
-    pub scale: f32,
+    /// What each channel of the map was divided by.
+    pub scale: [f32; 3],
     /// W: the encoder input width.
     pub width: usize,
 }
 
 impl LightInput {
-    pub fn new(map: &EnvMap, rotation_deg: f32, width: usize) -> Self {
+    pub fn new(map: &EnvMap, rotation_deg: f32, width: usize, norm: MapNorm) -> Self {
         let height = width / 2;
         let map = map.rotated_y(rotation_deg);
         // Enough sub-samples per encoder texel to cover every source texel it spans.
@@ -106,12 +108,12 @@ impl LightInput {
             }
             *out /= (ss * ss) as f32;
         }
-        let mean = rgb.iter().map(|c| c.x + c.y + c.z).sum::<f32>() / (3 * rgb.len()) as f32;
-        let scale = mean.max(f32::MIN_POSITIVE);
+        let mean = [0, 1, 2].map(|k| rgb.iter().map(|c| c[k]).sum::<f32>() / rgb.len() as f32);
+        let scale = norm.scale(mean);
         let mut pixels = vec![0.0; 3 * width * height];
         for (i, c) in rgb.iter().enumerate() {
             for k in 0..3 {
-                pixels[k * width * height + i] = (c[k] / scale).ln_1p();
+                pixels[k * width * height + i] = (c[k] / scale[k]).ln_1p();
             }
         }
         LightInput {

@@ -82,3 +82,19 @@ pub fn conv2d(init: &mut Init, c_in: usize, c_out: usize, k: usize) -> Conv2d {
         padding: PaddingConfig2d::Same,
     }
 }
+
+/// `bias` plus `shift`, as a fresh leaf: under autodiff it trains as any parameter (a bias
+/// computed from the old one would not be a leaf, which burn refuses to train); elsewhere it is
+/// a plain tensor, which cannot require a gradient.
+pub fn shifted_bias(bias: Option<Param<Tensor<1>>>, shift: f32) -> Option<Param<Tensor<1>>> {
+    bias.map(|b| {
+        b.map(|t| {
+            let t = t.add_scalar(shift).detach();
+            if t.is_autodiff() {
+                t.require_grad()
+            } else {
+                t
+            }
+        })
+    })
+}

@@ -33,8 +33,10 @@ mod features;
 mod init;
 pub mod loss;
 mod lr_schedule;
+mod map_norm;
 mod mlp;
 pub mod model;
+mod named;
 mod options;
 mod throughput;
 mod track;
@@ -54,8 +56,11 @@ pub use features::{feature, gbuffer_features, pixel_features, FEATURES};
 pub use init::{conv2d, Init};
 pub use loss::{log_l1, Loss};
 pub use lr_schedule::LrSchedule;
+pub use map_norm::MapNorm;
 pub use mlp::Mlp;
-pub use model::{layer_table, load_model, ModelConfig, ModelFile, DEFAULT_ENCODER_WIDTH};
+pub use model::{
+    layer_table, load_model, ModelConfig, ModelFile, DEFAULT_ENCODER_WIDTH, DEFAULT_MAP_NORM,
+};
 pub use options::{recipe_rate, TrainOptions};
 pub use throughput::{measure_inference, measure_throughput, InferenceSpeed};
 pub use track::{Track, TrackKind};

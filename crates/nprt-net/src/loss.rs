@@ -4,9 +4,11 @@
 
 use std::str::FromStr;
 
-use anyhow::{bail, Error};
+use anyhow::Error;
 use burn::tensor::Tensor;
 use serde::{Deserialize, Serialize};
+
+use crate::named::by_name;
 
 /// ε of the relative L2 loss (the report's relative metrics use the same).
 pub const RELATIVE_L2_EPS: f32 = 0.01;
@@ -74,10 +76,7 @@ impl Loss {
 impl FromStr for Loss {
     type Err = Error;
     fn from_str(s: &str) -> Result<Self, Error> {
-        match Loss::ALL.into_iter().find(|l| l.name() == s) {
-            Some(l) => Ok(l),
-            None => bail!("unknown loss '{s}' (expected log-l1 or rel-l2)"),
-        }
+        by_name(&Loss::ALL, Loss::name, s, "loss")
     }
 }
 

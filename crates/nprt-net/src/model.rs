@@ -11,6 +11,7 @@ use serde::{Deserialize, Serialize};
 use crate::activation::Activation;
 use crate::design::{Design, NprtNet};
 use crate::init::Init;
+use crate::map_norm::MapNorm;
 
 /// Identifies a model folder's config file.
 pub const MODEL_FORMAT: &str = "nprt-model";
@@ -33,11 +34,18 @@ pub struct ModelConfig {
     pub activation: Activation,
     /// Width W of the encoder's W × W/2 input map.
     pub encoder_width: usize,
+    /// How the map is normalised for the encoder (absent in older files: the paper's mean).
+    #[serde(default)]
+    pub map_norm: MapNorm,
 }
 
 /// Encoder input width when none is asked for: on the demo, 64 measured 10% worse in L1 than
 /// 128 for 10% less training time.
 pub const DEFAULT_ENCODER_WIDTH: usize = 128;
+
+/// Map normalisation when none is asked for: per channel, which got held-out maps' colour right
+/// where the paper's single mean did not (docs/model.md).
+pub const DEFAULT_MAP_NORM: MapNorm = MapNorm::Channel;
 
 impl ModelConfig {
     pub fn new(design: Design, activation: Option<Activation>) -> Self {
@@ -45,6 +53,7 @@ impl ModelConfig {
             design,
             activation: activation.unwrap_or(design.default_activation()),
             encoder_width: DEFAULT_ENCODER_WIDTH,
+            map_norm: DEFAULT_MAP_NORM,
         }
     }
 

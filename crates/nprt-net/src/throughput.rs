@@ -39,7 +39,7 @@ pub fn measure_throughput(
         features: random(batch_size * FEATURES, 1.0),
         radiance: random(batch_size * 3, 4.0),
         view: (0..batch_size).map(|i| (i % views) as i64).collect(),
-        scale: random(batch_size, 1.0)
+        scale: random(batch_size * 3, 1.0)
             .into_iter()
             .map(|s| s + 0.5)
             .collect(),
@@ -104,10 +104,10 @@ pub fn measure_inference(
     let (frame_ms, relight_ms, kept) = if crate::compute::is_cpu(device) {
         let kept = host.transfer_codes(&features);
         let frame = median_ms(&|| {
-            host.radiance(&features, &code, 1.0, None);
+            host.radiance(&features, &code, [1.0; 3], None);
         });
         let relight = median_ms(&|| {
-            host.radiance(&features, &code, 1.0, Some(&kept));
+            host.radiance(&features, &code, [1.0; 3], Some(&kept));
         });
         (frame, relight, true)
     } else {

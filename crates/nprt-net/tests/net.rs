@@ -43,14 +43,14 @@ fn tiny_batch(init: &Init, n: usize, seed: u64) -> Tiny {
     let mut r = |lo: f32, hi: f32| lo + (hi - lo) * rng.random::<f32>();
     let features: Vec<f32> = (0..n * FEATURES).map(|_| r(-1.0, 1.0).abs()).collect();
     let light: Vec<f32> = (0..2 * 3 * 32 * 64).map(|_| r(0.0, 2.0)).collect();
-    let scale: Vec<f32> = (0..n).map(|_| r(0.5, 1.5)).collect();
+    let scale: Vec<f32> = (0..n * 3).map(|_| r(0.5, 1.5)).collect();
     let reference: Vec<f32> = (0..n * 3).map(|_| r(0.0, 3.0)).collect();
     let view: Vec<i64> = (0..n as i64).map(|i| i % 2).collect();
     Tiny {
         features: init.tensor(features, [n, FEATURES]),
         light: init.tensor(light, [2, 3, 32, 64]),
         view: Tensor::from_data(TensorData::new(view, [n]), &init.device),
-        scale: init.tensor(scale, [n, 1]),
+        scale: init.tensor(scale, [n, 3]),
         reference: init.tensor(reference, [n, 3]),
     }
 }
@@ -186,28 +186,99 @@ fn saved_weights_load_into_a_fresh_network_exactly() {
 
 #[test]
 fn encoder_input_is_mean_normalised_log_of_the_rotated_map() {
+    use nprt_net::{LightInput, MapNorm};
     use nprt_scene::envmap::EnvMap;
-    // A constant map: every texel is log(1 + 1) after dividing by the mean; scale is the mean.
+    // A constant map: after dividing by the mean over channels, log(1 + 0.5), log(2), log(2.5);
+    // after dividing each channel by its own mean, log(2) in all three.
     let map = EnvMap::constant(glam::Vec3::new(2.0, 4.0, 6.0)).unwrap();
-    let input = nprt_net::LightInput::new(&map, 37.0, 64);
-    assert!((input.scale - 4.0).abs() < 1e-5);
-    let expect = [0.5f32.ln_1p(), 1.0f32.ln_1p(), 1.5f32.ln_1p()];
-    for (k, e) in expect.iter().enumerate() {
-        let channel = &input.pixels[k * 64 * 32..(k + 1) * 64 * 32];
-        assert!(channel.iter().all(|v| (v - e).abs() < 1e-5));
+    for (norm, scale, expect) in [
+        (MapNorm::Mean, [4.0; 3], [0.5f32, 1.0, 1.5]),
+        (MapNorm::Channel, [2.0, 4.0, 6.0], [1.0; 3]),
+    ] {
+        let input = LightInput::new(&map, 37.0, 64, norm);
+        for k in 0..3 {
+            assert!((input.scale[k] - scale[k]).abs() < 1e-5, "{norm:?}");
+            let channel = &input.pixels[k * 64 * 32..(k + 1) * 64 * 32];
+            assert!(channel.iter().all(|v| (v - expect[k].ln_1p()).abs() < 1e-5));
+        }
     }
     // A bright texel moves by the rotation: a quarter turn shifts it by a quarter of the width.
     let mut texels = vec![glam::Vec3::splat(0.1); 256 * 128];
-    texels[64 * 256 + 32] = glam::Vec3::splat(1000.0);
+    texels[64 * 256 + 32] = glam::Vec3::new(1000.0, 600.0, 300.0);
     let map = EnvMap::from_texels("spot", 256, 128, texels).unwrap();
+    // A tint (a gain per channel) reaches the per-channel encoder input only through its scale.
+    let gain = glam::Vec3::new(2.0, 1.0, 0.25);
+    let tinted = map.scaled(gain).unwrap();
+    let (a, b) = (
+        LightInput::new(&map, 10.0, 64, MapNorm::Channel),
+        LightInput::new(&tinted, 10.0, 64, MapNorm::Channel),
+    );
+    let most = a
+        .pixels
+        .iter()
+        .zip(&b.pixels)
+        .map(|(x, y)| (x - y).abs())
+        .fold(0.0, f32::max);
+    assert!(most < 1e-5, "per-channel input moved by {most}");
+    for k in 0..3 {
+        assert!((b.scale[k] / a.scale[k] - gain[k]).abs() < 1e-5);
+    }
+    let mean = |m: &EnvMap| LightInput::new(m, 10.0, 64, MapNorm::Mean).pixels;
+    assert!(
+        mean(&map) != mean(&tinted),
+        "the paper's input sees the tint"
+    );
     let peak = |rot: f32| {
-        let p = nprt_net::LightInput::new(&map, rot, 64).pixels;
+        let p = LightInput::new(&map, rot, 64, MapNorm::Mean).pixels;
         (0..64 * 32).max_by(|&a, &b| p[a].total_cmp(&p[b])).unwrap()
     };
     let (a, b) = (peak(0.0), peak(90.0));
     assert_eq!(a / 64, b / 64, "same row");
     let shift = (b % 64 + 64 - a % 64) % 64;
     assert_eq!(shift.min(64 - shift), 16, "{a} → {b}");
+}
+
+/// With per-channel normalisation every design's prediction follows a tint of the map exactly:
+/// the same radiance, each channel times its gain. With the paper's single mean it does not.
+#[test]
+fn per_channel_models_relight_a_tinted_map_by_its_tint() {
+    use nprt_net::{LightInput, MapNorm};
+    let device = Device::flex();
+    let mut texels = vec![glam::Vec3::new(0.2, 0.3, 0.5); 128 * 64];
+    texels[20 * 128 + 40] = glam::Vec3::new(900.0, 700.0, 400.0);
+    let map = nprt_scene::envmap::EnvMap::from_texels("sun", 128, 64, texels).unwrap();
+    let gain = glam::Vec3::new(1.8, 1.0, 0.3);
+    let tinted = map.scaled(gain).unwrap();
+    let n = 8;
+    let features = tiny_batch(&Init::new(0, &device), n, 9).features;
+    for design in Design::ALL {
+        for norm in MapNorm::ALL {
+            let config = ModelConfig {
+                encoder_width: 64,
+                map_norm: norm,
+                ..ModelConfig::new(design, None)
+            };
+            let net = config.build(&mut Init::new(5, &device));
+            let shade = |m: &nprt_scene::envmap::EnvMap| {
+                let input = LightInput::new(m, 0.0, 64, norm);
+                let pred = net.forward(
+                    features.clone(),
+                    Tensor::from_data(TensorData::new(input.pixels, [1, 3, 32, 64]), &device),
+                    Tensor::from_data(TensorData::new(vec![0i64; n], [n]), &device),
+                    Tensor::from_data(TensorData::new(input.scale.repeat(n), [n, 3]), &device),
+                );
+                nprt_net::cpu::host_values(pred.into_data())
+            };
+            let (a, b) = (shade(&map), shade(&tinted));
+            let worst = (0..n * 3)
+                .map(|i| (b[i] / (a[i] * gain[i % 3]) - 1.0).abs())
+                .fold(0.0f32, f32::max);
+            match norm {
+                MapNorm::Channel => assert!(worst < 1e-4, "{design:?}: off by {worst}"),
+                MapNorm::Mean => assert!(worst > 1e-2, "{design:?}: the mean is blind to tint"),
+            }
+        }
+    }
 }
 
 /// Every parameter's gradient as f64 values.
@@ -246,7 +317,7 @@ fn cpu_engine_matches_autodiff() {
         view: (0..n as i64)
             .map(|i| (i * 7 + i / 5) % views as i64)
             .collect(),
-        scale: r(0.5, 1.5, n),
+        scale: r(0.5, 1.5, n * 3),
         lights: r(0.0, 2.0, views * 3 * w * w / 2),
         light_width: w,
     };
@@ -273,7 +344,7 @@ fn cpu_engine_matches_autodiff() {
                     init.tensor(batch.features.clone(), [n, FEATURES]),
                     init.tensor(batch.lights.clone(), [views, 3, w / 2, w]),
                     Tensor::from_data(TensorData::new(batch.view.clone(), [n]), &device),
-                    init.tensor(batch.scale.clone(), [n, 1]),
+                    init.tensor(batch.scale.clone(), [n, 3]),
                 );
                 let exact_loss = objective.mean(pred, init.tensor(batch.radiance.clone(), [n, 3]));
                 let exact = GradientsParams::from_grads(exact_loss.backward(), &exact_net);
@@ -310,19 +381,20 @@ fn cpu_engine_radiance_matches_burn() {
     let n = 1300;
     let features: Vec<f32> = (0..n * FEATURES).map(|_| rng.random::<f32>()).collect();
     let code: Vec<f32> = (0..64).map(|_| rng.random::<f32>() - 0.5).collect();
+    let scale = [1.7, 0.6, 2.3];
     for design in Design::ALL {
         let net = ModelConfig::new(design, None).build(&mut Init::new(8, &device));
         let want = net.shade(
             Tensor::from_data(TensorData::new(features.clone(), [n, FEATURES]), &device),
             Tensor::<2>::from_data(TensorData::new(code.clone(), [1, 64]), &device).expand([n, 64]),
-            Tensor::full([n, 1], 1.7, &device),
+            Tensor::from_data(TensorData::new(scale.repeat(n), [n, 3]), &device),
         );
         let want = nprt_net::cpu::host_values(want.into_data());
         let host = nprt_net::cpu::HostTransport::from_net(&net);
         let kept = host.transfer_codes(&features);
         for got in [
-            host.radiance(&features, &code, 1.7, None),
-            host.radiance(&features, &code, 1.7, Some(&kept)),
+            host.radiance(&features, &code, scale, None),
+            host.radiance(&features, &code, scale, Some(&kept)),
         ] {
             let worst = got
                 .iter()
@@ -348,7 +420,7 @@ fn output_level_shift_scales_the_untrained_prediction() {
         let net = ModelConfig::new(design, None).build(&mut Init::new(8, &device));
         let shifted = net.clone().shift_output_level(level);
         let radiance = |net: &NprtNet| {
-            nprt_net::cpu::HostTransport::from_net(net).radiance(&features, &code, 1.0, None)
+            nprt_net::cpu::HostTransport::from_net(net).radiance(&features, &code, [1.0; 3], None)
         };
         for (a, b) in radiance(&shifted).iter().zip(radiance(&net)) {
             assert!(

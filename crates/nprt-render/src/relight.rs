@@ -26,11 +26,12 @@ pub struct Relighter {
     host: Option<HostTransport>,
 }
 
-/// What the encoder made of one lighting: the 64-d code ê and the map's mean.
+/// What the encoder made of one lighting: the 64-d code ê and what the map's channels were
+/// divided by.
 #[derive(Clone)]
 pub struct LightCode {
     code: Tensor<2>,
-    scale: f32,
+    scale: [f32; 3],
 }
 
 /// A G-buffer's foreground pixels as network inputs, and what of the network does not depend
@@ -70,7 +71,8 @@ impl Relighter {
 
     /// Encodes `map` rotated by `rotation_deg` about +Y.
     pub fn light_code(&self, map: &EnvMap, rotation_deg: f32) -> LightCode {
-        let input = LightInput::new(map, rotation_deg, self.file.config.encoder_width);
+        let config = &self.file.config;
+        let input = LightInput::new(map, rotation_deg, config.encoder_width, config.map_norm);
         let w = input.width;
         let pixels = Tensor::from_data(
             TensorData::new(input.pixels, [1, 3, w / 2, w]),
@@ -138,7 +140,10 @@ impl Relighter {
         let rows = features.len() / FEATURES;
         let mut rgb = Vec::with_capacity(rows * 3);
         let code = light.code.clone().expand([CHUNK, light.code.dims()[1]]);
-        let scale = Tensor::full([CHUNK, 1], light.scale, &self.device);
+        let scale = Tensor::from_data(
+            TensorData::new(light.scale.repeat(CHUNK), [CHUNK, 3]),
+            &self.device,
+        );
         for chunk in features.chunks(CHUNK * FEATURES) {
             let mut padded = chunk.to_vec();
             padded.resize(CHUNK * FEATURES, 0.0);

@@ -5,7 +5,7 @@ use std::time::Instant;
 
 use anyhow::Result;
 use nprt_net::deep_shading::DeepShadingOptions;
-use nprt_net::{Design, TrainOptions, DEFAULT_ENCODER_WIDTH};
+use nprt_net::{Design, TrainOptions, DEFAULT_ENCODER_WIDTH, DEFAULT_MAP_NORM};
 
 use crate::evaluation::{eval, train_deep_shading, DeepShadingArgs, EvalArgs};
 use crate::learn::{train, TrainArgs};
@@ -147,6 +147,7 @@ pub fn demo(a: DemoArgs) -> Result<()> {
             val_samples: defaults.val_samples,
             loss: defaults.loss,
             encoder_width: DEFAULT_ENCODER_WIDTH,
+            map_norm: DEFAULT_MAP_NORM,
             checkpoint_minutes: defaults.schedule.checkpoint_secs / 60.0,
             device: a.device,
         })?;
@@ -163,6 +164,7 @@ pub fn demo(a: DemoArgs) -> Result<()> {
         lr: deep_defaults.schedule.learning_rate,
         seed: deep_defaults.schedule.seed,
         encoder_width: deep_defaults.encoder_width,
+        map_norm: deep_defaults.map_norm,
         device: a.device,
     })?;
     step("4/5 evaluating against the baselines");

@@ -5,7 +5,7 @@ use std::path::PathBuf;
 use anyhow::{bail, Result};
 use nprt_eval::{evaluate, write_report, EvalOptions, Evaluation};
 use nprt_net::deep_shading::{self, DeepShadingOptions};
-use nprt_net::Schedule;
+use nprt_net::{MapNorm, Schedule};
 
 use crate::{DeviceArg, RunLength};
 
@@ -68,6 +68,10 @@ pub struct DeepShadingArgs {
     /// Width W of the light encoder's W × W/2 input (a multiple of 64).
     #[arg(long, default_value_t = DeepShadingOptions::default().encoder_width)]
     pub encoder_width: usize,
+    /// What the map is divided by for the encoder: channel (each channel's mean) or mean (one
+    /// mean over channels), as `nprt train --map-norm`.
+    #[arg(long, default_value_t = DeepShadingOptions::default().map_norm)]
+    pub map_norm: MapNorm,
     #[command(flatten)]
     pub device: DeviceArg,
 }
@@ -127,6 +131,7 @@ pub fn train_deep_shading(a: DeepShadingArgs) -> Result<()> {
         }),
         batch_views: a.batch_views,
         encoder_width: a.encoder_width,
+        map_norm: a.map_norm,
     };
     let (s, f) = deep_shading::train(&a.data, &opts, &a.out, &a.device.device()?)?;
     if let Some(e) = s.resumed_from_epoch {

@@ -10,8 +10,8 @@ use nprt_net::{device_name, is_cpu, Device};
 
 use crate::{DeviceArg, RunLength};
 use nprt_net::{
-    layer_table, measure_throughput, recipe_rate, Activation, Design, Engine, Init, Loss,
-    ModelConfig, Schedule, TrainOptions, DEFAULT_ENCODER_WIDTH,
+    layer_table, measure_throughput, recipe_rate, Activation, Design, Engine, Init, Loss, MapNorm,
+    ModelConfig, Schedule, TrainOptions, DEFAULT_ENCODER_WIDTH, DEFAULT_MAP_NORM,
 };
 
 #[derive(clap::Args)]
@@ -79,6 +79,11 @@ pub struct TrainArgs {
     /// Width W of the encoder's W × W/2 input map (a multiple of 64).
     #[arg(long, default_value_t = DEFAULT_ENCODER_WIDTH)]
     pub encoder_width: usize,
+    /// What the map is divided by before the encoder sees it, the prediction multiplied by the
+    /// same: channel (each channel's mean, so a held-out map's tint carries over exactly) or
+    /// mean (the paper's one mean over channels, which leaves colour to the encoder).
+    #[arg(long, default_value_t = DEFAULT_MAP_NORM)]
+    pub map_norm: MapNorm,
     /// Minutes between checkpoints within an epoch (one is always written at an epoch's end).
     #[arg(long, default_value_t = TrainOptions::default().schedule.checkpoint_secs / 60.0)]
     pub checkpoint_minutes: f64,
@@ -155,10 +160,12 @@ fn config(
     arch: Design,
     activation: Option<Activation>,
     encoder_width: usize,
+    map_norm: MapNorm,
 ) -> Result<ModelConfig> {
     check_input_width(encoder_width)?;
     Ok(ModelConfig {
         encoder_width,
+        map_norm,
         ..ModelConfig::new(arch, activation)
     })
 }
@@ -176,7 +183,7 @@ pub fn model_info(a: ModelInfoArgs) -> Result<()> {
             (file.config, net)
         }
         (None, Some(arch)) => {
-            let config = config(arch, a.activation, a.encoder_width)?;
+            let config = config(arch, a.activation, a.encoder_width, DEFAULT_MAP_NORM)?;
             let net = config.build(&mut Init::new(0, &Device::flex()));
             (config, net)
         }
@@ -184,11 +191,15 @@ pub fn model_info(a: ModelInfoArgs) -> Result<()> {
     };
     let arch = config.design;
     println!(
-        "design {} ({} transport layers), light encoder input {}×{}",
+        "design {} ({} transport layers), light encoder input {}×{}, map normalised by its {}",
         arch.name(),
         config.activation.name(),
         config.encoder_width,
-        config.encoder_width / 2
+        config.encoder_width / 2,
+        match config.map_norm {
+            MapNorm::Mean => "mean",
+            MapNorm::Channel => "mean per channel",
+        }
     );
     println!("{:<24} {:<22} {:>10}", "layer", "shape", "params");
     for row in layer_table(&net) {
@@ -221,9 +232,9 @@ fn training_schedule(a: &TrainArgs) -> Schedule {
 }
 
 pub fn train(a: TrainArgs) -> Result<()> {
-    let config = config(a.arch, a.activation, a.encoder_width)?;
+    let config = config(a.arch, a.activation, a.encoder_width, a.map_norm)?;
     let t0 = std::time::Instant::now();
-    let set = TrainingSet::load(&a.data, config.encoder_width)?;
+    let set = TrainingSet::load(&a.data, config.encoder_width, config.map_norm)?;
     let count = |v: &[nprt_net::data::ViewSamples]| v.iter().map(|s| s.len()).sum::<usize>();
     println!(
         "dataset '{}': {} training views ({} foreground pixels), {} test views ({} pixels), loaded in {:.1} s",

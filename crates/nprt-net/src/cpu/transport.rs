@@ -357,14 +357,14 @@ impl HostTransport {
         TransferCodes { tracks }
     }
 
-    /// Radiance (`n × 3`) of the rows of `features` lit by one light `code` of a map whose mean
-    /// is `scale`. With `known`, made by [`Self::transfer_codes`] from the same features, the
+    /// Radiance (`n × 3`) of the rows of `features` lit by one light `code` of a map normalised
+    /// by `scale`. With `known`, made by [`Self::transfer_codes`] from the same features, the
     /// transfer networks are not run again.
     pub fn radiance(
         &self,
         features: &[f32],
         code: &[f32],
-        scale: f32,
+        scale: [f32; 3],
         known: Option<&TransferCodes>,
     ) -> Vec<f32> {
         assert_eq!(code.len(), CODE_SIZE);
@@ -391,7 +391,8 @@ impl HostTransport {
                             (0..3).for_each(|i| out[r * 3 + i] += c[i]);
                         }
                     }
-                    out.iter_mut().for_each(|v| *v *= scale);
+                    out.chunks_exact_mut(3)
+                        .for_each(|c| (0..3).for_each(|i| c[i] *= scale[i]));
                 },
             );
         out
@@ -418,7 +419,7 @@ impl HostTransport {
         let n = rows.len();
         let features = &batch.features[rows.start * FEATURES..rows.end * FEATURES];
         let reference = &batch.radiance[rows.start * 3..rows.end * 3];
-        let scale = &batch.scale[rows];
+        let scale = &batch.scale[rows.start * 3..rows.end * 3];
         for (t, pass) in self.tracks.iter().zip(passes.iter_mut()) {
             t.forward(features, light, n, None, pass);
         }
@@ -433,10 +434,10 @@ impl HostTransport {
                 (0..3).for_each(|i| p[i] += c[i]);
             }
             for c in 0..3 {
-                let pred = p[c] * scale[r];
-                let (value, slope) = loss.element(pred, reference[r * 3 + c]);
+                let s = scale[r * 3 + c];
+                let (value, slope) = loss.element(p[c] * s, reference[r * 3 + c]);
                 g.loss += value as f64;
-                dr[r * 3 + c] = slope * norm * scale[r];
+                dr[r * 3 + c] = slope * norm * s;
             }
         }
         for ((t, pass), grads) in self.tracks.iter().zip(passes).zip(&mut g.tracks) {

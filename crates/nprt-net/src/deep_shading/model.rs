@@ -85,7 +85,12 @@ impl DeepShadingModel {
         rotation_deg: f32,
     ) -> Vec<Vec3> {
         let (img, pw, ph) = feature_image(&self.file.bounds, g, width, height);
-        let light = LightInput::new(map, rotation_deg, self.file.encoder_width);
+        let light = LightInput::new(
+            map,
+            rotation_deg,
+            self.file.encoder_width,
+            self.file.options.map_norm,
+        );
         let lw = light.width;
         let out = self.net.forward(
             Tensor::from_data(TensorData::new(img, [1, FEATURES, ph, pw]), &self.device),
@@ -93,7 +98,7 @@ impl DeepShadingModel {
                 TensorData::new(light.pixels, [1, 3, lw / 2, lw]),
                 &self.device,
             ),
-            Tensor::from_data(TensorData::new(vec![light.scale], [1]), &self.device),
+            Tensor::from_data(TensorData::new(light.scale.to_vec(), [1, 3]), &self.device),
         );
         let data = out.into_data();
         let v = data.as_slice::<f32>().expect("f32 output");

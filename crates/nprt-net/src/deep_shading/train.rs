@@ -21,6 +21,7 @@ use crate::encoder::{check_input_width, LightInput};
 use crate::features::FEATURES;
 use crate::init::Init;
 use crate::loss::log_l1_map;
+use crate::map_norm::MapNorm;
 use crate::model::{save_weights, WEIGHTS_FILE};
 use crate::trainer::{self, epoch_rng, Objective, Schedule, TrainSummary};
 
@@ -32,6 +33,9 @@ pub struct DeepShadingOptions {
     pub batch_views: usize,
     /// Width W of the light encoder's W × W/2 input.
     pub encoder_width: usize,
+    /// How the map is normalised for the encoder (absent in older files: the paper's mean).
+    #[serde(default)]
+    pub map_norm: MapNorm,
 }
 
 impl Default for DeepShadingOptions {
@@ -42,6 +46,7 @@ impl Default for DeepShadingOptions {
             schedule: Schedule::default(),
             batch_views: 4,
             encoder_width: crate::model::DEFAULT_ENCODER_WIDTH,
+            map_norm: crate::model::DEFAULT_MAP_NORM,
         }
     }
 }
@@ -68,9 +73,17 @@ impl Split {
     fn log_relative_level(&self) -> f32 {
         let (mut sum, mut n) = (0.0f64, 0u64);
         for s in &self.samples {
-            // Background pixels hold zero radiance here.
-            let fg: f64 = s.radiance.iter().map(|&r| r.max(0.0) as f64).sum();
-            sum += fg / s.light.scale as f64;
+            // Background pixels hold zero radiance here; channels are planes of `plane` values.
+            let plane = s.radiance.len() / 3;
+            sum += (0..3)
+                .map(|k| {
+                    let fg: f64 = s.radiance[k * plane..(k + 1) * plane]
+                        .iter()
+                        .map(|&r| r.max(0.0) as f64)
+                        .sum();
+                    fg / s.light.scale[k] as f64
+                })
+                .sum::<f64>();
             n += 3 * s.foreground;
         }
         ((sum / n.max(1) as f64).max(1e-12) as f32).ln()
@@ -81,6 +94,7 @@ impl Split {
         maps: &[EnvMap],
         bounds: &[[f32; 3]; 2],
         encoder_width: usize,
+        norm: MapNorm,
     ) -> Result<Self> {
         let Some(first) = views.first() else {
             return Ok(Split {
@@ -111,7 +125,7 @@ impl Split {
                     features,
                     radiance,
                     mask,
-                    light: LightInput::new(&v.record.lighting(maps)?, 0.0, encoder_width),
+                    light: LightInput::new(&v.record.lighting(maps)?, 0.0, encoder_width, norm),
                 })
             })
             .collect::<Result<_>>()?;
@@ -141,7 +155,10 @@ impl Split {
         let mask = tensor(cat(|s| &s.mask), [b, 1, ph, pw]);
         let light = tensor(cat(|s| &s.light.pixels), [b, 3, lw / 2, lw]);
         let scale = Tensor::from_data(
-            TensorData::new(views.iter().map(|s| s.light.scale).collect::<Vec<_>>(), [b]),
+            TensorData::new(
+                views.iter().flat_map(|s| s.light.scale).collect::<Vec<_>>(),
+                [b, 3],
+            ),
             device,
         );
         let pred = net.forward(features, light, scale);
@@ -177,6 +194,7 @@ impl Objective for UnetObjective {
             "dataset_hash": self.file.dataset_hash,
             "batch_views": self.file.options.batch_views,
             "encoder_width": self.file.encoder_width,
+            "map_norm": self.file.options.map_norm,
         })
     }
 
@@ -270,7 +288,13 @@ pub fn train(
     let maps = open_recorded_maps(&manifest)?;
     let split = |name: &str| -> Result<Split> {
         let views = load_views(data, &manifest, name)?;
-        Split::new(&views, &maps, &manifest.bounds, opts.encoder_width)
+        Split::new(
+            &views,
+            &maps,
+            &manifest.bounds,
+            opts.encoder_width,
+            opts.map_norm,
+        )
     };
     let train = split("train")?;
     if train.samples.is_empty() {

@@ -13,7 +13,7 @@ use crate::activation::Activation;
 use crate::encoder::{LightEncoder, CODE_SIZE};
 use crate::features::gbuffer_features;
 use crate::features::FEATURES;
-use crate::init::{conv2d, Init};
+use crate::init::{conv2d, shifted_bias, Init};
 use crate::mlp::Mlp;
 
 /// Channels of the encoder levels (full, ½, ¼ resolution) and of the ⅛-resolution bottleneck.
@@ -76,19 +76,15 @@ impl DeepShading {
         self.num_params() - self.light.num_params()
     }
 
-    /// Radiance [B, 3, H, W] from G-buffer features [B, 19, H, W] (H, W multiples of 8),
-    /// pre-processed maps [B, 3, W/2, W] and map means [B].
     /// Adds `log_level` to the output convolution's bias (see `NprtNet::shift_output_level`).
     pub fn shift_output_level(mut self, log_level: f32) -> Self {
-        self.out.bias = self
-            .out
-            .bias
-            .take()
-            .map(|b| b.map(|t| t.add_scalar(log_level).detach().require_grad()));
+        self.out.bias = shifted_bias(self.out.bias.take(), log_level);
         self
     }
 
-    pub fn forward(&self, features: Tensor<4>, light: Tensor<4>, scale: Tensor<1>) -> Tensor<4> {
+    /// Radiance [B, 3, H, W] from G-buffer features [B, 19, H, W] (H, W multiples of 8),
+    /// pre-processed maps [B, 3, W/2, W] and what each map's channels were divided by [B, 3].
+    pub fn forward(&self, features: Tensor<4>, light: Tensor<4>, scale: Tensor<2>) -> Tensor<4> {
         let code = self.light.forward(light);
         let mut x = features;
         let mut skips = Vec::new();
@@ -109,7 +105,7 @@ impl DeepShading {
             x = relu(conv.forward(Tensor::cat(vec![upsample(x), skip], 1)));
         }
         let [b, _, h, w] = x.dims();
-        self.out.forward(x).exp() * scale.reshape([b, 1, 1, 1]).expand([b, 3, h, w])
+        self.out.forward(x).exp() * scale.reshape([b, 3, 1, 1]).expand([b, 3, h, w])
     }
 }
 

@@ -1,0 +1,58 @@
+//! How an environment map is normalised for the encoder and its level restored at the output.
+
+use std::str::FromStr;
+
+use anyhow::Error;
+use serde::{Deserialize, Serialize};
+
+use crate::named::by_name;
+
+/// What a map is divided by before the encoder sees it; the network's radiance is multiplied
+/// by the same. Radiance is linear in the lighting, channel by channel, so either is exact under
+/// the change it divides out.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum MapNorm {
+    /// The paper's: one mean over texels and channels, exact under a change of intensity. The
+    /// map's colour reaches the prediction only through what the encoder learnt from the
+    /// training maps. Models saved before the choice existed were trained this way.
+    #[default]
+    Mean,
+    /// Each channel by its own mean, restored per channel: exact under any per-channel gain
+    /// (white balance, a warm or cool tint), so the colour of a held-out map need not be
+    /// learnt; the encoder sees only how the colour varies over the map.
+    Channel,
+}
+
+impl MapNorm {
+    pub const ALL: [MapNorm; 2] = [MapNorm::Mean, MapNorm::Channel];
+
+    pub fn name(self) -> &'static str {
+        match self {
+            MapNorm::Mean => "mean",
+            MapNorm::Channel => "channel",
+        }
+    }
+
+    /// The divisor of each channel for per-channel map means `mean`.
+    pub fn scale(self, mean: [f32; 3]) -> [f32; 3] {
+        let s = match self {
+            MapNorm::Mean => [(mean[0] + mean[1] + mean[2]) / 3.0; 3],
+            MapNorm::Channel => mean,
+        };
+        s.map(|v| v.max(f32::MIN_POSITIVE))
+    }
+}
+
+impl std::fmt::Display for MapNorm {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+impl FromStr for MapNorm {
+    type Err = Error;
+    fn from_str(s: &str) -> Result<Self, Error> {
+        by_name(&MapNorm::ALL, MapNorm::name, s, "map normalisation")
+    }
+}
