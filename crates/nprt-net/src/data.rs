@@ -70,9 +70,7 @@ impl TrainingSet {
             test,
         })
     }
-}
 
-impl TrainingSet {
     /// ln of the mean training radiance relative to its map's scale (what the networks
     /// predict before the scale), over every foreground pixel and channel.
     pub fn log_relative_level(&self) -> f32 {
@@ -81,13 +79,19 @@ impl TrainingSet {
             sum += relative_radiance(&v.radiance, v.light.scale);
             n += v.radiance.len();
         }
-        ((sum / n.max(1) as f64).max(1e-12) as f32).ln()
+        log_mean_level(sum, n)
     }
+}
+
+/// ln of the mean of `count` relative radiance values summing to `sum`, kept finite for data
+/// without light.
+pub(crate) fn log_mean_level(sum: f64, count: usize) -> f32 {
+    ((sum / count.max(1) as f64).max(1e-12) as f32).ln()
 }
 
 /// The sum of `radiance` ([n, 3], negative values as zero) divided channel by channel by
 /// `scale`.
-pub(crate) fn relative_radiance(radiance: &[f32], scale: [f32; 3]) -> f64 {
+fn relative_radiance(radiance: &[f32], scale: [f32; 3]) -> f64 {
     radiance
         .chunks_exact(3)
         .map(|c| {

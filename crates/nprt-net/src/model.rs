@@ -43,8 +43,8 @@ pub struct ModelConfig {
 /// 128 for 10% less training time.
 pub const DEFAULT_ENCODER_WIDTH: usize = 128;
 
-/// Map normalisation when none is asked for: per channel, which got held-out maps' colour right
-/// where the paper's single mean did not (docs/model.md).
+/// Map normalisation when none is asked for: per channel, better than the paper's single mean in
+/// every error measured on held-out maps, though not yet in their colour balance (docs/model.md).
 pub const DEFAULT_MAP_NORM: MapNorm = MapNorm::Channel;
 
 impl ModelConfig {

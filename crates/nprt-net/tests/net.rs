@@ -372,15 +372,21 @@ fn cpu_engine_matches_autodiff() {
     }
 }
 
+/// `n` rows of features in [0, 1) and one light code in [-0.5, 0.5), seeded.
+fn pixels_and_code(seed: u64, n: usize) -> (Vec<f32>, Vec<f32>) {
+    let mut rng = Pcg64Mcg::seed_from_u64(seed);
+    let features = (0..n * FEATURES).map(|_| rng.random::<f32>()).collect();
+    let code = (0..64).map(|_| rng.random::<f32>() - 0.5).collect();
+    (features, code)
+}
+
 /// Inference on the CPU engine, with and without the transfer outputs kept, against burn's
 /// forward pass of the same network.
 #[test]
 fn cpu_engine_radiance_matches_burn() {
     let device = Device::flex();
-    let mut rng = Pcg64Mcg::seed_from_u64(5);
     let n = 1300;
-    let features: Vec<f32> = (0..n * FEATURES).map(|_| rng.random::<f32>()).collect();
-    let code: Vec<f32> = (0..64).map(|_| rng.random::<f32>() - 0.5).collect();
+    let (features, code) = pixels_and_code(5, n);
     let scale = [1.7, 0.6, 2.3];
     for design in Design::ALL {
         let net = ModelConfig::new(design, None).build(&mut Init::new(8, &device));
@@ -411,10 +417,8 @@ fn cpu_engine_radiance_matches_burn() {
 #[test]
 fn output_level_shift_scales_the_untrained_prediction() {
     let device = Device::flex();
-    let mut rng = Pcg64Mcg::seed_from_u64(9);
     let n = 200;
-    let features: Vec<f32> = (0..n * FEATURES).map(|_| rng.random::<f32>()).collect();
-    let code: Vec<f32> = (0..64).map(|_| rng.random::<f32>() - 0.5).collect();
+    let (features, code) = pixels_and_code(9, n);
     let level = (2e-3f32).ln();
     for design in Design::ALL {
         let net = ModelConfig::new(design, None).build(&mut Init::new(8, &device));

@@ -16,7 +16,7 @@ use serde::{Deserialize, Serialize};
 use super::model::{read_file, DeepShadingFile, CONFIG_FILE, TAG};
 use super::unet::{feature_image, DeepShading};
 use crate::checkpoint::{self, RunState};
-use crate::data::open_recorded_maps;
+use crate::data::{log_mean_level, open_recorded_maps};
 use crate::encoder::{check_input_width, LightInput};
 use crate::features::FEATURES;
 use crate::init::Init;
@@ -71,7 +71,7 @@ impl Split {
     /// ln of the mean foreground radiance relative to its map's mean (as
     /// `TrainingSet::log_relative_level`).
     fn log_relative_level(&self) -> f32 {
-        let (mut sum, mut n) = (0.0f64, 0u64);
+        let (mut sum, mut n) = (0.0f64, 0usize);
         for s in &self.samples {
             // Background pixels hold zero radiance here; channels are planes of `plane` values.
             let plane = s.radiance.len() / 3;
@@ -84,9 +84,9 @@ impl Split {
                     fg / s.light.scale[k] as f64
                 })
                 .sum::<f64>();
-            n += 3 * s.foreground;
+            n += 3 * s.foreground as usize;
         }
-        ((sum / n.max(1) as f64).max(1e-12) as f32).ln()
+        log_mean_level(sum, n)
     }
 
     fn new(
