@@ -37,6 +37,8 @@ pub struct EvalOptions {
     /// Test views shown as images in the report.
     pub shown_views: usize,
     pub seed: u64,
+    /// Samples per pixel of the direct light of models that trace it.
+    pub direct_spp: u32,
     pub progress: bool,
 }
 
@@ -131,6 +133,7 @@ pub fn evaluate(o: &EvalOptions, device: &Device) -> Result<Evaluation> {
         ts: &ts,
         settings: s,
         seed: o.seed,
+        direct_spp: o.direct_spp,
         shown,
         bar: nprt_io::progress_bar(o.progress, total_steps, "evaluating", "steps"),
     };
@@ -179,6 +182,7 @@ pub fn evaluate(o: &EvalOptions, device: &Device) -> Result<Evaluation> {
         &maps[views[0].record.map],
         &nets,
         &bench.path_tracer(5, o.seed),
+        o.direct_spp,
     )?;
     let fg = views.iter().map(|v| v.foreground()).sum();
     let noise_floor = views

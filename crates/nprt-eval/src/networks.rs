@@ -7,9 +7,9 @@ use std::time::Instant;
 use anyhow::{bail, Result};
 use glam::Vec3;
 use nprt_net::Device;
-use nprt_render::Relighter;
-use nprt_scene::EnvMap;
-use nprt_trace::{render_gbuffer, GBuffer};
+use nprt_render::{DirectSampling, Relighter};
+use nprt_scene::{Camera, EnvMap};
+use nprt_trace::{render_gbuffer, GBuffer, TraceScene};
 
 use crate::error_analysis::Accumulator;
 use crate::evaluate::{ms, EvalOptions};
@@ -33,7 +33,7 @@ impl Net {
 
     fn kind_name(&self) -> String {
         match self {
-            Net::Nprt(r, _) => format!("nprt-{}", r.file.config.design.name()),
+            Net::Nprt(r, _) => format!("nprt-{}", r.file.config.label()),
             Net::DeepShading(..) => "deep-shading".into(),
         }
     }
@@ -52,30 +52,70 @@ impl Net {
         }
     }
 
-    /// Radiance of a G-buffer under a map, and (encoder, network) milliseconds.
+    /// A frame's radiance from its G-buffer `g` under `map` rotated by `rotation` degrees,
+    /// with what each stage cost; a model that traces direct light traces it as `sampling`
+    /// says.
     pub fn shade(
         &self,
+        ts: &TraceScene,
+        camera: &Camera,
         g: &GBuffer,
-        w: usize,
-        h: usize,
-        map: &EnvMap,
-        rotation: f32,
-    ) -> (Vec<Vec3>, f64, f64) {
+        (map, rotation): (&EnvMap, f32),
+        sampling: DirectSampling,
+    ) -> Shaded {
         match self {
             Net::Nprt(r, _) => {
                 let t = Instant::now();
                 let code = r.light_code(map, rotation);
-                let enc = ms(t);
+                let encoder_ms = ms(t);
                 let t = Instant::now();
-                let rgb = r.shade(g, &code);
-                (rgb, enc, ms(t))
+                let mut rgb = r.shade(g, &code);
+                let network_ms = ms(t);
+                let t = Instant::now();
+                if r.traces_direct() {
+                    let placed = map.rotated_y(rotation);
+                    r.complete(ts, camera, &placed, &g.mask, sampling, &mut rgb);
+                }
+                Shaded {
+                    rgb,
+                    encoder_ms,
+                    network_ms,
+                    direct_ms: ms(t),
+                }
             }
             Net::DeepShading(d, _) => {
                 let t = Instant::now();
-                let rgb = d.shade(g, w, h, map, rotation);
-                (rgb, 0.0, ms(t))
+                let rgb = d.shade(
+                    g,
+                    camera.width as usize,
+                    camera.height as usize,
+                    map,
+                    rotation,
+                );
+                Shaded {
+                    rgb,
+                    network_ms: ms(t),
+                    ..Shaded::default()
+                }
             }
         }
+    }
+}
+
+/// A network's frame and what its stages cost, in milliseconds.
+#[derive(Default)]
+pub struct Shaded {
+    /// Radiance of every pixel; background pixels zero unless direct light was traced.
+    pub rgb: Vec<Vec3>,
+    pub encoder_ms: f64,
+    pub network_ms: f64,
+    /// Tracing the direct light (models that leave it to the tracer; otherwise zero).
+    pub direct_ms: f64,
+}
+
+impl Shaded {
+    pub fn total_ms(&self) -> f64 {
+        self.encoder_ms + self.network_ms + self.direct_ms
     }
 }
 
@@ -166,8 +206,8 @@ fn validation_curve(dir: &Path, name: &str) -> Vec<(f64, f64)> {
     }
 }
 
-/// Every network on every test view; its cost per view is the G-buffer, the encoder and the
-/// network, as at run time.
+/// Every network on every test view; its cost per view is the G-buffer, the encoder, the
+/// network and any traced direct light, as at run time.
 pub fn run_networks(bench: &mut TestBench, nets: &[(Net, String)]) -> Vec<MethodResult> {
     let mut results = Vec::new();
     for (net, name) in nets {
@@ -175,20 +215,30 @@ pub fn run_networks(bench: &mut TestBench, nets: &[(Net, String)]) -> Vec<Method
         let loss_png = net.dir().join("loss.png");
         acc.result.loss_png = loss_png.is_file().then_some(loss_png);
         acc.result.validation = validation_curve(net.dir(), name);
+        if matches!(net, Net::Nprt(r, _) if r.traces_direct()) {
+            acc.result.note = format!(
+                "direct light traced at {} spp per view, in its time; its validation loss is on the indirect light, which is all its network learns",
+                bench.direct_spp
+            );
+        }
         for (k, v) in bench.views.iter().enumerate() {
             bench.bar.set_message(name.clone());
             let t = Instant::now();
             let g = render_gbuffer(bench.ts, &v.camera);
             let g_ms = ms(t);
-            let (rgb, enc, net_ms) = net.shade(
+            let sampling = DirectSampling {
+                spp: bench.direct_spp,
+                seed: v.record.seed ^ bench.seed ^ 0x5eed_d1ec,
+            };
+            let shaded = net.shade(
+                bench.ts,
+                &v.camera,
                 &g,
-                v.width,
-                v.height,
-                &bench.maps[v.record.map],
-                v.record.rotation_deg,
+                (&bench.maps[v.record.map], v.record.rotation_deg),
+                sampling,
             );
-            acc.add(v, &rgb, g_ms + enc + net_ms);
-            bench.show(k, name, &rgb);
+            acc.add(v, &shaded.rgb, g_ms + shaded.total_ms());
+            bench.show(k, name, &shaded.rgb);
             bench.bar.inc(1);
         }
         results.push(acc.finish());

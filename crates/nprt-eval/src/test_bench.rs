@@ -18,6 +18,8 @@ pub struct TestBench<'a> {
     pub settings: &'a Settings,
     /// Salt of every baseline's random seeds.
     pub seed: u64,
+    /// Samples per pixel of the direct light that models trained to leave it to the tracer add.
+    pub direct_spp: u32,
     pub shown: Vec<ShownView>,
     pub bar: ProgressBar,
 }

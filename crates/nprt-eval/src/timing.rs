@@ -3,12 +3,13 @@
 use std::time::Instant;
 
 use anyhow::{bail, Result};
+use nprt_render::DirectSampling;
 use nprt_scene::{Camera, EnvMap};
 use nprt_trace::{render, render_gbuffer, GBuffer, RenderSettings, TraceScene};
 use serde::{Deserialize, Serialize};
 
 use crate::evaluate::ms;
-use crate::networks::Net;
+use crate::networks::{Net, Shaded};
 
 /// Rows of the timing table.
 #[derive(Clone, Debug, Serialize, Deserialize)]
@@ -22,7 +23,8 @@ pub struct Timing {
 
 /// The paper's Tables 3 and 4 on this machine: per-stage times of one frame at
 /// `timing_res`², the median of three runs each; for Neural PRT designs also a lighting change
-/// under a still camera, which runs only the shading networks.
+/// under a still camera, which runs only the shading networks, and the direct light of those
+/// that trace it at `direct_spp`.
 pub fn time_table(
     timing_res: u32,
     ts: &TraceScene,
@@ -30,9 +32,13 @@ pub fn time_table(
     map: &EnvMap,
     nets: &[(Net, String)],
     pt: &RenderSettings,
+    direct_spp: u32,
 ) -> Result<Vec<Timing>> {
     let camera = camera.with_resolution(timing_res, timing_res);
-    let n = timing_res as usize;
+    let sampling = DirectSampling {
+        spp: direct_spp,
+        seed: pt.seed,
+    };
     let median = |mut v: Vec<f64>| {
         v.sort_by(f64::total_cmp);
         v[v.len() / 2]
@@ -54,13 +60,10 @@ pub fn time_table(
         gflops: None,
     });
     for (net, name) in nets {
-        let runs: Vec<(f64, f64)> = (0..3)
-            .map(|_| {
-                let (_, e, m) = net.shade(&g, n, n, map, 0.0);
-                (e, m)
-            })
+        let runs: Vec<Shaded> = (0..3)
+            .map(|_| net.shade(ts, &camera, &g, (map, 0.0), sampling))
             .collect();
-        let network_ms = median(runs.iter().map(|r| r.1).collect());
+        let network_ms = median(runs.iter().map(|r| r.network_ms).collect());
         let Net::Nprt(r, _) = net else {
             rows.push(Timing {
                 what: format!("{name}: network"),
@@ -76,7 +79,7 @@ pub fn time_table(
         };
         rows.push(Timing {
             what: format!("{name}: encoder"),
-            ms: median(runs.iter().map(|r| r.0).collect()),
+            ms: median(runs.iter().map(|r| r.encoder_ms).collect()),
             gflops: None,
         });
         rows.push(Timing {
@@ -84,6 +87,13 @@ pub fn time_table(
             ms: network_ms,
             gflops: gflops(false, network_ms),
         });
+        if r.traces_direct() {
+            rows.push(Timing {
+                what: format!("{name}: traced direct light, {direct_spp} spp"),
+                ms: median(runs.iter().map(|r| r.direct_ms).collect()),
+                gflops: None,
+            });
+        }
         if r.file.config.design != nprt_net::Design::Baseline {
             let px = r.pixels(&g);
             let code = r.light_code(map, 0.0);

@@ -4,19 +4,23 @@
 use std::path::Path;
 
 use anyhow::{bail, Result};
+use glam::Vec3;
 use nprt_data::dataset::{load_manifest_hashed, Manifest, ViewRecord};
 use nprt_scene::envmap::EnvMap;
+use nprt_trace::GBuffer;
 use rayon::prelude::*;
 
+use crate::direct_light::DirectLight;
 use crate::encoder::LightInput;
 use crate::features::gbuffer_features;
-use crate::map_norm::MapNorm;
+use crate::model::ModelConfig;
 
 /// The foreground pixels of one view.
 pub struct ViewSamples {
     /// [n, 19] inputs.
     pub features: Vec<f32>,
-    /// [n, 3] reference radiance.
+    /// [n, 3] the radiance the network learns: the reference's, or its indirect part for a
+    /// model that traces direct light.
     pub radiance: Vec<f32>,
     /// The view's map, rotated and pre-processed for the encoder.
     pub light: LightInput,
@@ -42,9 +46,9 @@ pub struct TrainingSet {
 }
 
 impl TrainingSet {
-    /// Reads every view of the dataset in `dir` (in parallel) and prepares its map for an
-    /// encoder of input width `encoder_width`, normalised by `norm`.
-    pub fn load(dir: &Path, encoder_width: usize, norm: MapNorm) -> Result<Self> {
+    /// Reads every view of the dataset in `dir` (in parallel) as the model `config` learns
+    /// it: its map prepared for the encoder, and the radiance it must predict.
+    pub fn load(dir: &Path, config: &ModelConfig) -> Result<Self> {
         let (manifest, dataset_hash) = load_manifest_hashed(dir)?;
         let maps = open_recorded_maps(&manifest)?;
         let load = |split: &str| -> Result<Vec<ViewSamples>> {
@@ -52,7 +56,7 @@ impl TrainingSet {
                 .views
                 .par_iter()
                 .filter(|v| v.split == split)
-                .map(|v| load_view(dir, &manifest, &maps, v, encoder_width, norm))
+                .map(|v| load_view(dir, &manifest, &maps, v, config))
                 .collect()
         };
         let train = load("train")?;
@@ -128,20 +132,82 @@ fn load_view(
     manifest: &Manifest,
     maps: &[EnvMap],
     view: &ViewRecord,
-    encoder_width: usize,
-    norm: MapNorm,
+    config: &ModelConfig,
 ) -> Result<ViewSamples> {
     let image = nprt_data::views::load_view(dir, manifest, view)?;
-    let g = &image.gbuffer;
+    let light = LightInput::new(
+        &view.lighting(maps)?,
+        0.0,
+        config.encoder_width,
+        config.map_norm,
+    );
+    Ok(view_samples(
+        &image.gbuffer,
+        &image.radiance,
+        &image.direct,
+        &manifest.bounds,
+        light,
+        config.direct,
+    ))
+}
+
+/// The foreground pixels of a view (G-buffer `g`, reference `radiance` and its `direct` part)
+/// as training samples under `light`, each with what the network learns of it (`mode`).
+fn view_samples(
+    g: &GBuffer,
+    radiance: &[Vec3],
+    direct: &[Vec3],
+    bounds: &[[f32; 3]; 2],
+    light: LightInput,
+    mode: DirectLight,
+) -> ViewSamples {
     let mut features = Vec::new();
-    let mut radiance = Vec::new();
+    let mut target = Vec::new();
     for i in (0..g.mask.len()).filter(|&i| g.mask[i] > 0.5) {
-        features.extend(gbuffer_features(&manifest.bounds, g, i));
-        radiance.extend(image.radiance[i].to_array());
+        features.extend(gbuffer_features(bounds, g, i));
+        target.extend(mode.target(radiance[i], direct[i]).to_array());
     }
-    Ok(ViewSamples {
+    ViewSamples {
         features,
-        radiance,
-        light: LightInput::new(&view.lighting(maps)?, 0.0, encoder_width, norm),
-    })
+        radiance: target,
+        light,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use glam::Vec3;
+    use nprt_trace::GSample;
+
+    #[test]
+    fn a_model_that_traces_direct_light_learns_the_rest_of_the_foreground() {
+        let mut g = GBuffer::default();
+        for mask in [1.0, 0.0, 1.0] {
+            g.push(GSample {
+                normal: Vec3::Y,
+                view: Vec3::Z,
+                mask,
+                ..GSample::default()
+            });
+        }
+        let radiance = [Vec3::new(1.0, 2.0, 3.0), Vec3::splat(9.0), Vec3::splat(0.5)];
+        // The last pixel's direct part exceeds its total by a rounding error.
+        let direct = [
+            Vec3::new(0.25, 0.5, 1.0),
+            Vec3::splat(9.0),
+            Vec3::splat(0.5000001),
+        ];
+        let map = EnvMap::constant(Vec3::ONE).unwrap();
+        let samples = |mode| {
+            let light = LightInput::new(&map, 0.0, 64, crate::MapNorm::Channel);
+            view_samples(&g, &radiance, &direct, &[[-1.0; 3], [1.0; 3]], light, mode)
+        };
+        let learned = samples(DirectLight::Learned);
+        assert_eq!(learned.radiance, [1.0, 2.0, 3.0, 0.5, 0.5, 0.5]);
+        let traced = samples(DirectLight::Traced);
+        assert_eq!(traced.radiance, [0.75, 1.5, 2.0, 0.0, 0.0, 0.0]);
+        assert_eq!(traced.features, learned.features);
+        assert_eq!(traced.len(), 2);
+    }
 }

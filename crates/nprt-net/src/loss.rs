@@ -2,13 +2,10 @@
 //! radiance, and a relative L2 whose minimiser on noisy targets is their mean. One definition
 //! serves training (burn and the CPU engine), validation and the log-L1 metric.
 
-use std::str::FromStr;
-
-use anyhow::Error;
 use burn::tensor::Tensor;
 use serde::{Deserialize, Serialize};
 
-use crate::named::by_name;
+use crate::named::named_choice;
 
 /// ε of the relative L2 loss (the report's relative metrics use the same).
 pub const RELATIVE_L2_EPS: f32 = 0.01;
@@ -73,12 +70,7 @@ impl Loss {
     }
 }
 
-impl FromStr for Loss {
-    type Err = Error;
-    fn from_str(s: &str) -> Result<Self, Error> {
-        by_name(&Loss::ALL, Loss::name, s, "loss")
-    }
-}
+named_choice!(Loss, "loss");
 
 /// Per-element |log(1 + p) − log(1 + r)|, any tensor rank.
 pub fn log_l1_map<const D: usize>(prediction: Tensor<D>, reference: Tensor<D>) -> Tensor<D> {

@@ -1,11 +1,8 @@
 //! How an environment map is normalised for the encoder and its level restored at the output.
 
-use std::str::FromStr;
-
-use anyhow::Error;
 use serde::{Deserialize, Serialize};
 
-use crate::named::by_name;
+use crate::named::named_choice;
 
 /// What a map is divided by before the encoder sees it; the network's radiance is multiplied
 /// by the same. Radiance is linear in the lighting, channel by channel, so either is exact under
@@ -44,15 +41,4 @@ impl MapNorm {
     }
 }
 
-impl std::fmt::Display for MapNorm {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.write_str(self.name())
-    }
-}
-
-impl FromStr for MapNorm {
-    type Err = Error;
-    fn from_str(s: &str) -> Result<Self, Error> {
-        by_name(&MapNorm::ALL, MapNorm::name, s, "map normalisation")
-    }
-}
+named_choice!(MapNorm, "map normalisation");

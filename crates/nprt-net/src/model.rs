@@ -10,6 +10,7 @@ use serde::{Deserialize, Serialize};
 
 use crate::activation::Activation;
 use crate::design::{Design, NprtNet};
+use crate::direct_light::DirectLight;
 use crate::init::Init;
 use crate::map_norm::MapNorm;
 
@@ -37,6 +38,11 @@ pub struct ModelConfig {
     /// How the map is normalised for the encoder (absent in older files: the paper's mean).
     #[serde(default)]
     pub map_norm: MapNorm,
+    /// Whether the network predicts direct light or leaves it to the tracer (absent in older
+    /// files: learned, as in the paper). Written only when traced, so that a learned model's
+    /// file and run key stay what they were and its unfinished runs still resume.
+    #[serde(default, skip_serializing_if = "DirectLight::is_learned")]
+    pub direct: DirectLight,
 }
 
 /// Encoder input width when none is asked for: on the demo, 64 measured 10% worse in L1 than
@@ -54,6 +60,15 @@ impl ModelConfig {
             activation: activation.unwrap_or(design.default_activation()),
             encoder_width: DEFAULT_ENCODER_WIDTH,
             map_norm: DEFAULT_MAP_NORM,
+            direct: DirectLight::Learned,
+        }
+    }
+
+    /// The design's name, marked `+direct` when direct light is traced: how reports name it.
+    pub fn label(&self) -> String {
+        match self.direct {
+            DirectLight::Learned => self.design.name().to_string(),
+            DirectLight::Traced => format!("{}+direct", self.design.name()),
         }
     }
 
@@ -228,4 +243,29 @@ pub fn layer_table(net: &NprtNet) -> Vec<LayerRow> {
         }
     }
     rows
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn older_configs_read_as_the_paper_s_and_learned_ones_keep_their_old_form() {
+        let old = r#"{"design": "dsep", "activation": "siren", "encoder_width": 128}"#;
+        let config: ModelConfig = serde_json::from_str(old).unwrap();
+        assert_eq!(config.map_norm, MapNorm::Mean);
+        assert_eq!(config.direct, DirectLight::Learned);
+        // A learned model's config (and so its run key) has no `direct` field, as before the
+        // choice existed; a traced one has it and reads back.
+        let json = serde_json::to_value(&config).unwrap();
+        assert!(json.get("direct").is_none(), "{json}");
+        let traced = ModelConfig {
+            direct: DirectLight::Traced,
+            ..config
+        };
+        let json = serde_json::to_string(&traced).unwrap();
+        assert!(json.contains(r#""direct":"traced""#), "{json}");
+        assert_eq!(serde_json::from_str::<ModelConfig>(&json).unwrap(), traced);
+        assert_eq!(traced.label(), "dsep+direct");
+    }
 }

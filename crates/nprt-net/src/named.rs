@@ -1,6 +1,27 @@
-//! Parsing of the small named choices (losses, map normalisations) from their CLI names.
+//! Parsing of the small named choices (losses, map normalisations, direct light) from their CLI
+//! names.
 
 use anyhow::{bail, Result};
+
+/// `Display` and `FromStr` by name for a choice with `ALL` and `name()`; `$what` names it in
+/// the error for an unknown name.
+macro_rules! named_choice {
+    ($t:ty, $what:literal) => {
+        impl std::fmt::Display for $t {
+            fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+                f.write_str(self.name())
+            }
+        }
+
+        impl std::str::FromStr for $t {
+            type Err = anyhow::Error;
+            fn from_str(s: &str) -> anyhow::Result<Self> {
+                $crate::named::by_name(&<$t>::ALL, <$t>::name, s, $what)
+            }
+        }
+    };
+}
+pub(crate) use named_choice;
 
 /// The one of `all` whose `name` is `s`; otherwise an error naming the `what`, `s` and every
 /// accepted name.
@@ -24,7 +45,7 @@ pub(crate) fn by_name<T: Copy>(
 
 #[cfg(test)]
 mod tests {
-    use crate::{Loss, MapNorm};
+    use crate::{DirectLight, Loss, MapNorm};
 
     #[test]
     fn names_parse_and_unknown_ones_list_the_choices() {
@@ -33,6 +54,9 @@ mod tests {
         }
         for n in MapNorm::ALL {
             assert_eq!(n.name().parse::<MapNorm>().unwrap(), n);
+        }
+        for d in DirectLight::ALL {
+            assert_eq!(d.name().parse::<DirectLight>().unwrap(), d);
         }
         let err = "l2".parse::<Loss>().unwrap_err().to_string();
         assert_eq!(err, "unknown loss 'l2' (expected log-l1 or rel-l2)");

@@ -1,8 +1,8 @@
 //! nprt-render: run-time Neural PRT. It owns turning a trained model plus a G-buffer and an
 //! environment map into a globally illuminated frame, camera paths and lighting schedules over
 //! time, and writing frames and animations. It reads models through nprt-net and traces only
-//! primary rays (for the G-buffer) through nprt-trace; it must not train networks, write
-//! datasets or compute error metrics.
+//! primary rays (for the G-buffer) through nprt-trace, and direct light for models that leave
+//! it to the tracer; it must not train networks, write datasets or compute error metrics.
 //!
 //! ```
 //! use nprt_render::{CameraPath, LightingSchedule};
@@ -27,7 +27,9 @@ mod sequence;
 pub mod video;
 
 pub use path::CameraPath;
-pub use relight::{background, FrameTimings, LightCode, Pixels, Relighter};
+pub use relight::{
+    background, DirectSampling, FrameTimings, LightCode, Pixels, Relighter, DEFAULT_DIRECT_SPP,
+};
 pub use schedule::LightingSchedule;
 pub use sequence::{render_sequence, FrameReport, Sequence, SequenceSummary};
 pub use video::{srgb8, write_animation, write_png, Animation};

@@ -9,8 +9,8 @@ use nprt_trace::{render_gbuffer, TraceScene};
 use serde::Serialize;
 
 use crate::{
-    background, write_animation, write_png, Animation, CameraPath, FrameTimings, LightingSchedule,
-    Relighter,
+    write_animation, write_png, Animation, CameraPath, DirectSampling, FrameTimings,
+    LightingSchedule, Relighter,
 };
 
 /// What to render and where.
@@ -23,6 +23,8 @@ pub struct Sequence<'a> {
     pub fps: u32,
     /// Exposure of the PNG frames and animation, in stops.
     pub exposure: f32,
+    /// Samples per pixel of the direct light, for a model that traces it.
+    pub direct_spp: u32,
     /// Also write each frame's linear radiance as OpenEXR.
     pub exr: bool,
     /// Output folder: frames/NNNN.png (.exr), animation.mp4 or .gif, timings.csv.
@@ -54,12 +56,14 @@ struct TimingRow<'a> {
     gbuffer_ms: f64,
     encoder_ms: f64,
     network_ms: f64,
+    direct_ms: f64,
     total_ms: f64,
 }
 
 /// Renders `seq` with `model` on `scene` (already checked to be the model's scene): the
 /// G-buffer from primary rays, the encoder only when the lighting changes, the network on
-/// foreground pixels, the map as background. While the camera stands still, the G-buffer and
+/// foreground pixels, then the traced direct light (models that leave it to the tracer) or the
+/// map as background. While the camera stands still, the G-buffer and
 /// the transfer networks' outputs are kept and only the shading networks run again. Calls
 /// `on_frame` after each frame.
 pub fn render_sequence(
@@ -111,12 +115,19 @@ pub fn render_sequence(
         let mut rgb = model.relight(&px, &code);
         t.network_ms += clock.elapsed().as_secs_f64() * 1e3;
         light = Some(((k, rot), code));
-        background(
+        let clock = Instant::now();
+        model.complete(
+            scene,
             &camera,
             &seq.lighting.maps[k].rotated_y(rot),
             &mask,
+            DirectSampling {
+                spp: seq.direct_spp,
+                seed: i as u64,
+            },
             &mut rgb,
         );
+        t.direct_ms = clock.elapsed().as_secs_f64() * 1e3;
         let png = frames_dir.join(format!("{i:04}.png"));
         write_png(&rgb, w as usize, h as usize, seq.exposure, &png)?;
         if seq.exr {
@@ -141,11 +152,13 @@ pub fn render_sequence(
             gbuffer_ms: t.gbuffer_ms,
             encoder_ms: t.encoder_ms,
             network_ms: t.network_ms,
+            direct_ms: t.direct_ms,
             total_ms: t.total_ms(),
         })?;
         sum.gbuffer_ms += t.gbuffer_ms;
         sum.encoder_ms += t.encoder_ms;
         sum.network_ms += t.network_ms;
+        sum.direct_ms += t.direct_ms;
         let eta_s = start.elapsed().as_secs_f64() / (i + 1) as f64 * (seq.frames - i - 1) as f64;
         on_frame(&FrameReport {
             index: i,
@@ -164,6 +177,7 @@ pub fn render_sequence(
             gbuffer_ms: sum.gbuffer_ms / n,
             encoder_ms: sum.encoder_ms / n,
             network_ms: sum.network_ms / n,
+            direct_ms: sum.direct_ms / n,
         },
     })
 }

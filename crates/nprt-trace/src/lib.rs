@@ -41,6 +41,6 @@ pub use bsdf::Bsdf;
 pub use coating::Coating;
 pub use frame::{Frame, GBuffer, GSample};
 pub use render::{
-    primary_sample, render, render_gbuffer, render_transport, PixelFilter, RenderSettings,
-    TraceScene,
+    primary_sample, render, render_direct, render_gbuffer, render_transport, PixelFilter,
+    RenderSettings, TraceScene,
 };

@@ -148,6 +148,35 @@ fn pixel(
     }
 }
 
+/// Direct light alone: the map seen directly and light that reached the first surface straight
+/// from it, `spp` samples per pixel through the pixel centre (matching the G-buffer). What a
+/// model that leaves direct light to the tracer adds at run time: the same image as [`render`]
+/// with `max_depth` 2 and [`PixelFilter::Centre`] under the same seed, without the G-buffer.
+pub fn render_direct(
+    ts: &TraceScene,
+    camera: &Camera,
+    env: &EnvMap,
+    spp: u32,
+    seed: u64,
+) -> Vec<Vec3> {
+    let w = camera.width as usize;
+    let ps = PathSettings {
+        max_depth: 2,
+        rr_depth: u32::MAX,
+    };
+    (0..w * camera.height as usize)
+        .into_par_iter()
+        .map(|i| {
+            let mut rng = pixel_rng(seed, i as u64);
+            let (o, d) = camera.ray(Vec2::new((i % w) as f32 + 0.5, (i / w) as f32 + 0.5));
+            let sum: Vec3 = (0..spp)
+                .map(|_| trace_path(ts, env, o, d, &ps, &mut rng).total)
+                .sum();
+            sum / spp.max(1) as f32
+        })
+        .collect()
+}
+
 /// The G-buffer of the ray through the centre of pixel (x, y).
 pub fn primary_sample(ts: &TraceScene, camera: &Camera, x: usize, y: usize) -> GSample {
     let (o, d) = camera.ray(Vec2::new(x as f32 + 0.5, y as f32 + 0.5));

@@ -1,9 +1,9 @@
 //! Cases with known answers: furnaces, a diffuse plane under a constant sky, Mitsuba's
-//! max_depth semantics, and determinism.
+//! max_depth semantics, direct light alone, and determinism.
 
 use glam::{Mat4, Vec3};
 use nprt_scene::{Camera, EnvMap, Material, Mesh, Scene};
-use nprt_trace::{render, Frame, PixelFilter, RenderSettings, TraceScene};
+use nprt_trace::{render, render_direct, Frame, PixelFilter, RenderSettings, TraceScene};
 
 fn settings(spp: u32, max_depth: Option<u32>) -> RenderSettings {
     RenderSettings {
@@ -158,6 +158,38 @@ fn max_depth_follows_mitsuba() {
     assert_eq!(
         render(&ts, &camera(), &env, &settings(1, Some(0))).mean(),
         Vec3::ZERO
+    );
+}
+
+#[test]
+fn direct_light_alone_is_the_depth_two_render_and_the_full_render_s_direct_part() {
+    let s = nprt_scene::builtin::scene("room").unwrap();
+    let ts = TraceScene::new(&s);
+    let cam = s.camera.clone().unwrap().with_resolution(24, 24);
+    let env = s.envmap.clone().unwrap();
+    let centre = |spp, max_depth| RenderSettings {
+        filter: PixelFilter::Centre,
+        ..settings(spp, max_depth)
+    };
+    // Bit for bit the reference tracer stopped after the first bounce, same seed.
+    let direct = render_direct(&ts, &cam, &env, 8, 7);
+    assert_eq!(
+        direct,
+        render(&ts, &cam, &env, &centre(8, Some(2))).radiance
+    );
+    // And, in the mean, the direct part the full render splits off, well short of its total
+    // (the room has indirect light), so it cannot be the total by mistake.
+    let full = render(&ts, &cam, &env, &centre(256, None));
+    let direct = render_direct(&ts, &cam, &env, 256, 9);
+    let mean = |v: &[Vec3]| v.iter().sum::<Vec3>() / v.len() as f32;
+    let (d, split, total) = (mean(&direct), mean(&full.direct), mean(&full.radiance));
+    assert!(
+        ((d - split) / split).abs().max_element() < 0.03,
+        "direct alone {d} against the full render's direct part {split}"
+    );
+    assert!(
+        (total - d).min_element() > 0.1 * total.min_element(),
+        "direct {d} against total {total}"
     );
 }
 

@@ -5,7 +5,10 @@ use std::time::Instant;
 
 use anyhow::Result;
 use nprt_net::deep_shading::DeepShadingOptions;
-use nprt_net::{Design, TrainOptions, DEFAULT_ENCODER_WIDTH, DEFAULT_MAP_NORM};
+use nprt_net::{
+    Design, DirectLight, ModelConfig, TrainOptions, DEFAULT_ENCODER_WIDTH, DEFAULT_MAP_NORM,
+};
+use nprt_render::DEFAULT_DIRECT_SPP;
 
 use crate::evaluation::{eval, train_deep_shading, DeepShadingArgs, EvalArgs};
 use crate::learn::{train, TrainArgs};
@@ -127,13 +130,25 @@ pub fn demo(a: DemoArgs) -> Result<()> {
     })?;
     let mut models = Vec::new();
     let defaults = TrainOptions::default();
-    for (i, design) in Design::ALL.into_iter().enumerate() {
+    // The paper's four designs, then D/S with its direct light traced at run time (the
+    // paper's suggested extension, docs/model.md).
+    let runs: Vec<(Design, DirectLight)> = Design::ALL
+        .into_iter()
+        .map(|d| (d, DirectLight::Learned))
+        .chain([(Design::Dsep, DirectLight::Traced)])
+        .collect();
+    for (i, &(design, direct)) in runs.iter().enumerate() {
+        let config = ModelConfig {
+            direct,
+            ..ModelConfig::new(design, None)
+        };
         step(&format!(
-            "2/5 training design {} of 4: {}",
+            "2/5 training design {} of {}: {}",
             i + 1,
-            design.name()
+            runs.len(),
+            config.label()
         ));
-        let out = a.out.join("models").join(design.name());
+        let out = a.out.join("models").join(config.label());
         train(TrainArgs {
             data: data.clone(),
             arch: design,
@@ -148,6 +163,7 @@ pub fn demo(a: DemoArgs) -> Result<()> {
             loss: defaults.loss,
             encoder_width: DEFAULT_ENCODER_WIDTH,
             map_norm: DEFAULT_MAP_NORM,
+            direct,
             checkpoint_minutes: defaults.schedule.checkpoint_secs / 60.0,
             device: a.device,
         })?;
@@ -179,6 +195,7 @@ pub fn demo(a: DemoArgs) -> Result<()> {
         views: None,
         shown_views: 3,
         seed: 0,
+        direct_spp: DEFAULT_DIRECT_SPP,
         device: a.device,
     })?;
     step("5/5 relighting a camera path under held-out lighting");
@@ -191,7 +208,7 @@ pub fn demo(a: DemoArgs) -> Result<()> {
         .collect();
     let frames = a.out.join("relit");
     render(RenderArgs {
-        model: models.last().expect("four models").clone(),
+        model: models.last().expect("five models").clone(),
         out: frames.clone(),
         scene: None,
         camera_path: None,
@@ -203,6 +220,7 @@ pub fn demo(a: DemoArgs) -> Result<()> {
         fps: 24,
         exposure: 0.0,
         exr: false,
+        direct_spp: DEFAULT_DIRECT_SPP,
         device: a.device,
     })?;
     println!(
@@ -218,8 +236,9 @@ pub fn demo(a: DemoArgs) -> Result<()> {
             d.mean.rmse, b.mean.rmse
         );
     }
-    if let (Some(d), Some(sh)) = (l1("nprt-dsep"), l1("sh-prt-9")) {
-        println!("headline: L1 D/S {d:.4} vs SH PRT (9) {sh:.4}, equal-time path tracing at {} spp {:.4}",
+    if let (Some(d), Some(dt), Some(sh)) = (l1("nprt-dsep"), l1("nprt-dsep+direct"), l1("sh-prt-9"))
+    {
+        println!("headline: L1 D/S {d:.4}, D/S with traced direct light {dt:.4} vs SH PRT (9) {sh:.4}, equal-time path tracing at {} spp {:.4}",
             e.equal_time_spp,
             e.methods.iter().find(|m| m.name.starts_with("pt-equal-time")).map_or(f64::NAN, |m| m.mean.l1));
     }

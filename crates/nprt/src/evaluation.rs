@@ -6,6 +6,7 @@ use anyhow::{bail, Result};
 use nprt_eval::{evaluate, write_report, EvalOptions, Evaluation};
 use nprt_net::deep_shading::{self, DeepShadingOptions};
 use nprt_net::{MapNorm, Schedule};
+use nprt_render::DEFAULT_DIRECT_SPP;
 
 use crate::{DeviceArg, RunLength};
 
@@ -35,9 +36,13 @@ pub struct EvalArgs {
     /// Test views shown as images (frames, crops, heat maps) in the report.
     #[arg(long, default_value_t = 3)]
     pub shown_views: usize,
-    /// Seed of the baselines' path-traced samples.
+    /// Seed of the baselines' path-traced samples (and of the traced direct light).
     #[arg(long, default_value_t = 0)]
     pub seed: u64,
+    /// Samples per pixel of the direct light of models trained with `nprt train --direct
+    /// traced`, traced per frame and counted in their time.
+    #[arg(long, default_value_t = DEFAULT_DIRECT_SPP)]
+    pub direct_spp: u32,
     #[command(flatten)]
     pub device: DeviceArg,
 }
@@ -90,6 +95,7 @@ pub fn eval(a: EvalArgs) -> Result<Evaluation> {
         max_views: a.views,
         shown_views: a.shown_views,
         seed: a.seed,
+        direct_spp: a.direct_spp,
         progress: true,
     };
     let e = evaluate(&opts, &a.device.device()?)?;

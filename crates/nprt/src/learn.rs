@@ -10,8 +10,8 @@ use nprt_net::{device_name, is_cpu, Device};
 
 use crate::{DeviceArg, RunLength};
 use nprt_net::{
-    layer_table, measure_throughput, recipe_rate, Activation, Design, Engine, Init, Loss, MapNorm,
-    ModelConfig, Schedule, TrainOptions, DEFAULT_ENCODER_WIDTH, DEFAULT_MAP_NORM,
+    layer_table, measure_throughput, recipe_rate, Activation, Design, DirectLight, Engine, Init,
+    Loss, MapNorm, ModelConfig, Schedule, TrainOptions, DEFAULT_ENCODER_WIDTH, DEFAULT_MAP_NORM,
 };
 
 #[derive(clap::Args)]
@@ -84,6 +84,12 @@ pub struct TrainArgs {
     /// mean (the paper's one mean over channels, which leaves colour to the encoder).
     #[arg(long, default_value_t = DEFAULT_MAP_NORM)]
     pub map_norm: MapNorm,
+    /// learned (the paper: the network predicts all the radiance) or traced (the network
+    /// learns the indirect light only, the reference minus its direct part, and `nprt render`
+    /// and `nprt eval` trace the direct light at run time with --direct-spp samples per pixel,
+    /// its cost counted in the model's time; docs/model.md).
+    #[arg(long, default_value_t = DirectLight::Learned)]
+    pub direct: DirectLight,
     /// Minutes between checkpoints within an epoch (one is always written at an epoch's end).
     #[arg(long, default_value_t = TrainOptions::default().schedule.checkpoint_secs / 60.0)]
     pub checkpoint_minutes: f64,
@@ -161,11 +167,13 @@ fn config(
     activation: Option<Activation>,
     encoder_width: usize,
     map_norm: MapNorm,
+    direct: DirectLight,
 ) -> Result<ModelConfig> {
     check_input_width(encoder_width)?;
     Ok(ModelConfig {
         encoder_width,
         map_norm,
+        direct,
         ..ModelConfig::new(arch, activation)
     })
 }
@@ -183,7 +191,13 @@ pub fn model_info(a: ModelInfoArgs) -> Result<()> {
             (file.config, net)
         }
         (None, Some(arch)) => {
-            let config = config(arch, a.activation, a.encoder_width, DEFAULT_MAP_NORM)?;
+            let config = config(
+                arch,
+                a.activation,
+                a.encoder_width,
+                DEFAULT_MAP_NORM,
+                DirectLight::Learned,
+            )?;
             let net = config.build(&mut Init::new(0, &Device::flex()));
             (config, net)
         }
@@ -191,7 +205,7 @@ pub fn model_info(a: ModelInfoArgs) -> Result<()> {
     };
     let arch = config.design;
     println!(
-        "design {} ({} transport layers), light encoder input {}×{}, map normalised by its {}",
+        "design {} ({} transport layers), light encoder input {}×{}, map normalised by its {}, direct light {}",
         arch.name(),
         config.activation.name(),
         config.encoder_width,
@@ -199,6 +213,10 @@ pub fn model_info(a: ModelInfoArgs) -> Result<()> {
         match config.map_norm {
             MapNorm::Mean => "mean",
             MapNorm::Channel => "mean per channel",
+        },
+        match config.direct {
+            DirectLight::Learned => "learned",
+            DirectLight::Traced => "traced at run time",
         }
     );
     println!("{:<24} {:<22} {:>10}", "layer", "shape", "params");
@@ -232,9 +250,9 @@ fn training_schedule(a: &TrainArgs) -> Schedule {
 }
 
 pub fn train(a: TrainArgs) -> Result<()> {
-    let config = config(a.arch, a.activation, a.encoder_width, a.map_norm)?;
+    let config = config(a.arch, a.activation, a.encoder_width, a.map_norm, a.direct)?;
     let t0 = std::time::Instant::now();
-    let set = TrainingSet::load(&a.data, config.encoder_width, config.map_norm)?;
+    let set = TrainingSet::load(&a.data, &config)?;
     let count = |v: &[nprt_net::data::ViewSamples]| v.iter().map(|s| s.len()).sum::<usize>();
     println!(
         "dataset '{}': {} training views ({} foreground pixels), {} test views ({} pixels), loaded in {:.1} s",

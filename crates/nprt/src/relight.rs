@@ -4,7 +4,10 @@
 use std::path::PathBuf;
 
 use anyhow::{bail, Context, Result};
-use nprt_render::{render_sequence, Animation, CameraPath, LightingSchedule, Relighter, Sequence};
+use nprt_render::{
+    render_sequence, Animation, CameraPath, LightingSchedule, Relighter, Sequence,
+    DEFAULT_DIRECT_SPP,
+};
 use nprt_trace::TraceScene;
 
 use crate::{parse_resolution, DeviceArg};
@@ -53,6 +56,10 @@ pub struct RenderArgs {
     /// Also write each frame's linear radiance as OpenEXR.
     #[arg(long)]
     pub exr: bool,
+    /// Samples per pixel of the direct light, for a model trained with `--direct traced`
+    /// (ignored for the others).
+    #[arg(long, default_value_t = DEFAULT_DIRECT_SPP)]
+    pub direct_spp: u32,
     #[command(flatten)]
     pub device: DeviceArg,
 }
@@ -94,13 +101,14 @@ pub fn render(a: RenderArgs) -> Result<()> {
         fps: a.fps,
         exposure: a.exposure,
         exr: a.exr,
+        direct_spp: a.direct_spp,
         out: &a.out,
     };
     let [w, h] = a.res;
     println!(
         "nprt render: {} ({}) on {spec}, {} frames at {w}×{h}, lighting {}",
         a.model.display(),
-        model.file.config.design.name(),
+        model.file.config.label(),
         a.frames,
         lighting
             .segments
@@ -109,24 +117,32 @@ pub fn render(a: RenderArgs) -> Result<()> {
             .collect::<Vec<_>>()
             .join(" → ")
     );
+    let completion = if model.traces_direct() {
+        "direct light"
+    } else {
+        "background"
+    };
     let done = render_sequence(&model, &TraceScene::new(&scene), &seq, |f| {
         let t = &f.timings;
         println!(
-            "frame {:>4}/{}: G-buffer {:7.1} ms, encoder {:6.1} ms, network {:8.1} ms (ETA {:.0} s)",
+            "frame {:>4}/{}: G-buffer {:7.1} ms, encoder {:6.1} ms, network {:8.1} ms, {} {:7.1} ms (ETA {:.0} s)",
             f.index + 1,
             a.frames,
             t.gbuffer_ms,
             t.encoder_ms,
             t.network_ms,
+            completion,
+            t.direct_ms,
             f.eta_s
         );
     })?;
     let m = done.mean;
     println!(
-        "mean per frame: G-buffer {:.1} ms, encoder {:.1} ms (once per lighting change), network {:.1} ms; total {:.1} ms ({:.2} fps)",
+        "mean per frame: G-buffer {:.1} ms, encoder {:.1} ms (once per lighting change), network {:.1} ms, {completion} {:.1} ms; total {:.1} ms ({:.2} fps)",
         m.gbuffer_ms,
         m.encoder_ms,
         m.network_ms,
+        m.direct_ms,
         m.total_ms(),
         1e3 / m.total_ms()
     );
