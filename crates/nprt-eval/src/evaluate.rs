@@ -11,13 +11,14 @@ use nprt_data::dataset::{load_checked_scene, load_manifest_hashed};
 use nprt_data::views::load_views;
 use nprt_net::data::open_recorded_maps;
 use nprt_net::Device;
+use nprt_render::oidn::Oidn;
+use nprt_render::DirectSampling;
 use nprt_trace::TraceScene;
 use serde::{Deserialize, Serialize};
 
 use crate::method::{Family, MethodResult};
 use crate::metrics::Metrics;
-use crate::networks::{load_networks, run_networks};
-use crate::oidn::Oidn;
+use crate::networks::{load_networks, run_networks, traces_direct};
 use crate::path_tracing::{equal_time_spp, run_denoised, run_path_tracing};
 use crate::sh_prt::run_sh_prt;
 use crate::test_bench::TestBench;
@@ -126,7 +127,11 @@ pub fn evaluate(o: &EvalOptions, device: &Device) -> Result<Evaluation> {
             methods: vec![],
         })
         .collect();
-    let total_steps = (views.len() * (nets.len() + 3)) as u64;
+    let denoised_nets = match &oidn {
+        Ok(_) => nets.iter().filter(|(n, _)| traces_direct(n)).count(),
+        Err(_) => 0,
+    };
+    let total_steps = (views.len() * (nets.len() + denoised_nets + 3)) as u64;
     let mut bench = TestBench {
         views: &views,
         maps: &maps,
@@ -138,7 +143,7 @@ pub fn evaluate(o: &EvalOptions, device: &Device) -> Result<Evaluation> {
         bar: nprt_io::progress_bar(o.progress, total_steps, "evaluating", "steps"),
     };
 
-    let mut results = run_networks(&mut bench, &nets);
+    let mut results = run_networks(&mut bench, &nets, oidn.as_ref().ok().copied())?;
     // Equal time is set by the Neural PRT designs (Deep Shading is a baseline); with none, by
     // whatever network was given.
     let budget = |family: Option<Family>| {
@@ -182,7 +187,11 @@ pub fn evaluate(o: &EvalOptions, device: &Device) -> Result<Evaluation> {
         &maps[views[0].record.map],
         &nets,
         &bench.path_tracer(5, o.seed),
-        o.direct_spp,
+        DirectSampling {
+            spp: o.direct_spp,
+            seed: o.seed,
+            denoiser: oidn.as_ref().ok().copied(),
+        },
     )?;
     let fg = views.iter().map(|v| v.foreground()).sum();
     let noise_floor = views
@@ -239,20 +248,32 @@ impl Evaluation {
             .methods
             .iter()
             .find(|m| m.family == Family::PathTracing && m.name.starts_with("pt-equal-time"));
+        let beats_in_l1 = |m: &MethodResult, other: &MethodResult| {
+            (
+                format!(
+                    "{} beats {} in L1 ({:.4} < {:.4})",
+                    m.name, other.name, m.mean.l1, other.mean.l1
+                ),
+                m.mean.l1 < other.mean.l1,
+            )
+        };
         for m in self
             .methods
             .iter()
             .filter(|m| m.family == Family::NeuralPrt)
         {
             for other in [sh9, pteq].into_iter().flatten() {
-                out.push((
-                    format!(
-                        "{} beats {} in L1 ({:.4} < {:.4})",
-                        m.name, other.name, m.mean.l1, other.mean.l1
-                    ),
-                    m.mean.l1 < other.mean.l1,
-                ));
+                out.push(beats_in_l1(m, other));
             }
+        }
+        // A design whose traced light is denoised against path tracing denoised alike.
+        let pteq_denoised = pteq.and_then(|p| self.method(&format!("{} + OIDN", p.name)));
+        for m in self
+            .methods
+            .iter()
+            .filter(|m| m.family == Family::Denoised && m.name.starts_with("nprt-"))
+        {
+            out.extend(pteq_denoised.map(|other| beats_in_l1(m, other)));
         }
         out
     }

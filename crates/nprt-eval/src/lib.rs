@@ -21,7 +21,6 @@ mod evaluate;
 mod method;
 pub mod metrics;
 mod networks;
-pub mod oidn;
 mod path_tracing;
 mod report;
 pub mod sh;

@@ -17,7 +17,8 @@ pub enum Family {
     DeepShading,
     /// Path tracing at a fixed sample count.
     PathTracing,
-    /// Path tracing denoised by Open Image Denoise.
+    /// Path tracing denoised by Open Image Denoise: a baseline's, or the direct light a Neural
+    /// PRT design traces.
     Denoised,
     /// Per-pixel spherical-harmonics PRT in a fixed view.
     ShPrt,

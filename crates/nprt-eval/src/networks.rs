@@ -7,6 +7,7 @@ use std::time::Instant;
 use anyhow::{bail, Result};
 use glam::Vec3;
 use nprt_net::Device;
+use nprt_render::oidn::Oidn;
 use nprt_render::{DirectSampling, Relighter};
 use nprt_scene::{Camera, EnvMap};
 use nprt_trace::{render_gbuffer, GBuffer, TraceScene};
@@ -62,7 +63,7 @@ impl Net {
         g: &GBuffer,
         (map, rotation): (&EnvMap, f32),
         sampling: DirectSampling,
-    ) -> Shaded {
+    ) -> Result<Shaded> {
         match self {
             Net::Nprt(r, _) => {
                 let t = Instant::now();
@@ -74,14 +75,14 @@ impl Net {
                 let t = Instant::now();
                 if r.traces_direct() {
                     let placed = map.rotated_y(rotation);
-                    r.complete(ts, camera, &placed, &g.mask, sampling, &mut rgb);
+                    r.complete(ts, camera, &placed, g, sampling, &mut rgb)?;
                 }
-                Shaded {
+                Ok(Shaded {
                     rgb,
                     encoder_ms,
                     network_ms,
                     direct_ms: ms(t),
-                }
+                })
             }
             Net::DeepShading(d, _) => {
                 let t = Instant::now();
@@ -92,11 +93,11 @@ impl Net {
                     map,
                     rotation,
                 );
-                Shaded {
+                Ok(Shaded {
                     rgb,
                     network_ms: ms(t),
                     ..Shaded::default()
-                }
+                })
             }
         }
     }
@@ -206,42 +207,65 @@ fn validation_curve(dir: &Path, name: &str) -> Vec<(f64, f64)> {
     }
 }
 
+/// Whether `net` leaves its direct light to the tracer.
+pub fn traces_direct(net: &Net) -> bool {
+    matches!(net, Net::Nprt(r, _) if r.traces_direct())
+}
+
 /// Every network on every test view; its cost per view is the G-buffer, the encoder, the
-/// network and any traced direct light, as at run time.
-pub fn run_networks(bench: &mut TestBench, nets: &[(Net, String)]) -> Vec<MethodResult> {
+/// network and any traced direct light, as at run time. A model that traces direct light runs
+/// a second time with that light denoised when `oidn` is given (a row of its own, "+ OIDN").
+pub fn run_networks(
+    bench: &mut TestBench,
+    nets: &[(Net, String)],
+    oidn: Option<&'static Oidn>,
+) -> Result<Vec<MethodResult>> {
     let mut results = Vec::new();
     for (net, name) in nets {
-        let mut acc = Accumulator::new(name, net.family(), Some(net.params()));
-        let loss_png = net.dir().join("loss.png");
-        acc.result.loss_png = loss_png.is_file().then_some(loss_png);
-        acc.result.validation = validation_curve(net.dir(), name);
-        if matches!(net, Net::Nprt(r, _) if r.traces_direct()) {
-            acc.result.note = format!(
-                "direct light traced at {} spp per view, in its time; its validation loss is on the indirect light, which is all its network learns",
-                bench.direct_spp
-            );
-        }
-        for (k, v) in bench.views.iter().enumerate() {
-            bench.bar.set_message(name.clone());
-            let t = Instant::now();
-            let g = render_gbuffer(bench.ts, &v.camera);
-            let g_ms = ms(t);
-            let sampling = DirectSampling {
-                spp: bench.direct_spp,
-                seed: v.record.seed ^ bench.seed ^ 0x5eed_d1ec,
+        let denoisers = [None]
+            .into_iter()
+            .chain(oidn.filter(|_| traces_direct(net)).map(Some));
+        for denoiser in denoisers {
+            let (row, family) = match denoiser {
+                None => (name.clone(), net.family()),
+                Some(_) => (format!("{name} + OIDN"), Family::Denoised),
             };
-            let shaded = net.shade(
-                bench.ts,
-                &v.camera,
-                &g,
-                (&bench.maps[v.record.map], v.record.rotation_deg),
-                sampling,
-            );
-            acc.add(v, &shaded.rgb, g_ms + shaded.total_ms());
-            bench.show(k, name, &shaded.rgb);
-            bench.bar.inc(1);
+            let mut acc = Accumulator::new(&row, family, Some(net.params()));
+            if denoiser.is_none() {
+                let loss_png = net.dir().join("loss.png");
+                acc.result.loss_png = loss_png.is_file().then_some(loss_png);
+                acc.result.validation = validation_curve(net.dir(), name);
+            }
+            if traces_direct(net) {
+                acc.result.note = format!(
+                    "direct light traced at {} spp per view{}, in its time; its validation loss is on the indirect light, which is all its network learns",
+                    bench.direct_spp,
+                    if denoiser.is_some() { " and denoised" } else { "" }
+                );
+            }
+            for (k, v) in bench.views.iter().enumerate() {
+                bench.bar.set_message(row.clone());
+                let t = Instant::now();
+                let g = render_gbuffer(bench.ts, &v.camera);
+                let g_ms = ms(t);
+                let sampling = DirectSampling {
+                    spp: bench.direct_spp,
+                    seed: v.record.seed ^ bench.seed ^ 0x5eed_d1ec,
+                    denoiser,
+                };
+                let shaded = net.shade(
+                    bench.ts,
+                    &v.camera,
+                    &g,
+                    (&bench.maps[v.record.map], v.record.rotation_deg),
+                    sampling,
+                )?;
+                acc.add(v, &shaded.rgb, g_ms + shaded.total_ms());
+                bench.show(k, &row, &shaded.rgb);
+                bench.bar.inc(1);
+            }
+            results.push(acc.finish());
         }
-        results.push(acc.finish());
     }
-    results
+    Ok(results)
 }

@@ -5,12 +5,12 @@ use std::time::Instant;
 
 use anyhow::Result;
 use glam::Vec3;
+use nprt_render::oidn::Oidn;
 use nprt_trace::render;
 
 use crate::error_analysis::Accumulator;
 use crate::evaluate::ms;
 use crate::method::{Family, MethodResult};
-use crate::oidn::Oidn;
 use crate::test_bench::TestBench;
 
 /// A path-traced baseline's results and its frames (the denoiser's input).
@@ -56,11 +56,8 @@ pub fn run_denoised(bench: &mut TestBench, oidn: &Oidn, base: &Traced) -> Result
     let name = format!("{} + OIDN", base.result.name);
     let mut acc = Accumulator::new(&name, Family::Denoised, None);
     for (k, (v, f)) in bench.views.iter().zip(&base.frames).enumerate() {
-        let albedo: Vec<Vec3> = (0..f.len())
-            .map(|i| (v.gbuffer.kd[i] + v.gbuffer.ks[i]).min(Vec3::ONE))
-            .collect();
         let t = Instant::now();
-        let d = oidn.denoise(f, &albedo, &v.gbuffer.normal, v.width, v.height)?;
+        let d = oidn.denoise_frame(f, &v.gbuffer, v.width, v.height)?;
         acc.add(v, &d, base.result.ms_per_view + ms(t));
         bench.show(k, &name, &d);
     }

@@ -24,7 +24,7 @@ pub struct Timing {
 /// The paper's Tables 3 and 4 on this machine: per-stage times of one frame at
 /// `timing_res`², the median of three runs each; for Neural PRT designs also a lighting change
 /// under a still camera, which runs only the shading networks, and the direct light of those
-/// that trace it at `direct_spp`.
+/// that trace it as `direct` says, also denoised when it names a denoiser.
 pub fn time_table(
     timing_res: u32,
     ts: &TraceScene,
@@ -32,12 +32,12 @@ pub fn time_table(
     map: &EnvMap,
     nets: &[(Net, String)],
     pt: &RenderSettings,
-    direct_spp: u32,
+    direct: DirectSampling,
 ) -> Result<Vec<Timing>> {
     let camera = camera.with_resolution(timing_res, timing_res);
-    let sampling = DirectSampling {
-        spp: direct_spp,
-        seed: pt.seed,
+    let raw = DirectSampling {
+        denoiser: None,
+        ..direct
     };
     let median = |mut v: Vec<f64>| {
         v.sort_by(f64::total_cmp);
@@ -60,9 +60,9 @@ pub fn time_table(
         gflops: None,
     });
     for (net, name) in nets {
-        let runs: Vec<Shaded> = (0..3)
-            .map(|_| net.shade(ts, &camera, &g, (map, 0.0), sampling))
-            .collect();
+        let runs = (0..3)
+            .map(|_| net.shade(ts, &camera, &g, (map, 0.0), raw))
+            .collect::<Result<Vec<Shaded>>>()?;
         let network_ms = median(runs.iter().map(|r| r.network_ms).collect());
         let Net::Nprt(r, _) = net else {
             rows.push(Timing {
@@ -89,10 +89,23 @@ pub fn time_table(
         });
         if r.traces_direct() {
             rows.push(Timing {
-                what: format!("{name}: traced direct light, {direct_spp} spp"),
+                what: format!("{name}: traced direct light, {} spp", direct.spp),
                 ms: median(runs.iter().map(|r| r.direct_ms).collect()),
                 gflops: None,
             });
+            if direct.denoiser.is_some() {
+                let denoised = (0..3)
+                    .map(|_| Ok(net.shade(ts, &camera, &g, (map, 0.0), direct)?.direct_ms))
+                    .collect::<Result<Vec<f64>>>()?;
+                rows.push(Timing {
+                    what: format!(
+                        "{name}: traced direct light, {} spp, denoised by OIDN",
+                        direct.spp
+                    ),
+                    ms: median(denoised),
+                    gflops: None,
+                });
+            }
         }
         if r.file.config.design != nprt_net::Design::Baseline {
             let px = r.pixels(&g);

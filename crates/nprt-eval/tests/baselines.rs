@@ -90,7 +90,7 @@ fn sh_prt_25_approaches_path_tracing_under_a_smooth_sky() {
 
 #[test]
 fn oidn_denoises_when_installed() {
-    let oidn = match nprt_eval::oidn::Oidn::open() {
+    let oidn = match nprt_render::oidn::Oidn::open() {
         Ok(o) => o,
         Err(e) if std::env::var_os("NPRT_REQUIRE_OIDN").is_none() => {
             eprintln!("skipping: {e:#}");

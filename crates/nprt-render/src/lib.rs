@@ -2,7 +2,9 @@
 //! environment map into a globally illuminated frame, camera paths and lighting schedules over
 //! time, and writing frames and animations. It reads models through nprt-net and traces only
 //! primary rays (for the G-buffer) through nprt-trace, and direct light for models that leave
-//! it to the tracer; it must not train networks, write datasets or compute error metrics.
+//! it to the tracer, which it can denoise with Open Image Denoise (the one binding, which the
+//! evaluation's denoised baselines use too); it must not train networks, write datasets or
+//! compute error metrics.
 //!
 //! ```
 //! use nprt_render::{CameraPath, LightingSchedule};
@@ -20,6 +22,7 @@
 //! # Ok::<(), anyhow::Error>(())
 //! ```
 
+pub mod oidn;
 mod path;
 mod relight;
 pub mod schedule;

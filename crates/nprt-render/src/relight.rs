@@ -12,6 +12,8 @@ use nprt_net::gbuffer_features;
 use nprt_net::{load_model, Device, DirectLight, LightInput, ModelFile, NprtNet, FEATURES};
 use nprt_scene::{Camera, EnvMap};
 use nprt_trace::{render_direct, GBuffer, TraceScene};
+
+use crate::oidn::Oidn;
 use rayon::prelude::*;
 
 /// Samples per pixel of the traced direct light when none is asked for: on the demo, D/S with
@@ -49,12 +51,14 @@ pub struct Pixels {
 }
 
 /// How a frame's direct light is traced, for a model that leaves it to the tracer.
-#[derive(Clone, Copy, Debug)]
+#[derive(Clone, Copy)]
 pub struct DirectSampling {
     /// Samples per pixel, each a shadow ray towards the importance-sampled map and a BSDF
     /// sample combined by MIS.
     pub spp: u32,
     pub seed: u64,
+    /// Denoises the traced light (with the G-buffer as auxiliaries) before it is added.
+    pub denoiser: Option<&'static Oidn>,
 }
 
 /// Milliseconds spent in each stage of one frame.
@@ -90,25 +94,31 @@ impl Relighter {
         self.file.config.direct == DirectLight::Traced
     }
 
-    /// Completes a frame the network shaded (`rgb`, background pixels zero) under `map` (the
-    /// lighting as placed in the world): for a model that traces direct light, adds every
-    /// pixel's direct light, traced through the pixel centre as `sampling` says (on background
-    /// pixels that is the map itself); otherwise fills background pixels with the map.
+    /// Completes a frame the network shaded (`rgb`, background pixels zero) from G-buffer `g`
+    /// under `map` (the lighting as placed in the world): for a model that traces direct light,
+    /// adds every pixel's direct light, traced through the pixel centre as `sampling` says (on
+    /// background pixels that is the map itself); otherwise fills background pixels with the
+    /// map.
     pub fn complete(
         &self,
         ts: &TraceScene,
         camera: &Camera,
         map: &EnvMap,
-        mask: &[f32],
+        g: &GBuffer,
         sampling: DirectSampling,
         rgb: &mut [Vec3],
-    ) {
-        if self.traces_direct() {
-            let direct = render_direct(ts, camera, map, sampling.spp, sampling.seed);
-            rgb.par_iter_mut().zip(direct).for_each(|(c, d)| *c += d);
-        } else {
-            background(camera, map, mask, rgb);
+    ) -> Result<()> {
+        if !self.traces_direct() {
+            background(camera, map, &g.mask, rgb);
+            return Ok(());
         }
+        let mut direct = render_direct(ts, camera, map, sampling.spp, sampling.seed);
+        if let Some(oidn) = sampling.denoiser {
+            let (w, h) = (camera.width as usize, camera.height as usize);
+            direct = oidn.denoise_frame(&direct, g, w, h)?;
+        }
+        rgb.par_iter_mut().zip(direct).for_each(|(c, d)| *c += d);
+        Ok(())
     }
 
     /// Encodes `map` rotated by `rotation_deg` about +Y.
@@ -236,11 +246,10 @@ mod tests {
             encoder_params: 0,
             training: serde_json::Value::Null,
         };
-        let dir = std::env::temp_dir().join(format!(
-            "nprt-relight-{}-{}",
-            std::process::id(),
-            direct.name()
-        ));
+        // One folder per call: tests run in parallel.
+        static CALLS: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
+        let call = CALLS.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+        let dir = std::env::temp_dir().join(format!("nprt-relight-{}-{call}", std::process::id()));
         save_model(&dir, &file, &net).unwrap();
         let r = Relighter::load(&dir, &device).unwrap();
         std::fs::remove_dir_all(&dir).unwrap();
@@ -260,11 +269,16 @@ mod tests {
         let map = nprt_scene::open_envmap("builtin:sky").unwrap();
         let g = render_gbuffer(&ts, &camera);
         assert!(g.mask.contains(&0.0) && g.mask.contains(&1.0));
-        let sampling = DirectSampling { spp: 2, seed: 5 };
+        let sampling = DirectSampling {
+            spp: 2,
+            seed: 5,
+            denoiser: None,
+        };
         let frame = |r: &Relighter| {
             let mut rgb = r.shade(&g, &r.light_code(&map, 0.0));
             let network = rgb.clone();
-            r.complete(&ts, &camera, &map, &g.mask, sampling, &mut rgb);
+            r.complete(&ts, &camera, &map, &g, sampling, &mut rgb)
+                .unwrap();
             (network, rgb)
         };
         let direct = render_direct(&ts, &camera, &map, sampling.spp, sampling.seed);
@@ -289,5 +303,53 @@ mod tests {
                 assert!((rgb[i] - sky[i]).abs().max_element() <= 1e-6 * sky[i].max_element());
             }
         }
+    }
+
+    #[test]
+    fn denoised_direct_light_is_closer_to_the_converged_one() {
+        let oidn = match Oidn::open() {
+            Ok(o) => o,
+            Err(e) if std::env::var_os("NPRT_REQUIRE_OIDN").is_none() => {
+                eprintln!("skipping: {e:#}");
+                return;
+            }
+            Err(e) => panic!("NPRT_REQUIRE_OIDN is set but {e:#}"),
+        };
+        let mut scene = nprt_scene::Scene::empty("sphere");
+        scene.add(
+            nprt_scene::Mesh::sphere(Vec3::ZERO, 1.0, 64),
+            nprt_scene::Material::diffuse("d", Vec3::splat(0.5)),
+        );
+        let ts = TraceScene::new(&scene);
+        let camera = Camera::look_at(Vec3::new(0.0, 0.5, 2.5), Vec3::ZERO, Vec3::Y, 60.0, 64, 48);
+        let map = nprt_scene::open_envmap("builtin:sky").unwrap();
+        let g = render_gbuffer(&ts, &camera);
+        let traced = relighter(DirectLight::Traced);
+        let code = traced.light_code(&map, 0.0);
+        let network = traced.shade(&g, &code);
+        // The direct light each way: the frame less what the network added.
+        let direct = |denoiser| {
+            let mut rgb = network.clone();
+            let sampling = DirectSampling {
+                spp: 2,
+                seed: 1,
+                denoiser,
+            };
+            traced
+                .complete(&ts, &camera, &map, &g, sampling, &mut rgb)
+                .unwrap();
+            rgb.iter()
+                .zip(&network)
+                .map(|(c, n)| *c - *n)
+                .collect::<Vec<_>>()
+        };
+        let converged = render_direct(&ts, &camera, &map, 1024, 2);
+        let l1 = |v: &[Vec3]| {
+            let fg = (0..v.len()).filter(|&i| g.mask[i] > 0.5);
+            fg.map(|i| (v[i] - converged[i]).abs().element_sum())
+                .sum::<f32>()
+        };
+        let (raw, denoised) = (l1(&direct(None)), l1(&direct(Some(oidn))));
+        assert!(denoised < 0.5 * raw, "L1 raw {raw}, denoised {denoised}");
     }
 }

@@ -5,9 +5,10 @@ use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 use anyhow::{bail, Context, Result};
-use nprt_trace::{render_gbuffer, TraceScene};
+use nprt_trace::{render_gbuffer, GBuffer, TraceScene};
 use serde::Serialize;
 
+use crate::oidn::Oidn;
 use crate::{
     write_animation, write_png, Animation, CameraPath, DirectSampling, FrameTimings,
     LightingSchedule, Relighter,
@@ -25,6 +26,8 @@ pub struct Sequence<'a> {
     pub exposure: f32,
     /// Samples per pixel of the direct light, for a model that traces it.
     pub direct_spp: u32,
+    /// Denoises that light before adding it.
+    pub denoiser: Option<&'static Oidn>,
     /// Also write each frame's linear radiance as OpenEXR.
     pub exr: bool,
     /// Output folder: frames/NNNN.png (.exr), animation.mp4 or .gif, timings.csv.
@@ -82,15 +85,15 @@ pub fn render_sequence(
     let mut pngs = Vec::new();
     let mut sum = FrameTimings::default();
     let mut light: Option<((usize, f32), crate::LightCode)> = None;
-    let mut still: Option<(nprt_scene::Camera, Vec<f32>, crate::Pixels)> = None;
+    let mut still: Option<(nprt_scene::Camera, GBuffer, crate::Pixels)> = None;
     let start = Instant::now();
     for i in 0..seq.frames {
         let camera = seq
             .path
             .camera(i as f32 / (seq.frames.max(2) - 1) as f32, w, h);
         let mut t = FrameTimings::default();
-        let (mask, px) = match still.take() {
-            Some((c, mask, px)) if c == camera => (mask, px),
+        let (g, px) = match still.take() {
+            Some((c, g, px)) if c == camera => (g, px),
             _ => {
                 let clock = Instant::now();
                 let g = render_gbuffer(scene, &camera);
@@ -98,7 +101,7 @@ pub fn render_sequence(
                 let clock = Instant::now();
                 let px = model.pixels(&g);
                 t.network_ms = clock.elapsed().as_secs_f64() * 1e3;
-                (g.mask, px)
+                (g, px)
             }
         };
         let (k, rot) = seq.lighting.at(i, seq.frames);
@@ -120,13 +123,14 @@ pub fn render_sequence(
             scene,
             &camera,
             &seq.lighting.maps[k].rotated_y(rot),
-            &mask,
+            &g,
             DirectSampling {
                 spp: seq.direct_spp,
                 seed: i as u64,
+                denoiser: seq.denoiser,
             },
             &mut rgb,
-        );
+        )?;
         t.direct_ms = clock.elapsed().as_secs_f64() * 1e3;
         let png = frames_dir.join(format!("{i:04}.png"));
         write_png(&rgb, w as usize, h as usize, seq.exposure, &png)?;
@@ -144,7 +148,7 @@ pub fn render_sequence(
             )?;
         }
         pngs.push(png);
-        still = Some((camera, mask, px));
+        still = Some((camera, g, px));
         csv.serialize(TimingRow {
             frame: i,
             map: &seq.lighting.segments[k].map,

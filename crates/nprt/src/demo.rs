@@ -8,6 +8,7 @@ use nprt_net::deep_shading::DeepShadingOptions;
 use nprt_net::{
     Design, DirectLight, ModelConfig, TrainOptions, DEFAULT_ENCODER_WIDTH, DEFAULT_MAP_NORM,
 };
+use nprt_render::oidn::Oidn;
 use nprt_render::DEFAULT_DIRECT_SPP;
 
 use crate::evaluation::{eval, train_deep_shading, DeepShadingArgs, EvalArgs};
@@ -221,6 +222,8 @@ pub fn demo(a: DemoArgs) -> Result<()> {
         exposure: 0.0,
         exr: false,
         direct_spp: DEFAULT_DIRECT_SPP,
+        // The traced light denoised where OIDN is installed: the cleaner frames.
+        denoise_direct: Oidn::open().is_ok(),
         device: a.device,
     })?;
     println!(

@@ -4,6 +4,7 @@
 use std::path::PathBuf;
 
 use anyhow::{bail, Context, Result};
+use nprt_render::oidn::Oidn;
 use nprt_render::{
     render_sequence, Animation, CameraPath, LightingSchedule, Relighter, Sequence,
     DEFAULT_DIRECT_SPP,
@@ -60,6 +61,10 @@ pub struct RenderArgs {
     /// (ignored for the others).
     #[arg(long, default_value_t = DEFAULT_DIRECT_SPP)]
     pub direct_spp: u32,
+    /// Denoise that direct light with Open Image Denoise (scripts/oidn.sh installs it) before
+    /// adding it: far less noise for a few ms per frame (docs/model.md#traced-direct-light).
+    #[arg(long)]
+    pub denoise_direct: bool,
     #[command(flatten)]
     pub device: DeviceArg,
 }
@@ -93,6 +98,14 @@ pub fn render(a: RenderArgs) -> Result<()> {
         }
     };
     let lighting = LightingSchedule::parse(&a.lighting, a.spin)?;
+    let denoiser = match (a.denoise_direct, model.traces_direct()) {
+        (false, _) => None,
+        (true, false) => bail!(
+            "--denoise-direct: model '{}' does not trace direct light (train it with --direct traced)",
+            a.model.display()
+        ),
+        (true, true) => Some(Oidn::open().context("--denoise-direct needs Open Image Denoise")?),
+    };
     let seq = Sequence {
         path: &path,
         lighting: &lighting,
@@ -102,6 +115,7 @@ pub fn render(a: RenderArgs) -> Result<()> {
         exposure: a.exposure,
         exr: a.exr,
         direct_spp: a.direct_spp,
+        denoiser,
         out: &a.out,
     };
     let [w, h] = a.res;

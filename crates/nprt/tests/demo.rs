@@ -43,11 +43,13 @@ fn quick_demo_then_render_and_eval() {
         "{names:?}"
     );
     if std::env::var_os("NPRT_REQUIRE_OIDN").is_some() {
+        // Both path-tracing baselines, and the traced direct light of D/S + direct.
         assert_eq!(
             names.iter().filter(|n| n.ends_with("+ OIDN")).count(),
-            2,
+            3,
             "{names:?}"
         );
+        assert!(names.contains(&"nprt-dsep+direct + OIDN"), "{names:?}");
     }
     for m in results["methods"].as_array().unwrap() {
         for k in ["l1", "l2", "rmse", "dssim", "mape", "mrse", "log_l1"] {
@@ -58,10 +60,11 @@ fn quick_demo_then_render_and_eval() {
             let l = c.as_f64().unwrap();
             assert!(l > 0.0 && l.is_finite(), "{} level {l}", m["name"]);
         }
-        // Every network's validation curve, one point per epoch (2), in training seconds.
+        // Every network's validation curve, one point per epoch (2), in training seconds (once:
+        // not again on the row with its traced light denoised).
         let name = m["name"].as_str().unwrap();
         let curve = m["validation"].as_array().unwrap();
-        if name.starts_with("nprt-") || name == "deep-shading" {
+        if (name.starts_with("nprt-") || name == "deep-shading") && !name.ends_with("+ OIDN") {
             let points: Vec<(f64, f64)> = curve
                 .iter()
                 .map(|p| (p[0].as_f64().unwrap(), p[1].as_f64().unwrap()))

@@ -1,6 +1,7 @@
 //! Intel Open Image Denoise, loaded at run time from the shared library that the `oidn` PyPI
 //! wheel ships (OIDN 1.4.3; `scripts/oidn.sh` unpacks it into target/oidn/lib). Optional: when
-//! the library is absent, the denoised baselines are reported as unavailable, with why.
+//! the library is absent, the denoised baselines are reported as unavailable, with why, and
+//! traced direct light cannot be denoised.
 
 use std::ffi::{c_char, c_void, CStr, CString};
 use std::path::{Path, PathBuf};
@@ -9,6 +10,7 @@ use std::sync::OnceLock;
 use anyhow::{bail, Context, Result};
 use glam::Vec3;
 use libloading::{Library, Symbol};
+use nprt_trace::GBuffer;
 
 const LIB: &str = "libOpenImageDenoise.so.1.4.3";
 const TBB: &str = "libtbb.so.12.5";
@@ -83,6 +85,23 @@ impl Oidn {
         let lib = unsafe { Library::new(dir.join(LIB)) }
             .with_context(|| format!("cannot load {}", dir.join(LIB).display()))?;
         Ok(Oidn { lib, _tbb: tbb })
+    }
+
+    /// Denoises an HDR frame with its G-buffer as auxiliaries: albedo kd + ks (clamped to 1)
+    /// and the shading normal, both zero on background pixels.
+    pub fn denoise_frame(
+        &self,
+        color: &[Vec3],
+        g: &GBuffer,
+        width: usize,
+        height: usize,
+    ) -> Result<Vec<Vec3>> {
+        let albedo: Vec<Vec3> =
+            g.kd.iter()
+                .zip(&g.ks)
+                .map(|(kd, ks)| (*kd + *ks).min(Vec3::ONE))
+                .collect();
+        self.denoise(color, &albedo, &g.normal, width, height)
     }
 
     /// Denoises HDR `color` with `albedo` and `normal` auxiliary images (the "RT" filter).
