@@ -18,7 +18,7 @@ use serde::{Deserialize, Serialize};
 
 use crate::method::{Family, MethodResult};
 use crate::metrics::Metrics;
-use crate::networks::{load_networks, run_networks, traces_direct};
+use crate::networks::{load_networks, run_networks};
 use crate::path_tracing::{equal_time_spp, run_denoised, run_path_tracing};
 use crate::sh_prt::run_sh_prt;
 use crate::test_bench::TestBench;
@@ -128,7 +128,7 @@ pub fn evaluate(o: &EvalOptions, device: &Device) -> Result<Evaluation> {
         })
         .collect();
     let denoised_nets = match &oidn {
-        Ok(_) => nets.iter().filter(|(n, _)| traces_direct(n)).count(),
+        Ok(_) => nets.iter().filter(|(n, _)| n.traces_direct()).count(),
         Err(_) => 0,
     };
     let total_steps = (views.len() * (nets.len() + denoised_nets + 3)) as u64;

@@ -32,6 +32,11 @@ impl Net {
         }
     }
 
+    /// Whether the network leaves its direct light to the tracer.
+    pub fn traces_direct(&self) -> bool {
+        matches!(self, Net::Nprt(r, _) if r.traces_direct())
+    }
+
     fn kind_name(&self) -> String {
         match self {
             Net::Nprt(r, _) => format!("nprt-{}", r.file.config.label()),
@@ -207,11 +212,6 @@ fn validation_curve(dir: &Path, name: &str) -> Vec<(f64, f64)> {
     }
 }
 
-/// Whether `net` leaves its direct light to the tracer.
-pub fn traces_direct(net: &Net) -> bool {
-    matches!(net, Net::Nprt(r, _) if r.traces_direct())
-}
-
 /// Every network on every test view; its cost per view is the G-buffer, the encoder, the
 /// network and any traced direct light, as at run time. A model that traces direct light runs
 /// a second time with that light denoised when `oidn` is given (a row of its own, "+ OIDN").
@@ -224,7 +224,7 @@ pub fn run_networks(
     for (net, name) in nets {
         let denoisers = [None]
             .into_iter()
-            .chain(oidn.filter(|_| traces_direct(net)).map(Some));
+            .chain(oidn.filter(|_| net.traces_direct()).map(Some));
         for denoiser in denoisers {
             let (row, family) = match denoiser {
                 None => (name.clone(), net.family()),
@@ -236,7 +236,7 @@ pub fn run_networks(
                 acc.result.loss_png = loss_png.is_file().then_some(loss_png);
                 acc.result.validation = validation_curve(net.dir(), name);
             }
-            if traces_direct(net) {
+            if net.traces_direct() {
                 acc.result.note = format!(
                     "direct light traced at {} spp per view{}, in its time; its validation loss is on the indirect light, which is all its network learns",
                     bench.direct_spp,
