@@ -8,6 +8,7 @@ use serde::{Deserialize, Serialize};
 use crate::activation::Activation;
 use crate::encoder::LightEncoder;
 use crate::init::{shifted_bias, Init};
+use crate::position_encoding::PositionEncoding;
 use crate::track::{Track, TrackKind};
 
 /// Size of the transport code ŝ.
@@ -83,6 +84,7 @@ impl NprtNet {
         design: Design,
         activation: Activation,
         encoder_width: usize,
+        encoding: PositionEncoding,
     ) -> Self {
         let encoder = LightEncoder::new(init, encoder_width);
         let kinds: &[TrackKind] = match design {
@@ -92,7 +94,7 @@ impl NprtNet {
         };
         let tracks = kinds
             .iter()
-            .map(|&k| Track::new(init, design, k, activation))
+            .map(|&k| Track::new(init, design, k, activation, encoding))
             .collect();
         NprtNet { encoder, tracks }
     }
@@ -146,8 +148,18 @@ impl NprtNet {
         self.num_params()
     }
 
-    /// Transport parameters: everything but the encoder (the paper's counts).
+    /// Transport parameters: everything but the encoder (the paper's counts, plus a hash
+    /// grid's tables where there is one).
     pub fn transport_params(&self) -> usize {
         self.tracks.iter().map(|t| t.num_params()).sum()
+    }
+
+    /// The hash grids' table entries (none for the paper's inputs).
+    pub fn grid_params(&self) -> usize {
+        self.tracks
+            .iter()
+            .filter_map(|t| t.grid.as_ref())
+            .map(|g| g.num_params())
+            .sum()
     }
 }

@@ -1,5 +1,5 @@
 //! nprt-net: the learned part of Neural PRT. It owns the light encoder, the four transport
-//! designs, the Deep Shading baseline network, the model folder format (weights plus config)
+//! designs and the hash-grid position encoding beyond them, the Deep Shading baseline network, the model folder format (weights plus config)
 //! and the one training loop every network goes through (checkpoints, exact resume).
 //! It reads datasets through nprt-data and environment maps through nprt-scene; it must not
 //! trace rays or write datasets, and it knows nothing of evaluation or frame rendering.
@@ -31,6 +31,7 @@ mod direct_light;
 pub mod encoder;
 mod epoch_plan;
 mod features;
+pub mod hash_grid;
 mod init;
 pub mod loss;
 mod lr_schedule;
@@ -39,6 +40,7 @@ mod mlp;
 pub mod model;
 mod named;
 mod options;
+mod position_encoding;
 mod throughput;
 mod track;
 mod train;
@@ -64,6 +66,7 @@ pub use model::{
     layer_table, load_model, ModelConfig, ModelFile, DEFAULT_ENCODER_WIDTH, DEFAULT_MAP_NORM,
 };
 pub use options::{recipe_rate, TrainOptions};
+pub use position_encoding::PositionEncoding;
 pub use throughput::{measure_inference, measure_throughput, InferenceSpeed};
 pub use track::{Track, TrackKind};
 pub use train::train;

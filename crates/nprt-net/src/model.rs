@@ -13,6 +13,7 @@ use crate::design::{Design, NprtNet};
 use crate::direct_light::DirectLight;
 use crate::init::Init;
 use crate::map_norm::MapNorm;
+use crate::position_encoding::PositionEncoding;
 
 /// Identifies a model folder's config file.
 pub const MODEL_FORMAT: &str = "nprt-model";
@@ -43,6 +44,10 @@ pub struct ModelConfig {
     /// file and run key stay what they were and its unfinished runs still resume.
     #[serde(default, skip_serializing_if = "DirectLight::is_learned")]
     pub direct: DirectLight,
+    /// How the transport network sees the position (absent in older files: as the paper
+    /// does). Written only for a hash grid, for the same reason as `direct`.
+    #[serde(default, skip_serializing_if = "PositionEncoding::is_none")]
+    pub encoding: PositionEncoding,
 }
 
 /// Encoder input width when none is asked for: on the demo, 64 measured 10% worse in L1 than
@@ -61,19 +66,32 @@ impl ModelConfig {
             encoder_width: DEFAULT_ENCODER_WIDTH,
             map_norm: DEFAULT_MAP_NORM,
             direct: DirectLight::Learned,
+            encoding: PositionEncoding::None,
         }
     }
 
-    /// The design's name, marked `+direct` when direct light is traced: how reports name it.
+    /// The design's name, marked `+grid` with a hash grid and `+direct` when direct light is
+    /// traced: how reports name it.
     pub fn label(&self) -> String {
-        match self.direct {
-            DirectLight::Learned => self.design.name().to_string(),
-            DirectLight::Traced => format!("{}+direct", self.design.name()),
-        }
+        let grid = match self.encoding {
+            PositionEncoding::None => "",
+            PositionEncoding::HashGrid => "+grid",
+        };
+        let direct = match self.direct {
+            DirectLight::Learned => "",
+            DirectLight::Traced => "+direct",
+        };
+        format!("{}{grid}{direct}", self.design.name())
     }
 
     pub fn build(&self, init: &mut Init) -> NprtNet {
-        NprtNet::new(init, self.design, self.activation, self.encoder_width)
+        NprtNet::new(
+            init,
+            self.design,
+            self.activation,
+            self.encoder_width,
+            self.encoding,
+        )
     }
 }
 
@@ -221,6 +239,17 @@ pub fn layer_table(net: &NprtNet) -> Vec<LayerRow> {
             1 => String::new(),
             _ => format!("{:?}.", track.kind).to_lowercase(),
         };
+        if let Some(grid) = &track.grid {
+            use crate::hash_grid::{LEVELS, LEVEL_FEATURES, TABLE_SIZE};
+            rows.push(LayerRow {
+                name: format!("{track_name}grid"),
+                shape: format!(
+                    "{LEVELS} levels × 2^{} × {LEVEL_FEATURES}",
+                    TABLE_SIZE.trailing_zeros()
+                ),
+                params: grid.num_params(),
+            });
+        }
         let parts = [
             ("transfer", track.transfer.as_ref()),
             ("shading", Some(&track.shading)),
@@ -267,5 +296,14 @@ mod tests {
         assert!(json.contains(r#""direct":"traced""#), "{json}");
         assert_eq!(serde_json::from_str::<ModelConfig>(&json).unwrap(), traced);
         assert_eq!(traced.label(), "dsep+direct");
+        assert!(!json.contains("encoding"), "{json}");
+        let grid = ModelConfig {
+            encoding: PositionEncoding::HashGrid,
+            ..traced
+        };
+        let json = serde_json::to_string(&grid).unwrap();
+        assert!(json.contains(r#""encoding":"hash-grid""#), "{json}");
+        assert_eq!(serde_json::from_str::<ModelConfig>(&json).unwrap(), grid);
+        assert_eq!(grid.label(), "dsep+grid+direct");
     }
 }

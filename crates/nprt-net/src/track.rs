@@ -8,8 +8,10 @@ use crate::activation::Activation;
 use crate::design::{Design, TRANSPORT_CODE};
 use crate::encoder::CODE_SIZE;
 use crate::features::{feature, FEATURES};
+use crate::hash_grid::HashGrid;
 use crate::init::Init;
 use crate::mlp::Mlp;
+use crate::position_encoding::PositionEncoding;
 
 /// Which pixel inputs a track reads, and how its outputs weight into radiance.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -39,9 +41,11 @@ impl TrackKind {
 }
 
 /// One transport track: an optional transfer network F_T on the pixel inputs, and the shading
-/// network Φ on [ŝ, ê] (or, for the baseline, on [ê, inputs]).
+/// network Φ on [ŝ, ê] (or, for the baseline, on [ê, inputs]). With a hash grid, the inputs
+/// are followed by the grid's encoding of the position.
 #[derive(Module, Debug)]
 pub struct Track {
+    pub grid: Option<HashGrid>,
     pub transfer: Option<Mlp>,
     pub shading: Mlp,
     #[module(skip)]
@@ -49,11 +53,22 @@ pub struct Track {
 }
 
 impl Track {
-    pub fn new(init: &mut Init, design: Design, kind: TrackKind, activation: Activation) -> Self {
-        let n_in = kind.inputs().len();
+    pub fn new(
+        init: &mut Init,
+        design: Design,
+        kind: TrackKind,
+        activation: Activation,
+        encoding: PositionEncoding,
+    ) -> Self {
+        let n_in = kind.inputs().len() + encoding.extra_inputs();
         let outputs = if kind == TrackKind::Albedo { 6 } else { 3 };
+        let grid = match encoding {
+            PositionEncoding::None => None,
+            PositionEncoding::HashGrid => Some(HashGrid::new(init)),
+        };
         match design {
             Design::Baseline => Track {
+                grid,
                 transfer: None,
                 shading: Mlp::new(init, &[CODE_SIZE + n_in, 256, 256, 256, 256, 3], activation),
                 kind,
@@ -61,6 +76,7 @@ impl Track {
             _ => {
                 let w = if design == Design::Dsep { 172 } else { 256 };
                 Track {
+                    grid,
                     transfer: Some(Mlp::new(init, &[n_in, w, w, TRANSPORT_CODE], activation)),
                     shading: Mlp::new(
                         init,
@@ -82,6 +98,10 @@ impl Track {
             let n = idx.len();
             let idx = Tensor::<1, Int>::from_data(TensorData::new(idx, [n]), &features.device());
             features.clone().select(1, idx)
+        };
+        let inputs = match &self.grid {
+            None => inputs,
+            Some(grid) => Tensor::cat(vec![inputs, grid.forward(features)], 1),
         };
         let out = match &self.transfer {
             None => self

@@ -133,16 +133,15 @@ pub fn demo(a: DemoArgs) -> Result<()> {
     let defaults = TrainOptions::default();
     // The paper's four designs, then D/S with its direct light traced at run time (the
     // paper's suggested extension, docs/model.md).
-    let runs: Vec<(Design, DirectLight)> = Design::ALL
+    let runs: Vec<ModelConfig> = Design::ALL
         .into_iter()
-        .map(|d| (d, DirectLight::Learned))
-        .chain([(Design::Dsep, DirectLight::Traced)])
+        .map(|d| ModelConfig::new(d, None))
+        .chain([ModelConfig {
+            direct: DirectLight::Traced,
+            ..ModelConfig::new(Design::Dsep, None)
+        }])
         .collect();
-    for (i, &(design, direct)) in runs.iter().enumerate() {
-        let config = ModelConfig {
-            direct,
-            ..ModelConfig::new(design, None)
-        };
+    for (i, config) in runs.iter().enumerate() {
         step(&format!(
             "2/5 training design {} of {}: {}",
             i + 1,
@@ -152,7 +151,7 @@ pub fn demo(a: DemoArgs) -> Result<()> {
         let out = a.out.join("models").join(config.label());
         train(TrainArgs {
             data: data.clone(),
-            arch: design,
+            arch: config.design,
             activation: None,
             out: out.clone(),
             run: p.training,
@@ -164,7 +163,8 @@ pub fn demo(a: DemoArgs) -> Result<()> {
             loss: defaults.loss,
             encoder_width: DEFAULT_ENCODER_WIDTH,
             map_norm: DEFAULT_MAP_NORM,
-            direct,
+            direct: config.direct,
+            encoding: config.encoding,
             checkpoint_minutes: defaults.schedule.checkpoint_secs / 60.0,
             device: a.device,
         })?;

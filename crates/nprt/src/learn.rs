@@ -11,7 +11,8 @@ use nprt_net::{device_name, is_cpu, Device};
 use crate::{DeviceArg, RunLength};
 use nprt_net::{
     layer_table, measure_throughput, recipe_rate, Activation, Design, DirectLight, Engine, Init,
-    Loss, MapNorm, ModelConfig, Schedule, TrainOptions, DEFAULT_ENCODER_WIDTH, DEFAULT_MAP_NORM,
+    Loss, MapNorm, ModelConfig, PositionEncoding, Schedule, TrainOptions, DEFAULT_ENCODER_WIDTH,
+    DEFAULT_MAP_NORM,
 };
 
 #[derive(clap::Args)]
@@ -30,6 +31,10 @@ pub struct ModelInfoArgs {
     /// Width W of the encoder's W × W/2 input map (a multiple of 64).
     #[arg(long, default_value_t = DEFAULT_ENCODER_WIDTH)]
     pub encoder_width: usize,
+    /// Position input encoding: none (the paper) or hash-grid (its tables are listed with
+    /// their parameters).
+    #[arg(long, default_value_t = PositionEncoding::None)]
+    pub encoding: PositionEncoding,
 }
 
 #[derive(clap::Args)]
@@ -90,6 +95,12 @@ pub struct TrainArgs {
     /// its cost counted in the model's time; docs/model.md).
     #[arg(long, default_value_t = DirectLight::Learned)]
     pub direct: DirectLight,
+    /// How the transport network sees the position: none (the paper: x, y, z only) or hash-grid
+    /// (a multiresolution hash grid on the scene's box, 8 levels from 4 to 64 cells a side,
+    /// 2^13 × 2 learned values each, 0.5 MB per track, whose interpolated values join the
+    /// inputs; docs/model.md). The design's layers are otherwise unchanged.
+    #[arg(long, default_value_t = PositionEncoding::None)]
+    pub encoding: PositionEncoding,
     /// Minutes between checkpoints within an epoch (one is always written at an epoch's end).
     #[arg(long, default_value_t = TrainOptions::default().schedule.checkpoint_secs / 60.0)]
     pub checkpoint_minutes: f64,
@@ -168,12 +179,14 @@ fn config(
     encoder_width: usize,
     map_norm: MapNorm,
     direct: DirectLight,
+    encoding: PositionEncoding,
 ) -> Result<ModelConfig> {
     check_input_width(encoder_width)?;
     Ok(ModelConfig {
         encoder_width,
         map_norm,
         direct,
+        encoding,
         ..ModelConfig::new(arch, activation)
     })
 }
@@ -197,6 +210,7 @@ pub fn model_info(a: ModelInfoArgs) -> Result<()> {
                 a.encoder_width,
                 DEFAULT_MAP_NORM,
                 DirectLight::Learned,
+                a.encoding,
             )?;
             let net = config.build(&mut Init::new(0, &Device::flex()));
             (config, net)
@@ -205,7 +219,7 @@ pub fn model_info(a: ModelInfoArgs) -> Result<()> {
     };
     let arch = config.design;
     println!(
-        "design {} ({} transport layers), light encoder input {}×{}, map normalised by its {}, direct light {}",
+        "design {} ({} transport layers), light encoder input {}×{}, map normalised by its {}, direct light {}, position encoding {}",
         arch.name(),
         config.activation.name(),
         config.encoder_width,
@@ -217,21 +231,35 @@ pub fn model_info(a: ModelInfoArgs) -> Result<()> {
         match config.direct {
             DirectLight::Learned => "learned",
             DirectLight::Traced => "traced at run time",
-        }
+        },
+        config.encoding
     );
     println!("{:<24} {:<22} {:>10}", "layer", "shape", "params");
     for row in layer_table(&net) {
         println!("{:<24} {:<22} {:>10}", row.name, row.shape, row.params);
     }
     let transport = net.transport_params();
+    let grid = net.grid_params();
     let encoder = nprt_net::NprtNet::total_params(&net) - transport;
     let paper = arch.paper_params();
+    let mb = |params: usize| params as f64 * 4.0 / 1e6;
     println!("encoder parameters:   {encoder:>10}");
     println!(
-        "transport parameters: {transport:>10} (paper: {paper}, {:+.2}%)",
-        (transport as f64 / paper as f64 - 1.0) * 100.0
+        "transport parameters: {:>10} (paper: {paper}, {:+.2}%)",
+        transport - grid,
+        ((transport - grid) as f64 / paper as f64 - 1.0) * 100.0
     );
-    println!("total parameters:     {:>10}", transport + encoder);
+    if grid > 0 {
+        println!(
+            "hash grid entries:    {grid:>10} ({:.2} MB as f32)",
+            mb(grid)
+        );
+    }
+    println!(
+        "total parameters:     {:>10} ({:.2} MB as f32)",
+        transport + encoder,
+        mb(transport + encoder)
+    );
     Ok(())
 }
 
@@ -250,7 +278,14 @@ fn training_schedule(a: &TrainArgs) -> Schedule {
 }
 
 pub fn train(a: TrainArgs) -> Result<()> {
-    let config = config(a.arch, a.activation, a.encoder_width, a.map_norm, a.direct)?;
+    let config = config(
+        a.arch,
+        a.activation,
+        a.encoder_width,
+        a.map_norm,
+        a.direct,
+        a.encoding,
+    )?;
     let t0 = std::time::Instant::now();
     let set = TrainingSet::load(&a.data, &config)?;
     let count = |v: &[nprt_net::data::ViewSamples]| v.iter().map(|s| s.len()).sum::<usize>();
@@ -277,7 +312,7 @@ pub fn train(a: TrainArgs) -> Result<()> {
     }
     println!(
         "trained {} ({}) for {:.2} epochs: {} steps, {:.2} M samples in {:.1} s ({:.0} K samples/s); training loss {:.5}, validation loss {:.5}",
-        a.arch.name(),
+        config.label(),
         config.activation.name(),
         s.epochs,
         s.steps,

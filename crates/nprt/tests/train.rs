@@ -83,13 +83,22 @@ fn losses(model: &Path) -> Vec<(Option<f64>, Option<f64>)> {
 
 #[test]
 fn a_tiny_dataset_is_overfit() {
-    for arch in ["prt", "dsep"] {
-        let out = fresh_dir(&format!("overfit-{arch}"));
+    for (arch, encoding) in [("prt", "none"), ("dsep", "none"), ("dsep", "hash-grid")] {
+        let out = fresh_dir(&format!("overfit-{arch}-{encoding}"));
         // One full batch per epoch.
         train(
             &out,
             arch,
-            &["--epochs", "300", "--lr", "1e-3", "--batch-size", "4096"],
+            &[
+                "--epochs",
+                "300",
+                "--lr",
+                "1e-3",
+                "--batch-size",
+                "4096",
+                "--encoding",
+                encoding,
+            ],
         );
         let rows = losses(&out);
         let train: Vec<f64> = rows.iter().filter_map(|r| r.0).collect();
@@ -107,6 +116,11 @@ fn a_tiny_dataset_is_overfit() {
         assert_eq!(&png[1..4], b"PNG");
         let info = ok(&["model", "info", "--model", out.to_str().unwrap()]);
         assert!(info.contains(&format!("design {arch}")), "{info}");
+        assert!(
+            info.contains(&format!("position encoding {encoding}"))
+                && info.contains("grid") == (encoding == "hash-grid"),
+            "{info}"
+        );
     }
 }
 
@@ -114,8 +128,18 @@ fn a_tiny_dataset_is_overfit() {
 fn resumed_training_equals_an_uninterrupted_run() {
     let straight = fresh_dir("resume-straight");
     let resumed = fresh_dir("resume-parts");
-    // The paper's constant rate lets a finished run be lengthened.
-    let paper = |epochs| ["--epochs", epochs, "--schedule", "paper"];
+    // The paper's constant rate lets a finished run be lengthened; the hash grid's table and
+    // its Adam moments must come back too.
+    let paper = |epochs| {
+        [
+            "--epochs",
+            epochs,
+            "--schedule",
+            "paper",
+            "--encoding",
+            "hash-grid",
+        ]
+    };
     train(&straight, "albedo", &paper("3"));
     train(&resumed, "albedo", &paper("1"));
     let out = train(&resumed, "albedo", &paper("3"));

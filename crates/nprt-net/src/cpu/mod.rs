@@ -49,6 +49,11 @@ pub fn gradients(
     let mut params = GradientsParams::from_grads(surrogate.backward(), net);
     let inner = device.clone().inner();
     for (track, grads) in net.tracks.iter().zip(g.tracks) {
+        if let (Some(grid), Some(g)) = (&track.grid, grads.grid) {
+            let shape = grid.table.val().dims();
+            let g = Tensor::<2>::from_data(TensorData::new(g, shape), &inner);
+            params.register::<2>(grid.table.id, g);
+        }
         if let (Some(mlp), Some(g)) = (&track.transfer, grads.transfer) {
             register(&mut params, mlp, g, &inner);
         }

@@ -13,6 +13,7 @@ use crate::batch::Batch;
 use crate::design::{NprtNet, TRANSPORT_CODE};
 use crate::encoder::CODE_SIZE;
 use crate::features::{feature, FEATURES};
+use crate::hash_grid;
 use crate::loss::Loss;
 use crate::track::TrackKind;
 
@@ -30,6 +31,8 @@ const ONE_GROUP: [u32; BLOCK] = [0; BLOCK];
 pub struct HostTrack {
     pub kind: TrackKind,
     inputs: Vec<usize>,
+    /// The hash grid's tables, `LEVELS · TABLE_SIZE × LEVEL_FEATURES`, when the track has one.
+    pub grid: Option<Vec<f32>>,
     pub transfer: Option<DenseStack>,
     pub shading: DenseStack,
 }
@@ -59,8 +62,10 @@ pub struct TransferCodes {
 /// A track's state over one block; its buffers are reused from block to block.
 #[derive(Default)]
 struct TrackPass {
-    /// Gathered inputs (empty when the track reads all features).
+    /// Gathered inputs (empty when the track reads all features and has no grid).
     x: Vec<f32>,
+    /// Gradient at those inputs (for the grid's part).
+    d_x: Vec<f32>,
     transfer: Tape,
     shading: Tape,
     /// exp of the shading network's outputs.
@@ -78,8 +83,14 @@ struct Lighting<'a> {
 }
 
 impl HostTrack {
-    fn reads_all(&self) -> bool {
-        self.inputs.len() == FEATURES
+    /// Whether the first layer reads the features as they are.
+    fn reads_features(&self) -> bool {
+        self.inputs.len() == FEATURES && self.grid.is_none()
+    }
+
+    /// Width of the first layer's per-row input: the features read plus the grid's encoding.
+    fn width(&self) -> usize {
+        self.inputs.len() + self.grid.as_ref().map_or(0, |_| hash_grid::OUTPUTS)
     }
 
     /// The shading network's first-layer weight rows that multiply ê: after ŝ, or first for
@@ -101,6 +112,7 @@ impl HostTrack {
 
     fn zeros_like(&self) -> Self {
         HostTrack {
+            grid: self.grid.as_ref().map(|t| vec![0.0; t.len()]),
             transfer: self.transfer.as_ref().map(DenseStack::zeros_like),
             shading: self.shading.zeros_like(),
             ..self.clone()
@@ -112,21 +124,45 @@ impl HostTrack {
             a.add(b);
         }
         self.shading.add(&other.shading);
+        if let (Some(a), Some(b)) = (&mut self.grid, &other.grid) {
+            a.iter_mut().zip(b).for_each(|(x, y)| *x += y);
+        }
     }
 
-    /// This track's inputs of each row, gathered into `x` when it reads only some of the
-    /// features; the rows as a matrix.
+    /// This track's inputs of each row (with the grid's encoding after them), gathered into
+    /// `x` unless it reads the features as they are; the rows as a matrix.
     fn inputs<'a>(&self, features: &'a [f32], x: &'a mut Vec<f32>, n: usize) -> MatRef<'a> {
-        if self.reads_all() {
+        if self.reads_features() {
             return MatRef::new(features, n, FEATURES);
         }
-        x.clear();
-        x.extend(
-            features
-                .chunks_exact(FEATURES)
-                .flat_map(|f| self.inputs.iter().map(|&i| f[i])),
-        );
-        MatRef::new(x, n, self.inputs.len())
+        let width = self.width();
+        x.resize(n * width, 0.0);
+        for (row, f) in x
+            .chunks_exact_mut(width)
+            .zip(features.chunks_exact(FEATURES))
+        {
+            let (own, encoded) = row.split_at_mut(self.inputs.len());
+            own.iter_mut()
+                .zip(&self.inputs)
+                .for_each(|(v, &i)| *v = f[i]);
+            if let Some(table) = &self.grid {
+                hash_grid::encode(table, &hash_grid::corners(hash_grid::position(f)), encoded);
+            }
+        }
+        MatRef::new(x, n, width)
+    }
+
+    /// Adds to the grid's gradient what the gradient at the first layer's inputs (`d_x`,
+    /// `rows × width`) sends back through the encoding.
+    fn grid_backward(&self, features: &[f32], d_x: &[f32], grads: &mut HostTrack) {
+        let Some(grad) = &mut grads.grid else { return };
+        let own = self.inputs.len();
+        for (d, f) in d_x
+            .chunks_exact(self.width())
+            .zip(features.chunks_exact(FEATURES))
+        {
+            hash_grid::scatter(grad, &hash_grid::corners(hash_grid::position(f)), &d[own..]);
+        }
     }
 
     /// Forward over `n` rows of `features` under `light`. `known` holds the transfer
@@ -227,12 +263,21 @@ impl HostTrack {
         self.d_outputs(pass, features, dr);
         let TrackPass {
             x,
+            d_x,
             transfer,
             shading,
             d_out,
             d_transfer,
             ..
         } = pass;
+        // The gradient at the first layer's inputs is needed only to train the grid.
+        let d_input = match self.grid {
+            Some(_) => {
+                d_x.resize(n * self.width(), 0.0);
+                Some(d_x.as_mut_slice())
+            }
+            None => None,
+        };
         match (&self.transfer, &mut grads.transfer) {
             (Some(ft), Some(g)) => {
                 d_transfer.resize(n * TRANSPORT_CODE, 0.0);
@@ -247,7 +292,7 @@ impl HostTrack {
                     Some(d_codes),
                 );
                 let x = self.inputs(features, x, n);
-                ft.backward(x, None, transfer, d_transfer, g, None, None);
+                ft.backward(x, None, transfer, d_transfer, g, d_input, None);
             }
             _ => {
                 let x = self.inputs(features, x, n);
@@ -257,11 +302,12 @@ impl HostTrack {
                     shading,
                     d_out,
                     &mut grads.shading,
-                    None,
+                    d_input,
                     Some(d_codes),
                 );
             }
         }
+        self.grid_backward(features, d_x, grads);
     }
 }
 
@@ -273,6 +319,10 @@ impl HostTransport {
             .map(|t| HostTrack {
                 kind: t.kind,
                 inputs: t.kind.inputs(),
+                grid: t
+                    .grid
+                    .as_ref()
+                    .map(|g| super::host_values(g.table.val().into_data())),
                 transfer: t.transfer.as_ref().map(DenseStack::from_mlp),
                 shading: DenseStack::from_mlp(&t.shading),
             })
