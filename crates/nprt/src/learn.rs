@@ -290,12 +290,13 @@ pub fn train(a: TrainArgs) -> Result<()> {
     let set = TrainingSet::load(&a.data, &config)?;
     let count = |v: &[nprt_net::data::ViewSamples]| v.iter().map(|s| s.len()).sum::<usize>();
     println!(
-        "dataset '{}': {} training views ({} foreground pixels), {} test views ({} pixels), loaded in {:.1} s",
+        "dataset '{}': {} training views ({} foreground pixels), {} test views ({} pixels), {:.2} GB in memory, loaded in {:.1} s",
         a.data.display(),
         set.train.len(),
         count(&set.train),
         set.test.len(),
         count(&set.test),
+        set.bytes() as f64 / 1e9,
         t0.elapsed().as_secs_f64()
     );
     let opts = TrainOptions {

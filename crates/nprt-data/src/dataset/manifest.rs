@@ -229,6 +229,11 @@ impl ViewRecord {
                 maps.len()
             )
         })?;
+        self.light(map)
+    }
+
+    /// The view's lighting made from its own map `map` (the manifest's map `self.map`).
+    pub fn light(&self, map: &EnvMap) -> Result<EnvMap> {
         Ok(map
             .scaled(Vec3::from_array(self.gain))?
             .rotated_y(self.rotation_deg))
