@@ -2,6 +2,7 @@
 //! (held-out lighting), their errors, the error analysis against directness and specularity,
 //! and timings at a fixed resolution (the paper's Tables 3 and 4).
 
+use std::collections::{BTreeMap, BTreeSet};
 use std::path::PathBuf;
 use std::time::Instant;
 
@@ -9,7 +10,7 @@ use anyhow::{bail, Result};
 use glam::Vec3;
 use nprt_data::dataset::{load_checked_scene, load_manifest_hashed};
 use nprt_data::views::load_views;
-use nprt_net::data::open_recorded_maps;
+use nprt_net::data::open_recorded_map;
 use nprt_net::Device;
 use nprt_render::oidn::Oidn;
 use nprt_render::DirectSampling;
@@ -99,7 +100,6 @@ pub fn evaluate(o: &EvalOptions, device: &Device) -> Result<Evaluation> {
         &s.scene_hash,
         &format!("dataset '{}' was rendered from", o.data.display()),
     )?;
-    let maps = open_recorded_maps(&manifest)?;
     let mut views = load_views(&o.data, &manifest, "test")?;
     views.sort_by_key(|v| v.record.index);
     if let Some(n) = o.max_views {
@@ -108,6 +108,15 @@ pub fn evaluate(o: &EvalOptions, device: &Device) -> Result<Evaluation> {
     if views.is_empty() {
         bail!("dataset '{}' has no test views", o.data.display());
     }
+    // Only the maps of the views evaluated: a dataset with a fresh map per training view has
+    // thousands of others.
+    let maps = views
+        .iter()
+        .map(|v| v.record.map)
+        .collect::<BTreeSet<_>>()
+        .into_iter()
+        .map(|m| Ok((m, open_recorded_map(&manifest, m)?)))
+        .collect::<Result<BTreeMap<_, _>>>()?;
     let nets = load_networks(o, device, &dataset_hash, &s.scene_hash)?;
     let ts = TraceScene::new(&scene);
     let oidn = Oidn::open();
@@ -184,7 +193,7 @@ pub fn evaluate(o: &EvalOptions, device: &Device) -> Result<Evaluation> {
         o.timing_res,
         &ts,
         &views[0].camera,
-        &maps[views[0].record.map],
+        bench.map(&views[0]),
         &nets,
         &bench.path_tracer(5, o.seed),
         DirectSampling {

@@ -257,7 +257,7 @@ pub fn run_networks(
                     bench.ts,
                     &v.camera,
                     &g,
-                    (&bench.maps[v.record.map], v.record.rotation_deg),
+                    (bench.map(v), v.record.rotation_deg),
                     sampling,
                 )?;
                 acc.add(v, &shaded.rgb, g_ms + shaded.total_ms());

@@ -1,6 +1,8 @@
 //! What every method is evaluated on: the dataset's test views with their maps, the scene to
 //! trace, the views whose images the report shows, and the evaluation's progress bar.
 
+use std::collections::BTreeMap;
+
 use glam::Vec3;
 use indicatif::ProgressBar;
 use nprt_data::dataset::Settings;
@@ -12,7 +14,8 @@ use crate::evaluate::ShownView;
 
 pub struct TestBench<'a> {
     pub views: &'a [ImageView],
-    pub maps: &'a [EnvMap],
+    /// The maps the views name, by their index in the dataset's manifest.
+    pub maps: &'a BTreeMap<usize, EnvMap>,
     pub ts: &'a TraceScene<'a>,
     /// The dataset's integrator settings (max_depth, Russian roulette).
     pub settings: &'a Settings,
@@ -25,9 +28,14 @@ pub struct TestBench<'a> {
 }
 
 impl TestBench<'_> {
+    /// The map view `v` names, as the dataset records it.
+    pub fn map(&self, v: &ImageView) -> &EnvMap {
+        &self.maps[&v.record.map]
+    }
+
     /// The map lighting view `v`, rotated as recorded.
     pub fn lighting(&self, v: &ImageView) -> EnvMap {
-        self.maps[v.record.map].rotated_y(v.record.rotation_deg)
+        self.map(v).rotated_y(v.record.rotation_deg)
     }
 
     /// The dataset's path tracer at `spp`, every sample through the pixel centre.
