@@ -1,6 +1,7 @@
 //! nprt-net: the learned part of Neural PRT. It owns the light encoder, the four transport
-//! designs and the hash-grid position encoding beyond them, the Deep Shading baseline network, the model folder format (weights plus config)
-//! and the one training loop every network goes through (checkpoints, exact resume).
+//! designs and the hash-grid position encoding beyond them, the Deep Shading baseline network,
+//! the model folder format (weights plus config) and the one training loop every network goes
+//! through (checkpoints, exact resume).
 //! It reads datasets through nprt-data and environment maps through nprt-scene; it must not
 //! trace rays or write datasets, and it knows nothing of evaluation or frame rendering.
 //!

@@ -149,7 +149,17 @@ impl HostTrack {
                 hash_grid::encode(table, &hash_grid::corners(hash_grid::position(f)), encoded);
             }
         }
-        MatRef::new(x, n, width)
+        self.gathered(features, x, n)
+    }
+
+    /// The rows' inputs as [`Self::inputs`] left them for these `features`: backward reads
+    /// them from there rather than gathering and encoding them again.
+    fn gathered<'a>(&self, features: &'a [f32], x: &'a [f32], n: usize) -> MatRef<'a> {
+        if self.reads_features() {
+            MatRef::new(features, n, FEATURES)
+        } else {
+            MatRef::new(x, n, self.width())
+        }
     }
 
     /// Adds to the grid's gradient what the gradient at the first layer's inputs (`d_x`,
@@ -291,11 +301,11 @@ impl HostTrack {
                     Some(d_transfer),
                     Some(d_codes),
                 );
-                let x = self.inputs(features, x, n);
+                let x = self.gathered(features, x, n);
                 ft.backward(x, None, transfer, d_transfer, g, d_input, None);
             }
             _ => {
-                let x = self.inputs(features, x, n);
+                let x = self.gathered(features, x, n);
                 self.shading.backward(
                     x,
                     Some(&shared),
