@@ -18,8 +18,10 @@
 //! ```
 
 pub mod builtin;
+mod bump_map;
 mod camera;
 mod color;
+mod conductor_ior;
 mod distribution;
 pub mod envmap;
 mod envmap_spec;
@@ -34,8 +36,10 @@ mod procedural;
 mod scene;
 mod texture;
 
+pub use bump_map::BumpMap;
 pub use camera::{Camera, CameraVolume, FovAxis};
 pub use color::{linear_to_srgb, luminance, srgb_to_linear};
+pub use conductor_ior::{conductor_names, named_conductor};
 pub use envmap::EnvMap;
 pub use envmap_spec::open_envmap;
 pub use fresnel::{fresnel_conductor, fresnel_dielectric, DielectricFresnel};

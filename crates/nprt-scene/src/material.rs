@@ -8,6 +8,7 @@
 
 use glam::{Vec2, Vec3};
 
+use crate::bump_map::BumpMap;
 use crate::color::luminance;
 use crate::fresnel::{fresnel_conductor, fresnel_dielectric};
 use crate::texture::Texture;
@@ -123,6 +124,8 @@ pub struct Material {
     pub transmittance: Texture,
     /// Opacity, the luminance of this texture (Mitsuba's `mask`); `None` is opaque.
     pub opacity: Option<Texture>,
+    /// A height field tilting the shading normal (Mitsuba's `bumpmap`).
+    pub bump: Option<BumpMap>,
 }
 
 impl Material {
@@ -135,6 +138,7 @@ impl Material {
             scattering: Scattering::FresnelFree,
             transmittance: Texture::constant(0.0),
             opacity: None,
+            bump: None,
         }
     }
 
@@ -168,6 +172,7 @@ impl Material {
         surface
             && self.transmittance.is_constant()
             && self.opacity.as_ref().is_none_or(Texture::is_constant)
+            && self.bump.is_none()
     }
 
     pub fn eval(&self, uv: Vec2) -> BsdfParams {

@@ -1,6 +1,6 @@
 //! Mitsuba XML scenes, the subset DESIGN.md lists: obj/ply/rectangle/cube/sphere shapes;
-//! diffuse/conductor/roughconductor/plastic/roughplastic/dielectric/thindielectric/twosided/mask
-//! (and diffuse+conductor `blendbsdf`) BSDFs; bitmap/checkerboard textures; envmap/constant
+//! diffuse/conductor/roughconductor (RGB or named index)/plastic/roughplastic/dielectric/
+//! thindielectric/twosided/mask/bumpmap (and diffuse+conductor `blendbsdf`) BSDFs; bitmap/checkerboard textures; envmap/constant
 //! emitters; a perspective sensor with hdrfilm and sampler; the path integrator; `<default>`,
 //! `$name` and `<ref>`. Files of format version 0.x (Mitsuba 0.5/0.6, e.g. Bitterli's scenes)
 //! are upgraded as Mitsuba 3 upgrades them: camelCase property names, a diffuse BSDF's
@@ -18,7 +18,9 @@ use anyhow::{anyhow, bail, Context, Result};
 use glam::{Affine2, Mat3, Mat4, Vec2, Vec3};
 use roxmltree::{Document, Node};
 
+use crate::bump_map::BumpMap;
 use crate::camera::{look_at, Camera, FovAxis};
+use crate::conductor_ior::{conductor_names, named_conductor};
 use crate::envmap::EnvMap;
 use crate::material::{Material, Scattering, Surface, MIN_ALPHA};
 use crate::mesh::Mesh;
@@ -746,6 +748,8 @@ impl<'a> Ctx<'a> {
                 "bsdf" => out.push(self.nested_material(c)?),
                 "ref" => match self.named.get(&self.req(c, "id")?) {
                     Some(Named::Material(m)) => out.push(self.scene.materials[*m].clone()),
+                    // A bump map's height, given by reference.
+                    Some(Named::Texture(_)) if node.attribute("type") == Some("bumpmap") => {}
                     _ => return self.fail(c, "does not refer to a BSDF declared earlier"),
                 },
                 _ => {}
@@ -776,6 +780,9 @@ impl<'a> Ctx<'a> {
                     return self.fail(node, "glass has no front and back: do not wrap it in twosided");
                 }
                 m.two_sided = true;
+                if let Some(bump) = &mut m.bump {
+                    bump.mirrored_behind = true;
+                }
                 m.name = name;
                 return Ok(m);
             }
@@ -805,7 +812,10 @@ impl<'a> Ctx<'a> {
                         k: self.colour_prop(node, "k", Vec3::ONE)?,
                     },
                     (true, Some(_)) => return self.fail(node, "give either a material or eta and k, not both"),
-                    (false, Some(other)) => return self.fail(node, format!("the named conductor '{other}' needs Mitsuba's spectral tables, which nprt does not ship; give its RGB eta and k instead")),
+                    (false, Some(named)) => match named_conductor(named) {
+                        Some((eta, k)) => Scattering::Conductor { eta, k },
+                        None => return self.fail(node, format!("unknown conductor material '{named}' (Mitsuba 3 names: {})", conductor_names().collect::<Vec<_>>().join(", "))),
+                    },
                 };
                 let mut m = Material::new(&name, Surface::Direct { kd: Texture::constant(0.0), ks, alpha: Texture::constant(alpha) }, false);
                 m.scattering = scattering;
@@ -842,14 +852,59 @@ impl<'a> Ctx<'a> {
                 return Ok(m);
             }
             "blendbsdf" => return self.blend(node, name),
-            "bumpmap" => return self.fail(node, "bump mapping is not supported yet: reference the BSDF nested inside it instead (scenes that declare it with an id and use that id render as in Mitsuba)"),
-            other => return self.fail(node, format!("unsupported BSDF plugin '{other}' (supported: diffuse, conductor, roughconductor, plastic, roughplastic, dielectric, thindielectric, twosided, mask, blendbsdf of diffuse + conductor)")),
+            "bumpmap" => return self.bump_map(node, name),
+            other => return self.fail(node, format!("unsupported BSDF plugin '{other}' (supported: diffuse, conductor, roughconductor, plastic, roughplastic, dielectric, thindielectric, twosided, mask, bumpmap, blendbsdf of diffuse + conductor)")),
         };
         Ok(Material::new(
             &name,
             Surface::Direct { kd, ks, alpha },
             false,
         ))
+    }
+
+    /// Mitsuba 3's `bumpmap`: one nested texture (the height, whatever its name) and one BSDF.
+    fn bump_map(&mut self, node: Node<'a, 'a>, name: String) -> Result<Material> {
+        let mut heights = vec![];
+        for c in node.children().filter(Node::is_element) {
+            match c.tag_name().name() {
+                "texture" => heights.push(self.texture(c)?),
+                "ref" => {
+                    if let Some(Named::Texture(t)) = self.named.get(&self.req(c, "id")?) {
+                        heights.push(t.clone());
+                    }
+                }
+                _ => {}
+            }
+        }
+        if heights.len() != 1 {
+            return self.fail(
+                node,
+                format!(
+                    "needs exactly one nested texture (the height), has {}",
+                    heights.len()
+                ),
+            );
+        }
+        let height = heights.remove(0);
+        let scale = self.float_prop(node, "scale", 1.0)?;
+        let mut m = self.single_nested(node)?;
+        if m.bump.is_some() {
+            return self.fail(node, "a bump map inside a bump map is not supported");
+        }
+        if m.opacity.is_some() {
+            // Mitsuba would shadow the pass-through light too; nprt's mask passes light unbumped.
+            return self.fail(
+                node,
+                "a mask inside a bump map is not supported: put the mask outside it",
+            );
+        }
+        m.bump = Some(BumpMap {
+            height,
+            scale,
+            mirrored_behind: false,
+        });
+        m.name = name;
+        Ok(m)
     }
 
     /// `blendbsdf` of one diffuse and one (rough)conductor is exactly DESIGN.md's model:
@@ -1116,14 +1171,74 @@ mod tests {
         assert!(s.warnings.iter().any(|w| w.contains("area emitter")));
         assert!(s.warnings.iter().any(|w| w.contains("without an id")));
 
-        // Used by a shape, a bump map is refused by name rather than rendered flat.
-        let bump = text.replace(
-            r#"<ref id="Cushion"/>"#,
-            r#"<bsdf type="bumpmap"><bsdf type="diffuse"/></bsdf>"#,
-        );
-        let err = parse(&bump, Path::new("k.xml"), &SceneOptions::default()).unwrap_err();
+        // Used by a shape, a bump map needs its height texture, and records which wrapper is
+        // outside: twosided(bumpmap(…)) mirrors the bumps seen from behind.
+        let with = |shape: &str| {
+            let t = text.replace(r#"<ref id="Cushion"/>"#, shape);
+            parse(&t, Path::new("k.xml"), &SceneOptions::default())
+        };
+        let err = with(r#"<bsdf type="bumpmap"><bsdf type="diffuse"/></bsdf>"#).unwrap_err();
         assert!(
-            format!("{err:#}").contains("bump mapping is not supported"),
+            format!("{err:#}").contains("k.xml:")
+                && format!("{err:#}").contains("needs exactly one nested texture"),
+            "{err:#}"
+        );
+        let checker = r#"<texture type="checkerboard" name="map"/>"#;
+        for (shape, two_sided, mirrored) in [
+            (
+                format!(
+                    r#"<bsdf type="bumpmap"><float name="scale" value="0.3"/>{checker}<bsdf type="twosided"><bsdf type="diffuse"/></bsdf></bsdf>"#
+                ),
+                true,
+                false,
+            ),
+            (
+                format!(
+                    r#"<bsdf type="twosided"><bsdf type="bumpmap">{checker}<bsdf type="diffuse"/></bsdf></bsdf>"#
+                ),
+                true,
+                true,
+            ),
+            (
+                format!(r#"<bsdf type="bumpmap">{checker}<bsdf type="diffuse"/></bsdf>"#),
+                false,
+                false,
+            ),
+        ] {
+            let s = with(&shape).unwrap();
+            let m = &s.materials[s.meshes[3].material];
+            let bump = m.bump.as_ref().expect("bumped");
+            assert_eq!(
+                (m.two_sided, bump.mirrored_behind),
+                (two_sided, mirrored),
+                "{shape}"
+            );
+            assert!(matches!(bump.height, Texture::Checkerboard { .. }));
+            assert_eq!(bump.scale, if shape.contains("0.3") { 0.3 } else { 1.0 });
+        }
+        let err = with(&format!(r#"<bsdf type="bumpmap">{checker}<bsdf type="mask"><bsdf type="diffuse"/></bsdf></bsdf>"#)).unwrap_err();
+        assert!(
+            format!("{err:#}").contains("mask inside a bump map"),
+            "{err:#}"
+        );
+        // Conductors named as in Mitsuba 3 take its complex index; unknown names are refused.
+        let named = |m: &str| {
+            with(&format!(
+                r#"<bsdf type="roughconductor"><string name="material" value="{m}"/></bsdf>"#
+            ))
+        };
+        let s = named("Au").unwrap();
+        assert_eq!(
+            s.materials[s.meshes[3].material].scattering,
+            Scattering::Conductor {
+                eta: named_conductor("Au").unwrap().0,
+                k: named_conductor("Au").unwrap().1
+            }
+        );
+        let err = named("Unobtainium").unwrap_err();
+        assert!(
+            format!("{err:#}").contains("unknown conductor material 'Unobtainium'")
+                && format!("{err:#}").contains("Cu_palik"),
             "{err:#}"
         );
         // Mitsuba 3 names are not renamed in a 0.x file's camelCase world, nor the reverse.

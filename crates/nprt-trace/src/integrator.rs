@@ -18,8 +18,12 @@ pub struct SurfacePoint {
     pub p: Vec3,
     /// Geometric normal, on the same side as the shading normal.
     pub ng: Vec3,
-    /// Shading normal; flipped towards the viewer on two-sided materials.
+    /// Shading normal (bump-mapped where the material has a bump map); flipped towards the
+    /// viewer on two-sided materials.
     pub ns: Vec3,
+    /// A bump-mapped point's shading normal before the bump, oriented as `ns`: directions on
+    /// opposite sides of the two carry no light ([`Bsdf::with_bump`]).
+    pub unbumped: Option<Vec3>,
     pub params: BsdfParams,
     /// Index into the scene's materials.
     pub material: usize,
@@ -41,7 +45,9 @@ pub fn offset_origin(p: Vec3, ng: Vec3, dir: Vec3) -> Vec3 {
     p + ng * eps.copysign(ng.dot(dir))
 }
 
-/// Interpolates position, normals and uv at a hit, and evaluates the material there.
+/// Interpolates position, normals and uv at a hit, and evaluates the material there. As in
+/// Mitsuba 3, a mesh without texture coordinates is parametrised by its barycentrics, and a
+/// degenerate uv mapping falls back to an arbitrary tangent frame.
 pub fn surface_point(scene: &Scene, hit: &Hit, dir: Vec3) -> SurfacePoint {
     let mesh = &scene.meshes[hit.mesh as usize];
     let tri = mesh.indices[hit.tri as usize];
@@ -54,31 +60,60 @@ pub fn surface_point(scene: &Scene, hit: &Hit, dir: Vec3) -> SurfacePoint {
     };
     let p = lerp3(&mesh.positions);
     let v = tri.map(|i| mesh.positions[i as usize]);
-    let mut ng = (v[1] - v[0]).cross(v[2] - v[0]).normalize_or(Vec3::Y);
+    let face = (v[1] - v[0]).cross(v[2] - v[0]).normalize_or(Vec3::Y);
     let mut ns = if mesh.normals.is_empty() {
-        ng
+        face
     } else {
-        lerp3(&mesh.normals).normalize_or(ng)
+        lerp3(&mesh.normals).normalize_or(face)
     };
-    let uv = if mesh.uvs.is_empty() {
-        Vec2::ZERO
+    let (uv, dp_du, dp_dv) = if mesh.uvs.is_empty() {
+        (Vec2::new(hit.b1, hit.b2), v[1] - v[0], v[2] - v[0])
     } else {
-        tri.iter()
-            .zip(w)
-            .map(|(&i, wi)| mesh.uvs[i as usize] * wi)
-            .sum()
+        let t = tri.map(|i| mesh.uvs[i as usize]);
+        let uv = t[0] * w[0] + t[1] * w[1] + t[2] * w[2];
+        let (duv0, duv1) = (t[1] - t[0], t[2] - t[0]);
+        let (dp0, dp1) = (v[1] - v[0], v[2] - v[0]);
+        let det = duv0.x * duv1.y - duv0.y * duv1.x;
+        if det != 0.0 {
+            (
+                uv,
+                (dp0 * duv1.y - dp1 * duv0.y) / det,
+                (dp1 * duv0.x - dp0 * duv1.x) / det,
+            )
+        } else {
+            let f = Frame3::new(face);
+            (uv, f.s, f.t)
+        }
     };
     let material = &scene.materials[mesh.material];
-    if material.two_sided && ns.dot(dir) > 0.0 {
+    let behind = material.two_sided && ns.dot(dir) > 0.0;
+    let mut unbumped = None;
+    if let Some(bump) = &material.bump {
+        let nb = bump.normal(uv, ns, face, dp_du, dp_dv);
+        // Seen from behind, Mitsuba's twosided negates the bumped frame when it is inside the
+        // bump map, and mirrors it across the surface when it wraps the bump map.
+        let (mut n, base) = match (behind, bump.mirrored_behind) {
+            (false, _) => (nb, ns),
+            (true, false) => (-nb, -ns),
+            (true, true) => (nb - 2.0 * nb.dot(ns) * ns, -ns),
+        };
+        // Mitsuba's flip_invalid_normals: a bumped normal turned away from the viewer while
+        // the surface faces it has its tilt mirrored about the unbumped normal.
+        if dir.dot(base) * dir.dot(n) <= 0.0 {
+            n = 2.0 * n.dot(base) * base - n;
+        }
+        ns = n;
+        unbumped = Some(base);
+    } else if behind {
         ns = -ns;
     }
-    if ng.dot(ns) < 0.0 {
-        ng = -ng;
-    }
+    let base = unbumped.unwrap_or(ns);
+    let ng = if face.dot(base) < 0.0 { -face } else { face };
     SurfacePoint {
         p,
         ng,
         ns,
+        unbumped,
         params: material.eval(uv),
         material: mesh.material,
     }
@@ -153,7 +188,8 @@ fn walk(
         let sp = surface_point(ts.scene, &hit, dir);
         let frame = Frame3::new(sp.ns);
         let wo = frame.to_local(-dir);
-        let bsdf = Bsdf::new(sp.params, ts.coatings[sp.material].as_ref());
+        let bsdf = Bsdf::new(sp.params, ts.coatings[sp.material].as_ref())
+            .with_bump(sp.unbumped.map(|n| frame.to_local(n)));
         if !bsdf.scatters(wo) {
             return None;
         }
@@ -254,4 +290,83 @@ pub fn trace_escape(
     walk(ts, origin, dir, s, rng, |_, _| {})
         .filter(|e| e.depth > 0)
         .map(|e| (e.dir, e.beta))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use nprt_scene::{Bitmap, BumpMap, Material, Mesh, Texture};
+    use std::sync::Arc;
+
+    /// A floor (the rectangle facing +Y) bumped by a height ramp along u, tilting its normal
+    /// 45° towards −x, as one material wrapped each way by twosided.
+    fn ramp_floor(two_sided: bool, mirrored_behind: bool) -> Scene {
+        let mut mesh = Mesh::rectangle();
+        mesh.transform(glam::Mat4::from_rotation_x(-std::f32::consts::FRAC_PI_2));
+        let mut m = Material::diffuse("ramp", Vec3::splat(0.5));
+        m.two_sided = two_sided;
+        m.bump = Some(BumpMap {
+            height: Texture::Bitmap {
+                image: Arc::new(Bitmap {
+                    width: 4,
+                    height: 1,
+                    texels: (0..4).map(|i| Vec3::splat(i as f32)).collect(),
+                }),
+                to_uv: glam::Affine2::IDENTITY,
+                factor: Vec3::ONE,
+            },
+            // Slope 0.5 · 4 per unit u over du/dx = 1/2: 1, so 45°.
+            scale: 0.5,
+            mirrored_behind,
+        });
+        let mut scene = Scene::empty("ramp");
+        scene.meshes.push(mesh);
+        scene.materials.push(m);
+        scene
+    }
+
+    fn shading_normal(scene: &Scene, dir: Vec3) -> SurfacePoint {
+        let hit = Hit {
+            t: 1.0,
+            mesh: 0,
+            tri: 0,
+            b1: 0.3,
+            b2: 0.2,
+        };
+        surface_point(scene, &hit, dir.normalize())
+    }
+
+    /// Mitsuba 3's bump-mapped frame: tilted by the height's slope; a tilt turned away from
+    /// the viewer is mirrored about the unbumped normal (flip_invalid_normals); seen from
+    /// behind, a bump map outside twosided negates the frame, one inside it mirrors the frame
+    /// across the surface.
+    #[test]
+    fn bumped_normals_face_the_viewer_as_in_mitsuba() {
+        let tilted = Vec3::new(-1.0, 1.0, 0.0).normalize();
+        let close = |a: Vec3, b: Vec3| (a - b).length() < 1e-5;
+        let front = shading_normal(&ramp_floor(false, false), Vec3::new(0.3, -1.0, 0.1));
+        assert!(close(front.ns, tilted), "{}", front.ns);
+        assert!(close(front.unbumped.unwrap(), Vec3::Y));
+        // Grazing from +x, the viewer sees the tilted normal's back: its tilt is mirrored.
+        let grazing = shading_normal(&ramp_floor(false, false), Vec3::new(-1.0, -0.3, 0.0));
+        assert!(
+            close(grazing.ns, Vec3::new(1.0, 1.0, 0.0).normalize()),
+            "{}",
+            grazing.ns
+        );
+        let below = Vec3::new(0.3, 1.0, 0.1);
+        let negated = shading_normal(&ramp_floor(true, false), below);
+        assert!(close(negated.ns, -tilted), "{}", negated.ns);
+        assert!(close(negated.unbumped.unwrap(), -Vec3::Y));
+        assert!(
+            negated.ng.dot(Vec3::Y) < 0.0,
+            "the geometric normal follows"
+        );
+        let mirrored = shading_normal(&ramp_floor(true, true), below);
+        assert!(
+            close(mirrored.ns, Vec3::new(-1.0, -1.0, 0.0).normalize()),
+            "{}",
+            mirrored.ns
+        );
+    }
 }

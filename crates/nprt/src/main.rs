@@ -291,6 +291,13 @@ struct ReferenceArgs {
 }
 
 fn main() {
+    // A closed pipe (`nprt … | head`) ends the process quietly, as for other command-line
+    // tools, instead of panicking in println!.
+    // SAFETY: restores the default disposition of one signal before any thread starts.
+    #[cfg(unix)]
+    unsafe {
+        libc::signal(libc::SIGPIPE, libc::SIG_DFL);
+    }
     let cli = Cli::parse();
     let result = run(cli);
     nprt_net::finish();

@@ -178,6 +178,49 @@ fn legacy_materials_scene_matches_mitsuba_within_2_percent() {
     agree("legacy_materials", 0.02);
 }
 
+/// Bump maps (outside and inside twosided, through a uv transform, on a mirror, seen from
+/// behind) and conductors named by material (copper, gold), in a Mitsuba 3 file. Means within
+/// 0.5%: leaving out the bumps' terminator shadowing moves them by 1.4%.
+#[test]
+fn bump_maps_and_named_conductors_match_mitsuba_within_half_a_percent() {
+    agree("bumps", 0.005);
+}
+
+/// nprt's table of named conductors is what Mitsuba 3's RGB variants derive from its spectral
+/// tables, name for name.
+#[test]
+fn named_conductors_are_mitsuba_s() {
+    if std::env::var("NPRT_SKIP_MITSUBA").as_deref() == Ok("1") {
+        eprintln!("SKIPPED on request (NPRT_SKIP_MITSUBA=1): named conductors");
+        return;
+    }
+    let python = std::env::var("NPRT_PYTHON").expect("NPRT_PYTHON must name a Python with mitsuba installed (scripts/test sets it up); NPRT_SKIP_MITSUBA=1 skips on purpose");
+    let out = Command::new(python)
+        .arg(repo().join("tests/mitsuba/conductor_iors.py"))
+        .output()
+        .expect("cannot start NPRT_PYTHON");
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let theirs: std::collections::BTreeMap<String, [[f32; 3]; 2]> =
+        serde_json::from_slice(&out.stdout).unwrap();
+    let ours: Vec<&str> = nprt_scene::conductor_names().collect();
+    assert_eq!(ours, theirs.keys().map(String::as_str).collect::<Vec<_>>());
+    for (name, [eta, k]) in &theirs {
+        let (e, kk) = nprt_scene::named_conductor(name).unwrap();
+        let close = |a: Vec3, b: [f32; 3]| {
+            (a - Vec3::from(b)).abs().max_element()
+                <= 1e-5 * (1.0 + Vec3::from(b).abs().max_element())
+        };
+        assert!(
+            close(e, *eta) && close(kk, *k),
+            "{name}: ours {e} {kk}, Mitsuba {eta:?} {k:?}"
+        );
+    }
+}
+
 /// The folder of large optional data beside the repository (`NPRT_SHARED`, else `../shared`)
 /// when it holds `sub`. Absent, the test is skipped, unless `NPRT_REQUIRE_SHARED=1` (CI) makes
 /// that a failure.
