@@ -1,12 +1,12 @@
 //! Mitsuba XML scenes, the subset DESIGN.md lists: obj/ply/rectangle/cube/sphere shapes;
 //! diffuse/conductor/roughconductor (RGB or named index)/plastic/roughplastic/dielectric/
-//! thindielectric/twosided/mask/bumpmap (and diffuse+conductor `blendbsdf`) BSDFs; bitmap/checkerboard textures; envmap/constant
-//! emitters; a perspective sensor with hdrfilm and sampler; the path integrator; `<default>`,
-//! `$name` and `<ref>`. Files of format version 0.x (Mitsuba 0.5/0.6, e.g. Bitterli's scenes)
-//! are upgraded as Mitsuba 3 upgrades them: camelCase property names, a diffuse BSDF's
-//! `diffuseReflectance`, texture `uscale`/`uoffset`. Shapes carrying an area emitter are
-//! removed with a warning (the scene is lit by its environment only). Anything else stops
-//! with an error naming the file, line and element.
+//! thindielectric/twosided/mask/bumpmap (and diffuse+conductor `blendbsdf`) BSDFs;
+//! bitmap/checkerboard textures; envmap/constant emitters; a perspective sensor with hdrfilm and
+//! sampler; the path integrator; `<default>`, `$name` and `<ref>`. Files of format version 0.x
+//! (Mitsuba 0.5/0.6, e.g. Bitterli's scenes) are upgraded as Mitsuba 3 upgrades them: camelCase
+//! property names, a diffuse BSDF's `diffuseReflectance`, texture `uscale`/`uoffset`. Shapes
+//! carrying an area emitter are removed with a warning (the scene is lit by its environment only).
+//! Anything else stops with an error naming the file, line and element.
 
 use std::borrow::Cow;
 
