@@ -1,15 +1,21 @@
 //! Where the networks run: the `--device` choice of every command that trains or infers, and
 //! the one place that turns it into a burn [`Device`]. Model code never asks; it runs on the
 //! device its tensors live on, so a model folder is the same whichever trained it.
+//!
+//! Two GPU routes share burn's one set of GPU kernels (cubecl): CUDA (`gpu`), and wgpu
+//! (`wgpu`: Vulkan or Metal, whatever the vendor). The second also runs on a software Vulkan
+//! driver (Mesa's lavapipe), which is how CI, without a GPU, tests the GPU code path.
 
 use anyhow::{bail, Result};
 use burn::tensor::{Device, DeviceType};
 
-/// `--device`: the CPU, an NVIDIA GPU through CUDA, or the GPU when one is present.
+/// `--device`: the CPU, an NVIDIA GPU through CUDA, any GPU through wgpu, or the CUDA GPU
+/// when one is present.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
 pub enum Compute {
     Cpu,
     Gpu,
+    Wgpu,
     #[default]
     Auto,
 }
@@ -19,12 +25,14 @@ impl Compute {
         match self {
             Compute::Cpu => "cpu",
             Compute::Gpu => "gpu",
+            Compute::Wgpu => "wgpu",
             Compute::Auto => "auto",
         }
     }
 
-    /// The device to run on. `gpu` without a usable CUDA device is an error naming what is
-    /// missing; `auto` then falls back to the CPU.
+    /// The device to run on. `gpu` without a usable CUDA device, or `wgpu` without a Vulkan
+    /// or Metal adapter, is an error naming what is missing; `auto` falls back to the CPU
+    /// (it never picks wgpu, which may be a software driver slower than the CPU engine).
     /// The chosen device also becomes burn's default (see [`make_default`]).
     pub fn device(self) -> Result<Device> {
         let device = match self {
@@ -41,9 +49,22 @@ impl Compute {
                     }
                 ),
             },
+            Compute::Wgpu => match Device::enumerate(DeviceType::Wgpu).into_iter().next() {
+                Some(device) => device,
+                None => bail!(
+                    "--device wgpu: no Vulkan or Metal adapter found (on Linux install a Vulkan \
+                     driver; scripts/vulkan.sh installs Mesa's software one); use --device cpu"
+                ),
+            },
             Compute::Auto => first_gpu().unwrap_or_else(Device::flex),
         };
         make_default(&device);
+        if !is_cpu(&device) {
+            GPUS_USED
+                .lock()
+                .unwrap_or_else(|e| e.into_inner())
+                .push(device.clone());
+        }
         Ok(device)
     }
 }
@@ -53,18 +74,34 @@ impl Compute {
 /// the CUDA backend is compiled in, GPU or not: without this a resumed CPU run on a machine
 /// with no NVIDIA driver panicked. burn reads the choice from `BURN_DEVICE` on every use.
 pub(crate) fn make_default(device: &Device) {
-    let name = if is_cpu(device) { "flex" } else { "cuda" };
+    let name = backend_name(device);
     if std::env::var("BURN_DEVICE").ok().as_deref() != Some(name) {
         std::env::set_var("BURN_DEVICE", name);
     }
 }
 
-/// Waits for the work queued on burn's default device when that is a GPU. Called once a
-/// command is done: work still queued at exit ran after the CUDA driver had shut down and
-/// panicked in burn's device thread (seen after resuming a run on an H100).
+/// Waits for the work queued on the GPU devices this process used. Called once a command is
+/// done: work still running at exit ran after the driver had shut down, and panicked in burn's
+/// device thread (CUDA, seen after resuming a run on an H100) or crashed inside the software
+/// Vulkan driver's shader compiler (lavapipe, on most runs that compiled a kernel).
 pub fn finish() {
-    if std::env::var("BURN_DEVICE").ok().as_deref() == Some("cuda") {
-        Device::default().sync().ok();
+    for device in GPUS_USED.lock().unwrap_or_else(|e| e.into_inner()).iter() {
+        device.sync().ok();
+    }
+}
+
+/// The GPU devices handed out by [`Compute::device`].
+static GPUS_USED: std::sync::Mutex<Vec<Device>> = std::sync::Mutex::new(Vec::new());
+
+/// burn's name of the backend `device` belongs to (what `BURN_DEVICE` takes): "flex" for the
+/// CPU, "cuda" or "wgpu".
+pub fn backend_name(device: &Device) -> &'static str {
+    if is_cpu(device) {
+        "flex"
+    } else if format!("{device:?}").contains("Wgpu") {
+        "wgpu"
+    } else {
+        "cuda"
     }
 }
 
@@ -73,12 +110,15 @@ pub fn is_cpu(device: &Device) -> bool {
     device.clone().inner() == Device::flex()
 }
 
-/// A short name for progress lines and reports: "cpu" or "cuda:N".
+/// A short name for progress lines and reports: "cpu", or the backend and the device's own
+/// name ("cuda: NVIDIA H100 PCIe", "wgpu: llvmpipe (LLVM 15.0.6, 256 bits)").
 pub fn device_name(device: &Device) -> String {
-    if is_cpu(device) {
-        "cpu".into()
-    } else {
-        format!("{device:?}")
+    match backend_name(device) {
+        "flex" => "cpu".into(),
+        backend => match device.identity() {
+            Some(id) => format!("{backend}: {}", id.name),
+            None => backend.into(),
+        },
     }
 }
 
@@ -99,8 +139,11 @@ impl std::str::FromStr for Compute {
         match s {
             "cpu" => Ok(Compute::Cpu),
             "gpu" => Ok(Compute::Gpu),
+            "wgpu" => Ok(Compute::Wgpu),
             "auto" => Ok(Compute::Auto),
-            _ => Err(format!("unknown device '{s}' (expected cpu, gpu or auto)")),
+            _ => Err(format!(
+                "unknown device '{s}' (expected cpu, gpu, wgpu or auto)"
+            )),
         }
     }
 }
@@ -124,6 +167,7 @@ mod tests {
         assert!("tpu"
             .parse::<Compute>()
             .unwrap_err()
-            .contains("cpu, gpu or auto"));
+            .contains("cpu, gpu, wgpu or auto"));
+        assert_eq!("wgpu".parse::<Compute>(), Ok(Compute::Wgpu));
     }
 }

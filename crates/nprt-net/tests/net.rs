@@ -1,13 +1,17 @@
 //! Networks: parameter counts, gradients against finite differences, weight round-trips.
 
-use burn::module::{Module, ModuleMapper, ModuleVisitor, Param, ParamId};
+mod common;
+
+use burn::module::{Module, ModuleMapper, Param, ParamId};
 use burn::optim::GradientsParams;
 use burn::tensor::{DType, Int, Tensor, TensorData};
-use nprt_net::hash_grid::{LEVELS, LEVEL_FEATURES, TABLE_SIZE};
+use common::{
+    exact_gradients, gradient_errors, gradient_values, loud_grids, random_batch, variants, Shapes,
+};
 use nprt_net::model::{load_weights, save_weights};
+use nprt_net::FEATURES;
 use nprt_net::{log_l1, Loss};
 use nprt_net::{Activation, Design, Device, Init, ModelConfig, NprtNet};
-use nprt_net::{PositionEncoding, FEATURES};
 use rand::{RngExt, SeedableRng};
 use rand_pcg::Pcg64Mcg;
 
@@ -66,14 +70,6 @@ fn loss(net: &NprtNet, b: &Tiny) -> Tensor<1> {
     log_l1(pred, b.reference.clone())
 }
 
-/// Ids and shapes of every parameter tensor.
-struct Shapes(Vec<(ParamId, Vec<usize>)>);
-impl ModuleVisitor for Shapes {
-    fn visit_float<const D: usize>(&mut self, p: &Param<Tensor<D>>) {
-        self.0.push((p.id, p.val().dims().to_vec()));
-    }
-}
-
 /// Adds `delta` to one element of one parameter.
 struct Nudge {
     id: ParamId,
@@ -96,49 +92,6 @@ impl ModuleMapper for Nudge {
 
 fn value(t: Tensor<1>) -> f64 {
     t.into_data().convert::<f64>().as_slice::<f64>().unwrap()[0]
-}
-
-/// Every design with the paper's inputs and each of its activations, then with a hash grid and
-/// its own activation.
-fn variants() -> Vec<ModelConfig> {
-    let mut all = Vec::new();
-    for design in Design::ALL {
-        for activation in [Activation::Siren, Activation::Relu] {
-            all.push(ModelConfig::new(design, Some(activation)));
-        }
-        all.push(ModelConfig {
-            encoding: PositionEncoding::HashGrid,
-            ..ModelConfig::new(design, None)
-        });
-    }
-    all
-}
-
-/// Gives every hash grid table values of order one, so that the encoding weighs in the output
-/// as in a trained network (an untrained grid holds ±1e-4, next to nothing).
-struct LoudGrids(Pcg64Mcg);
-impl ModuleMapper for LoudGrids {
-    fn map_float<const D: usize>(&mut self, p: Param<Tensor<D>>) -> Param<Tensor<D>> {
-        if p.val().dims()[..] != [LEVELS * TABLE_SIZE, LEVEL_FEATURES] {
-            return p;
-        }
-        p.map(|t| {
-            let values: Vec<f32> = (0..LEVELS * TABLE_SIZE * LEVEL_FEATURES)
-                .map(|_| self.0.random::<f32>() * 2.0 - 1.0)
-                .collect();
-            let data = TensorData::new(values, t.dims());
-            let loud = Tensor::from_data(data, (&t.device(), t.dtype()));
-            if t.is_autodiff() {
-                loud.require_grad()
-            } else {
-                loud
-            }
-        })
-    }
-}
-
-fn loud_grids(net: NprtNet) -> NprtNet {
-    net.map(&mut LoudGrids(Pcg64Mcg::seed_from_u64(17)))
 }
 
 /// Every parameter tensor of every design (encoder included, hash grid where there is one),
@@ -338,46 +291,15 @@ fn per_channel_models_relight_a_tinted_map_by_its_tint() {
     }
 }
 
-/// Every parameter's gradient as f64 values.
-fn gradient_values(grads: &GradientsParams, id: ParamId, rank: usize) -> Vec<f64> {
-    match rank {
-        1 => grads.get::<1>(id).map(|g| g.into_data()),
-        2 => grads.get::<2>(id).map(|g| g.into_data()),
-        4 => grads.get::<4>(id).map(|g| g.into_data()),
-        _ => unreachable!(),
-    }
-    .expect("every parameter has a gradient")
-    .convert::<f64>()
-    .try_into_vec::<f64>()
-    .unwrap()
-}
-
 /// The CPU engine's loss and gradients against burn's autodiff on the same batch, for every
-/// design and activation: a batch that is not a whole number of the engine's blocks, three
-/// maps, samples of each map spread through it. Both f32 paths are measured against burn in
+/// design and activation (the batch: [`random_batch`]). Both f32 paths are measured against burn in
 /// f64, and the engine's error must stay within twice burn's own f32 error (plus 1e-6 of the
 /// gradient's norm): where ReLU units sit within rounding of zero, both f32 paths differ from
 /// the exact gradient, and from each other, by more than rounding.
 #[test]
 fn cpu_engine_matches_autodiff() {
     let device = Device::flex().autodiff();
-    let mut rng = Pcg64Mcg::seed_from_u64(21);
-    let (n, views, w) = (1100, 3, 64);
-    let mut r = |lo: f32, hi: f32, k: usize| -> Vec<f32> {
-        (0..k)
-            .map(|_| lo + (hi - lo) * rng.random::<f32>())
-            .collect()
-    };
-    let batch = nprt_net::Batch {
-        features: r(0.0, 1.0, n * FEATURES),
-        radiance: r(0.0, 3.0, n * 3),
-        view: (0..n as i64)
-            .map(|i| (i * 7 + i / 5) % views as i64)
-            .collect(),
-        scale: r(0.5, 1.5, n * 3),
-        lights: r(0.0, 2.0, views * 3 * w * w / 2),
-        light_width: w,
-    };
+    let (batch, w) = (random_batch(1100, 3, 21), 64);
     for variant in variants() {
         let name = format!("{}/{:?}", variant.label(), variant.activation);
         let config = ModelConfig {
@@ -394,34 +316,13 @@ fn cpu_engine_matches_autodiff() {
                 (loss - burn_loss).abs() <= 1e-6 * burn_loss,
                 "{name}/{objective:?}: loss {loss} vs {burn_loss}"
             );
-            let mut init = Init::with_dtype(4, &device, DType::F64);
-            let exact_net = loud_grids(config.build(&mut init));
-            assert!(!nprt_net::cpu::applies(&exact_net, &device));
-            let pred = exact_net.forward(
-                init.tensor(batch.features.clone(), [n, FEATURES]),
-                init.tensor(batch.lights.clone(), [views, 3, w / 2, w]),
-                Tensor::from_data(TensorData::new(batch.view.clone(), [n]), &device),
-                init.tensor(batch.scale.clone(), [n, 3]),
-            );
-            let exact_loss = objective.mean(pred, init.tensor(batch.radiance.clone(), [n, 3]));
-            let exact = GradientsParams::from_grads(exact_loss.backward(), &exact_net);
-            let mut shapes = Shapes(Vec::new());
-            net.visit(&mut shapes);
-            for (id, dims) in shapes.0 {
-                let truth = gradient_values(&exact, id, dims.len());
-                let error = |g: &GradientsParams| {
-                    let g = gradient_values(g, id, dims.len());
-                    g.iter()
-                        .zip(&truth)
-                        .map(|(x, y)| (x - y).powi(2))
-                        .sum::<f64>()
-                        .sqrt()
-                };
-                let norm = truth.iter().map(|v| v * v).sum::<f64>().sqrt();
-                let (ours, theirs) = (error(&engine), error(&burn));
+            let (_, exact) = exact_gradients(&config, &batch, objective);
+            for e in gradient_errors(&net, &exact, [&engine, &burn]) {
+                let (ours, theirs) = (e.errors[0], e.errors[1]);
                 assert!(
-                    ours <= 2.0 * theirs + 1e-6 * norm,
-                    "{name}/{objective:?} param {id} {dims:?}: engine error {ours:e}, burn f32 error {theirs:e}, gradient norm {norm:e}"
+                    ours <= 2.0 * theirs + 1e-6 * e.norm,
+                    "{name}/{objective:?} param {} {:?}: engine error {ours:e}, burn f32 error {theirs:e}, gradient norm {:e}",
+                    e.id, e.dims, e.norm
                 );
             }
         }

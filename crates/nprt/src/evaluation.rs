@@ -153,5 +153,6 @@ pub fn train_deep_shading(a: DeepShadingArgs) -> Result<()> {
         s.final_val,
         a.out.display()
     );
+    println!("time: {}", s.split.describe());
     Ok(())
 }

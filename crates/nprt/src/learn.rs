@@ -6,7 +6,7 @@ use std::process::Command as Process;
 use anyhow::{bail, Context, Result};
 use nprt_net::data::TrainingSet;
 use nprt_net::encoder::check_input_width;
-use nprt_net::{device_name, is_cpu, Device};
+use nprt_net::{backend_name, device_name, is_cpu, Device};
 
 use crate::{DeviceArg, RunLength};
 use nprt_net::{
@@ -323,6 +323,7 @@ pub fn train(a: TrainArgs) -> Result<()> {
         s.final_train,
         s.final_val
     );
+    println!("time: {}", s.split.describe());
     println!(
         "model in '{}' (loss curves: loss.csv, loss.png)",
         a.out.display()
@@ -388,9 +389,19 @@ fn bench_train(a: BenchTrainArgs) -> Result<()> {
         a.views,
         a.steps
     );
-    let peer = match &a.python {
-        Some(py) => run_pytorch(py, &a, threads, cpu)?,
-        None => {
+    // PyTorch's device of the same kind; it has none for wgpu.
+    let torch_device = match backend_name(&device) {
+        "flex" => Some("cpu"),
+        "cuda" => Some("cuda"),
+        _ => None,
+    };
+    let peer = match (&a.python, torch_device) {
+        (Some(py), Some(torch_device)) => run_pytorch(py, &a, threads, torch_device)?,
+        (Some(_), None) => {
+            println!("(PyTorch has no wgpu device: peer skipped)");
+            Vec::new()
+        }
+        (None, _) => {
             println!(
                 "(no --python given: PyTorch peer skipped; bench/train_vs_pytorch.sh sets one up)"
             );
@@ -437,7 +448,7 @@ fn run_pytorch(
     python: &PathBuf,
     a: &BenchTrainArgs,
     threads: usize,
-    cpu: bool,
+    torch_device: &str,
 ) -> Result<Vec<(String, f64)>> {
     let script = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../bench/train_pytorch.py");
     let designs: Vec<&str> = a.designs.arch.iter().map(|d| d.name()).collect();
@@ -449,7 +460,7 @@ fn run_pytorch(
         .args(["--steps", &a.steps.to_string()])
         .args(["--warmup", &a.warmup.to_string()])
         .args(["--threads", &threads.to_string()])
-        .args(["--device", if cpu { "cpu" } else { "cuda" }]);
+        .args(["--device", torch_device]);
     if let Some(act) = a.activation {
         cmd.args(["--activation", act.name()]);
     }

@@ -37,9 +37,10 @@ struct Cli {
 /// `--device`, shared by every command that runs the networks.
 #[derive(clap::Args, Clone, Copy)]
 pub(crate) struct DeviceArg {
-    /// Where the networks run: cpu, gpu (an NVIDIA GPU through CUDA; an error if none is found)
-    /// or auto (the GPU when one is found, else the CPU). A model folder is the same whichever
-    /// trained it.
+    /// Where the networks run: cpu, gpu (an NVIDIA GPU through CUDA; an error if none is found),
+    /// wgpu (any Vulkan or Metal GPU through wgpu, Mesa's software Vulkan driver included,
+    /// which is how the GPU path is tested without a GPU) or auto (the CUDA GPU when one is
+    /// found, else the CPU). A model folder is the same whichever trained it.
     #[arg(long = "device", default_value = "auto")]
     pub(crate) compute: nprt_net::Compute,
 }

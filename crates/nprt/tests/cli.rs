@@ -210,24 +210,11 @@ fn help_explains_every_flag() {
 
 #[test]
 fn device_gpu_without_one_fails_clearly_and_auto_falls_back() {
-    let run = |device: &str| {
-        nprt(&[
-            "bench",
-            "infer",
-            "--arch",
-            "baseline",
-            "--resolution",
-            "8",
-            "--repeats",
-            "1",
-            "--device",
-            device,
-        ])
-    };
+    let run = common::tiny_inference;
     let gpu = run("gpu");
     if gpu.status.success() {
         // A machine with a CUDA GPU: the frame ran on it.
-        assert!(String::from_utf8_lossy(&gpu.stdout).contains("Cuda"));
+        assert!(String::from_utf8_lossy(&gpu.stdout).contains(" on cuda: "));
     } else {
         let err = String::from_utf8_lossy(&gpu.stderr);
         assert!(err.contains("--device gpu: no CUDA GPU found"), "{err}");
@@ -237,5 +224,5 @@ fn device_gpu_without_one_fails_clearly_and_auto_falls_back() {
     }
     let bad = run("tpu");
     assert!(!bad.status.success());
-    assert!(String::from_utf8_lossy(&bad.stderr).contains("expected cpu, gpu or auto"));
+    assert!(String::from_utf8_lossy(&bad.stderr).contains("expected cpu, gpu, wgpu or auto"));
 }

@@ -83,21 +83,47 @@ fn losses(model: &Path) -> Vec<(Option<f64>, Option<f64>)> {
 
 #[test]
 fn a_tiny_dataset_is_overfit() {
-    for (arch, encoding) in [("prt", "none"), ("dsep", "none"), ("dsep", "hash-grid")] {
-        let out = fresh_dir(&format!("overfit-{arch}-{encoding}"));
+    overfits(
+        &[("prt", "none"), ("dsep", "none"), ("dsep", "hash-grid")],
+        "cpu",
+        300,
+    );
+}
+
+/// The GPU code path (burn's GPU kernels, batches moved to the device) on wgpu, which CI runs
+/// on a software Vulkan device: it learns, and resumes exactly.
+#[test]
+fn the_gpu_path_overfits_and_resumes_exactly() {
+    if !common::wgpu_runs() {
+        return;
+    }
+    // A third of the CPU's epochs: the software device takes 0.4 s a step, and by then the
+    // loss has fallen to a tenth.
+    overfits(&[("dsep", "hash-grid")], "wgpu", 100);
+    resumes_exactly("wgpu");
+}
+
+/// Each (design, encoding) of `cases` trained on `device` for `epochs` of one full batch: its
+/// training loss falls below 0.03 and an eighth of its start.
+fn overfits(cases: &[(&str, &str)], device: &str, epochs: usize) {
+    let epochs_arg = epochs.to_string();
+    for &(arch, encoding) in cases {
+        let out = fresh_dir(&format!("overfit-{arch}-{encoding}-{device}"));
         // One full batch per epoch.
         train(
             &out,
             arch,
             &[
                 "--epochs",
-                "300",
+                &epochs_arg,
                 "--lr",
                 "1e-3",
                 "--batch-size",
                 "4096",
                 "--encoding",
                 encoding,
+                "--device",
+                device,
             ],
         );
         let rows = losses(&out);
@@ -109,7 +135,7 @@ fn a_tiny_dataset_is_overfit() {
             "{arch}: training loss {first:.4} → {last:.4}"
         );
         assert!(
-            rows.iter().filter(|r| r.1.is_some()).count() == 300,
+            rows.iter().filter(|r| r.1.is_some()).count() == epochs,
             "a validation loss per epoch"
         );
         let png = std::fs::read(out.join("loss.png")).unwrap();
@@ -126,8 +152,14 @@ fn a_tiny_dataset_is_overfit() {
 
 #[test]
 fn resumed_training_equals_an_uninterrupted_run() {
-    let straight = fresh_dir("resume-straight");
-    let resumed = fresh_dir("resume-parts");
+    resumes_exactly("cpu");
+}
+
+/// On `device`: a run stopped after an epoch and resumed to three equals three in one go, to
+/// the bit; one seed gives one model, another seed another.
+fn resumes_exactly(device: &str) {
+    let straight = fresh_dir(&format!("resume-straight-{device}"));
+    let resumed = fresh_dir(&format!("resume-parts-{device}"));
     // The paper's constant rate lets a finished run be lengthened; the hash grid's table and
     // its Adam moments must come back too.
     let paper = |epochs| {
@@ -138,6 +170,8 @@ fn resumed_training_equals_an_uninterrupted_run() {
             "paper",
             "--encoding",
             "hash-grid",
+            "--device",
+            device,
         ]
     };
     train(&straight, "albedo", &paper("3"));
@@ -152,13 +186,17 @@ fn resumed_training_equals_an_uninterrupted_run() {
     let val = |d: &Path| losses(d).iter().filter_map(|r| r.1).collect::<Vec<_>>();
     assert_eq!(val(&straight), val(&resumed));
     // The same seed gives the same model; another seed another one.
-    let again = fresh_dir("resume-again");
+    let again = fresh_dir(&format!("resume-again-{device}"));
     train(&again, "albedo", &paper("3"));
     assert!(weights(&again) == weights(&straight));
-    let other = fresh_dir("resume-seed");
-    train(&other, "albedo", &["--epochs", "1", "--seed", "7"]);
-    let one = fresh_dir("resume-one");
-    train(&one, "albedo", &["--epochs", "1"]);
+    let other = fresh_dir(&format!("resume-seed-{device}"));
+    train(
+        &other,
+        "albedo",
+        &["--epochs", "1", "--seed", "7", "--device", device],
+    );
+    let one = fresh_dir(&format!("resume-one-{device}"));
+    train(&one, "albedo", &["--epochs", "1", "--device", device]);
     assert!(weights(&other) != weights(&one));
 }
 

@@ -48,3 +48,36 @@ pub fn fresh_dir(name: &str) -> PathBuf {
 pub fn assets() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("../../tests/assets")
 }
+
+/// One tiny inference benchmark (an 8×8 frame of the baseline design) on `device`.
+pub fn tiny_inference(device: &str) -> Output {
+    nprt(&[
+        "bench",
+        "infer",
+        "--arch",
+        "baseline",
+        "--resolution",
+        "8",
+        "--repeats",
+        "1",
+        "--device",
+        device,
+    ])
+}
+
+/// Whether `--device wgpu` runs here (a Vulkan driver, e.g. the software one scripts/vulkan.sh
+/// installs). Where NPRT_REQUIRE_VULKAN is set (scripts/test sets it) it must.
+pub fn wgpu_runs() -> bool {
+    let o = tiny_inference("wgpu");
+    let err = String::from_utf8_lossy(&o.stderr);
+    if o.status.success() {
+        return true;
+    }
+    assert!(
+        std::env::var_os("NPRT_REQUIRE_VULKAN").is_none(),
+        "NPRT_REQUIRE_VULKAN is set but --device wgpu failed: {err}"
+    );
+    assert!(err.contains("--device wgpu: no Vulkan"), "{err}");
+    eprintln!("skipped: {err}");
+    false
+}
