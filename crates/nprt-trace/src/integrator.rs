@@ -157,13 +157,30 @@ struct Escape {
     delta: bool,
 }
 
+/// A ray from the camera and what it hits, traced once and shared by every path that starts
+/// along it: all the samples through a pixel's centre (the dataset's convention, the traced
+/// direct light, the transport of SH PRT) then save a ray each.
+#[derive(Clone, Copy, Debug)]
+pub struct CameraRay {
+    pub dir: Vec3,
+    pub hit: Option<Hit>,
+}
+
+impl CameraRay {
+    pub fn trace(ts: &TraceScene, origin: Vec3, dir: Vec3) -> Self {
+        CameraRay {
+            dir,
+            hit: ts.accel.intersect(origin, dir, f32::INFINITY),
+        }
+    }
+}
+
 /// Follows a path by BSDF sampling, calling `at_surface` at each vertex before it scatters,
 /// until it leaves the scene (`Some`) or ends on a surface (absorbed, Russian roulette from
 /// `rr_depth`, or `max_depth` reached: `None`). The one walk behind both integrators.
 fn walk(
     ts: &TraceScene,
-    mut origin: Vec3,
-    mut dir: Vec3,
+    ray: &CameraRay,
     s: &PathSettings,
     rng: &mut Pcg64Mcg,
     mut at_surface: impl FnMut(&Vertex, &mut Pcg64Mcg),
@@ -172,8 +189,9 @@ fn walk(
     // Product of the relative indices crossed: Russian roulette judges the throughput as if
     // outside, as Mitsuba 3 does.
     let mut eta = 1.0f32;
+    let (mut dir, mut next) = (ray.dir, ray.hit);
     loop {
-        let Some(hit) = ts.accel.intersect(origin, dir, f32::INFINITY) else {
+        let Some(hit) = next else {
             return Some(Escape {
                 dir,
                 beta,
@@ -206,7 +224,7 @@ fn walk(
             .bsdf
             .sample(wo, Vec2::new(rng.random(), rng.random()), rng.random())?;
         dir = frame.to_world(bs.wi);
-        origin = offset_origin(v.sp.p, v.sp.ng, dir);
+        let origin = offset_origin(v.sp.p, v.sp.ng, dir);
         beta *= bs.weight;
         pdf = bs.pdf;
         delta = bs.delta;
@@ -219,6 +237,7 @@ fn walk(
             }
             beta /= q;
         }
+        next = ts.accel.intersect(origin, dir, f32::INFINITY);
     }
 }
 
@@ -227,8 +246,7 @@ fn walk(
 pub fn trace_path(
     ts: &TraceScene,
     env: &EnvMap,
-    origin: Vec3,
-    dir: Vec3,
+    ray: &CameraRay,
     s: &PathSettings,
     rng: &mut Pcg64Mcg,
 ) -> PathRadiance {
@@ -236,7 +254,7 @@ pub fn trace_path(
     if s.max_depth == 0 {
         return out;
     }
-    let escape = walk(ts, origin, dir, s, rng, |v, rng| {
+    let escape = walk(ts, ray, s, rng, |v, rng| {
         if !v.bsdf.is_smooth() {
             return;
         }
@@ -282,12 +300,11 @@ pub fn trace_path(
 /// Russian roulette, `max_depth`) or misses the scene from the start (no scattered light).
 pub fn trace_escape(
     ts: &TraceScene,
-    origin: Vec3,
-    dir: Vec3,
+    ray: &CameraRay,
     s: &PathSettings,
     rng: &mut Pcg64Mcg,
 ) -> Option<(Vec3, Vec3)> {
-    walk(ts, origin, dir, s, rng, |_, _| {})
+    walk(ts, ray, s, rng, |_, _| {})
         .filter(|e| e.depth > 0)
         .map(|e| (e.dir, e.beta))
 }

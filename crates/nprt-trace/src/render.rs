@@ -10,7 +10,9 @@ use rayon::prelude::*;
 use crate::accel::Accel;
 use crate::coating::Coating;
 use crate::frame::{Frame, GBuffer, GSample};
-use crate::integrator::{surface_point, trace_escape, trace_path, PathRadiance, PathSettings};
+use crate::integrator::{
+    surface_point, trace_escape, trace_path, CameraRay, PathRadiance, PathSettings,
+};
 
 /// Where a pixel's samples go through the film.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -124,23 +126,26 @@ fn pixel(
 ) -> PixelOut {
     let index = (y * camera.width as usize + x) as u64;
     let mut rng = pixel_rng(s.seed, index);
-    let centre = Vec2::new(x as f32 + 0.5, y as f32 + 0.5);
+    let centre = centre_ray(ts, camera, x, y);
     let mut sum = PathRadiance::default();
     for _ in 0..s.spp {
-        let film = match s.filter {
-            PixelFilter::Box => Vec2::new(
-                x as f32 + rng.random::<f32>(),
-                y as f32 + rng.random::<f32>(),
-            ),
+        let ray = match s.filter {
+            PixelFilter::Box => {
+                let film = Vec2::new(
+                    x as f32 + rng.random::<f32>(),
+                    y as f32 + rng.random::<f32>(),
+                );
+                let (o, d) = camera.ray(film);
+                CameraRay::trace(ts, o, d)
+            }
             PixelFilter::Centre => centre,
         };
-        let (o, d) = camera.ray(film);
-        let r = trace_path(ts, env, o, d, ps, &mut rng);
+        let r = trace_path(ts, env, &ray, ps, &mut rng);
         sum.total += r.total;
         sum.direct += r.direct;
     }
     let n = s.spp.max(1) as f32;
-    let gb = primary_sample(ts, camera, x, y);
+    let gb = gsample(ts, &centre);
     PixelOut {
         radiance: sum.total / n,
         direct: sum.direct / n,
@@ -168,26 +173,36 @@ pub fn render_direct(
         .into_par_iter()
         .map(|i| {
             let mut rng = pixel_rng(seed, i as u64);
-            let (o, d) = camera.ray(Vec2::new((i % w) as f32 + 0.5, (i / w) as f32 + 0.5));
+            let ray = centre_ray(ts, camera, i % w, i / w);
             let sum: Vec3 = (0..spp)
-                .map(|_| trace_path(ts, env, o, d, &ps, &mut rng).total)
+                .map(|_| trace_path(ts, env, &ray, &ps, &mut rng).total)
                 .sum();
             sum / spp.max(1) as f32
         })
         .collect()
 }
 
+/// The ray through the centre of pixel (x, y), traced.
+fn centre_ray(ts: &TraceScene, camera: &Camera, x: usize, y: usize) -> CameraRay {
+    let (o, d) = camera.ray(Vec2::new(x as f32 + 0.5, y as f32 + 0.5));
+    CameraRay::trace(ts, o, d)
+}
+
 /// The G-buffer of the ray through the centre of pixel (x, y).
 pub fn primary_sample(ts: &TraceScene, camera: &Camera, x: usize, y: usize) -> GSample {
-    let (o, d) = camera.ray(Vec2::new(x as f32 + 0.5, y as f32 + 0.5));
-    match ts.accel.intersect(o, d, f32::INFINITY) {
+    gsample(ts, &centre_ray(ts, camera, x, y))
+}
+
+/// The G-buffer of what `ray` hits.
+fn gsample(ts: &TraceScene, ray: &CameraRay) -> GSample {
+    match ray.hit {
         Some(hit) => {
-            let sp = surface_point(ts.scene, &hit, d);
+            let sp = surface_point(ts.scene, &hit, ray.dir);
             let (kd, ks, alpha) = sp.params.gbuffer();
             GSample {
                 position: sp.p,
                 normal: sp.ns,
-                view: -d,
+                view: -ray.dir,
                 kd,
                 ks,
                 alpha,
@@ -234,9 +249,9 @@ pub fn render_transport(
             let mut rng = pixel_rng(s.seed, i as u64);
             let mut t = vec![Vec3::ZERO; basis_len];
             let mut y_k = vec![0.0; basis_len];
-            let (o, d) = camera.ray(Vec2::new((i % w) as f32 + 0.5, (i / w) as f32 + 0.5));
+            let ray = centre_ray(ts, camera, i % w, i / w);
             for _ in 0..s.spp {
-                if let Some((dir, beta)) = trace_escape(ts, o, d, &ps, &mut rng) {
+                if let Some((dir, beta)) = trace_escape(ts, &ray, &ps, &mut rng) {
                     basis(dir, &mut y_k);
                     for (tk, yk) in t.iter_mut().zip(&y_k) {
                         *tk += beta * *yk;
