@@ -22,6 +22,11 @@ pub fn choose(
     test_maps: Option<usize>,
     seed: u64,
 ) -> Result<(Vec<String>, MapAssignment)> {
+    if train_views == 0 || test_views == 0 {
+        bail!(
+            "a dataset needs at least one training and one test view (the test views are the references validation and `nprt eval` measure against); got {train_views} and {test_views}"
+        );
+    }
     if envmaps == "builtin" {
         if test_maps.is_some() {
             bail!("--test-maps applies to a folder of maps; --envmaps builtin gives every view its own lighting");

@@ -172,6 +172,26 @@ fn bad_scenes_arguments_and_outputs_are_refused() {
         &["reference", "builtin:room", "--out", o, "--set", "novalue"],
         &["NAME=VALUE", "novalue"],
     );
+    let data = dir.join("data");
+    for (train, test) in [("0", "1"), ("1", "0")] {
+        fails(
+            &[
+                "generate",
+                "--scene",
+                "builtin:room",
+                "--envmaps",
+                "builtin",
+                "--out",
+                data.to_str().unwrap(),
+                "--train-views",
+                train,
+                "--test-views",
+                test,
+            ],
+            &["at least one training and one test view"],
+        );
+    }
+    assert!(!data.exists());
     fails(
         &[
             "reference",
