@@ -59,11 +59,9 @@ impl Compute {
             Compute::Auto => first_gpu().unwrap_or_else(Device::flex),
         };
         make_default(&device);
-        if !is_cpu(&device) {
-            GPUS_USED
-                .lock()
-                .unwrap_or_else(|e| e.into_inner())
-                .push(device.clone());
+        let mut used = GPUS_USED.lock().unwrap_or_else(|e| e.into_inner());
+        if !is_cpu(&device) && !used.contains(&device) {
+            used.push(device.clone());
         }
         Ok(device)
     }
@@ -74,7 +72,7 @@ impl Compute {
 /// the CUDA backend is compiled in, GPU or not: without this a resumed CPU run on a machine
 /// with no NVIDIA driver panicked. burn reads the choice from `BURN_DEVICE` on every use.
 pub(crate) fn make_default(device: &Device) {
-    let name = backend_name(device);
+    let name = Backend::of(device).burn_name();
     if std::env::var("BURN_DEVICE").ok().as_deref() != Some(name) {
         std::env::set_var("BURN_DEVICE", name);
     }
@@ -93,15 +91,42 @@ pub fn finish() {
 /// The GPU devices handed out by [`Compute::device`].
 static GPUS_USED: std::sync::Mutex<Vec<Device>> = std::sync::Mutex::new(Vec::new());
 
-/// burn's name of the backend `device` belongs to (what `BURN_DEVICE` takes): "flex" for the
-/// CPU, "cuda" or "wgpu".
-pub fn backend_name(device: &Device) -> &'static str {
-    if is_cpu(device) {
-        "flex"
-    } else if format!("{device:?}").contains("Wgpu") {
-        "wgpu"
-    } else {
-        "cuda"
+/// The burn backend a device belongs to.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Backend {
+    /// flex, where the hand-written engine applies.
+    Cpu,
+    Cuda,
+    Wgpu,
+}
+
+impl Backend {
+    pub fn of(device: &Device) -> Self {
+        if is_cpu(device) {
+            Backend::Cpu
+        } else if format!("{device:?}").contains("Wgpu") {
+            // burn names the runtime only in its dispatch enum, which it does not re-export.
+            Backend::Wgpu
+        } else {
+            Backend::Cuda
+        }
+    }
+
+    /// The name in reports: "cpu", "cuda" or "wgpu".
+    pub fn name(self) -> &'static str {
+        match self {
+            Backend::Cpu => "cpu",
+            Backend::Cuda => "cuda",
+            Backend::Wgpu => "wgpu",
+        }
+    }
+
+    /// burn's name for it, what `BURN_DEVICE` takes.
+    fn burn_name(self) -> &'static str {
+        match self {
+            Backend::Cpu => "flex",
+            backend => backend.name(),
+        }
     }
 }
 
@@ -113,12 +138,13 @@ pub fn is_cpu(device: &Device) -> bool {
 /// A short name for progress lines and reports: "cpu", or the backend and the device's own
 /// name ("cuda: NVIDIA H100 PCIe", "wgpu: llvmpipe (LLVM 15.0.6, 256 bits)").
 pub fn device_name(device: &Device) -> String {
-    match backend_name(device) {
-        "flex" => "cpu".into(),
-        backend => match device.identity() {
-            Some(id) => format!("{backend}: {}", id.name),
-            None => backend.into(),
-        },
+    let backend = Backend::of(device);
+    match (backend != Backend::Cpu)
+        .then(|| device.identity())
+        .flatten()
+    {
+        Some(id) => format!("{}: {}", backend.name(), id.name),
+        None => backend.name().into(),
     }
 }
 

@@ -53,7 +53,7 @@ pub use batch::{Batch, Engine};
 pub use burn;
 pub use burn::tensor::Device;
 pub use checkpoint::RunState;
-pub use compute::{backend_name, device_name, finish, is_cpu, Compute};
+pub use compute::{device_name, finish, is_cpu, Backend, Compute};
 pub use design::{Design, NprtNet, TRANSPORT_CODE};
 pub use direct_light::DirectLight;
 pub use encoder::{LightEncoder, LightInput};

@@ -6,7 +6,7 @@ use std::process::Command as Process;
 use anyhow::{bail, Context, Result};
 use nprt_net::data::TrainingSet;
 use nprt_net::encoder::check_input_width;
-use nprt_net::{backend_name, device_name, is_cpu, Device};
+use nprt_net::{device_name, is_cpu, Backend, Device};
 
 use crate::{DeviceArg, RunLength};
 use nprt_net::{
@@ -390,10 +390,10 @@ fn bench_train(a: BenchTrainArgs) -> Result<()> {
         a.steps
     );
     // PyTorch's device of the same kind; it has none for wgpu.
-    let torch_device = match backend_name(&device) {
-        "flex" => Some("cpu"),
-        "cuda" => Some("cuda"),
-        _ => None,
+    let torch_device = match Backend::of(&device) {
+        Backend::Cpu => Some("cpu"),
+        Backend::Cuda => Some("cuda"),
+        Backend::Wgpu => None,
     };
     let peer = match (&a.python, torch_device) {
         (Some(py), Some(torch_device)) => run_pytorch(py, &a, threads, torch_device)?,
