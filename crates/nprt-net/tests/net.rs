@@ -295,7 +295,8 @@ fn per_channel_models_relight_a_tinted_map_by_its_tint() {
 /// design and activation (the batch: [`random_batch`]). Both f32 paths are measured against burn in
 /// f64, and the engine's error must stay within twice burn's own f32 error (plus 1e-6 of the
 /// gradient's norm): where ReLU units sit within rounding of zero, both f32 paths differ from
-/// the exact gradient, and from each other, by more than rounding.
+/// the exact gradient, and from each other, by more than rounding. The transport networks are
+/// held to that on burn's light codes; the encoder in `host_encoder_matches_autodiff`.
 #[test]
 fn cpu_engine_matches_autodiff() {
     let device = Device::flex().autodiff();
@@ -311,7 +312,24 @@ fn cpu_engine_matches_autodiff() {
             assert!(nprt_net::cpu::applies(&net, &device));
             let (burn_loss, burn) =
                 batch.gradients(&net, &device, nprt_net::Engine::Autodiff, objective);
-            let (loss, engine) = nprt_net::cpu::gradients(&net, &batch, &device, objective);
+            // The transport networks on burn's light codes, whose gradient at the codes burn
+            // then carries through the encoder: every gradient held to f32 rounding.
+            let codes = net.encoder.forward(batch.light_tensor(&device));
+            let host_codes = nprt_net::cpu::host_values(codes.clone().into_data());
+            let (loss, mut engine, d_codes) =
+                nprt_net::cpu::transport_gradients(&net, &batch, &host_codes, &device, objective);
+            let d_codes = Tensor::<2>::from_data(TensorData::new(d_codes, codes.dims()), &device);
+            let through = (codes * d_codes).sum().backward();
+            let mut encoder = Shapes(Vec::new());
+            net.encoder.visit(&mut encoder);
+            let through = GradientsParams::from_grads(through, &net);
+            for (id, dims) in &encoder.0 {
+                match dims.len() {
+                    1 => engine.register::<1>(*id, through.get::<1>(*id).unwrap()),
+                    2 => engine.register::<2>(*id, through.get::<2>(*id).unwrap()),
+                    _ => engine.register::<4>(*id, through.get::<4>(*id).unwrap()),
+                }
+            }
             assert!(
                 (loss - burn_loss).abs() <= 1e-6 * burn_loss,
                 "{name}/{objective:?}: loss {loss} vs {burn_loss}"
@@ -325,7 +343,114 @@ fn cpu_engine_matches_autodiff() {
                     e.id, e.dims, e.norm
                 );
             }
+            // The whole step, the encoder on the engine too (held to rounding by
+            // `host_encoder_matches_autodiff`). Its codes differ from burn's by f32 rounding,
+            // enough to move the odd ReLU pre-activation across zero and with it one sample's
+            // share of a gradient (measured: up to 6e-4 of a gradient's norm): a check that
+            // every gradient is filed where it belongs, not of rounding.
+            let (loss, whole) = nprt_net::cpu::gradients(&net, &batch, &device, objective);
+            assert!((loss - burn_loss).abs() <= 1e-5 * burn_loss);
+            for e in gradient_errors(&net, &exact, [&whole]) {
+                assert!(
+                    e.errors[0] <= 1e-2 * e.norm,
+                    "{name}/{objective:?} whole step, param {} {:?}: error {:e}, norm {:e}",
+                    e.id,
+                    e.dims,
+                    e.errors[0],
+                    e.norm
+                );
+            }
         }
+    }
+}
+
+/// The CPU engine's light encoder against burn's autodiff, in f32 and in f64, for the same
+/// gradient at the codes: codes, and every weight's gradient.
+#[test]
+fn host_encoder_matches_autodiff() {
+    let device = Device::flex().autodiff();
+    let batch = random_batch(8, 3, 23);
+    let (views, w) = (3, batch.light_width);
+    let config = ModelConfig {
+        encoder_width: w,
+        ..ModelConfig::new(Design::Prt, None)
+    };
+    let mut rng = Pcg64Mcg::seed_from_u64(24);
+    let d_codes: Vec<f32> = (0..views * 64).map(|_| rng.random::<f32>() - 0.5).collect();
+    let burn = |dtype: DType| {
+        let mut init = Init::with_dtype(4, &device, dtype);
+        let net = config.build(&mut init);
+        let lights = init.tensor(batch.lights.clone(), [views, 3, w / 2, w]);
+        let codes = net.encoder.forward(lights);
+        let d = init.tensor(d_codes.clone(), [views, 64]);
+        let grads = GradientsParams::from_grads((codes.clone() * d).sum().backward(), &net);
+        (
+            net,
+            codes
+                .into_data()
+                .convert::<f64>()
+                .try_to_vec::<f64>()
+                .unwrap(),
+            grads,
+        )
+    };
+    let (net, burn_codes, burn_grads) = burn(DType::F32);
+    let (_, exact_codes, exact) = burn(DType::F64);
+    let host = nprt_net::cpu::HostEncoder::from_burn(&net.encoder);
+    let pass = host.forward(&batch.lights, w);
+    let error = |codes: &[f64]| -> f64 {
+        codes
+            .iter()
+            .zip(&exact_codes)
+            .map(|(a, b)| (a - b).powi(2))
+            .sum::<f64>()
+            .sqrt()
+    };
+    let ours: Vec<f64> = pass.codes.iter().map(|&c| c as f64).collect();
+    assert!(
+        error(&ours) <= 2.0 * error(&burn_codes) + 1e-7,
+        "codes: {:e} against burn's {:e}",
+        error(&ours),
+        error(&burn_codes)
+    );
+    let g = host.backward(&pass, &d_codes);
+    let mut ours = GradientsParams::new();
+    let cpu = Device::flex();
+    let tensor = |v: Vec<f32>, dims: &[usize]| TensorData::new(v, dims.to_vec());
+    for (conv, g) in net.encoder.convs.iter().zip(g.convs) {
+        let dims = conv.weight.val().dims();
+        ours.register::<4>(
+            conv.weight.id,
+            Tensor::from_data(tensor(g.weight, &dims), &cpu),
+        );
+        let bias = conv.bias.as_ref().expect("convolutions have biases");
+        ours.register::<1>(bias.id, Tensor::from_data(tensor(g.bias, &[32]), &cpu));
+    }
+    let code = &net.encoder.to_code;
+    let dims = code.weight.val().dims();
+    ours.register::<2>(
+        code.weight.id,
+        Tensor::from_data(tensor(g.to_code.weight, &dims), &cpu),
+    );
+    let bias = code.bias.as_ref().expect("the code layer has a bias");
+    ours.register::<1>(
+        bias.id,
+        Tensor::from_data(tensor(g.to_code.bias, &[64]), &cpu),
+    );
+    let errors = gradient_errors(&net.encoder, &exact, [&ours, &burn_grads]);
+    assert_eq!(
+        errors.len(),
+        12,
+        "5 convolutions and the code layer, with biases"
+    );
+    for e in errors {
+        let (ours, theirs) = (e.errors[0], e.errors[1]);
+        assert!(
+            ours <= 2.0 * theirs + 1e-6 * e.norm,
+            "{:?}: engine error {ours:e}, burn f32 error {theirs:e}, norm {:e}",
+            e.dims,
+            e.norm
+        );
     }
 }
 

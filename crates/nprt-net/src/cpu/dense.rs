@@ -5,10 +5,11 @@
 use std::ops::Range;
 
 use burn::module::Param;
+use burn::nn::Linear;
 use burn::tensor::Tensor;
 
 use super::matmul::{matmul, MatRef, Op};
-use super::sincos::sincos_scaled;
+use super::sincos::{sin_scaled, sincos_scaled};
 use crate::activation::{Activation, OMEGA_0};
 use crate::mlp::Mlp;
 
@@ -47,9 +48,16 @@ impl SharedInput<'_> {
     }
 }
 
-/// What a forward pass over a block of rows keeps: each layer's output and, for hidden layers,
-/// its activation's derivative at the pre-activation (ReLU needs none: its output says it).
-/// Its buffers are reused from block to block.
+/// Whether a forward pass keeps what backward needs (training) or only the outputs (inference).
+#[derive(Clone, Copy, PartialEq, Eq)]
+pub enum Pass {
+    Train,
+    Infer,
+}
+
+/// What a forward pass over a block of rows keeps: each layer's output and, for hidden layers
+/// of a training pass, its activation's derivative at the pre-activation (ReLU needs none: its
+/// output says it). Its buffers are reused from block to block.
 #[derive(Default)]
 pub struct Tape {
     outputs: Vec<Vec<f32>>,
@@ -67,11 +75,21 @@ impl Tape {
     }
 }
 
-fn host<const D: usize>(p: &Param<Tensor<D>>) -> Vec<f32> {
+pub(super) fn host<const D: usize>(p: &Param<Tensor<D>>) -> Vec<f32> {
     super::host_values(p.val().into_data())
 }
 
 impl Dense {
+    pub fn from_linear(l: &Linear) -> Self {
+        let [d_in, d_out] = l.weight.val().dims();
+        Dense {
+            weight: host(&l.weight),
+            bias: l.bias.as_ref().map_or(vec![0.0; d_out], host),
+            d_in,
+            d_out,
+        }
+    }
+
     /// The weight rows `rows` as a matrix.
     fn rows(&self, rows: Range<usize>) -> MatRef<'_> {
         MatRef::new(
@@ -93,21 +111,8 @@ impl Dense {
 
 impl DenseStack {
     pub fn from_mlp(mlp: &Mlp) -> Self {
-        let layers = mlp
-            .layers
-            .iter()
-            .map(|l| {
-                let [d_in, d_out] = l.weight.val().dims();
-                Dense {
-                    weight: host(&l.weight),
-                    bias: l.bias.as_ref().map_or(vec![0.0; d_out], host),
-                    d_in,
-                    d_out,
-                }
-            })
-            .collect();
         DenseStack {
-            layers,
+            layers: mlp.layers.iter().map(Dense::from_linear).collect(),
             activation: mlp.activation,
         }
     }
@@ -145,8 +150,8 @@ impl DenseStack {
     }
 
     /// Runs the rows of `x` (with `shared`, the rest of layer 0's input) through every layer,
-    /// keeping what [`Self::backward`] needs.
-    pub fn forward(&self, x: MatRef, shared: Option<&SharedInput>, tape: &mut Tape) {
+    /// keeping what [`Self::backward`] needs when `pass` is [`Pass::Train`].
+    pub fn forward(&self, x: MatRef, shared: Option<&SharedInput>, tape: &mut Tape, pass: Pass) {
         let n = self.layers.len();
         tape.outputs.resize_with(n, Vec::new);
         tape.slopes.resize_with(n, Vec::new);
@@ -176,8 +181,9 @@ impl DenseStack {
             };
             let hidden = l + 1 < n;
             let siren = hidden && self.activation == Activation::Siren;
-            // A SIREN layer's product goes to the slope buffer, which then receives ω0·cos.
-            let z = if siren {
+            // A SIREN layer's product goes to the slope buffer, which then receives ω0·cos
+            // (for backward only: inference takes the sine in place).
+            let z = if siren && pass == Pass::Train {
                 &mut tape.slopes[l]
             } else {
                 &mut rest[0]
@@ -195,10 +201,14 @@ impl DenseStack {
                     row.iter_mut().for_each(|v| *v = v.max(0.0));
                 }
             }
-            if siren {
-                let out = &mut rest[0];
-                out.resize(x.rows * layer.d_out, 0.0);
-                sincos_scaled(&mut tape.slopes[l], OMEGA_0, out);
+            match (siren, pass) {
+                (false, _) => {}
+                (true, Pass::Infer) => sin_scaled(&mut rest[0], OMEGA_0),
+                (true, Pass::Train) => {
+                    let out = &mut rest[0];
+                    out.resize(x.rows * layer.d_out, 0.0);
+                    sincos_scaled(&mut tape.slopes[l], OMEGA_0, out);
+                }
             }
         }
     }

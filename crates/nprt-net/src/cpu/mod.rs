@@ -1,27 +1,30 @@
-//! The CPU engine: the transport networks' training step written for the host (fused bias and
-//! activation passes, vectorised sin/cos, blocked matrix products) instead of through burn's
-//! autodiff graph, which on SIREN designs lost to PyTorch. The light encoder stays on burn: the
-//! gradient this engine finds at the light codes is handed back to burn's autodiff for it.
+//! The CPU engine: a design's training step written for the host (fused bias and activation
+//! passes, vectorised sin/cos, blocked matrix products, the encoder's convolutions as matrix
+//! products) instead of through burn's autodiff graph, which on SIREN designs lost to PyTorch
+//! and spent a third of a step in the encoder's convolutions. burn keeps the weights and Adam.
 //!
 //! Used wherever the network lives on burn's CPU backend in f32; any other device or precision
 //! (the f64 gradient checks, a GPU) takes burn's own path, and a test holds the two together.
 
 mod dense;
+mod light_encoder;
 mod matmul;
 mod peak;
 pub mod sincos;
 mod transport;
 
 use burn::module::Param;
+use burn::nn::Linear;
 use burn::optim::GradientsParams;
 use burn::tensor::{DType, Device, Tensor, TensorData};
 
 use crate::batch::Batch;
 use crate::design::NprtNet;
-use crate::encoder::CODE_SIZE;
 use crate::loss::Loss;
 use crate::mlp::Mlp;
+use dense::Dense;
 pub use dense::DenseStack;
+pub use light_encoder::{EncoderPass, HostEncoder};
 pub use peak::{measured_peak, Peak};
 pub use transport::{HostTransport, TransferCodes, TransportGradients};
 
@@ -31,22 +34,43 @@ pub fn applies(net: &NprtNet, device: &Device) -> bool {
     crate::compute::is_cpu(device) && weight.val().dtype() == DType::F32
 }
 
-/// The batch's loss and every parameter's gradient, with the transport networks on the CPU
-/// engine and the encoder through burn's autodiff (`device` is an autodiff device).
+/// The batch's loss and every parameter's gradient, computed on the CPU engine (`device` is
+/// the autodiff device the network lives on).
 pub fn gradients(
     net: &NprtNet,
     batch: &Batch,
     device: &Device,
     loss: Loss,
 ) -> (f64, GradientsParams) {
-    let codes = net.encoder.forward(batch.light_tensor(device));
-    let host_codes = host_values(codes.clone().into_data());
-    let g = HostTransport::from_net(net).gradients(batch, &host_codes, loss);
-    // d loss / d encoder = d (Σ codes ⊙ g.codes) / d encoder, with g.codes held constant.
-    let views = host_codes.len() / CODE_SIZE;
-    let d_codes = Tensor::<2>::from_data(TensorData::new(g.codes, [views, CODE_SIZE]), device);
-    let surrogate = (codes * d_codes.detach()).sum();
-    let mut params = GradientsParams::from_grads(surrogate.backward(), net);
+    let encoder = HostEncoder::from_burn(&net.encoder);
+    let light = encoder.forward(&batch.lights, batch.light_width);
+    let (loss, mut params, d_codes) = transport_gradients(net, batch, &light.codes, device, loss);
+    let inner = device.clone().inner();
+    let e = encoder.backward(&light, &d_codes);
+    for (conv, g) in net.encoder.convs.iter().zip(e.convs) {
+        let shape = conv.weight.val().dims();
+        let weight = Tensor::<4>::from_data(TensorData::new(g.weight, shape), &inner);
+        params.register::<4>(conv.weight.id, weight);
+        if let Some(Param { id, .. }) = &conv.bias {
+            let bias = TensorData::new(g.bias, [shape[0]]);
+            params.register::<1>(*id, Tensor::from_data(bias, &inner));
+        }
+    }
+    register_linear(&mut params, &net.encoder.to_code, e.to_code, &inner);
+    (loss, params)
+}
+
+/// The part of [`gradients`] after the encoder: for the light `codes` (`views × CODE_SIZE`),
+/// the batch's loss, the transport networks' gradients and the gradient at the codes.
+pub fn transport_gradients(
+    net: &NprtNet,
+    batch: &Batch,
+    codes: &[f32],
+    device: &Device,
+    loss: Loss,
+) -> (f64, GradientsParams, Vec<f32>) {
+    let g = HostTransport::from_net(net).gradients(batch, codes, loss);
+    let mut params = GradientsParams::new();
     let inner = device.clone().inner();
     for (track, grads) in net.tracks.iter().zip(g.tracks) {
         if let (Some(grid), Some(g)) = (&track.grid, grads.grid) {
@@ -59,18 +83,23 @@ pub fn gradients(
         }
         register(&mut params, &track.shading, grads.shading, &inner);
     }
-    (g.loss, params)
+    (g.loss, params, g.codes)
 }
 
 /// Files the gradients `g` of `mlp`'s layers under their parameters' ids.
 fn register(params: &mut GradientsParams, mlp: &Mlp, g: DenseStack, device: &Device) {
     for (layer, g) in mlp.layers.iter().zip(g.layers) {
-        let weight = TensorData::new(g.weight, [g.d_in, g.d_out]);
-        params.register::<2>(layer.weight.id, Tensor::from_data(weight, device));
-        if let Some(Param { id, .. }) = &layer.bias {
-            let bias = TensorData::new(g.bias, [g.d_out]);
-            params.register::<1>(*id, Tensor::from_data(bias, device));
-        }
+        register_linear(params, layer, g, device);
+    }
+}
+
+/// Files the gradient `g` of one dense layer under its parameters' ids.
+fn register_linear(params: &mut GradientsParams, layer: &Linear, g: Dense, device: &Device) {
+    let weight = TensorData::new(g.weight, [g.d_in, g.d_out]);
+    params.register::<2>(layer.weight.id, Tensor::from_data(weight, device));
+    if let Some(Param { id, .. }) = &layer.bias {
+        let bias = TensorData::new(g.bias, [g.d_out]);
+        params.register::<1>(*id, Tensor::from_data(bias, device));
     }
 }
 

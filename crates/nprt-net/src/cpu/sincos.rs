@@ -27,16 +27,19 @@ const ROUND: f32 = 12_582_912.0;
 
 #[inline(always)]
 fn sincos_one(x: f32) -> (f32, f32) {
-    let j = (x * FRAC_2_PI + ROUND) - ROUND;
-    let q = j as i32;
+    let t = x * FRAC_2_PI + ROUND;
+    let j = t - ROUND;
+    // The quadrant j mod 4 is in t's last mantissa bits (ROUND is a multiple of 4 and |j| is
+    // far below 2^22): Rust's saturating `j as i32` would keep the loop scalar.
+    let q = t.to_bits();
     let r = ((x - j * P1) - j * P2) - j * P3;
     let z = r * r;
     let s = ((-1.951_529_6e-4 * z + 8.332_161e-3) * z - 1.666_665_5e-1) * z * r + r;
     let c = ((2.443_315_7e-5 * z - 1.388_731_6e-3) * z + 4.166_664_6e-2) * z * z - 0.5 * z + 1.0;
     let swap = q & 1 != 0;
     let (sin, cos) = if swap { (c, s) } else { (s, c) };
-    let sin = f32::from_bits(sin.to_bits() ^ (((q & 2) as u32) << 30));
-    let cos = f32::from_bits(cos.to_bits() ^ ((((q + 1) & 2) as u32) << 30));
+    let sin = f32::from_bits(sin.to_bits() ^ ((q & 2) << 30));
+    let cos = f32::from_bits(cos.to_bits() ^ ((q.wrapping_add(1) & 2) << 30));
     (sin, cos)
 }
 
@@ -67,6 +70,36 @@ pub fn sincos_scaled(x: &mut [f32], scale: f32, sin: &mut [f32]) {
                 let a = *x * scale;
                 *s = a.sin();
                 *x = scale * a.cos();
+            }
+        }
+    }
+}
+
+/// The vectorised loop of [`sin_scaled`]: arguments beyond the reduced range are left as they
+/// are; returns whether there were any.
+#[multiversion(targets("x86_64+avx512f+avx512vl+fma", "x86_64+avx2+fma", "aarch64+neon"))]
+fn sin_scaled_simd(x: &mut [f32], scale: f32) -> bool {
+    let mut outside = false;
+    for x in x.iter_mut() {
+        let a = *x * scale;
+        let inside = a.abs() <= REDUCED_RANGE;
+        *x = if inside { sincos_one(a).0 } else { *x };
+        outside |= !inside;
+    }
+    outside
+}
+
+/// `x[i] = sin(scale·x[i])` in place: a SIREN activation where its derivative is not needed
+/// (inference), without [`sincos_scaled`]'s second buffer and cos.
+pub fn sin_scaled(x: &mut [f32], scale: f32) {
+    // A value the loop replaced is at most 1 in size, so with |scale| at most half the range
+    // only the arguments it left behind still exceed the range when scaled.
+    assert!(scale.abs() <= REDUCED_RANGE / 2.0);
+    if sin_scaled_simd(x, scale) {
+        for x in x.iter_mut() {
+            let a = *x * scale;
+            if !(a.abs() <= REDUCED_RANGE) {
+                *x = a.sin();
             }
         }
     }
@@ -107,6 +140,21 @@ mod tests {
             e <= MAX_ERROR as f64,
             "worst error {e} over ±{REDUCED_RANGE}"
         );
+    }
+
+    #[test]
+    fn sin_alone_equals_the_pair_s_sin_bit_for_bit() {
+        let xs: Vec<f32> = (0..100_001)
+            .map(|i| (i as f32 - 5e4) * 3e-4)
+            .chain([-1e6, 3e7, f32::NAN, 0.0, 300.0, -273.1])
+            .collect();
+        let (mut sin, mut cos) = (vec![0.0; xs.len()], xs.clone());
+        sincos_scaled(&mut cos, 30.0, &mut sin);
+        let mut alone = xs.clone();
+        sin_scaled(&mut alone, 30.0);
+        for ((a, s), x) in alone.iter().zip(&sin).zip(&xs) {
+            assert!(a.to_bits() == s.to_bits(), "sin(30·{x}): {a} against {s}");
+        }
     }
 
     #[test]

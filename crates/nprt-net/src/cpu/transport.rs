@@ -7,7 +7,7 @@
 
 use rayon::prelude::*;
 
-use super::dense::{DenseStack, SharedInput, Tape};
+use super::dense::{DenseStack, Pass, SharedInput, Tape};
 use super::matmul::MatRef;
 use crate::batch::Batch;
 use crate::design::{NprtNet, TRANSPORT_CODE};
@@ -185,20 +185,25 @@ impl HostTrack {
         n: usize,
         known: Option<&[f32]>,
         pass: &mut TrackPass,
+        purpose: Pass,
     ) {
         let shared = self.shared(light);
         let x = self.inputs(features, &mut pass.x, n);
         match (&self.transfer, known) {
             (Some(_), Some(s)) => {
                 let s = MatRef::new(s, n, TRANSPORT_CODE);
-                self.shading.forward(s, Some(&shared), &mut pass.shading);
+                self.shading
+                    .forward(s, Some(&shared), &mut pass.shading, purpose);
             }
             (Some(ft), None) => {
-                ft.forward(x, None, &mut pass.transfer);
+                ft.forward(x, None, &mut pass.transfer, purpose);
                 let s = MatRef::new(pass.transfer.output(), n, TRANSPORT_CODE);
-                self.shading.forward(s, Some(&shared), &mut pass.shading);
+                self.shading
+                    .forward(s, Some(&shared), &mut pass.shading, purpose);
             }
-            (None, _) => self.shading.forward(x, Some(&shared), &mut pass.shading),
+            (None, _) => self
+                .shading
+                .forward(x, Some(&shared), &mut pass.shading, purpose),
         }
         pass.exps.clear();
         pass.exps
@@ -212,7 +217,7 @@ impl HostTrack {
         };
         let mut pass = TrackPass::default();
         let x = self.inputs(features, &mut pass.x, n);
-        ft.forward(x, None, &mut pass.transfer);
+        ft.forward(x, None, &mut pass.transfer, Pass::Infer);
         pass.transfer.output().to_vec()
     }
 
@@ -445,7 +450,7 @@ impl HostTransport {
                         let s = known.filter(|_| t.transfer.is_some()).map(|c| {
                             &c.tracks[k][b * BLOCK * TRANSPORT_CODE..][..rows * TRANSPORT_CODE]
                         });
-                        t.forward(f, light, rows, s, pass);
+                        t.forward(f, light, rows, s, pass, Pass::Infer);
                         for r in 0..rows {
                             let c = t.radiance(pass, f, r);
                             (0..3).for_each(|i| out[r * 3 + i] += c[i]);
@@ -481,7 +486,7 @@ impl HostTransport {
         let reference = &batch.radiance[rows.start * 3..rows.end * 3];
         let scale = &batch.scale[rows.start * 3..rows.end * 3];
         for (t, pass) in self.tracks.iter().zip(passes.iter_mut()) {
-            t.forward(features, light, n, None, pass);
+            t.forward(features, light, n, None, pass, Pass::Train);
         }
         // d mean / d value.
         let norm = 1.0 / batch.len() as f32 / 3.0;

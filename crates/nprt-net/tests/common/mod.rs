@@ -117,9 +117,10 @@ pub struct GradientError<const K: usize> {
     pub norm: f64,
 }
 
-/// For every parameter of `net`, the distance of each of `candidates` from `truth`.
-pub fn gradient_errors<const K: usize>(
-    net: &NprtNet,
+/// For every parameter of `net` (a network or a part of one), the distance of each of
+/// `candidates` from `truth`.
+pub fn gradient_errors<M: Module, const K: usize>(
+    net: &M,
     truth: &GradientsParams,
     candidates: [&GradientsParams; K],
 ) -> Vec<GradientError<K>> {
