@@ -147,10 +147,11 @@ impl Relighter {
     /// each further lighting runs only the shading networks.
     pub fn pixels(&self, g: &GBuffer) -> Pixels {
         let foreground: Vec<usize> = (0..g.mask.len()).filter(|&i| g.mask[i] > 0.5).collect();
-        let features: Vec<f32> = foreground
-            .par_iter()
-            .flat_map_iter(|&i| gbuffer_features(&self.file.bounds, g, i))
-            .collect();
+        let mut features = vec![0.0; foreground.len() * FEATURES];
+        features
+            .par_chunks_mut(FEATURES)
+            .zip(&foreground)
+            .for_each(|(f, &i)| f.copy_from_slice(&gbuffer_features(&self.file.bounds, g, i)));
         let transfer = self.host.as_ref().map(|h| h.transfer_codes(&features));
         Pixels {
             count: g.mask.len(),

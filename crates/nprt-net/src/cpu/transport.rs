@@ -59,7 +59,8 @@ pub struct TransferCodes {
     tracks: Vec<Vec<f32>>,
 }
 
-/// A track's state over one block; its buffers are reused from block to block.
+/// A track's state over one block; its buffers are reused from block to block, and kept by
+/// each worker thread from call to call ([`with_passes`]).
 #[derive(Default)]
 struct TrackPass {
     /// Gathered inputs (empty when the track reads all features and has no grid).
@@ -73,6 +74,25 @@ struct TrackPass {
     /// Gradients at the shading network's outputs and at ŝ.
     d_out: Vec<f32>,
     d_transfer: Vec<f32>,
+}
+
+thread_local! {
+    /// Each thread's block buffers, kept between calls: buffers allocated anew for every
+    /// block or step came as freshly mapped pages each time, whose clearing by the kernel was
+    /// 19% of a D/S frame in perf.
+    static PASSES: std::cell::Cell<Vec<TrackPass>> = const { std::cell::Cell::new(Vec::new()) };
+}
+
+/// Runs `f` with `tracks` block buffers of this thread's. They are taken out while `f` runs,
+/// so a nested call on the same thread gets fresh ones instead of aliasing them.
+fn with_passes<R>(tracks: usize, f: impl FnOnce(&mut [TrackPass]) -> R) -> R {
+    let mut passes = PASSES.take();
+    if passes.len() < tracks {
+        passes.resize_with(tracks, TrackPass::default);
+    }
+    let result = f(&mut passes[..tracks]);
+    PASSES.set(passes);
+    result
 }
 
 /// The light codes of a block: each view's code, and each row's view.
@@ -210,15 +230,15 @@ impl HostTrack {
             .extend(pass.shading.output().iter().map(|o| o.exp()));
     }
 
-    /// ŝ of `n` rows of `features` (empty for a track without a transfer network).
-    fn transfer_code(&self, features: &[f32], n: usize) -> Vec<f32> {
-        let Some(ft) = &self.transfer else {
-            return Vec::new();
-        };
-        let mut pass = TrackPass::default();
-        let x = self.inputs(features, &mut pass.x, n);
-        ft.forward(x, None, &mut pass.transfer, Pass::Infer);
-        pass.transfer.output().to_vec()
+    /// ŝ of the rows of `features` into `out` (`rows × TRANSPORT_CODE`), for a track with a
+    /// transfer network.
+    fn transfer_code(&self, ft: &DenseStack, features: &[f32], out: &mut [f32]) {
+        with_passes(1, |passes| {
+            let pass = &mut passes[0];
+            let x = self.inputs(features, &mut pass.x, features.len() / FEATURES);
+            ft.forward(x, None, &mut pass.transfer, Pass::Infer);
+            out.copy_from_slice(pass.transfer.output());
+        })
     }
 
     /// Radiance of row `r` before the map's scale.
@@ -357,16 +377,16 @@ impl HostTransport {
             .into_par_iter()
             .map(|run| {
                 let mut g = self.zero_gradients(views);
-                let mut passes: Vec<TrackPass> =
-                    self.tracks.iter().map(|_| TrackPass::default()).collect();
-                for b in run * per_run..((run + 1) * per_run).min(blocks) {
-                    let rows = b * BLOCK..((b + 1) * BLOCK).min(n);
-                    let light = Lighting {
-                        codes,
-                        view: &view[rows.clone()],
-                    };
-                    self.block(batch, rows, light, loss, &mut passes, &mut g);
-                }
+                with_passes(self.tracks.len(), |passes| {
+                    for b in run * per_run..((run + 1) * per_run).min(blocks) {
+                        let rows = b * BLOCK..((b + 1) * BLOCK).min(n);
+                        let light = Lighting {
+                            codes,
+                            view: &view[rows.clone()],
+                        };
+                        self.block(batch, rows, light, loss, passes, &mut g);
+                    }
+                });
                 g
             })
             .collect();
@@ -409,14 +429,22 @@ impl HostTransport {
     /// Each track's ŝ for the rows of `features`: the part of the network a lighting change
     /// leaves as it is (empty for the baseline, whose every layer sees the light code).
     pub fn transfer_codes(&self, features: &[f32]) -> TransferCodes {
+        let n = features.len() / FEATURES;
+        // Written in place: collected block by block, the codes of a 512² frame (67 MB a
+        // track) were copied as the vector grew, into freshly mapped pages each time.
         let tracks = self
             .tracks
             .iter()
             .map(|t| {
-                features
-                    .par_chunks(BLOCK * FEATURES)
-                    .flat_map_iter(|f| t.transfer_code(f, f.len() / FEATURES))
-                    .collect()
+                let Some(ft) = &t.transfer else {
+                    return Vec::new();
+                };
+                let mut codes = vec![0.0; n * TRANSPORT_CODE];
+                codes
+                    .par_chunks_mut(BLOCK * TRANSPORT_CODE)
+                    .zip(features.par_chunks(BLOCK * FEATURES))
+                    .for_each(|(out, f)| t.transfer_code(ft, f, out));
+                codes
             })
             .collect();
         TransferCodes { tracks }
@@ -438,9 +466,8 @@ impl HostTransport {
         out.par_chunks_mut(BLOCK * 3)
             .zip(features.par_chunks(BLOCK * FEATURES))
             .enumerate()
-            .for_each_init(
-                || -> Vec<TrackPass> { self.tracks.iter().map(|_| TrackPass::default()).collect() },
-                |passes, (b, (out, f))| {
+            .for_each(|(b, (out, f))| {
+                with_passes(self.tracks.len(), |passes| {
                     let rows = f.len() / FEATURES;
                     let light = Lighting {
                         codes: code,
@@ -458,8 +485,8 @@ impl HostTransport {
                     }
                     out.chunks_exact_mut(3)
                         .for_each(|c| (0..3).for_each(|i| c[i] *= scale[i]));
-                },
-            );
+                })
+            });
         out
     }
 
