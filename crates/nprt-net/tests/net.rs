@@ -413,30 +413,9 @@ fn host_encoder_matches_autodiff() {
         error(&ours),
         error(&burn_codes)
     );
-    let g = host.backward(&pass, &d_codes);
     let mut ours = GradientsParams::new();
-    let cpu = Device::flex();
-    let tensor = |v: Vec<f32>, dims: &[usize]| TensorData::new(v, dims.to_vec());
-    for (conv, g) in net.encoder.convs.iter().zip(g.convs) {
-        let dims = conv.weight.val().dims();
-        ours.register::<4>(
-            conv.weight.id,
-            Tensor::from_data(tensor(g.weight, &dims), &cpu),
-        );
-        let bias = conv.bias.as_ref().expect("convolutions have biases");
-        ours.register::<1>(bias.id, Tensor::from_data(tensor(g.bias, &[32]), &cpu));
-    }
-    let code = &net.encoder.to_code;
-    let dims = code.weight.val().dims();
-    ours.register::<2>(
-        code.weight.id,
-        Tensor::from_data(tensor(g.to_code.weight, &dims), &cpu),
-    );
-    let bias = code.bias.as_ref().expect("the code layer has a bias");
-    ours.register::<1>(
-        bias.id,
-        Tensor::from_data(tensor(g.to_code.bias, &[64]), &cpu),
-    );
+    let g = host.backward(&pass, &d_codes);
+    nprt_net::cpu::register_encoder(&mut ours, &net.encoder, g, &Device::flex());
     let errors = gradient_errors(&net.encoder, &exact, [&ours, &burn_grads]);
     assert_eq!(
         errors.len(),

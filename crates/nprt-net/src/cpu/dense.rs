@@ -8,6 +8,7 @@ use burn::module::Param;
 use burn::nn::Linear;
 use burn::tensor::Tensor;
 
+use super::accumulate;
 use super::matmul::{matmul, MatRef, Op};
 use super::sincos::{sin_scaled, sincos_scaled};
 use crate::activation::{Activation, OMEGA_0};
@@ -90,6 +91,21 @@ impl Dense {
         }
     }
 
+    /// All zeros in this layer's shapes: a gradient accumulator.
+    pub fn zeros_like(&self) -> Self {
+        Dense {
+            weight: vec![0.0; self.weight.len()],
+            bias: vec![0.0; self.bias.len()],
+            ..*self
+        }
+    }
+
+    /// Adds `other` (same shapes) to this one.
+    pub fn add(&mut self, other: &Self) {
+        accumulate(&mut self.weight, &other.weight);
+        accumulate(&mut self.bias, &other.bias);
+    }
+
     /// The weight rows `rows` as a matrix.
     fn rows(&self, rows: Range<usize>) -> MatRef<'_> {
         MatRef::new(
@@ -119,17 +135,8 @@ impl DenseStack {
 
     /// All zeros in this stack's shapes: a gradient accumulator.
     pub fn zeros_like(&self) -> Self {
-        let layers = self
-            .layers
-            .iter()
-            .map(|l| Dense {
-                weight: vec![0.0; l.weight.len()],
-                bias: vec![0.0; l.bias.len()],
-                ..*l
-            })
-            .collect();
         DenseStack {
-            layers,
+            layers: self.layers.iter().map(Dense::zeros_like).collect(),
             activation: self.activation,
         }
     }
@@ -137,11 +144,7 @@ impl DenseStack {
     /// Adds `other` (same shapes) to this one.
     pub fn add(&mut self, other: &Self) {
         for (a, b) in self.layers.iter_mut().zip(&other.layers) {
-            a.weight
-                .iter_mut()
-                .zip(&b.weight)
-                .for_each(|(x, y)| *x += y);
-            a.bias.iter_mut().zip(&b.bias).for_each(|(x, y)| *x += y);
+            a.add(b);
         }
     }
 

@@ -10,6 +10,7 @@
 use burn::nn::conv::Conv2d;
 use rayon::prelude::*;
 
+use super::accumulate;
 use super::dense::{host, Dense};
 use super::matmul::{matmul, MatRef, Op};
 use crate::encoder::{LightEncoder, CHANNELS, CODE_SIZE};
@@ -114,7 +115,7 @@ fn fold_add(cols: &[f32], h: usize, w: usize, dx: &mut [f32]) {
                 1 => (&mut dst[..], grad),
                 _ => (&mut dst[1..], &grad[..w - 1]),
             };
-            to.iter_mut().zip(from).for_each(|(d, g)| *d += g);
+            accumulate(to, from);
         }
     }
 }
@@ -130,25 +131,16 @@ impl HostEncoder {
     fn zeros_like(&self) -> Self {
         HostEncoder {
             convs: self.convs.iter().map(Conv::zeros_like).collect(),
-            to_code: Dense {
-                weight: vec![0.0; self.to_code.weight.len()],
-                bias: vec![0.0; self.to_code.bias.len()],
-                ..self.to_code
-            },
+            to_code: self.to_code.zeros_like(),
         }
     }
 
     fn add(&mut self, other: &Self) {
-        let pairs = self.convs.iter_mut().zip(&other.convs);
-        for (a, b) in pairs
-            .flat_map(|(a, b)| [(&mut a.weight, &b.weight), (&mut a.bias, &b.bias)])
-            .chain([
-                (&mut self.to_code.weight, &other.to_code.weight),
-                (&mut self.to_code.bias, &other.to_code.bias),
-            ])
-        {
-            a.iter_mut().zip(b).for_each(|(x, y)| *x += y);
+        for (a, b) in self.convs.iter_mut().zip(&other.convs) {
+            accumulate(&mut a.weight, &b.weight);
+            accumulate(&mut a.bias, &b.bias);
         }
+        self.to_code.add(&other.to_code);
     }
 
     /// The codes of `lights` (views × [3, W/2, W], channel-major, as [`crate::batch::Batch`]
@@ -196,42 +188,35 @@ impl HostEncoder {
                 cols_m,
                 Op::Plain,
             );
-            // z becomes the ReLU output; `sum` gets it plus the skip (the input, zero-padded
-            // to CHANNELS channels).
-            let mut sum = vec![0.0; CHANNELS * hw];
-            for (c, (z, s)) in z
-                .chunks_exact_mut(hw)
-                .zip(sum.chunks_exact_mut(hw))
-                .enumerate()
-            {
-                let b = conv.bias[c];
+            // z becomes the ReLU output.
+            for (z, b) in z.chunks_exact_mut(hw).zip(&conv.bias) {
                 z.iter_mut().for_each(|v| *v = (*v + b).max(0.0));
-                s.copy_from_slice(z);
-                if c < conv.c_in {
-                    let skip = &x[c * hw..][..hw];
-                    s.iter_mut().zip(skip).for_each(|(s, k)| *s += k);
-                }
             }
+            // The pool takes the ReLU output plus the skip (the input, zero-padded to CHANNELS
+            // channels).
             let (ph, pw) = (h / 2, w / 2);
             let mut pooled = vec![0.0; CHANNELS * ph * pw];
             let mut argmax = vec![0u32; CHANNELS * ph * pw];
             for c in 0..CHANNELS {
+                let value = |p: usize| {
+                    let at = c * hw + p;
+                    if c < conv.c_in {
+                        z[at] + x[at]
+                    } else {
+                        z[at]
+                    }
+                };
                 for y in 0..ph {
                     for xo in 0..pw {
                         let at = (c * ph + y) * pw + xo;
                         // The first of the window's maxima, in row order.
                         let window = [0, 1, w, w + 1].map(|d| 2 * y * w + 2 * xo + d);
-                        let best = window
+                        let (best, max) = window
+                            .map(|p| (p, value(p)))
                             .into_iter()
-                            .reduce(|a, b| {
-                                if sum[c * hw + b] > sum[c * hw + a] {
-                                    b
-                                } else {
-                                    a
-                                }
-                            })
+                            .reduce(|a, b| if b.1 > a.1 { b } else { a })
                             .expect("a 2×2 window");
-                        pooled[at] = sum[c * hw + best];
+                        pooled[at] = max;
                         argmax[at] = best as u32;
                     }
                 }

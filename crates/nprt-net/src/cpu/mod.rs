@@ -20,6 +20,7 @@ use burn::tensor::{DType, Device, Tensor, TensorData};
 
 use crate::batch::Batch;
 use crate::design::NprtNet;
+use crate::encoder::LightEncoder;
 use crate::loss::Loss;
 use crate::mlp::Mlp;
 use dense::Dense;
@@ -45,19 +46,29 @@ pub fn gradients(
     let encoder = HostEncoder::from_burn(&net.encoder);
     let light = encoder.forward(&batch.lights, batch.light_width);
     let (loss, mut params, d_codes) = transport_gradients(net, batch, &light.codes, device, loss);
-    let inner = device.clone().inner();
-    let e = encoder.backward(&light, &d_codes);
-    for (conv, g) in net.encoder.convs.iter().zip(e.convs) {
+    let grads = encoder.backward(&light, &d_codes);
+    register_encoder(&mut params, &net.encoder, grads, &device.clone().inner());
+    (loss, params)
+}
+
+/// Files the gradients `g` of `encoder`'s weights (from [`HostEncoder::backward`]) under their
+/// parameters' ids.
+pub fn register_encoder(
+    params: &mut GradientsParams,
+    encoder: &LightEncoder,
+    g: HostEncoder,
+    device: &Device,
+) {
+    for (conv, g) in encoder.convs.iter().zip(g.convs) {
         let shape = conv.weight.val().dims();
-        let weight = Tensor::<4>::from_data(TensorData::new(g.weight, shape), &inner);
+        let weight = Tensor::<4>::from_data(TensorData::new(g.weight, shape), device);
         params.register::<4>(conv.weight.id, weight);
         if let Some(Param { id, .. }) = &conv.bias {
             let bias = TensorData::new(g.bias, [shape[0]]);
-            params.register::<1>(*id, Tensor::from_data(bias, &inner));
+            params.register::<1>(*id, Tensor::from_data(bias, device));
         }
     }
-    register_linear(&mut params, &net.encoder.to_code, e.to_code, &inner);
-    (loss, params)
+    register_linear(params, &encoder.to_code, g.to_code, device);
 }
 
 /// The part of [`gradients`] after the encoder: for the light `codes` (`views × CODE_SIZE`),
@@ -101,6 +112,11 @@ fn register_linear(params: &mut GradientsParams, layer: &Linear, g: Dense, devic
         let bias = TensorData::new(g.bias, [g.d_out]);
         params.register::<1>(*id, Tensor::from_data(bias, device));
     }
+}
+
+/// `acc += x`, element by element: gradients summed over blocks, runs and maps.
+fn accumulate(acc: &mut [f32], x: &[f32]) {
+    acc.iter_mut().zip(x).for_each(|(a, v)| *a += v);
 }
 
 /// A tensor's values as f32 on the host.

@@ -7,6 +7,7 @@
 
 use rayon::prelude::*;
 
+use super::accumulate;
 use super::dense::{DenseStack, Pass, SharedInput, Tape};
 use super::matmul::MatRef;
 use crate::batch::Batch;
@@ -145,7 +146,7 @@ impl HostTrack {
         }
         self.shading.add(&other.shading);
         if let (Some(a), Some(b)) = (&mut self.grid, &other.grid) {
-            a.iter_mut().zip(b).for_each(|(x, y)| *x += y);
+            accumulate(a, b);
         }
     }
 
@@ -394,7 +395,7 @@ impl HostTransport {
             .into_iter()
             .reduce(|mut a, b| {
                 a.loss += b.loss;
-                a.codes.iter_mut().zip(&b.codes).for_each(|(x, y)| *x += y);
+                accumulate(&mut a.codes, &b.codes);
                 a.tracks
                     .iter_mut()
                     .zip(&b.tracks)
