@@ -4,6 +4,7 @@ use std::time::Instant;
 
 use anyhow::{bail, Result};
 use glam::Vec3;
+use nprt_net::median;
 use nprt_render::DirectSampling;
 use nprt_scene::{Camera, EnvMap};
 use nprt_trace::{render, render_gbuffer, GBuffer, RenderSettings, TraceScene};
@@ -39,10 +40,6 @@ pub fn time_table(
     let raw = DirectSampling {
         denoiser: None,
         ..direct
-    };
-    let median = |mut v: Vec<f64>| {
-        v.sort_by(f64::total_cmp);
-        v[v.len() / 2]
     };
     let mut rows = Vec::new();
     let mut g = GBuffer::default();

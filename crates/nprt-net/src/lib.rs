@@ -68,7 +68,7 @@ pub use model::{
 };
 pub use options::{recipe_rate, TrainOptions};
 pub use position_encoding::PositionEncoding;
-pub use throughput::{measure_inference, measure_throughput, InferenceSpeed};
+pub use throughput::{measure_inference, measure_throughput, median, InferenceSpeed};
 pub use track::{Track, TrackKind};
 pub use train::train;
 pub use trainer::{Objective, Schedule, TrainSummary};

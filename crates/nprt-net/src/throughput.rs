@@ -59,6 +59,14 @@ pub fn measure_throughput(
     (batch_size * steps) as f64 / timed.elapsed().as_secs_f64()
 }
 
+/// The median of timings (the upper one of an even count): what benchmarks report, since a
+/// shared machine's speed drifts from run to run.
+pub fn median(mut v: Vec<f64>) -> f64 {
+    assert!(!v.is_empty(), "median of no timings");
+    v.sort_by(f64::total_cmp);
+    v[v.len() / 2]
+}
+
 /// Inference speed of a design's transport networks.
 pub struct InferenceSpeed {
     pub pixels: usize,
@@ -91,15 +99,15 @@ pub fn measure_inference(
     let code: Vec<f32> = (0..CODE_SIZE).map(|_| rng.random::<f32>() - 0.5).collect();
     let median_ms = |run: &dyn Fn()| {
         run();
-        let mut ms: Vec<f64> = (0..repeats.max(1))
-            .map(|_| {
-                let t = Instant::now();
-                run();
-                t.elapsed().as_secs_f64() * 1e3
-            })
-            .collect();
-        ms.sort_by(f64::total_cmp);
-        ms[ms.len() / 2]
+        median(
+            (0..repeats.max(1))
+                .map(|_| {
+                    let t = Instant::now();
+                    run();
+                    t.elapsed().as_secs_f64() * 1e3
+                })
+                .collect(),
+        )
     };
     let (frame_ms, relight_ms, kept) = if crate::compute::is_cpu(device) {
         let kept = host.transfer_codes(&features);

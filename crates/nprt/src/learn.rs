@@ -10,9 +10,9 @@ use nprt_net::{device_name, is_cpu, Backend, Device};
 
 use crate::{DeviceArg, RunLength};
 use nprt_net::{
-    layer_table, measure_throughput, recipe_rate, Activation, Design, DirectLight, Engine, Init,
-    Loss, MapNorm, ModelConfig, PositionEncoding, Schedule, TrainOptions, DEFAULT_ENCODER_WIDTH,
-    DEFAULT_MAP_NORM,
+    layer_table, measure_throughput, median, recipe_rate, Activation, Design, DirectLight, Engine,
+    Init, Loss, MapNorm, ModelConfig, PositionEncoding, Schedule, TrainOptions,
+    DEFAULT_ENCODER_WIDTH, DEFAULT_MAP_NORM,
 };
 
 #[derive(clap::Args)]
@@ -165,6 +165,10 @@ pub struct BenchTrainArgs {
     /// Untimed steps before them (a GPU compiles and tunes its kernels in the first steps).
     #[arg(long, default_value_t = 2)]
     warmup: usize,
+    /// Rounds per design, each timing the PyTorch peer and then nprt; the medians are
+    /// compared, and the range of the rounds' ratios is printed beside them.
+    #[arg(long, default_value_t = 3)]
+    rounds: usize,
     /// Python with PyTorch for the side-by-side peer (bench/train_vs_pytorch.sh installs one);
     /// it runs on the same device (CUDA for a GPU).
     #[arg(long)]
@@ -382,8 +386,10 @@ fn bench_train(a: BenchTrainArgs) -> Result<()> {
     let threads = rayon::current_num_threads();
     let device = a.device.device()?;
     let cpu = is_cpu(&device);
+    let rounds = a.rounds.max(1);
     println!(
-        "training throughput on {}, batch {}, {} maps per batch, {} timed steps, {threads} threads",
+        "training throughput on {}, batch {}, {} maps per batch, {} timed steps, {threads} threads, \
+         median of {rounds} rounds",
         device_name(&device),
         a.batch_size,
         a.views,
@@ -396,21 +402,27 @@ fn bench_train(a: BenchTrainArgs) -> Result<()> {
         Backend::Wgpu => None,
     };
     let peer = match (&a.python, torch_device) {
-        (Some(py), Some(torch_device)) => run_pytorch(py, &a, threads, torch_device)?,
+        (Some(py), Some(torch_device)) => Some((py, torch_device)),
         (Some(_), None) => {
             println!("(PyTorch has no wgpu device: peer skipped)");
-            Vec::new()
+            None
         }
         (None, _) => {
             println!(
                 "(no --python given: PyTorch peer skipped; bench/train_vs_pytorch.sh sets one up)"
             );
-            Vec::new()
+            None
         }
     };
     println!(
-        "{:<10} {:<6} {:>14} {:>18} {:>17} {:>8}",
-        "design", "act", "nprt samples/s", "autodiff samples/s", "PyTorch samples/s", "ratio"
+        "{:<10} {:<6} {:>14} {:>18} {:>17} {:>8} {:>15}",
+        "design",
+        "act",
+        "nprt samples/s",
+        "autodiff samples/s",
+        "PyTorch samples/s",
+        "ratio",
+        "rounds' ratios"
     );
     for &arch in &a.designs.arch {
         let config = ModelConfig::new(arch, a.activation);
@@ -425,36 +437,54 @@ fn bench_train(a: BenchTrainArgs) -> Result<()> {
                 &device,
             )
         };
-        let ours = measure(Engine::Auto);
+        // Rounds alternate the peer and nprt, so that a drift in the machine's speed (identical
+        // runs here differ by up to 30%) reaches both alike; medians are compared.
+        let mut ours = Vec::new();
+        let mut theirs = Vec::new();
+        for _ in 0..rounds {
+            if let Some((py, torch_device)) = peer {
+                theirs.push(run_pytorch(py, &a, arch, threads, torch_device)?);
+            }
+            ours.push(measure(Engine::Auto));
+        }
+        let ratios: Vec<f64> = ours.iter().zip(&theirs).map(|(o, t)| o / t).collect();
+        let ours = median(ours);
         // Off the CPU burn's autodiff is the only path, so the column would repeat the first.
         let autodiff = cpu.then(|| measure(Engine::Autodiff));
-        let theirs = peer.iter().find(|p| p.0 == arch.name()).map(|p| p.1);
+        let theirs = (!theirs.is_empty()).then(|| median(theirs));
+        let spread = match ratios.iter().copied().reduce(f64::min) {
+            Some(low) => {
+                let high = ratios.iter().copied().fold(low, f64::max);
+                format!("{low:.2}–{high:.2}×")
+            }
+            None => "-".into(),
+        };
         println!(
-            "{:<10} {:<6} {:>14.0} {:>18} {:>17} {:>8}",
+            "{:<10} {:<6} {:>14.0} {:>18} {:>17} {:>8} {:>15}",
             arch.name(),
             config.activation.name(),
             ours,
             autodiff.map_or("-".into(), |t| format!("{t:.0}")),
             theirs.map_or("-".into(), |t| format!("{t:.0}")),
-            theirs.map_or("-".into(), |t| format!("{:.2}×", ours / t))
+            theirs.map_or("-".into(), |t| format!("{:.2}×", ours / t)),
+            spread
         );
     }
     Ok(())
 }
 
-/// Runs bench/train_pytorch.py first (so both see the same idle machine state in turn) and
-/// returns (design, samples/s) pairs.
+/// Runs bench/train_pytorch.py for one design and returns its samples/s.
 fn run_pytorch(
     python: &PathBuf,
     a: &BenchTrainArgs,
+    design: Design,
     threads: usize,
     torch_device: &str,
-) -> Result<Vec<(String, f64)>> {
+) -> Result<f64> {
     let script = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../bench/train_pytorch.py");
-    let designs: Vec<&str> = a.designs.arch.iter().map(|d| d.name()).collect();
     let mut cmd = Process::new(python);
     cmd.arg(&script)
-        .args(["--designs", &designs.join(",")])
+        .args(["--designs", design.name()])
         .args(["--batch-size", &a.batch_size.to_string()])
         .args(["--views", &a.views.to_string()])
         .args(["--steps", &a.steps.to_string()])
@@ -476,15 +506,14 @@ fn run_pytorch(
                 .unwrap_or("")
         );
     }
-    String::from_utf8_lossy(&out.stdout)
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    let line = stdout
         .lines()
-        .map(|l| {
-            let v: serde_json::Value =
-                serde_json::from_str(l).context("PyTorch peer printed non-JSON")?;
-            Ok((
-                v["design"].as_str().unwrap_or_default().to_string(),
-                v["samples_per_s"].as_f64().unwrap_or(f64::NAN),
-            ))
-        })
-        .collect()
+        .last()
+        .context("PyTorch peer printed nothing")?;
+    let v: serde_json::Value =
+        serde_json::from_str(line).context("PyTorch peer printed non-JSON")?;
+    v["samples_per_s"]
+        .as_f64()
+        .context("PyTorch peer printed no samples_per_s")
 }

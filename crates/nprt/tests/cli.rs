@@ -246,3 +246,67 @@ fn device_gpu_without_one_fails_clearly_and_auto_falls_back() {
     assert!(!bad.status.success());
     assert!(String::from_utf8_lossy(&bad.stderr).contains("expected cpu, gpu, wgpu or auto"));
 }
+
+/// A stand-in for the PyTorch peer: a script that reports the samples/s listed in `rates`,
+/// one per call in turn (its calls counted in `calls`), or fails with `boom` when `rates` is
+/// empty.
+fn fake_peer(dir: &std::path::Path, rates: &[u32]) -> std::path::PathBuf {
+    let script = dir.join("python");
+    let calls = dir.join("calls");
+    let body = if rates.is_empty() {
+        "echo boom >&2; exit 1".to_string()
+    } else {
+        format!(
+            "echo x >> '{calls}'; n=$(wc -l < '{calls}'); rates=({rates})\n\
+             echo \"{{\\\"design\\\": \\\"baseline\\\", \\\"samples_per_s\\\": ${{rates[$((n - 1))]}}}}\"",
+            calls = calls.display(),
+            rates = rates.iter().map(u32::to_string).collect::<Vec<_>>().join(" ")
+        )
+    };
+    std::fs::write(&script, format!("#!/usr/bin/env bash\n{body}\n")).unwrap();
+    use std::os::unix::fs::PermissionsExt;
+    std::fs::set_permissions(&script, std::fs::Permissions::from_mode(0o755)).unwrap();
+    script
+}
+
+#[test]
+fn bench_train_alternates_rounds_with_the_peer_and_compares_medians() {
+    let dir = tmp("bench-peer");
+    let args = |python: &std::path::Path| {
+        let mut a: Vec<String> = "bench train --arch baseline --batch-size 64 --views 1 \
+                                  --steps 1 --warmup 0 --rounds 3 --device cpu --python"
+            .split(' ')
+            .map(String::from)
+            .collect();
+        a.push(python.display().to_string());
+        a
+    };
+    let python = fake_peer(&dir, &[1000, 5000, 2000]);
+    let a = args(&python);
+    let out = common::ok(&a.iter().map(String::as_str).collect::<Vec<_>>());
+    // One peer run per round, and the median of its three rates (not their mean, 2667) in
+    // the PyTorch column.
+    let calls = std::fs::read_to_string(dir.join("calls")).unwrap();
+    assert_eq!(calls.lines().count(), 3, "{out}");
+    let row: Vec<&str> = out
+        .lines()
+        .find(|l| l.starts_with("baseline"))
+        .unwrap_or_else(|| panic!("no baseline row in:\n{out}"))
+        .split_whitespace()
+        .collect();
+    assert_eq!(row[4], "2000", "{out}");
+    let ours: f64 = row[2].parse().unwrap();
+    let ratio: f64 = row[5].trim_end_matches('×').parse().unwrap();
+    assert!((ratio - ours / 2000.0).abs() <= 0.01, "{out}");
+    assert!(
+        row[6].contains('–'),
+        "no range of the rounds' ratios: {out}"
+    );
+
+    let failing = fake_peer(&tmp("bench-peer-fails"), &[]);
+    let a = args(&failing);
+    common::fails(
+        &a.iter().map(String::as_str).collect::<Vec<_>>(),
+        &["PyTorch peer failed: boom"],
+    );
+}
