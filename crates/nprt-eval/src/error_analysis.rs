@@ -42,6 +42,7 @@ impl Accumulator {
                 validation: vec![],
                 level: [f64::NAN; 3],
                 tint_error: f64::NAN,
+                equal_time: None,
             },
             err: vec![],
             direct: vec![],

@@ -19,8 +19,8 @@ use serde::{Deserialize, Serialize};
 
 use crate::method::{Family, MethodResult};
 use crate::metrics::Metrics;
-use crate::networks::{load_networks, run_networks};
-use crate::path_tracing::{equal_time_spp, run_denoised, run_path_tracing};
+use crate::networks::{load_networks, run_networks, Net};
+use crate::path_tracing::{equal_time_spp, run_denoised, run_path_tracing, Traced};
 use crate::sh_prt::run_sh_prt;
 use crate::test_bench::TestBench;
 use crate::timing::{time_table, Timing};
@@ -51,6 +51,7 @@ pub struct Evaluation {
     pub test_views: usize,
     pub resolution: [usize; 2],
     pub foreground_pixels: usize,
+    /// Path tracing's sample count at the cost of the slowest design.
     pub equal_time_spp: u32,
     /// Samples per pixel of the references (the test views).
     #[serde(default)]
@@ -140,7 +141,16 @@ pub fn evaluate(o: &EvalOptions, device: &Device) -> Result<Evaluation> {
         Ok(_) => nets.iter().filter(|(n, _)| n.traces_direct()).count(),
         Err(_) => 0,
     };
-    let total_steps = (views.len() * (nets.len() + denoised_nets + 3)) as u64;
+    // Per view: each network (and denoised traced design), path tracing at 5 spp and at each
+    // tier's equal time (at most two), SH PRT.
+    let tiers = nets
+        .iter()
+        .filter(|(n, _)| n.family() == Family::NeuralPrt)
+        .map(|(n, _)| n.traces_direct())
+        .collect::<BTreeSet<_>>()
+        .len()
+        .max(1);
+    let total_steps = (views.len() * (nets.len() + denoised_nets + 2 + tiers)) as u64;
     let mut bench = TestBench {
         views: &views,
         maps: &maps,
@@ -153,40 +163,43 @@ pub fn evaluate(o: &EvalOptions, device: &Device) -> Result<Evaluation> {
     };
 
     let mut results = run_networks(&mut bench, &nets, oidn.as_ref().ok().copied())?;
-    // Equal time is set by the Neural PRT designs (Deep Shading is a baseline); with none, by
-    // whatever network was given.
-    let budget = |family: Option<Family>| {
-        results
-            .iter()
-            .filter(|r| family.is_none_or(|f| r.family == f))
-            .map(|r| r.ms_per_view)
-            .fold(0.0, f64::max)
-    };
-    let slowest_ms = match budget(Some(Family::NeuralPrt)) {
-        0.0 => budget(None),
-        ms => ms,
-    };
     let pt5 = run_path_tracing(&mut bench, "pt-5spp", 5, 0x5eed_0005);
-    let equal_time_spp = equal_time_spp(&pt5.result, slowest_ms);
-    let mut pteq = run_path_tracing(
-        &mut bench,
-        &format!("pt-equal-time ({equal_time_spp} spp)"),
-        equal_time_spp,
-        0x5eed_e9a1,
-    );
-    pteq.result.note = format!(
-        "{equal_time_spp} spp: the time of the slowest design ({slowest_ms:.0} ms per view)"
-    );
+    let mut equal_time = Vec::new();
+    for tier in equal_time_tiers(&nets, &results) {
+        let spp = equal_time_spp(&pt5.result, tier.ms);
+        let name = format!("pt-equal-time ({spp} spp)");
+        let denoised = format!("{name} + OIDN");
+        for r in results.iter_mut().filter(|r| tier.rows.contains(&r.name)) {
+            r.equal_time = Some(name.clone());
+        }
+        for r in results.iter_mut() {
+            let plain = r.name.strip_suffix(" + OIDN").unwrap_or(&r.name);
+            if r.family == Family::Denoised && tier.rows.iter().any(|t| t == plain) {
+                r.equal_time = Some(denoised.clone());
+            }
+        }
+        // Two tiers of equal cost share one row.
+        if equal_time.iter().any(|(n, _): &(u32, Traced)| *n == spp) {
+            continue;
+        }
+        let mut pt = run_path_tracing(&mut bench, &name, spp, 0x5eed_e9a1);
+        pt.result.note = format!(
+            "{spp} spp: the time of {} ({:.0} ms per view)",
+            tier.what, tier.ms
+        );
+        equal_time.push((spp, pt));
+    }
+    let equal_time_spp = equal_time.iter().map(|(n, _)| *n).max().unwrap_or(5);
     let mut baselines = Vec::new();
     if let Ok(oidn) = &oidn {
-        for base in [&pt5, &pteq] {
+        for base in std::iter::once(&pt5).chain(equal_time.iter().map(|(_, t)| t)) {
             baselines.push(run_denoised(&mut bench, oidn, base)?);
         }
     }
     baselines.extend(run_sh_prt(&mut bench, o.sh_spp));
     bench.bar.finish_and_clear();
     results.push(pt5.result);
-    results.push(pteq.result);
+    results.extend(equal_time.into_iter().map(|(_, t)| t.result));
     results.extend(baselines);
 
     let timings = time_table(
@@ -253,10 +266,6 @@ impl Evaluation {
             ));
         }
         let sh9 = self.method("sh-prt-9");
-        let pteq = self
-            .methods
-            .iter()
-            .find(|m| m.family == Family::PathTracing && m.name.starts_with("pt-equal-time"));
         let beats_in_l1 = |m: &MethodResult, other: &MethodResult| {
             (
                 format!(
@@ -266,24 +275,69 @@ impl Evaluation {
                 m.mean.l1 < other.mean.l1,
             )
         };
-        for m in self
-            .methods
-            .iter()
-            .filter(|m| m.family == Family::NeuralPrt)
-        {
-            for other in [sh9, pteq].into_iter().flatten() {
+        // Each design against SH PRT 9 and path tracing of its own cost; a design whose traced
+        // light is denoised, against path tracing denoised alike.
+        for m in self.methods.iter().filter(|m| {
+            m.family == Family::NeuralPrt
+                || (m.family == Family::Denoised && m.name.starts_with("nprt-"))
+        }) {
+            let sh = sh9.filter(|_| m.family == Family::NeuralPrt);
+            let pt = m.equal_time.as_deref().and_then(|n| self.method(n));
+            for other in [sh, pt].into_iter().flatten() {
                 out.push(beats_in_l1(m, other));
             }
         }
-        // A design whose traced light is denoised against path tracing denoised alike.
-        let pteq_denoised = pteq.and_then(|p| self.method(&format!("{} + OIDN", p.name)));
-        for m in self
-            .methods
-            .iter()
-            .filter(|m| m.family == Family::Denoised && m.name.starts_with("nprt-"))
-        {
-            out.extend(pteq_denoised.map(|other| beats_in_l1(m, other)));
-        }
         out
     }
+}
+
+/// Designs of one cost tier, and the path tracing of their cost they are compared with.
+struct Tier {
+    /// The tier's slowest design, in words.
+    what: &'static str,
+    ms: f64,
+    /// Names of the tier's rows.
+    rows: Vec<String>,
+}
+
+/// Equal time is set per tier of Neural PRT designs: those that learn all their light, and
+/// those that trace their direct light, which costs them the tracing too. Each design is held
+/// to path tracing of its tier's slowest design, not to one that costs the traced designs'
+/// time. With no design, the slowest network given (Deep Shading is a baseline) sets it.
+fn equal_time_tiers(nets: &[(Net, String)], results: &[MethodResult]) -> Vec<Tier> {
+    let slowest = |rows: &[String]| {
+        results
+            .iter()
+            .filter(|r| rows.contains(&r.name))
+            .map(|r| r.ms_per_view)
+            .fold(0.0, f64::max)
+    };
+    let tiers: Vec<Tier> = [
+        (false, "the slowest design that learns all its light"),
+        (true, "the slowest design that traces its direct light"),
+    ]
+    .into_iter()
+    .map(|(traced, what)| {
+        let rows: Vec<String> = nets
+            .iter()
+            .filter(|(n, _)| n.family() == Family::NeuralPrt && n.traces_direct() == traced)
+            .map(|(_, name)| name.clone())
+            .collect();
+        Tier {
+            what,
+            ms: slowest(&rows),
+            rows,
+        }
+    })
+    .filter(|t| !t.rows.is_empty())
+    .collect();
+    if !tiers.is_empty() {
+        return tiers;
+    }
+    let rows: Vec<String> = nets.iter().map(|(_, name)| name.clone()).collect();
+    vec![Tier {
+        what: "the slowest network",
+        ms: slowest(&rows),
+        rows,
+    }]
 }

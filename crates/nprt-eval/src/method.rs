@@ -72,4 +72,8 @@ pub struct MethodResult {
     /// brightness); averaged over views. It tells a held-out map's colour rendered wrong.
     #[serde(default)]
     pub tint_error: f64,
+    /// The path-tracing row of this method's own cost (Neural PRT designs, and their
+    /// denoised rows), which the paper's claims compare it with.
+    #[serde(default)]
+    pub equal_time: Option<String>,
 }

@@ -239,11 +239,23 @@ pub fn demo(a: DemoArgs) -> Result<()> {
             d.mean.rmse, b.mean.rmse
         );
     }
-    if let (Some(d), Some(dt), Some(sh)) = (l1("nprt-dsep"), l1("nprt-dsep+direct"), l1("sh-prt-9"))
-    {
-        println!("headline: L1 D/S {d:.4}, D/S with traced direct light {dt:.4} vs SH PRT (9) {sh:.4}, equal-time path tracing at {} spp {:.4}",
-            e.equal_time_spp,
-            e.methods.iter().find(|m| m.name.starts_with("pt-equal-time")).map_or(f64::NAN, |m| m.mean.l1));
+    // A design's L1 beside that of path tracing of its own cost.
+    let against_pt = |name: &str| {
+        let m = e.method(name)?;
+        let pt = e.method(m.equal_time.as_deref()?)?;
+        Some(format!(
+            "{:.4} vs equal-time path tracing {} {:.4}",
+            m.mean.l1,
+            pt.name.trim_start_matches("pt-equal-time "),
+            pt.mean.l1
+        ))
+    };
+    if let (Some(d), Some(dt), Some(sh)) = (
+        against_pt("nprt-dsep"),
+        against_pt("nprt-dsep+direct"),
+        l1("sh-prt-9"),
+    ) {
+        println!("headline: L1 D/S {d}; D/S with traced direct light {dt}; SH PRT (9) {sh:.4}");
     }
     let failed = e.checks().into_iter().filter(|c| !c.1).count();
     println!(

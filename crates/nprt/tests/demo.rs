@@ -38,15 +38,42 @@ fn quick_demo_then_render_and_eval() {
     ] {
         assert!(names.contains(&want), "{want} missing from {names:?}");
     }
-    assert!(
-        names.iter().any(|n| n.starts_with("pt-equal-time")),
-        "{names:?}"
-    );
+    // Each design is held to path tracing of its own tier's cost: the traced design to one at
+    // least as dear as the designs that learn all their light.
+    let equal_time_of = |name: &str| -> String {
+        let m = results["methods"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .find(|m| m["name"] == name)
+            .unwrap();
+        let pt = m["equal_time"].as_str().unwrap_or_else(|| panic!("{name}"));
+        assert!(names.contains(&pt), "{name}: {pt} is not a row");
+        pt.to_string()
+    };
+    let spp = |pt: &str| -> u32 {
+        let n = pt.trim_start_matches("pt-equal-time (");
+        n[..n.find(' ').unwrap()].parse().unwrap()
+    };
+    let traced = spp(&equal_time_of("nprt-dsep+direct"));
+    for d in ["nprt-baseline", "nprt-prt", "nprt-albedo", "nprt-dsep"] {
+        assert!(spp(&equal_time_of(d)) <= traced, "{d}");
+    }
+    let equal_time_rows = names
+        .iter()
+        .filter(|n| n.starts_with("pt-equal-time") && !n.ends_with("+ OIDN"))
+        .count();
+    assert!((1..=2).contains(&equal_time_rows), "{names:?}");
     if std::env::var_os("NPRT_REQUIRE_OIDN").is_some() {
-        // Both path-tracing baselines, and the traced direct light of D/S + direct.
+        // Every path-tracing baseline, and the traced direct light of D/S + direct, the latter
+        // held to path tracing denoised alike.
         assert_eq!(
             names.iter().filter(|n| n.ends_with("+ OIDN")).count(),
-            3,
+            2 + equal_time_rows,
+            "{names:?}"
+        );
+        assert!(
+            equal_time_of("nprt-dsep+direct + OIDN").ends_with(" + OIDN"),
             "{names:?}"
         );
         assert!(names.contains(&"nprt-dsep+direct + OIDN"), "{names:?}");
