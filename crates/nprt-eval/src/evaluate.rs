@@ -141,16 +141,10 @@ pub fn evaluate(o: &EvalOptions, device: &Device) -> Result<Evaluation> {
         Ok(_) => nets.iter().filter(|(n, _)| n.traces_direct()).count(),
         Err(_) => 0,
     };
+    let tiers = equal_time_tiers(&nets);
     // Per view: each network (and denoised traced design), path tracing at 5 spp and at each
-    // tier's equal time (at most two), SH PRT.
-    let tiers = nets
-        .iter()
-        .filter(|(n, _)| n.family() == Family::NeuralPrt)
-        .map(|(n, _)| n.traces_direct())
-        .collect::<BTreeSet<_>>()
-        .len()
-        .max(1);
-    let total_steps = (views.len() * (nets.len() + denoised_nets + 2 + tiers)) as u64;
+    // tier's equal time, SH PRT.
+    let total_steps = (views.len() * (nets.len() + denoised_nets + 2 + tiers.len())) as u64;
     let mut bench = TestBench {
         views: &views,
         maps: &maps,
@@ -164,29 +158,28 @@ pub fn evaluate(o: &EvalOptions, device: &Device) -> Result<Evaluation> {
 
     let mut results = run_networks(&mut bench, &nets, oidn.as_ref().ok().copied())?;
     let pt5 = run_path_tracing(&mut bench, "pt-5spp", 5, 0x5eed_0005);
-    let mut equal_time = Vec::new();
-    for tier in equal_time_tiers(&nets, &results) {
-        let spp = equal_time_spp(&pt5.result, tier.ms);
+    let mut equal_time: Vec<(u32, Traced)> = Vec::new();
+    for tier in &tiers {
+        let ms = tier.slowest_ms(&results);
+        let spp = equal_time_spp(&pt5.result, ms);
         let name = format!("pt-equal-time ({spp} spp)");
-        let denoised = format!("{name} + OIDN");
-        for r in results.iter_mut().filter(|r| tier.rows.contains(&r.name)) {
-            r.equal_time = Some(name.clone());
-        }
+        // A design's row and its denoised row (traced light denoised), each held to path
+        // tracing treated alike.
         for r in results.iter_mut() {
             let plain = r.name.strip_suffix(" + OIDN").unwrap_or(&r.name);
-            if r.family == Family::Denoised && tier.rows.iter().any(|t| t == plain) {
-                r.equal_time = Some(denoised.clone());
+            if tier.rows.iter().any(|t| t == plain) {
+                r.equal_time = Some(match r.family {
+                    Family::Denoised => format!("{name} + OIDN"),
+                    _ => name.clone(),
+                });
             }
         }
         // Two tiers of equal cost share one row.
-        if equal_time.iter().any(|(n, _): &(u32, Traced)| *n == spp) {
+        if equal_time.iter().any(|(n, _)| *n == spp) {
             continue;
         }
         let mut pt = run_path_tracing(&mut bench, &name, spp, 0x5eed_e9a1);
-        pt.result.note = format!(
-            "{spp} spp: the time of {} ({:.0} ms per view)",
-            tier.what, tier.ms
-        );
+        pt.result.note = format!("{spp} spp: the time of {} ({ms:.0} ms per view)", tier.what);
         equal_time.push((spp, pt));
     }
     let equal_time_spp = equal_time.iter().map(|(n, _)| *n).max().unwrap_or(5);
@@ -291,53 +284,50 @@ impl Evaluation {
     }
 }
 
-/// Designs of one cost tier, and the path tracing of their cost they are compared with.
+/// Designs of one cost tier, which are compared with path tracing of their slowest one's cost.
 struct Tier {
     /// The tier's slowest design, in words.
     what: &'static str,
-    ms: f64,
     /// Names of the tier's rows.
     rows: Vec<String>,
+}
+
+impl Tier {
+    /// Time per view of the tier's slowest design.
+    fn slowest_ms(&self, results: &[MethodResult]) -> f64 {
+        results
+            .iter()
+            .filter(|r| self.rows.contains(&r.name))
+            .map(|r| r.ms_per_view)
+            .fold(0.0, f64::max)
+    }
 }
 
 /// Equal time is set per tier of Neural PRT designs: those that learn all their light, and
 /// those that trace their direct light, which costs them the tracing too. Each design is held
 /// to path tracing of its tier's slowest design, not to one that costs the traced designs'
 /// time. With no design, the slowest network given (Deep Shading is a baseline) sets it.
-fn equal_time_tiers(nets: &[(Net, String)], results: &[MethodResult]) -> Vec<Tier> {
-    let slowest = |rows: &[String]| {
-        results
-            .iter()
-            .filter(|r| rows.contains(&r.name))
-            .map(|r| r.ms_per_view)
-            .fold(0.0, f64::max)
-    };
+fn equal_time_tiers(nets: &[(Net, String)]) -> Vec<Tier> {
     let tiers: Vec<Tier> = [
         (false, "the slowest design that learns all its light"),
         (true, "the slowest design that traces its direct light"),
     ]
     .into_iter()
-    .map(|(traced, what)| {
-        let rows: Vec<String> = nets
+    .map(|(traced, what)| Tier {
+        what,
+        rows: nets
             .iter()
             .filter(|(n, _)| n.family() == Family::NeuralPrt && n.traces_direct() == traced)
             .map(|(_, name)| name.clone())
-            .collect();
-        Tier {
-            what,
-            ms: slowest(&rows),
-            rows,
-        }
+            .collect(),
     })
     .filter(|t| !t.rows.is_empty())
     .collect();
     if !tiers.is_empty() {
         return tiers;
     }
-    let rows: Vec<String> = nets.iter().map(|(_, name)| name.clone()).collect();
     vec![Tier {
         what: "the slowest network",
-        ms: slowest(&rows),
-        rows,
+        rows: nets.iter().map(|(_, name)| name.clone()).collect(),
     }]
 }
