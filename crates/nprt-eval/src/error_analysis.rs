@@ -59,11 +59,9 @@ impl Accumulator {
             .per_view
             .push(Metrics::compute(pred, &view.radiance, &g.mask, view.width));
         self.ms.push(ms);
-        let mut sums = [DVec3::ZERO; 2];
+        let sums = [light(pred, &g.mask), light(&view.radiance, &g.mask)];
         for i in (0..g.mask.len()).filter(|&i| g.mask[i] > 0.5) {
             let r = view.radiance[i];
-            sums[0] += pred[i].as_dvec3();
-            sums[1] += r.as_dvec3();
             self.err
                 .push(((pred[i] - r).abs().element_sum() / 3.0) as f64);
             self.direct
@@ -88,6 +86,17 @@ impl Accumulator {
         r.tint_error = self.tints.iter().sum::<f64>() / self.tints.len().max(1) as f64;
         self.result
     }
+}
+
+/// The light an image shows on the foreground, per channel: negative values (SH PRT's ringing)
+/// count as none, as on a display. Summed as they were, an SH frame whose light summed to about
+/// zero gave a tint error of order 1e10; with the levels non-negative it is at most 2.
+fn light(rgb: &[Vec3], mask: &[f32]) -> DVec3 {
+    rgb.iter()
+        .zip(mask)
+        .filter(|(_, &m)| m > 0.5)
+        .map(|(c, _)| c.max(Vec3::ZERO).as_dvec3())
+        .sum()
 }
 
 /// The largest relative deviation of a channel's level from the mean of the three.
@@ -122,5 +131,22 @@ mod tests {
         // A warm map rendered neutral: red 20% under the mean, blue 20% over it.
         assert!((tint_error(DVec3::new(0.8, 1.0, 1.2)) - 0.2).abs() < 1e-12);
         assert!((tint_error(DVec3::new(0.4, 0.5, 0.6)) - 0.2).abs() < 1e-12);
+    }
+
+    #[test]
+    fn negative_light_counts_as_none_so_the_tint_error_stays_bounded() {
+        let mask = [1.0, 1.0, 0.0];
+        // The second pixel rings below zero in green and blue; the third is background.
+        let rgb = [
+            Vec3::new(0.5, 0.2, 0.1),
+            Vec3::new(0.1, -0.2, -0.1),
+            Vec3::splat(9.0),
+        ];
+        let l = light(&rgb, &mask);
+        assert!((l - DVec3::new(0.6, 0.2, 0.1)).abs().max_element() < 1e-6);
+        // Light in one channel only: the largest tint error there is.
+        assert!((tint_error(DVec3::new(3.0, 0.0, 0.0)) - 2.0).abs() < 1e-12);
+        let dark = light(&[Vec3::splat(-1.0)], &[1.0]);
+        assert!(tint_error(dark) < 1e-12);
     }
 }

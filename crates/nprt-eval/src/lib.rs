@@ -16,6 +16,7 @@
 //! assert!((m.l1 - 0.1).abs() < 1e-6);
 //! ```
 
+pub mod claim;
 mod error_analysis;
 mod evaluate;
 mod method;

@@ -22,6 +22,10 @@ pub struct Metrics {
 
 impl Metrics {
     pub const NAMES: [&'static str; 7] = ["L1", "L2", "RMSE", "dSSIM", "MAPE", "MRSE", "log-L1"];
+    /// Indices into [`Self::NAMES`] and [`Self::values`].
+    pub const L1: usize = 0;
+    pub const RMSE: usize = 2;
+    pub const LOG_L1: usize = 6;
 
     pub fn values(&self) -> [f64; 7] {
         [

@@ -251,9 +251,15 @@ fn noise_floor_note(md: &mut String, e: &Evaluation) -> Result<()> {
 
 /// Which of the paper's claims hold on this evaluation.
 fn claims(md: &mut String, e: &Evaluation) -> Result<()> {
-    writeln!(md, "## The paper's claims, here\n")?;
-    for (claim, ok) in e.checks() {
-        writeln!(md, "- {} {claim}", if ok { "✅" } else { "❌" })?;
+    writeln!(
+        md,
+        "## The paper's claims, here\n\nEach judged on the per-view differences over the {} test \
+         views: ✅ at least two standard errors in its favour, ❌ two against, ≈ not resolved by \
+         these views (more held-out lightings would decide).\n",
+        e.test_views
+    )?;
+    for c in e.checks() {
+        writeln!(md, "- {} {}", c.verdict.mark(), c.text)?;
     }
     Ok(())
 }

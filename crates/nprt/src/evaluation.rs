@@ -120,8 +120,8 @@ pub fn eval(a: EvalArgs) -> Result<Evaluation> {
             "–"
         );
     }
-    for (claim, ok) in e.checks() {
-        println!("{} {claim}", if ok { "holds: " } else { "FAILS: " });
+    for c in e.checks() {
+        println!("{:<13} {}", format!("{}:", c.verdict.word()), c.text);
     }
     println!("report: {} and {}", md.display(), html.display());
     Ok(e)
