@@ -19,7 +19,7 @@
 //!     volume: scene.camera_volume.clone().unwrap(),
 //!     map_specs,
 //!     maps,
-//!     lighting: dataset::MapAssignment::Pool { test_maps: 1 },
+//!     lighting: dataset::MapAssignment::Pool { test_maps: 1, builtin_share: 0.0 },
 //!     train_views: 2,
 //!     test_views: 1,
 //!     train_resolution: [8, 8],

@@ -14,12 +14,16 @@ use rand_pcg::Pcg64Mcg;
 
 /// The maps of a dataset and how its views take them, from `--envmaps`: `builtin` draws one
 /// fresh procedural lighting per view ([`builtin_per_view`]); a folder's maps form a pool
-/// with `test_maps` of them (default: a fifth) held out for testing.
+/// with `test_maps` of them (default: a fifth) held out for testing, and `builtin_share` of
+/// the training views (drawn by [`takes_builtin`]) take a fresh procedural lighting of their
+/// own instead, listed after the folder's maps, so a few real maps are mixed with many
+/// lightings while the test views keep the held-out real ones.
 pub fn choose(
     envmaps: &str,
     train_views: u64,
     test_views: u64,
     test_maps: Option<usize>,
+    builtin_share: f32,
     seed: u64,
 ) -> Result<(Vec<String>, MapAssignment)> {
     if train_views == 0 || test_views == 0 {
@@ -31,14 +35,42 @@ pub fn choose(
         if test_maps.is_some() {
             bail!("--test-maps applies to a folder of maps; --envmaps builtin gives every view its own lighting");
         }
+        if builtin_share > 0.0 {
+            bail!("--mix-builtin applies to a folder of maps; --envmaps builtin already gives every view its own built-in lighting");
+        }
         return Ok((
             builtin_per_view(train_views, test_views, seed),
             MapAssignment::PerView,
         ));
     }
-    let specs = specs_in_dir(Path::new(envmaps))?;
+    if !(0.0..=1.0).contains(&builtin_share) {
+        bail!(
+            "--mix-builtin is a share of the training views, between 0 and 1; got {builtin_share}"
+        );
+    }
+    let mut specs = specs_in_dir(Path::new(envmaps))?;
     let test_maps = test_maps.unwrap_or_else(|| default_test_count(specs.len()));
-    Ok((specs, MapAssignment::Pool { test_maps }))
+    let mixed = (0..train_views)
+        .filter(|&i| takes_builtin(seed, i, builtin_share))
+        .count() as u64;
+    specs.extend(builtin_per_view(mixed, 0, seed));
+    Ok((
+        specs,
+        MapAssignment::Pool {
+            test_maps,
+            builtin_share,
+        },
+    ))
+}
+
+/// Whether training view `index` of a folder-lit dataset takes its own built-in lighting: a
+/// draw of its own (seeded by `seed` and `index`), so the other views' cameras, maps and
+/// rotations are those of the same dataset without mixing.
+pub fn takes_builtin(seed: u64, index: u64, builtin_share: f32) -> bool {
+    builtin_share > 0.0
+        && Pcg64Mcg::seed_from_u64(seed ^ 0x6d18_b017_7e00 ^ index.wrapping_mul(0x9e37_79b9))
+            .random::<f32>()
+            < builtin_share
 }
 
 /// One built-in lighting per view, drawn from `seed`, training views first: two in three are
@@ -181,9 +213,10 @@ mod tests {
             .count();
         assert!((200..260).contains(&skies), "{skies} skies of 340");
         assert!(load_all(&specs[..6]).is_ok());
-        let (specs, how) = choose("builtin", 3, 2, None, 0).unwrap();
+        let (specs, how) = choose("builtin", 3, 2, None, 0.0, 0).unwrap();
         assert_eq!((specs.len(), how), (5, MapAssignment::PerView));
-        assert!(choose("builtin", 3, 2, Some(1), 0).is_err());
+        assert!(choose("builtin", 3, 2, Some(1), 0.0, 0).is_err());
+        assert!(choose("builtin", 3, 2, None, 0.5, 0).is_err());
     }
 
     #[test]

@@ -123,6 +123,7 @@ pub fn demo(a: DemoArgs) -> Result<()> {
         jitter_exposure: 1.0,
         jitter_tint: 0.3,
         test_maps: None,
+        mix_builtin: 0.0,
         shard: (0, 1),
         camera_volume: None,
         volume_min: None,

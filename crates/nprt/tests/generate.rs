@@ -292,6 +292,75 @@ fn real_maps_and_a_file_scene_with_flags_work() {
     assert!(ok(&["dataset", "verify", dir.to_str().unwrap()]).contains("3 of 3"));
 }
 
+/// `--mix-builtin`: some training views of a folder-lit dataset get a built-in lighting of
+/// their own, listed after the folder's maps; the test views keep the held-out folder maps.
+#[test]
+fn a_folder_of_maps_mixes_in_builtin_lightings() {
+    let dir = tmp("mixed");
+    let maps = assets().join("envmaps");
+    fn args<'a>(out: &'a str, envmaps: &'a str, share: &'a str) -> Vec<&'a str> {
+        [
+            "generate",
+            "--out",
+            out,
+            "--scene",
+            "builtin:room",
+            "--envmaps",
+            envmaps,
+            "--mix-builtin",
+            share,
+            "--train-views",
+            "8",
+            "--test-views",
+            "2",
+            "--train-res",
+            "8",
+            "--test-res",
+            "8",
+            "--spp",
+            "1",
+            "--test-spp",
+            "2",
+        ]
+        .into()
+    }
+    let d = dir.to_str().unwrap();
+    ok(&args(d, maps.to_str().unwrap(), "0.5"));
+    let m: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(dir.join("manifest.json")).unwrap()).unwrap();
+    let specs: Vec<&str> = m["settings"]["envmaps"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|e| e["spec"].as_str().unwrap())
+        .collect();
+    let folder = specs
+        .iter()
+        .take_while(|s| !s.starts_with("builtin:"))
+        .count();
+    assert_eq!(folder, 3, "{specs:?}");
+    let own: Vec<u64> = m["views"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .filter(|v| v["map"].as_u64().unwrap() >= 3)
+        .map(|v| {
+            assert_eq!(v["split"], "train", "a test view took a built-in map");
+            v["map"].as_u64().unwrap()
+        })
+        .collect();
+    assert!(!own.is_empty() && own.len() < 8, "{own:?}");
+    assert_eq!(own, (3..specs.len() as u64).collect::<Vec<_>>());
+    let never = tmp("never-mixed");
+    let n = never.to_str().unwrap();
+    fails(
+        &args(n, maps.to_str().unwrap(), "1.5"),
+        &["between 0 and 1"],
+    );
+    fails(&args(n, "builtin", "0.5"), &["applies to a folder"]);
+    assert!(!never.exists());
+}
+
 #[test]
 fn hand_edited_manifests_are_refused_by_name_in_every_command() {
     let dir = tmp("edited");

@@ -179,7 +179,10 @@ mod tests {
             volume: scene.camera_volume.clone().unwrap(),
             map_specs,
             maps,
-            lighting: MapAssignment::Pool { test_maps: 1 },
+            lighting: MapAssignment::Pool {
+                test_maps: 1,
+                builtin_share: 0.0,
+            },
             train_views: 1,
             test_views: 1,
             train_resolution: [8, 8],

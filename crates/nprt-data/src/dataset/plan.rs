@@ -37,10 +37,15 @@ pub struct Request<'a> {
 }
 
 /// How the views of a dataset take their maps.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, PartialEq)]
 pub enum MapAssignment {
-    /// This many maps are held out for testing; each view draws one of its split's maps.
-    Pool { test_maps: usize },
+    /// This many maps are held out for testing; each view draws one of its split's maps,
+    /// except the training views [`crate::lighting::takes_builtin`] picks with
+    /// `builtin_share`: each of those has its own map, the maps after the pool's, in view order.
+    Pool {
+        test_maps: usize,
+        builtin_share: f32,
+    },
     /// The maps are one per view in view order (training views first), so no two views share
     /// a lighting and the test views' lightings are never trained on.
     PerView,
@@ -49,17 +54,41 @@ pub enum MapAssignment {
 /// Builds the manifest: cameras, maps and rotations of every view, from the settings alone.
 pub fn plan(req: &Request, ts: &TraceScene) -> Result<Manifest> {
     let views_total = (req.train_views + req.test_views) as usize;
-    let (train_maps, test_maps) = match req.lighting {
-        MapAssignment::Pool { test_maps } => {
-            crate::lighting::split(req.maps.len(), test_maps, req.seed)?
+    let builtin_share = match req.lighting {
+        MapAssignment::Pool { builtin_share, .. } => builtin_share,
+        MapAssignment::PerView => 0.0,
+    };
+    let own_map = |index: u64| crate::lighting::takes_builtin(req.seed, index, builtin_share);
+    let mixed = (0..req.train_views).filter(|&i| own_map(i)).count();
+    // The maps the training views draw from, then each split's maps as recorded: the training
+    // views' with the mixed views' own maps, which follow the pool's.
+    let (train_pool, train_maps, test_maps) = match req.lighting {
+        MapAssignment::Pool { test_maps, .. } => {
+            let Some(folder) = req.maps.len().checked_sub(mixed) else {
+                bail!(
+                    "{mixed} training views take a built-in lighting of their own, but only {} maps were given",
+                    req.maps.len()
+                );
+            };
+            let (train, test) = crate::lighting::split(folder, test_maps, req.seed)?;
+            let recorded = train
+                .iter()
+                .copied()
+                .chain(folder..req.maps.len())
+                .collect();
+            (train, recorded, test)
         }
         MapAssignment::PerView if req.maps.len() != views_total => bail!(
             "one map per view needs {views_total} maps, got {}",
             req.maps.len()
         ),
         MapAssignment::PerView => {
-            let train = req.train_views as usize;
-            ((0..train).collect(), (train..views_total).collect())
+            let train: Vec<usize> = (0..req.train_views as usize).collect();
+            (
+                train.clone(),
+                train,
+                (req.train_views as usize..views_total).collect(),
+            )
         }
     };
     check_jitter(&req.jitter)?;
@@ -104,10 +133,11 @@ pub fn plan(req: &Request, ts: &TraceScene) -> Result<Manifest> {
         },
     };
     let mut views = Vec::with_capacity((req.train_views + req.test_views) as usize);
+    let mut next_own = req.maps.len() - mixed;
     for index in 0..req.train_views + req.test_views {
         let train = index < req.train_views;
-        let (split, local, pool, [w, h]) = if train {
-            ("train", index, &train_maps, req.train_resolution)
+        let (split, local, maps, [w, h]) = if train {
+            ("train", index, &train_pool, req.train_resolution)
         } else {
             (
                 "test",
@@ -121,10 +151,14 @@ pub fn plan(req: &Request, ts: &TraceScene) -> Result<Manifest> {
                 .wrapping_add(0x1f83_d9ab_fb41_bd6b)
                 .wrapping_mul(index + 1),
         );
-        let drawn = pool[(rng.random::<u64>() % pool.len() as u64) as usize];
+        let drawn = maps[(rng.random::<u64>() % maps.len() as u64) as usize];
         let map = match req.lighting {
-            MapAssignment::Pool { .. } => drawn,
             MapAssignment::PerView => index as usize,
+            MapAssignment::Pool { .. } if train && own_map(index) => {
+                next_own += 1;
+                next_own - 1
+            }
+            MapAssignment::Pool { .. } => drawn,
         };
         let rotation_deg = rng.random::<f32>() * 360.0;
         let seed = rng.random::<u64>();
@@ -179,4 +213,71 @@ fn jittered_gain(j: &Jitter, rng: &mut Pcg64Mcg) -> [f32; 3] {
     let (e, r, b) = (stops(j.exposure), stops(j.tint), stops(j.tint));
     let tint = glam::Vec3::new(r.exp2(), 1.0, b.exp2());
     (tint / nprt_scene::luminance(tint) * e.exp2()).to_array()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::lighting::{builtin_per_view, load_all, takes_builtin};
+    use nprt_scene::{load_scene, SceneOptions};
+
+    /// Mixing built-in lightings into a pool of maps gives the picked training views their own
+    /// maps and leaves every other view, the test views among them, as without mixing.
+    #[test]
+    fn mixed_training_views_take_their_own_maps_and_leave_the_rest_alone() {
+        let scene = load_scene("builtin:room", &SceneOptions::default()).unwrap();
+        let ts = TraceScene::new(&scene);
+        let (train_views, seed, share) = (40, 7, 0.5);
+        let pool: Vec<String> = (1..=4).map(|i| format!("builtin:indoor:{i}")).collect();
+        let mixed = (0..train_views)
+            .filter(|&i| takes_builtin(seed, i, share))
+            .count();
+        assert!((8..32).contains(&mixed), "{mixed} of {train_views} mixed");
+        let manifest = |specs: Vec<String>, builtin_share| {
+            let req = Request {
+                scene_spec: "builtin:room".into(),
+                scene: &scene,
+                scene_source: vec![],
+                volume: scene.camera_volume.clone().unwrap(),
+                maps: load_all(&specs).unwrap(),
+                map_specs: specs,
+                lighting: MapAssignment::Pool {
+                    test_maps: 1,
+                    builtin_share,
+                },
+                train_views,
+                test_views: 6,
+                train_resolution: [4, 4],
+                test_resolution: [4, 4],
+                spp: 1,
+                test_spp: 2,
+                seed,
+                jitter: Jitter::default(),
+            };
+            plan(&req, &ts)
+        };
+        let plain = manifest(pool.clone(), 0.0).unwrap();
+        let own = builtin_per_view(mixed as u64, 0, seed);
+        let with = manifest([pool.clone(), own].concat(), share).unwrap();
+        let (p, w) = (&plain.settings, &with.settings);
+        assert_eq!(p.test_maps, w.test_maps);
+        assert_eq!(w.train_maps.len(), p.train_maps.len() + mixed);
+        let mut next = pool.len();
+        for (a, b) in plain.views.iter().zip(&with.views) {
+            if a.split == "train" && takes_builtin(seed, a.index, share) {
+                assert_eq!(b.map, next, "view {}", a.index);
+                next += 1;
+            } else {
+                assert_eq!(a.map, b.map, "view {}", a.index);
+                assert!(b.map < pool.len());
+            }
+            assert_eq!(
+                (a.camera_to_world, a.rotation_deg, a.seed),
+                (b.camera_to_world, b.rotation_deg, b.seed)
+            );
+        }
+        assert_eq!(next, pool.len() + mixed);
+        let err = manifest(pool, share).unwrap_err().to_string();
+        assert!(err.contains("built-in lighting of their own"), "{err}");
+    }
 }
