@@ -38,8 +38,9 @@ fn quick_demo_then_render_and_eval() {
     ] {
         assert!(names.contains(&want), "{want} missing from {names:?}");
     }
-    // Each design is held to path tracing of its own tier's cost: the traced design to one at
-    // least as dear as the designs that learn all their light.
+    // Each design is held to path tracing of its own tier's cost: the four that learn all their
+    // light share one row, the traced design has its own unless both tiers cost the same spp.
+    // Which tier costs more is a measured time, so it is not asserted.
     let equal_time_of = |name: &str| -> String {
         let m = results["methods"]
             .as_array()
@@ -51,19 +52,20 @@ fn quick_demo_then_render_and_eval() {
         assert!(names.contains(&pt), "{name}: {pt} is not a row");
         pt.to_string()
     };
-    let spp = |pt: &str| -> u32 {
-        let n = pt.trim_start_matches("pt-equal-time (");
-        n[..n.find(' ').unwrap()].parse().unwrap()
-    };
-    let traced = spp(&equal_time_of("nprt-dsep+direct"));
-    for d in ["nprt-baseline", "nprt-prt", "nprt-albedo", "nprt-dsep"] {
-        assert!(spp(&equal_time_of(d)) <= traced, "{d}");
+    let learned = equal_time_of("nprt-dsep");
+    for d in ["nprt-baseline", "nprt-prt", "nprt-albedo"] {
+        assert_eq!(equal_time_of(d), learned, "{d}");
     }
+    let traced = equal_time_of("nprt-dsep+direct");
     let equal_time_rows = names
         .iter()
         .filter(|n| n.starts_with("pt-equal-time") && !n.ends_with("+ OIDN"))
         .count();
-    assert!((1..=2).contains(&equal_time_rows), "{names:?}");
+    assert_eq!(
+        equal_time_rows,
+        if traced == learned { 1 } else { 2 },
+        "{names:?}"
+    );
     if std::env::var_os("NPRT_REQUIRE_OIDN").is_some() {
         // Every path-tracing baseline, and the traced direct light of D/S + direct, the latter
         // held to path tracing denoised alike.
