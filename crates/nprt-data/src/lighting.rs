@@ -50,10 +50,11 @@ pub fn choose(
     }
     let mut specs = specs_in_dir(Path::new(envmaps))?;
     let test_maps = test_maps.unwrap_or_else(|| default_test_count(specs.len()));
-    let mixed = (0..train_views)
-        .filter(|&i| takes_builtin(seed, i, builtin_share))
-        .count() as u64;
-    specs.extend(builtin_per_view(mixed, 0, seed));
+    specs.extend(builtin_per_view(
+        mixed_views(seed, train_views, builtin_share) as u64,
+        0,
+        seed,
+    ));
     Ok((
         specs,
         MapAssignment::Pool {
@@ -71,6 +72,14 @@ pub fn takes_builtin(seed: u64, index: u64, builtin_share: f32) -> bool {
         && Pcg64Mcg::seed_from_u64(seed ^ 0x6d18_b017_7e00 ^ index.wrapping_mul(0x9e37_79b9))
             .random::<f32>()
             < builtin_share
+}
+
+/// How many of `train_views` training views [`takes_builtin`] picks: the built-in maps a
+/// mixed dataset lists after its folder's.
+pub fn mixed_views(seed: u64, train_views: u64, builtin_share: f32) -> usize {
+    (0..train_views)
+        .filter(|&i| takes_builtin(seed, i, builtin_share))
+        .count()
 }
 
 /// One built-in lighting per view, drawn from `seed`, training views first: two in three are

@@ -59,7 +59,7 @@ pub fn plan(req: &Request, ts: &TraceScene) -> Result<Manifest> {
         MapAssignment::PerView => 0.0,
     };
     let own_map = |index: u64| crate::lighting::takes_builtin(req.seed, index, builtin_share);
-    let mixed = (0..req.train_views).filter(|&i| own_map(i)).count();
+    let mixed = crate::lighting::mixed_views(req.seed, req.train_views, builtin_share);
     // The maps the training views draw from, then each split's maps as recorded: the training
     // views' with the mixed views' own maps, which follow the pool's.
     let (train_pool, train_maps, test_maps) = match req.lighting {
@@ -218,7 +218,7 @@ fn jittered_gain(j: &Jitter, rng: &mut Pcg64Mcg) -> [f32; 3] {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::lighting::{builtin_per_view, load_all, takes_builtin};
+    use crate::lighting::{builtin_per_view, load_all, mixed_views, takes_builtin};
     use nprt_scene::{load_scene, SceneOptions};
 
     /// Mixing built-in lightings into a pool of maps gives the picked training views their own
@@ -229,9 +229,7 @@ mod tests {
         let ts = TraceScene::new(&scene);
         let (train_views, seed, share) = (40, 7, 0.5);
         let pool: Vec<String> = (1..=4).map(|i| format!("builtin:indoor:{i}")).collect();
-        let mixed = (0..train_views)
-            .filter(|&i| takes_builtin(seed, i, share))
-            .count();
+        let mixed = mixed_views(seed, train_views, share);
         assert!((8..32).contains(&mixed), "{mixed} of {train_views} mixed");
         let manifest = |specs: Vec<String>, builtin_share| {
             let req = Request {
