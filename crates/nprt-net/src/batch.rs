@@ -57,6 +57,38 @@ impl Batch {
         b
     }
 
+    /// Batches of at most `batch_size` over a fixed, evenly strided subset of at most
+    /// `max_samples` of `views`' pixels, each holding only the maps of the views it touches: the
+    /// same pixels every time, for a loss or a level measured across a run.
+    pub fn strided<'a>(
+        views: &'a [&'a ViewSamples],
+        max_samples: usize,
+        batch_size: usize,
+    ) -> impl Iterator<Item = Batch> + 'a {
+        let total: usize = views.iter().map(|v| v.len()).sum();
+        let stride = total.div_ceil(max_samples.max(1)).max(1);
+        let picked: Vec<(u32, u32)> = views
+            .iter()
+            .enumerate()
+            .flat_map(|(v, view)| (0..view.len() as u32).map(move |p| (v as u32, p)))
+            .step_by(stride)
+            .collect();
+        let chunks: Vec<Vec<(u32, u32)>> = picked
+            .chunks(batch_size.max(1))
+            .map(<[_]>::to_vec)
+            .collect();
+        chunks.into_iter().map(move |chunk| {
+            let mut used: Vec<u32> = chunk.iter().map(|s| s.0).collect();
+            used.dedup();
+            let local: Vec<(u32, u32)> = chunk
+                .iter()
+                .map(|&(v, p)| (used.partition_point(|&u| u < v) as u32, p))
+                .collect();
+            let sub: Vec<&ViewSamples> = used.iter().map(|&v| views[v as usize]).collect();
+            Batch::gather(&sub, &local)
+        })
+    }
+
     pub fn len(&self) -> usize {
         self.view.len()
     }

@@ -21,6 +21,7 @@
 
 mod activation;
 mod batch;
+mod calibration;
 mod checkpoint;
 mod compute;
 pub mod cpu;
@@ -52,6 +53,7 @@ pub use activation::{Activation, OMEGA_0};
 pub use batch::{Batch, Engine};
 pub use burn;
 pub use burn::tensor::Device;
+pub use calibration::{level_gain, Calibration, LEVEL_SAMPLES};
 pub use checkpoint::RunState;
 pub use compute::{device_name, finish, is_cpu, Backend, Compute};
 pub use design::{Design, NprtNet, TRANSPORT_CODE};

@@ -115,6 +115,17 @@ pub struct ModelFile {
     pub encoder_params: usize,
     /// Training settings and progress (informative).
     pub training: serde_json::Value,
+    /// What the network's radiance is multiplied by, per channel, to have its training targets'
+    /// level (`nprt train --calibrate level`, crate::calibration); absent: as the network says.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub level_gain: Option<[f32; 3]>,
+}
+
+impl ModelFile {
+    /// The gain on each channel of the network's radiance (1 without calibration).
+    pub fn output_gain(&self) -> [f32; 3] {
+        self.level_gain.unwrap_or([1.0; 3])
+    }
 }
 
 /// Writes `model.json` and the weights of `net` into `dir`, each file atomically.

@@ -1,5 +1,5 @@
-//! Parsing of the small named choices (losses, map normalisations, direct light) from their CLI
-//! names.
+//! Parsing of the small named choices (losses, map normalisations, direct light, calibration)
+//! from their CLI names.
 
 use anyhow::{bail, Result};
 
@@ -45,7 +45,7 @@ pub(crate) fn by_name<T: Copy>(
 
 #[cfg(test)]
 mod tests {
-    use crate::{DirectLight, Loss, MapNorm};
+    use crate::{Calibration, DirectLight, Loss, MapNorm};
 
     #[test]
     fn names_parse_and_unknown_ones_list_the_choices() {
@@ -58,6 +58,11 @@ mod tests {
         for d in DirectLight::ALL {
             assert_eq!(d.name().parse::<DirectLight>().unwrap(), d);
         }
+        for c in Calibration::ALL {
+            assert_eq!(c.name().parse::<Calibration>().unwrap(), c);
+        }
+        let err = "mean".parse::<Calibration>().unwrap_err().to_string();
+        assert_eq!(err, "unknown calibration 'mean' (expected none or level)");
         let err = "l2".parse::<Loss>().unwrap_err().to_string();
         assert_eq!(err, "unknown loss 'l2' (expected log-l1 or rel-l2)");
         let err = "max".parse::<MapNorm>().unwrap_err().to_string();

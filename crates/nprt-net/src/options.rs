@@ -4,6 +4,7 @@
 use anyhow::{bail, Result};
 use serde::{Deserialize, Serialize};
 
+use crate::calibration::Calibration;
 use crate::design::Design;
 use crate::loss::Loss;
 use crate::lr_schedule::LrSchedule;
@@ -21,6 +22,10 @@ pub struct TrainOptions {
     /// What training minimises (validation is always the paper's log-L1).
     #[serde(default)]
     pub loss: Loss,
+    /// Whether the saved model's radiance is calibrated to its training targets' level; it
+    /// leaves training itself alone, so it is not part of the run's key.
+    #[serde(default)]
+    pub calibration: Calibration,
 }
 
 impl Default for TrainOptions {
@@ -35,6 +40,7 @@ impl Default for TrainOptions {
             views_per_batch: 8,
             val_samples: 65_536,
             loss: Loss::LogL1,
+            calibration: Calibration::None,
         }
     }
 }

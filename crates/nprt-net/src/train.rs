@@ -13,6 +13,7 @@ use burn::optim::GradientsParams;
 use burn::tensor::Device;
 
 use crate::batch::{Batch, Engine};
+use crate::calibration::{level_gain, Calibration, LEVEL_SAMPLES};
 use crate::checkpoint::RunState;
 use crate::data::{TrainingSet, ViewSamples};
 use crate::design::NprtNet;
@@ -119,6 +120,7 @@ impl Objective for PixelObjective<'_> {
         net: &NprtNet,
         schedule: &Schedule,
         state: &RunState,
+        device: &Device,
     ) -> Result<()> {
         let transport_params = net.transport_params();
         let options = TrainOptions {
@@ -143,6 +145,15 @@ impl Objective for PixelObjective<'_> {
                 "seconds": state.seconds,
                 "adam_epsilon": ADAM_EPSILON,
                 "loss": self.opts.loss.name(),
+            }),
+            level_gain: (self.opts.calibration == Calibration::Level).then(|| {
+                level_gain(
+                    &net.valid(),
+                    &self.set.train,
+                    LEVEL_SAMPLES,
+                    self.opts.batch_size,
+                    device,
+                )
             }),
         };
         save_model(out, &file, net)

@@ -140,13 +140,15 @@ pub trait Objective: Sync {
     ) -> (f64, GradientsParams, u64);
     /// Loss on held-out data with a network off the autodiff device; NaN where there is none.
     fn validation_loss(&self, net: &Self::Net, device: &Device) -> f64;
-    /// Writes the model folder's own files (config and weights) for the network as it stands.
+    /// Writes the model folder's own files (config and weights) for the network as it stands;
+    /// `device` is the one [`Self::validation_loss`] runs on.
     fn save_model(
         &self,
         out: &Path,
         net: &Self::Net,
         schedule: &Schedule,
         state: &RunState,
+        device: &Device,
     ) -> Result<()>;
 }
 
@@ -214,6 +216,7 @@ pub fn train<O: Objective>(
     schedule.check()?;
     let tag = objective.tag();
     let device = device.clone().autodiff();
+    let inner = device.clone().inner();
     let mut net = objective.build(&mut Init::new(schedule.seed, &device));
     let mut optim = AdamConfig::new().with_epsilon(ADAM_EPSILON).init();
     std::fs::create_dir_all(checkpoint::dir(out))
@@ -278,8 +281,10 @@ pub fn train<O: Objective>(
     let mut guard = DivergenceGuard::default();
 
     let mut split = TimeSplit::default();
+    let mut trained = false;
 
     while ck.state.epoch < schedule.epochs && !out_of_time(ck.state.seconds) {
+        trained = true;
         let epoch = ck.state.epoch;
         let total = steps_in(epoch);
         let row_every = (total as u64).div_ceil(TRAIN_ROWS_PER_EPOCH).max(1);
@@ -360,7 +365,7 @@ pub fn train<O: Objective>(
                 }
                 if last_checkpoint.elapsed().as_secs_f64() > schedule.checkpoint_secs {
                     let saving = Instant::now();
-                    save(objective, schedule, out, &mut ck, &net, &optim)?;
+                    save(objective, schedule, out, &mut ck, &net, &optim, &inner)?;
                     split.saving += since(saving);
                     last_checkpoint = Instant::now();
                 }
@@ -369,7 +374,7 @@ pub fn train<O: Objective>(
         })?;
         // The epoch ended, or the budget ran out within it: validate and save either way.
         let validating = Instant::now();
-        let val = objective.validation_loss(&net.valid(), &device.clone().inner());
+        let val = objective.validation_loss(&net.valid(), &inner);
         split.validation += since(validating);
         let s = &mut ck.state;
         if s.batch >= total {
@@ -399,11 +404,16 @@ pub fn train<O: Objective>(
             });
         }
         let saving = Instant::now();
-        save(objective, schedule, out, &mut ck, &net, &optim)?;
+        save(objective, schedule, out, &mut ck, &net, &optim, &inner)?;
         split.saving += since(saving);
         last_checkpoint = Instant::now();
     }
     bar.finish_and_clear();
+    if !trained {
+        // A finished run asked again: its model files follow this invocation's options (the
+        // output calibration, say), since nothing else will write them.
+        objective.save_model(out, &net, schedule, &ck.state, &inner)?;
+    }
     let last = |f: fn(&LossRow) -> Option<f64>| ck.history.iter().rev().find_map(f);
     Ok(TrainSummary {
         epochs: ck.state.epoch as f64
@@ -491,7 +501,8 @@ impl DivergenceGuard {
     }
 }
 
-/// The checkpoint, then the model folder's own files, loss.csv and loss.png.
+/// The checkpoint, then the model folder's own files, loss.csv and loss.png; `device` is the
+/// one validation runs on.
 fn save<O: Objective>(
     objective: &O,
     schedule: &Schedule,
@@ -499,9 +510,10 @@ fn save<O: Objective>(
     ck: &mut Checkpoint,
     net: &O::Net,
     optim: &ModuleOptimizer,
+    device: &Device,
 ) -> Result<()> {
     checkpoint::write(out, ck, net, optim, &objective.tag())?;
-    objective.save_model(out, net, schedule, &ck.state)?;
+    objective.save_model(out, net, schedule, &ck.state, device)?;
     curves::write_csv(&out.join("loss.csv"), &ck.history)?;
     curves::plot(&out.join("loss.png"), &ck.history, &objective.title())
 }

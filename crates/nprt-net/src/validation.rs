@@ -17,29 +17,14 @@ pub fn validation_loss(
     device: &Device,
 ) -> f64 {
     let views: Vec<&ViewSamples> = set.test.iter().filter(|v| !v.is_empty()).collect();
-    let total: usize = views.iter().map(|v| v.len()).sum();
-    if total == 0 {
+    let (mut sum, mut count) = (0.0, 0);
+    for batch in Batch::strided(&views, max_samples, batch_size) {
+        let (pred, reference) = batch.forward(net, device);
+        sum += log_l1(pred, reference).into_scalar::<f32>() as f64 * batch.len() as f64;
+        count += batch.len();
+    }
+    if count == 0 {
         return f64::NAN;
     }
-    let stride = total.div_ceil(max_samples.max(1));
-    let picked: Vec<(u32, u32)> = views
-        .iter()
-        .enumerate()
-        .flat_map(|(v, view)| (0..view.len() as u32).map(move |p| (v as u32, p)))
-        .step_by(stride)
-        .collect();
-    let mut sum = 0.0;
-    for chunk in picked.chunks(batch_size.max(1)) {
-        // Only the views this chunk touches go through the encoder.
-        let mut used: Vec<u32> = chunk.iter().map(|s| s.0).collect();
-        used.dedup();
-        let local: Vec<(u32, u32)> = chunk
-            .iter()
-            .map(|&(v, p)| (used.partition_point(|&u| u < v) as u32, p))
-            .collect();
-        let sub: Vec<&ViewSamples> = used.iter().map(|&v| views[v as usize]).collect();
-        let (pred, reference) = Batch::gather(&sub, &local).forward(net, device);
-        sum += log_l1(pred, reference).into_scalar::<f32>() as f64 * chunk.len() as f64;
-    }
-    sum / picked.len() as f64
+    sum / count as f64
 }

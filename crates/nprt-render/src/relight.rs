@@ -130,9 +130,10 @@ impl Relighter {
             TensorData::new(input.pixels, [1, 3, w / 2, w]),
             &self.device,
         );
+        let gain = self.file.output_gain();
         LightCode {
             code: self.net.encoder.forward(pixels),
-            scale: input.scale,
+            scale: std::array::from_fn(|k| input.scale[k] * gain[k]),
         }
     }
 
@@ -226,8 +227,35 @@ mod tests {
     use nprt_net::{Design, Init, ModelConfig};
     use nprt_trace::render_gbuffer;
 
+    /// A unit sphere of `material` at the origin, `segments` around: these tests' scene.
+    fn sphere(material: nprt_scene::Material, segments: u32) -> nprt_scene::Scene {
+        let mut scene = nprt_scene::Scene::empty("sphere");
+        scene.add(
+            nprt_scene::Mesh::sphere(Vec3::ZERO, 1.0, segments),
+            material,
+        );
+        scene
+    }
+
+    /// A `width` × `height` camera looking at the sphere from above the +Z axis.
+    fn camera(width: u32, height: u32) -> Camera {
+        Camera::look_at(
+            Vec3::new(0.0, 0.5, 2.5),
+            Vec3::ZERO,
+            Vec3::Y,
+            60.0,
+            width,
+            height,
+        )
+    }
+
     /// An untrained D/S model saved to a fresh folder, with its direct light `direct`.
     fn relighter(direct: DirectLight) -> Relighter {
+        calibrated(direct, None)
+    }
+
+    /// [`relighter`] with its output calibrated by `level_gain`.
+    fn calibrated(direct: DirectLight, level_gain: Option<[f32; 3]>) -> Relighter {
         let config = ModelConfig {
             encoder_width: 64,
             direct,
@@ -246,6 +274,7 @@ mod tests {
             transport_params: net.transport_params(),
             encoder_params: 0,
             training: serde_json::Value::Null,
+            level_gain,
         };
         // One folder per call: tests run in parallel.
         static CALLS: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
@@ -260,13 +289,12 @@ mod tests {
     #[test]
     fn a_model_that_traces_direct_light_adds_it_to_every_pixel() {
         // A glossy sphere before a sky: foreground and background pixels.
-        let mut scene = nprt_scene::Scene::empty("sphere");
-        scene.add(
-            nprt_scene::Mesh::sphere(Vec3::ZERO, 1.0, 32),
+        let scene = sphere(
             nprt_scene::Material::glossy("g", Vec3::splat(0.3), Vec3::splat(0.2), 0.2),
+            32,
         );
         let ts = TraceScene::new(&scene);
-        let camera = Camera::look_at(Vec3::new(0.0, 0.5, 2.5), Vec3::ZERO, Vec3::Y, 60.0, 16, 12);
+        let camera = camera(16, 12);
         let map = nprt_scene::open_envmap("builtin:sky").unwrap();
         let g = render_gbuffer(&ts, &camera);
         assert!(g.mask.contains(&0.0) && g.mask.contains(&1.0));
@@ -307,6 +335,29 @@ mod tests {
     }
 
     #[test]
+    fn a_calibrated_model_multiplies_each_channel_of_the_network_by_its_gain() {
+        let scene = sphere(nprt_scene::Material::diffuse("d", Vec3::splat(0.5)), 32);
+        let ts = TraceScene::new(&scene);
+        let camera = camera(16, 12);
+        let map = nprt_scene::open_envmap("builtin:sky").unwrap();
+        let g = render_gbuffer(&ts, &camera);
+        let gain = Vec3::new(2.0, 1.0, 0.5);
+        let shade = |r: &Relighter| r.shade(&g, &r.light_code(&map, 30.0));
+        let plain = shade(&relighter(DirectLight::Traced));
+        let scaled = shade(&calibrated(DirectLight::Traced, Some(gain.to_array())));
+        let mut lit = 0;
+        for (i, (p, s)) in plain.iter().zip(&scaled).enumerate() {
+            let want = *p * gain;
+            assert!(
+                (*s - want).abs().max_element() <= 1e-5 * want.max_element(),
+                "pixel {i}: {s} against {want}"
+            );
+            lit += usize::from(p.min_element() > 0.0);
+        }
+        assert!(lit > 0, "the untrained network shades something");
+    }
+
+    #[test]
     fn denoised_direct_light_is_closer_to_the_converged_one() {
         let oidn = match Oidn::open() {
             Ok(o) => o,
@@ -316,13 +367,9 @@ mod tests {
             }
             Err(e) => panic!("NPRT_REQUIRE_OIDN is set but {e:#}"),
         };
-        let mut scene = nprt_scene::Scene::empty("sphere");
-        scene.add(
-            nprt_scene::Mesh::sphere(Vec3::ZERO, 1.0, 64),
-            nprt_scene::Material::diffuse("d", Vec3::splat(0.5)),
-        );
+        let scene = sphere(nprt_scene::Material::diffuse("d", Vec3::splat(0.5)), 64);
         let ts = TraceScene::new(&scene);
-        let camera = Camera::look_at(Vec3::new(0.0, 0.5, 2.5), Vec3::ZERO, Vec3::Y, 60.0, 64, 48);
+        let camera = camera(64, 48);
         let map = nprt_scene::open_envmap("builtin:sky").unwrap();
         let g = render_gbuffer(&ts, &camera);
         let traced = relighter(DirectLight::Traced);

@@ -164,6 +164,7 @@ pub fn demo(a: DemoArgs) -> Result<()> {
             views_per_batch: defaults.views_per_batch,
             val_samples: defaults.val_samples,
             loss: defaults.loss,
+            calibrate: defaults.calibration,
             encoder_width: DEFAULT_ENCODER_WIDTH,
             map_norm: DEFAULT_MAP_NORM,
             direct: config.direct,

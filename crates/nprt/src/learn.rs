@@ -10,9 +10,9 @@ use nprt_net::{device_name, is_cpu, Backend, Device};
 
 use crate::{DeviceArg, RunLength};
 use nprt_net::{
-    layer_table, measure_throughput, median, recipe_rate, Activation, Design, DirectLight, Engine,
-    Init, Loss, MapNorm, ModelConfig, PositionEncoding, Schedule, TrainOptions,
-    DEFAULT_ENCODER_WIDTH, DEFAULT_MAP_NORM,
+    layer_table, measure_throughput, median, recipe_rate, Activation, Calibration, Design,
+    DirectLight, Engine, Init, Loss, MapNorm, ModelConfig, PositionEncoding, Schedule,
+    TrainOptions, DEFAULT_ENCODER_WIDTH, DEFAULT_MAP_NORM,
 };
 
 #[derive(clap::Args)]
@@ -78,6 +78,14 @@ pub struct TrainArgs {
     /// docs/model.md). The validation loss is log-L1 either way.
     #[arg(long, default_value = "log-l1")]
     pub loss: Loss,
+    /// none (the network's output as it is, the paper) or level (each channel of the saved
+    /// model's radiance multiplied by the training targets' mean over its own, measured on
+    /// training pixels whenever the model is saved, and again when a finished run is asked
+    /// with another choice: log-L1 settles on a median, darker than the mean. It gets the level
+    /// right but costs L1 where the darkness is light the network cannot place, as in the demo;
+    /// docs/model.md).
+    #[arg(long, default_value_t = TrainOptions::default().calibration)]
+    pub calibrate: Calibration,
     /// Test-view pixels (held-out lighting) used for the validation loss after each epoch.
     #[arg(long, default_value_t = TrainOptions::default().val_samples)]
     pub val_samples: usize,
@@ -205,6 +213,11 @@ pub fn model_info(a: ModelInfoArgs) -> Result<()> {
                 &file.dataset_hash[..12.min(file.dataset_hash.len())],
                 &file.scene_hash[..12.min(file.scene_hash.len())]
             );
+            if let Some([r, g, b]) = file.level_gain {
+                println!(
+                    "output calibrated to its training level: gain R {r:.3} G {g:.3} B {b:.3}"
+                );
+            }
             (file.config, net)
         }
         (None, Some(arch)) => {
@@ -309,6 +322,7 @@ pub fn train(a: TrainArgs) -> Result<()> {
         views_per_batch: a.views_per_batch,
         val_samples: a.val_samples,
         loss: a.loss,
+        calibration: a.calibrate,
     };
     opts.check().context("bad training options")?;
     let s = nprt_net::train(&set, &config, &opts, &a.out, &a.device.device()?)?;
@@ -328,6 +342,11 @@ pub fn train(a: TrainArgs) -> Result<()> {
         s.final_val
     );
     println!("time: {}", s.split.describe());
+    if let Some([r, g, b]) = nprt_net::model::read_model_file(&a.out)?.level_gain {
+        println!(
+            "level gain (training targets' mean over the network's, per channel): R {r:.3} G {g:.3} B {b:.3}"
+        );
+    }
     println!(
         "model in '{}' (loss curves: loss.csv, loss.png)",
         a.out.display()

@@ -200,6 +200,52 @@ fn resumes_exactly(device: &str) {
     assert!(weights(&other) != weights(&one));
 }
 
+/// `--calibrate level` gives the saved model a gain per channel, its training targets' level
+/// over its own; a finished run asked again follows the flag without training.
+#[test]
+fn a_model_is_calibrated_to_its_training_level_on_request() {
+    let out = fresh_dir("calibrate");
+    let gain = |d: &Path| -> Option<Vec<f64>> {
+        let j: serde_json::Value =
+            serde_json::from_slice(&std::fs::read(d.join("model.json")).unwrap()).unwrap();
+        j.get("level_gain").map(|g| {
+            let g: Vec<f64> = g
+                .as_array()
+                .unwrap()
+                .iter()
+                .map(|v| v.as_f64().unwrap())
+                .collect();
+            assert_eq!(g.len(), 3);
+            g
+        })
+    };
+    let weights = |d: &Path| std::fs::read(d.join("weights.safetensors")).unwrap();
+    let run = |calibrate| train(&out, "dsep", &["--epochs", "2", "--calibrate", calibrate]);
+    let text = run("none");
+    assert_eq!(gain(&out), None, "the paper's output by default");
+    assert!(!text.contains("level gain"), "{text}");
+    let trained = weights(&out);
+
+    let text = run("level");
+    assert!(text.contains("level gain"), "{text}");
+    let g = gain(&out).expect("a gain once asked for");
+    let info = ok(&["model", "info", "--model", out.to_str().unwrap()]);
+    assert!(
+        info.contains("output calibrated to its training level"),
+        "{info}"
+    );
+    assert!(
+        g.iter().all(|v| v.is_finite() && *v > 0.0) && g.iter().any(|v| *v != 1.0),
+        "{g:?}"
+    );
+    assert!(weights(&out) == trained, "asking again does not train");
+    // Measured on the same pixels of the same weights: the same gain every time.
+    run("level");
+    assert_eq!(gain(&out), Some(g));
+    run("none");
+    assert_eq!(gain(&out), None);
+}
+
 /// Deep Shading trains through the same loop: exact resume (Adam's moments included), the
 /// same loss files, and a refusal to resume other settings.
 #[test]

@@ -252,6 +252,7 @@ impl Objective for UnetObjective {
         net: &DeepShading,
         schedule: &Schedule,
         state: &RunState,
+        _device: &Device,
     ) -> Result<()> {
         save_weights(&out.join(WEIGHTS_FILE), net, TAG)?;
         let mut file = self.file.clone();
