@@ -73,11 +73,9 @@ impl Batch {
             .flat_map(|(v, view)| (0..view.len() as u32).map(move |p| (v as u32, p)))
             .step_by(stride)
             .collect();
-        let chunks: Vec<Vec<(u32, u32)>> = picked
-            .chunks(batch_size.max(1))
-            .map(<[_]>::to_vec)
-            .collect();
-        chunks.into_iter().map(move |chunk| {
+        let batch_size = batch_size.max(1);
+        (0..picked.len()).step_by(batch_size).map(move |start| {
+            let chunk = &picked[start..(start + batch_size).min(picked.len())];
             let mut used: Vec<u32> = chunk.iter().map(|s| s.0).collect();
             used.dedup();
             let local: Vec<(u32, u32)> = chunk
