@@ -3,6 +3,7 @@
 # same layers, batch, maps per batch and loss) on this machine's cores; prints samples/s of
 # each design and the ratio. PyTorch goes into target/torch-venv on first use (about 5 GB,
 # since PyPI's wheel carries CUDA libraries).
+# For `--device gpu` build the CUDA backend in: NPRT_FEATURES=cuda bench/train_vs_pytorch.sh --device gpu
 # usage: bench/train_vs_pytorch.sh [nprt bench train options, e.g. --steps 20 --arch prt]
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -12,5 +13,5 @@ if ! "$venv/bin/python" -c 'import torch' 2>/dev/null; then
   python3 -m venv "$venv" >&2
   "$venv/bin/pip" install -q --disable-pip-version-check torch==2.15.0 >&2
 fi
-cargo build --release -q -p nprt
+cargo build --release -q -p nprt ${NPRT_FEATURES:+--features "$NPRT_FEATURES"}
 exec target/release/nprt bench train --python "$venv/bin/python" "$@"

@@ -38,10 +38,14 @@
 //! # Ok::<(), anyhow::Error>(())
 //! ```
 
+mod camera_choice;
 pub mod cameras;
 pub mod dataset;
+mod generate;
 pub mod lighting;
 pub mod views;
 
+pub use camera_choice::CameraChoice;
 pub use cameras::{place_camera, PlacementError};
 pub use dataset::{Manifest, Request};
+pub use generate::{generate, GenerateOptions, Planned};

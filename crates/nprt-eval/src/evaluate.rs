@@ -4,13 +4,12 @@
 
 use std::collections::{BTreeMap, BTreeSet};
 use std::path::PathBuf;
-use std::time::Instant;
 
 use anyhow::{bail, Result};
-use glam::Vec3;
+use nprt_data::dataset::Manifest;
 use nprt_data::dataset::{load_checked_scene, load_manifest_hashed};
-use nprt_data::views::load_views;
-use nprt_net::data::open_recorded_map;
+use nprt_data::views::{load_views, ImageView};
+use nprt_net::training::training_set::open_recorded_map;
 use nprt_net::Device;
 use nprt_render::oidn::Oidn;
 use nprt_render::DirectSampling;
@@ -18,32 +17,15 @@ use nprt_trace::TraceScene;
 use serde::{Deserialize, Serialize};
 
 use crate::claim::Claim;
+use crate::eval_options::EvalOptions;
 use crate::method::{Family, MethodResult};
 use crate::metrics::Metrics;
 use crate::networks::{load_networks, run_networks, Net};
 use crate::path_tracing::{equal_time_spp, run_denoised, run_path_tracing, Traced};
 use crate::sh_prt::run_sh_prt;
+use crate::shown_view::ShownView;
 use crate::test_bench::TestBench;
 use crate::timing::{time_table, Timing};
-
-#[derive(Clone, Debug)]
-pub struct EvalOptions {
-    pub data: PathBuf,
-    pub models: Vec<PathBuf>,
-    pub deep_shading: Option<PathBuf>,
-    /// Paths per pixel of the SH transport precomputation.
-    pub sh_spp: u32,
-    /// Side of the square frames of the timing table (the paper: 512).
-    pub timing_res: u32,
-    /// Evaluate only the first N test views.
-    pub max_views: Option<usize>,
-    /// Test views shown as images in the report.
-    pub shown_views: usize,
-    pub seed: u64,
-    /// Samples per pixel of the direct light of models that trace it.
-    pub direct_spp: u32,
-    pub progress: bool,
-}
 
 #[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct Evaluation {
@@ -75,23 +57,6 @@ pub struct Evaluation {
     pub shown: Vec<ShownView>,
 }
 
-/// A test view's images for the report.
-#[derive(Clone, Debug)]
-pub struct ShownView {
-    pub index: usize,
-    pub width: usize,
-    pub height: usize,
-    pub mask: Vec<f32>,
-    pub reference: Vec<Vec3>,
-    /// (method name, radiance).
-    pub methods: Vec<(String, Vec<Vec3>)>,
-}
-
-/// Milliseconds since `t`.
-pub(crate) fn ms(t: Instant) -> f64 {
-    t.elapsed().as_secs_f64() * 1e3
-}
-
 /// Runs the whole evaluation: the networks first (the slowest Neural PRT design sets the
 /// equal-time sample count), then path tracing, denoised path tracing and SH PRT.
 pub fn evaluate(o: &EvalOptions, device: &Device) -> Result<Evaluation> {
@@ -102,14 +67,7 @@ pub fn evaluate(o: &EvalOptions, device: &Device) -> Result<Evaluation> {
         &s.scene_hash,
         &format!("dataset '{}' was rendered from", o.data.display()),
     )?;
-    let mut views = load_views(&o.data, &manifest, "test")?;
-    views.sort_by_key(|v| v.record.index);
-    if let Some(n) = o.max_views {
-        views.truncate(n);
-    }
-    if views.is_empty() {
-        bail!("dataset '{}' has no test views", o.data.display());
-    }
+    let views = test_views(o, &manifest)?;
     // Only the maps of the views evaluated: a dataset with a fresh map per training view has
     // thousands of others.
     let maps = views
@@ -129,14 +87,7 @@ pub fn evaluate(o: &EvalOptions, device: &Device) -> Result<Evaluation> {
     };
     let shown = views[..o.shown_views.min(views.len())]
         .iter()
-        .map(|v| ShownView {
-            index: v.record.index as usize,
-            width: v.width,
-            height: v.height,
-            mask: v.gbuffer.mask.clone(),
-            reference: v.radiance.clone(),
-            methods: vec![],
-        })
+        .map(ShownView::of)
         .collect();
     let denoised_nets = match &oidn {
         Ok(_) => nets.iter().filter(|(n, _)| n.traces_direct()).count(),
@@ -159,30 +110,7 @@ pub fn evaluate(o: &EvalOptions, device: &Device) -> Result<Evaluation> {
 
     let mut results = run_networks(&mut bench, &nets, oidn.as_ref().ok().copied())?;
     let pt5 = run_path_tracing(&mut bench, "pt-5spp", 5, 0x5eed_0005);
-    let mut equal_time: Vec<(u32, Traced)> = Vec::new();
-    for tier in &tiers {
-        let ms = tier.slowest_ms(&results);
-        let spp = equal_time_spp(&pt5.result, ms);
-        let name = format!("pt-equal-time ({spp} spp)");
-        // A design's row and its denoised row (traced light denoised), each held to path
-        // tracing treated alike.
-        for r in results.iter_mut() {
-            let plain = r.name.strip_suffix(" + OIDN").unwrap_or(&r.name);
-            if tier.rows.iter().any(|t| t == plain) {
-                r.equal_time = Some(match r.family {
-                    Family::Denoised => format!("{name} + OIDN"),
-                    _ => name.clone(),
-                });
-            }
-        }
-        // Two tiers of equal cost share one row.
-        if equal_time.iter().any(|(n, _)| *n == spp) {
-            continue;
-        }
-        let mut pt = run_path_tracing(&mut bench, &name, spp, 0x5eed_e9a1);
-        pt.result.note = format!("{spp} spp: the time of {} ({ms:.0} ms per view)", tier.what);
-        equal_time.push((spp, pt));
-    }
+    let equal_time = run_equal_time(&mut bench, &tiers, &pt5, &mut results);
     let equal_time_spp = equal_time.iter().map(|(n, _)| *n).max().unwrap_or(5);
     let mut baselines = Vec::new();
     if let Ok(oidn) = &oidn {
@@ -210,19 +138,7 @@ pub fn evaluate(o: &EvalOptions, device: &Device) -> Result<Evaluation> {
         },
     )?;
     let fg = views.iter().map(|v| v.foreground()).sum();
-    let noise_floor = views
-        .iter()
-        .map(|v| {
-            let half = v.half.as_ref()?;
-            Some(Metrics::compute(
-                half,
-                &v.radiance,
-                &v.gbuffer.mask,
-                v.width,
-            ))
-        })
-        .collect::<Option<Vec<_>>>()
-        .map(|per_view| Metrics::mean(&per_view));
+    let noise_floor = noise_floor(&views);
     Ok(Evaluation {
         data: o.data.clone(),
         scene: s.scene.clone(),
@@ -240,6 +156,71 @@ pub fn evaluate(o: &EvalOptions, device: &Device) -> Result<Evaluation> {
         cpu_threads: rayon::current_num_threads(),
         shown: bench.shown,
     })
+}
+
+/// The test views evaluated, in index order, the first `max_views` of them.
+fn test_views(o: &EvalOptions, manifest: &Manifest) -> Result<Vec<ImageView>> {
+    let mut views = load_views(&o.data, manifest, "test")?;
+    views.sort_by_key(|v| v.record.index);
+    if let Some(n) = o.max_views {
+        views.truncate(n);
+    }
+    if views.is_empty() {
+        bail!("dataset '{}' has no test views", o.data.display());
+    }
+    Ok(views)
+}
+
+/// Path tracing at each tier's equal time (one row per distinct sample count), filing every
+/// design's row under its tier's peer; returns the rows with their sample counts.
+fn run_equal_time(
+    bench: &mut TestBench,
+    tiers: &[Tier],
+    pt5: &Traced,
+    results: &mut [MethodResult],
+) -> Vec<(u32, Traced)> {
+    let mut equal_time: Vec<(u32, Traced)> = Vec::new();
+    for tier in tiers {
+        let ms = tier.slowest_ms(results);
+        let spp = equal_time_spp(&pt5.result, ms);
+        let name = format!("pt-equal-time ({spp} spp)");
+        // A design's row and its denoised row (traced light denoised), each held to path
+        // tracing treated alike.
+        for r in results.iter_mut() {
+            let plain = r.name.strip_suffix(" + OIDN").unwrap_or(&r.name);
+            if tier.rows.iter().any(|t| t == plain) {
+                r.equal_time = Some(match r.family {
+                    Family::Denoised => format!("{name} + OIDN"),
+                    _ => name.clone(),
+                });
+            }
+        }
+        // Two tiers of equal cost share one row.
+        if equal_time.iter().any(|(n, _)| *n == spp) {
+            continue;
+        }
+        let mut pt = run_path_tracing(bench, &name, spp, 0x5eed_e9a1);
+        pt.result.note = format!("{spp} spp: the time of {} ({ms:.0} ms per view)", tier.what);
+        equal_time.push((spp, pt));
+    }
+    equal_time
+}
+
+/// The references' own error: each test view's first half of samples against the whole.
+fn noise_floor(views: &[ImageView]) -> Option<Metrics> {
+    views
+        .iter()
+        .map(|v| {
+            let half = v.half.as_ref()?;
+            Some(Metrics::compute(
+                half,
+                &v.radiance,
+                &v.gbuffer.mask,
+                v.width,
+            ))
+        })
+        .collect::<Option<Vec<_>>>()
+        .map(|per_view| Metrics::mean(&per_view))
 }
 
 impl Evaluation {

@@ -18,6 +18,7 @@
 
 pub mod claim;
 mod error_analysis;
+mod eval_options;
 mod evaluate;
 mod method;
 pub mod metrics;
@@ -26,10 +27,13 @@ mod path_tracing;
 mod report;
 pub mod sh;
 mod sh_prt;
+mod shown_view;
+mod stopwatch;
 mod test_bench;
 mod timing;
 
-pub use evaluate::{evaluate, EvalOptions, Evaluation};
+pub use eval_options::EvalOptions;
+pub use evaluate::{evaluate, Evaluation};
 pub use method::{Family, MethodResult, BINS};
 pub use metrics::Metrics;
 pub use report::write_report;

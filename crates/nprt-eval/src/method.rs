@@ -24,13 +24,6 @@ pub enum Family {
     ShPrt,
 }
 
-impl Family {
-    /// A trained network (Neural PRT design or Deep Shading).
-    pub fn is_network(self) -> bool {
-        matches!(self, Family::NeuralPrt | Family::DeepShading)
-    }
-}
-
 /// Bins of the error analysis (directness and specularity in [0, 1]).
 pub const BINS: usize = 10;
 

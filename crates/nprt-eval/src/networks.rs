@@ -13,8 +13,9 @@ use nprt_scene::{Camera, EnvMap};
 use nprt_trace::{render_gbuffer, GBuffer, TraceScene};
 
 use crate::error_analysis::Accumulator;
-use crate::evaluate::{ms, EvalOptions};
+use crate::eval_options::EvalOptions;
 use crate::method::{Family, MethodResult};
+use crate::stopwatch::ms;
 use crate::test_bench::TestBench;
 use nprt_net::deep_shading::DeepShadingModel;
 
@@ -200,7 +201,7 @@ fn check_model(
 /// A model folder's validation loss against its training seconds; a loss.csv that cannot be
 /// read costs the report this curve only.
 fn validation_curve(dir: &Path, name: &str) -> Vec<(f64, f64)> {
-    match nprt_net::curves::read_csv(&dir.join("loss.csv")) {
+    match nprt_net::training::loss_curves::read_csv(&dir.join("loss.csv")) {
         Ok(rows) => rows
             .iter()
             .filter_map(|r| Some((r.seconds, r.val?)))

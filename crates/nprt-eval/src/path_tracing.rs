@@ -9,8 +9,8 @@ use nprt_render::oidn::Oidn;
 use nprt_trace::render;
 
 use crate::error_analysis::Accumulator;
-use crate::evaluate::ms;
 use crate::method::{Family, MethodResult};
+use crate::stopwatch::ms;
 use crate::test_bench::TestBench;
 
 /// A path-traced baseline's results and its frames (the denoiser's input).

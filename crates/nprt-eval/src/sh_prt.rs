@@ -4,9 +4,9 @@
 use std::time::Instant;
 
 use crate::error_analysis::Accumulator;
-use crate::evaluate::ms;
 use crate::method::{Family, MethodResult};
 use crate::sh::ShTransport;
+use crate::stopwatch::ms;
 use crate::test_bench::TestBench;
 
 /// SH PRT 9 and 25 on every test view; `sh_spp` paths per pixel for the transport.

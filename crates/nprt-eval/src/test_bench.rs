@@ -10,7 +10,7 @@ use nprt_data::views::ImageView;
 use nprt_scene::EnvMap;
 use nprt_trace::{PixelFilter, RenderSettings, TraceScene};
 
-use crate::evaluate::ShownView;
+use crate::shown_view::ShownView;
 
 pub struct TestBench<'a> {
     pub views: &'a [ImageView],

@@ -10,8 +10,8 @@ use nprt_scene::{Camera, EnvMap};
 use nprt_trace::{render, render_gbuffer, GBuffer, RenderSettings, TraceScene};
 use serde::{Deserialize, Serialize};
 
-use crate::evaluate::ms;
 use crate::networks::{Net, Shaded};
+use crate::stopwatch::ms;
 
 /// Rows of the timing table.
 #[derive(Clone, Debug, Serialize, Deserialize)]
@@ -37,118 +37,138 @@ pub fn time_table(
     direct: DirectSampling,
 ) -> Result<Vec<Timing>> {
     let camera = camera.with_resolution(timing_res, timing_res);
-    let raw = DirectSampling {
-        denoiser: None,
-        ..direct
-    };
-    let mut rows = Vec::new();
     let mut g = GBuffer::default();
-    let gb = median(
-        (0..3)
-            .map(|_| {
-                let t = Instant::now();
-                g = render_gbuffer(ts, &camera);
-                ms(t)
-            })
-            .collect(),
-    );
-    rows.push(Timing {
+    let mut rows = vec![Timing {
         what: "G-buffer (primary rays)".into(),
-        ms: gb,
+        ms: median_of_runs(|| g = render_gbuffer(ts, &camera)),
         gflops: None,
-    });
+    }];
+    let frame = TimedFrame {
+        ts,
+        camera: &camera,
+        map,
+        g: &g,
+        direct,
+    };
     for (net, name) in nets {
-        let runs = (0..3)
-            .map(|_| net.shade(ts, &camera, &g, (map, 0.0), raw))
-            .collect::<Result<Vec<Shaded>>>()?;
-        let network_ms = median(runs.iter().map(|r| r.network_ms).collect());
-        let Net::Nprt(r, _) = net else {
-            rows.push(Timing {
-                what: format!("{name}: network"),
-                ms: network_ms,
-                gflops: None,
-            });
-            continue;
-        };
-        let foreground = g.mask.iter().filter(|&&m| m > 0.5).count() as f64;
-        let gflops = |transfer_known, ms: f64| {
-            r.flops_per_pixel(transfer_known)
-                .map(|f| f * foreground / (ms * 1e6))
-        };
-        rows.push(Timing {
-            what: format!("{name}: encoder"),
-            ms: median(runs.iter().map(|r| r.encoder_ms).collect()),
-            gflops: None,
-        });
-        rows.push(Timing {
-            what: format!("{name}: network"),
-            ms: network_ms,
-            gflops: gflops(false, network_ms),
-        });
-        if r.traces_direct() {
-            rows.push(Timing {
-                what: format!("{name}: traced direct light, {} spp", direct.spp),
-                ms: median(runs.iter().map(|r| r.direct_ms).collect()),
-                gflops: None,
-            });
-            if direct.denoiser.is_some() {
-                // Only the completion runs again: the network's part is the same either way.
-                let denoised = (0..3)
-                    .map(|_| {
-                        let mut rgb = vec![Vec3::ZERO; g.mask.len()];
-                        let t = Instant::now();
-                        r.complete(ts, &camera, map, &g, direct, &mut rgb)?;
-                        Ok(ms(t))
-                    })
-                    .collect::<Result<Vec<f64>>>()?;
-                rows.push(Timing {
-                    what: format!(
-                        "{name}: traced direct light, {} spp, denoised by OIDN",
-                        direct.spp
-                    ),
-                    ms: median(denoised),
-                    gflops: None,
-                });
-            }
-        }
-        if r.file.config.design != nprt_net::Design::Baseline {
-            let px = r.pixels(&g);
-            let code = r.light_code(map, 0.0);
-            let relight_ms = median(
-                (0..3)
-                    .map(|_| {
-                        let t = Instant::now();
-                        r.relight(&px, &code);
-                        ms(t)
-                    })
-                    .collect(),
-            );
-            rows.push(Timing {
-                what: format!(
-                    "{name}: network, lighting change under a still camera ({:.1}× faster)",
-                    network_ms / relight_ms
-                ),
-                ms: relight_ms,
-                gflops: gflops(true, relight_ms),
-            });
-        }
+        rows.extend(frame.network_rows(net, name)?);
     }
-    let pt_ms = median(
-        (0..3)
-            .map(|_| {
-                let t = Instant::now();
-                render(ts, &camera, map, pt);
-                ms(t)
-            })
-            .collect(),
-    );
     rows.push(Timing {
         what: "path tracing, 5 spp".into(),
-        ms: pt_ms,
+        ms: median_of_runs(|| {
+            render(ts, &camera, map, pt);
+        }),
         gflops: None,
     });
     if rows.iter().any(|r| !r.ms.is_finite()) {
         bail!("a timing was not finite");
     }
     Ok(rows)
+}
+
+/// Runs each timing takes; the median is reported.
+const RUNS: usize = 3;
+
+/// The median of [`RUNS`] timed calls of `f`, in milliseconds.
+fn median_of_runs(mut f: impl FnMut()) -> f64 {
+    median(
+        (0..RUNS)
+            .map(|_| {
+                let t = Instant::now();
+                f();
+                ms(t)
+            })
+            .collect(),
+    )
+}
+
+/// The frame every network is timed on.
+struct TimedFrame<'a> {
+    ts: &'a TraceScene<'a>,
+    camera: &'a Camera,
+    map: &'a EnvMap,
+    g: &'a GBuffer,
+    direct: DirectSampling,
+}
+
+impl TimedFrame<'_> {
+    /// One network's rows: its network time, and for a Neural PRT design its encoder, the
+    /// traced direct light (raw and denoised) of a design that traces it, and a lighting change
+    /// under a still camera.
+    fn network_rows(&self, net: &Net, name: &str) -> Result<Vec<Timing>> {
+        let (ts, camera, map, g, direct) = (self.ts, self.camera, self.map, self.g, self.direct);
+        let raw = DirectSampling {
+            denoiser: None,
+            ..direct
+        };
+        let runs = (0..RUNS)
+            .map(|_| net.shade(ts, camera, g, (map, 0.0), raw))
+            .collect::<Result<Vec<Shaded>>>()?;
+        let network_ms = median(runs.iter().map(|r| r.network_ms).collect());
+        let row = |what: String, ms: f64, gflops: Option<f64>| Timing { what, ms, gflops };
+        let Net::Nprt(r, _) = net else {
+            return Ok(vec![row(format!("{name}: network"), network_ms, None)]);
+        };
+        let foreground = g.mask.iter().filter(|&&m| m > 0.5).count() as f64;
+        let gflops = |transfer_known, ms: f64| {
+            r.flops_per_pixel(transfer_known)
+                .map(|f| f * foreground / (ms * 1e6))
+        };
+        let mut rows = vec![
+            row(
+                format!("{name}: encoder"),
+                median(runs.iter().map(|r| r.encoder_ms).collect()),
+                None,
+            ),
+            row(
+                format!("{name}: network"),
+                network_ms,
+                gflops(false, network_ms),
+            ),
+        ];
+        if r.traces_direct() {
+            rows.push(row(
+                format!("{name}: traced direct light, {} spp", direct.spp),
+                median(runs.iter().map(|r| r.direct_ms).collect()),
+                None,
+            ));
+            if direct.denoiser.is_some() {
+                // Only the completion runs again: the network's part is the same either way.
+                let mut failed = None;
+                let denoised = median_of_runs(|| {
+                    let mut rgb = vec![Vec3::ZERO; g.mask.len()];
+                    if let Err(e) = r.complete(ts, camera, map, g, direct, &mut rgb) {
+                        failed = Some(e);
+                    }
+                });
+                if let Some(e) = failed {
+                    return Err(e);
+                }
+                rows.push(row(
+                    format!(
+                        "{name}: traced direct light, {} spp, denoised by OIDN",
+                        direct.spp
+                    ),
+                    denoised,
+                    None,
+                ));
+            }
+        }
+        if r.file.config.design != nprt_net::Design::Baseline {
+            let px = r.pixels(g);
+            let code = r.light_code(map, 0.0);
+            let relight_ms = median_of_runs(|| {
+                r.relight(&px, &code);
+            });
+            rows.push(row(
+                format!(
+                    "{name}: network, lighting change under a still camera ({:.1}× faster)",
+                    network_ms / relight_ms
+                ),
+                relight_ms,
+                gflops(true, relight_ms),
+            ));
+        }
+        Ok(rows)
+    }
 }

@@ -1,7 +1,10 @@
 //! nprt-net: the learned part of Neural PRT. It owns the light encoder, the four transport
 //! designs and the hash-grid position encoding beyond them, the Deep Shading baseline network,
 //! the model folder format (weights plus config) and the one training loop every network goes
-//! through (checkpoints, exact resume).
+//! through (checkpoints, exact resume). Its folders keep the pieces apart, as tiny-cuda-nn
+//! does: `network` (layers, encoder, designs), `encoding` (what the networks see), `model`
+//! (config and folder), `training` (data, batches, loss, schedule, loop), `cpu` (the CPU
+//! engine, which takes plain slices), `deep_shading` and `bench`.
 //! It reads datasets through nprt-data and environment maps through nprt-scene; it must not
 //! trace rays or write datasets, and it knows nothing of evaluation or frame rendering.
 //!
@@ -19,59 +22,41 @@
 //! assert!((net.transport_params() as f64 / paper - 1.0).abs() < 0.05);
 //! ```
 
-mod activation;
-mod batch;
-mod calibration;
-mod checkpoint;
-mod compute;
+pub mod bench;
+mod choice;
 pub mod cpu;
-pub mod curves;
-pub mod data;
 pub mod deep_shading;
-mod design;
-mod direct_light;
-pub mod encoder;
-mod epoch_plan;
-mod features;
-pub mod hash_grid;
-mod init;
-pub mod loss;
-mod lr_schedule;
-mod map_norm;
-mod mlp;
+mod device;
+pub mod encoding;
 pub mod model;
-mod named;
-mod options;
-mod position_encoding;
-mod throughput;
-mod track;
-mod train;
-pub mod trainer;
-mod validation;
+pub mod network;
+pub mod training;
 
-pub use activation::{Activation, OMEGA_0};
-pub use batch::{Batch, Engine};
+pub use bench::throughput::{measure_inference, measure_throughput, median, InferenceSpeed};
 pub use burn;
 pub use burn::tensor::Device;
-pub use calibration::{level_gain, Calibration, LEVEL_SAMPLES};
-pub use checkpoint::RunState;
-pub use compute::{device_name, finish, is_cpu, Backend, Compute};
-pub use design::{Design, NprtNet, TRANSPORT_CODE};
-pub use direct_light::DirectLight;
-pub use encoder::{LightEncoder, LightInput};
-pub use features::{feature, gbuffer_features, pixel_features, FEATURES};
-pub use init::{conv2d, Init};
-pub use loss::{log_l1, Loss};
-pub use lr_schedule::LrSchedule;
-pub use map_norm::MapNorm;
-pub use mlp::Mlp;
-pub use model::{
-    layer_table, load_model, ModelConfig, ModelFile, DEFAULT_ENCODER_WIDTH, DEFAULT_MAP_NORM,
-};
-pub use options::{recipe_rate, TrainOptions};
-pub use position_encoding::PositionEncoding;
-pub use throughput::{measure_inference, measure_throughput, median, InferenceSpeed};
-pub use track::{Track, TrackKind};
-pub use train::train;
-pub use trainer::{Objective, Schedule, TrainSummary};
-pub use validation::validation_loss;
+pub use device::{device_name, finish, host_values, is_cpu, Backend, Compute};
+pub use encoding::features::{feature, gbuffer_features, pixel_features, FEATURES};
+pub use encoding::map_norm::MapNorm;
+pub use encoding::position_encoding::PositionEncoding;
+pub use model::config::{ModelConfig, DEFAULT_ENCODER_WIDTH, DEFAULT_MAP_NORM};
+pub use model::direct_light::DirectLight;
+pub use model::folder::{load_model, read_model_file, ModelFile};
+pub use model::layer_table::layer_table;
+pub use network::activation::{Activation, OMEGA_0};
+pub use network::design::{Design, TRANSPORT_CODE};
+pub use network::encoder::{LightEncoder, LightInput};
+pub use network::init::{conv2d, Init};
+pub use network::mlp::Mlp;
+pub use network::nprt_net::NprtNet;
+pub use network::track::{Track, TrackKind};
+pub use training::batch::{Batch, Engine};
+pub use training::calibration::{level_gain, Calibration, LEVEL_SAMPLES};
+pub use training::checkpoint::RunState;
+pub use training::loss::{log_l1, Loss};
+pub use training::lr_schedule::LrSchedule;
+pub use training::nprt_objective::train;
+pub use training::run_length::RunLength;
+pub use training::train_options::{recipe_rate, TrainOptions};
+pub use training::training_loop::{Objective, Schedule, TrainSummary};
+pub use training::validation::validation_loss;

@@ -8,7 +8,7 @@ use burn::tensor::{DType, Int, Tensor, TensorData};
 use common::{
     exact_gradients, gradient_errors, gradient_values, loud_grids, random_batch, variants, Shapes,
 };
-use nprt_net::model::{load_weights, save_weights};
+use nprt_net::model::folder::{load_weights, save_weights};
 use nprt_net::FEATURES;
 use nprt_net::{log_l1, Loss};
 use nprt_net::{Activation, Design, Device, Init, ModelConfig, NprtNet};
@@ -277,7 +277,7 @@ fn per_channel_models_relight_a_tinted_map_by_its_tint() {
                     Tensor::from_data(TensorData::new(vec![0i64; n], [n]), &device),
                     Tensor::from_data(TensorData::new(input.scale.repeat(n), [n, 3]), &device),
                 );
-                nprt_net::cpu::host_values(pred.into_data())
+                nprt_net::host_values(pred.into_data())
             };
             let (a, b) = (shade(&map), shade(&tinted));
             let worst = (0..n * 3)
@@ -315,9 +315,14 @@ fn cpu_engine_matches_autodiff() {
             // The transport networks on burn's light codes, whose gradient at the codes burn
             // then carries through the encoder: every gradient held to f32 rounding.
             let codes = net.encoder.forward(batch.light_tensor(&device));
-            let host_codes = nprt_net::cpu::host_values(codes.clone().into_data());
-            let (loss, mut engine, d_codes) =
-                nprt_net::cpu::transport_gradients(&net, &batch, &host_codes, &device, objective);
+            let host_codes = nprt_net::host_values(codes.clone().into_data());
+            let (loss, mut engine, d_codes) = nprt_net::cpu::transport_gradients(
+                &net,
+                &batch.samples(),
+                &host_codes,
+                &device,
+                objective,
+            );
             let d_codes = Tensor::<2>::from_data(TensorData::new(d_codes, codes.dims()), &device);
             let through = (codes * d_codes).sum().backward();
             let mut encoder = Shapes(Vec::new());
@@ -348,7 +353,8 @@ fn cpu_engine_matches_autodiff() {
             // enough to move the odd ReLU pre-activation across zero and with it one sample's
             // share of a gradient (measured: up to 6e-4 of a gradient's norm): a check that
             // every gradient is filed where it belongs, not of rounding.
-            let (loss, whole) = nprt_net::cpu::gradients(&net, &batch, &device, objective);
+            let (loss, whole) =
+                nprt_net::cpu::gradients(&net, &batch.samples(), &device, objective);
             assert!((loss - burn_loss).abs() <= 1e-5 * burn_loss);
             for e in gradient_errors(&net, &exact, [&whole]) {
                 assert!(
@@ -457,7 +463,7 @@ fn cpu_engine_radiance_matches_burn() {
             Tensor::<2>::from_data(TensorData::new(code.clone(), [1, 64]), &device).expand([n, 64]),
             Tensor::from_data(TensorData::new(scale.repeat(n), [n, 3]), &device),
         );
-        let want = nprt_net::cpu::host_values(want.into_data());
+        let want = nprt_net::host_values(want.into_data());
         let host = nprt_net::cpu::HostTransport::from_net(&net);
         let kept = host.transfer_codes(&features);
         for got in [

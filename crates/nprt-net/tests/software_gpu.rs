@@ -11,7 +11,7 @@ mod common;
 use burn::module::Module;
 use burn::optim::AdamConfig;
 use common::{exact_gradients, gradient_errors, loud_grids, random_batch, variants};
-use nprt_net::model::{load_weights, save_weights};
+use nprt_net::model::folder::{load_weights, save_weights};
 use nprt_net::{Compute, Design, Device, Engine, Init, Loss, ModelConfig, NprtNet};
 
 /// The wgpu device, or None (test skipped) where there is none and none is required.

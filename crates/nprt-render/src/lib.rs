@@ -22,17 +22,19 @@
 //! # Ok::<(), anyhow::Error>(())
 //! ```
 
+mod animation;
 pub mod oidn;
 mod path;
 mod relight;
+mod render_job;
 pub mod schedule;
 mod sequence;
-pub mod video;
 
+pub use animation::{write_animation, Animation};
 pub use path::CameraPath;
 pub use relight::{
     background, DirectSampling, FrameTimings, LightCode, Pixels, Relighter, DEFAULT_DIRECT_SPP,
 };
+pub use render_job::{RenderJob, RenderOptions, DEFAULT_LIGHTING};
 pub use schedule::LightingSchedule;
 pub use sequence::{render_sequence, FrameReport, Sequence, SequenceSummary};
-pub use video::{srgb8, write_animation, write_png, Animation};

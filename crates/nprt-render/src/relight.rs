@@ -72,6 +72,24 @@ pub struct FrameTimings {
 }
 
 impl FrameTimings {
+    /// Adds `t`'s stages to these.
+    pub fn add(&mut self, t: &FrameTimings) {
+        self.gbuffer_ms += t.gbuffer_ms;
+        self.encoder_ms += t.encoder_ms;
+        self.network_ms += t.network_ms;
+        self.direct_ms += t.direct_ms;
+    }
+
+    /// Every stage times `k` (a mean from a sum).
+    pub fn scaled(&self, k: f64) -> FrameTimings {
+        FrameTimings {
+            gbuffer_ms: self.gbuffer_ms * k,
+            encoder_ms: self.encoder_ms * k,
+            network_ms: self.network_ms * k,
+            direct_ms: self.direct_ms * k,
+        }
+    }
+
     pub fn total_ms(&self) -> f64 {
         self.gbuffer_ms + self.encoder_ms + self.network_ms + self.direct_ms
     }
@@ -175,7 +193,7 @@ impl Relighter {
     pub fn relight(&self, px: &Pixels, light: &LightCode) -> Vec<Vec3> {
         let rgb = match &self.host {
             Some(host) => {
-                let code = cpu::host_values(light.code.clone().into_data());
+                let code = nprt_net::host_values(light.code.clone().into_data());
                 host.radiance(&px.features, &code, light.scale, px.transfer.as_ref())
             }
             None => self.burn_radiance(&px.features, light),
@@ -202,7 +220,8 @@ impl Relighter {
             let mut padded = chunk.to_vec();
             padded.resize(CHUNK * FEATURES, 0.0);
             let f = Tensor::from_data(TensorData::new(padded, [CHUNK, FEATURES]), &self.device);
-            let out = cpu::host_values(self.net.shade(f, code.clone(), scale.clone()).into_data());
+            let out =
+                nprt_net::host_values(self.net.shade(f, code.clone(), scale.clone()).into_data());
             rgb.extend_from_slice(&out[..chunk.len() / FEATURES * 3]);
         }
         rgb
@@ -223,7 +242,7 @@ pub fn background(camera: &Camera, map: &EnvMap, mask: &[f32], rgb: &mut [Vec3])
 #[cfg(test)]
 mod tests {
     use super::*;
-    use nprt_net::model::{save_model, MODEL_FORMAT, MODEL_VERSION};
+    use nprt_net::model::folder::{save_model, MODEL_FORMAT, MODEL_VERSION};
     use nprt_net::{Design, Init, ModelConfig};
     use nprt_trace::render_gbuffer;
 

@@ -5,13 +5,16 @@ use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 use anyhow::{bail, Context, Result};
+use glam::Vec3;
 use nprt_trace::{render_gbuffer, GBuffer, TraceScene};
 use serde::Serialize;
 
 use crate::oidn::Oidn;
+use nprt_io::write_png;
+
 use crate::{
-    write_animation, write_png, Animation, CameraPath, DirectSampling, FrameTimings,
-    LightingSchedule, Relighter,
+    write_animation, Animation, CameraPath, DirectSampling, FrameTimings, LightingSchedule,
+    Relighter,
 };
 
 /// What to render and where.
@@ -133,20 +136,7 @@ pub fn render_sequence(
         )?;
         t.direct_ms = clock.elapsed().as_secs_f64() * 1e3;
         let png = frames_dir.join(format!("{i:04}.png"));
-        write_png(&rgb, w as usize, h as usize, seq.exposure, &png)?;
-        if seq.exr {
-            let ch = ["R", "G", "B"]
-                .iter()
-                .enumerate()
-                .map(|(c, name)| (name.to_string(), rgb.iter().map(|v| v[c]).collect()))
-                .collect::<Vec<_>>();
-            nprt_trace::exr_io::write_channels(
-                &png.with_extension("exr"),
-                w as usize,
-                h as usize,
-                &ch,
-            )?;
-        }
+        write_frame(&rgb, [w as usize, h as usize], seq, &png)?;
         pngs.push(png);
         still = Some((camera, g, px));
         csv.serialize(TimingRow {
@@ -159,10 +149,7 @@ pub fn render_sequence(
             direct_ms: t.direct_ms,
             total_ms: t.total_ms(),
         })?;
-        sum.gbuffer_ms += t.gbuffer_ms;
-        sum.encoder_ms += t.encoder_ms;
-        sum.network_ms += t.network_ms;
-        sum.direct_ms += t.direct_ms;
+        sum.add(&t);
         let eta_s = start.elapsed().as_secs_f64() / (i + 1) as f64 * (seq.frames - i - 1) as f64;
         on_frame(&FrameReport {
             index: i,
@@ -173,15 +160,24 @@ pub fn render_sequence(
     let csv = csv.into_inner().context("cannot finish timings.csv")?;
     nprt_io::write_file(&seq.out.join("timings.csv"), csv)?;
     let animation = write_animation(&pngs, seq.fps, &seq.out.join("animation"))?;
-    let n = seq.frames as f64;
     Ok(SequenceSummary {
         frames_dir,
         animation,
-        mean: FrameTimings {
-            gbuffer_ms: sum.gbuffer_ms / n,
-            encoder_ms: sum.encoder_ms / n,
-            network_ms: sum.network_ms / n,
-            direct_ms: sum.direct_ms / n,
-        },
+        mean: sum.scaled(1.0 / seq.frames as f64),
     })
+}
+
+/// A frame's radiance as a tone-mapped PNG at `png`, and as linear OpenEXR beside it when the
+/// sequence asks for it.
+fn write_frame(rgb: &[Vec3], [w, h]: [usize; 2], seq: &Sequence, png: &Path) -> Result<()> {
+    write_png(rgb, w, h, seq.exposure, png)?;
+    if seq.exr {
+        let ch = ["R", "G", "B"]
+            .iter()
+            .enumerate()
+            .map(|(c, name)| (name.to_string(), rgb.iter().map(|v| v[c]).collect()))
+            .collect::<Vec<_>>();
+        nprt_io::exr::write_channels(&png.with_extension("exr"), w, h, &ch)?;
+    }
+    Ok(())
 }

@@ -63,21 +63,25 @@ impl CameraVolume {
             spread_deg: f.spread_deg,
             fov_deg: f.fov_deg,
         };
-        let problem = if !(v.min.is_finite() && v.max.is_finite() && v.min.cmple(v.max).all()) {
-            Some("\"min\" must not exceed \"max\" on any axis")
-        } else if v.look == Vec3::ZERO {
-            Some("\"look\" must be a non-zero direction")
-        } else if !(v.spread_deg >= 0.0 && v.spread_deg < 90.0) {
-            Some("\"spread_deg\" must be in [0, 90)")
-        } else if !(v.fov_deg > 0.0 && v.fov_deg < 180.0) {
-            Some("\"fov_deg\" must be in (0, 180)")
-        } else {
-            None
-        };
-        if let Some(p) = problem {
+        if let Some(p) = v.problem() {
             bail!("camera volume '{}': {p}", path.display());
         }
         Ok(v)
+    }
+
+    /// What makes this volume unusable, if anything: the rule each field breaks.
+    pub fn problem(&self) -> Option<&'static str> {
+        if !(self.min.is_finite() && self.max.is_finite() && self.min.cmple(self.max).all()) {
+            Some("\"min\" must not exceed \"max\" on any axis")
+        } else if !self.look.is_finite() || self.look == Vec3::ZERO {
+            Some("\"look\" must be a non-zero direction")
+        } else if !(self.spread_deg >= 0.0 && self.spread_deg < 90.0) {
+            Some("\"spread_deg\" must be in [0, 90)")
+        } else if !(self.fov_deg > 0.0 && self.fov_deg < 180.0) {
+            Some("\"fov_deg\" must be in (0, 180)")
+        } else {
+            None
+        }
     }
 }
 

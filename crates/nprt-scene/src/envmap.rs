@@ -8,8 +8,8 @@ use anyhow::{bail, Context, Result};
 use glam::{Mat3, Vec2, Vec3};
 
 use crate::distribution::Distribution2D;
-use crate::image_file::read_linear_rgb;
 use crate::luminance;
+use nprt_io::read_linear_rgb;
 
 use std::f32::consts::PI;
 
@@ -148,6 +148,17 @@ impl EnvMap {
     /// How many negative texel channels were clamped to zero on load.
     pub fn clamped_negative(&self) -> usize {
         self.data.clamped
+    }
+
+    /// The warning owed to the user when texels were clamped on load (real captures have some).
+    pub fn clamp_warning(&self) -> Option<String> {
+        (self.data.clamped > 0).then(|| {
+            format!(
+                "environment map '{}': {} negative texel channels clamped to 0",
+                self.name(),
+                self.data.clamped
+            )
+        })
     }
     pub fn to_world(&self) -> Mat3 {
         self.to_world

@@ -9,11 +9,11 @@ use anyhow::{anyhow, bail, Context, Result};
 use glam::{Affine2, Mat4, Vec2, Vec3};
 
 use crate::camera::{Camera, FovAxis};
-use crate::image_file::linear_rgb;
 use crate::material::{Material, Surface};
 use crate::mesh::Mesh;
 use crate::scene::Scene;
 use crate::texture::{Bitmap, Texture};
+use nprt_io::linear_rgb;
 
 pub fn load(path: &Path) -> Result<Scene> {
     let name = path.display().to_string();

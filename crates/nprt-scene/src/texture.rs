@@ -7,7 +7,7 @@ use anyhow::{Context, Result};
 use glam::{Affine2, Vec2, Vec3};
 
 use crate::color::luminance;
-use crate::image_file::{read_linear_rgb, LinearImage};
+use nprt_io::{read_linear_rgb, LinearImage};
 
 /// A linear-RGB image sampled with bilinear filtering and repeat wrapping (Mitsuba's and glTF's
 /// defaults).

@@ -69,8 +69,6 @@ const VECTOR_LAYERS: [(&str, [&str; 3]); 7] = [
     ("kd", RGB),
     ("ks", RGB),
 ];
-/// The one-component layers, after the vector layers.
-const SCALAR_LAYERS: [&str; 2] = ["alpha", "mask"];
 
 fn channel_name(prefix: &str, component: &str) -> String {
     if prefix.is_empty() {
@@ -81,15 +79,6 @@ fn channel_name(prefix: &str, component: &str) -> String {
 }
 
 impl Frame {
-    /// Every channel name, in the order documented above.
-    pub fn channel_names() -> Vec<String> {
-        VECTOR_LAYERS
-            .iter()
-            .flat_map(|(p, names)| names.map(|n| channel_name(p, n)))
-            .chain(SCALAR_LAYERS.map(String::from))
-            .collect()
-    }
-
     fn vector_layers(&self) -> [&Vec<Vec3>; 7] {
         let g = &self.gbuffer;
         [
@@ -122,7 +111,7 @@ impl Frame {
         out
     }
 
-    /// The frame held by named channels (as [`crate::exr_io::read_channels`] returns them),
+    /// The frame held by named channels (as [`nprt_io::exr::read_channels`] returns them),
     /// refusing a missing or wrongly sized channel and non-finite values.
     pub fn from_channels(
         width: usize,
@@ -177,7 +166,7 @@ impl Frame {
     }
 
     pub fn write_exr(&self, path: &Path) -> Result<()> {
-        crate::exr_io::write_channels(path, self.width, self.height, &self.channels())
+        nprt_io::exr::write_channels(path, self.width, self.height, &self.channels())
     }
 
     /// Mean radiance over all pixels.

@@ -3,14 +3,14 @@
 //! directly; 2: direct illumination; …), Russian roulette starts at `rr_depth`.
 
 use glam::{Vec2, Vec3};
-use nprt_scene::{BsdfParams, EnvMap, Scene};
+use nprt_scene::{BsdfParams, Camera, EnvMap, Scene};
 use rand::RngExt;
 use rand_pcg::Pcg64Mcg;
 
 use crate::accel::Hit;
 use crate::bsdf::Bsdf;
-use crate::render::TraceScene;
 use crate::shading_frame::Frame3;
+use crate::trace_scene::TraceScene;
 
 /// A surface point seen along a ray, oriented for shading.
 #[derive(Clone, Copy, Debug)]
@@ -172,6 +172,12 @@ impl CameraRay {
             dir,
             hit: ts.accel.intersect(origin, dir, f32::INFINITY),
         }
+    }
+
+    /// The ray through the centre of pixel (x, y) of `camera`, traced.
+    pub fn centre(ts: &TraceScene, camera: &Camera, x: usize, y: usize) -> Self {
+        let (o, d) = camera.ray(Vec2::new(x as f32 + 0.5, y as f32 + 0.5));
+        Self::trace(ts, o, d)
     }
 }
 

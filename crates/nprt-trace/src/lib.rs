@@ -29,18 +29,23 @@
 mod accel;
 mod bsdf;
 mod coating;
-pub mod exr_io;
 mod frame;
+mod gbuffer_pass;
 mod integrator;
 mod microfacet;
+mod pixel_rng;
+mod reference;
 mod render;
 mod shading_frame;
+mod trace_scene;
+mod transport_pass;
 
 pub use accel::{Accel, Hit};
 pub use bsdf::Bsdf;
 pub use coating::Coating;
 pub use frame::{Frame, GBuffer, GSample};
-pub use render::{
-    primary_sample, render, render_direct, render_gbuffer, render_transport, PixelFilter,
-    RenderSettings, TraceScene,
-};
+pub use gbuffer_pass::{primary_sample, render_gbuffer};
+pub use reference::{render_reference, Reference, ReferenceOptions, DEFAULT_REFERENCE_SPP};
+pub use render::{render, render_direct, PixelFilter, RenderSettings};
+pub use trace_scene::TraceScene;
+pub use transport_pass::render_transport;

@@ -251,7 +251,7 @@ fn gbuffer_holds_the_centre_hit() {
     // The frame survives an EXR round trip channel for channel.
     let path = std::env::temp_dir().join(format!("nprt-gb-{}.exr", std::process::id()));
     f.write_exr(&path).unwrap();
-    let (w, h, ch) = nprt_trace::exr_io::read_channels(&path).unwrap();
+    let (w, h, ch) = nprt_io::exr::read_channels(&path).unwrap();
     assert_eq!((w, h), (32, 32));
     for (name, data) in f.channels() {
         assert_eq!(ch[&name], data, "channel {name}");

@@ -1,32 +1,33 @@
 //! `nprt demo`: the whole pipeline on the built-in scene and lighting, sized for a laptop CPU.
+//! Every stage runs with its library's defaults except the sizes below.
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 use anyhow::Result;
+use nprt_data::GenerateOptions;
 use nprt_eval::claim::Verdict;
+use nprt_eval::{EvalOptions, Evaluation};
 use nprt_net::deep_shading::DeepShadingOptions;
-use nprt_net::{
-    Design, DirectLight, ModelConfig, TrainOptions, DEFAULT_ENCODER_WIDTH, DEFAULT_MAP_NORM,
-};
+use nprt_net::{Design, Device, DirectLight, ModelConfig, RunLength, TrainOptions};
 use nprt_render::oidn::Oidn;
-use nprt_render::DEFAULT_DIRECT_SPP;
+use nprt_render::RenderOptions;
 
-use crate::evaluation::{eval, train_deep_shading, DeepShadingArgs, EvalArgs};
-use crate::learn::{train, TrainArgs};
-use crate::relight::{render, RenderArgs};
-use crate::{DeviceArg, GenerateArgs, RunLength};
+use crate::eval::EvalJob;
+use crate::flags::DeviceArg;
+use crate::train::TrainJob;
+use crate::train_deep_shading::DeepShadingJob;
 
 #[derive(clap::Args)]
 pub struct DemoArgs {
     /// Output folder (dataset, models, report, relit frames). Re-running resumes what is done.
     #[arg(long, default_value = "nprt-demo")]
-    pub out: PathBuf,
+    out: PathBuf,
     /// Tiny sizes (under a minute on 2 cores): checks the pipeline, not the method.
     #[arg(long)]
-    pub quick: bool,
+    quick: bool,
     #[command(flatten)]
-    pub device: DeviceArg,
+    device: DeviceArg,
 }
 
 /// The demo's sizes.
@@ -57,8 +58,8 @@ const FULL: Plan = Plan {
     test_res: 64,
     spp: 64,
     test_spp: 1024,
-    training: minutes(2.0),
-    deep_shading: minutes(2.0),
+    training: RunLength::minutes(2.0),
+    deep_shading: RunLength::minutes(2.0),
     sh_spp: 256,
     timing_res: 512,
     frames: 48,
@@ -72,70 +73,104 @@ const QUICK: Plan = Plan {
     test_res: 32,
     spp: 16,
     test_spp: 32,
-    training: epochs(2),
-    deep_shading: epochs(2),
+    training: RunLength::epochs(2),
+    deep_shading: RunLength::epochs(2),
     sh_spp: 16,
     timing_res: 64,
     frames: 4,
     frame_res: 48,
 };
 
-/// A training budget of wall-clock minutes: what a faster machine gets is a better model.
-const fn minutes(m: f64) -> RunLength {
-    RunLength {
-        epochs: None,
-        minutes: Some(m),
-        schedule: None,
-    }
-}
+/// Announces each step with the time so far.
+struct Steps(Instant);
 
-/// A fixed number of epochs, for a reproducible quick run.
-const fn epochs(e: usize) -> RunLength {
-    RunLength {
-        epochs: Some(e),
-        minutes: None,
-        schedule: None,
-    }
-}
-
-pub fn demo(a: DemoArgs) -> Result<()> {
-    let p = if a.quick { QUICK } else { FULL };
-    let start = Instant::now();
-    let step = |what: &str| {
+impl Steps {
+    fn begin(&self, what: &str) {
         println!(
             "\n== {what} ({:.0} s so far)",
-            start.elapsed().as_secs_f64()
-        )
-    };
+            self.0.elapsed().as_secs_f64()
+        );
+    }
+}
+
+pub fn run(a: DemoArgs) -> Result<()> {
+    let p = if a.quick { QUICK } else { FULL };
+    let device = a.device.device()?;
+    let steps = Steps(Instant::now());
     let data = a.out.join("dataset");
-    step("1/5 generating the dataset: builtin:room under the built-in skies and indoor maps");
-    crate::generate(GenerateArgs {
+    steps
+        .begin("1/5 generating the dataset: builtin:room under the built-in skies and indoor maps");
+    crate::generate::run(&GenerateOptions {
         scene: "builtin:room".into(),
         envmaps: "builtin".into(),
         out: data.clone(),
         train_views: p.train_views,
         test_views: p.test_views,
-        train_res: [p.train_res; 2],
-        test_res: [p.test_res; 2],
+        train_resolution: [p.train_res; 2],
+        test_resolution: [p.test_res; 2],
         spp: p.spp,
         test_spp: p.test_spp,
-        seed: 0,
-        jitter_exposure: 1.0,
-        jitter_tint: 0.3,
-        test_maps: None,
-        mix_builtin: 0.0,
-        shard: (0, 1),
-        camera_volume: None,
-        volume_min: None,
-        volume_max: None,
-        look: None,
-        spread: 30.0,
-        fov: 60.0,
+        ..GenerateOptions::default()
     })?;
-    let mut models = Vec::new();
-    let defaults = TrainOptions::default();
-    // The paper's four designs, then D/S with its direct light traced at run time (the
-    // paper's suggested extension, docs/model.md).
+    let models = train_designs(&p, &data, &a.out, &device, &steps)?;
+    steps.begin("3/5 training the Deep Shading baseline");
+    let deep = a.out.join("models").join("deep-shading");
+    let defaults = DeepShadingOptions::default();
+    crate::train_deep_shading::run(
+        &DeepShadingJob {
+            data: data.clone(),
+            opts: DeepShadingOptions {
+                schedule: p.deep_shading.apply(defaults.schedule.clone()),
+                ..defaults
+            },
+            out: deep.clone(),
+        },
+        &device,
+    )?;
+    steps.begin("4/5 evaluating against the baselines");
+    let report = a.out.join("report");
+    let e = crate::eval::run(
+        &EvalJob {
+            opts: EvalOptions {
+                data: data.clone(),
+                models: models.clone(),
+                deep_shading: Some(deep),
+                sh_spp: p.sh_spp,
+                timing_res: p.timing_res,
+                ..EvalOptions::default()
+            },
+            out: report.clone(),
+        },
+        &device,
+    )?;
+    steps.begin("5/5 relighting a camera path under held-out lighting");
+    let frames = a.out.join("relit");
+    relight(
+        &p,
+        &data,
+        models.last().expect("five models"),
+        &frames,
+        &device,
+    )?;
+    println!(
+        "\n== nprt demo done in {:.0} s",
+        steps.0.elapsed().as_secs_f64()
+    );
+    println!("report: {}", report.join("report.html").display());
+    println!("relit frames: {}", frames.display());
+    print_headline(&e);
+    Ok(())
+}
+
+/// The paper's four designs, then D/S with its direct light traced at run time (the paper's
+/// suggested extension, docs/model.md); returns their model folders in that order.
+fn train_designs(
+    p: &Plan,
+    data: &Path,
+    out: &Path,
+    device: &Device,
+    steps: &Steps,
+) -> Result<Vec<PathBuf>> {
     let runs: Vec<ModelConfig> = Design::ALL
         .into_iter()
         .map(|d| ModelConfig::new(d, None))
@@ -144,98 +179,53 @@ pub fn demo(a: DemoArgs) -> Result<()> {
             ..ModelConfig::new(Design::Dsep, None)
         }])
         .collect();
+    let mut models = Vec::new();
     for (i, config) in runs.iter().enumerate() {
-        step(&format!(
+        steps.begin(&format!(
             "2/5 training design {} of {}: {}",
             i + 1,
             runs.len(),
             config.label()
         ));
-        let out = a.out.join("models").join(config.label());
-        train(TrainArgs {
-            data: data.clone(),
-            arch: config.design,
-            activation: None,
-            out: out.clone(),
-            run: p.training,
-            batch_size: defaults.batch_size,
-            lr: None,
-            seed: defaults.schedule.seed,
-            views_per_batch: defaults.views_per_batch,
-            val_samples: defaults.val_samples,
-            loss: defaults.loss,
-            calibrate: defaults.calibration,
-            encoder_width: DEFAULT_ENCODER_WIDTH,
-            map_norm: DEFAULT_MAP_NORM,
-            direct: config.direct,
-            encoding: config.encoding,
-            checkpoint_minutes: defaults.schedule.checkpoint_secs / 60.0,
-            device: a.device,
-        })?;
-        models.push(out);
+        let job = TrainJob {
+            data: data.to_path_buf(),
+            config: config.clone(),
+            opts: TrainOptions::default().with_run(config.design, p.training, None),
+            out: out.join("models").join(config.label()),
+        };
+        crate::train::run(&job, device)?;
+        models.push(job.out);
     }
-    step("3/5 training the Deep Shading baseline");
-    let deep = a.out.join("models").join("deep-shading");
-    let deep_defaults = DeepShadingOptions::default();
-    train_deep_shading(DeepShadingArgs {
-        data: data.clone(),
-        out: deep.clone(),
-        run: p.deep_shading,
-        batch_views: deep_defaults.batch_views,
-        lr: deep_defaults.schedule.learning_rate,
-        seed: deep_defaults.schedule.seed,
-        encoder_width: deep_defaults.encoder_width,
-        map_norm: deep_defaults.map_norm,
-        device: a.device,
-    })?;
-    step("4/5 evaluating against the baselines");
-    let report = a.out.join("report");
-    let e = eval(EvalArgs {
-        model: models.clone(),
-        data: data.clone(),
-        out: report.clone(),
-        deep_shading: Some(deep),
-        sh_spp: p.sh_spp,
-        timing_res: p.timing_res,
-        views: None,
-        shown_views: 3,
-        seed: 0,
-        direct_spp: DEFAULT_DIRECT_SPP,
-        device: a.device,
-    })?;
-    step("5/5 relighting a camera path under held-out lighting");
-    let manifest = nprt_data::dataset::load_manifest(&data)?;
+    Ok(models)
+}
+
+/// A camera path through the scene, relit by `model` under the dataset's held-out maps.
+fn relight(p: &Plan, data: &Path, model: &Path, frames: &Path, device: &Device) -> Result<()> {
+    let manifest = nprt_data::dataset::load_manifest(data)?;
     let s = &manifest.settings;
-    let held_out: Vec<String> = s
+    let held_out: Vec<&str> = s
         .test_maps
         .iter()
-        .map(|&k| s.envmaps[k].spec.clone())
+        .map(|&k| s.envmaps[k].spec.as_str())
         .collect();
-    let frames = a.out.join("relit");
-    render(RenderArgs {
-        model: models.last().expect("five models").clone(),
-        out: frames.clone(),
-        scene: None,
-        camera_path: None,
-        camera_volume: None,
-        lighting: held_out.join(","),
-        spin: 120.0,
-        frames: p.frames,
-        res: [p.frame_res; 2],
-        fps: 24,
-        exposure: 0.0,
-        exr: false,
-        direct_spp: DEFAULT_DIRECT_SPP,
-        // The traced light denoised where OIDN is installed: the cleaner frames.
-        denoise_direct: Oidn::open().is_ok(),
-        device: a.device,
-    })?;
-    println!(
-        "\n== nprt demo done in {:.0} s",
-        start.elapsed().as_secs_f64()
-    );
-    println!("report: {}", report.join("report.html").display());
-    println!("relit frames: {}", frames.display());
+    crate::render::run(
+        &RenderOptions {
+            model: model.to_path_buf(),
+            out: frames.to_path_buf(),
+            lighting: held_out.join(","),
+            frames: p.frames,
+            resolution: [p.frame_res; 2],
+            // The traced light denoised where OIDN is installed: the cleaner frames.
+            denoise_direct: Oidn::open().is_ok(),
+            ..RenderOptions::default()
+        },
+        device,
+    )
+}
+
+/// The figures the demo exists for: each design against path tracing of its own cost, and
+/// the paper's claims as the report judges them.
+fn print_headline(e: &Evaluation) {
     let l1 = |name: &str| e.method(name).map(|m| m.mean.l1);
     if let (Some(d), Some(b)) = (e.method("nprt-dsep"), e.method("nprt-baseline")) {
         println!(
@@ -269,5 +259,4 @@ pub fn demo(a: DemoArgs) -> Result<()> {
         count(Verdict::Fails),
         count(Verdict::Unresolved)
     );
-    Ok(())
 }

@@ -4,7 +4,7 @@
 mod common;
 
 use common::{assets, fails, fresh_dir, nprt};
-use nprt_trace::exr_io::{read_channels, write_channels};
+use nprt_io::exr::{read_channels, write_channels};
 
 /// A created scratch folder.
 fn tmp(name: &str) -> std::path::PathBuf {
@@ -206,6 +206,43 @@ fn bad_scenes_arguments_and_outputs_are_refused() {
     assert!(!out.exists());
 }
 
+/// `--envmap` replaces the scene's lighting, so the scene's own map file is never opened: a
+/// scene whose map is absent renders with it, and without it fails naming the missing file.
+#[test]
+fn envmap_replaces_a_scene_map_that_is_missing() {
+    let dir = tmp("missing-map");
+    std::fs::create_dir_all(&dir).unwrap();
+    let xml = dir.join("lit.xml");
+    std::fs::write(
+        &xml,
+        "<scene version=\"3.0.0\">\n  <shape type=\"rectangle\"/>\n  \
+         <emitter type=\"envmap\"><string name=\"filename\" value=\"gone.exr\"/></emitter>\n</scene>\n",
+    )
+    .unwrap();
+    let out = dir.join("x.exr");
+    let args = |extra: &[&'static str]| -> Vec<String> {
+        let mut a: Vec<String> = [
+            "reference",
+            xml.to_str().unwrap(),
+            "--out",
+            out.to_str().unwrap(),
+        ]
+        .map(String::from)
+        .into();
+        a.extend(["--spp", "1", "--width", "8", "--height", "8"].map(String::from));
+        a.extend(extra.iter().map(|s| s.to_string()));
+        a
+    };
+    fn run(a: &[String]) -> Vec<&str> {
+        a.iter().map(String::as_str).collect()
+    }
+    fails(&run(&args(&[])), &["gone.exr"]);
+    assert!(!out.exists());
+    let text = common::ok(&run(&args(&["--envmap", "builtin:sky"])));
+    assert!(text.contains("rendered 8×8"), "{text}");
+    assert!(out.exists());
+}
+
 #[test]
 fn help_explains_every_flag() {
     let o = nprt(&["reference", "--help"]);
@@ -237,7 +274,12 @@ fn device_gpu_without_one_fails_clearly_and_auto_falls_back() {
         assert!(String::from_utf8_lossy(&gpu.stdout).contains(" on cuda: "));
     } else {
         let err = String::from_utf8_lossy(&gpu.stderr);
-        assert!(err.contains("--device gpu: no CUDA GPU found"), "{err}");
+        let why = if cfg!(feature = "cuda") {
+            "--device gpu: no CUDA GPU found"
+        } else {
+            "--device gpu: this nprt was built without CUDA support"
+        };
+        assert!(err.contains(why), "{err}");
         let auto = run("auto");
         assert!(auto.status.success());
         assert!(String::from_utf8_lossy(&auto.stdout).contains(" on cpu,"));
@@ -263,7 +305,10 @@ fn fake_peer(dir: &std::path::Path, rates: &[u32]) -> std::path::PathBuf {
             rates = rates.iter().map(u32::to_string).collect::<Vec<_>>().join(" ")
         )
     };
-    std::fs::write(&script, format!("#!/usr/bin/env bash\n{body}\n")).unwrap();
+    // The script nprt hands its peer must be the embedded PyTorch benchmark.
+    let check =
+        "grep -q 'samples_per_s' \"$1\" || { echo \"not the peer script: $1\" >&2; exit 1; }";
+    std::fs::write(&script, format!("#!/usr/bin/env bash\n{check}\n{body}\n")).unwrap();
     use std::os::unix::fs::PermissionsExt;
     std::fs::set_permissions(&script, std::fs::Permissions::from_mode(0o755)).unwrap();
     script

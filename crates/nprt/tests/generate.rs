@@ -284,6 +284,8 @@ fn real_maps_and_a_file_scene_with_flags_work() {
         "2",
         "--test-spp",
         "4",
+        "--mix-builtin",
+        "0",
     ]);
     assert!(
         out.contains("under 2 maps") && out.contains("under 1 held-out maps"),
@@ -326,6 +328,15 @@ fn a_folder_of_maps_mixes_in_builtin_lightings() {
     }
     let d = dir.to_str().unwrap();
     ok(&args(d, maps.to_str().unwrap(), "0.5"));
+    // Without the flag a folder dataset mixes half in: the share measured best is the default.
+    let default = tmp("mixed-default");
+    let mut unflagged = args(default.to_str().unwrap(), maps.to_str().unwrap(), "0.5");
+    unflagged.drain(7..9);
+    ok(&unflagged);
+    assert_eq!(
+        std::fs::read(default.join("manifest.json")).unwrap(),
+        std::fs::read(dir.join("manifest.json")).unwrap()
+    );
     let m: serde_json::Value =
         serde_json::from_slice(&std::fs::read(dir.join("manifest.json")).unwrap()).unwrap();
     let specs: Vec<&str> = m["settings"]["envmaps"]

@@ -8,8 +8,8 @@ use std::path::{Path, PathBuf};
 use std::process::Command;
 
 use glam::Vec3;
+use nprt_io::exr::{read_channels, write_channels};
 use nprt_scene::{load_scene, EnvMap, SceneOptions};
-use nprt_trace::exr_io::{read_channels, write_channels};
 use nprt_trace::{render, PixelFilter, RenderSettings, TraceScene};
 
 const SPP: u32 = 64;
@@ -111,6 +111,7 @@ fn agree_on(name: &str, scene_path: &Path, tolerance: f32) {
 
     let opts = SceneOptions {
         set: vec![("envmap".into(), map.display().to_string())],
+        ..SceneOptions::default()
     };
     let scene = load_scene(scene_path.to_str().unwrap(), &opts).unwrap();
     let ts = TraceScene::new(&scene);

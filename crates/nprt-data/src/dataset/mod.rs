@@ -16,6 +16,6 @@ pub use manifest::{
     VolumeRecord, FORMAT_VERSION, MANIFEST,
 };
 pub use plan::{plan, MapAssignment, Request};
-pub use scene_identity::{load_checked_scene, scene_hash, scene_source};
+pub use scene_identity::{load_checked_scene, relit, scene_hash, scene_source};
 pub use verify::{verify, Report};
 pub use view_file::{check_view, read_view, write_view, ViewImage};

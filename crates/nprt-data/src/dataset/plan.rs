@@ -92,20 +92,7 @@ pub fn plan(req: &Request, ts: &TraceScene) -> Result<Manifest> {
         }
     };
     check_jitter(&req.jitter)?;
-    let envmaps = req
-        .map_specs
-        .iter()
-        .zip(&req.maps)
-        .map(|(spec, map)| {
-            let hash = crate::lighting::map_hash(spec)?;
-            Ok(MapRecord {
-                spec: spec.clone(),
-                hash,
-                width: map.width(),
-                height: map.height(),
-            })
-        })
-        .collect::<Result<Vec<_>>>()?;
+    let envmaps = map_records(req)?;
     let v = &req.volume;
     let settings = Settings {
         format_version: FORMAT_VERSION,
@@ -132,17 +119,58 @@ pub fn plan(req: &Request, ts: &TraceScene) -> Result<Manifest> {
             fov_deg: v.fov_deg,
         },
     };
+    let views = plan_views(req, ts, &train_pool, &test_maps, mixed, own_map)?;
+    let (lo, hi) = req.scene.bounds();
+    let manifest = Manifest {
+        settings,
+        bounds: [lo.into(), hi.into()],
+        views,
+    };
+    manifest
+        .check()
+        .with_context(|| format!("cannot plan a dataset for scene '{}'", req.scene_spec))?;
+    Ok(manifest)
+}
+
+/// What the manifest records of each map: its spec, a hash of its file and its size.
+fn map_records(req: &Request) -> Result<Vec<MapRecord>> {
+    req.map_specs
+        .iter()
+        .zip(&req.maps)
+        .map(|(spec, map)| {
+            let hash = crate::lighting::map_hash(spec)?;
+            Ok(MapRecord {
+                spec: spec.clone(),
+                hash,
+                width: map.width(),
+                height: map.height(),
+            })
+        })
+        .collect()
+}
+
+/// Every view's camera, map, rotation, jitter and seed, in index order: training views draw
+/// from `train_pool` (or, where `own_map` says, take the next of the mixed views' own maps,
+/// which follow the pool's), test views from `test_maps`.
+fn plan_views(
+    req: &Request,
+    ts: &TraceScene,
+    train_pool: &[usize],
+    test_maps: &[usize],
+    mixed: usize,
+    own_map: impl Fn(u64) -> bool,
+) -> Result<Vec<ViewRecord>> {
     let mut views = Vec::with_capacity((req.train_views + req.test_views) as usize);
     let mut next_own = req.maps.len() - mixed;
     for index in 0..req.train_views + req.test_views {
         let train = index < req.train_views;
         let (split, local, maps, [w, h]) = if train {
-            ("train", index, &train_pool, req.train_resolution)
+            ("train", index, train_pool, req.train_resolution)
         } else {
             (
                 "test",
                 index - req.train_views,
-                &test_maps,
+                test_maps,
                 req.test_resolution,
             )
         };
@@ -182,16 +210,7 @@ pub fn plan(req: &Request, ts: &TraceScene) -> Result<Manifest> {
             seed,
         });
     }
-    let (lo, hi) = req.scene.bounds();
-    let manifest = Manifest {
-        settings,
-        bounds: [lo.into(), hi.into()],
-        views,
-    };
-    manifest
-        .check()
-        .with_context(|| format!("cannot plan a dataset for scene '{}'", req.scene_spec))?;
-    Ok(manifest)
+    Ok(views)
 }
 
 /// Refuses jitter that could not be recorded (gains are kept within [1/64, 64]).

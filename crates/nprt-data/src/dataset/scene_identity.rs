@@ -14,9 +14,10 @@ pub fn scene_source(spec: &str) -> Result<Vec<u8>> {
 }
 
 /// Loads the scene `spec` and checks it is the one with hash `expected` (that a dataset was
-/// rendered from, or a model trained on, as `what` says).
+/// rendered from, or a model trained on, as `what` says). Its own lighting is not read: a
+/// dataset's views, and a model's frames, are lit by maps of their own.
 pub fn load_checked_scene(spec: &str, expected: &str, what: &str) -> Result<Scene> {
-    let scene = nprt_scene::load_scene(spec, &nprt_scene::SceneOptions::default())?;
+    let scene = nprt_scene::load_scene(spec, &relit())?;
     let hash = scene_hash(&scene, &scene_source(spec)?);
     if hash != expected {
         bail!(
@@ -26,6 +27,15 @@ pub fn load_checked_scene(spec: &str, expected: &str, what: &str) -> Result<Scen
         );
     }
     Ok(scene)
+}
+
+/// How a scene is read for datasets and models: lit by their own maps, so the scene's
+/// environment emitter is skipped (its map file need not exist).
+pub fn relit() -> nprt_scene::SceneOptions {
+    nprt_scene::SceneOptions {
+        lighting_replaced: true,
+        ..Default::default()
+    }
 }
 
 /// Hash of what the network will learn: geometry, material parameters at vertices, and the

@@ -6,7 +6,7 @@ use std::path::Path;
 
 use anyhow::{bail, Context, Result};
 use glam::Vec3;
-use nprt_trace::exr_io::{read_channels, write_channels};
+use nprt_io::exr::{read_channels, write_channels};
 use nprt_trace::Frame;
 
 use super::manifest::ViewRecord;

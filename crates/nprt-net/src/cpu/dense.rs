@@ -11,8 +11,8 @@ use burn::tensor::Tensor;
 use super::accumulate;
 use super::matmul::{matmul, MatRef, Op};
 use super::sincos::{sin_scaled, sincos_scaled};
-use crate::activation::{Activation, OMEGA_0};
-use crate::mlp::Mlp;
+use crate::network::activation::{Activation, OMEGA_0};
+use crate::network::mlp::Mlp;
 
 /// One dense layer `y = x·W + b`, W row-major `d_in × d_out` as burn's `Linear` keeps it.
 #[derive(Clone, Debug, PartialEq)]
@@ -77,7 +77,7 @@ impl Tape {
 }
 
 pub(super) fn host<const D: usize>(p: &Param<Tensor<D>>) -> Vec<f32> {
-    super::host_values(p.val().into_data())
+    crate::device::host_values(p.val().into_data())
 }
 
 impl Dense {

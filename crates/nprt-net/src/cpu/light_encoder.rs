@@ -4,7 +4,7 @@
 //! one pass for bias, ReLU and skip and one for the 2×2 max-pool. burn's convolutions took about
 //! 30% of a training step (`nprt bench train --views 1` against `--views 8`, docs/model.md).
 //!
-//! Computes what [`crate::encoder::LightEncoder::forward`] computes, in f32; the test that holds
+//! Computes what [`crate::network::encoder::LightEncoder::forward`] computes, in f32; the test that holds
 //! the CPU engine to burn's autodiff covers every weight here.
 
 use burn::nn::conv::Conv2d;
@@ -13,7 +13,7 @@ use rayon::prelude::*;
 use super::accumulate;
 use super::dense::{host, Dense};
 use super::matmul::{matmul, MatRef, Op};
-use crate::encoder::{LightEncoder, CHANNELS, CODE_SIZE};
+use crate::network::encoder::{LightEncoder, CHANNELS, CODE_SIZE};
 
 /// Taps of a 3×3 kernel.
 const TAPS: usize = 9;
@@ -143,7 +143,7 @@ impl HostEncoder {
         self.to_code.add(&other.to_code);
     }
 
-    /// The codes of `lights` (views × [3, W/2, W], channel-major, as [`crate::batch::Batch`]
+    /// The codes of `lights` (views × [3, W/2, W], channel-major, as [`crate::training::batch::Batch`]
     /// keeps them) for a map width `width`.
     pub fn forward(&self, lights: &[f32], width: usize) -> EncoderPass {
         let per_view = 3 * width * width / 2;

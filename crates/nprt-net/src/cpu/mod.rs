@@ -10,6 +10,7 @@ mod dense;
 mod light_encoder;
 mod matmul;
 mod peak;
+mod samples;
 pub mod sincos;
 mod transport;
 
@@ -18,33 +19,33 @@ use burn::nn::Linear;
 use burn::optim::GradientsParams;
 use burn::tensor::{DType, Device, Tensor, TensorData};
 
-use crate::batch::Batch;
-use crate::design::NprtNet;
-use crate::encoder::LightEncoder;
-use crate::loss::Loss;
-use crate::mlp::Mlp;
+use crate::network::encoder::LightEncoder;
+use crate::network::mlp::Mlp;
+use crate::network::nprt_net::NprtNet;
+use crate::training::loss::Loss;
 use dense::Dense;
 pub use dense::DenseStack;
 pub use light_encoder::{EncoderPass, HostEncoder};
 pub use peak::{measured_peak, Peak};
+pub use samples::Samples;
 pub use transport::{HostTransport, TransferCodes, TransportGradients};
 
 /// Whether the CPU engine can run `net` on `device`.
 pub fn applies(net: &NprtNet, device: &Device) -> bool {
     let weight = &net.tracks[0].shading.layers[0].weight;
-    crate::compute::is_cpu(device) && weight.val().dtype() == DType::F32
+    crate::device::is_cpu(device) && weight.val().dtype() == DType::F32
 }
 
 /// The batch's loss and every parameter's gradient, computed on the CPU engine (`device` is
 /// the autodiff device the network lives on).
 pub fn gradients(
     net: &NprtNet,
-    batch: &Batch,
+    batch: &Samples,
     device: &Device,
     loss: Loss,
 ) -> (f64, GradientsParams) {
     let encoder = HostEncoder::from_burn(&net.encoder);
-    let light = encoder.forward(&batch.lights, batch.light_width);
+    let light = encoder.forward(batch.lights, batch.light_width);
     let (loss, mut params, d_codes) = transport_gradients(net, batch, &light.codes, device, loss);
     let grads = encoder.backward(&light, &d_codes);
     register_encoder(&mut params, &net.encoder, grads, &device.clone().inner());
@@ -75,7 +76,7 @@ pub fn register_encoder(
 /// the batch's loss, the transport networks' gradients and the gradient at the codes.
 pub fn transport_gradients(
     net: &NprtNet,
-    batch: &Batch,
+    batch: &Samples,
     codes: &[f32],
     device: &Device,
     loss: Loss,
@@ -117,11 +118,4 @@ fn register_linear(params: &mut GradientsParams, layer: &Linear, g: Dense, devic
 /// `acc += x`, element by element: gradients summed over blocks, runs and maps.
 fn accumulate(acc: &mut [f32], x: &[f32]) {
     acc.iter_mut().zip(x).for_each(|(a, v)| *a += v);
-}
-
-/// A tensor's values as f32 on the host.
-pub fn host_values(data: TensorData) -> Vec<f32> {
-    data.convert::<f32>()
-        .try_into_vec::<f32>()
-        .expect("converted to f32")
 }

@@ -1,7 +1,7 @@
 //! The transport tracks of a design on the host: forward, the training loss and backward for a
 //! whole batch, block by block on all cores, given the light codes the encoder made.
 //!
-//! Computes exactly what [`crate::design::NprtNet::shade`] and [`crate::loss::Loss::mean`] compute
+//! Computes exactly what [`crate::network::nprt_net::NprtNet::shade`] and [`crate::training::loss::Loss::mean`] compute
 //! (same operations in f32), so that burn's autodiff and this path agree to rounding; a test
 //! holds them to that.
 
@@ -10,13 +10,14 @@ use rayon::prelude::*;
 use super::accumulate;
 use super::dense::{DenseStack, Pass, SharedInput, Tape};
 use super::matmul::MatRef;
-use crate::batch::Batch;
-use crate::design::{NprtNet, TRANSPORT_CODE};
-use crate::encoder::CODE_SIZE;
-use crate::features::{feature, FEATURES};
-use crate::hash_grid;
-use crate::loss::Loss;
-use crate::track::TrackKind;
+use super::samples::Samples;
+use crate::encoding::features::{feature, FEATURES};
+use crate::encoding::hash_grid;
+use crate::network::design::TRANSPORT_CODE;
+use crate::network::encoder::CODE_SIZE;
+use crate::network::nprt_net::NprtNet;
+use crate::network::track::TrackKind;
+use crate::training::loss::Loss;
 
 /// Rows per block: small enough that a block's activations stay in the caches, large enough
 /// for efficient matrix products.
@@ -358,7 +359,7 @@ impl HostTransport {
                 grid: t
                     .grid
                     .as_ref()
-                    .map(|g| super::host_values(g.table.val().into_data())),
+                    .map(|g| crate::device::host_values(g.table.val().into_data())),
                 transfer: t.transfer.as_ref().map(DenseStack::from_mlp),
                 shading: DenseStack::from_mlp(&t.shading),
             })
@@ -368,7 +369,7 @@ impl HostTransport {
 
     /// The batch's mean `loss` and its gradients, for the light codes `codes`
     /// (`views × CODE_SIZE`, the encoder's output for the batch's maps).
-    pub fn gradients(&self, batch: &Batch, codes: &[f32], loss: Loss) -> TransportGradients {
+    pub fn gradients(&self, batch: &Samples, codes: &[f32], loss: Loss) -> TransportGradients {
         let n = batch.len();
         let views = codes.len() / CODE_SIZE;
         let view: Vec<u32> = batch.view.iter().map(|&v| v as u32).collect();
@@ -502,7 +503,7 @@ impl HostTransport {
     /// Adds the loss and gradients of the batch's rows `rows` to `g`.
     fn block(
         &self,
-        batch: &Batch,
+        batch: &Samples,
         rows: std::ops::Range<usize>,
         light: Lighting,
         loss: Loss,

@@ -1,13 +1,15 @@
 //! The Deep Shading baseline (Nalbach et al. 2017): a per-scene U-Net from G-buffer images to
 //! radiance, trained on the same dataset as the Neural PRT designs, by the same loop
-//! ([`crate::trainer`]: checkpoints with Adam's state, exact resume). The paper's comparison
+//! ([`crate::training::training_loop`]: checkpoints with Adam's state, exact resume). The paper's comparison
 //! gives it the lighting too: the map goes through the same light encoder (trained jointly)
 //! and its code is added to the U-Net's bottleneck.
 
 mod model;
+mod options;
 mod train;
 mod unet;
 
 pub use model::{read_file, DeepShadingFile, DeepShadingModel, CONFIG_FILE, TAG};
-pub use train::{train, DeepShadingOptions};
+pub use options::DeepShadingOptions;
+pub use train::train;
 pub use unet::{feature_image, DeepShading};

@@ -2,19 +2,19 @@
 
 use std::path::Path;
 
-use anyhow::{bail, Context, Result};
+use anyhow::Result;
 use burn::tensor::{Device, Tensor, TensorData};
 use glam::Vec3;
 use nprt_scene::EnvMap;
 use nprt_trace::GBuffer;
 use serde::{Deserialize, Serialize};
 
-use super::train::DeepShadingOptions;
+use super::options::DeepShadingOptions;
 use super::unet::{feature_image, DeepShading};
-use crate::encoder::LightInput;
-use crate::features::FEATURES;
-use crate::init::Init;
-use crate::model::{load_weights, WEIGHTS_FILE};
+use crate::encoding::features::FEATURES;
+use crate::model::folder::{load_weights, read_config, WEIGHTS_FILE};
+use crate::network::encoder::LightInput;
+use crate::network::init::Init;
 
 pub const TAG: &str = "deep-shading";
 pub const CONFIG_FILE: &str = "deep-shading.json";
@@ -44,22 +44,7 @@ pub struct DeepShadingModel {
 }
 
 pub fn read_file(dir: &Path) -> Result<DeepShadingFile> {
-    let path = dir.join(CONFIG_FILE);
-    let text = std::fs::read_to_string(&path).with_context(|| {
-        format!(
-            "'{}' is not a Deep Shading model folder (no readable {CONFIG_FILE})",
-            dir.display()
-        )
-    })?;
-    let f: DeepShadingFile = serde_json::from_str(&text)
-        .with_context(|| format!("'{}' is malformed", path.display()))?;
-    if f.format != TAG || f.version != 1 {
-        bail!(
-            "'{}' is not a version-1 Deep Shading config",
-            path.display()
-        );
-    }
-    Ok(f)
+    read_config(dir, CONFIG_FILE, TAG, 1, "Deep Shading model")
 }
 
 impl DeepShadingModel {

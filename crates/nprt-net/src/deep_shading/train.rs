@@ -11,45 +11,19 @@ use nprt_data::dataset::load_manifest_hashed;
 use nprt_data::views::{load_views, ImageView};
 use nprt_scene::EnvMap;
 use rand::seq::SliceRandom;
-use serde::{Deserialize, Serialize};
 
 use super::model::{read_file, DeepShadingFile, CONFIG_FILE, TAG};
+use super::options::DeepShadingOptions;
 use super::unet::{feature_image, DeepShading};
-use crate::checkpoint::{self, RunState};
-use crate::data::{log_mean_level, open_recorded_maps};
-use crate::encoder::{check_input_width, LightInput};
-use crate::features::FEATURES;
-use crate::init::Init;
-use crate::loss::log_l1_map;
-use crate::map_norm::MapNorm;
-use crate::model::{save_weights, WEIGHTS_FILE};
-use crate::trainer::{self, epoch_rng, Objective, Schedule, TrainSummary};
-
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-pub struct DeepShadingOptions {
-    #[serde(flatten)]
-    pub schedule: Schedule,
-    /// Whole views per step.
-    pub batch_views: usize,
-    /// Width W of the light encoder's W × W/2 input.
-    pub encoder_width: usize,
-    /// How the map is normalised for the encoder (absent in older files: the paper's mean).
-    #[serde(default)]
-    pub map_norm: MapNorm,
-}
-
-impl Default for DeepShadingOptions {
-    fn default() -> Self {
-        DeepShadingOptions {
-            // Its learning rate too: 1e-3 was measured to kill this ReLU U-Net (every
-            // activation dead, the output a constant).
-            schedule: Schedule::default(),
-            batch_views: 4,
-            encoder_width: crate::model::DEFAULT_ENCODER_WIDTH,
-            map_norm: crate::model::DEFAULT_MAP_NORM,
-        }
-    }
-}
+use crate::encoding::features::FEATURES;
+use crate::encoding::map_norm::MapNorm;
+use crate::model::folder::{save_weights, WEIGHTS_FILE};
+use crate::network::encoder::{check_input_width, LightInput};
+use crate::network::init::Init;
+use crate::training::checkpoint::{self, RunState};
+use crate::training::loss::log_l1_map;
+use crate::training::training_loop::{self, epoch_rng, Objective, Schedule, TrainSummary};
+use crate::training::training_set::{log_mean_level, open_recorded_maps};
 
 /// What training needs of each view, padded to multiples of 8.
 struct Sample {
@@ -318,6 +292,6 @@ pub fn train(
         seconds: 0.0,
     };
     let objective = UnetObjective { train, test, file };
-    let summary = trainer::train(&objective, &opts.schedule, out, device)?;
+    let summary = training_loop::train(&objective, &opts.schedule, out, device)?;
     Ok((summary, read_file(out)?))
 }

@@ -9,12 +9,12 @@ use burn::tensor::activation::relu;
 use burn::tensor::Tensor;
 use nprt_trace::GBuffer;
 
-use crate::activation::Activation;
-use crate::encoder::{LightEncoder, CODE_SIZE};
-use crate::features::gbuffer_features;
-use crate::features::FEATURES;
-use crate::init::{conv2d, shifted_bias, Init};
-use crate::mlp::Mlp;
+use crate::encoding::features::gbuffer_features;
+use crate::encoding::features::FEATURES;
+use crate::network::activation::Activation;
+use crate::network::encoder::{LightEncoder, CODE_SIZE};
+use crate::network::init::{conv2d, shifted_bias, Init};
+use crate::network::mlp::Mlp;
 
 /// Channels of the encoder levels (full, ½, ¼ resolution) and of the ⅛-resolution bottleneck.
 const WIDTHS: [usize; 4] = [16, 32, 64, 64];

@@ -4,7 +4,7 @@
 use burn::module::{Module, ModuleMapper, ModuleVisitor, Param, ParamId};
 use burn::optim::GradientsParams;
 use burn::tensor::{DType, Tensor, TensorData};
-use nprt_net::hash_grid::{LEVELS, LEVEL_FEATURES, TABLE_SIZE};
+use nprt_net::encoding::hash_grid::{LEVELS, LEVEL_FEATURES, TABLE_SIZE};
 use nprt_net::{Activation, Batch, Design, Device, Init, Loss, ModelConfig, NprtNet};
 use nprt_net::{PositionEncoding, FEATURES};
 use rand::{RngExt, SeedableRng};

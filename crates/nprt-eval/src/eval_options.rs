@@ -1,0 +1,42 @@
+//! The options of an evaluation, each default stated once here.
+
+use std::path::PathBuf;
+
+use nprt_render::DEFAULT_DIRECT_SPP;
+
+/// What to evaluate; `Default` needs `data` and `models` filled in.
+#[derive(Clone, Debug)]
+pub struct EvalOptions {
+    pub data: PathBuf,
+    pub models: Vec<PathBuf>,
+    pub deep_shading: Option<PathBuf>,
+    /// Paths per pixel of the SH transport precomputation.
+    pub sh_spp: u32,
+    /// Side of the square frames of the timing table (the paper: 512).
+    pub timing_res: u32,
+    /// Evaluate only the first N test views.
+    pub max_views: Option<usize>,
+    /// Test views shown as images in the report.
+    pub shown_views: usize,
+    pub seed: u64,
+    /// Samples per pixel of the direct light of models that trace it.
+    pub direct_spp: u32,
+    pub progress: bool,
+}
+
+impl Default for EvalOptions {
+    fn default() -> Self {
+        EvalOptions {
+            data: PathBuf::new(),
+            models: vec![],
+            deep_shading: None,
+            sh_spp: 256,
+            timing_res: 512,
+            max_views: None,
+            shown_views: 3,
+            seed: 0,
+            direct_spp: DEFAULT_DIRECT_SPP,
+            progress: true,
+        }
+    }
+}

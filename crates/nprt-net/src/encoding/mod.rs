@@ -1,0 +1,7 @@
+//! What the networks see: a pixel's G-buffer features, the position encodings beyond the
+//! paper's (a hash grid), and how a map is normalised for the encoder.
+
+pub mod features;
+pub mod hash_grid;
+pub mod map_norm;
+pub mod position_encoding;

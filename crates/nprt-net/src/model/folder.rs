@@ -1,0 +1,169 @@
+//! The model folder: `model.json` (what to build, how to feed it, where it came from) and the
+//! weights, saved and loaded; also the one reader of a folder's versioned JSON config, which
+//! Deep Shading's folder shares.
+
+use std::path::Path;
+
+use anyhow::{bail, Context, Result};
+use burn::module::Module;
+use burn::store::{ModuleSnapshot, SafetensorsStore};
+use burn::tensor::Device;
+use serde::de::DeserializeOwned;
+use serde::{Deserialize, Serialize};
+
+use crate::model::config::ModelConfig;
+use crate::network::init::Init;
+use crate::network::nprt_net::NprtNet;
+
+/// Identifies a model folder's config file.
+pub const MODEL_FORMAT: &str = "nprt-model";
+/// Bumped whenever a saved model would be read differently.
+pub const MODEL_VERSION: u32 = 1;
+pub const CONFIG_FILE: &str = "model.json";
+pub const WEIGHTS_FILE: &str = "weights.safetensors";
+
+/// The config file of a model folder: what to build, how to feed it, where it came from.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct ModelFile {
+    pub format: String,
+    pub version: u32,
+    #[serde(flatten)]
+    pub config: ModelConfig,
+    /// Scene bounds that normalise positions to [−1, 1].
+    pub bounds: [[f32; 3]; 2],
+    /// The scene the model was trained for, as the dataset names it (a file path or a
+    /// built-in name), and its BLAKE3 hash as in the dataset manifest.
+    #[serde(default)]
+    pub scene: String,
+    pub scene_hash: String,
+    /// BLAKE3 of the training dataset's manifest.json.
+    pub dataset_hash: String,
+    pub transport_params: usize,
+    pub encoder_params: usize,
+    /// Training settings and progress (informative).
+    pub training: serde_json::Value,
+    /// What the network's radiance is multiplied by, per channel, to have its training targets'
+    /// level (`nprt train --calibrate level`, crate::training::calibration); absent: as the network says.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub level_gain: Option<[f32; 3]>,
+}
+
+impl ModelFile {
+    /// The gain on each channel of the network's radiance (1 without calibration).
+    pub fn output_gain(&self) -> [f32; 3] {
+        self.level_gain.unwrap_or([1.0; 3])
+    }
+}
+
+/// Writes `model.json` and the weights of `net` into `dir`, each file atomically.
+pub fn save_model(dir: &Path, file: &ModelFile, net: &NprtNet) -> Result<()> {
+    save_weights(&dir.join(WEIGHTS_FILE), net, file.config.design.name())?;
+    let json = serde_json::to_vec_pretty(file)?;
+    nprt_io::write_file(&dir.join(CONFIG_FILE), &json)
+}
+
+/// Weights as safetensors, tagged with the design (or other network kind) that produced them.
+pub fn save_weights<M: Module>(path: &Path, net: &M, tag: &str) -> Result<()> {
+    // One metadata key only: the header is then byte-for-byte reproducible.
+    let mut store = SafetensorsStore::from_bytes(None)
+        .clear_metadata()
+        .metadata("nprt_design", tag);
+    net.save_into(&mut store)
+        .map_err(|e| anyhow::anyhow!("cannot serialise weights: {e}"))?;
+    let bytes = store
+        .get_bytes()
+        .map_err(|e| anyhow::anyhow!("cannot serialise weights: {e}"))?;
+    nprt_io::write_file(path, &bytes)
+}
+
+/// Loads weights saved by [`save_weights`] into `net`, which must be of the same design.
+pub fn load_weights<M: Module>(path: &Path, net: &mut M, tag: &str) -> Result<()> {
+    let bytes =
+        std::fs::read(path).with_context(|| format!("cannot read weights '{}'", path.display()))?;
+    let saved_design = read_design_tag(&bytes)
+        .with_context(|| format!("'{}' is not an nprt weights file", path.display()))?;
+    if saved_design != tag {
+        bail!(
+            "weights '{}' belong to design '{saved_design}', not '{tag}'",
+            path.display()
+        );
+    }
+    let mut store = SafetensorsStore::from_bytes(Some(bytes)).validate(true);
+    let result = net
+        .load_from(&mut store)
+        .map_err(|e| anyhow::anyhow!("cannot load weights '{}': {e}", path.display()))?;
+    if !result.errors.is_empty() || !result.missing.is_empty() || !result.unused.is_empty() {
+        bail!(
+            "weights '{}' do not fit the '{tag}' network: {} missing, {} unexpected, {} bad tensors (first: {})",
+            path.display(),
+            result.missing.len(),
+            result.unused.len(),
+            result.errors.len(),
+            result
+                .missing
+                .first()
+                .map(|m| m.0.clone())
+                .or(result.unused.first().cloned())
+                .or(result.errors.first().map(|e| format!("{e:?}")))
+                .unwrap_or_default()
+        );
+    }
+    Ok(())
+}
+
+/// The `nprt_design` entry of a safetensors header.
+fn read_design_tag(bytes: &[u8]) -> Result<String> {
+    let (_, metadata) = safetensors::SafeTensors::read_metadata(bytes)
+        .map_err(|e| anyhow::anyhow!("not a safetensors file: {e}"))?;
+    metadata
+        .metadata()
+        .as_ref()
+        .and_then(|m| m.get("nprt_design"))
+        .cloned()
+        .context("no nprt_design tag in its metadata")
+}
+
+/// Reads a model folder's config, refusing other formats and versions.
+pub fn read_model_file(dir: &Path) -> Result<ModelFile> {
+    read_config(dir, CONFIG_FILE, MODEL_FORMAT, MODEL_VERSION, "model")
+}
+
+/// Reads the versioned JSON config `file_name` of a folder of `kind` ("model", "Deep Shading
+/// model"): errors name the folder or file and say whether it is missing, not JSON, another
+/// format, another version or malformed.
+pub fn read_config<T: DeserializeOwned>(
+    dir: &Path,
+    file_name: &str,
+    format: &str,
+    version: u32,
+    kind: &str,
+) -> Result<T> {
+    let path = dir.join(file_name);
+    let text = std::fs::read_to_string(&path).with_context(|| {
+        format!(
+            "'{}' is not a {kind} folder (no readable {file_name})",
+            dir.display()
+        )
+    })?;
+    let value: serde_json::Value = serde_json::from_str(&text)
+        .with_context(|| format!("'{}' is not valid JSON", path.display()))?;
+    if value["format"] != format {
+        bail!("'{}' is not an nprt {kind} config", path.display());
+    }
+    if value["version"] != version {
+        bail!(
+            "{kind} '{}' is format version {}, this nprt reads version {version}; retrain it with this version",
+            dir.display(),
+            value["version"]
+        );
+    }
+    serde_json::from_value(value).with_context(|| format!("'{}' is malformed", path.display()))
+}
+
+/// Loads a trained model folder onto `device`.
+pub fn load_model(dir: &Path, device: &Device) -> Result<(ModelFile, NprtNet)> {
+    let file = read_model_file(dir)?;
+    let mut net = file.config.build(&mut Init::new(0, device));
+    load_weights(&dir.join(WEIGHTS_FILE), &mut net, file.config.design.name())?;
+    Ok((file, net))
+}

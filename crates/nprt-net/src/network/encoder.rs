@@ -1,0 +1,125 @@
+//! The light encoder F_L: a small CNN that turns a lat-long environment map into the light code ê.
+
+use burn::module::Module;
+use burn::nn::conv::Conv2d;
+use burn::nn::pool::{MaxPool2d, MaxPool2dConfig};
+use burn::nn::Linear;
+use burn::tensor::activation::relu;
+use burn::tensor::Tensor;
+use glam::Vec2;
+use nprt_scene::envmap::{uv_to_direction, EnvMap};
+
+use crate::encoding::map_norm::MapNorm;
+use crate::network::activation::Activation;
+use crate::network::init::{conv2d, Init};
+use crate::network::mlp::Mlp;
+
+/// Convolution blocks of the paper's encoder.
+pub const BLOCKS: usize = 5;
+/// Channels of every convolution.
+pub const CHANNELS: usize = 32;
+/// Size of the light code ê.
+pub const CODE_SIZE: usize = 64;
+
+/// The encoder's input width must halve cleanly through every block, and the height is half
+/// the width.
+pub fn check_input_width(width: usize) -> anyhow::Result<()> {
+    let step = 2usize.pow(BLOCKS as u32 + 1);
+    if width < step || !width.is_multiple_of(step) {
+        anyhow::bail!(
+            "encoder input width {width} must be a positive multiple of {step} (the map is W×W/2 and {BLOCKS} blocks halve it)"
+        );
+    }
+    Ok(())
+}
+
+/// 5 × (3×3 conv with 32 channels, ReLU, skip connection, 2×2 max-pool), then one dense layer
+/// to the 64-d code. The skip adds the block's input to the ReLU output; the first block's
+/// 3-channel input is zero-padded to 32 channels for that sum, so the skips add no parameters.
+#[derive(Module, Debug)]
+pub struct LightEncoder {
+    pub convs: Vec<Conv2d>,
+    pub pool: MaxPool2d,
+    pub to_code: Linear,
+}
+
+impl LightEncoder {
+    pub fn new(init: &mut Init, width: usize) -> Self {
+        let convs = (0..BLOCKS)
+            .map(|i| conv2d(init, if i == 0 { 3 } else { CHANNELS }, CHANNELS, 3))
+            .collect();
+        let flat = CHANNELS * (width >> BLOCKS) * (width >> (BLOCKS + 1));
+        let mut to_code = Mlp::new(init, &[flat, CODE_SIZE], Activation::Relu);
+        LightEncoder {
+            convs,
+            pool: MaxPool2dConfig::new([2, 2]).with_strides([2, 2]).init(),
+            to_code: to_code.layers.remove(0),
+        }
+    }
+
+    /// Maps [V, 3, W/2, W] pre-processed maps to [V, 64] codes.
+    pub fn forward(&self, mut x: Tensor<4>) -> Tensor<2> {
+        for conv in &self.convs {
+            let [v, c, h, w] = x.dims();
+            let skip = if c == CHANNELS {
+                x.clone()
+            } else {
+                let pad = Tensor::zeros([v, CHANNELS - c, h, w], (&x.device(), x.dtype()));
+                Tensor::cat(vec![x.clone(), pad], 1)
+            };
+            x = self.pool.forward(relu(conv.forward(x)) + skip);
+        }
+        self.to_code.forward(x.flatten(1, 3))
+    }
+}
+
+/// An environment map prepared for the encoder: box-filtered to W × W/2, divided by its mean
+/// (over channels or per channel, [`MapNorm`]) and passed through log(1 + x), as the paper
+/// pre-processes it.
+///
+/// Radiance is linear in the lighting, so the network predicts radiance for the normalised map
+/// and the model multiplies each channel by `scale` to restore the absolute level.
+#[derive(Clone, Debug)]
+pub struct LightInput {
+    /// Channel-major [3, W/2, W] values.
+    pub pixels: Vec<f32>,
+    /// What each channel of the map was divided by.
+    pub scale: [f32; 3],
+    /// W: the encoder input width.
+    pub width: usize,
+}
+
+impl LightInput {
+    pub fn new(map: &EnvMap, rotation_deg: f32, width: usize, norm: MapNorm) -> Self {
+        let height = width / 2;
+        let map = map.rotated_y(rotation_deg);
+        // Enough sub-samples per encoder texel to cover every source texel it spans.
+        let ss = map.width().div_ceil(width).max(2);
+        let mut rgb = vec![glam::Vec3::ZERO; width * height];
+        for (i, out) in rgb.iter_mut().enumerate() {
+            let (x, y) = (i % width, i / width);
+            for s in 0..ss * ss {
+                let (sx, sy) = (s % ss, s / ss);
+                let uv = Vec2::new(
+                    (x as f32 + (sx as f32 + 0.5) / ss as f32) / width as f32,
+                    (y as f32 + (sy as f32 + 0.5) / ss as f32) / height as f32,
+                );
+                *out += map.eval(uv_to_direction(uv));
+            }
+            *out /= (ss * ss) as f32;
+        }
+        let mean = [0, 1, 2].map(|k| rgb.iter().map(|c| c[k]).sum::<f32>() / rgb.len() as f32);
+        let scale = norm.scale(mean);
+        let mut pixels = vec![0.0; 3 * width * height];
+        for (i, c) in rgb.iter().enumerate() {
+            for k in 0..3 {
+                pixels[k * width * height + i] = (c[k] / scale[k]).ln_1p();
+            }
+        }
+        LightInput {
+            pixels,
+            scale,
+            width,
+        }
+    }
+}

@@ -1,0 +1,127 @@
+//! One transport track of a design: an optional transfer network on the pixel inputs and the
+//! shading network on the transport and light codes.
+
+use burn::module::Module;
+use burn::tensor::{Int, Tensor, TensorData};
+
+use crate::encoding::features::{feature, FEATURES};
+use crate::encoding::hash_grid::HashGrid;
+use crate::encoding::position_encoding::PositionEncoding;
+use crate::network::activation::Activation;
+use crate::network::design::{Design, TRANSPORT_CODE};
+use crate::network::encoder::CODE_SIZE;
+use crate::network::init::Init;
+use crate::network::mlp::Mlp;
+
+/// Which pixel inputs a track reads, and how its outputs weight into radiance.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum TrackKind {
+    /// All 19 inputs; outputs are radiance.
+    Full,
+    /// All 19 inputs; 6 outputs, kd·exp(first 3) + ks·exp(last 3).
+    Albedo,
+    /// x, n, kd; weighted by kd.
+    Diffuse,
+    /// x, n, ks, ωo, ωr, α; weighted by ks.
+    Specular,
+}
+
+impl TrackKind {
+    pub fn inputs(self) -> Vec<usize> {
+        use feature::*;
+        match self {
+            TrackKind::Full | TrackKind::Albedo => (0..FEATURES).collect(),
+            TrackKind::Diffuse => [POSITION, NORMAL, KD].into_iter().flatten().collect(),
+            TrackKind::Specular => [POSITION, NORMAL, KS, VIEW, MIRROR, ALPHA]
+                .into_iter()
+                .flatten()
+                .collect(),
+        }
+    }
+}
+
+/// One transport track: an optional transfer network F_T on the pixel inputs, and the shading
+/// network Φ on [ŝ, ê] (or, for the baseline, on [ê, inputs]). With a hash grid, the inputs
+/// are followed by the grid's encoding of the position.
+#[derive(Module, Debug)]
+pub struct Track {
+    pub grid: Option<HashGrid>,
+    pub transfer: Option<Mlp>,
+    pub shading: Mlp,
+    #[module(skip)]
+    pub kind: TrackKind,
+}
+
+impl Track {
+    pub fn new(
+        init: &mut Init,
+        design: Design,
+        kind: TrackKind,
+        activation: Activation,
+        encoding: PositionEncoding,
+    ) -> Self {
+        let n_in = kind.inputs().len() + encoding.extra_inputs();
+        let outputs = if kind == TrackKind::Albedo { 6 } else { 3 };
+        let grid = match encoding {
+            PositionEncoding::None => None,
+            PositionEncoding::HashGrid => Some(HashGrid::new(init)),
+        };
+        match design {
+            Design::Baseline => Track {
+                grid,
+                transfer: None,
+                shading: Mlp::new(init, &[CODE_SIZE + n_in, 256, 256, 256, 256, 3], activation),
+                kind,
+            },
+            _ => {
+                let w = if design == Design::Dsep { 172 } else { 256 };
+                Track {
+                    grid,
+                    transfer: Some(Mlp::new(init, &[n_in, w, w, TRANSPORT_CODE], activation)),
+                    shading: Mlp::new(
+                        init,
+                        &[TRANSPORT_CODE + CODE_SIZE, w, w, outputs],
+                        Activation::Relu,
+                    ),
+                    kind,
+                }
+            }
+        }
+    }
+
+    /// Radiance of this track (before the map's scale) for features [B, 19] and codes [B, 64].
+    pub fn forward(&self, features: &Tensor<2>, code: &Tensor<2>) -> Tensor<2> {
+        let inputs = if self.kind == TrackKind::Full || self.kind == TrackKind::Albedo {
+            features.clone()
+        } else {
+            let idx: Vec<i64> = self.kind.inputs().into_iter().map(|i| i as i64).collect();
+            let n = idx.len();
+            let idx = Tensor::<1, Int>::from_data(TensorData::new(idx, [n]), &features.device());
+            features.clone().select(1, idx)
+        };
+        let inputs = match &self.grid {
+            None => inputs,
+            Some(grid) => Tensor::cat(vec![inputs, grid.forward(features)], 1),
+        };
+        let out = match &self.transfer {
+            None => self
+                .shading
+                .forward(Tensor::cat(vec![code.clone(), inputs], 1)),
+            Some(ft) => {
+                let s = ft.forward(inputs);
+                self.shading.forward(Tensor::cat(vec![s, code.clone()], 1))
+            }
+        };
+        // Outputs are log-radiance: exp keeps radiance positive over its high dynamic range.
+        let slice = |r: std::ops::Range<usize>| features.clone().narrow(1, r.start, r.len());
+        match self.kind {
+            TrackKind::Full => out.exp(),
+            TrackKind::Albedo => {
+                slice(feature::KD) * out.clone().narrow(1, 0, 3).exp()
+                    + slice(feature::KS) * out.narrow(1, 3, 3).exp()
+            }
+            TrackKind::Diffuse => slice(feature::KD) * out.exp(),
+            TrackKind::Specular => slice(feature::KS) * out.exp(),
+        }
+    }
+}

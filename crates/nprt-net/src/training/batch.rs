@@ -1,0 +1,149 @@
+//! A batch of pixel samples in host memory and its forward pass.
+
+use burn::optim::GradientsParams;
+use burn::tensor::{Device, Int, Tensor, TensorData};
+
+use crate::cpu::Samples;
+
+use crate::encoding::features::FEATURES;
+use crate::network::nprt_net::NprtNet;
+use crate::training::loss::Loss;
+use crate::training::training_set::ViewSamples;
+
+/// Which code computes a batch's gradients.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Engine {
+    /// The CPU engine where it applies (burn's CPU backend, f32), else burn's autodiff.
+    Auto,
+    /// burn's autodiff graph on any device: the reference the CPU engine is held to.
+    Autodiff,
+}
+
+/// Samples drawn from several views, and those views' maps.
+pub struct Batch {
+    pub features: Vec<f32>,
+    pub radiance: Vec<f32>,
+    /// Index into `lights` of each sample.
+    pub view: Vec<i64>,
+    /// [n, 3] what the prediction's channels are multiplied by (the map's `LightInput::scale`).
+    pub scale: Vec<f32>,
+    /// [V, 3, W/2, W] pre-processed maps.
+    pub lights: Vec<f32>,
+    /// W of the maps.
+    pub light_width: usize,
+}
+
+impl Batch {
+    /// Gathers `samples` ((view position in `views`, pixel) pairs) from `views`.
+    pub fn gather(views: &[&ViewSamples], samples: &[(u32, u32)]) -> Self {
+        let mut b = Batch {
+            features: Vec::with_capacity(samples.len() * FEATURES),
+            radiance: Vec::with_capacity(samples.len() * 3),
+            view: Vec::with_capacity(samples.len()),
+            scale: Vec::with_capacity(samples.len() * 3),
+            lights: views
+                .iter()
+                .flat_map(|v| v.light.pixels.iter().copied())
+                .collect(),
+            light_width: views.first().map_or(0, |v| v.light.width),
+        };
+        for &(v, p) in samples {
+            let (view, p) = (views[v as usize], p as usize);
+            b.features
+                .extend_from_slice(&view.features[p * FEATURES..(p + 1) * FEATURES]);
+            b.radiance
+                .extend_from_slice(&view.radiance[p * 3..p * 3 + 3]);
+            b.view.push(v as i64);
+            b.scale.extend_from_slice(&view.light.scale);
+        }
+        b
+    }
+
+    /// Batches of at most `batch_size` over a fixed, evenly strided subset of at most
+    /// `max_samples` of `views`' pixels, each holding only the maps of the views it touches: the
+    /// same pixels every time, for a loss or a level measured across a run.
+    pub fn strided<'a>(
+        views: &'a [&'a ViewSamples],
+        max_samples: usize,
+        batch_size: usize,
+    ) -> impl Iterator<Item = Batch> + 'a {
+        let total: usize = views.iter().map(|v| v.len()).sum();
+        let stride = total.div_ceil(max_samples.max(1)).max(1);
+        let picked: Vec<(u32, u32)> = views
+            .iter()
+            .enumerate()
+            .flat_map(|(v, view)| (0..view.len() as u32).map(move |p| (v as u32, p)))
+            .step_by(stride)
+            .collect();
+        let batch_size = batch_size.max(1);
+        (0..picked.len()).step_by(batch_size).map(move |start| {
+            let chunk = &picked[start..(start + batch_size).min(picked.len())];
+            let mut used: Vec<u32> = chunk.iter().map(|s| s.0).collect();
+            used.dedup();
+            let local: Vec<(u32, u32)> = chunk
+                .iter()
+                .map(|&(v, p)| (used.partition_point(|&u| u < v) as u32, p))
+                .collect();
+            let sub: Vec<&ViewSamples> = used.iter().map(|&v| views[v as usize]).collect();
+            Batch::gather(&sub, &local)
+        })
+    }
+
+    pub fn len(&self) -> usize {
+        self.view.len()
+    }
+
+    /// The batch as the CPU engine takes it.
+    pub fn samples(&self) -> Samples<'_> {
+        Samples {
+            features: &self.features,
+            radiance: &self.radiance,
+            view: &self.view,
+            scale: &self.scale,
+            lights: &self.lights,
+            light_width: self.light_width,
+        }
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.view.is_empty()
+    }
+
+    /// The views' maps [V, 3, W/2, W] on `device`.
+    pub fn light_tensor(&self, device: &Device) -> Tensor<4> {
+        let w = self.light_width;
+        let shape = [self.lights.len() / (3 * w * w / 2), 3, w / 2, w];
+        Tensor::from_data(TensorData::new(self.lights.clone(), shape), device)
+    }
+
+    /// Predicted radiance [B, 3] and the reference [B, 3] on `device`.
+    pub fn forward(&self, net: &NprtNet, device: &Device) -> (Tensor<2>, Tensor<2>) {
+        let n = self.len();
+        let f = Tensor::from_data(
+            TensorData::new(self.features.clone(), [n, FEATURES]),
+            device,
+        );
+        let r = Tensor::from_data(TensorData::new(self.radiance.clone(), [n, 3]), device);
+        let v = Tensor::<1, Int>::from_data(TensorData::new(self.view.clone(), [n]), device);
+        let s = Tensor::from_data(TensorData::new(self.scale.clone(), [n, 3]), device);
+        (net.forward(f, self.light_tensor(device), v, s), r)
+    }
+
+    /// `loss` on this batch and every parameter's gradient (`device` is an autodiff device),
+    /// computed by `engine`.
+    pub fn gradients(
+        &self,
+        net: &NprtNet,
+        device: &Device,
+        engine: Engine,
+        loss: Loss,
+    ) -> (f64, GradientsParams) {
+        if engine == Engine::Auto && crate::cpu::applies(net, device) {
+            return crate::cpu::gradients(net, &self.samples(), device, loss);
+        }
+        let (pred, reference) = self.forward(net, device);
+        let loss = loss.mean(pred, reference);
+        let value = loss.clone().into_scalar::<f64>();
+        (value, GradientsParams::from_grads(loss.backward(), net))
+    }
+}

@@ -1,0 +1,139 @@
+//! Output calibration: a gain per channel that gives a trained network's radiance the level of
+//! its training targets.
+//!
+//! The paper's loss, L1 on log(1 + x), is minimised by the median of what the network cannot
+//! tell apart, below the mean for right-skewed radiance (a sun patch it cannot yet place, a
+//! rare bright path in a noisy target). Regression in log space has the same bias in
+//! statistics, where the classic correction (Duan's smearing estimate, 1983) multiplies the
+//! back-transformed prediction by a factor measured on the training residuals. This is that
+//! factor per channel: the training targets' sum over the network's. The mean of noisy
+//! targets is unbiased, so no converged reference is needed, and no held-out view is seen.
+
+use burn::tensor::Device;
+
+use crate::choice::named_choice;
+use crate::device::host_values;
+use crate::network::nprt_net::NprtNet;
+use crate::training::batch::Batch;
+use crate::training::training_set::ViewSamples;
+
+/// Whether a trained model's radiance is calibrated to its training targets' level.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Calibration {
+    /// The network's output as it is (the paper). Models saved before the choice existed.
+    #[default]
+    None,
+    /// Each channel multiplied by [`level_gain`], measured whenever the model is saved.
+    Level,
+}
+
+named_choice!(Calibration, "calibration", {
+    None => "none",
+    Level => "level",
+});
+
+/// Training pixels the level gain is measured on: its standard error on the demo is far below
+/// the darkness it corrects, for the time of one validation pass.
+pub const LEVEL_SAMPLES: usize = 65_536;
+
+/// Per channel, the sum of the targets over the sum of `net`'s predictions on a fixed, evenly
+/// strided subset of at most `max_samples` of `views`' pixels, each pixel relative to its map's
+/// scale so that every lighting counts alike. 1 for a channel whose targets or predictions hold
+/// no light: a degenerate dataset keeps the network's output.
+pub fn level_gain(
+    net: &NprtNet,
+    views: &[ViewSamples],
+    max_samples: usize,
+    batch_size: usize,
+    device: &Device,
+) -> [f32; 3] {
+    let views: Vec<&ViewSamples> = views.iter().filter(|v| !v.is_empty()).collect();
+    let (mut predicted, mut target) = ([0.0f64; 3], [0.0f64; 3]);
+    for batch in Batch::strided(&views, max_samples, batch_size) {
+        let (pred, _) = batch.forward(net, device);
+        let pred = host_values(pred.into_data());
+        for (i, s) in batch.scale.chunks_exact(3).enumerate() {
+            for k in 0..3 {
+                predicted[k] += (pred[3 * i + k] / s[k]) as f64;
+                target[k] += (batch.radiance[3 * i + k] / s[k]) as f64;
+            }
+        }
+    }
+    std::array::from_fn(|k| {
+        let gain = target[k] / predicted[k];
+        if gain.is_finite() && gain > 0.0 {
+            gain as f32
+        } else {
+            1.0
+        }
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::encoding::features::FEATURES;
+    use crate::encoding::map_norm::MapNorm;
+    use crate::model::config::ModelConfig;
+    use crate::network::encoder::LightInput;
+    use crate::network::init::Init;
+    use crate::Design;
+    use nprt_scene::envmap::EnvMap;
+
+    #[test]
+    fn the_gain_is_the_factor_between_targets_and_predictions() {
+        let device = Device::flex();
+        let config = ModelConfig {
+            encoder_width: 64,
+            ..ModelConfig::new(Design::Albedo, None)
+        };
+        let net = config.build(&mut Init::new(1, &device));
+        let sky = nprt_scene::open_envmap("builtin:sky").unwrap();
+        let warm = EnvMap::constant(glam::Vec3::new(3.0, 1.0, 0.2)).unwrap();
+        // Two views under maps of very different scales, with pseudo-random inputs in ±1.
+        let views: Vec<ViewSamples> = [(&sky, 200), (&warm, 57)]
+            .into_iter()
+            .enumerate()
+            .map(|(v, (map, n))| {
+                let features = (0..n * FEATURES)
+                    .map(|i| ((i * 7919 + v * 104_729) % 2001) as f32 / 1000.0 - 1.0)
+                    .collect();
+                ViewSamples {
+                    features,
+                    radiance: vec![0.0; 3 * n],
+                    light: LightInput::new(map, 40.0 * v as f32, 64, MapNorm::Channel),
+                }
+            })
+            .collect();
+        // Targets that are exactly the network's predictions times a known factor per channel.
+        let factor = [1.3f32, 0.7, 2.0];
+        let views: Vec<ViewSamples> = views
+            .into_iter()
+            .map(|mut view| {
+                let all: Vec<(u32, u32)> = (0..view.len() as u32).map(|p| (0, p)).collect();
+                let (pred, _) = Batch::gather(&[&view], &all).forward(&net, &device);
+                view.radiance = host_values(pred.into_data())
+                    .chunks_exact(3)
+                    .flat_map(|c| [0, 1, 2].map(|k| c[k] * factor[k]))
+                    .collect();
+                view
+            })
+            .collect();
+        // Over every pixel, and over a strided subset in small batches.
+        for (max_samples, batch_size) in [(1000, 1000), (50, 16)] {
+            let gain = level_gain(&net, &views, max_samples, batch_size, &device);
+            for k in 0..3 {
+                assert!(
+                    (gain[k] / factor[k] - 1.0).abs() < 1e-4,
+                    "{gain:?} against {factor:?}"
+                );
+            }
+        }
+        // Targets without light: the network's output is kept, not zeroed.
+        let mut dark = views;
+        for v in &mut dark {
+            v.radiance.iter_mut().for_each(|r| *r = 0.0);
+        }
+        assert_eq!(level_gain(&net, &dark, 1000, 1000, &device), [1.0; 3]);
+    }
+}

@@ -1,0 +1,17 @@
+//! Training: the training set in memory, batches, the loss, the learning-rate schedule, the one
+//! training loop with checkpoints and exact resume, the Neural PRT objective run through it,
+//! validation, calibration and loss curves.
+
+pub mod batch;
+pub mod calibration;
+pub mod checkpoint;
+pub mod epoch_plan;
+pub mod loss;
+pub mod loss_curves;
+pub mod lr_schedule;
+pub mod nprt_objective;
+pub mod run_length;
+pub mod train_options;
+pub mod training_loop;
+pub mod training_set;
+pub mod validation;

@@ -1,0 +1,196 @@
+//! Training a Neural PRT design as the paper does: Adam at 1e-4, L1 on log(1 + x), the
+//! encoder trained jointly, batches that mix foreground pixels of several views, each lit by
+//! its own rotated map. The loop itself (checkpoints, exact resume) is
+//! [`crate::training::training_loop`].
+//!
+//! A run lives in its model folder: the model (config and latest weights), `loss.csv`,
+//! `loss.png` and `checkpoint/`.
+
+use std::path::Path;
+use std::sync::Mutex;
+
+use anyhow::Result;
+use burn::module::Module;
+use burn::optim::GradientsParams;
+use burn::tensor::Device;
+
+use crate::model::config::ModelConfig;
+use crate::model::folder::{read_model_file, save_model, ModelFile, MODEL_FORMAT, MODEL_VERSION};
+use crate::network::init::Init;
+use crate::network::nprt_net::NprtNet;
+use crate::training::batch::{Batch, Engine};
+use crate::training::calibration::{level_gain, Calibration, LEVEL_SAMPLES};
+use crate::training::checkpoint::RunState;
+use crate::training::epoch_plan::{group_batches, EpochPlan};
+use crate::training::train_options::TrainOptions;
+use crate::training::training_loop::{self, Objective, Schedule, TrainSummary, ADAM_EPSILON};
+use crate::training::training_set::{TrainingSet, ViewSamples};
+use crate::training::validation::validation_loss;
+
+/// A Neural PRT design learning a dataset's pixels.
+struct PixelObjective<'a> {
+    set: &'a TrainingSet,
+    config: &'a ModelConfig,
+    opts: &'a TrainOptions,
+    /// The model file as last saved, returned to the caller.
+    saved: Mutex<Option<ModelFile>>,
+}
+
+impl Objective for PixelObjective<'_> {
+    type Net = NprtNet;
+    type Batch = Batch;
+
+    fn tag(&self) -> String {
+        self.config.design.name().to_string()
+    }
+
+    fn title(&self) -> String {
+        format!(
+            "{} ({})",
+            self.config.design.name(),
+            self.config.activation.name()
+        )
+    }
+
+    fn run_key(&self) -> serde_json::Value {
+        serde_json::json!({
+            "config": self.config,
+            "dataset_hash": self.set.dataset_hash,
+            "batch_size": self.opts.batch_size,
+            "views_per_batch": self.opts.views_per_batch,
+            "val_samples": self.opts.val_samples,
+            "loss": self.opts.loss,
+        })
+    }
+
+    fn build(&self, init: &mut Init) -> NprtNet {
+        self.config
+            .build(init)
+            .shift_output_level(self.set.log_relative_level())
+    }
+
+    fn steps(&self, seed: u64, epoch: usize) -> usize {
+        EpochPlan::new(self.set, self.opts, seed, epoch).total()
+    }
+
+    fn batches(&self, seed: u64, epoch: usize, from: usize) -> impl Iterator<Item = Batch> + '_ {
+        let plan = EpochPlan::new(self.set, self.opts, seed, epoch);
+        let starts: Vec<usize> = plan
+            .batches
+            .iter()
+            .scan(0, |acc, &n| {
+                *acc += n;
+                Some(*acc - n)
+            })
+            .collect();
+        plan.groups
+            .into_iter()
+            .zip(plan.batches)
+            .zip(starts)
+            .enumerate()
+            .filter(move |(_, ((_, count), start))| start + count > from)
+            .flat_map(move |(g, ((group, count), start))| {
+                let views: Vec<&ViewSamples> = group.iter().map(|&v| &self.set.train[v]).collect();
+                let batches = group_batches(&views, count, seed, epoch, g);
+                batches
+                    .into_iter()
+                    .skip(from.saturating_sub(start))
+                    .map(move |samples| Batch::gather(&views, &samples))
+            })
+    }
+
+    fn gradients(
+        &self,
+        net: &NprtNet,
+        batch: &Batch,
+        device: &Device,
+    ) -> (f64, GradientsParams, u64) {
+        let (loss, grads) = batch.gradients(net, device, Engine::Auto, self.opts.loss);
+        (loss, grads, batch.len() as u64)
+    }
+
+    fn validation_loss(&self, net: &NprtNet, device: &Device) -> f64 {
+        validation_loss(
+            net,
+            self.set,
+            self.opts.val_samples,
+            self.opts.batch_size,
+            device,
+        )
+    }
+
+    fn save_model(
+        &self,
+        out: &Path,
+        net: &NprtNet,
+        schedule: &Schedule,
+        state: &RunState,
+        device: &Device,
+    ) -> Result<()> {
+        let transport_params = net.transport_params();
+        let options = TrainOptions {
+            schedule: schedule.clone(),
+            ..self.opts.clone()
+        };
+        let file = ModelFile {
+            format: MODEL_FORMAT.into(),
+            version: MODEL_VERSION,
+            config: self.config.clone(),
+            bounds: self.set.manifest.bounds,
+            scene: self.set.manifest.settings.scene.clone(),
+            scene_hash: self.set.manifest.settings.scene_hash.clone(),
+            dataset_hash: self.set.dataset_hash.clone(),
+            transport_params,
+            encoder_params: net.num_params() - transport_params,
+            training: serde_json::json!({
+                "options": options,
+                "epochs_done": state.epoch,
+                "steps": state.step,
+                "samples": state.samples,
+                "seconds": state.seconds,
+                "adam_epsilon": ADAM_EPSILON,
+                "loss": self.opts.loss.name(),
+            }),
+            level_gain: (self.opts.calibration == Calibration::Level).then(|| {
+                level_gain(
+                    &net.valid(),
+                    &self.set.train,
+                    LEVEL_SAMPLES,
+                    self.opts.batch_size,
+                    device,
+                )
+            }),
+        };
+        save_model(out, &file, net)?;
+        *self.saved.lock().unwrap_or_else(|e| e.into_inner()) = Some(file);
+        Ok(())
+    }
+}
+
+/// Trains (or resumes training of) the model in `out`; returns the run's summary and the
+/// model's config as saved.
+pub fn train(
+    set: &TrainingSet,
+    config: &ModelConfig,
+    opts: &TrainOptions,
+    out: &Path,
+    device: &Device,
+) -> Result<(TrainSummary, ModelFile)> {
+    opts.check()?;
+    let objective = PixelObjective {
+        set,
+        config,
+        opts,
+        saved: Mutex::new(None),
+    };
+    let summary = training_loop::train(&objective, &opts.schedule, out, device)?;
+    let saved = objective
+        .saved
+        .into_inner()
+        .unwrap_or_else(|e| e.into_inner());
+    let file = match saved {
+        Some(file) => file,
+        None => read_model_file(out)?,
+    };
+    Ok((summary, file))
+}

@@ -1,0 +1,639 @@
+//! The one training loop, whatever the network: Adam as the paper (ε = 1e-8), checkpoints
+//! with the optimiser's moments, exact resume, a divergence stop that keeps the last good
+//! checkpoint, per-epoch validation, `loss.csv` and `loss.png`. What is trained, on which
+//! batches and with which loss is an [`Objective`]: the Neural PRT designs and the Deep
+//! Shading U-Net are two.
+//!
+//! Resume is exact because a batch is a function of the seed, the epoch and its index only,
+//! and parameter ids (which key Adam's state) are stable.
+//!
+//! Batches are built on a thread of their own, a few ahead of the step that takes them, so
+//! that a fast device does not wait for the host to gather its samples; the run reports how
+//! its time split between steps, waiting for batches, validation and saving.
+
+use std::path::Path;
+use std::time::Instant;
+
+use anyhow::{bail, Context, Result};
+use burn::module::Module;
+use burn::optim::{AdamConfig, GradientsParams, ModuleOptimizer};
+use burn::tensor::Device;
+use rand::SeedableRng;
+use rand_pcg::Pcg64Mcg;
+use serde::{Deserialize, Serialize};
+
+use crate::network::init::Init;
+use crate::training::checkpoint::{self, Checkpoint, RunState};
+use crate::training::loss_curves::{self as curves, LossRow};
+use crate::training::lr_schedule::LrSchedule;
+
+pub const ADAM_EPSILON: f32 = 1e-8;
+/// Training-loss rows per epoch in loss.csv.
+const TRAIN_ROWS_PER_EPOCH: u64 = 20;
+
+/// The loop's own settings, shared by every network.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Schedule {
+    /// Passes over the data; with a time budget, the most the run may do.
+    pub epochs: usize,
+    /// The peak learning rate.
+    pub learning_rate: f64,
+    /// How the rate moves over the run (the paper: constant).
+    #[serde(default)]
+    pub lr_schedule: LrSchedule,
+    /// Wall-clock budget of training time, minutes: the run stops when its accumulated time
+    /// reaches it (or after `epochs`, whichever comes first), and a decaying schedule decays
+    /// over it instead of over the epochs.
+    #[serde(default)]
+    pub minutes: Option<f64>,
+    /// Seed of the initial weights and of the batch order.
+    pub seed: u64,
+    /// Seconds between checkpoints inside an epoch (one is always written at each epoch end).
+    #[serde(skip)]
+    pub checkpoint_secs: f64,
+    #[serde(skip)]
+    pub progress: bool,
+}
+
+impl Default for Schedule {
+    /// The paper's learning rate; a checkpoint every 5 minutes within an epoch.
+    fn default() -> Self {
+        Schedule {
+            epochs: 20,
+            learning_rate: 1e-4,
+            lr_schedule: LrSchedule::Paper,
+            minutes: None,
+            seed: 0,
+            checkpoint_secs: 300.0,
+            progress: true,
+        }
+    }
+}
+
+impl Schedule {
+    /// Refuses settings no run can use.
+    pub fn check(&self) -> Result<()> {
+        if self.epochs == 0 {
+            bail!("the number of epochs must be positive");
+        }
+        if !(self.learning_rate > 0.0 && self.learning_rate.is_finite()) {
+            bail!(
+                "the learning rate must be a positive number, got {}",
+                self.learning_rate
+            );
+        }
+        if let Some(m) = self.minutes {
+            if !(m > 0.0 && m.is_finite()) {
+                bail!("the time budget must be a positive number of minutes, got {m}");
+            }
+        }
+        Ok(())
+    }
+
+    /// The budget in seconds, if the run has one.
+    fn budget_secs(&self) -> Option<f64> {
+        self.minutes.map(|m| m * 60.0)
+    }
+
+    /// "epoch 3/20", or "epoch 3" for a run bounded by its time budget alone.
+    fn epoch_label(&self, epoch: usize) -> String {
+        if self.epochs == usize::MAX {
+            format!("epoch {epoch}")
+        } else {
+            format!("epoch {epoch}/{}", self.epochs)
+        }
+    }
+}
+
+/// Batches built ahead of the step that takes them.
+const BATCHES_AHEAD: usize = 2;
+
+/// What one network's training is: its construction, its batches and its loss.
+pub trait Objective: Sync {
+    type Net: Module;
+    /// Built on the batch thread, taken by the training thread.
+    type Batch: Send;
+    /// Names the network in its weights' metadata and in messages.
+    fn tag(&self) -> String;
+    /// Title of the loss plot.
+    fn title(&self) -> String;
+    /// All that shapes the run besides the schedule (network, data, batching): a checkpoint
+    /// resumes only under an equal key.
+    fn run_key(&self) -> serde_json::Value;
+    fn build(&self, init: &mut Init) -> Self::Net;
+    /// Batches in `epoch`.
+    fn steps(&self, seed: u64, epoch: usize) -> usize;
+    /// The batches of `epoch` from index `from` on; a function of `seed` and `epoch` only.
+    fn batches(
+        &self,
+        seed: u64,
+        epoch: usize,
+        from: usize,
+    ) -> impl Iterator<Item = Self::Batch> + '_;
+    /// The batch's mean loss, every parameter's gradient, and how many samples (pixels) the
+    /// batch holds; `device` is an autodiff device.
+    fn gradients(
+        &self,
+        net: &Self::Net,
+        batch: &Self::Batch,
+        device: &Device,
+    ) -> (f64, GradientsParams, u64);
+    /// Loss on held-out data with a network off the autodiff device; NaN where there is none.
+    fn validation_loss(&self, net: &Self::Net, device: &Device) -> f64;
+    /// Writes the model folder's own files (config and weights) for the network as it stands;
+    /// `device` is the one [`Self::validation_loss`] runs on.
+    fn save_model(
+        &self,
+        out: &Path,
+        net: &Self::Net,
+        schedule: &Schedule,
+        state: &RunState,
+        device: &Device,
+    ) -> Result<()>;
+}
+
+/// What a finished (or resumed and finished) run reports.
+pub struct TrainSummary {
+    /// Epochs done, counting a part-done one by its share of batches.
+    pub epochs: f64,
+    pub steps: u64,
+    pub samples: u64,
+    pub seconds: f64,
+    pub final_train: f64,
+    pub final_val: f64,
+    pub resumed_from_epoch: Option<f64>,
+    /// Where this invocation's time went.
+    pub split: TimeSplit,
+}
+
+/// Where a run's wall time went, seconds: the steps (gradients and the optimiser, until the
+/// loss is back on the host), waiting for the next batch, validation, and saving (checkpoint,
+/// model files, loss curves).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct TimeSplit {
+    pub steps: f64,
+    pub batch_wait: f64,
+    pub validation: f64,
+    pub saving: f64,
+}
+
+impl TimeSplit {
+    /// "steps 96.1%, waiting for batches 0.2%, validation 2.5%, saving 1.2% of 12.3 s".
+    pub fn describe(&self) -> String {
+        let total = self.steps + self.batch_wait + self.validation + self.saving;
+        let pct = |t: f64| 100.0 * t / total.max(1e-12);
+        format!(
+            "steps {:.1}%, waiting for batches {:.1}%, validation {:.1}%, saving {:.1}% of {total:.1} s",
+            pct(self.steps),
+            pct(self.batch_wait),
+            pct(self.validation),
+            pct(self.saving)
+        )
+    }
+}
+
+/// Seconds since `start`.
+fn since(start: Instant) -> f64 {
+    start.elapsed().as_secs_f64()
+}
+
+/// The random stream of one part (`stream`) of one epoch: shuffles depend on nothing else.
+pub fn epoch_rng(seed: u64, epoch: u64, stream: u64) -> Pcg64Mcg {
+    let key = [seed, epoch, stream].map(u64::to_le_bytes).concat();
+    let h = blake3::hash(&key);
+    let mut first = [0; 8];
+    first.copy_from_slice(&h.as_bytes()[..8]);
+    Pcg64Mcg::seed_from_u64(u64::from_le_bytes(first))
+}
+
+/// Trains (or resumes training of) `objective`'s network in the model folder `out`.
+pub fn train<O: Objective>(
+    objective: &O,
+    schedule: &Schedule,
+    out: &Path,
+    device: &Device,
+) -> Result<TrainSummary> {
+    schedule.check()?;
+    let device = device.clone().autodiff();
+    let inner = device.clone().inner();
+    let mut net = objective.build(&mut Init::new(schedule.seed, &device));
+    let optim = AdamConfig::new().with_epsilon(ADAM_EPSILON).init();
+    std::fs::create_dir_all(checkpoint::dir(out))
+        .with_context(|| format!("cannot create model folder '{}'", out.display()))?;
+    let (ck, resumed_from_epoch, mut optim) = start(objective, schedule, out, &mut net, optim)?;
+    let mut run = Run::new(objective, schedule, ck);
+    let mut trained = false;
+    while run.ck.state.epoch < schedule.epochs && !run.out_of_time() {
+        trained = true;
+        net = run.epoch(objective, out, &device, net, &mut optim)?;
+        // The epoch ended, or the budget ran out within it: validate and save either way.
+        let validating = Instant::now();
+        let val = objective.validation_loss(&net.valid(), &inner);
+        run.split.validation += since(validating);
+        run.end_epoch(val);
+        run.save(objective, out, &net, &optim, &inner)?;
+    }
+    run.bar.finish_and_clear();
+    if !trained {
+        // A finished run asked again: its model files follow this invocation's options (the
+        // output calibration, say), since nothing else will write them.
+        objective.save_model(out, &net, schedule, &run.ck.state, &inner)?;
+    }
+    Ok(run.summary(resumed_from_epoch))
+}
+
+/// The run's checkpoint: the one in `out` (into `net`, with the optimiser's state) or a fresh
+/// one, and the epoch it resumes from.
+fn start<O: Objective>(
+    objective: &O,
+    schedule: &Schedule,
+    out: &Path,
+    net: &mut O::Net,
+    optim: ModuleOptimizer,
+) -> Result<(Checkpoint, Option<f64>, ModuleOptimizer)> {
+    let Some(saved) = checkpoint::read(out)? else {
+        let fresh = Checkpoint {
+            run: run_key(objective, schedule),
+            state: RunState::default(),
+            history: Vec::new(),
+            weights: String::new(),
+            optimizer: String::new(),
+        };
+        return Ok((fresh, None, optim));
+    };
+    let optim = resume(objective, schedule, out, &saved, net, optim)?;
+    let s = &saved.state;
+    let at =
+        s.epoch as f64 + s.batch as f64 / objective.steps(schedule.seed, s.epoch).max(1) as f64;
+    if schedule.progress {
+        eprintln!("resuming '{}' from epoch {at:.2}", out.display());
+    }
+    Ok((saved, Some(at), optim))
+}
+
+/// A run between steps: the checkpoint it builds, the loss-table row being summed, the
+/// divergence guard, where the time went and the progress bar.
+struct Run<'s> {
+    schedule: &'s Schedule,
+    ck: Checkpoint,
+    /// Seconds of training the run may take, when it has a time budget.
+    budget: Option<f64>,
+    /// Batches in each epoch.
+    steps: Vec<usize>,
+    total_batches: usize,
+    done_batches: usize,
+    bar: nprt_io::ProgressBar,
+    started: Instant,
+    seconds_before: f64,
+    last_checkpoint: Instant,
+    row_sum: f64,
+    row_n: u64,
+    last_train: f64,
+    guard: DivergenceGuard,
+    split: TimeSplit,
+}
+
+impl<'s> Run<'s> {
+    fn new<O: Objective>(objective: &O, schedule: &'s Schedule, ck: Checkpoint) -> Self {
+        // A time budget sets the run's length (and the bar's, in seconds); otherwise its
+        // batches do.
+        let budget = schedule.budget_secs();
+        let epochs = match budget {
+            Some(_) => ck.state.epoch + 1,
+            None => schedule.epochs,
+        };
+        let steps: Vec<usize> = (0..epochs.max(ck.state.epoch + 1))
+            .map(|e| objective.steps(schedule.seed, e))
+            .collect();
+        let total_batches = match budget {
+            Some(_) => 0,
+            None => steps[..schedule.epochs].iter().sum(),
+        };
+        let done_batches = steps[..ck.state.epoch].iter().sum::<usize>() + ck.state.batch;
+        let what = format!("training {}", objective.tag());
+        let bar = match budget {
+            Some(b) => nprt_io::progress_bar(schedule.progress, b.ceil() as u64, &what, "s"),
+            None => {
+                nprt_io::progress_bar(schedule.progress, total_batches as u64, &what, "batches")
+            }
+        };
+        bar.set_position(match budget {
+            Some(_) => ck.state.seconds as u64,
+            None => done_batches as u64,
+        });
+        bar.reset_eta();
+        Run {
+            schedule,
+            budget,
+            steps,
+            total_batches,
+            done_batches,
+            bar,
+            started: Instant::now(),
+            seconds_before: ck.state.seconds,
+            last_checkpoint: Instant::now(),
+            row_sum: 0.0,
+            row_n: 0,
+            last_train: f64::NAN,
+            guard: DivergenceGuard::default(),
+            split: TimeSplit::default(),
+            ck,
+        }
+    }
+
+    fn out_of_time(&self) -> bool {
+        self.budget.is_some_and(|b| self.ck.state.seconds >= b)
+    }
+
+    /// Batches in `epoch`, asking the objective for epochs past those counted so far.
+    fn steps_in<O: Objective>(&mut self, objective: &O, epoch: usize) -> usize {
+        while self.steps.len() <= epoch {
+            self.steps
+                .push(objective.steps(self.schedule.seed, self.steps.len()));
+        }
+        self.steps[epoch]
+    }
+
+    /// The learning rate of the next step.
+    fn learning_rate(&self) -> f64 {
+        let progress = match self.budget {
+            Some(b) => self.ck.state.seconds / b,
+            None => self.done_batches as f64 / self.total_batches.max(1) as f64,
+        };
+        self.schedule.learning_rate * self.schedule.lr_schedule.factor(progress)
+    }
+
+    /// One epoch from the checkpoint's batch on, until its end or the time budget's, with
+    /// checkpoints as due. Batches are built on a thread of their own.
+    fn epoch<O: Objective>(
+        &mut self,
+        objective: &O,
+        out: &Path,
+        device: &Device,
+        net: O::Net,
+        optim: &mut ModuleOptimizer,
+    ) -> Result<O::Net> {
+        let epoch = self.ck.state.epoch;
+        let total = self.steps_in(objective, epoch);
+        let row_every = (total as u64).div_ceil(TRAIN_ROWS_PER_EPOCH).max(1);
+        let from = self.ck.state.batch;
+        let (seed, inner) = (self.schedule.seed, device.clone().inner());
+        // The network moves into the scope and back out, so that the optimiser updates the
+        // only handle to its tensors.
+        std::thread::scope(|scope| -> Result<O::Net> {
+            let mut net = net;
+            let (sender, batches) = std::sync::mpsc::sync_channel(BATCHES_AHEAD);
+            scope.spawn(move || {
+                for batch in objective.batches(seed, epoch, from) {
+                    if sender.send(batch).is_err() {
+                        break; // the epoch stopped early (time budget or an error)
+                    }
+                }
+            });
+            loop {
+                let waiting = Instant::now();
+                let Ok(batch) = batches.recv() else { break };
+                self.split.batch_wait += since(waiting);
+                let stepping = Instant::now();
+                let lr = self.learning_rate();
+                let (value, grads, samples) = objective.gradients(&net, &batch, device);
+                self.check_divergence(value, epoch, out)?;
+                net = optim.step(lr, net, grads);
+                self.split.steps += since(stepping);
+                self.record_step(value, samples, epoch, total, row_every);
+                if self.out_of_time() {
+                    break;
+                }
+                if self.last_checkpoint.elapsed().as_secs_f64() > self.schedule.checkpoint_secs {
+                    self.save(objective, out, &net, optim, &inner)?;
+                }
+            }
+            Ok(net)
+        })
+    }
+
+    /// Stops the run when the loss of the step just taken says it diverged.
+    fn check_divergence(&mut self, value: f64, epoch: usize, out: &Path) -> Result<()> {
+        let Some(why) = self.guard.check(value, self.ck.state.step) else {
+            return Ok(());
+        };
+        self.bar.abandon();
+        let kept = if checkpoint::exists(out) {
+            format!(
+                "the last good checkpoint in '{}' is kept",
+                checkpoint::dir(out).display()
+            )
+        } else {
+            "no checkpoint had been written yet".to_string()
+        };
+        bail!(
+            "training diverged at epoch {} step {} ({why}); {kept}; lower --lr and use another --out",
+            epoch + 1,
+            self.ck.state.step
+        )
+    }
+
+    /// Counts a finished step and its loss, adding a loss-table row every `row_every` steps.
+    fn record_step(
+        &mut self,
+        value: f64,
+        samples: u64,
+        epoch: usize,
+        total: usize,
+        row_every: u64,
+    ) {
+        self.done_batches += 1;
+        let s = &mut self.ck.state;
+        s.batch += 1;
+        s.step += 1;
+        s.samples += samples;
+        s.seconds = self.seconds_before + self.started.elapsed().as_secs_f64();
+        self.row_sum += value;
+        self.row_n += 1;
+        self.last_train = value;
+        if s.step.is_multiple_of(row_every) {
+            self.ck.history.push(LossRow {
+                step: s.step,
+                epoch: epoch as f64 + s.batch as f64 / total as f64,
+                samples: s.samples,
+                seconds: s.seconds,
+                train: Some(self.row_sum / self.row_n as f64),
+                val: None,
+            });
+            (self.row_sum, self.row_n) = (0.0, 0);
+        }
+        match self.budget {
+            Some(_) => self.bar.set_position(s.seconds as u64),
+            None => self.bar.inc(1),
+        }
+        self.bar.set_message(format!(
+            "{} loss {:.4} {:.0}K samples/s",
+            self.schedule.epoch_label(epoch + 1),
+            self.guard.ema,
+            s.samples as f64 / s.seconds.max(1e-9) / 1e3
+        ));
+    }
+
+    /// Closes the epoch (or the part of it the budget left) with its validation loss `val`.
+    fn end_epoch(&mut self, val: f64) {
+        let total = self.steps[self.ck.state.epoch];
+        let s = &mut self.ck.state;
+        if s.batch >= total {
+            s.epoch += 1;
+            s.batch = 0;
+        }
+        self.ck.history.push(LossRow {
+            step: s.step,
+            epoch: s.epoch as f64 + s.batch as f64 / total.max(1) as f64,
+            samples: s.samples,
+            seconds: s.seconds,
+            train: (self.row_n > 0).then(|| self.row_sum / self.row_n as f64),
+            val: Some(val),
+        });
+        (self.row_sum, self.row_n) = (0.0, 0);
+        if self.schedule.progress {
+            // Also when the bar is hidden (output not a terminal), so logs show progress.
+            let train = self.ck.history.iter().rev().find_map(|r| r.train);
+            self.bar.suspend(|| {
+                eprintln!(
+                    "{}: train loss {:.5}, validation loss {val:.5}, {:.0} K samples/s, {:.0} s",
+                    self.schedule.epoch_label(s.epoch),
+                    train.unwrap_or(self.last_train),
+                    s.samples as f64 / s.seconds.max(1e-9) / 1e3,
+                    s.seconds
+                )
+            });
+        }
+    }
+
+    /// Writes the checkpoint, the model files and the loss curves.
+    fn save<O: Objective>(
+        &mut self,
+        objective: &O,
+        out: &Path,
+        net: &O::Net,
+        optim: &ModuleOptimizer,
+        device: &Device,
+    ) -> Result<()> {
+        let saving = Instant::now();
+        save(
+            objective,
+            self.schedule,
+            out,
+            &mut self.ck,
+            net,
+            optim,
+            device,
+        )?;
+        self.split.saving += since(saving);
+        self.last_checkpoint = Instant::now();
+        Ok(())
+    }
+
+    fn summary(mut self, resumed_from_epoch: Option<f64>) -> TrainSummary {
+        let state = self.ck.state;
+        let last = |f: fn(&LossRow) -> Option<f64>| self.ck.history.iter().rev().find_map(f);
+        let (final_train, final_val) = (last(|r| r.train), last(|r| r.val));
+        let in_epoch = self.steps.get(state.epoch).copied();
+        TrainSummary {
+            epochs: state.epoch as f64 + state.batch as f64 / in_epoch.unwrap_or(1).max(1) as f64,
+            steps: state.step,
+            samples: state.samples,
+            seconds: state.seconds,
+            final_train: final_train.unwrap_or(self.last_train),
+            final_val: final_val.unwrap_or(f64::NAN),
+            resumed_from_epoch,
+            split: std::mem::take(&mut self.split),
+        }
+    }
+}
+
+/// All that must match for a checkpoint to resume: the network's key, the learning rate and
+/// the seed; for a decaying rate also its schedule and the run's length it decays over, so
+/// that a finished run is not lengthened (the paper's constant rate may be).
+fn run_key<O: Objective>(objective: &O, schedule: &Schedule) -> serde_json::Value {
+    let mut key = serde_json::json!({
+        "network": objective.run_key(),
+        "learning_rate": schedule.learning_rate,
+        "seed": schedule.seed,
+    });
+    if schedule.lr_schedule.needs_horizon() {
+        key["lr_schedule"] = serde_json::json!({
+            "name": schedule.lr_schedule.name(),
+            "epochs": (schedule.epochs != usize::MAX).then_some(schedule.epochs),
+            "minutes": schedule.minutes,
+        });
+    }
+    key
+}
+
+/// Checks that `saved` belongs to this run and loads its weights and optimiser state.
+fn resume<O: Objective>(
+    objective: &O,
+    schedule: &Schedule,
+    out: &Path,
+    saved: &Checkpoint,
+    net: &mut O::Net,
+    optim: ModuleOptimizer,
+) -> Result<ModuleOptimizer> {
+    if saved.run != run_key(objective, schedule) {
+        bail!(
+            "model folder '{}' holds a run with other settings (network, dataset or hyper-parameters; a run with a decaying --schedule also keeps its --epochs and --minutes); choose another --out or delete it",
+            out.display()
+        );
+    }
+    checkpoint::restore(out, saved, net, optim, &objective.tag())
+}
+
+/// Stops a run whose loss is not finite or whose running mean rose ten times above its best
+/// (measured after 200 steps, once the start's transient is over).
+struct DivergenceGuard {
+    ema: f64,
+    best: f64,
+}
+
+impl Default for DivergenceGuard {
+    fn default() -> Self {
+        DivergenceGuard {
+            ema: f64::NAN,
+            best: f64::INFINITY,
+        }
+    }
+}
+
+impl DivergenceGuard {
+    /// Takes the loss of step `step`; says why the run diverged, if it did.
+    fn check(&mut self, loss: f64, step: u64) -> Option<String> {
+        self.ema = if self.ema.is_nan() {
+            loss
+        } else {
+            0.98 * self.ema + 0.02 * loss
+        };
+        if step > 200 {
+            self.best = self.best.min(self.ema);
+        }
+        (!loss.is_finite() || self.ema > 10.0 * self.best).then(|| {
+            format!(
+                "loss {loss}, running mean {:.4}, best {:.4}",
+                self.ema, self.best
+            )
+        })
+    }
+}
+
+/// The checkpoint, then the model folder's own files, loss.csv and loss.png; `device` is the
+/// one validation runs on.
+fn save<O: Objective>(
+    objective: &O,
+    schedule: &Schedule,
+    out: &Path,
+    ck: &mut Checkpoint,
+    net: &O::Net,
+    optim: &ModuleOptimizer,
+    device: &Device,
+) -> Result<()> {
+    checkpoint::write(out, ck, net, optim, &objective.tag())?;
+    objective.save_model(out, net, schedule, &ck.state, device)?;
+    curves::write_csv(&out.join("loss.csv"), &ck.history)?;
+    curves::plot(&out.join("loss.png"), &ck.history, &objective.title())
+}

@@ -1,0 +1,240 @@
+//! `nprt bench train` and `nprt bench infer`: flags and tables; the measurements are
+//! `nprt_net::bench`.
+
+use std::path::PathBuf;
+
+use anyhow::Result;
+use nprt_net::bench::pytorch_peer::{PeerRun, PeerScript};
+use nprt_net::{
+    device_name, is_cpu, measure_throughput, median, Activation, Backend, Design, Engine,
+    ModelConfig,
+};
+
+use crate::flags::DeviceArg;
+
+#[derive(clap::Subcommand)]
+pub enum BenchCommand {
+    /// Training samples/s of each design (forward, backward and Adam on one batch) with the CPU
+    /// engine and with burn's autodiff graph, beside the PyTorch peer (bench/train_pytorch.py,
+    /// embedded in nprt) running the same networks, batch and loss when --python is given; the
+    /// ratio is the engine's to PyTorch's.
+    Train(BenchTrainArgs),
+    /// Inference speed of each design's transport networks on the CPU engine at a square
+    /// resolution, every pixel foreground: a frame from a new viewpoint, and a lighting change
+    /// under a still camera (transfer outputs kept), with achieved GFLOP/s beside the machine's
+    /// f32 peak (measured with register-resident FMA chains on as many threads).
+    Infer(BenchInferArgs),
+}
+
+/// The designs a benchmark measures.
+#[derive(clap::Args)]
+pub struct BenchDesigns {
+    /// Designs to measure, comma-separated.
+    #[arg(
+        long,
+        default_value = "baseline,prt,albedo,dsep",
+        value_delimiter = ','
+    )]
+    arch: Vec<Design>,
+}
+
+#[derive(clap::Args)]
+pub struct BenchInferArgs {
+    #[command(flatten)]
+    designs: BenchDesigns,
+    /// Width and height of the frame in pixels (the paper's Table 3: 512).
+    #[arg(long, default_value_t = 512)]
+    resolution: usize,
+    /// Runs per measurement; the median is reported.
+    #[arg(long, default_value_t = 5)]
+    repeats: usize,
+    #[command(flatten)]
+    device: DeviceArg,
+}
+
+#[derive(clap::Args)]
+pub struct BenchTrainArgs {
+    #[command(flatten)]
+    designs: BenchDesigns,
+    /// siren or relu (default: each design's own).
+    #[arg(long)]
+    activation: Option<Activation>,
+    /// Samples per batch.
+    #[arg(long, default_value_t = 16_384)]
+    batch_size: usize,
+    /// Maps (views) per batch.
+    #[arg(long, default_value_t = 8)]
+    views: usize,
+    /// Timed steps per design.
+    #[arg(long, default_value_t = 10)]
+    steps: usize,
+    /// Untimed steps before them (a GPU compiles and tunes its kernels in the first steps).
+    #[arg(long, default_value_t = 2)]
+    warmup: usize,
+    /// Rounds per design, each timing the PyTorch peer and then nprt; the medians are
+    /// compared, and the range of the rounds' ratios is printed beside them.
+    #[arg(long, default_value_t = 3)]
+    rounds: usize,
+    /// Python with PyTorch for the side-by-side peer (bench/train_vs_pytorch.sh installs one);
+    /// it runs on the same device (CUDA for a GPU).
+    #[arg(long)]
+    python: Option<PathBuf>,
+    #[command(flatten)]
+    device: DeviceArg,
+}
+
+pub fn run(cmd: BenchCommand) -> Result<()> {
+    match cmd {
+        BenchCommand::Train(a) => train(a),
+        BenchCommand::Infer(a) => infer(a),
+    }
+}
+
+fn infer(a: BenchInferArgs) -> Result<()> {
+    let device = a.device.device()?;
+    // A peak is measured only for the CPU; on a GPU the column is left empty.
+    let peak = is_cpu(&device).then(|| nprt_net::cpu::measured_peak(rayon::current_num_threads()));
+    println!(
+        "inference at {r}×{r} on {}, every pixel foreground, encoder not counted{}",
+        device_name(&device),
+        peak.as_ref().map_or(String::new(), |p| format!(
+            "; f32 peak {:.0} GFLOP/s ({} threads, {}-lane FMA chains, measured)",
+            p.gflops, p.threads, p.lanes
+        )),
+        r = a.resolution
+    );
+    println!(
+        "{:<10} {:>9} {:>8} {:>6} {:>11} {:>8} {:>6} {:>8}",
+        "design", "frame ms", "GFLOP/s", "peak", "relight ms", "GFLOP/s", "peak", "speed-up"
+    );
+    for &arch in &a.designs.arch {
+        let config = ModelConfig::new(arch, None);
+        let s =
+            nprt_net::measure_inference(&config, a.resolution * a.resolution, a.repeats, &device);
+        let pct = |g: f64| {
+            peak.as_ref()
+                .map_or("-".into(), |p| format!("{:.0}%", 100.0 * g / p.gflops))
+        };
+        println!(
+            "{:<10} {:>9.1} {:>8.1} {:>6} {:>11.1} {:>8.1} {:>6} {:>7.2}×",
+            arch.name(),
+            s.frame_ms,
+            s.frame_gflops,
+            pct(s.frame_gflops),
+            s.relight_ms,
+            s.relight_gflops,
+            pct(s.relight_gflops),
+            s.frame_ms / s.relight_ms
+        );
+    }
+    Ok(())
+}
+
+fn train(a: BenchTrainArgs) -> Result<()> {
+    let threads = rayon::current_num_threads();
+    let device = a.device.device()?;
+    let cpu = is_cpu(&device);
+    let rounds = a.rounds.max(1);
+    println!(
+        "training throughput on {}, batch {}, {} maps per batch, {} timed steps, {threads} threads, \
+         median of {rounds} rounds",
+        device_name(&device),
+        a.batch_size,
+        a.views,
+        a.steps
+    );
+    let peer = peer(a.python.as_ref(), &device)?;
+    println!(
+        "{:<10} {:<6} {:>14} {:>18} {:>17} {:>8} {:>15}",
+        "design",
+        "act",
+        "nprt samples/s",
+        "autodiff samples/s",
+        "PyTorch samples/s",
+        "ratio",
+        "rounds' ratios"
+    );
+    for &arch in &a.designs.arch {
+        let config = ModelConfig::new(arch, a.activation);
+        let measure = |engine| {
+            measure_throughput(
+                &config,
+                engine,
+                a.batch_size,
+                a.views,
+                a.steps,
+                a.warmup,
+                &device,
+            )
+        };
+        // Rounds alternate the peer and nprt, so that a drift in the machine's speed (identical
+        // runs here differ by up to 30%) reaches both alike; medians are compared.
+        let mut ours = Vec::new();
+        let mut theirs = Vec::new();
+        for _ in 0..rounds {
+            if let Some((python, torch_device, script)) = &peer {
+                theirs.push(script.run(&PeerRun {
+                    python,
+                    design: arch,
+                    activation: a.activation,
+                    batch_size: a.batch_size,
+                    views: a.views,
+                    steps: a.steps,
+                    warmup: a.warmup,
+                    threads,
+                    torch_device,
+                })?);
+            }
+            ours.push(measure(Engine::Auto));
+        }
+        let ratios: Vec<f64> = ours.iter().zip(&theirs).map(|(o, t)| o / t).collect();
+        let ours = median(ours);
+        // Off the CPU burn's autodiff is the only path, so the column would repeat the first.
+        let autodiff = cpu.then(|| measure(Engine::Autodiff));
+        let theirs = (!theirs.is_empty()).then(|| median(theirs));
+        let spread = match ratios.iter().copied().reduce(f64::min) {
+            Some(low) => {
+                let high = ratios.iter().copied().fold(low, f64::max);
+                format!("{low:.2}–{high:.2}×")
+            }
+            None => "-".into(),
+        };
+        println!(
+            "{:<10} {:<6} {:>14.0} {:>18} {:>17} {:>8} {:>15}",
+            arch.name(),
+            config.activation.name(),
+            ours,
+            autodiff.map_or("-".into(), |t| format!("{t:.0}")),
+            theirs.map_or("-".into(), |t| format!("{t:.0}")),
+            theirs.map_or("-".into(), |t| format!("{:.2}×", ours / t)),
+            spread
+        );
+    }
+    Ok(())
+}
+
+/// The PyTorch peer to compare with, if one was given and PyTorch has a device of this kind
+/// (none for wgpu): its Python, PyTorch's device name and the script written out.
+fn peer<'a>(
+    python: Option<&'a PathBuf>,
+    device: &nprt_net::Device,
+) -> Result<Option<(&'a PathBuf, &'static str, PeerScript)>> {
+    let torch_device = match Backend::of(device) {
+        Backend::Cpu => Some("cpu"),
+        Backend::Cuda => Some("cuda"),
+        Backend::Wgpu => None,
+    };
+    Ok(match (python, torch_device) {
+        (Some(py), Some(torch_device)) => Some((py, torch_device, PeerScript::write()?)),
+        (Some(_), None) => {
+            println!("(PyTorch has no wgpu device: peer skipped)");
+            None
+        }
+        (None, _) => {
+            println!(
+                "(no --python given: PyTorch peer skipped; bench/train_vs_pytorch.sh sets one up)"
+            );
+            None
+        }
+    })
+}

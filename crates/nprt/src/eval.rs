@@ -1,0 +1,118 @@
+//! `nprt eval`: flags for evaluating models against the baselines; the work is
+//! `nprt_eval::evaluate` and `write_report`.
+
+use std::path::PathBuf;
+
+use anyhow::{bail, Result};
+use nprt_eval::{evaluate, write_report, EvalOptions, Evaluation};
+use nprt_net::Device;
+
+use crate::flags::DeviceArg;
+
+/// The defaults every flag shows, from the one place that states them.
+fn d() -> EvalOptions {
+    EvalOptions::default()
+}
+
+#[derive(clap::Args)]
+pub struct EvalArgs {
+    /// Trained model folders (repeat the flag or separate with commas).
+    #[arg(long, required = true, value_delimiter = ',')]
+    model: Vec<PathBuf>,
+    /// Dataset folder; its test views (held-out lighting) are evaluated.
+    #[arg(long)]
+    data: PathBuf,
+    /// Report folder: report.md, report.html (self-contained), results.json, images/.
+    #[arg(long)]
+    out: PathBuf,
+    /// A Deep Shading model folder (from `nprt train-deep-shading`) to compare too.
+    #[arg(long)]
+    deep_shading: Option<PathBuf>,
+    /// Paths per pixel of the SH PRT transport precomputation.
+    #[arg(long, default_value_t = d().sh_spp)]
+    sh_spp: u32,
+    /// Side of the square frames of the timing table (the paper: 512).
+    #[arg(long, default_value_t = d().timing_res)]
+    timing_res: u32,
+    /// Evaluate only the first N test views.
+    #[arg(long)]
+    views: Option<usize>,
+    /// Test views shown as images (frames, crops, heat maps) in the report.
+    #[arg(long, default_value_t = d().shown_views)]
+    shown_views: usize,
+    /// Seed of the baselines' path-traced samples (and of the traced direct light).
+    #[arg(long, default_value_t = d().seed)]
+    seed: u64,
+    /// Samples per pixel of the direct light of models trained with `nprt train --direct
+    /// traced`, traced per frame and counted in their time.
+    #[arg(long, default_value_t = d().direct_spp)]
+    direct_spp: u32,
+    #[command(flatten)]
+    device: DeviceArg,
+}
+
+/// An evaluation and where its report goes.
+pub struct EvalJob {
+    pub opts: EvalOptions,
+    pub out: PathBuf,
+}
+
+impl From<EvalArgs> for EvalJob {
+    fn from(a: EvalArgs) -> Self {
+        EvalJob {
+            opts: EvalOptions {
+                data: a.data,
+                models: a.model,
+                deep_shading: a.deep_shading,
+                sh_spp: a.sh_spp,
+                timing_res: a.timing_res,
+                max_views: a.views,
+                shown_views: a.shown_views,
+                seed: a.seed,
+                direct_spp: a.direct_spp,
+                progress: true,
+            },
+            out: a.out,
+        }
+    }
+}
+
+pub fn command(a: EvalArgs) -> Result<()> {
+    let device = a.device.device()?;
+    run(&a.into(), &device).map(|_| ())
+}
+
+/// Runs the evaluation and writes the report; prints where it is and the headline figures.
+pub fn run(job: &EvalJob, device: &Device) -> Result<Evaluation> {
+    let opts = &job.opts;
+    if opts.sh_spp == 0 || opts.timing_res < 8 {
+        bail!("--sh-spp must be at least 1 and --timing-res at least 8");
+    }
+    let e = evaluate(opts, device)?;
+    let (md, html) = write_report(&e, &job.out)?;
+    println!(
+        "{:<32} {:>10} {:>10} {:>10} {:>12}",
+        "method", "L1", "RMSE", "dSSIM", "ms / view"
+    );
+    for m in &e.methods {
+        println!(
+            "{:<32} {:>10.5} {:>10.5} {:>10.5} {:>12.1}",
+            m.name, m.mean.l1, m.mean.rmse, m.mean.dssim, m.ms_per_view
+        );
+    }
+    if let Some(f) = &e.noise_floor {
+        println!(
+            "{:<32} {:>10.5} {:>10.5} {:>10.5} {:>12}",
+            format!("reference noise ({} spp)", e.reference_spp),
+            f.l1,
+            f.rmse,
+            f.dssim,
+            "–"
+        );
+    }
+    for c in e.checks() {
+        println!("{:<13} {}", format!("{}:", c.verdict.word()), c.text);
+    }
+    println!("report: {} and {}", md.display(), html.display());
+    Ok(e)
+}

@@ -1,0 +1,193 @@
+//! `nprt train`: flags for training one design; the work is `nprt_net::train`.
+
+use std::path::{Path, PathBuf};
+
+use anyhow::{Context, Result};
+use nprt_net::network::encoder::check_input_width;
+use nprt_net::training::training_set::{TrainingSet, ViewSamples};
+use nprt_net::{
+    Activation, Calibration, Design, Device, DirectLight, Loss, MapNorm, ModelConfig,
+    PositionEncoding, TrainOptions, DEFAULT_ENCODER_WIDTH, DEFAULT_MAP_NORM,
+};
+
+use crate::flags::{DeviceArg, RunArgs};
+
+/// The defaults every flag shows, from the one place that states them.
+fn d() -> TrainOptions {
+    TrainOptions::default()
+}
+
+#[derive(clap::Args)]
+pub struct TrainArgs {
+    /// Dataset folder made by `nprt generate` (holding manifest.json).
+    #[arg(long)]
+    data: PathBuf,
+    /// Transport design: baseline, prt, albedo or dsep.
+    #[arg(long)]
+    arch: Design,
+    /// siren or relu for the layers that read the pixel inputs (default: the paper's choice).
+    #[arg(long)]
+    activation: Option<Activation>,
+    /// Model folder to write; re-running with the same settings resumes the run in it, and a
+    /// larger --epochs or --minutes continues a finished one (with --schedule paper).
+    #[arg(long)]
+    out: PathBuf,
+    /// The run's length (--epochs: passes over all foreground pixels of the training views,
+    /// the paper: 500; on 2 CPU cores one epoch of the default 400-view 128² dataset takes
+    /// about 4 minutes with dsep) and learning-rate schedule.
+    #[command(flatten)]
+    run: RunArgs,
+    /// Samples per batch.
+    #[arg(long, default_value_t = d().batch_size)]
+    batch_size: usize,
+    /// Adam's (peak) learning rate [default with --schedule cosine: 5e-4 for prt, albedo and
+    /// dsep, 3e-4 for baseline, measured on demo-sized data (docs/model.md); with --schedule
+    /// paper, the paper's 1e-4].
+    #[arg(long)]
+    lr: Option<f64>,
+    /// Seed of the initial weights and of the batch order.
+    #[arg(long, default_value_t = d().schedule.seed)]
+    seed: u64,
+    /// Views whose pixels are mixed in each batch, each lit by its own rotated map.
+    #[arg(long, default_value_t = d().views_per_batch)]
+    views_per_batch: usize,
+    /// Training loss: log-l1 (the paper's L1 on log(1 + x): minimised by the median of what the
+    /// network cannot tell apart, target noise or detail not yet learnt, which is darker than
+    /// the mean) or rel-l2 ((p − r)² / (p² + 0.01) with p held constant in the denominator,
+    /// minimised by the mean: right in level, worse in detail at short budgets; see
+    /// docs/model.md). The validation loss is log-L1 either way.
+    #[arg(long, default_value_t = d().loss)]
+    loss: Loss,
+    /// none (the network's output as it is, the paper) or level (each channel of the saved
+    /// model's radiance multiplied by the training targets' mean over its own, measured on
+    /// training pixels whenever the model is saved, and again when a finished run is asked
+    /// with another choice: log-L1 settles on a median, darker than the mean. It gets the level
+    /// right but costs L1 where the darkness is light the network cannot place, as in the demo;
+    /// docs/model.md).
+    #[arg(long, default_value_t = d().calibration)]
+    calibrate: Calibration,
+    /// Test-view pixels (held-out lighting) used for the validation loss after each epoch.
+    #[arg(long, default_value_t = d().val_samples)]
+    val_samples: usize,
+    /// Width W of the encoder's W × W/2 input map (a multiple of 64).
+    #[arg(long, default_value_t = DEFAULT_ENCODER_WIDTH)]
+    encoder_width: usize,
+    /// What the map is divided by before the encoder sees it, the prediction multiplied by the
+    /// same: channel (each channel's mean, so a held-out map's tint carries over exactly) or
+    /// mean (the paper's one mean over channels, which leaves colour to the encoder).
+    #[arg(long, default_value_t = DEFAULT_MAP_NORM)]
+    map_norm: MapNorm,
+    /// learned (the paper: the network predicts all the radiance) or traced (the network
+    /// learns the indirect light only, the reference minus its direct part, and `nprt render`
+    /// and `nprt eval` trace the direct light at run time with --direct-spp samples per pixel,
+    /// its cost counted in the model's time; docs/model.md).
+    #[arg(long, default_value_t = DirectLight::default())]
+    direct: DirectLight,
+    /// How the transport network sees the position: none (the paper: x, y, z only) or hash-grid
+    /// (a multiresolution hash grid on the scene's box, 8 levels from 4 to 64 cells a side,
+    /// 2^13 × 2 learned values each, 0.5 MB per track, whose interpolated values join the
+    /// inputs; docs/model.md). The design's layers are otherwise unchanged.
+    #[arg(long, default_value_t = PositionEncoding::default())]
+    encoding: PositionEncoding,
+    /// Minutes between checkpoints within an epoch (one is always written at an epoch's end).
+    #[arg(long, default_value_t = d().schedule.checkpoint_secs / 60.0)]
+    checkpoint_minutes: f64,
+    #[command(flatten)]
+    device: DeviceArg,
+}
+
+/// One training run as the library takes it.
+pub struct TrainJob {
+    pub data: PathBuf,
+    pub config: ModelConfig,
+    pub opts: TrainOptions,
+    pub out: PathBuf,
+}
+
+impl TryFrom<TrainArgs> for TrainJob {
+    type Error = anyhow::Error;
+    fn try_from(a: TrainArgs) -> Result<Self> {
+        check_input_width(a.encoder_width)?;
+        let config = ModelConfig {
+            encoder_width: a.encoder_width,
+            map_norm: a.map_norm,
+            direct: a.direct,
+            encoding: a.encoding,
+            ..ModelConfig::new(a.arch, a.activation)
+        };
+        let defaults = TrainOptions::default();
+        let opts = TrainOptions {
+            schedule: nprt_net::Schedule {
+                seed: a.seed,
+                checkpoint_secs: a.checkpoint_minutes * 60.0,
+                ..defaults.schedule.clone()
+            },
+            batch_size: a.batch_size,
+            views_per_batch: a.views_per_batch,
+            val_samples: a.val_samples,
+            loss: a.loss,
+            calibration: a.calibrate,
+        }
+        .with_run(a.arch, a.run.into(), a.lr);
+        opts.check().context("bad training options")?;
+        Ok(TrainJob {
+            data: a.data,
+            config,
+            opts,
+            out: a.out,
+        })
+    }
+}
+
+pub fn command(a: TrainArgs) -> Result<()> {
+    let device = a.device.device()?;
+    run(&TrainJob::try_from(a)?, &device)
+}
+
+/// Loads the dataset, trains and prints what the run did.
+pub fn run(job: &TrainJob, device: &Device) -> Result<()> {
+    let t0 = std::time::Instant::now();
+    let set = TrainingSet::load(&job.data, &job.config)?;
+    print_dataset(&job.data, &set, t0.elapsed().as_secs_f64());
+    let (s, file) = nprt_net::train(&set, &job.config, &job.opts, &job.out, device)?;
+    if let Some(e) = s.resumed_from_epoch {
+        println!("resumed from epoch {e:.2}");
+    }
+    let config = &job.config;
+    println!(
+        "trained {} ({}) for {:.2} epochs: {} steps, {:.2} M samples in {:.1} s ({:.0} K samples/s); training loss {:.5}, validation loss {:.5}",
+        config.label(),
+        config.activation,
+        s.epochs,
+        s.steps,
+        s.samples as f64 / 1e6,
+        s.seconds,
+        s.samples as f64 / s.seconds.max(1e-9) / 1e3,
+        s.final_train,
+        s.final_val
+    );
+    println!("time: {}", s.split.describe());
+    if let Some([r, g, b]) = file.level_gain {
+        println!(
+            "level gain (training targets' mean over the network's, per channel): R {r:.3} G {g:.3} B {b:.3}"
+        );
+    }
+    println!(
+        "model in '{}' (loss curves: loss.csv, loss.png)",
+        job.out.display()
+    );
+    Ok(())
+}
+
+fn print_dataset(dir: &Path, set: &TrainingSet, seconds: f64) {
+    let count = |v: &[ViewSamples]| v.iter().map(|s| s.len()).sum::<usize>();
+    println!(
+        "dataset '{}': {} training views ({} foreground pixels), {} test views ({} pixels), {:.2} GB in memory, loaded in {seconds:.1} s",
+        dir.display(),
+        set.train.len(),
+        count(&set.train),
+        set.test.len(),
+        count(&set.test),
+        set.bytes() as f64 / 1e9,
+    );
+}
