@@ -94,10 +94,22 @@ pub struct Camera {
     pub height: u32,
 }
 
-/// Mitsuba's `lookat`: columns (left, up, forward, origin).
+/// Mitsuba's `lookat`: columns (left, up, forward, origin). Looking along `up` itself (straight
+/// up or down with +Y up) leaves the roll undefined, where Mitsuba's frame is NaN; the world
+/// axis least aligned with the view then serves as up, so the frame stays well defined.
 pub fn look_at(origin: Vec3, target: Vec3, up: Vec3) -> Mat4 {
     let dir = (target - origin).normalize();
-    let left = up.cross(dir).normalize();
+    let left = up.cross(dir).try_normalize().unwrap_or_else(|| {
+        let a = dir.abs();
+        let axis = if a.x <= a.y && a.x <= a.z {
+            Vec3::X
+        } else if a.y <= a.z {
+            Vec3::Y
+        } else {
+            Vec3::Z
+        };
+        axis.cross(dir).normalize()
+    });
     let new_up = dir.cross(left);
     Mat4::from_cols(
         left.extend(0.0),
@@ -174,6 +186,27 @@ impl Camera {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A camera looking straight up or down along its up vector (a camera path keyframe with
+    /// its target above it) still has an orthonormal frame and finite rays.
+    #[test]
+    fn looking_along_up_gives_a_finite_frame() {
+        for target in [Vec3::new(0.0, 2.0, 1.0), Vec3::new(0.0, -3.0, 1.0)] {
+            let c = Camera::look_at(Vec3::new(0.0, 1.0, 1.0), target, Vec3::Y, 60.0, 8, 8);
+            let m = c.to_world;
+            let (l, u, f) = (
+                m.x_axis.truncate(),
+                m.y_axis.truncate(),
+                m.z_axis.truncate(),
+            );
+            for (a, b) in [(l, u), (u, f), (f, l)] {
+                assert!(a.dot(b).abs() < 1e-6, "{m:?}");
+            }
+            assert!((f - (target - Vec3::new(0.0, 1.0, 1.0)).normalize()).length() < 1e-6);
+            let (o, d) = c.ray(glam::Vec2::new(1.5, 6.5));
+            assert!(o.is_finite() && d.is_finite() && (d.length() - 1.0).abs() < 1e-5);
+        }
+    }
 
     #[test]
     fn centre_ray_looks_at_target_and_left_is_left() {

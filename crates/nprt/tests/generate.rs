@@ -251,6 +251,21 @@ fn bad_input_is_refused_before_anything_is_written() {
         "2/2",
     ]);
     assert!(!o2.status.success() && String::from_utf8_lossy(&o2.stderr).contains("K/N"));
+    // No samples would write black targets.
+    fails(
+        &[
+            "generate",
+            "--out",
+            o,
+            "--scene",
+            "builtin:room",
+            "--envmaps",
+            "builtin",
+            "--spp",
+            "0",
+        ],
+        &["spp is 0"],
+    );
     assert!(!out.exists(), "nothing may be written on bad input");
 }
 

@@ -372,6 +372,20 @@ fn bad_runs_stop_clearly_and_keep_the_last_good_checkpoint() {
         &[
             "train",
             "--data",
+            data,
+            "--arch",
+            "prt",
+            "--out",
+            o,
+            "--val-samples",
+            "0",
+        ],
+        &["validation samples must be positive"],
+    );
+    fails(
+        &[
+            "train",
+            "--data",
             "/nonexistent/ds",
             "--arch",
             "prt",

@@ -133,6 +133,9 @@ impl Manifest {
                 s.format_version
             );
         }
+        if s.spp == 0 {
+            bail!("spp is 0: training views need at least one sample per pixel");
+        }
         if let Some(n) = s.test_spp {
             if n < 2 || n % 2 != 0 {
                 bail!("test_spp is {n}: it must be even and at least 2 (test views are rendered as two independent halves)");

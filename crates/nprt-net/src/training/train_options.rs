@@ -80,6 +80,11 @@ impl TrainOptions {
         if self.batch_size == 0 || self.views_per_batch == 0 {
             bail!("the batch size and the views per batch must be positive");
         }
+        if self.val_samples == 0 {
+            bail!(
+                "the validation samples must be positive: every epoch ends with a validation loss"
+            );
+        }
         Ok(())
     }
 }
