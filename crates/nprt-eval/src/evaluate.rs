@@ -60,6 +60,9 @@ pub struct Evaluation {
 /// Runs the whole evaluation: the networks first (the slowest Neural PRT design sets the
 /// equal-time sample count), then path tracing, denoised path tracing and SH PRT.
 pub fn evaluate(o: &EvalOptions, device: &Device) -> Result<Evaluation> {
+    if o.sh_spp == 0 || o.timing_res < 8 {
+        bail!("--sh-spp must be at least 1 and --timing-res at least 8");
+    }
     let (manifest, dataset_hash) = load_manifest_hashed(&o.data)?;
     let s = &manifest.settings;
     let scene = load_checked_scene(

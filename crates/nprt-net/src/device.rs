@@ -8,9 +8,10 @@
 //! compiled in only with the cargo feature of its name (`cuda`, `wgpu`); a build without one
 //! says so when that device is asked for.
 
-use crate::choice::named_choice;
 use anyhow::{bail, Result};
 use burn::tensor::{Device, TensorData};
+
+use crate::choice::named_choice;
 
 /// `--device`: the CPU, an NVIDIA GPU through CUDA, any GPU through wgpu, or the CUDA GPU
 /// when one is present.
@@ -54,7 +55,11 @@ impl Compute {
                     }
                 ),
             },
-            Compute::Wgpu => match first_wgpu()? {
+            Compute::Wgpu if !cfg!(feature = "wgpu") => bail!(
+                "--device wgpu: this nprt was built without wgpu support; rebuild it with \
+                 `cargo build --release --features wgpu` (docs/building.md), or use --device cpu"
+            ),
+            Compute::Wgpu => match first_wgpu() {
                 Some(device) => device,
                 None => bail!(
                     "--device wgpu: no Vulkan or Metal adapter found (on Linux install a Vulkan \
@@ -178,18 +183,15 @@ fn first_gpu() -> Option<Device> {
 }
 
 #[cfg(feature = "wgpu")]
-fn first_wgpu() -> Result<Option<Device>> {
-    Ok(Device::enumerate(burn::tensor::DeviceType::Wgpu)
+fn first_wgpu() -> Option<Device> {
+    Device::enumerate(burn::tensor::DeviceType::Wgpu)
         .into_iter()
-        .next())
+        .next()
 }
 
 #[cfg(not(feature = "wgpu"))]
-fn first_wgpu() -> Result<Option<Device>> {
-    bail!(
-        "--device wgpu: this nprt was built without wgpu support; rebuild it with \
-         `cargo build --release --features wgpu` (docs/building.md), or use --device cpu"
-    )
+fn first_wgpu() -> Option<Device> {
+    None
 }
 
 fn cuda_driver_present() -> bool {

@@ -115,12 +115,11 @@ impl TryFrom<TrainArgs> for TrainJob {
             encoding: a.encoding,
             ..ModelConfig::new(a.arch, a.activation)
         };
-        let defaults = TrainOptions::default();
         let opts = TrainOptions {
             schedule: nprt_net::Schedule {
                 seed: a.seed,
                 checkpoint_secs: a.checkpoint_minutes * 60.0,
-                ..defaults.schedule.clone()
+                ..d().schedule
             },
             batch_size: a.batch_size,
             views_per_batch: a.views_per_batch,

@@ -9,13 +9,13 @@
 use std::path::Path;
 use std::sync::Mutex;
 
-use anyhow::Result;
+use anyhow::{Context, Result};
 use burn::module::Module;
 use burn::optim::GradientsParams;
 use burn::tensor::Device;
 
 use crate::model::config::ModelConfig;
-use crate::model::folder::{read_model_file, save_model, ModelFile, MODEL_FORMAT, MODEL_VERSION};
+use crate::model::folder::{save_model, ModelFile, MODEL_FORMAT, MODEL_VERSION};
 use crate::network::init::Init;
 use crate::network::nprt_net::NprtNet;
 use crate::training::batch::{Batch, Engine};
@@ -184,13 +184,11 @@ pub fn train(
         saved: Mutex::new(None),
     };
     let summary = training_loop::train(&objective, &opts.schedule, out, device)?;
-    let saved = objective
+    // The loop saves the model on every path that returns a summary.
+    let file = objective
         .saved
         .into_inner()
-        .unwrap_or_else(|e| e.into_inner());
-    let file = match saved {
-        Some(file) => file,
-        None => read_model_file(out)?,
-    };
+        .unwrap_or_else(|e| e.into_inner())
+        .context("training returned without saving the model")?;
     Ok((summary, file))
 }

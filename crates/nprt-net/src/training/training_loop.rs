@@ -221,17 +221,18 @@ pub fn train<O: Objective>(
     std::fs::create_dir_all(checkpoint::dir(out))
         .with_context(|| format!("cannot create model folder '{}'", out.display()))?;
     let (ck, resumed_from_epoch, mut optim) = start(objective, schedule, out, &mut net, optim)?;
-    let mut run = Run::new(objective, schedule, ck);
+    let mut run = Run::new(objective, schedule, out, ck);
     let mut trained = false;
     while run.ck.state.epoch < schedule.epochs && !run.out_of_time() {
         trained = true;
-        net = run.epoch(objective, out, &device, net, &mut optim)?;
+        let total = run.steps_in(run.ck.state.epoch);
+        net = run.epoch(total, &device, net, &mut optim)?;
         // The epoch ended, or the budget ran out within it: validate and save either way.
         let validating = Instant::now();
         let val = objective.validation_loss(&net.valid(), &inner);
         run.split.validation += since(validating);
-        run.end_epoch(val);
-        run.save(objective, out, &net, &optim, &inner)?;
+        run.end_epoch(val, total);
+        run.save(&net, &optim, &inner)?;
     }
     run.bar.finish_and_clear();
     if !trained {
@@ -273,13 +274,14 @@ fn start<O: Objective>(
 
 /// A run between steps: the checkpoint it builds, the loss-table row being summed, the
 /// divergence guard, where the time went and the progress bar.
-struct Run<'s> {
+struct Run<'s, O: Objective> {
+    objective: &'s O,
     schedule: &'s Schedule,
+    /// The model folder.
+    out: &'s Path,
     ck: Checkpoint,
     /// Seconds of training the run may take, when it has a time budget.
     budget: Option<f64>,
-    /// Batches in each epoch.
-    steps: Vec<usize>,
     total_batches: usize,
     done_batches: usize,
     bar: nprt_io::ProgressBar,
@@ -293,23 +295,17 @@ struct Run<'s> {
     split: TimeSplit,
 }
 
-impl<'s> Run<'s> {
-    fn new<O: Objective>(objective: &O, schedule: &'s Schedule, ck: Checkpoint) -> Self {
+impl<'s, O: Objective> Run<'s, O> {
+    fn new(objective: &'s O, schedule: &'s Schedule, out: &'s Path, ck: Checkpoint) -> Self {
         // A time budget sets the run's length (and the bar's, in seconds); otherwise its
         // batches do.
         let budget = schedule.budget_secs();
-        let epochs = match budget {
-            Some(_) => ck.state.epoch + 1,
-            None => schedule.epochs,
-        };
-        let steps: Vec<usize> = (0..epochs.max(ck.state.epoch + 1))
-            .map(|e| objective.steps(schedule.seed, e))
-            .collect();
+        let steps_in = |epoch: usize| objective.steps(schedule.seed, epoch);
         let total_batches = match budget {
             Some(_) => 0,
-            None => steps[..schedule.epochs].iter().sum(),
+            None => (0..schedule.epochs).map(steps_in).sum(),
         };
-        let done_batches = steps[..ck.state.epoch].iter().sum::<usize>() + ck.state.batch;
+        let done_batches = (0..ck.state.epoch).map(steps_in).sum::<usize>() + ck.state.batch;
         let what = format!("training {}", objective.tag());
         let bar = match budget {
             Some(b) => nprt_io::progress_bar(schedule.progress, b.ceil() as u64, &what, "s"),
@@ -323,9 +319,10 @@ impl<'s> Run<'s> {
         });
         bar.reset_eta();
         Run {
+            objective,
             schedule,
+            out,
             budget,
-            steps,
             total_batches,
             done_batches,
             bar,
@@ -345,13 +342,9 @@ impl<'s> Run<'s> {
         self.budget.is_some_and(|b| self.ck.state.seconds >= b)
     }
 
-    /// Batches in `epoch`, asking the objective for epochs past those counted so far.
-    fn steps_in<O: Objective>(&mut self, objective: &O, epoch: usize) -> usize {
-        while self.steps.len() <= epoch {
-            self.steps
-                .push(objective.steps(self.schedule.seed, self.steps.len()));
-        }
-        self.steps[epoch]
+    /// Batches in `epoch`.
+    fn steps_in(&self, epoch: usize) -> usize {
+        self.objective.steps(self.schedule.seed, epoch)
     }
 
     /// The learning rate of the next step.
@@ -363,18 +356,16 @@ impl<'s> Run<'s> {
         self.schedule.learning_rate * self.schedule.lr_schedule.factor(progress)
     }
 
-    /// One epoch from the checkpoint's batch on, until its end or the time budget's, with
-    /// checkpoints as due. Batches are built on a thread of their own.
-    fn epoch<O: Objective>(
+    /// One epoch of `total` batches from the checkpoint's batch on, until its end or the time
+    /// budget's, with checkpoints as due. Batches are built on a thread of their own.
+    fn epoch(
         &mut self,
-        objective: &O,
-        out: &Path,
+        total: usize,
         device: &Device,
         net: O::Net,
         optim: &mut ModuleOptimizer,
     ) -> Result<O::Net> {
-        let epoch = self.ck.state.epoch;
-        let total = self.steps_in(objective, epoch);
+        let (objective, epoch) = (self.objective, self.ck.state.epoch);
         let row_every = (total as u64).div_ceil(TRAIN_ROWS_PER_EPOCH).max(1);
         let from = self.ck.state.batch;
         let (seed, inner) = (self.schedule.seed, device.clone().inner());
@@ -397,7 +388,7 @@ impl<'s> Run<'s> {
                 let stepping = Instant::now();
                 let lr = self.learning_rate();
                 let (value, grads, samples) = objective.gradients(&net, &batch, device);
-                self.check_divergence(value, epoch, out)?;
+                self.check_divergence(value, epoch)?;
                 net = optim.step(lr, net, grads);
                 self.split.steps += since(stepping);
                 self.record_step(value, samples, epoch, total, row_every);
@@ -405,7 +396,7 @@ impl<'s> Run<'s> {
                     break;
                 }
                 if self.last_checkpoint.elapsed().as_secs_f64() > self.schedule.checkpoint_secs {
-                    self.save(objective, out, &net, optim, &inner)?;
+                    self.save(&net, optim, &inner)?;
                 }
             }
             Ok(net)
@@ -413,15 +404,15 @@ impl<'s> Run<'s> {
     }
 
     /// Stops the run when the loss of the step just taken says it diverged.
-    fn check_divergence(&mut self, value: f64, epoch: usize, out: &Path) -> Result<()> {
+    fn check_divergence(&mut self, value: f64, epoch: usize) -> Result<()> {
         let Some(why) = self.guard.check(value, self.ck.state.step) else {
             return Ok(());
         };
         self.bar.abandon();
-        let kept = if checkpoint::exists(out) {
+        let kept = if checkpoint::exists(self.out) {
             format!(
                 "the last good checkpoint in '{}' is kept",
-                checkpoint::dir(out).display()
+                checkpoint::dir(self.out).display()
             )
         } else {
             "no checkpoint had been written yet".to_string()
@@ -474,9 +465,9 @@ impl<'s> Run<'s> {
         ));
     }
 
-    /// Closes the epoch (or the part of it the budget left) with its validation loss `val`.
-    fn end_epoch(&mut self, val: f64) {
-        let total = self.steps[self.ck.state.epoch];
+    /// Closes the epoch of `total` batches (or the part of it the budget left) with its
+    /// validation loss `val`.
+    fn end_epoch(&mut self, val: f64, total: usize) {
         let s = &mut self.ck.state;
         if s.batch >= total {
             s.epoch += 1;
@@ -507,43 +498,31 @@ impl<'s> Run<'s> {
     }
 
     /// Writes the checkpoint, the model files and the loss curves.
-    fn save<O: Objective>(
-        &mut self,
-        objective: &O,
-        out: &Path,
-        net: &O::Net,
-        optim: &ModuleOptimizer,
-        device: &Device,
-    ) -> Result<()> {
+    fn save(&mut self, net: &O::Net, optim: &ModuleOptimizer, device: &Device) -> Result<()> {
         let saving = Instant::now();
-        save(
-            objective,
-            self.schedule,
-            out,
-            &mut self.ck,
-            net,
-            optim,
-            device,
-        )?;
+        let (objective, out, ck) = (self.objective, self.out, &mut self.ck);
+        checkpoint::write(out, ck, net, optim, &objective.tag())?;
+        objective.save_model(out, net, self.schedule, &ck.state, device)?;
+        curves::write_csv(&out.join("loss.csv"), &ck.history)?;
+        curves::plot(&out.join("loss.png"), &ck.history, &objective.title())?;
         self.split.saving += since(saving);
         self.last_checkpoint = Instant::now();
         Ok(())
     }
 
-    fn summary(mut self, resumed_from_epoch: Option<f64>) -> TrainSummary {
+    fn summary(&self, resumed_from_epoch: Option<f64>) -> TrainSummary {
         let state = self.ck.state;
         let last = |f: fn(&LossRow) -> Option<f64>| self.ck.history.iter().rev().find_map(f);
-        let (final_train, final_val) = (last(|r| r.train), last(|r| r.val));
-        let in_epoch = self.steps.get(state.epoch).copied();
         TrainSummary {
-            epochs: state.epoch as f64 + state.batch as f64 / in_epoch.unwrap_or(1).max(1) as f64,
+            epochs: state.epoch as f64
+                + state.batch as f64 / self.steps_in(state.epoch).max(1) as f64,
             steps: state.step,
             samples: state.samples,
             seconds: state.seconds,
-            final_train: final_train.unwrap_or(self.last_train),
-            final_val: final_val.unwrap_or(f64::NAN),
+            final_train: last(|r| r.train).unwrap_or(self.last_train),
+            final_val: last(|r| r.val).unwrap_or(f64::NAN),
             resumed_from_epoch,
-            split: std::mem::take(&mut self.split),
+            split: self.split,
         }
     }
 }
@@ -619,21 +598,4 @@ impl DivergenceGuard {
             )
         })
     }
-}
-
-/// The checkpoint, then the model folder's own files, loss.csv and loss.png; `device` is the
-/// one validation runs on.
-fn save<O: Objective>(
-    objective: &O,
-    schedule: &Schedule,
-    out: &Path,
-    ck: &mut Checkpoint,
-    net: &O::Net,
-    optim: &ModuleOptimizer,
-    device: &Device,
-) -> Result<()> {
-    checkpoint::write(out, ck, net, optim, &objective.tag())?;
-    objective.save_model(out, net, schedule, &ck.state, device)?;
-    curves::write_csv(&out.join("loss.csv"), &ck.history)?;
-    curves::plot(&out.join("loss.png"), &ck.history, &objective.title())
 }
