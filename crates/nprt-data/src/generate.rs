@@ -75,16 +75,44 @@ pub struct Planned<'a> {
     pub warnings: Vec<String>,
 }
 
+/// Memory a planned view holds for the whole run: its record and manifest line, and with
+/// built-in lighting its own procedural map (256×128 texels and their sampling distribution).
+const BYTES_PER_VIEW: u128 = 1 << 10;
+const BYTES_PER_BUILTIN_MAP: u128 = 1 << 20;
+
+/// Refuses view counts and resolutions this machine's memory cannot hold, before anything is
+/// allocated (`--train-views 1000000000000` grew until killed).
+fn check_sizes(opts: &GenerateOptions, builtin_share: f32) -> Result<()> {
+    let views = opts.train_views as u128 + opts.test_views as u128;
+    let own_maps = if opts.envmaps == "builtin" {
+        views
+    } else {
+        (opts.train_views as f64 * builtin_share.clamp(0.0, 1.0) as f64) as u128
+    };
+    nprt_io::ensure_memory(
+        views * BYTES_PER_VIEW + own_maps * BYTES_PER_BUILTIN_MAP,
+        &format!("planning {views} views"),
+    )?;
+    for (split, [w, h]) in [
+        ("training", opts.train_resolution),
+        ("test", opts.test_resolution),
+    ] {
+        nprt_trace::Frame::check_size(w, h, &format!("a {w}×{h} {split} view"))?;
+    }
+    Ok(())
+}
+
 /// Plans the dataset (nothing is written before the plan holds), calls `planned` with it, then
 /// renders this shard's missing views.
 pub fn generate(opts: &GenerateOptions, planned: impl FnOnce(Planned)) -> Result<Summary> {
-    let scene = load_scene(&opts.scene, &dataset::relit())?;
-    let volume = opts.camera.resolve(&scene, &opts.scene)?;
     let share = match (opts.envmaps.as_str(), opts.mix_builtin) {
         (_, Some(share)) => share,
         ("builtin", None) => 0.0,
         (_, None) => lighting::DEFAULT_MIX_BUILTIN,
     };
+    check_sizes(opts, share)?;
+    let scene = load_scene(&opts.scene, &dataset::relit())?;
+    let volume = opts.camera.resolve(&scene, &opts.scene)?;
     let (specs, assignment) = lighting::choose(
         &opts.envmaps,
         opts.train_views,
@@ -98,7 +126,7 @@ pub fn generate(opts: &GenerateOptions, planned: impl FnOnce(Planned)) -> Result
         .warnings
         .iter()
         .cloned()
-        .chain(maps.iter().filter_map(|m| m.clamp_warning()))
+        .chain(maps.iter().flat_map(|m| m.warnings()))
         .collect();
     let request = Request {
         scene_spec: opts.scene.clone(),

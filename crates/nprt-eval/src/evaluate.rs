@@ -140,6 +140,7 @@ pub fn evaluate(o: &EvalOptions, device: &Device) -> Result<Evaluation> {
             denoiser: oidn.as_ref().ok().copied(),
         },
     )?;
+    check_finite(&results, &views)?;
     let fg = views.iter().map(|v| v.foreground()).sum();
     let noise_floor = noise_floor(&views);
     Ok(Evaluation {
@@ -159,6 +160,27 @@ pub fn evaluate(o: &EvalOptions, device: &Device) -> Result<Evaluation> {
         cpu_threads: rayon::current_num_threads(),
         shown: bench.shown,
     })
+}
+
+/// Stops at a metric that is not a finite number (it would be `null` in results.json and
+/// silently drop out of every mean), naming the method and test view.
+fn check_finite(results: &[MethodResult], views: &[ImageView]) -> Result<()> {
+    for r in results {
+        for (m, v) in r.per_view.iter().zip(views) {
+            let values = m.values();
+            if let Some(k) = values.iter().position(|x| !x.is_finite()) {
+                bail!(
+                    "{}: {} on test view {} ('{}') is {}, so no report is written",
+                    r.name,
+                    Metrics::NAMES[k],
+                    v.record.index,
+                    v.record.file,
+                    values[k]
+                );
+            }
+        }
+    }
+    Ok(())
 }
 
 /// The test views evaluated, in index order, the first `max_views` of them.

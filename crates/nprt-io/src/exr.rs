@@ -1,5 +1,6 @@
 //! Multi-channel OpenEXR files of f32 channels, written atomically (temporary file, then
-//! rename) so a killed run never leaves a half-written image.
+//! rename) so a killed run never leaves a half-written image, and never holding a NaN or an
+//! infinity: an image that would is a failed run, not an output.
 
 use std::collections::HashMap;
 use std::path::Path;
@@ -9,7 +10,8 @@ use anyhow::{bail, Context, Result};
 
 use crate::atomic::write_atomically;
 
-/// Writes `channels` (name, row-major data of `width × height`) to `path`.
+/// Writes `channels` (name, row-major data of `width × height`) to `path`; refuses non-finite
+/// values, naming the channel and pixel.
 pub fn write_channels(
     path: &Path,
     width: usize,
@@ -21,6 +23,15 @@ pub fn write_channels(
             bail!(
                 "channel '{name}' has {} values for a {width}×{height} image",
                 data.len()
+            );
+        }
+        if let Some(i) = data.iter().position(|v| !v.is_finite()) {
+            bail!(
+                "refusing to write '{}': channel '{name}' is {} at pixel ({}, {})",
+                path.display(),
+                data[i],
+                i % width,
+                i / width
             );
         }
     }
@@ -57,4 +68,32 @@ pub fn read_channels(path: &Path) -> Result<(usize, usize, HashMap<String, Vec<f
         );
     }
     Ok((w, h, out))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn non_finite_pixels_are_refused_by_channel_and_pixel() {
+        let dir = std::env::temp_dir().join(format!("nprt-io-exr-{}", std::process::id()));
+        let path = dir.join("x.exr");
+        let mut data = vec![0.25f32; 4 * 2];
+        write_channels(&path, 4, 2, &[("R".into(), data.clone())]).unwrap();
+        assert_eq!(read_channels(&path).unwrap().2["R"], data);
+        data[6] = f32::NAN;
+        let err = write_channels(&path, 4, 2, &[("R".into(), data)]).unwrap_err();
+        assert!(
+            format!("{err}").contains("channel 'R' is NaN at pixel (2, 1)"),
+            "{err}"
+        );
+        let rgb = [glam::Vec3::ONE, glam::Vec3::new(0.0, f32::INFINITY, 0.0)];
+        let png = dir.join("x.png");
+        let err = crate::write_png(&rgb, 2, 1, 0.0, &png).unwrap_err();
+        assert!(
+            format!("{err}").contains("pixel (1, 0)") && !png.exists(),
+            "{err}"
+        );
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
 }

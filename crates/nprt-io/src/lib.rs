@@ -1,7 +1,8 @@
 //! nprt-io: how every nprt stage touches the file system and the terminal. It owns writing
 //! files so that no run ever leaves a half-written one (a temporary file renamed into place),
-//! checking early that an output folder is writable, the one style of progress bar with an
-//! ETA, and the file formats of pixels: multi-channel OpenEXR, the one image reader (EXR, PNG,
+//! checking early that an output folder is writable (and never replacing a device, FIFO or
+//! link target it was not asked to), checking sizes against the machine's memory and cores
+//! before allocating, the one style of progress bar with an ETA, and the file formats of pixels: multi-channel OpenEXR, the one image reader (EXR, PNG,
 //! JPEG, Radiance HDR as linear RGB), tone-mapped PNG, the sRGB curve, and line plots. It sits
 //! at the bottom of the stack and must know nothing of scenes or networks: callers hand it
 //! bytes, pixels or a closure that writes a file.
@@ -18,14 +19,19 @@
 mod atomic;
 pub mod exr;
 mod image_read;
+mod limits;
 mod plot;
 mod png;
 mod progress;
 mod srgb;
 
-pub use atomic::{check_writable, create_parent_dir, write_atomically, write_file};
+pub use atomic::{
+    check_writable, create_parent_dir, leftover_temporaries, output_target, write_atomically,
+    write_file,
+};
 pub use image_read::{linear_rgb, read_linear_rgb, LinearImage};
 pub use indicatif::ProgressBar;
+pub use limits::{available_memory, check_threads, ensure_memory, thread_limit};
 pub use plot::plot_lines;
 pub use png::{srgb8, to_image, write_png};
 pub use progress::progress_bar;

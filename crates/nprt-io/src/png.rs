@@ -2,7 +2,7 @@
 
 use std::path::Path;
 
-use anyhow::Result;
+use anyhow::{bail, Result};
 use glam::Vec3;
 use image::RgbImage;
 
@@ -22,7 +22,8 @@ pub fn to_image(rgb: &[Vec3], width: usize, height: usize, exposure: f32) -> Rgb
     })
 }
 
-/// Writes a tone-mapped PNG atomically.
+/// Writes a tone-mapped PNG atomically; refuses non-finite radiance (which tone-maps to a
+/// plausible-looking black or white), naming the pixel.
 pub fn write_png(
     rgb: &[Vec3],
     width: usize,
@@ -30,6 +31,15 @@ pub fn write_png(
     exposure: f32,
     path: &Path,
 ) -> Result<()> {
+    if let Some(i) = rgb.iter().position(|v| !v.is_finite()) {
+        bail!(
+            "refusing to write '{}': the radiance at pixel ({}, {}) is {}",
+            path.display(),
+            i % width.max(1),
+            i / width.max(1),
+            rgb[i]
+        );
+    }
     let img = to_image(rgb, width, height, exposure);
     write_atomically(path, |tmp| {
         Ok(img.save_with_format(tmp, image::ImageFormat::Png)?)

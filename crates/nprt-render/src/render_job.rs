@@ -85,6 +85,8 @@ impl RenderJob {
         if opts.frames == 0 || opts.fps == 0 {
             bail!("--frames and --fps must be at least 1");
         }
+        let [w, h] = opts.resolution;
+        nprt_trace::Frame::check_size(w, h, &format!("a {w}×{h} frame"))?;
         let model = Relighter::load(&opts.model, device)?;
         let scene_spec = match (&opts.scene, model.file.scene.as_str()) {
             (Some(s), _) => s.clone(),

@@ -48,6 +48,11 @@ pub fn direction_to_uv(d: Vec3) -> Vec2 {
     Vec2::new(u - u.floor(), d.y.clamp(-1.0, 1.0).acos() / PI)
 }
 
+/// The largest texel channel a map may hold: the sun's disc in real captures is below 1e9,
+/// and sums over a map of brighter texels overflow f32 (a Radiance HDR file's top exponent,
+/// 1.7e38, rendered all infinite).
+pub const MAX_RADIANCE: f32 = 1e12;
+
 impl EnvMap {
     /// Builds a map from row-major texels; `width` must be twice `height`. Negative channels
     /// (small ones occur in real captures) are clamped to zero and counted; non-finite ones
@@ -68,9 +73,12 @@ impl EnvMap {
                 texels.len()
             );
         }
-        if let Some(i) = texels.iter().position(|t| !t.is_finite()) {
+        if let Some(i) = texels
+            .iter()
+            .position(|t| !t.is_finite() || t.max_element() > MAX_RADIANCE)
+        {
             bail!(
-                "{name}: texel ({}, {}) is not finite: {}",
+                "{name}: texel ({}, {}) is {}, not a finite radiance of at most {MAX_RADIANCE:e} (a corrupt file, or a scale far too large)",
                 i % width,
                 i / width,
                 texels[i]
@@ -150,15 +158,24 @@ impl EnvMap {
         self.data.clamped
     }
 
-    /// The warning owed to the user when texels were clamped on load (real captures have some).
-    pub fn clamp_warning(&self) -> Option<String> {
-        (self.data.clamped > 0).then(|| {
-            format!(
+    /// The warnings owed to the user about a loaded map: texels clamped on load (real
+    /// captures have some), or no light at all (every view under it renders black).
+    pub fn warnings(&self) -> Vec<String> {
+        let mut warnings = vec![];
+        if self.data.clamped > 0 {
+            warnings.push(format!(
                 "environment map '{}': {} negative texel channels clamped to 0",
                 self.name(),
                 self.data.clamped
-            )
-        })
+            ));
+        }
+        if self.data.texels.iter().all(|t| *t == Vec3::ZERO) {
+            warnings.push(format!(
+                "environment map '{}' is black everywhere: it lights nothing, and images under it are black",
+                self.name()
+            ));
+        }
+        warnings
     }
     pub fn to_world(&self) -> Mat3 {
         self.to_world
@@ -391,6 +408,34 @@ mod tests {
             .unwrap_err()
             .to_string();
         assert!(err.contains("nan.exr") && err.contains("(5, 0)"), "{err}");
+        assert_eq!(m.warnings().len(), 1, "{:?}", m.warnings());
+    }
+
+    /// A Radiance HDR texel at the top exponent (1.7e38) made every sum over the map infinite.
+    #[test]
+    fn rejects_texels_beyond_any_real_radiance_and_warns_of_black_maps() {
+        let mut t = vec![Vec3::ONE; 32];
+        t[9] = Vec3::new(0.0, 1.7e38, 0.0);
+        let err = EnvMap::from_texels("huge.hdr", 8, 4, t)
+            .unwrap_err()
+            .to_string();
+        assert!(
+            err.contains("huge.hdr") && err.contains("(1, 1)") && err.contains("1e12"),
+            "{err}"
+        );
+        let bright = vec![Vec3::splat(MAX_RADIANCE); 32];
+        assert!(EnvMap::from_texels("sun", 8, 4, bright)
+            .unwrap()
+            .warnings()
+            .is_empty());
+        let black = EnvMap::from_texels("black.exr", 8, 4, vec![Vec3::ZERO; 32]).unwrap();
+        let warnings = black.warnings();
+        assert!(
+            warnings.len() == 1
+                && warnings[0].contains("black.exr")
+                && warnings[0].contains("black everywhere"),
+            "{warnings:?}"
+        );
     }
 
     #[test]

@@ -111,14 +111,25 @@ impl Frame {
         out
     }
 
+    /// Memory that making a frame holds per pixel: its layers (92 bytes), the sample
+    /// accumulators, a relit frame's network inputs, and the copies a file is written from.
+    pub const BYTES_PER_PIXEL: u128 = 512;
+
+    /// Refuses a `width × height` frame (`what`: "a 100000×100000 frame") that this machine's
+    /// memory cannot hold, before anything is allocated.
+    pub fn check_size(width: u32, height: u32, what: &str) -> Result<()> {
+        nprt_io::ensure_memory(width as u128 * height as u128 * Self::BYTES_PER_PIXEL, what)
+    }
+
     /// The frame held by named channels (as [`nprt_io::exr::read_channels`] returns them),
-    /// refusing a missing or wrongly sized channel and non-finite values.
+    /// refusing a missing or wrongly sized channel, non-finite values, and negative ones where
+    /// they have no meaning (radiance, reflectances, alpha, mask), naming the pixel.
     pub fn from_channels(
         width: usize,
         height: usize,
         ch: &HashMap<String, Vec<f32>>,
     ) -> Result<Frame> {
-        let get = |name: &str| -> Result<&Vec<f32>> {
+        let get = |name: &str, non_negative: bool| -> Result<&Vec<f32>> {
             let data = ch
                 .get(name)
                 .with_context(|| format!("lacks channel '{name}'"))?;
@@ -128,17 +139,31 @@ impl Frame {
                     data.len()
                 );
             }
-            if data.iter().any(|v| !v.is_finite()) {
-                bail!("channel '{name}' holds non-finite values");
+            if let Some(i) = data
+                .iter()
+                .position(|v| !v.is_finite() || (non_negative && *v < 0.0))
+            {
+                bail!(
+                    "channel '{name}' is {} at pixel ({}, {}){}",
+                    data[i],
+                    i % width,
+                    i / width,
+                    if data[i].is_finite() {
+                        ", but cannot be negative"
+                    } else {
+                        ""
+                    }
+                );
             }
             Ok(data)
         };
         let mut layers = Vec::with_capacity(VECTOR_LAYERS.len());
         for (prefix, names) in VECTOR_LAYERS {
+            let colour = names == RGB;
             let c = [
-                get(&channel_name(prefix, names[0]))?,
-                get(&channel_name(prefix, names[1]))?,
-                get(&channel_name(prefix, names[2]))?,
+                get(&channel_name(prefix, names[0]), colour)?,
+                get(&channel_name(prefix, names[1]), colour)?,
+                get(&channel_name(prefix, names[2]), colour)?,
             ];
             layers.push(
                 (0..width * height)
@@ -159,8 +184,8 @@ impl Frame {
                 view,
                 kd,
                 ks,
-                alpha: get("alpha")?.clone(),
-                mask: get("mask")?.clone(),
+                alpha: get("alpha", true)?.clone(),
+                mask: get("mask", true)?.clone(),
             },
         })
     }

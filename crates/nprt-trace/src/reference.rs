@@ -77,7 +77,7 @@ pub fn render_reference(scene_spec: &str, opts: &ReferenceOptions) -> Result<Ref
         }
     }
     .rotated_y(opts.rotate_deg);
-    warnings.extend(env.clamp_warning());
+    warnings.extend(env.warnings());
     let mut camera = scene.camera.clone().unwrap_or_else(|| {
         warnings.push(format!(
             "scene '{scene_spec}' has no camera; framing its bounds from +Z"
@@ -87,6 +87,11 @@ pub fn render_reference(scene_spec: &str, opts: &ReferenceOptions) -> Result<Ref
     if let Some([w, h]) = opts.resolution {
         camera = camera.with_resolution(w, h);
     }
+    Frame::check_size(
+        camera.width,
+        camera.height,
+        &format!("a {}×{} frame", camera.width, camera.height),
+    )?;
     let max_depth = match opts.max_depth {
         Some(d) => u32::try_from(d).ok(),
         None => scene.max_depth,

@@ -30,6 +30,9 @@ fn verify(dir: &Path) -> Result<()> {
     if r.missing.len() > 20 {
         println!("missing: … and {} more", r.missing.len() - 20);
     }
+    for f in &r.leftovers {
+        println!("leftover: {f} (a temporary file of a killed or running generate; a re-run of its shard removes it)");
+    }
     println!(
         "{}: {} of {} views complete, {} missing, {} corrupt",
         dir.display(),

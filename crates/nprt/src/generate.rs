@@ -143,6 +143,12 @@ pub fn run(opts: &GenerateOptions) -> Result<()> {
     for r in &summary.redone {
         eprintln!("redone: {r}");
     }
+    if summary.removed_temporaries > 0 {
+        eprintln!(
+            "removed {} temporary files left by killed runs",
+            summary.removed_temporaries
+        );
+    }
     let per_view = if summary.rendered > 0 {
         summary.seconds / summary.rendered as f64
     } else {

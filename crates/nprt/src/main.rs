@@ -88,13 +88,28 @@ fn main() {
     let result = run(cli);
     nprt_net::finish();
     if let Err(e) = result {
-        eprintln!("error: {e:#}");
+        eprintln!("error: {}", describe(&e));
         std::process::exit(1);
     }
 }
 
+/// The error and its causes, each said once: some libraries' messages (exr's, image's)
+/// already end with their cause's, which `{:#}` would print twice.
+fn describe(e: &anyhow::Error) -> String {
+    let mut text = String::new();
+    for cause in e.chain().map(|c| c.to_string()) {
+        if text.is_empty() {
+            text = cause;
+        } else if !text.ends_with(&cause) {
+            text = format!("{text}: {cause}");
+        }
+    }
+    text
+}
+
 fn run(cli: Cli) -> Result<()> {
     if let Some(n) = cli.threads {
+        nprt_io::check_threads(n)?;
         rayon::ThreadPoolBuilder::new()
             .num_threads(n)
             .build_global()

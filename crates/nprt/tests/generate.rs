@@ -202,7 +202,7 @@ fn bad_input_is_refused_before_anything_is_written() {
             "--test-views",
             "2",
         ],
-        &["different settings"],
+        &["other settings:", "spp (4 here, 8 asked)"],
     );
     // Map folders: missing, empty, a single map, an unreadable map.
     let maps = tmp("maps");
@@ -393,7 +393,7 @@ fn hand_edited_manifests_are_refused_by_name_in_every_command() {
     generate(&dir, &[]);
     let path = dir.join("manifest.json");
     let good: serde_json::Value = serde_json::from_slice(&std::fs::read(&path).unwrap()).unwrap();
-    let edits: [(&str, fn(&mut serde_json::Value)); 5] = [
+    let edits: [(&str, fn(&mut serde_json::Value)); 13] = [
         ("map index 99 is out of range", |m| {
             m["settings"]["test_maps"][0] = 99.into()
         }),
@@ -407,6 +407,28 @@ fn hand_edited_manifests_are_refused_by_name_in_every_command() {
             m["views"][2]["file"] = "../../etc/passwd".into()
         }),
         ("fov_x_deg", |m| m["views"][3]["fov_x_deg"] = 0.into()),
+        ("lists no views", |m| {
+            m["views"] = serde_json::json!([]);
+        }),
+        ("plan 9 train views, but the list holds", |m| {
+            m["settings"]["train_views"] = 9.into()
+        }),
+        ("named by more than one view", |m| {
+            m["views"][1]["file"] = m["views"][0]["file"].clone()
+        }),
+        ("has index 0", |m| m["views"][1]["index"] = 0.into()),
+        ("both a training and a test map", |m| {
+            m["settings"]["test_maps"][0] = m["settings"]["train_maps"][0].clone()
+        }),
+        ("spanning at least two axes", |m| {
+            m["bounds"] = serde_json::json!([[0, 0, 0], [0, 0, 1]]);
+        }),
+        ("camera_to_world is not a rotation", |m| {
+            m["views"][0]["camera_to_world"] = serde_json::json!(vec![0.0; 16]);
+        }),
+        ("not its split's resolution", |m| {
+            m["views"][0]["width"] = 7.into()
+        }),
     ];
     let model = dir.join("model");
     for (needle, edit) in edits {

@@ -12,27 +12,7 @@ fn dataset() -> &'static Path {
     static DIR: OnceLock<PathBuf> = OnceLock::new();
     DIR.get_or_init(|| {
         let dir = fresh_dir("train-data");
-        ok(&[
-            "generate",
-            "--scene",
-            "builtin:room",
-            "--envmaps",
-            "builtin",
-            "--out",
-            dir.to_str().unwrap(),
-            "--train-views",
-            "3",
-            "--test-views",
-            "1",
-            "--train-res",
-            "12",
-            "--test-res",
-            "12",
-            "--spp",
-            "16",
-            "--test-spp",
-            "32",
-        ]);
+        common::room_dataset(&dir, [3, 1], 12, 16);
         dir
     })
 }
@@ -409,7 +389,17 @@ fn bad_runs_stop_clearly_and_keep_the_last_good_checkpoint() {
     .unwrap();
     fails(
         &["model", "info", "--model", o],
-        &["belong to design 'baseline', not 'prt'"],
+        &["belong to a 'baseline:relu' network, not 'prt:relu'"],
+    );
+    // The activation is recorded in the weights too: editing it is caught.
+    std::fs::write(
+        out.join("model.json"),
+        json.replace("\"activation\": \"relu\"", "\"activation\": \"siren\""),
+    )
+    .unwrap();
+    fails(
+        &["model", "info", "--model", o],
+        &["belong to a 'baseline:relu' network, not 'baseline:siren'"],
     );
 }
 

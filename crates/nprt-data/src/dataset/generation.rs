@@ -1,7 +1,8 @@
 //! Rendering a planned dataset: views are rendered by whichever shard owns them (index mod N),
 //! written atomically, and skipped on resume once they read back complete.
 
-use std::path::Path;
+use std::collections::{BTreeSet, HashSet};
+use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 use anyhow::{bail, Context, Result};
@@ -20,15 +21,15 @@ pub fn prepare(dir: &Path, manifest: &Manifest) -> Result<()> {
     if dir.join(MANIFEST).exists() {
         let existing = load_manifest(dir)?;
         if existing != *manifest {
-            let what = if existing.settings != manifest.settings {
-                "different settings"
+            let differences = existing.settings.differences(&manifest.settings);
+            let what = if differences.is_empty() {
+                "a different camera or lighting plan".to_string()
             } else {
-                "a different camera or lighting plan"
+                format!("other settings: {}", differences.join(", "))
             };
             bail!(
-                "'{}' holds a dataset made with {what}; use another --out folder or the same settings (existing: {})",
-                dir.display(),
-                serde_json::to_string(&existing.settings)?
+                "'{}' holds a dataset made with {what}; use another --out folder or the same settings",
+                dir.display()
             );
         }
         return Ok(());
@@ -99,6 +100,8 @@ pub struct Summary {
     pub rendered: u64,
     pub skipped: u64,
     pub redone: Vec<String>,
+    /// Temporary files of this shard's views that killed runs left behind, now removed.
+    pub removed_temporaries: usize,
     pub seconds: f64,
     pub samples: f64,
 }
@@ -118,7 +121,10 @@ pub fn run(
         .filter(|v| v.index % shard.1 == shard.0)
         .collect();
     let mut todo = vec![];
-    let mut summary = Summary::default();
+    let mut summary = Summary {
+        removed_temporaries: remove_leftovers(dir, &mine)?,
+        ..Summary::default()
+    };
     for v in mine {
         let path = dir.join(&v.file);
         match path
@@ -145,6 +151,24 @@ pub fn run(
     bar.finish_and_clear();
     summary.seconds = t0.elapsed().as_secs_f64();
     Ok(summary)
+}
+
+/// Removes the temporary files that killed runs left for `views` (another shard's are not
+/// ours to touch: it may be writing them now).
+fn remove_leftovers(dir: &Path, views: &[&ViewRecord]) -> Result<usize> {
+    let mine: HashSet<PathBuf> = views.iter().map(|v| dir.join(&v.file)).collect();
+    let folders: BTreeSet<&Path> = mine.iter().filter_map(|p| p.parent()).collect();
+    let mut removed = 0;
+    for folder in folders {
+        for (tmp, target) in nprt_io::leftover_temporaries(folder)? {
+            if mine.contains(&folder.join(target)) {
+                std::fs::remove_file(&tmp)
+                    .with_context(|| format!("cannot remove '{}'", tmp.display()))?;
+                removed += 1;
+            }
+        }
+    }
+    Ok(removed)
 }
 
 #[cfg(test)]

@@ -153,10 +153,18 @@ impl Manifest {
         if s.train_maps.is_empty() || s.test_maps.is_empty() {
             bail!("settings.train_maps and settings.test_maps must each name at least one map");
         }
+        if let Some(i) = s.train_maps.iter().find(|i| s.test_maps.contains(i)) {
+            bail!("map {i} is both a training and a test map: test lightings must be unseen in training");
+        }
+        let [lo, hi] = self.bounds;
         if !self.bounds.iter().flatten().all(|v| v.is_finite())
-            || (0..3).any(|k| self.bounds[0][k] > self.bounds[1][k])
+            || (0..3).any(|k| lo[k] > hi[k])
+            || (0..3).filter(|&k| lo[k] < hi[k]).count() < 2
         {
-            bail!("bounds {:?} are not a finite box (min ≤ max)", self.bounds);
+            bail!(
+                "bounds {:?} are not a finite box (min ≤ max) spanning at least two axes",
+                self.bounds
+            );
         }
         for v in &self.views {
             let what = format!("view {} ('{}')", v.index, v.file);
@@ -184,6 +192,23 @@ impl Manifest {
             if !v.camera_to_world.iter().all(|x| x.is_finite()) || !v.rotation_deg.is_finite() {
                 bail!("{what}: camera_to_world or rotation_deg holds a non-finite number");
             }
+            if !is_rigid(&Mat4::from_cols_array(&v.camera_to_world)) {
+                bail!("{what}: camera_to_world is not a rotation and translation (orthonormal axes, last row 0 0 0 1)");
+            }
+            let resolution = if v.split == "train" {
+                s.train_resolution
+            } else {
+                s.test_resolution
+            };
+            if [v.width, v.height] != resolution {
+                bail!(
+                    "{what}: size {}×{} is not its split's resolution {}×{}",
+                    v.width,
+                    v.height,
+                    resolution[0],
+                    resolution[1]
+                );
+            }
             if !v.gain.iter().all(|g| (1.0 / 64.0..=64.0).contains(g)) {
                 bail!("{what}: gain {:?} is not within [1/64, 64]", v.gain);
             }
@@ -202,11 +227,82 @@ impl Manifest {
                 bail!("{what}: file must be a path inside the dataset folder");
             }
         }
+        self.check_view_list()
+    }
+}
+
+impl Manifest {
+    /// The view list against the settings: one view per index 0..n in order, unique files,
+    /// and as many views of each split as the settings say.
+    fn check_view_list(&self) -> Result<()> {
+        let s = &self.settings;
+        if self.views.is_empty() {
+            bail!("the manifest lists no views");
+        }
+        let mut files = std::collections::HashSet::new();
+        for (i, v) in self.views.iter().enumerate() {
+            if v.index != i as u64 {
+                bail!(
+                    "view {i} of the list has index {} (indices run 0, 1, … in order)",
+                    v.index
+                );
+            }
+            if !files.insert(v.file.as_str()) {
+                bail!("file '{}' is named by more than one view", v.file);
+            }
+        }
+        let count = |split: &str| self.views.iter().filter(|v| v.split == split).count() as u64;
+        for (split, planned) in [("train", s.train_views), ("test", s.test_views)] {
+            if count(split) != planned {
+                bail!(
+                    "the settings plan {planned} {split} views, but the list holds {}",
+                    count(split)
+                );
+            }
+        }
         Ok(())
     }
 }
 
+/// Whether `m` only rotates and translates (what a camera's placement does; an all-zero
+/// matrix, say, gave NaN rays and metrics).
+fn is_rigid(m: &Mat4) -> bool {
+    let [x, y, z] = [
+        m.x_axis.truncate(),
+        m.y_axis.truncate(),
+        m.z_axis.truncate(),
+    ];
+    let unit = |a: Vec3| (a.length() - 1.0).abs() < 1e-3;
+    let orthogonal = |a: Vec3, b: Vec3| a.dot(b).abs() < 1e-3;
+    [x, y, z].into_iter().all(unit)
+        && orthogonal(x, y)
+        && orthogonal(y, z)
+        && orthogonal(x, z)
+        && m.row(3) == glam::Vec4::W
+}
+
 impl Settings {
+    /// The fields in which `self` and `other` differ, each with both values: what a refusal to
+    /// mix two datasets names.
+    pub fn differences(&self, other: &Settings) -> Vec<String> {
+        let (serde_json::Value::Object(a), serde_json::Value::Object(b)) = (
+            serde_json::to_value(self).unwrap_or_default(),
+            serde_json::to_value(other).unwrap_or_default(),
+        ) else {
+            return vec![];
+        };
+        let null = serde_json::Value::Null;
+        let mut keys: Vec<&String> = a.keys().chain(b.keys()).collect();
+        keys.sort();
+        keys.dedup();
+        keys.into_iter()
+            .filter_map(|k| {
+                let (x, y) = (a.get(k).unwrap_or(&null), b.get(k).unwrap_or(&null));
+                (x != y).then(|| format!("{k} ({x} here, {y} asked)"))
+            })
+            .collect()
+    }
+
     /// Whether `view`'s file holds the first half of its samples apart (see [`Settings::test_spp`]).
     pub fn in_halves(&self, view: &ViewRecord) -> bool {
         view.split == "test" && self.test_spp.is_some()

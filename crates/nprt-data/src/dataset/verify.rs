@@ -14,6 +14,8 @@ pub struct Report {
     pub complete: usize,
     pub missing: Vec<String>,
     pub corrupt: Vec<String>,
+    /// Temporary files of views whose writing was killed (or is under way in a running shard).
+    pub leftovers: Vec<String>,
 }
 
 /// Reads every view back fully (in parallel: this is also how fast a trainer can load them).
@@ -35,6 +37,16 @@ pub fn verify(dir: &Path) -> Result<Report> {
         views: manifest.views.len(),
         ..Default::default()
     };
+    let folders: std::collections::BTreeSet<PathBuf> = manifest
+        .views
+        .iter()
+        .filter_map(|v| Path::new(&v.file).parent().map(Path::to_path_buf))
+        .collect();
+    for folder in folders {
+        for (tmp, _) in nprt_io::leftover_temporaries(&dir.join(folder))? {
+            report.leftovers.push(tmp.display().to_string());
+        }
+    }
     for (v, state) in manifest.views.iter().zip(states) {
         match state {
             Ok(()) => report.complete += 1,

@@ -38,7 +38,7 @@ pub fn write_view(path: &Path, image: &ViewImage) -> Result<()> {
 }
 
 /// Reads a view file, refusing one whose size disagrees with its record, that lacks a channel
-/// (the half's too, when `in_halves`) or that holds non-finite values.
+/// (the half's too, when `in_halves`) or that holds non-finite or negative radiance.
 pub fn read_view(path: &Path, view: &ViewRecord, in_halves: bool) -> Result<ViewImage> {
     let (w, h, ch) = read_channels(path)?;
     if (w, h) != (view.width as usize, view.height as usize) {
@@ -55,8 +55,16 @@ pub fn read_view(path: &Path, view: &ViewRecord, in_halves: bool) -> Result<View
             bail!("a half.* channel does not hold {w}×{h} values");
         }
         let half: Vec<Vec3> = (0..w * h).map(|i| Vec3::new(r[i], g[i], b[i])).collect();
-        if !half.iter().all(|v| v.is_finite()) {
-            bail!("channel half.* holds non-finite values");
+        if let Some(i) = half
+            .iter()
+            .position(|v| !v.is_finite() || v.min_element() < 0.0)
+        {
+            bail!(
+                "channel half.* is {} at pixel ({}, {}), not a finite, non-negative radiance",
+                half[i],
+                i % w,
+                i / w
+            );
         }
         Some(half)
     } else {

@@ -2,7 +2,7 @@
 
 use std::path::Path;
 
-use anyhow::Result;
+use anyhow::{Context, Result};
 use burn::tensor::{Device, Tensor, TensorData};
 use glam::Vec3;
 use nprt_scene::EnvMap;
@@ -13,7 +13,7 @@ use super::options::DeepShadingOptions;
 use super::unet::{feature_image, DeepShading};
 use crate::encoding::features::FEATURES;
 use crate::model::folder::{load_weights, read_config, WEIGHTS_FILE};
-use crate::network::encoder::LightInput;
+use crate::network::encoder::{check_input_width, LightInput};
 use crate::network::init::Init;
 
 pub const TAG: &str = "deep-shading";
@@ -43,8 +43,12 @@ pub struct DeepShadingModel {
     device: Device,
 }
 
+/// Reads a Deep Shading folder's config, refusing an encoder width no network can have.
 pub fn read_file(dir: &Path) -> Result<DeepShadingFile> {
-    read_config(dir, CONFIG_FILE, TAG, 1, "Deep Shading model")
+    let file: DeepShadingFile = read_config(dir, CONFIG_FILE, TAG, 1, "Deep Shading model")?;
+    check_input_width(file.encoder_width)
+        .with_context(|| format!("Deep Shading model '{}'", dir.display()))?;
+    Ok(file)
 }
 
 impl DeepShadingModel {

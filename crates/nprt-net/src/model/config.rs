@@ -66,6 +66,13 @@ impl ModelConfig {
         format!("{}{grid}{direct}", self.design.name())
     }
 
+    /// What the weights file records of the network that wrote it: the design and the
+    /// activation, which both change what the same weights compute (an edit of model.json's
+    /// activation went undetected).
+    pub fn weights_tag(&self) -> String {
+        format!("{}:{}", self.design.name(), self.activation)
+    }
+
     pub fn build(&self, init: &mut Init) -> NprtNet {
         NprtNet::new(
             init,

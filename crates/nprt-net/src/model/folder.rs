@@ -12,6 +12,7 @@ use serde::de::DeserializeOwned;
 use serde::{Deserialize, Serialize};
 
 use crate::model::config::ModelConfig;
+use crate::network::encoder::check_input_width;
 use crate::network::init::Init;
 use crate::network::nprt_net::NprtNet;
 
@@ -57,12 +58,13 @@ impl ModelFile {
 
 /// Writes `model.json` and the weights of `net` into `dir`, each file atomically.
 pub fn save_model(dir: &Path, file: &ModelFile, net: &NprtNet) -> Result<()> {
-    save_weights(&dir.join(WEIGHTS_FILE), net, file.config.design.name())?;
+    save_weights(&dir.join(WEIGHTS_FILE), net, &file.config.weights_tag())?;
     let json = serde_json::to_vec_pretty(file)?;
     nprt_io::write_file(&dir.join(CONFIG_FILE), &json)
 }
 
-/// Weights as safetensors, tagged with the design (or other network kind) that produced them.
+/// Weights as safetensors, tagged with the network that produced them (`design:activation`,
+/// [`ModelConfig::weights_tag`], or another network kind's name).
 pub fn save_weights<M: Module>(path: &Path, net: &M, tag: &str) -> Result<()> {
     // One metadata key only: the header is then byte-for-byte reproducible.
     let mut store = SafetensorsStore::from_bytes(None)
@@ -73,7 +75,32 @@ pub fn save_weights<M: Module>(path: &Path, net: &M, tag: &str) -> Result<()> {
     let bytes = store
         .get_bytes()
         .map_err(|e| anyhow::anyhow!("cannot serialise weights: {e}"))?;
+    if let Some(name) = non_finite_tensor(&bytes)? {
+        bail!(
+            "refusing to write '{}': weight tensor '{name}' holds NaN or infinity (training diverged)",
+            path.display()
+        );
+    }
     nprt_io::write_file(path, &bytes)
+}
+
+/// The first tensor of a safetensors file that holds a non-finite value, if one does.
+fn non_finite_tensor(bytes: &[u8]) -> Result<Option<String>> {
+    let tensors = safetensors::SafeTensors::deserialize(bytes)
+        .map_err(|e| anyhow::anyhow!("not a safetensors file: {e}"))?;
+    for (name, view) in tensors.tensors() {
+        let finite = match view.dtype() {
+            safetensors::Dtype::F32 => view
+                .data()
+                .chunks_exact(4)
+                .all(|b| f32::from_le_bytes([b[0], b[1], b[2], b[3]]).is_finite()),
+            _ => true,
+        };
+        if !finite {
+            return Ok(Some(name));
+        }
+    }
+    Ok(None)
 }
 
 /// Loads weights saved by [`save_weights`] into `net`, which must be of the same design.
@@ -82,9 +109,19 @@ pub fn load_weights<M: Module>(path: &Path, net: &mut M, tag: &str) -> Result<()
         std::fs::read(path).with_context(|| format!("cannot read weights '{}'", path.display()))?;
     let saved_design = read_design_tag(&bytes)
         .with_context(|| format!("'{}' is not an nprt weights file", path.display()))?;
-    if saved_design != tag {
+    // Weights saved before the tag named the activation carry the design alone.
+    let legacy = !saved_design.contains(':') && tag.split(':').next() == Some(&*saved_design);
+    if saved_design != tag && !legacy {
         bail!(
-            "weights '{}' belong to design '{saved_design}', not '{tag}'",
+            "weights '{}' belong to a '{saved_design}' network, not '{tag}'",
+            path.display()
+        );
+    }
+    if let Some(name) = non_finite_tensor(&bytes)
+        .with_context(|| format!("'{}' is not an nprt weights file", path.display()))?
+    {
+        bail!(
+            "weights '{}' are unusable: tensor '{name}' holds NaN or infinity",
             path.display()
         );
     }
@@ -123,9 +160,13 @@ fn read_design_tag(bytes: &[u8]) -> Result<String> {
         .context("no nprt_design tag in its metadata")
 }
 
-/// Reads a model folder's config, refusing other formats and versions.
+/// Reads a model folder's config, refusing other formats and versions, and sizes no network
+/// can have (an edited encoder_width would allocate without bound).
 pub fn read_model_file(dir: &Path) -> Result<ModelFile> {
-    read_config(dir, CONFIG_FILE, MODEL_FORMAT, MODEL_VERSION, "model")
+    let file: ModelFile = read_config(dir, CONFIG_FILE, MODEL_FORMAT, MODEL_VERSION, "model")?;
+    check_input_width(file.config.encoder_width)
+        .with_context(|| format!("model '{}'", dir.display()))?;
+    Ok(file)
 }
 
 /// Reads the versioned JSON config `file_name` of a folder of `kind` ("model", "Deep Shading
@@ -164,6 +205,10 @@ pub fn read_config<T: DeserializeOwned>(
 pub fn load_model(dir: &Path, device: &Device) -> Result<(ModelFile, NprtNet)> {
     let file = read_model_file(dir)?;
     let mut net = file.config.build(&mut Init::new(0, device));
-    load_weights(&dir.join(WEIGHTS_FILE), &mut net, file.config.design.name())?;
+    load_weights(
+        &dir.join(WEIGHTS_FILE),
+        &mut net,
+        &file.config.weights_tag(),
+    )?;
     Ok((file, net))
 }

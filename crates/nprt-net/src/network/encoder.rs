@@ -21,13 +21,18 @@ pub const CHANNELS: usize = 32;
 /// Size of the light code ê.
 pub const CODE_SIZE: usize = 64;
 
+/// The widest encoder input: 8× the default. The dense layer after the blocks has W² weights,
+/// and every view holds its W × W/2 map in training, so widths far beyond it (6400000 tried to
+/// allocate 245 TB) can only fail.
+pub const MAX_INPUT_WIDTH: usize = 1024;
+
 /// The encoder's input width must halve cleanly through every block, and the height is half
 /// the width.
 pub fn check_input_width(width: usize) -> anyhow::Result<()> {
     let step = 2usize.pow(BLOCKS as u32 + 1);
-    if width < step || !width.is_multiple_of(step) {
+    if width < step || !width.is_multiple_of(step) || width > MAX_INPUT_WIDTH {
         anyhow::bail!(
-            "encoder input width {width} must be a positive multiple of {step} (the map is W×W/2 and {BLOCKS} blocks halve it)"
+            "encoder input width {width} must be a multiple of {step} from {step} to {MAX_INPUT_WIDTH} (the map is W×W/2 and {BLOCKS} blocks halve it)"
         );
     }
     Ok(())

@@ -41,7 +41,7 @@ impl Objective for PixelObjective<'_> {
     type Batch = Batch;
 
     fn tag(&self) -> String {
-        self.config.design.name().to_string()
+        self.config.weights_tag()
     }
 
     fn title(&self) -> String {

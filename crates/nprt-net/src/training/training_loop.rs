@@ -220,6 +220,7 @@ pub fn train<O: Objective>(
     let optim = AdamConfig::new().with_epsilon(ADAM_EPSILON).init();
     std::fs::create_dir_all(checkpoint::dir(out))
         .with_context(|| format!("cannot create model folder '{}'", out.display()))?;
+    let _lock = lock_folder(out)?;
     let (ck, resumed_from_epoch, mut optim) = start(objective, schedule, out, &mut net, optim)?;
     let mut run = Run::new(objective, schedule, out, ck);
     let mut trained = false;
@@ -231,6 +232,10 @@ pub fn train<O: Objective>(
         let validating = Instant::now();
         let val = objective.validation_loss(&net.valid(), &inner);
         run.split.validation += since(validating);
+        if !val.is_finite() {
+            // The last step's update broke the weights after a finite loss: nothing is saved.
+            return Err(run.diverged(&format!("validation loss {val}"), run.ck.state.epoch));
+        }
         run.end_epoch(val, total);
         run.save(&net, &optim, &inner)?;
     }
@@ -241,6 +246,37 @@ pub fn train<O: Objective>(
         objective.save_model(out, &net, schedule, &run.ck.state, &inner)?;
     }
     Ok(run.summary(resumed_from_epoch))
+}
+
+/// Takes the model folder `out` for this run until the returned file is dropped (the OS
+/// releases it if the process dies); a second run on the same folder is refused by name.
+fn lock_folder(out: &Path) -> Result<std::fs::File> {
+    use std::io::Write;
+    let path = out.join(".lock");
+    let mut file = std::fs::OpenOptions::new()
+        .read(true)
+        .write(true)
+        .create(true)
+        .truncate(false)
+        .open(&path)
+        .with_context(|| format!("cannot open '{}'", path.display()))?;
+    if let Err(e) = file.try_lock() {
+        let holder = std::fs::read_to_string(&path).unwrap_or_default();
+        return Err(match e {
+            std::fs::TryLockError::WouldBlock => anyhow::anyhow!(
+                "model folder '{}' is in use by another training run ({}); wait for it to end or use another --out",
+                out.display(),
+                holder.trim()
+            ),
+            std::fs::TryLockError::Error(e) => {
+                anyhow::Error::new(e).context(format!("cannot lock '{}'", path.display()))
+            }
+        });
+    }
+    file.set_len(0)?;
+    write!(file, "pid {}", std::process::id())
+        .with_context(|| format!("cannot write '{}'", path.display()))?;
+    Ok(file)
 }
 
 /// The run's checkpoint: the one in `out` (into `net`, with the optimiser's state) or a fresh
@@ -405,9 +441,14 @@ impl<'s, O: Objective> Run<'s, O> {
 
     /// Stops the run when the loss of the step just taken says it diverged.
     fn check_divergence(&mut self, value: f64, epoch: usize) -> Result<()> {
-        let Some(why) = self.guard.check(value, self.ck.state.step) else {
-            return Ok(());
-        };
+        match self.guard.check(value, self.ck.state.step) {
+            Some(why) => Err(self.diverged(&why, epoch)),
+            None => Ok(()),
+        }
+    }
+
+    /// The error that ends a diverged run (`why`: the loss that says so) in epoch `epoch`.
+    fn diverged(&mut self, why: &str, epoch: usize) -> anyhow::Error {
         self.bar.abandon();
         let kept = if checkpoint::exists(self.out) {
             format!(
@@ -417,7 +458,7 @@ impl<'s, O: Objective> Run<'s, O> {
         } else {
             "no checkpoint had been written yet".to_string()
         };
-        bail!(
+        anyhow::anyhow!(
             "training diverged at epoch {} step {} ({why}); {kept}; lower --lr and use another --out",
             epoch + 1,
             self.ck.state.step

@@ -57,6 +57,23 @@ impl TrainingSet {
     /// it: its map prepared for the encoder, and the radiance it must predict.
     pub fn load(dir: &Path, config: &ModelConfig) -> Result<Self> {
         let (manifest, dataset_hash) = load_manifest_hashed(dir)?;
+        let width = config.encoder_width as u128;
+        let most = manifest
+            .views
+            .iter()
+            .map(|v| {
+                let pixels = v.width as u128 * v.height as u128;
+                pixels * (FEATURES as u128 + 3) * 4 + width * width / 2 * 3 * 4
+            })
+            .sum();
+        nprt_io::ensure_memory(
+            most,
+            &format!(
+                "loading the {} views of '{}' with encoder width {width}",
+                manifest.views.len(),
+                dir.display()
+            ),
+        )?;
         // Views grouped by their map, each map open only while its views load: a dataset with
         // a fresh map per view held all of them at once, 3.4 GB at the paper's size.
         let mut by_map: BTreeMap<usize, Vec<usize>> = BTreeMap::new();

@@ -38,12 +38,37 @@ pub fn load(path: &Path, opts: &SceneOptions) -> Result<Scene> {
     parse(&text, path, opts)
 }
 
+/// How deep elements may nest. Real scenes nest a few levels (a two-sided blend of bump-mapped
+/// BSDFs with textures is under 10); the reader recurses per level, so without a bound a
+/// hostile file (3000 nested `<bsdf>`) overflowed the stack.
+const MAX_NESTING: usize = 100;
+
+/// Refuses a document nested deeper than [`MAX_NESTING`], naming the first element too deep.
+fn check_nesting(doc: &Document, file: &str) -> Result<()> {
+    // Depth by node id, filled in document order (a parent comes before its children).
+    let mut depth = vec![0usize; doc.descendants().count() + 1];
+    for node in doc.descendants() {
+        let d = node
+            .parent()
+            .map_or(0, |p| depth[p.id().get() as usize] + 1);
+        depth[node.id().get() as usize] = d;
+        if d > MAX_NESTING {
+            bail!(
+                "{}: elements nest more than {MAX_NESTING} levels deep",
+                pos(file, doc, node)
+            );
+        }
+    }
+    Ok(())
+}
+
 /// Parses the Mitsuba scene `text` of the file `path` (which names it in errors and anchors
 /// its relative file references).
 pub fn parse(text: &str, path: &Path, opts: &SceneOptions) -> Result<Scene> {
     let file = path.display().to_string();
     let doc =
         Document::parse(text).map_err(|e| anyhow!("scene file '{file}' is not valid XML: {e}"))?;
+    check_nesting(&doc, &file)?;
     let root = doc.root_element();
     if root.tag_name().name() != "scene" {
         bail!(

@@ -120,6 +120,25 @@ fn errors_name_file_line_and_element() {
 }
 
 #[test]
+fn deep_nesting_is_refused_not_a_stack_overflow() {
+    let dir = std::env::temp_dir().join(format!("nprt-mi-deep-{}", std::process::id()));
+    let n = 3000;
+    let deep = format!(
+        r#"<scene version="3.0.0"><shape type="cube">{}<bsdf type="diffuse"/>{}</shape></scene>"#,
+        r#"<bsdf type="twosided">"#.repeat(n),
+        "</bsdf>".repeat(n)
+    );
+    let err = format!(
+        "{:#}",
+        load(&write(&dir, "deep.xml", &deep), &SceneOptions::default()).unwrap_err()
+    );
+    assert!(
+        err.contains("deep.xml:1:") && err.contains("more than 100 levels"),
+        "{err}"
+    );
+}
+
+#[test]
 fn mitsuba_0x_property_names_upgrade_as_mitsuba_3() {
     for (old, new) in [
         ("toWorld", "to_world"),

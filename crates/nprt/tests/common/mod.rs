@@ -37,6 +37,33 @@ pub fn fails(args: &[&str], needles: &[&str]) {
     assert!(!err.contains("panicked"), "{err}");
 }
 
+/// A dataset of builtin:room under built-in lighting in `dir`: `[train, test]` views of
+/// `res`², training views at `spp` samples per pixel, test views at twice that.
+pub fn room_dataset(dir: &Path, [train, test]: [u32; 2], res: u32, spp: u32) {
+    let [train, test, res, spp, test_spp] = [train, test, res, spp, 2 * spp].map(|n| n.to_string());
+    ok(&[
+        "generate",
+        "--scene",
+        "builtin:room",
+        "--envmaps",
+        "builtin",
+        "--out",
+        dir.to_str().unwrap(),
+        "--train-views",
+        &train,
+        "--test-views",
+        &test,
+        "--train-res",
+        &res,
+        "--test-res",
+        &res,
+        "--spp",
+        &spp,
+        "--test-spp",
+        &test_spp,
+    ]);
+}
+
 /// A fresh, empty (not yet created) folder path unique to this test process.
 pub fn fresh_dir(name: &str) -> PathBuf {
     let d = std::env::temp_dir().join(format!("nprt-it-{}-{name}", std::process::id()));

@@ -1,0 +1,496 @@
+//! Hostile input and odd paths (issue 36), as a demanding new user tries them: outputs that
+//! are not plain files, results that would be NaN or black, sizes beyond the machine, and
+//! datasets broken in ways a verifier must see. Every case ends in a clear error or a warning,
+//! never a panic, a replaced device or a non-finite file written with exit 0.
+
+mod common;
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Stdio};
+
+use common::{fails, fresh_dir, nprt, ok};
+use nprt_io::exr::{read_channels, write_channels};
+
+/// A tiny dataset of builtin:room (4 + 2 views of 8×8) in `dir`.
+fn tiny_dataset(dir: &Path) {
+    common::room_dataset(dir, [4, 2], 8, 1);
+}
+
+fn train_args<'a>(data: &'a str, out: &'a str, extra: &[&'a str]) -> Vec<&'a str> {
+    let mut args = vec![
+        "train",
+        "--data",
+        data,
+        "--arch",
+        "baseline",
+        "--out",
+        out,
+        "--encoder-width",
+        "64",
+    ];
+    args.extend_from_slice(extra);
+    args
+}
+
+/// `nprt reference` of builtin:room at 8×8, 1 spp, into `out`.
+fn reference_args(out: &Path) -> Vec<&str> {
+    vec![
+        "reference",
+        "builtin:room",
+        "--envmap",
+        "builtin:sky",
+        "--spp",
+        "1",
+        "--width",
+        "8",
+        "--height",
+        "8",
+        "--out",
+        out.to_str().unwrap(),
+    ]
+}
+
+/// `nprt render` of `model`: `frames` 8×8 frames with linear EXRs into `out`, with `extra`.
+fn render_exr(model: &str, out: &Path, frames: &str, extra: &[&str]) -> std::process::Output {
+    let mut args = vec![
+        "render",
+        "--model",
+        model,
+        "--frames",
+        frames,
+        "--res",
+        "8",
+        "--exr",
+        "--out",
+        out.to_str().unwrap(),
+    ];
+    args.extend_from_slice(extra);
+    nprt(&args)
+}
+
+/// Starts a training run on `out` that lasts until killed.
+fn endless_training(data: &str, out: &str) -> std::process::Child {
+    Command::new(env!("CARGO_BIN_EXE_nprt"))
+        .args(train_args(data, out, &["--epochs", "1000000"]))
+        .stdout(Stdio::null())
+        .stderr(Stdio::null())
+        .spawn()
+        .unwrap()
+}
+
+#[cfg(unix)]
+#[test]
+fn outputs_through_links_are_written_through_and_special_files_never_replaced() {
+    use std::os::unix::fs::FileTypeExt;
+    let dir = fresh_dir("odd-outputs");
+    std::fs::create_dir_all(&dir).unwrap();
+    // A link: the file it points to is written, the link stays a link.
+    let target = dir.join("target.exr");
+    let link = dir.join("link.exr");
+    std::os::unix::fs::symlink(&target, &link).unwrap();
+    ok(&reference_args(&link));
+    assert!(std::fs::symlink_metadata(&link)
+        .unwrap()
+        .file_type()
+        .is_symlink());
+    assert_eq!(read_channels(&target).unwrap().0, 8);
+    // A FIFO and a device are refused and left as they were.
+    let fifo = dir.join("fifo.exr");
+    assert!(Command::new("mkfifo")
+        .arg(&fifo)
+        .status()
+        .unwrap()
+        .success());
+    for (path, kind) in [
+        (fifo.as_path(), "a FIFO"),
+        (Path::new("/dev/full"), "a device"),
+    ] {
+        let out = path.to_str().unwrap();
+        fails(&reference_args(path), &[out, kind, "not a regular file"]);
+    }
+    assert!(std::fs::symlink_metadata(&fifo)
+        .unwrap()
+        .file_type()
+        .is_fifo());
+    assert!(std::fs::symlink_metadata("/dev/full")
+        .unwrap()
+        .file_type()
+        .is_char_device());
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+/// Writes a 2:1 Radiance HDR map of one value.
+fn flat_map(path: &Path, value: f32) {
+    image::Rgb32FImage::from_pixel(16, 8, image::Rgb([value; 3]))
+        .save(path)
+        .unwrap();
+}
+
+#[test]
+fn non_finite_results_are_refused_and_black_lighting_is_warned_of() {
+    let dir = fresh_dir("nan");
+    let data = dir.join("ds");
+    tiny_dataset(&data);
+    let d = data.to_str().unwrap();
+    // A learning rate that breaks the weights: the run stops with exit 1 (it saved a model
+    // with a NaN validation loss and exit 0), and what it kept renders finite frames or none.
+    let blown = dir.join("blown");
+    let b = blown.to_str().unwrap();
+    fails(
+        &train_args(d, b, &["--lr", "1e30", "--epochs", "2"]),
+        &["training diverged", "validation loss NaN", "lower --lr"],
+    );
+    let blown_frames = dir.join("blown-frames");
+    let rendered = render_exr(b, &blown_frames, "1", &[]);
+    if rendered.status.success() {
+        let (_, _, ch) = read_channels(&blown_frames.join("frames/0000.exr")).unwrap();
+        assert!(ch.values().flatten().all(|v| v.is_finite()));
+    } else {
+        assert_eq!(rendered.status.code(), Some(1));
+    }
+
+    // A camera path keyframe straight above its target renders finite frames.
+    let model = dir.join("model");
+    let m = model.to_str().unwrap();
+    ok(&train_args(d, m, &["--epochs", "1"]));
+    let path = dir.join("up.json");
+    std::fs::write(
+        &path,
+        r#"{"keyframes": [{"position": [0, 1, 1], "target": [0, 2, 1]}, {"position": [0, 1, 1], "target": [0, 2, 1]}]}"#,
+    )
+    .unwrap();
+    let frames = dir.join("frames");
+    let up = render_exr(m, &frames, "2", &["--camera-path", path.to_str().unwrap()]);
+    assert!(
+        up.status.success(),
+        "{}",
+        String::from_utf8_lossy(&up.stderr)
+    );
+    let (_, _, ch) = read_channels(&frames.join("frames/0000.exr")).unwrap();
+    assert!(ch["R"].iter().all(|v| v.is_finite()));
+
+    // A map at the top of Radiance HDR's exponent range (everything rendered infinite) is
+    // refused; an all-black map is warned of.
+    let maps = dir.join("maps");
+    std::fs::create_dir_all(&maps).unwrap();
+    let huge = dir.join("huge.hdr");
+    flat_map(&huge, 1e38);
+    fails(
+        &[
+            "reference",
+            "builtin:room",
+            "--envmap",
+            huge.to_str().unwrap(),
+            "--out",
+            dir.join("x.exr").to_str().unwrap(),
+        ],
+        &["huge.hdr", "not a finite radiance of at most 1e12"],
+    );
+    flat_map(&maps.join("black.hdr"), 0.0);
+    flat_map(&maps.join("white.hdr"), 1.0);
+    let out = nprt(&[
+        "generate",
+        "--scene",
+        "builtin:room",
+        "--envmaps",
+        maps.to_str().unwrap(),
+        "--mix-builtin",
+        "0",
+        "--out",
+        dir.join("dark").to_str().unwrap(),
+        "--train-views",
+        "2",
+        "--test-views",
+        "1",
+        "--train-res",
+        "8",
+        "--test-res",
+        "8",
+        "--spp",
+        "1",
+        "--test-spp",
+        "2",
+    ]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{err}");
+    assert!(
+        err.contains("warning: environment map") && err.contains("black.hdr' is black everywhere"),
+        "{err}"
+    );
+
+    // Test views whose camera is all zeros (NaN metrics before) are refused by every command.
+    let manifest = data.join("manifest.json");
+    let mut json: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(&manifest).unwrap()).unwrap();
+    let test = json["views"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .position(|v| v["split"] == "test")
+        .unwrap();
+    json["views"][test]["camera_to_world"] = serde_json::json!(vec![0.0; 16]);
+    std::fs::write(&manifest, serde_json::to_vec(&json).unwrap()).unwrap();
+    fails(
+        &[
+            "eval",
+            "--data",
+            d,
+            "--model",
+            m,
+            "--out",
+            dir.join("report").to_str().unwrap(),
+        ],
+        &["manifest.json", "camera_to_world is not a rotation"],
+    );
+    assert!(!dir.join("report").exists());
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn sizes_beyond_the_machine_are_refused_before_allocating() {
+    let dir = fresh_dir("sizes");
+    let data = dir.join("ds");
+    tiny_dataset(&data);
+    let d = data.to_str().unwrap();
+    let out = dir.join("o");
+    let o = out.to_str().unwrap();
+    let started = std::time::Instant::now();
+    fails(
+        &[
+            "generate",
+            "--scene",
+            "builtin:room",
+            "--envmaps",
+            "builtin",
+            "--out",
+            o,
+            "--train-views",
+            "1000000000000",
+        ],
+        &[
+            "planning 1000000000040 views needs",
+            "GiB",
+            "available here",
+        ],
+    );
+    fails(
+        &[
+            "reference",
+            "builtin:room",
+            "--envmap",
+            "builtin:sky",
+            "--width",
+            "100000",
+            "--height",
+            "100000",
+            "--out",
+            &format!("{o}.exr"),
+        ],
+        &["a 100000×100000 frame needs"],
+    );
+    fails(
+        &train_args(d, o, &["--encoder-width", "6400000"]),
+        &["encoder input width 6400000", "to 1024"],
+    );
+    fails(
+        &["--threads", "100000", "dataset", "verify", d],
+        &["--threads 100000 is not in 1..="],
+    );
+    let model = dir.join("model");
+    ok(&train_args(d, model.to_str().unwrap(), &["--epochs", "1"]));
+    fails(
+        &[
+            "render",
+            "--model",
+            model.to_str().unwrap(),
+            "--res",
+            "100000",
+            "--out",
+            o,
+        ],
+        &["a 100000×100000 frame needs"],
+    );
+    assert!(!out.exists());
+    // Refused at once, not after growing for minutes (a generous bound: debug builds, busy CI).
+    assert!(started.elapsed().as_secs() < 120);
+    let deep = dir.join("deep.xml");
+    std::fs::write(
+        &deep,
+        format!(
+            r#"<scene version="3.0.0"><shape type="cube">{}<bsdf type="diffuse"/>{}</shape></scene>"#,
+            r#"<bsdf type="twosided">"#.repeat(3000),
+            "</bsdf>".repeat(3000)
+        ),
+    )
+    .unwrap();
+    fails(
+        &[
+            "reference",
+            deep.to_str().unwrap(),
+            "--envmap",
+            "builtin:sky",
+            "--out",
+            &format!("{o}.exr"),
+        ],
+        &["deep.xml:1:", "more than 100 levels"],
+    );
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+/// The path of the first view of `split` in the dataset `data`.
+fn view_file(data: &Path, split: &str) -> PathBuf {
+    let json: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(data.join("manifest.json")).unwrap()).unwrap();
+    let view = json["views"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .find(|v| v["split"] == split)
+        .unwrap();
+    data.join(view["file"].as_str().unwrap())
+}
+
+#[test]
+fn verify_reports_bad_texels_and_leftovers_and_train_names_the_pixel() {
+    let dir = fresh_dir("verify");
+    let data = dir.join("ds");
+    tiny_dataset(&data);
+    let d = data.to_str().unwrap();
+    // A negative radiance texel: verify calls the view corrupt and train names file and pixel
+    // (instead of diverging and blaming --lr).
+    let view = view_file(&data, "train");
+    let (w, h, mut ch) = read_channels(&view).unwrap();
+    let original = std::fs::read(&view).unwrap();
+    ch.get_mut("G").unwrap()[2 * w + 5] = -0.5;
+    let channels: Vec<(String, Vec<f32>)> = ch.into_iter().collect();
+    write_channels(&view, w, h, &channels).unwrap();
+    let name = view.file_name().unwrap().to_str().unwrap();
+    let o = nprt(&["dataset", "verify", d]);
+    let stdout = String::from_utf8_lossy(&o.stdout);
+    assert_eq!(o.status.code(), Some(1));
+    assert!(
+        stdout.contains(&format!("corrupt: views/{name}"))
+            && stdout.contains("channel 'G' is -0.5 at pixel (5, 2), but cannot be negative"),
+        "{stdout}"
+    );
+    let model = dir.join("model");
+    fails(
+        &train_args(d, model.to_str().unwrap(), &["--epochs", "1"]),
+        &[name, "channel 'G' is -0.5 at pixel (5, 2)"],
+    );
+    std::fs::write(&view, original).unwrap();
+    // A temporary file a killed run left: verify reports it, a re-run of generate removes it.
+    let leftover = view.with_file_name(format!(".{name}.4242.tmp"));
+    std::fs::write(&leftover, b"half a view").unwrap();
+    let report = ok(&["dataset", "verify", d]);
+    assert!(
+        report.contains("leftover:") && report.contains(".4242.tmp"),
+        "{report}"
+    );
+    tiny_dataset(&data);
+    assert!(!leftover.exists());
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn a_second_training_run_on_one_folder_is_refused_by_name() {
+    let dir = fresh_dir("lock");
+    let data = dir.join("ds");
+    tiny_dataset(&data);
+    let d = data.to_str().unwrap();
+    let out = dir.join("model");
+    let o = out.to_str().unwrap();
+    let mut first = endless_training(d, o);
+    let lock = out.join(".lock");
+    let waited = std::time::Instant::now();
+    while !std::fs::read_to_string(&lock).is_ok_and(|s| s.starts_with("pid")) {
+        assert!(
+            waited.elapsed().as_secs() < 120,
+            "the first run never took the lock"
+        );
+        std::thread::sleep(std::time::Duration::from_millis(50));
+    }
+    fails(
+        &train_args(d, o, &["--epochs", "1"]),
+        &[
+            "is in use by another training run",
+            &format!("pid {}", first.id()),
+        ],
+    );
+    first.kill().unwrap();
+    first.wait().unwrap();
+    // The lock dies with its process: the next run takes it.
+    let mut next = endless_training(d, o);
+    let holder = format!("pid {}", next.id());
+    while std::fs::read_to_string(&lock).ok().as_deref() != Some(holder.as_str()) {
+        assert!(
+            waited.elapsed().as_secs() < 240,
+            "the lock was not released"
+        );
+        std::thread::sleep(std::time::Duration::from_millis(50));
+    }
+    next.kill().unwrap();
+    next.wait().unwrap();
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+/// The smaller cases: camera flags on a scene's own volume, `reference --spp 0`, and error
+/// messages that say the OS's reason once.
+#[test]
+fn small_cases_are_answered_precisely() {
+    let dir = fresh_dir("small");
+    let data = dir.join("ds");
+    let mut args = vec![
+        "generate",
+        "--scene",
+        "builtin:room",
+        "--envmaps",
+        "builtin",
+        "--out",
+        data.to_str().unwrap(),
+        "--train-views",
+        "2",
+        "--test-views",
+        "1",
+        "--train-res",
+        "8",
+        "--test-res",
+        "8",
+        "--spp",
+        "1",
+        "--test-spp",
+        "2",
+    ];
+    args.extend(["--fov", "45", "--spread", "10"]);
+    ok(&args);
+    let json: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(data.join("manifest.json")).unwrap()).unwrap();
+    let volume = &json["settings"]["camera_volume"];
+    assert_eq!(
+        (volume["fov_deg"].as_f64(), volume["spread_deg"].as_f64()),
+        (Some(45.0), Some(10.0))
+    );
+    assert!(json["views"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .all(|v| v["fov_x_deg"] == 45.0));
+
+    let x = dir.join("x.exr");
+    let mut zero = reference_args(&x);
+    zero[5] = "0";
+    fails(&zero, &["samples per pixel must be at least 1"]);
+
+    let o = nprt(&[
+        "reference",
+        "builtin:room",
+        "--envmap",
+        "/nonexistent/map.exr",
+        "--out",
+        dir.join("y.exr").to_str().unwrap(),
+    ]);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(1));
+    assert_eq!(err.matches("(os error 2)").count(), 1, "{err}");
+    std::fs::remove_dir_all(&dir).unwrap();
+}
