@@ -43,9 +43,11 @@ pub mod cameras;
 pub mod dataset;
 mod generate;
 pub mod lighting;
+mod shard;
 pub mod views;
 
 pub use camera_choice::CameraChoice;
 pub use cameras::{place_camera, PlacementError};
 pub use dataset::{Manifest, Request};
 pub use generate::{generate, GenerateOptions, Planned};
+pub use shard::shard_from_env;

@@ -69,9 +69,11 @@ pub struct GenerateArgs {
     /// --envmaps builtin.
     #[arg(long)]
     mix_builtin: Option<f32>,
-    /// Render only views with index ≡ K (mod N), e.g. 0/4 … 3/4 on four machines.
-    #[arg(long, default_value = "0/1", value_parser = parse_shard)]
-    shard: (u64, u64),
+    /// Render only views with index ≡ K (mod N), e.g. 0/4 … 3/4 on four machines. Default:
+    /// the task of the Slurm job array this runs in (SLURM_ARRAY_TASK_ID of
+    /// SLURM_ARRAY_TASK_COUNT; scripts/slurm-generate), else 0/1, the whole dataset.
+    #[arg(long, value_parser = parse_shard)]
+    shard: Option<(u64, u64)>,
     /// Camera active volume from a JSON file (as a scene's sidecar NAME.camera.json, which is
     /// read by default: docs/dataset.md); overrides the scene's.
     #[arg(long, conflicts_with = "volume_min")]
@@ -96,9 +98,15 @@ pub struct GenerateArgs {
     fov: Option<f32>,
 }
 
-impl From<GenerateArgs> for GenerateOptions {
-    fn from(a: GenerateArgs) -> Self {
-        GenerateOptions {
+impl TryFrom<GenerateArgs> for GenerateOptions {
+    type Error = anyhow::Error;
+
+    fn try_from(a: GenerateArgs) -> Result<Self> {
+        let shard = match a.shard {
+            Some(shard) => shard,
+            None => nprt_data::shard_from_env()?.unwrap_or((0, 1)),
+        };
+        Ok(GenerateOptions {
             scene: a.scene,
             envmaps: a.envmaps,
             out: a.out,
@@ -123,9 +131,9 @@ impl From<GenerateArgs> for GenerateOptions {
                 spread_deg: a.spread,
                 fov_deg: a.fov,
             },
-            shard: a.shard,
+            shard,
             progress: true,
-        }
+        })
     }
 }
 

@@ -118,7 +118,7 @@ fn run(cli: Cli) -> Result<()> {
     match cli.command {
         Command::Reference(a) => reference::run(a),
         Command::Demo(a) => demo::run(a),
-        Command::Generate(a) => generate::run(&a.into()),
+        Command::Generate(a) => generate::run(&a.try_into()?),
         Command::Dataset(c) => dataset::run(c),
         Command::Model(c) => model_info::run(c),
         Command::Train(a) => train::command(a),

@@ -273,8 +273,8 @@ fn lock_folder(out: &Path) -> Result<std::fs::File> {
             }
         });
     }
-    file.set_len(0)?;
-    write!(file, "pid {}", std::process::id())
+    file.set_len(0)
+        .and_then(|()| write!(file, "pid {}", std::process::id()))
         .with_context(|| format!("cannot write '{}'", path.display()))?;
     Ok(file)
 }
