@@ -51,8 +51,33 @@ pub fn write_channels(
     })
 }
 
-/// Reads every f32/f16 channel of the first layer: (width, height, name → data).
+/// The size of `path`'s first layer as its header states it, read without decoding a pixel;
+/// refuses a size the memory here cannot decode (a corrupt header claimed gigabytes, which the
+/// decoder allocated before finding the data malformed).
+pub fn checked_size(path: &Path) -> Result<(usize, usize)> {
+    let meta = ::exr::meta::MetaData::read_from_file(path, false)
+        .with_context(|| format!("cannot read '{}'", path.display()))?;
+    let header = meta
+        .headers
+        .first()
+        .with_context(|| format!("'{}' has no layers", path.display()))?;
+    let (w, h) = (header.layer_size.width(), header.layer_size.height());
+    let channels = header.channels.list.len().max(1) as u128;
+    // Each channel decoded once as stored and once as f32.
+    crate::ensure_memory(
+        w as u128 * h as u128 * channels * 8,
+        &format!(
+            "decoding '{}' ({w}×{h}, {channels} channels)",
+            path.display()
+        ),
+    )?;
+    Ok((w, h))
+}
+
+/// Reads every f32/f16 channel of the first layer: (width, height, name → data), after
+/// [`checked_size`].
 pub fn read_channels(path: &Path) -> Result<(usize, usize, HashMap<String, Vec<f32>>)> {
+    checked_size(path)?;
     let image = read_all_flat_layers_from_file(path)
         .with_context(|| format!("cannot read '{}'", path.display()))?;
     let layer = image
@@ -92,6 +117,30 @@ mod tests {
         let err = crate::write_png(&rgb, 2, 1, 0.0, &png).unwrap_err();
         assert!(
             format!("{err}").contains("pixel (1, 0)") && !png.exists(),
+            "{err}"
+        );
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+
+    /// A header claiming a huge image (found by fuzzing: the decoder allocated 10 GB before
+    /// finding the data malformed) is refused from the header alone.
+    #[test]
+    fn sizes_are_read_from_the_header_and_huge_ones_refused() {
+        let dir = std::env::temp_dir().join(format!("nprt-io-exr-size-{}", std::process::id()));
+        let path = dir.join("x.exr");
+        write_channels(&path, 4, 2, &[("R".into(), vec![1.0; 8])]).unwrap();
+        assert_eq!(checked_size(&path).unwrap(), (4, 2));
+        let mut bytes = std::fs::read(&path).unwrap();
+        let name = b"dataWindow\0box2i\0";
+        let at = bytes.windows(name.len()).position(|w| w == name).unwrap() + name.len();
+        // size (4 bytes), then x_min, y_min, x_max, y_max: both maxima become 2^20.
+        for field in [12, 16] {
+            bytes[at + field..at + field + 4].copy_from_slice(&(1i32 << 20).to_le_bytes());
+        }
+        std::fs::write(&path, bytes).unwrap();
+        let err = format!("{:#}", read_channels(&path).unwrap_err());
+        assert!(
+            err.contains("(1048577×1048577, 1 channels) needs") && err.contains("GiB"),
             "{err}"
         );
         std::fs::remove_dir_all(&dir).unwrap();

@@ -62,6 +62,7 @@ pub fn linear_rgb(img: image::DynamicImage, raw: bool) -> LinearImage {
 
 fn read_exr(path: &Path) -> Result<LinearImage> {
     use ::exr::prelude::*;
+    crate::exr::checked_size(path)?;
     let image = read_first_rgba_layer_from_file(
         path,
         |res, _| LinearImage {

@@ -6,7 +6,7 @@ use std::path::Path;
 
 use anyhow::{bail, Context, Result};
 use glam::Vec3;
-use nprt_io::exr::{read_channels, write_channels};
+use nprt_io::exr::{checked_size, read_channels, write_channels};
 use nprt_trace::Frame;
 
 use super::manifest::ViewRecord;
@@ -40,10 +40,12 @@ pub fn write_view(path: &Path, image: &ViewImage) -> Result<()> {
 /// Reads a view file, refusing one whose size disagrees with its record, that lacks a channel
 /// (the half's too, when `in_halves`) or that holds non-finite or negative radiance.
 pub fn read_view(path: &Path, view: &ViewRecord, in_halves: bool) -> Result<ViewImage> {
-    let (w, h, ch) = read_channels(path)?;
+    // The size is checked from the header, before a corrupt one makes the decoder allocate.
+    let (w, h) = checked_size(path)?;
     if (w, h) != (view.width as usize, view.height as usize) {
         bail!("is {w}×{h}, expected {}×{}", view.width, view.height);
     }
+    let (_, _, ch) = read_channels(path)?;
     let frame = Frame::from_channels(w, h, &ch)?;
     let half = if in_halves {
         let [r, g, b] = HALF.map(|name| {
