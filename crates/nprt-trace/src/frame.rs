@@ -45,6 +45,19 @@ impl GBuffer {
         self.alpha.push(s.alpha);
         self.mask.push(s.mask);
     }
+
+    /// Pixel `i`.
+    pub fn sample(&self, i: usize) -> GSample {
+        GSample {
+            position: self.position[i],
+            normal: self.normal[i],
+            view: self.view[i],
+            kd: self.kd[i],
+            ks: self.ks[i],
+            alpha: self.alpha[i],
+            mask: self.mask[i],
+        }
+    }
 }
 
 #[derive(Clone, Debug)]

@@ -146,7 +146,9 @@ pub fn command(a: TrainArgs) -> Result<()> {
 /// Loads the dataset, trains and prints what the run did.
 pub fn run(job: &TrainJob, device: &Device) -> Result<()> {
     let t0 = std::time::Instant::now();
-    let set = TrainingSet::load(&job.data, &job.config)?;
+    let set = TrainingSet::load(&job.data, &job.config, job.opts.schedule.progress, |why| {
+        eprintln!("{why}")
+    })?;
     print_dataset(&job.data, &set, t0.elapsed().as_secs_f64());
     let (s, file) = nprt_net::train(&set, &job.config, &job.opts, &job.out, device)?;
     if let Some(e) = s.resumed_from_epoch {
@@ -181,12 +183,13 @@ pub fn run(job: &TrainJob, device: &Device) -> Result<()> {
 fn print_dataset(dir: &Path, set: &TrainingSet, seconds: f64) {
     let count = |v: &[ViewSamples]| v.iter().map(|s| s.len()).sum::<usize>();
     println!(
-        "dataset '{}': {} training views ({} foreground pixels), {} test views ({} pixels), {:.2} GB in memory, loaded in {seconds:.1} s",
+        "dataset '{}': {} training views ({} foreground pixels), {} test views ({} pixels), {:.2} GB packed (mapped; only the views in use are resident), {:.2} GB of maps in memory, loaded in {seconds:.1} s",
         dir.display(),
         set.train.len(),
         count(&set.train),
         set.test.len(),
         count(&set.test),
+        set.pack.bytes() as f64 / 1e9,
         set.bytes() as f64 / 1e9,
     );
 }

@@ -387,13 +387,16 @@ fn a_folder_of_maps_mixes_in_builtin_lightings() {
     assert!(!never.exists());
 }
 
+/// A hand edit of a manifest's JSON.
+type ManifestEdit = fn(&mut serde_json::Value);
+
 #[test]
 fn hand_edited_manifests_are_refused_by_name_in_every_command() {
     let dir = tmp("edited");
     generate(&dir, &[]);
     let path = dir.join("manifest.json");
     let good: serde_json::Value = serde_json::from_slice(&std::fs::read(&path).unwrap()).unwrap();
-    let edits: [(&str, fn(&mut serde_json::Value)); 13] = [
+    let edits: [(&str, ManifestEdit); 13] = [
         ("map index 99 is out of range", |m| {
             m["settings"]["test_maps"][0] = 99.into()
         }),

@@ -449,3 +449,60 @@ fn a_time_budget_stops_the_run_and_a_cosine_run_keeps_its_length() {
         &["decaying --schedule"],
     );
 }
+
+#[test]
+fn a_dataset_is_packed_once_and_again_only_when_it_changes() {
+    let dir = fresh_dir("pack-data");
+    common::room_dataset(&dir, [2, 1], 10, 4);
+    let d = dir.to_str().unwrap();
+    let pack = |args: &[&str]| {
+        let o = common::nprt(args);
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        (
+            String::from_utf8_lossy(&o.stdout).into_owned(),
+            String::from_utf8_lossy(&o.stderr).into_owned(),
+        )
+    };
+    let (out, err) = pack(&["dataset", "pack", d]);
+    assert!(err.contains(&format!("packing '{d}'")), "{err}");
+    assert!(
+        out.contains("packed-radiance.bin") && out.contains("of 3 views"),
+        "{out}"
+    );
+    let (_, err) = pack(&["dataset", "pack", d]);
+    assert!(
+        !err.contains("packing"),
+        "a current pack is used as it is: {err}"
+    );
+    assert!(ok(&["dataset", "verify", d]).contains("packed-radiance.bin: current"));
+
+    // A view redone after packing: verify says so, and training packs again before it reads.
+    let view = dir.join("views").join("train_00001.exr");
+    let bytes = std::fs::read(&view).unwrap();
+    std::thread::sleep(std::time::Duration::from_millis(20));
+    std::fs::write(&view, bytes).unwrap();
+    assert!(ok(&["dataset", "verify", d]).contains("out of date"));
+    let model = fresh_dir("pack-model");
+    let (_, err) = pack(&[
+        "train",
+        "--data",
+        d,
+        "--arch",
+        "baseline",
+        "--out",
+        model.to_str().unwrap(),
+        "--encoder-width",
+        "64",
+        "--batch-size",
+        "64",
+        "--epochs",
+        "1",
+    ]);
+    assert!(err.contains("again: a view file changed"), "{err}");
+    // Models that trace the direct light learn from their own pack.
+    let (_, err) = pack(&["dataset", "pack", d, "--direct", "traced"]);
+    assert!(err.contains("packing"), "{err}");
+    assert!(dir.join("packed-indirect.bin").exists());
+    std::fs::remove_dir_all(&dir).unwrap();
+    std::fs::remove_dir_all(&model).unwrap();
+}

@@ -174,7 +174,8 @@ fn remove_leftovers(dir: &Path, views: &[&ViewRecord]) -> Result<usize> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::dataset::{plan, read_view, scene_source, Jitter, MapAssignment, Request};
+    use crate::dataset::plan::room_request;
+    use crate::dataset::{plan, read_view, Request};
     use nprt_scene::{load_scene, SceneOptions};
 
     fn mse(a: &[Vec3], b: &[Vec3]) -> f64 {
@@ -192,29 +193,10 @@ mod tests {
     fn test_views_in_halves_hold_their_own_noise() {
         let scene = load_scene("builtin:room", &SceneOptions::default()).unwrap();
         let ts = TraceScene::new(&scene);
-        let map_specs: Vec<String> = ["builtin:indoor:1", "builtin:indoor:2"]
-            .map(String::from)
-            .into();
-        let maps = crate::lighting::load_all(&map_specs).unwrap();
         let request = Request {
-            scene_spec: "builtin:room".into(),
-            scene: &scene,
-            scene_source: scene_source("builtin:room").unwrap(),
-            volume: scene.camera_volume.clone().unwrap(),
-            map_specs,
-            maps,
-            lighting: MapAssignment::Pool {
-                test_maps: 1,
-                builtin_share: 0.0,
-            },
-            train_views: 1,
-            test_views: 1,
-            train_resolution: [8, 8],
             test_resolution: [32, 32],
-            spp: 2,
             test_spp: 8,
-            seed: 0,
-            jitter: Jitter::default(),
+            ..room_request(&scene, ["builtin:indoor:1", "builtin:indoor:2"])
         };
         let manifest = plan(&request, &ts).unwrap();
         let dir = std::env::temp_dir().join(format!("nprt-halves-{}", std::process::id()));

@@ -5,6 +5,8 @@
 
 mod generation;
 mod manifest;
+mod packed;
+mod packed_pixel;
 mod plan;
 mod scene_identity;
 mod verify;
@@ -15,6 +17,8 @@ pub use manifest::{
     load_manifest, load_manifest_hashed, Jitter, Manifest, MapRecord, Settings, ViewRecord,
     VolumeRecord, FORMAT_VERSION, MANIFEST,
 };
+pub use packed::{views_stamp, PackHeader, PackedDataset, PackedTarget, PACK_FORMAT, PACK_VERSION};
+pub use packed_pixel::{PackedPixel, PACKED_PIXEL_BYTES};
 pub use plan::{plan, MapAssignment, Request};
 pub use scene_identity::{load_checked_scene, relit, scene_hash, scene_source};
 pub use verify::{verify, Report};

@@ -234,6 +234,33 @@ fn jittered_gain(j: &Jitter, rng: &mut Pcg64Mcg) -> [f32; 3] {
     (tint / nprt_scene::luminance(tint) * e.exp2()).to_array()
 }
 
+/// A request for a small dataset of the built-in room under two maps, one held out for the test
+/// views (tests change what they need with struct update syntax).
+#[cfg(test)]
+pub(crate) fn room_request<'a>(scene: &'a Scene, map_specs: [&str; 2]) -> Request<'a> {
+    let map_specs: Vec<String> = map_specs.map(String::from).into();
+    Request {
+        scene_spec: "builtin:room".into(),
+        scene,
+        scene_source: super::scene_source("builtin:room").unwrap(),
+        volume: scene.camera_volume.clone().unwrap(),
+        maps: crate::lighting::load_all(&map_specs).unwrap(),
+        map_specs,
+        lighting: MapAssignment::Pool {
+            test_maps: 1,
+            builtin_share: 0.0,
+        },
+        train_views: 1,
+        test_views: 1,
+        train_resolution: [8, 8],
+        test_resolution: [8, 8],
+        spp: 2,
+        test_spp: 2,
+        seed: 0,
+        jitter: Jitter::default(),
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

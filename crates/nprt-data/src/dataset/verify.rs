@@ -4,7 +4,8 @@ use std::path::{Path, PathBuf};
 
 use anyhow::Result;
 
-use super::manifest::load_manifest;
+use super::manifest::load_manifest_hashed;
+use super::packed::{views_stamp, PackedDataset, PackedTarget};
 use super::view_file::check_view;
 
 /// Completeness of a dataset folder.
@@ -16,12 +17,14 @@ pub struct Report {
     pub corrupt: Vec<String>,
     /// Temporary files of views whose writing was killed (or is under way in a running shard).
     pub leftovers: Vec<String>,
+    /// Each pack present and its state (a pack out of date is made again by the next training).
+    pub packs: Vec<String>,
 }
 
 /// Reads every view back fully (in parallel: this is also how fast a trainer can load them).
 pub fn verify(dir: &Path) -> Result<Report> {
     use rayon::prelude::*;
-    let manifest = load_manifest(dir)?;
+    let (manifest, hash) = load_manifest_hashed(dir)?;
     let states: Vec<Result<(), String>> = manifest
         .views
         .par_iter()
@@ -46,6 +49,25 @@ pub fn verify(dir: &Path) -> Result<Report> {
         for (tmp, _) in nprt_io::leftover_temporaries(&dir.join(folder))? {
             report.leftovers.push(tmp.display().to_string());
         }
+    }
+    for target in [PackedTarget::Radiance, PackedTarget::Indirect] {
+        let path = PackedDataset::path(dir, target);
+        if !path.exists() {
+            continue;
+        }
+        let state = views_stamp(dir, &manifest)
+            .and_then(|stamp| PackedDataset::open_current(dir, &manifest, &hash, &stamp, target));
+        report.packs.push(match state {
+            Ok(p) => format!(
+                "{}: current ({} records)",
+                path.display(),
+                p.records().len()
+            ),
+            Err(e) => format!(
+                "{}: out of date, the next training packs it again ({e:#})",
+                path.display()
+            ),
+        });
     }
     for (v, state) in manifest.views.iter().zip(states) {
         match state {

@@ -2,7 +2,7 @@
 //! a G-buffer pixel (for training, the renderer and Deep Shading alike).
 
 use glam::Vec3;
-use nprt_trace::GBuffer;
+use nprt_trace::{GBuffer, GSample};
 
 /// Floats per pixel: x (3, normalised), ωo (3), ωr (3), n (3), kd (3), ks (3), α (1).
 pub const FEATURES: usize = 19;
@@ -42,13 +42,10 @@ pub fn pixel_features(
 
 /// The 19 inputs of pixel `i` of a G-buffer.
 pub fn gbuffer_features(bounds: &[[f32; 3]; 2], g: &GBuffer, i: usize) -> [f32; FEATURES] {
-    pixel_features(
-        bounds,
-        g.position[i],
-        g.normal[i],
-        g.view[i],
-        g.kd[i],
-        g.ks[i],
-        g.alpha[i],
-    )
+    sample_features(bounds, &g.sample(i))
+}
+
+/// The 19 inputs of a G-buffer sample.
+pub fn sample_features(bounds: &[[f32; 3]; 2], s: &GSample) -> [f32; FEATURES] {
+    pixel_features(bounds, s.position, s.normal, s.view, s.kd, s.ks, s.alpha)
 }

@@ -1,6 +1,6 @@
 //! Who supplies a model's direct light: its network (the paper) or the tracer at run time.
 
-use glam::Vec3;
+use nprt_data::dataset::PackedTarget;
 
 use crate::choice::named_choice;
 
@@ -30,13 +30,13 @@ impl DirectLight {
         *self == DirectLight::Learned
     }
 
-    /// What the network learns of a pixel with reference `radiance` and its `direct` part.
-    /// Both come from the same paths, so their difference is an estimate of the indirect light
-    /// that is never negative but for rounding.
-    pub fn target(self, radiance: Vec3, direct: Vec3) -> Vec3 {
+    /// What the network learns of a pixel: all its radiance, or the indirect part. Reference
+    /// and direct part come from the same paths, so their difference is an estimate of the
+    /// indirect light that is never negative but for rounding.
+    pub fn packed_target(self) -> PackedTarget {
         match self {
-            DirectLight::Learned => radiance,
-            DirectLight::Traced => (radiance - direct).max(Vec3::ZERO),
+            DirectLight::Learned => PackedTarget::Radiance,
+            DirectLight::Traced => PackedTarget::Indirect,
         }
     }
 }

@@ -48,11 +48,10 @@ impl Batch {
             light_width: views.first().map_or(0, |v| v.light.width),
         };
         for &(v, p) in samples {
-            let (view, p) = (views[v as usize], p as usize);
-            b.features
-                .extend_from_slice(&view.features[p * FEATURES..(p + 1) * FEATURES]);
-            b.radiance
-                .extend_from_slice(&view.radiance[p * 3..p * 3 + 3]);
+            let view = views[v as usize];
+            let (features, radiance) = view.sample(p as usize);
+            b.features.extend_from_slice(&features);
+            b.radiance.extend_from_slice(&radiance);
             b.view.push(v as i64);
             b.scale.extend_from_slice(&view.light.scale);
         }

@@ -59,6 +59,7 @@ pub fn level_gain(
             }
         }
     }
+    views.iter().for_each(|v| v.release());
     std::array::from_fn(|k| {
         let gain = target[k] / predicted[k];
         if gain.is_finite() && gain > 0.0 {
@@ -71,14 +72,18 @@ pub fn level_gain(
 
 #[cfg(test)]
 mod tests {
+    use std::sync::Arc;
+
     use super::*;
-    use crate::encoding::features::FEATURES;
     use crate::encoding::map_norm::MapNorm;
     use crate::model::config::ModelConfig;
     use crate::network::encoder::LightInput;
     use crate::network::init::Init;
     use crate::Design;
+    use glam::Vec3;
+    use nprt_data::dataset::{PackedDataset, PackedPixel, PackedTarget};
     use nprt_scene::envmap::EnvMap;
+    use nprt_trace::GSample;
 
     #[test]
     fn the_gain_is_the_factor_between_targets_and_predictions() {
@@ -89,39 +94,66 @@ mod tests {
         };
         let net = config.build(&mut Init::new(1, &device));
         let sky = nprt_scene::open_envmap("builtin:sky").unwrap();
-        let warm = EnvMap::constant(glam::Vec3::new(3.0, 1.0, 0.2)).unwrap();
-        // Two views under maps of very different scales, with pseudo-random inputs in ±1.
-        let views: Vec<ViewSamples> = [(&sky, 200), (&warm, 57)]
-            .into_iter()
-            .enumerate()
-            .map(|(v, (map, n))| {
-                let features = (0..n * FEATURES)
-                    .map(|i| ((i * 7919 + v * 104_729) % 2001) as f32 / 1000.0 - 1.0)
-                    .collect();
-                ViewSamples {
-                    features,
-                    radiance: vec![0.0; 3 * n],
-                    light: LightInput::new(map, 40.0 * v as f32, 64, MapNorm::Channel),
-                }
-            })
-            .collect();
+        let warm = EnvMap::constant(Vec3::new(3.0, 1.0, 0.2)).unwrap();
+        let bounds = [[-1.0; 3], [1.0; 3]];
+        // Two views under maps of very different scales, with pseudo-random inputs.
+        let sizes = [200, 57];
+        let value = |i: usize, v: usize| ((i * 7919 + v * 104_729) % 2001) as f32 / 1000.0 - 1.0;
+        let records = |radiance: &dyn Fn(usize, usize) -> Vec3| -> Vec<Vec<PackedPixel>> {
+            (0..2)
+                .map(|v| {
+                    (0..sizes[v])
+                        .map(|p| {
+                            let f = |k: usize| value(7 * p + k, v);
+                            let s = GSample {
+                                position: Vec3::new(f(0), f(1), f(2)),
+                                normal: Vec3::new(f(3), f(4), 0.5).normalize(),
+                                view: Vec3::new(f(5), 0.5, f(6)).normalize(),
+                                kd: Vec3::splat(f(0).abs()),
+                                ks: Vec3::splat(f(1).abs()),
+                                alpha: f(2).abs(),
+                                mask: 1.0,
+                            };
+                            PackedPixel::encode(&s, radiance(v, p), &bounds)
+                        })
+                        .collect()
+                })
+                .collect()
+        };
+        let views = |records: Vec<Vec<PackedPixel>>| -> Vec<ViewSamples> {
+            let pack = Arc::new(PackedDataset::from_records(
+                bounds,
+                PackedTarget::Radiance,
+                records,
+            ));
+            [&sky, &warm]
+                .into_iter()
+                .enumerate()
+                .map(|(v, map)| {
+                    let light = LightInput::new(map, 40.0 * v as f32, 64, MapNorm::Channel);
+                    ViewSamples::new(pack.clone(), v, light)
+                })
+                .collect()
+        };
+        let dark = views(records(&|_, _| Vec3::ZERO));
         // Targets that are exactly the network's predictions times a known factor per channel.
         let factor = [1.3f32, 0.7, 2.0];
-        let views: Vec<ViewSamples> = views
-            .into_iter()
-            .map(|mut view| {
+        let predictions: Vec<Vec<f32>> = dark
+            .iter()
+            .map(|view| {
                 let all: Vec<(u32, u32)> = (0..view.len() as u32).map(|p| (0, p)).collect();
-                let (pred, _) = Batch::gather(&[&view], &all).forward(&net, &device);
-                view.radiance = host_values(pred.into_data())
-                    .chunks_exact(3)
-                    .flat_map(|c| [0, 1, 2].map(|k| c[k] * factor[k]))
-                    .collect();
-                view
+                let (pred, _) = Batch::gather(&[view], &all).forward(&net, &device);
+                host_values(pred.into_data())
             })
             .collect();
+        let scaled = views(records(&|v, p| {
+            Vec3::from_array(std::array::from_fn(|k| {
+                predictions[v][3 * p + k] * factor[k]
+            }))
+        }));
         // Over every pixel, and over a strided subset in small batches.
         for (max_samples, batch_size) in [(1000, 1000), (50, 16)] {
-            let gain = level_gain(&net, &views, max_samples, batch_size, &device);
+            let gain = level_gain(&net, &scaled, max_samples, batch_size, &device);
             for k in 0..3 {
                 assert!(
                     (gain[k] / factor[k] - 1.0).abs() < 1e-4,
@@ -130,10 +162,6 @@ mod tests {
             }
         }
         // Targets without light: the network's output is kept, not zeroed.
-        let mut dark = views;
-        for v in &mut dark {
-            v.radiance.iter_mut().for_each(|r| *r = 0.0);
-        }
         assert_eq!(level_gain(&net, &dark, 1000, 1000, &device), [1.0; 3]);
     }
 }

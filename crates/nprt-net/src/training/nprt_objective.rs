@@ -90,12 +90,12 @@ impl Objective for PixelObjective<'_> {
             .enumerate()
             .filter(move |(_, ((_, count), start))| start + count > from)
             .flat_map(move |(g, ((group, count), start))| {
-                let views: Vec<&ViewSamples> = group.iter().map(|&v| &self.set.train[v]).collect();
-                let batches = group_batches(&views, count, seed, epoch, g);
+                let views = GroupViews(group.iter().map(|&v| &self.set.train[v]).collect());
+                let batches = group_batches(&views.0, count, seed, epoch, g);
                 batches
                     .into_iter()
                     .skip(from.saturating_sub(start))
-                    .map(move |samples| Batch::gather(&views, &samples))
+                    .map(move |samples| Batch::gather(&views.0, &samples))
             })
     }
 
@@ -164,6 +164,16 @@ impl Objective for PixelObjective<'_> {
         save_model(out, &file, net)?;
         *self.saved.lock().unwrap_or_else(|e| e.into_inner()) = Some(file);
         Ok(())
+    }
+}
+
+/// The views of a group of batches, whose records are let go once the group is done: an
+/// epoch then holds only a group's views in memory, however large the dataset.
+struct GroupViews<'a>(Vec<&'a ViewSamples>);
+
+impl Drop for GroupViews<'_> {
+    fn drop(&mut self) {
+        self.0.iter().for_each(|v| v.release());
     }
 }
 

@@ -23,6 +23,7 @@ pub fn validation_loss(
         sum += log_l1(pred, reference).into_scalar::<f32>() as f64 * batch.len() as f64;
         count += batch.len();
     }
+    views.iter().for_each(|v| v.release());
     if count == 0 {
         return f64::NAN;
     }
