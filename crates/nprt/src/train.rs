@@ -19,7 +19,9 @@ fn d() -> TrainOptions {
 
 #[derive(clap::Args)]
 pub struct TrainArgs {
-    /// Dataset folder made by `nprt generate` (holding manifest.json).
+    /// Dataset folder made by `nprt generate` (holding manifest.json). The first training packs
+    /// it (one memory-mapped file beside manifest.json, made again when a view changes; see
+    /// `nprt dataset pack`), so the folder must be writable then.
     #[arg(long)]
     data: PathBuf,
     /// Transport design: baseline, prt, albedo or dsep.

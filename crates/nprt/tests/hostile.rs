@@ -434,8 +434,8 @@ fn a_second_training_run_on_one_folder_is_refused_by_name() {
     std::fs::remove_dir_all(&dir).unwrap();
 }
 
-/// The smaller cases: camera flags on a scene's own volume, `reference --spp 0`, and error
-/// messages that say the OS's reason once.
+/// The smaller cases: camera flags on a scene's own volume, `reference --spp 0`,
+/// `train --val-samples 0`, and error messages that say the OS's reason once.
 #[test]
 fn small_cases_are_answered_precisely() {
     let dir = fresh_dir("small");
@@ -475,6 +475,18 @@ fn small_cases_are_answered_precisely() {
         .unwrap()
         .iter()
         .all(|v| v["fov_x_deg"] == 45.0));
+
+    // No validation samples: refused, not silently one.
+    let model = dir.join("model");
+    fails(
+        &train_args(
+            data.to_str().unwrap(),
+            model.to_str().unwrap(),
+            &["--epochs", "1", "--val-samples", "0"],
+        ),
+        &["validation samples must be positive"],
+    );
+    assert!(!model.join("model.json").exists());
 
     let x = dir.join("x.exr");
     let mut zero = reference_args(&x);
