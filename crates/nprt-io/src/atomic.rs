@@ -130,6 +130,20 @@ pub fn leftover_temporaries(dir: &Path) -> Result<Vec<(PathBuf, String)>> {
     Ok(found)
 }
 
+/// Removes the [leftover temporaries](leftover_temporaries) in `dir` of the files `ours` claims
+/// (given each file's path): another run's may be under way. Returns how many were removed.
+pub fn remove_temporaries(dir: &Path, ours: impl Fn(&Path) -> bool) -> Result<usize> {
+    let mut removed = 0;
+    for (tmp, target) in leftover_temporaries(dir)? {
+        if ours(&dir.join(target)) {
+            std::fs::remove_file(&tmp)
+                .with_context(|| format!("cannot remove '{}'", tmp.display()))?;
+            removed += 1;
+        }
+    }
+    Ok(removed)
+}
+
 /// Writes `bytes` to `path` atomically.
 pub fn write_file(path: &Path, bytes: impl AsRef<[u8]>) -> Result<()> {
     write_atomically(path, |tmp| Ok(std::fs::write(tmp, bytes.as_ref())?))

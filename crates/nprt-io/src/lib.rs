@@ -26,8 +26,8 @@ mod progress;
 mod srgb;
 
 pub use atomic::{
-    check_writable, create_parent_dir, leftover_temporaries, output_target, write_atomically,
-    write_file,
+    check_writable, create_parent_dir, leftover_temporaries, output_target, remove_temporaries,
+    write_atomically, write_file,
 };
 pub use image_read::{linear_rgb, read_linear_rgb, LinearImage};
 pub use indicatif::ProgressBar;

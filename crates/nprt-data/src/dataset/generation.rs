@@ -160,13 +160,7 @@ fn remove_leftovers(dir: &Path, views: &[&ViewRecord]) -> Result<usize> {
     let folders: BTreeSet<&Path> = mine.iter().filter_map(|p| p.parent()).collect();
     let mut removed = 0;
     for folder in folders {
-        for (tmp, target) in nprt_io::leftover_temporaries(folder)? {
-            if mine.contains(&folder.join(target)) {
-                std::fs::remove_file(&tmp)
-                    .with_context(|| format!("cannot remove '{}'", tmp.display()))?;
-                removed += 1;
-            }
-        }
+        removed += nprt_io::remove_temporaries(folder, |target| mine.contains(target))?;
     }
     Ok(removed)
 }

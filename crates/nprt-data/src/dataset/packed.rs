@@ -97,12 +97,8 @@ pub struct PackedDataset {
 }
 
 enum Records {
-    /// The file, `len` bytes of records at `offset`.
-    Mapped {
-        map: Mmap,
-        offset: usize,
-        len: usize,
-    },
+    /// The file, `len` bytes of records after the prelude.
+    Mapped { map: Mmap, len: usize },
     /// Built in memory (tests, small sets).
     Memory(Vec<PackedPixel>),
 }
@@ -174,7 +170,7 @@ impl PackedDataset {
         // file stays as it was while mapped.
         let map = unsafe { Mmap::map(&file) }
             .with_context(|| format!("cannot map '{}'", path.display()))?;
-        let (header, offset, len) = read_header(&map)
+        let (header, len) = read_header(&map)
             .with_context(|| format!("'{}' is not a usable pack", path.display()))?;
         ensure!(
             header.dataset_hash == dataset_hash,
@@ -190,7 +186,7 @@ impl PackedDataset {
             .with_context(|| format!("'{}' does not match its manifest", path.display()))?;
         let pack = PackedDataset {
             header,
-            records: Records::Mapped { map, offset, len },
+            records: Records::Mapped { map, len },
         };
         // In pieces, each let go once hashed, so that checking a pack larger than memory
         // never holds more than one piece.
@@ -209,7 +205,8 @@ impl PackedDataset {
         Ok(pack)
     }
 
-    /// A pack held in memory: `views[i]` are the records of view i.
+    /// A pack held in memory: `views[i]` are the records of view i. It names no dataset and
+    /// holds no hashes: nothing on disk to check it against.
     pub fn from_records(
         bounds: [[f32; 3]; 2],
         target: PackedTarget,
@@ -230,9 +227,7 @@ impl PackedDataset {
             target,
             bounds,
             views: ranges,
-            records_hash: blake3::hash(bytemuck::cast_slice(&records))
-                .to_hex()
-                .to_string(),
+            records_hash: String::new(),
         };
         PackedDataset {
             header,
@@ -247,8 +242,8 @@ impl PackedDataset {
     /// Every record, views one after another in manifest order (as a GPU engine uploads them).
     pub fn records(&self) -> &[PackedPixel] {
         match &self.records {
-            Records::Mapped { map, offset, len } => {
-                bytemuck::cast_slice(&map[*offset..offset + len])
+            Records::Mapped { map, len } => {
+                bytemuck::cast_slice(&map[PRELUDE_BYTES..PRELUDE_BYTES + len])
             }
             Records::Memory(r) => r,
         }
@@ -276,11 +271,11 @@ impl PackedDataset {
     }
 
     fn release_bytes(&self, start: usize, len: usize) {
-        if let (Records::Mapped { map, offset, .. }, true) = (&self.records, len > 0) {
+        if let (Records::Mapped { map, .. }, true) = (&self.records, len > 0) {
             // SAFETY: a read-only shared file mapping: dropped pages are read from the file again
             // when next touched, so no content is lost. Failure only leaves pages resident.
             let _ = unsafe {
-                map.unchecked_advise_range(UncheckedAdvice::DontNeed, offset + start, len)
+                map.unchecked_advise_range(UncheckedAdvice::DontNeed, PRELUDE_BYTES + start, len)
             };
         }
     }
@@ -331,14 +326,8 @@ fn pack(
     progress: bool,
 ) -> Result<()> {
     let path = PackedDataset::path(dir, target);
-    let name = path.file_name().map(|n| n.to_string_lossy().to_string());
     // Temporaries of a killed packing: ours, since the lock is held.
-    for (tmp, of) in nprt_io::leftover_temporaries(dir)? {
-        if Some(&of) == name.as_ref() {
-            std::fs::remove_file(&tmp)
-                .with_context(|| format!("cannot remove '{}'", tmp.display()))?;
-        }
-    }
+    nprt_io::remove_temporaries(dir, |of| of == path)?;
     nprt_io::write_atomically(&path, |tmp| {
         let mut w = BufWriter::with_capacity(8 << 20, File::create(tmp)?);
         w.write_all(&[0; PRELUDE_BYTES])?;
@@ -422,9 +411,9 @@ fn view_records(
     Ok(records)
 }
 
-/// The header of a mapped pack, where its records start and their length in bytes, after checking that every part
+/// The header of a mapped pack and its records' length in bytes, after checking that every part
 /// lies where the prelude says.
-fn read_header(bytes: &[u8]) -> Result<(PackHeader, usize, usize)> {
+fn read_header(bytes: &[u8]) -> Result<(PackHeader, usize)> {
     ensure!(bytes.len() >= PRELUDE_BYTES, "shorter than its prelude");
     let p: Prelude = bytemuck::pod_read_unaligned(&bytes[..PRELUDE_BYTES]);
     ensure!(
@@ -455,7 +444,7 @@ fn read_header(bytes: &[u8]) -> Result<(PackHeader, usize, usize)> {
         header.format,
         header.version
     );
-    Ok((header, PRELUDE_BYTES, p.records_len as usize))
+    Ok((header, p.records_len as usize))
 }
 
 /// Each view's records lie within the file, one after another, at most one per pixel.
