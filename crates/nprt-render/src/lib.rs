@@ -23,6 +23,8 @@
 //! ```
 
 mod animation;
+#[cfg(feature = "wgpu")]
+pub mod gpu;
 pub mod oidn;
 mod path;
 mod relight;

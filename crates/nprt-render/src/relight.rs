@@ -31,6 +31,9 @@ pub struct Relighter {
     device: Device,
     /// The transport networks on the CPU engine, where it applies.
     host: Option<HostTransport>,
+    /// The encoder and transport networks as our own kernels, for `--device wgpu`.
+    #[cfg(feature = "wgpu")]
+    gpu: Option<crate::gpu::GpuNetwork>,
 }
 
 /// What the encoder made of one lighting: the 64-d code ê and what the map's channels were
@@ -48,6 +51,8 @@ pub struct Pixels {
     foreground: Vec<usize>,
     features: Vec<f32>,
     transfer: Option<TransferCodes>,
+    #[cfg(feature = "wgpu")]
+    gpu: Option<crate::gpu::GpuPixels>,
 }
 
 /// How a frame's direct light is traced, for a model that leaves it to the tracer.
@@ -96,7 +101,23 @@ impl FrameTimings {
 }
 
 impl Relighter {
+    /// Loads the model in `dir` to run on `device`. A wgpu device runs the frame path's own
+    /// kernels (crate::gpu), with the weights read on the host; any other runs burn's
+    /// network, through the CPU engine where it applies.
     pub fn load(dir: &Path, device: &Device) -> Result<Self> {
+        #[cfg(feature = "wgpu")]
+        if nprt_net::Backend::of(device) == nprt_net::Backend::Wgpu {
+            let host_device = Device::flex();
+            let (file, net) = load_model(dir, &host_device)?;
+            let gpu = Some(crate::gpu::GpuNetwork::new(&net)?);
+            return Ok(Relighter {
+                file,
+                net,
+                device: host_device,
+                host: None,
+                gpu,
+            });
+        }
         let (file, net) = load_model(dir, device)?;
         let host = cpu::applies(&net, device).then(|| HostTransport::from_net(&net));
         Ok(Relighter {
@@ -104,7 +125,22 @@ impl Relighter {
             net,
             device: device.clone(),
             host,
+            #[cfg(feature = "wgpu")]
+            gpu: None,
         })
+    }
+
+    /// Where the networks run, for reports: "CPU engine", "GPU kernels on ADAPTER" or burn's
+    /// device.
+    pub fn networks_on(&self) -> String {
+        #[cfg(feature = "wgpu")]
+        if let Some(gpu) = &self.gpu {
+            return format!("GPU kernels on {}", gpu.adapter());
+        }
+        match self.host {
+            Some(_) => "CPU engine".into(),
+            None => format!("burn on {}", nprt_net::device_name(&self.device)),
+        }
     }
 
     /// Whether the model leaves direct light to the tracer ([`Self::complete`] traces it).
@@ -143,15 +179,24 @@ impl Relighter {
     pub fn light_code(&self, map: &EnvMap, rotation_deg: f32) -> LightCode {
         let config = &self.file.config;
         let input = LightInput::new(map, rotation_deg, config.encoder_width, config.map_norm);
+        let scale = std::array::from_fn(|k| input.scale[k] * self.file.output_gain()[k]);
+        #[cfg(feature = "wgpu")]
+        if let Some(gpu) = &self.gpu {
+            let code = gpu.light_code(&input);
+            let n = code.len();
+            return LightCode {
+                code: Tensor::from_data(TensorData::new(code, [1, n]), &self.device),
+                scale,
+            };
+        }
         let w = input.width;
         let pixels = Tensor::from_data(
             TensorData::new(input.pixels, [1, 3, w / 2, w]),
             &self.device,
         );
-        let gain = self.file.output_gain();
         LightCode {
             code: self.net.encoder.forward(pixels),
-            scale: std::array::from_fn(|k| input.scale[k] * gain[k]),
+            scale,
         }
     }
 
@@ -175,6 +220,8 @@ impl Relighter {
         Pixels {
             count: g.mask.len(),
             foreground,
+            #[cfg(feature = "wgpu")]
+            gpu: self.gpu.as_ref().map(|gpu| gpu.pixels(&features)),
             features,
             transfer,
         }
@@ -196,13 +243,24 @@ impl Relighter {
                 let code = nprt_net::host_values(light.code.clone().into_data());
                 host.radiance(&px.features, &code, light.scale, px.transfer.as_ref())
             }
-            None => self.burn_radiance(&px.features, light),
+            None => self.device_radiance(px, light),
         };
         let mut out = vec![Vec3::ZERO; px.count];
         for (k, &i) in px.foreground.iter().enumerate() {
             out[i] = Vec3::from_slice(&rgb[3 * k..3 * k + 3]);
         }
         out
+    }
+
+    /// Radiance (`n × 3`) of the pixels off the CPU engine: on the frame path's kernels where
+    /// the model runs on them, else through burn.
+    fn device_radiance(&self, px: &Pixels, light: &LightCode) -> Vec<f32> {
+        #[cfg(feature = "wgpu")]
+        if let (Some(gpu), Some(pixels)) = (&self.gpu, &px.gpu) {
+            let code = nprt_net::host_values(light.code.clone().into_data());
+            return gpu.radiance(pixels, &code, light.scale);
+        }
+        self.burn_radiance(&px.features, light)
     }
 
     /// Radiance (`n × 3`) of feature rows through burn, in chunks of one fixed shape: a GPU

@@ -10,6 +10,7 @@ mod bench;
 mod dataset;
 mod demo;
 mod eval;
+mod export;
 mod flags;
 mod generate;
 mod model_info;
@@ -74,6 +75,10 @@ enum Command {
     /// Train the Deep Shading baseline (a per-scene U-Net on G-buffer images, with the light
     /// code at its bottleneck) on a dataset.
     TrainDeepShading(train_deep_shading::DeepShadingArgs),
+    /// Write a trained model as an engine runs it: the GPU frame path's compute kernels (WGSL,
+    /// with GLSL and HLSL translations) and its weights in a documented layout
+    /// (docs/export.md). Needs the `wgpu` feature.
+    Export(export::ExportArgs),
 }
 
 fn main() {
@@ -126,5 +131,6 @@ fn run(cli: Cli) -> Result<()> {
         Command::Render(a) => render::command(a),
         Command::Eval(a) => eval::command(a),
         Command::TrainDeepShading(a) => train_deep_shading::command(a),
+        Command::Export(a) => export::run(a),
     }
 }

@@ -97,9 +97,10 @@ pub fn run(opts: &RenderOptions, device: &Device) -> Result<()> {
     let job = RenderJob::prepare(opts, device)?;
     let [w, h] = opts.resolution;
     println!(
-        "nprt render: {} ({}) on {}, {} frames at {w}×{h}, lighting {}",
+        "nprt render: {} ({}, networks on the {}) on {}, {} frames at {w}×{h}, lighting {}",
         opts.model.display(),
         job.model.file.config.label(),
+        job.model.networks_on(),
         job.scene_spec,
         opts.frames,
         job.lighting

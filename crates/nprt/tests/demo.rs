@@ -4,6 +4,7 @@ mod common;
 
 use common::{fails, fresh_dir, nprt, ok};
 use serde_json::Value;
+use std::path::Path;
 
 #[test]
 fn quick_demo_then_render_and_eval() {
@@ -224,22 +225,28 @@ fn quick_demo_then_render_and_eval() {
     std::fs::write(&sched, r#"{"segments": [{"map": "builtin:indoor:12", "rotation_deg": [0, 90]}, {"map": "builtin:sky:50:10:3", "weight": 2}]}"#).unwrap();
     let r = dir.join("r");
     let m = model.to_str().unwrap();
-    let out = ok(&[
-        "render",
-        "--model",
-        m,
-        "--out",
-        r.to_str().unwrap(),
-        "--camera-path",
-        path.to_str().unwrap(),
-        "--lighting",
-        sched.to_str().unwrap(),
-        "--frames",
-        "3",
-        "--res",
-        "24x16",
-        "--exr",
-    ]);
+    let render = |out: &Path, device: &str| {
+        ok(&[
+            "render",
+            "--model",
+            m,
+            "--out",
+            out.to_str().unwrap(),
+            "--camera-path",
+            path.to_str().unwrap(),
+            "--lighting",
+            sched.to_str().unwrap(),
+            "--frames",
+            "3",
+            "--res",
+            "24x16",
+            "--exr",
+            "--device",
+            device,
+        ])
+    };
+    let out = render(&r, "cpu");
+    assert!(out.contains("networks on the CPU engine"), "{out}");
     assert!(
         out.contains("frame    3/3: G-buffer") && out.contains("mean per frame"),
         "{out}"
@@ -247,6 +254,7 @@ fn quick_demo_then_render_and_eval() {
     assert!(r.join("frames/0002.exr").is_file() && r.join("frames/0002.png").is_file());
     let img = image::open(r.join("frames/0000.png")).unwrap();
     assert_eq!((img.width(), img.height()), (24, 16));
+    gpu_frames_match(&render, &r);
 
     // Refusals, each naming what is wrong.
     let rr = dir.join("rr");
@@ -313,4 +321,31 @@ fn quick_demo_then_render_and_eval() {
     let o = nprt(&["eval", "--help"]);
     assert!(String::from_utf8_lossy(&o.stdout).contains("--sh-spp"));
     std::fs::remove_dir_all(&dir).ok();
+}
+
+/// `nprt render --device wgpu` (the GPU frame path's kernels, here on Mesa's software Vulkan)
+/// makes the frames `render` made with the CPU engine in `cpu_frames`, to within 1e-5 of each
+/// frame's brightest value (lavapipe: ~1e-6, the sums running in another order).
+fn gpu_frames_match(render: &dyn Fn(&Path, &str) -> String, cpu_frames: &Path) {
+    if !common::wgpu_runs() {
+        return;
+    }
+    let gpu_frames = cpu_frames.with_extension("wgpu");
+    let out = render(&gpu_frames, "wgpu");
+    assert!(out.contains("networks on the GPU kernels on "), "{out}");
+    for frame in 0..3 {
+        let name = format!("frames/{frame:04}.exr");
+        let cpu = nprt_io::read_linear_rgb(&cpu_frames.join(&name), true).unwrap();
+        let gpu = nprt_io::read_linear_rgb(&gpu_frames.join(&name), true).unwrap();
+        let peak = cpu
+            .texels
+            .iter()
+            .fold(0.0f32, |m, p| m.max(p.max_element()));
+        let worst = (cpu.texels.iter().zip(&gpu.texels))
+            .fold(0.0f32, |m, (a, b)| m.max((*a - *b).abs().max_element()));
+        assert!(
+            worst <= 1e-5 * peak,
+            "frame {frame}: off by {worst} of {peak}"
+        );
+    }
 }

@@ -51,6 +51,11 @@ fn resolution(level: usize) -> u32 {
     RESOLUTIONS[level]
 }
 
+/// Cells along each side at every level: what a GPU kernel needs to find the same vertices.
+pub fn resolutions() -> [u32; LEVELS] {
+    *RESOLUTIONS
+}
+
 /// The vertices around `position` (normalised to [−1, 1], clamped to the box) at every level.
 pub fn corners(position: [f32; 3]) -> Corners {
     let mut c = Corners {

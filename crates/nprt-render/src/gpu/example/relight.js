@@ -1,0 +1,215 @@
+// A worked example of running an nprt export: every step nprt's own GPU frame path takes
+// (nprt-render/src/gpu/gpu_network.rs), in WebGPU. One block of rows: the example's G-buffer is
+// small; a renderer cuts larger frames into blocks of at most 65,536 rows.
+
+const status = document.getElementById('status');
+const report = new URLSearchParams(location.search).has('report');
+
+async function bytes(url) {
+  const response = await fetch(url);
+  if (!response.ok) throw new Error(`${url}: ${response.status} ${response.statusText}`);
+  return response.arrayBuffer();
+}
+const json = async (url) => JSON.parse(new TextDecoder().decode(await bytes(url)));
+const floats = async (url) => new Float32Array(await bytes(url));
+
+async function main() {
+  const exp = await json('../export.json');
+  const weights = await floats('../' + exp.weights.file);
+  const ex = await json('example.json');
+  const gbuffer = await floats(ex.gbuffer.file);
+  const light = await floats(ex.light.file);
+  const reference = await floats(ex.reference.file);
+
+  if (!navigator.gpu) throw new Error('this browser has no WebGPU');
+  const adapter = await navigator.gpu.requestAdapter();
+  if (!adapter) throw new Error('no WebGPU adapter');
+  const device = await adapter.requestDevice({
+    requiredLimits: {
+      maxStorageBufferBindingSize: adapter.limits.maxStorageBufferBindingSize,
+      maxBufferSize: adapter.limits.maxBufferSize,
+    },
+  });
+  const STORAGE = GPUBufferUsage.STORAGE | GPUBufferUsage.COPY_SRC | GPUBufferUsage.COPY_DST;
+
+  // Buffers: uploaded data, and room for `n` floats.
+  const upload = (data) => {
+    const buffer = device.createBuffer({ size: Math.max(16, data.byteLength), usage: STORAGE });
+    device.queue.writeBuffer(buffer, 0, data);
+    return buffer;
+  };
+  const room = (n) => device.createBuffer({ size: Math.max(16, 4 * n), usage: STORAGE });
+  const tensors = new Map(exp.weights.tensors.map((t) => [t.name, t]));
+  const tensor = (name) => {
+    const t = tensors.get(name);
+    const n = t.shape.reduce((a, b) => a * b, 1);
+    return { buffer: upload(weights.subarray(t.offset, t.offset + n)), shape: t.shape };
+  };
+  const dense = (layer) => {
+    const w = tensor(layer.weight);
+    return { weight: w.buffer, bias: tensor(layer.bias).buffer, dIn: w.shape[0], dOut: w.shape[1] };
+  };
+  const mlp = (m) => ({ layers: m.layers.map(dense), activation: m.hidden_activation === 'siren' ? 2 : 1 });
+
+  // Kernels: each reads a uniform block of u32 parameters at binding 0 and storage buffers after it.
+  const pipelines = {};
+  for (const k of exp.kernels) {
+    const code = new TextDecoder().decode(await bytes('../' + k.wgsl));
+    const module = device.createShaderModule({ code });
+    pipelines[k.name] = device.createComputePipeline({ layout: 'auto', compute: { module, entryPoint: k.entry_point } });
+  }
+  const dispatch = (pass, name, params, buffers, x, y = 1) => {
+    const words = new Uint32Array(Math.ceil(params.length / 4) * 4);
+    words.set(params);
+    const uniform = device.createBuffer({ size: words.byteLength, usage: GPUBufferUsage.UNIFORM | GPUBufferUsage.COPY_DST });
+    device.queue.writeBuffer(uniform, 0, words);
+    const entries = [{ binding: 0, resource: { buffer: uniform } }]
+      .concat(buffers.map((buffer, i) => ({ binding: i + 1, resource: { buffer } })));
+    const pipeline = pipelines[name];
+    pass.setPipeline(pipeline);
+    pass.setBindGroup(0, device.createBindGroup({ layout: pipeline.getBindGroupLayout(0), entries }));
+    pass.dispatchWorkgroups(x, y);
+  };
+  const groups = (n) => Math.ceil(n / 64);
+  // y = act(x·W[wRow..] + bias) over `rows` rows of `dIn` inputs (dense.wgsl).
+  const denseLayer = (pass, layer, x, rows, dIn, wRow, bias, activation, y) =>
+    dispatch(pass, 'dense', [rows, dIn, layer.dOut, activation, dIn, wRow * layer.dOut, 0, 0],
+      [x, layer.weight, bias, y], groups(layer.dOut), groups(rows));
+  // An MLP: hidden layers take its activation, the last is linear; ping-pongs through `scratch`.
+  const runMlp = (pass, m, x, rows, first, scratch, out) => {
+    const last = m.layers.length - 1;
+    m.layers.forEach((layer, i) => {
+      const input = i === 0 ? x : scratch[i % 2];
+      const output = i === last ? out : scratch[(i + 1) % 2];
+      const activation = i === last ? 0 : m.activation;
+      if (i === 0) denseLayer(pass, layer, input, rows, first.dIn, first.wRow, first.bias ?? layer.bias, activation, output);
+      else denseLayer(pass, layer, input, rows, layer.dIn, 0, layer.bias, activation, output);
+    });
+  };
+
+  // The networks.
+  const blocks = exp.encoder.blocks.map((b) => ({ cIn: b.in_channels, weight: tensor(b.weight).buffer, bias: tensor(b.bias).buffer }));
+  const toCode = dense(exp.encoder.to_code);
+  const kinds = { full: 0, albedo: 1, diffuse: 2, specular: 3 };
+  const resolutions = upload(new Uint32Array(exp.tracks.find((t) => t.grid)?.grid.resolutions ?? [0, 0, 0, 0]));
+  const tracks = exp.tracks.map((t) => ({
+    kind: kinds[t.kind],
+    index: upload(new Uint32Array(t.inputs)),
+    count: t.inputs.length,
+    width: t.width,
+    grid: t.grid ? tensor(t.grid.table).buffer : null,
+    transfer: t.transfer ? mlp(t.transfer) : null,
+    shading: mlp(t.shading),
+    codeRows: t.code_rows,
+  }));
+  const empty = room(4);
+
+  // The G-buffer's foreground pixels as rows of 19 inputs.
+  const per = ex.gbuffer.floats_per_pixel;
+  const pixels = ex.width * ex.height;
+  const foreground = [];
+  for (let i = 0; i < pixels; i++) if (gbuffer[i * per + per - 1] > 0.5) foreground.push(i);
+  const rows = foreground.length;
+  const rowInputs = new Float32Array(rows * 19);
+  foreground.forEach((p, r) => rowInputs.set(gbuffer.subarray(p * per, p * per + 19), r * 19));
+  const features = upload(rowInputs);
+  const widest = Math.max(...tracks.flatMap((t) => [t.width, ...(t.transfer?.layers ?? []).concat(t.shading.layers).map((l) => l.dOut)]));
+  const scratch = [room(rows * widest), room(rows * widest)];
+  const outputs = tracks.map((t) => room(rows * t.shading.layers.at(-1).dOut));
+  const rgb = room(rows * 3);
+
+  // 1. The light code: 5 convolution blocks, then a dense layer (once per lighting change).
+  const code = room(64);
+  let encoder = device.createCommandEncoder();
+  let pass = encoder.beginComputePass();
+  let [h, w] = [ex.light.shape[1], ex.light.shape[2]];
+  let x = upload(light);
+  for (const b of blocks) {
+    const out = room(32 * (h / 2) * (w / 2));
+    dispatch(pass, 'encoder_block', [b.cIn, h, w, 0], [x, b.weight, b.bias, out], groups(32 * (h / 2) * (w / 2)));
+    [x, h, w] = [out, h / 2, w / 2];
+  }
+  denseLayer(pass, toCode, x, 1, toCode.dIn, 0, toCode.bias, 0, code);
+
+  // 2. What does not depend on the lighting (once per camera): each track's inputs and, where
+  // it has one, its transfer network's output ŝ.
+  const kept = tracks.map((t) => {
+    const inputs = t.transfer ? scratch[0] : room(rows * t.width);
+    dispatch(pass, 'track_inputs', [rows, t.count, t.width, t.grid ? 1 : 0],
+      [features, t.index, t.grid ?? empty, resolutions, inputs], groups(rows));
+    if (!t.transfer) return inputs;
+    const s = room(rows * 64);
+    runMlp(pass, t.transfer, inputs, rows, { dIn: t.width, wRow: 0 }, scratch, s);
+    return s;
+  });
+  pass.end();
+  device.queue.submit([encoder.finish()]);
+
+  // 3. Per lighting: the code's share of each shading network's first layer, the shading
+  // networks, and exp, kd/ks and the map's scale (combine.wgsl).
+  const relight = () => {
+    const encoder = device.createCommandEncoder();
+    const pass = encoder.beginComputePass();
+    tracks.forEach((t, i) => {
+      const first = t.shading.layers[0];
+      const bias = room(first.dOut);
+      dispatch(pass, 'code_bias', [first.dOut, t.codeRows[0], 64, 0], [code, first.weight, first.bias, bias], groups(first.dOut));
+      // The rows that multiply the pixel's own inputs: before ê's (ŝ first), or after them.
+      const codeFirst = t.codeRows[0] === 0;
+      const dIn = first.dIn - 64;
+      runMlp(pass, t.shading, kept[i], rows, { dIn, wRow: codeFirst ? 64 : 0, bias }, scratch, outputs[i]);
+    });
+    const params = new Uint32Array([rows, tracks.length, tracks[0].kind, tracks.at(-1).kind, 0, 0, 0, 0, 0, 0, 0, 0]);
+    new Float32Array(params.buffer, 32, 3).set(ex.light.scale);
+    dispatch(pass, 'combine', params, [features, outputs[0], outputs.at(-1), rgb], groups(rows));
+    pass.end();
+    const readback = device.createBuffer({ size: rows * 12, usage: GPUBufferUsage.MAP_READ | GPUBufferUsage.COPY_DST });
+    encoder.copyBufferToBuffer(rgb, 0, readback, 0, rows * 12);
+    device.queue.submit([encoder.finish()]);
+    return readback;
+  };
+  const start = performance.now();
+  const readback = relight();
+  await readback.mapAsync(GPUMapMode.READ);
+  const ms = performance.now() - start;
+  const radiance = new Float32Array(readback.getMappedRange().slice(0));
+
+  // Against the CPU engine: the largest difference over the brightest reference value.
+  let peak = 0;
+  let worst = 0;
+  foreground.forEach((p, r) => {
+    for (let c = 0; c < 3; c++) {
+      const want = reference[p * 3 + c];
+      peak = Math.max(peak, Math.abs(want));
+      worst = Math.max(worst, Math.abs(radiance[r * 3 + c] - want));
+    }
+  });
+  const error = worst / peak;
+
+  const canvas = document.getElementById('frame');
+  [canvas.width, canvas.height] = [ex.width, ex.height];
+  const draw = () => {
+    const gain = 2 ** Number(document.getElementById('exposure').value);
+    const image = new ImageData(ex.width, ex.height);
+    const srgb = (v) => 255 * (v <= 0.0031308 ? 12.92 * v : 1.055 * v ** (1 / 2.4) - 0.055);
+    foreground.forEach((p, r) => {
+      for (let c = 0; c < 3; c++) image.data[p * 4 + c] = srgb(Math.min(1, Math.max(0, radiance[r * 3 + c] * gain)));
+    });
+    for (let p = 0; p < pixels; p++) image.data[p * 4 + 3] = 255;
+    canvas.getContext('2d').putImageData(image, 0, 0);
+  };
+  draw();
+  document.getElementById('exposure').oninput = draw;
+  status.textContent = `${rows} foreground pixels of ${ex.width}×${ex.height} under ${ex.map}, ` +
+    `shaded in ${ms.toFixed(1)} ms (with read-back; adapter: ${adapter.info?.description || adapter.info?.vendor || 'unnamed'}).\n` +
+    `Largest difference from the CPU engine: ${error.toExponential(2)} of the brightest value.`;
+  return { rows, error, ms, image: canvas.toDataURL('image/png') };
+}
+
+main().then(
+  async (result) => { if (report) await fetch('/result', { method: 'POST', body: JSON.stringify(result) }); },
+  async (e) => {
+    status.textContent = 'error: ' + e.message;
+    if (report) await fetch('/result', { method: 'POST', body: JSON.stringify({ error: String(e.message) }) });
+  },
+);

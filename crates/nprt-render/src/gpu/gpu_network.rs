@@ -1,0 +1,523 @@
+//! A trained model's networks on the GPU. The weights are uploaded once; a lighting's code is
+//! made by the encoder kernels; a camera's pixels go once through what does not depend on the
+//! lighting (each track's transfer network ŝ, or the baseline's gathered inputs), kept on the
+//! device; each lighting then runs only the shading networks and the combination.
+
+use std::sync::Arc;
+
+use anyhow::Result;
+use nprt_net::cpu::{DenseStack, HostEncoder, HostTransport};
+use nprt_net::encoding::hash_grid;
+use nprt_net::network::encoder::{BLOCKS, CHANNELS, CODE_SIZE};
+use nprt_net::{Activation, LightInput, NprtNet, TrackKind, FEATURES, TRANSPORT_CODE};
+use wgpu::util::DeviceExt;
+
+use super::gpu_device::GpuDevice;
+use super::kernels::{groups_for, Kernel, DENSE_TILE};
+
+/// Rows per block of dispatches: a block's widest activations (256 f32 per row, 64 MiB) stay
+/// within WebGPU's 128 MiB storage-binding limit, and every kernel's workgroup count within
+/// 65,535.
+const CHUNK: usize = 65_536;
+
+/// One dense layer's weights (`d_in × d_out`, burn's layout) and bias on the device.
+struct GpuDense {
+    weight: wgpu::Buffer,
+    bias: wgpu::Buffer,
+    d_in: usize,
+    d_out: usize,
+}
+
+/// An MLP on the device: hidden layers take `activation`, the last is linear.
+struct GpuMlp {
+    layers: Vec<GpuDense>,
+    activation: Activation,
+}
+
+/// One transport track on the device.
+struct GpuTrack {
+    kind: TrackKind,
+    /// The feature indices the track reads, in its input order.
+    index: wgpu::Buffer,
+    count: usize,
+    /// Inputs per row: `count` plus the hash grid's encoding.
+    width: usize,
+    grid: Option<wgpu::Buffer>,
+    transfer: Option<GpuMlp>,
+    shading: GpuMlp,
+}
+
+/// A model's encoder and transport networks on the GPU.
+pub struct GpuNetwork {
+    gpu: Arc<GpuDevice>,
+    convs: Vec<(wgpu::Buffer, wgpu::Buffer, usize)>,
+    to_code: GpuDense,
+    tracks: Vec<GpuTrack>,
+    resolutions: wgpu::Buffer,
+    /// Bound where a kernel's optional input is absent (a track without a grid).
+    empty: wgpu::Buffer,
+}
+
+/// A camera's foreground pixels on the device and what of the network does not depend on the
+/// lighting, with the buffers a lighting change reuses.
+pub struct GpuPixels {
+    rows: usize,
+    chunks: Vec<PixelChunk>,
+    /// Ping-pong activations and each track's shading outputs, for the largest chunk.
+    scratch: [wgpu::Buffer; 2],
+    outputs: Vec<wgpu::Buffer>,
+    /// Radiance of every row, `rows × 3`.
+    rgb: wgpu::Buffer,
+}
+
+struct PixelChunk {
+    first: usize,
+    rows: usize,
+    features: wgpu::Buffer,
+    /// Per track, what its shading network's first layer reads besides the light code: ŝ
+    /// (`rows × TRANSPORT_CODE`) or, for the baseline, the gathered inputs (`rows × width`).
+    kept: Vec<wgpu::Buffer>,
+}
+
+fn activation_code(a: Activation) -> u32 {
+    match a {
+        Activation::Relu => 1,
+        Activation::Siren => 2,
+    }
+}
+
+fn kind_code(kind: TrackKind) -> u32 {
+    match kind {
+        TrackKind::Full => 0,
+        TrackKind::Albedo => 1,
+        TrackKind::Diffuse => 2,
+        TrackKind::Specular => 3,
+    }
+}
+
+impl GpuNetwork {
+    /// Uploads `net`'s weights to the process's GPU device.
+    pub fn new(net: &NprtNet) -> Result<Self> {
+        let gpu = GpuDevice::get()?;
+        let host = HostTransport::from_net(net);
+        let encoder = HostEncoder::from_burn(&net.encoder);
+        let storage = |data: &[f32]| upload(&gpu, bytemuck::cast_slice(data));
+        let dense = |d: &nprt_net::cpu::Dense| GpuDense {
+            weight: storage(&d.weight),
+            bias: storage(&d.bias),
+            d_in: d.d_in,
+            d_out: d.d_out,
+        };
+        let mlp = |s: &DenseStack| GpuMlp {
+            layers: s.layers.iter().map(dense).collect(),
+            activation: s.activation,
+        };
+        let tracks = host
+            .tracks
+            .iter()
+            .map(|t| {
+                let index: Vec<u32> = t.kind.inputs().iter().map(|&i| i as u32).collect();
+                GpuTrack {
+                    kind: t.kind,
+                    index: upload(&gpu, bytemuck::cast_slice(&index)),
+                    count: index.len(),
+                    width: index.len() + t.grid.as_ref().map_or(0, |_| hash_grid::OUTPUTS),
+                    grid: t.grid.as_deref().map(storage),
+                    transfer: t.transfer.as_ref().map(mlp),
+                    shading: mlp(&t.shading),
+                }
+            })
+            .collect();
+        let convs = encoder
+            .convs
+            .iter()
+            .map(|c| (storage(&c.weight), storage(&c.bias), c.c_in))
+            .collect();
+        Ok(GpuNetwork {
+            convs,
+            to_code: dense(&encoder.to_code),
+            tracks,
+            resolutions: upload(&gpu, bytemuck::cast_slice(&hash_grid::resolutions())),
+            empty: upload(&gpu, &[0; 16]),
+            gpu,
+        })
+    }
+
+    /// The device's adapter, for reports.
+    pub fn adapter(&self) -> &str {
+        &self.gpu.adapter
+    }
+
+    /// The light code ê (`CODE_SIZE` values) of a pre-processed map.
+    pub fn light_code(&self, input: &LightInput) -> Vec<f32> {
+        let gpu = &*self.gpu;
+        let (mut h, mut w) = (input.width / 2, input.width);
+        let mut x = upload(gpu, bytemuck::cast_slice(&input.pixels));
+        let code = buffer(gpu, CODE_SIZE);
+        let mut encoder = gpu.device.create_command_encoder(&Default::default());
+        {
+            let mut pass = encoder.begin_compute_pass(&Default::default());
+            for (weight, bias, c_in) in &self.convs {
+                let out = buffer(gpu, CHANNELS * (h / 2) * (w / 2));
+                gpu.kernels.dispatch(
+                    &gpu.device,
+                    &mut pass,
+                    Kernel::EncoderBlock,
+                    &[*c_in as u32, h as u32, w as u32, 0],
+                    &[&x, weight, bias, &out],
+                    groups_for(CHANNELS * (h / 2) * (w / 2)),
+                );
+                (x, h, w) = (out, h / 2, w / 2);
+            }
+            debug_assert_eq!(self.convs.len(), BLOCKS);
+            let flat = Rows {
+                x: &x,
+                rows: 1,
+                d_in: self.to_code.d_in,
+                w_row: 0,
+            };
+            dense_layer(
+                gpu,
+                &mut pass,
+                &self.to_code,
+                flat,
+                &self.to_code.bias,
+                0,
+                &code,
+            );
+        }
+        gpu.queue.submit([encoder.finish()]);
+        read(gpu, &code, CODE_SIZE)
+    }
+
+    /// Uploads the network inputs of a camera's foreground pixels (`rows × FEATURES`) and runs
+    /// what does not depend on the lighting.
+    pub fn pixels(&self, features: &[f32]) -> GpuPixels {
+        let gpu = &*self.gpu;
+        let rows = features.len() / FEATURES;
+        let largest = rows.clamp(1, CHUNK);
+        let widest = self
+            .tracks
+            .iter()
+            .flat_map(|t| {
+                let transfer = t.transfer.iter().flat_map(|m| &m.layers);
+                transfer
+                    .chain(&t.shading.layers)
+                    .map(|l| l.d_out)
+                    .chain([t.width])
+            })
+            .max()
+            .expect("a network has layers");
+        let scratch = [0, 1].map(|_| buffer(gpu, largest * widest));
+        let outputs = self
+            .tracks
+            .iter()
+            .map(|t| {
+                buffer(
+                    gpu,
+                    largest * t.shading.layers.last().expect("layers").d_out,
+                )
+            })
+            .collect();
+        let mut encoder = gpu.device.create_command_encoder(&Default::default());
+        let mut chunks = Vec::new();
+        {
+            let mut pass = encoder.begin_compute_pass(&Default::default());
+            for (k, f) in features.chunks(CHUNK * FEATURES).enumerate() {
+                let n = f.len() / FEATURES;
+                let features = upload(gpu, bytemuck::cast_slice(f));
+                let kept = self
+                    .tracks
+                    .iter()
+                    .map(|t| {
+                        let Some(transfer) = &t.transfer else {
+                            let x = buffer(gpu, n * t.width);
+                            self.track_inputs(&mut pass, t, &features, n, &x);
+                            return x;
+                        };
+                        let s = buffer(gpu, n * TRANSPORT_CODE);
+                        self.track_inputs(&mut pass, t, &features, n, &scratch[0]);
+                        let first = FirstLayer {
+                            x_stride: t.width,
+                            w_row: 0,
+                            bias: None,
+                        };
+                        mlp(
+                            gpu,
+                            &mut pass,
+                            transfer,
+                            &scratch[0],
+                            n,
+                            first,
+                            &scratch,
+                            &s,
+                        );
+                        s
+                    })
+                    .collect();
+                chunks.push(PixelChunk {
+                    first: k * CHUNK,
+                    rows: n,
+                    features,
+                    kept,
+                });
+            }
+        }
+        gpu.queue.submit([encoder.finish()]);
+        GpuPixels {
+            rows,
+            chunks,
+            scratch,
+            outputs,
+            rgb: buffer(gpu, rows.max(1) * 3),
+        }
+    }
+
+    fn track_inputs(
+        &self,
+        pass: &mut wgpu::ComputePass,
+        t: &GpuTrack,
+        features: &wgpu::Buffer,
+        rows: usize,
+        x: &wgpu::Buffer,
+    ) {
+        let table = t.grid.as_ref().unwrap_or(&self.empty);
+        let params = [rows, t.count, t.width, usize::from(t.grid.is_some())].map(|v| v as u32);
+        self.gpu.kernels.dispatch(
+            &self.gpu.device,
+            pass,
+            Kernel::TrackInputs,
+            &params,
+            &[features, &t.index, table, &self.resolutions, x],
+            groups_for(rows),
+        );
+    }
+
+    /// Radiance (`rows × 3`) of `px` under the light `code`, each channel multiplied by
+    /// `scale` (the map's normalisation times the model's level gain).
+    pub fn radiance(&self, px: &GpuPixels, code: &[f32], scale: [f32; 3]) -> Vec<f32> {
+        if px.rows == 0 {
+            return Vec::new();
+        }
+        let gpu = &*self.gpu;
+        let code = upload(gpu, bytemuck::cast_slice(code));
+        let mut encoder = gpu.device.create_command_encoder(&Default::default());
+        {
+            let mut pass = encoder.begin_compute_pass(&Default::default());
+            // Each track's first shading layer with the light code's share folded into its bias.
+            let biases: Vec<wgpu::Buffer> = self
+                .tracks
+                .iter()
+                .map(|t| {
+                    let first = &t.shading.layers[0];
+                    let code_row = if t.transfer.is_some() {
+                        TRANSPORT_CODE
+                    } else {
+                        0
+                    };
+                    let bias = buffer(gpu, first.d_out);
+                    let params = [first.d_out, code_row, CODE_SIZE, 0].map(|v| v as u32);
+                    gpu.kernels.dispatch(
+                        &gpu.device,
+                        &mut pass,
+                        Kernel::CodeBias,
+                        &params,
+                        &[&code, &first.weight, &first.bias, &bias],
+                        groups_for(first.d_out),
+                    );
+                    bias
+                })
+                .collect();
+            for chunk in &px.chunks {
+                for ((t, kept), (bias, out)) in self
+                    .tracks
+                    .iter()
+                    .zip(&chunk.kept)
+                    .zip(biases.iter().zip(&px.outputs))
+                {
+                    let first = match t.transfer {
+                        // [ŝ, ê]: ŝ's rows come first.
+                        Some(_) => FirstLayer {
+                            x_stride: TRANSPORT_CODE,
+                            w_row: 0,
+                            bias: Some(bias),
+                        },
+                        // The baseline's [ê, inputs]: the inputs' rows follow ê's.
+                        None => FirstLayer {
+                            x_stride: t.width,
+                            w_row: CODE_SIZE,
+                            bias: Some(bias),
+                        },
+                    };
+                    mlp(
+                        gpu,
+                        &mut pass,
+                        &t.shading,
+                        kept,
+                        chunk.rows,
+                        first,
+                        &px.scratch,
+                        out,
+                    );
+                }
+                let kinds: Vec<u32> = self.tracks.iter().map(|t| kind_code(t.kind)).collect();
+                let mut params = vec![
+                    chunk.rows as u32,
+                    kinds.len() as u32,
+                    kinds[0],
+                    *kinds.last().expect("a track"),
+                    chunk.first as u32,
+                    0,
+                    0,
+                    0,
+                ];
+                params.extend(scale.map(f32::to_bits));
+                params.push(0);
+                let out1 = px.outputs.last().expect("a track");
+                gpu.kernels.dispatch(
+                    &gpu.device,
+                    &mut pass,
+                    Kernel::Combine,
+                    &params,
+                    &[&chunk.features, &px.outputs[0], out1, &px.rgb],
+                    groups_for(chunk.rows),
+                );
+            }
+        }
+        gpu.queue.submit([encoder.finish()]);
+        read(gpu, &px.rgb, px.rows * 3)
+    }
+}
+
+/// How an MLP's first layer reads its input: the inputs per row (the row stride), the weight
+/// row they start at, and a bias in place of the layer's own (the light code's share folded
+/// in).
+struct FirstLayer<'a> {
+    x_stride: usize,
+    w_row: usize,
+    bias: Option<&'a wgpu::Buffer>,
+}
+
+/// Records `m` over `rows` rows of `x` into `out`, through the two `scratch` buffers.
+#[allow(clippy::too_many_arguments)]
+fn mlp(
+    gpu: &GpuDevice,
+    pass: &mut wgpu::ComputePass,
+    m: &GpuMlp,
+    x: &wgpu::Buffer,
+    rows: usize,
+    first: FirstLayer,
+    scratch: &[wgpu::Buffer; 2],
+    out: &wgpu::Buffer,
+) {
+    let last = m.layers.len() - 1;
+    for (i, layer) in m.layers.iter().enumerate() {
+        let activation = if i == last {
+            0
+        } else {
+            activation_code(m.activation)
+        };
+        let output = if i == last {
+            out
+        } else {
+            &scratch[(i + 1) % 2]
+        };
+        let (input, d_in, w_row, bias) = match i {
+            0 => (
+                x,
+                first.x_stride,
+                first.w_row,
+                first.bias.unwrap_or(&layer.bias),
+            ),
+            _ => (&scratch[i % 2], layer.d_in, 0, &layer.bias),
+        };
+        let layer_in = Rows {
+            x: input,
+            rows,
+            d_in,
+            w_row,
+        };
+        dense_layer(gpu, pass, layer, layer_in, bias, activation, output);
+    }
+}
+
+/// The rows a dense layer reads: `rows × d_in` values of `x`, multiplied by the weight rows
+/// from `w_row`.
+struct Rows<'a> {
+    x: &'a wgpu::Buffer,
+    rows: usize,
+    d_in: usize,
+    w_row: usize,
+}
+
+/// Records one dense layer: `y = act(x·W[w_row..] + bias)`.
+fn dense_layer(
+    gpu: &GpuDevice,
+    pass: &mut wgpu::ComputePass,
+    layer: &GpuDense,
+    x: Rows,
+    bias: &wgpu::Buffer,
+    activation: u32,
+    y: &wgpu::Buffer,
+) {
+    let params = [
+        x.rows,
+        x.d_in,
+        layer.d_out,
+        activation as usize,
+        x.d_in,
+        x.w_row * layer.d_out,
+        0,
+        0,
+    ];
+    let tiles = |n: usize| (n as u32).div_ceil(DENSE_TILE);
+    gpu.kernels.dispatch(
+        &gpu.device,
+        pass,
+        Kernel::Dense,
+        &params.map(|v| v as u32),
+        &[x.x, &layer.weight, bias, y],
+        [tiles(layer.d_out), tiles(x.rows)],
+    );
+}
+
+/// A storage buffer holding `bytes`.
+fn upload(gpu: &GpuDevice, bytes: &[u8]) -> wgpu::Buffer {
+    gpu.device
+        .create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: None,
+            contents: bytes,
+            usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
+        })
+}
+
+/// An uninitialised storage buffer of `floats` f32.
+fn buffer(gpu: &GpuDevice, floats: usize) -> wgpu::Buffer {
+    gpu.device.create_buffer(&wgpu::BufferDescriptor {
+        label: None,
+        size: (floats.max(4) * 4) as u64,
+        usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
+        mapped_at_creation: false,
+    })
+}
+
+/// The first `floats` values of `buffer`, once the queue's work is done.
+fn read(gpu: &GpuDevice, buffer: &wgpu::Buffer, floats: usize) -> Vec<f32> {
+    let size = (floats * 4) as u64;
+    let staging = gpu.device.create_buffer(&wgpu::BufferDescriptor {
+        label: Some("readback"),
+        size,
+        usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+        mapped_at_creation: false,
+    });
+    let mut encoder = gpu.device.create_command_encoder(&Default::default());
+    encoder.copy_buffer_to_buffer(buffer, 0, &staging, 0, size);
+    gpu.queue.submit([encoder.finish()]);
+    let slice = staging.slice(..);
+    slice.map_async(wgpu::MapMode::Read, |r| {
+        r.expect("mapping a GPU buffer for reading")
+    });
+    gpu.wait();
+    let view = slice.get_mapped_range().expect("a mapped GPU buffer");
+    bytemuck::cast_slice(&view).to_vec()
+}

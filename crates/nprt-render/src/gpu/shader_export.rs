@@ -1,0 +1,313 @@
+//! `nprt export`: a trained model in the form an engine runs it. The frame path's WGSL kernels
+//! as the viewer runs them, validated and translated to GLSL (4.30 compute) and HLSL (shader
+//! model 5.1) by naga; every weight, little-endian f32, in one `weights.bin`; and
+//! `export.json`, which says where each tensor lies, how the networks are wired and how a
+//! frame runs them (docs/export.md).
+
+use std::path::{Path, PathBuf};
+
+use anyhow::{bail, Context, Result};
+use nprt_net::cpu::{Dense, DenseStack, HostEncoder, HostTransport};
+use nprt_net::encoding::hash_grid;
+use nprt_net::network::encoder::CODE_SIZE;
+use nprt_net::{gbuffer_features, load_model, Device, LightInput, FEATURES, TRANSPORT_CODE};
+use nprt_trace::{render_gbuffer, TraceScene};
+use serde_json::{json, Value};
+
+use super::kernels::SOURCES;
+use crate::{CameraPath, Relighter};
+
+/// Version of the export's layout, bumped whenever a reader would read it differently.
+pub const EXPORT_VERSION: u32 = 1;
+
+/// The worked example's view: the model's scene from the start of `nprt render`'s default
+/// camera path, at this size, under this lighting.
+pub struct ExampleView {
+    pub width: u32,
+    pub height: u32,
+    pub map: String,
+}
+
+/// What an export wrote.
+pub struct ExportSummary {
+    pub files: Vec<PathBuf>,
+    /// Weights written, in f32 values.
+    pub weights: usize,
+    /// Why no worked example was written, if none was.
+    pub no_example: Option<String>,
+}
+
+/// The worked example's page and script, copied into every export.
+const EXAMPLE_PAGE: [(&str, &str); 2] = [
+    ("example/index.html", include_str!("example/index.html")),
+    ("example/relight.js", include_str!("example/relight.js")),
+];
+
+/// The weights in file order, each tensor recorded in `export.json` by name, offset (in f32
+/// values) and shape.
+#[derive(Default)]
+struct WeightFile {
+    values: Vec<f32>,
+    tensors: Vec<Value>,
+}
+
+impl WeightFile {
+    fn add(&mut self, name: &str, shape: &[usize], values: &[f32]) -> Value {
+        assert_eq!(
+            shape.iter().product::<usize>(),
+            values.len(),
+            "{name}'s shape"
+        );
+        let offset = self.values.len();
+        self.values.extend_from_slice(values);
+        self.tensors
+            .push(json!({ "name": name, "offset": offset, "shape": shape }));
+        json!(name)
+    }
+
+    fn dense(&mut self, name: &str, d: &Dense) -> Value {
+        json!({
+            "weight": self.add(&format!("{name}.weight"), &[d.d_in, d.d_out], &d.weight),
+            "bias": self.add(&format!("{name}.bias"), &[d.d_out], &d.bias),
+        })
+    }
+
+    fn mlp(&mut self, name: &str, m: &DenseStack) -> Value {
+        let layers: Vec<Value> = (m.layers.iter().enumerate())
+            .map(|(i, l)| self.dense(&format!("{name}.{i}"), l))
+            .collect();
+        json!({ "hidden_activation": m.activation.to_string(), "layers": layers })
+    }
+}
+
+/// Exports the model in `model_dir` into `out` (created if need be; files in it are replaced,
+/// each atomically), with a worked example relighting `view` of its scene.
+pub fn export_model(model_dir: &Path, out: &Path, view: &ExampleView) -> Result<ExportSummary> {
+    let (file, net) = load_model(model_dir, &Device::flex())?;
+    let mut files = Vec::new();
+    let mut write = |name: &str, bytes: &[u8]| -> Result<()> {
+        let path = out.join(name);
+        nprt_io::write_file(&path, bytes)?;
+        files.push(path);
+        Ok(())
+    };
+    let mut kernels = Vec::new();
+    for k in &SOURCES {
+        let (glsl, hlsl) = translate(k.wgsl).with_context(|| format!("kernel {}", k.name))?;
+        write(&format!("{}.wgsl", k.name), k.wgsl.as_bytes())?;
+        write(&format!("{}.comp.glsl", k.name), glsl.as_bytes())?;
+        write(&format!("{}.hlsl", k.name), hlsl.as_bytes())?;
+        kernels.push(json!({
+            "name": k.name,
+            "wgsl": format!("{}.wgsl", k.name),
+            "glsl": format!("{}.comp.glsl", k.name),
+            "hlsl": format!("{}.hlsl", k.name),
+            "entry_point": "main",
+        }));
+    }
+
+    let mut weights = WeightFile::default();
+    let encoder = HostEncoder::from_burn(&net.encoder);
+    let convs: Vec<Value> = (encoder.convs.iter().enumerate())
+        .map(|(i, c)| {
+            json!({
+                "in_channels": c.c_in,
+                "weight": weights.add(&format!("encoder.conv{i}.weight"), &[c.bias.len(), c.c_in, 3, 3], &c.weight),
+                "bias": weights.add(&format!("encoder.conv{i}.bias"), &[c.bias.len()], &c.bias),
+            })
+        })
+        .collect();
+    let to_code = weights.dense("encoder.to_code", &encoder.to_code);
+    let tracks: Vec<Value> = (HostTransport::from_net(&net).tracks.iter().enumerate())
+        .map(|(i, t)| {
+            let grid = t.grid.as_ref().map(|g| {
+                let rows = g.len() / hash_grid::LEVEL_FEATURES;
+                json!({
+                    "table": weights.add(&format!("track{i}.grid"), &[rows, hash_grid::LEVEL_FEATURES], g),
+                    "resolutions": hash_grid::resolutions(),
+                })
+            });
+            let transfer = t.transfer.as_ref().map(|m| weights.mlp(&format!("track{i}.transfer"), m));
+            json!({
+                "kind": format!("{:?}", t.kind).to_lowercase(),
+                "inputs": t.kind.inputs(),
+                "width": t.kind.inputs().len() + t.grid.as_ref().map_or(0, |_| hash_grid::OUTPUTS),
+                "grid": grid,
+                "transfer": transfer,
+                "shading": weights.mlp(&format!("track{i}.shading"), &t.shading),
+                // Which weight rows of the shading network's first layer multiply the light
+                // code: after ŝ, or first for the baseline's [ê, inputs].
+                "code_rows": if t.transfer.is_some() { [TRANSPORT_CODE, TRANSPORT_CODE + CODE_SIZE] } else { [0, CODE_SIZE] },
+            })
+        })
+        .collect();
+    write(
+        "weights.bin",
+        &weights
+            .values
+            .iter()
+            .flat_map(|v| v.to_le_bytes())
+            .collect::<Vec<u8>>(),
+    )?;
+    let config = &file.config;
+    let manifest = json!({
+        "format": "nprt-export",
+        "version": EXPORT_VERSION,
+        "model": {
+            "design": config.design.to_string(),
+            "direct": config.direct.to_string(),
+            "bounds": file.bounds,
+            "output_gain": file.output_gain(),
+            "map_norm": config.map_norm.to_string(),
+            "scene": file.scene,
+        },
+        "encoder": { "input_width": config.encoder_width, "blocks": convs, "to_code": to_code },
+        "tracks": tracks,
+        "kernels": kernels,
+        "weights": { "file": "weights.bin", "dtype": "f32le", "tensors": weights.tensors },
+    });
+    write(
+        "export.json",
+        serde_json::to_string_pretty(&manifest)?.as_bytes(),
+    )?;
+    let no_example = match example(model_dir, &file, view)? {
+        Example::Files(example) => {
+            for (name, bytes) in example {
+                write(&name, &bytes)?;
+            }
+            for (name, text) in EXAMPLE_PAGE {
+                write(name, text.as_bytes())?;
+            }
+            None
+        }
+        Example::Skipped(why) => Some(why),
+    };
+    Ok(ExportSummary {
+        files,
+        weights: weights.values.len(),
+        no_example,
+    })
+}
+
+/// The worked example's files (name in the export, contents), or why there is none.
+enum Example {
+    Files(Vec<(String, Vec<u8>)>),
+    Skipped(String),
+}
+
+/// The worked example's data: a G-buffer of the model's scene (`gbuffer.bin`: per pixel the
+/// 19 network inputs and the foreground mask), the encoder's input for a lighting
+/// (`light.bin`), the CPU engine's radiance of the same (`reference.bin`), and
+/// `example.json` saying what they are.
+fn example(model_dir: &Path, file: &nprt_net::ModelFile, view: &ExampleView) -> Result<Example> {
+    // The page shades its rows in one block (relight.js).
+    if view.width as usize * view.height as usize > 65_536 {
+        bail!(
+            "the worked example's G-buffer is {}×{}: at most 65,536 pixels",
+            view.width,
+            view.height
+        );
+    }
+    nprt_trace::Frame::check_size(view.width, view.height, "the worked example's G-buffer")?;
+    if file.scene.is_empty() {
+        return Ok(Example::Skipped(
+            "the model does not record its scene".into(),
+        ));
+    }
+    let scene = nprt_data::dataset::load_checked_scene(
+        &file.scene,
+        &file.scene_hash,
+        &format!("model '{}' was trained on", model_dir.display()),
+    )?;
+    let Some(volume) = &scene.camera_volume else {
+        return Ok(Example::Skipped(format!(
+            "scene '{}' has no camera volume",
+            file.scene
+        )));
+    };
+    let camera = CameraPath::through_volume(volume).camera(0.0, view.width, view.height);
+    let ts = TraceScene::new(&scene);
+    let g = render_gbuffer(&ts, &camera);
+    let map = nprt_scene::open_envmap(&view.map)?;
+    let relighter = Relighter::load(model_dir, &Device::flex())?;
+    let reference = relighter.shade(&g, &relighter.light_code(&map, 0.0));
+    let config = &file.config;
+    let input = LightInput::new(&map, 0.0, config.encoder_width, config.map_norm);
+    let gain = file.output_gain();
+    let scale: [f32; 3] = std::array::from_fn(|k| input.scale[k] * gain[k]);
+    let gbuffer: Vec<f32> = (0..g.mask.len())
+        .flat_map(|i| {
+            let mut f = gbuffer_features(&file.bounds, &g, i).to_vec();
+            f.push(g.mask[i]);
+            f
+        })
+        .collect();
+    let bytes = |v: &[f32]| v.iter().flat_map(|x| x.to_le_bytes()).collect::<Vec<u8>>();
+    let description = json!({
+        "width": view.width,
+        "height": view.height,
+        "map": view.map,
+        "rotation_deg": 0.0,
+        "gbuffer": { "file": "gbuffer.bin", "floats_per_pixel": FEATURES + 1, "layout": "19 network inputs, then the foreground mask, per pixel in row order" },
+        "light": { "file": "light.bin", "shape": [3, config.encoder_width / 2, config.encoder_width], "scale": scale },
+        "reference": { "file": "reference.bin", "floats_per_pixel": 3, "engine": "nprt's CPU engine" },
+        // A model that traces direct light leaves it to the renderer: its networks give the rest.
+        "network_radiance": if config.direct.is_learned() { "all of it" } else { "indirect light only" },
+    });
+    let reference: Vec<f32> = reference.iter().flat_map(|c| c.to_array()).collect();
+    Ok(Example::Files(vec![
+        (
+            "example/example.json".into(),
+            serde_json::to_vec_pretty(&description)?,
+        ),
+        ("example/gbuffer.bin".into(), bytes(&gbuffer)),
+        ("example/light.bin".into(), bytes(&input.pixels)),
+        ("example/reference.bin".into(), bytes(&reference)),
+    ]))
+}
+
+/// `wgsl` validated and translated to GLSL 4.30 and HLSL 5.1.
+pub fn translate(wgsl: &str) -> Result<(String, String)> {
+    use naga::back::{glsl, hlsl};
+    let module = naga::front::wgsl::parse_str(wgsl)
+        .map_err(|e| anyhow::anyhow!("{}", e.emit_to_string(wgsl)))?;
+    let info = naga::valid::Validator::new(
+        naga::valid::ValidationFlags::all(),
+        naga::valid::Capabilities::empty(),
+    )
+    .validate(&module)
+    .map_err(|e| anyhow::anyhow!("{}", e.emit_to_string(wgsl)))?;
+    let mut glsl_text = String::new();
+    // Explicit `layout(binding = N)`, N the WGSL binding, so that an engine binds the GLSL
+    // kernels exactly as the WGSL ones (HLSL's registers follow the bindings already).
+    let binding_map = module
+        .global_variables
+        .iter()
+        .filter_map(|(_, g)| g.binding)
+        .map(|b| (b, b.binding as u8))
+        .collect();
+    let options = glsl::Options {
+        version: glsl::Version::Desktop(430),
+        binding_map,
+        ..Default::default()
+    };
+    let pipeline = glsl::PipelineOptions {
+        shader_stage: naga::ShaderStage::Compute,
+        entry_point: "main".into(),
+        multiview: None,
+    };
+    glsl::Writer::new(
+        &mut glsl_text,
+        &module,
+        &info,
+        &options,
+        &pipeline,
+        Default::default(),
+    )?
+    .write()?;
+    let mut hlsl_text = String::new();
+    let options = hlsl::Options::default();
+    let pipeline = hlsl::PipelineOptions { entry_point: None };
+    hlsl::Writer::new(&mut hlsl_text, &options, &pipeline).write(&module, &info, None)?;
+    Ok((glsl_text, hlsl_text))
+}

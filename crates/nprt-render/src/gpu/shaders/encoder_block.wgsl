@@ -1,0 +1,63 @@
+// One block of the light encoder: 3×3 convolution to 32 channels with zero padding, ReLU, the
+// block's input added (zero beyond its channels), 2×2 max-pool. Input c_in × h × w, output
+// 32 × h/2 × w/2, channel-major as burn's tensors; one thread per output value.
+
+struct Block {
+    c_in: u32,
+    h: u32,
+    w: u32,
+    _pad: u32,
+}
+
+@group(0) @binding(0) var<uniform> p: Block;
+@group(0) @binding(1) var<storage, read> input: array<f32>;
+@group(0) @binding(2) var<storage, read> weight: array<f32>;
+@group(0) @binding(3) var<storage, read> bias: array<f32>;
+@group(0) @binding(4) var<storage, read_write> out: array<f32>;
+
+const CHANNELS: u32 = 32u;
+
+fn conv(c: u32, y: u32, x: u32) -> f32 {
+    var s = 0.0;
+    for (var ci = 0u; ci < p.c_in; ci++) {
+        for (var ky = 0u; ky < 3u; ky++) {
+            let yy = i32(y + ky) - 1;
+            if (yy < 0 || yy >= i32(p.h)) {
+                continue;
+            }
+            for (var kx = 0u; kx < 3u; kx++) {
+                let xx = i32(x + kx) - 1;
+                if (xx < 0 || xx >= i32(p.w)) {
+                    continue;
+                }
+                s += weight[((c * p.c_in + ci) * 3u + ky) * 3u + kx]
+                    * input[(ci * p.h + u32(yy)) * p.w + u32(xx)];
+            }
+        }
+    }
+    return s + bias[c];
+}
+
+@compute @workgroup_size(64)
+fn main(@builtin(global_invocation_id) id: vec3<u32>) {
+    let ho = p.h / 2u;
+    let wo = p.w / 2u;
+    let i = id.x;
+    if (i >= CHANNELS * ho * wo) {
+        return;
+    }
+    let c = i / (ho * wo);
+    let oy = (i / wo) % ho;
+    let ox = i % wo;
+    var m = -3.0e38;
+    for (var d = 0u; d < 4u; d++) {
+        let y = 2u * oy + d / 2u;
+        let x = 2u * ox + d % 2u;
+        var v = max(conv(c, y, x), 0.0);
+        if (c < p.c_in) {
+            v += input[(c * p.h + y) * p.w + x];
+        }
+        m = max(m, v);
+    }
+    out[i] = m;
+}

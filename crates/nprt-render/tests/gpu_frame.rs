@@ -1,0 +1,115 @@
+//! The GPU frame path's kernels (crate::gpu) against the CPU engine they must agree with:
+//! light codes and radiance of every design, both activations, with and without the hash
+//! grid, on a real G-buffer. Runs on whatever adapter wgpu finds; CI's is Mesa's software
+//! Vulkan (scripts/vulkan.sh). Without one the tests skip, unless NPRT_REQUIRE_VULKAN is set
+//! (scripts/test sets it once lavapipe is installed).
+#![cfg(feature = "wgpu")]
+
+use glam::Vec3;
+use nprt_net::cpu::{HostEncoder, HostTransport};
+use nprt_net::{
+    gbuffer_features, Activation, Design, Device, Init, LightInput, MapNorm, ModelConfig, NprtNet,
+    PositionEncoding,
+};
+use nprt_render::gpu::{GpuDevice, GpuNetwork};
+use nprt_scene::{load_scene, Camera, SceneOptions};
+use nprt_trace::{render_gbuffer, TraceScene};
+
+/// Whether a GPU adapter is here; panics where one is required and missing.
+fn gpu_present() -> bool {
+    match GpuDevice::get() {
+        Ok(gpu) => {
+            eprintln!("adapter: {}", gpu.adapter);
+            true
+        }
+        Err(e) if std::env::var_os("NPRT_REQUIRE_VULKAN").is_none() => {
+            eprintln!("skipped: {e:#}");
+            false
+        }
+        Err(e) => panic!("NPRT_REQUIRE_VULKAN is set but {e:#}"),
+    }
+}
+
+/// The network inputs of the foreground pixels of a 40 × 30 view of the built-in room.
+fn room_features() -> Vec<f32> {
+    let scene = load_scene("builtin:room", &SceneOptions::default()).unwrap();
+    let ts = TraceScene::new(&scene);
+    let (lo, hi) = scene.bounds();
+    let bounds = [lo.to_array(), hi.to_array()];
+    let eye = lo + (hi - lo) * Vec3::new(0.5, 0.6, 0.8);
+    let target = lo + (hi - lo) * Vec3::new(0.4, 0.3, 0.1);
+    let camera = Camera::look_at(eye, target, Vec3::Y, 70.0, 40, 30);
+    let g = render_gbuffer(&ts, &camera);
+    (0..g.mask.len())
+        .filter(|&i| g.mask[i] > 0.5)
+        .flat_map(|i| gbuffer_features(&bounds, &g, i))
+        .collect()
+}
+
+/// Largest |a − b| over the largest |b|.
+fn relative_difference(a: &[f32], b: &[f32]) -> f32 {
+    assert_eq!(a.len(), b.len());
+    let scale = b.iter().fold(0.0f32, |m, v| m.max(v.abs()));
+    a.iter()
+        .zip(b)
+        .fold(0.0f32, |m, (x, y)| m.max((x - y).abs()))
+        / scale
+}
+
+/// An untrained network, its hash grids (if any) scaled to values of order one so that the
+/// encoding weighs in the output as in a trained network (an untrained grid holds ±1e-4).
+fn model(design: Design, activation: Activation, encoding: PositionEncoding, seed: u64) -> NprtNet {
+    let config = ModelConfig {
+        encoder_width: 64,
+        encoding,
+        ..ModelConfig::new(design, Some(activation))
+    };
+    let mut net = config.build(&mut Init::new(seed, &Device::flex()));
+    for grid in net.tracks.iter_mut().filter_map(|t| t.grid.as_mut()) {
+        grid.table = grid.table.clone().map(|t| t.mul_scalar(1e4));
+    }
+    net
+}
+
+#[test]
+fn gpu_light_codes_and_radiance_match_the_cpu_engine_for_every_design() {
+    if !gpu_present() {
+        return;
+    }
+    let features = room_features();
+    assert!(features.len() > 19 * 500, "the view sees the room");
+    let map = nprt_scene::open_envmap("builtin:sky:25:40").unwrap();
+    let input = LightInput::new(&map, 30.0, 64, MapNorm::Channel);
+    let scale = [2.0, 1.0, 0.5];
+    let mut seed = 0;
+    for design in [Design::Baseline, Design::Prt, Design::Albedo, Design::Dsep] {
+        for activation in [Activation::Relu, Activation::Siren] {
+            for encoding in [PositionEncoding::None, PositionEncoding::HashGrid] {
+                seed += 1;
+                let net = model(design, activation, encoding, seed);
+                let gpu = GpuNetwork::new(&net).unwrap();
+                let code = gpu.light_code(&input);
+                let want_code = HostEncoder::from_burn(&net.encoder)
+                    .forward(&input.pixels, 64)
+                    .codes;
+                let code_error = relative_difference(&code, &want_code);
+                let rgb = gpu.radiance(&gpu.pixels(&features), &want_code, scale);
+                let host = HostTransport::from_net(&net);
+                let want = host.radiance(&features, &want_code, scale, None);
+                let error = relative_difference(&rgb, &want);
+                eprintln!(
+                    "{design} {activation} {encoding}: code {code_error:.2e}, radiance {error:.2e}"
+                );
+                // Lavapipe: at most 3e-7 and 1.4e-6 (the sums run in another order).
+                assert!(
+                    code_error < 3e-6,
+                    "{design} {activation} {encoding}: light code off by {code_error}"
+                );
+                assert!(
+                    error < 1e-5,
+                    "{design} {activation} {encoding}: radiance off by {error}"
+                );
+            }
+        }
+    }
+}

@@ -1,0 +1,301 @@
+//! `nprt export`: the kernels validate and translate, the weights lie where export.json says,
+//! and the worked example's WebGPU page, run in headless Chromium (Debian's, on its bundled
+//! SwiftShader; scripts/chromium.sh installs it), makes the CPU engine's image. Without
+//! Chromium that part skips, unless NPRT_REQUIRE_CHROMIUM is set (scripts/test sets it).
+#![cfg(feature = "wgpu")]
+
+mod common;
+
+use std::io::{BufRead, BufReader, Read, Write};
+use std::net::{TcpListener, TcpStream};
+use std::path::{Path, PathBuf};
+use std::sync::mpsc;
+use std::time::{Duration, Instant};
+
+use base64::Engine;
+use common::{fails, fresh_dir, ok, room_dataset};
+use serde_json::Value;
+
+const KERNELS: [&str; 5] = [
+    "encoder_block",
+    "track_inputs",
+    "dense",
+    "code_bias",
+    "combine",
+];
+
+#[test]
+fn export_writes_kernels_weights_and_a_worked_example_that_webgpu_runs() {
+    let dir = fresh_dir("export");
+    let data = dir.join("data");
+    room_dataset(&data, [8, 2], 16, 4);
+    let model = dir.join("model");
+    let m = model.to_str().unwrap();
+    ok(&[
+        "train",
+        "--data",
+        data.to_str().unwrap(),
+        "--out",
+        m,
+        "--arch",
+        "dsep",
+        "--epochs",
+        "1",
+        "--encoding",
+        "hash-grid",
+    ]);
+    let out = dir.join("export");
+    let printed = ok(&[
+        "export",
+        m,
+        "--out",
+        out.to_str().unwrap(),
+        "--example-res",
+        "48x36",
+    ]);
+    assert!(printed.contains("worked example: serve"), "{printed}");
+
+    for k in KERNELS {
+        let glsl = std::fs::read_to_string(out.join(format!("{k}.comp.glsl"))).unwrap();
+        assert!(
+            glsl.starts_with("#version 430 core") && glsl.contains("layout(std430, binding = 1)"),
+            "{k}: {glsl}"
+        );
+        let hlsl = std::fs::read_to_string(out.join(format!("{k}.hlsl"))).unwrap();
+        assert!(
+            hlsl.contains("register(b0)") && hlsl.contains("[numthreads("),
+            "{k}: {hlsl}"
+        );
+        assert!(out.join(format!("{k}.wgsl")).is_file());
+    }
+
+    // Every tensor where export.json says, back to back, and equal to the model's weights.
+    let manifest: Value =
+        serde_json::from_slice(&std::fs::read(out.join("export.json")).unwrap()).unwrap();
+    let bytes = std::fs::read(out.join("weights.bin")).unwrap();
+    let weights: Vec<f32> = bytes
+        .chunks_exact(4)
+        .map(|b| f32::from_le_bytes(b.try_into().unwrap()))
+        .collect();
+    let mut next = 0;
+    for t in manifest["weights"]["tensors"].as_array().unwrap() {
+        assert_eq!(t["offset"].as_u64().unwrap() as usize, next, "{t}");
+        next += t["shape"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|d| d.as_u64().unwrap() as usize)
+            .product::<usize>();
+    }
+    assert_eq!(next, weights.len());
+    let (_, net) = nprt_net::load_model(&model, &nprt_net::Device::flex()).unwrap();
+    assert_eq!(weights.len(), net.total_params());
+    let host = nprt_net::cpu::HostTransport::from_net(&net);
+    let tensor = |name: &str| {
+        let t = manifest["weights"]["tensors"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .find(|t| t["name"] == name)
+            .unwrap();
+        let n: usize = t["shape"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|d| d.as_u64().unwrap() as usize)
+            .product();
+        let o = t["offset"].as_u64().unwrap() as usize;
+        weights[o..o + n].to_vec()
+    };
+    assert_eq!(
+        tensor("track1.shading.0.weight"),
+        host.tracks[1].shading.layers[0].weight
+    );
+    assert_eq!(
+        tensor("track0.grid"),
+        *host.tracks[0].grid.as_ref().unwrap()
+    );
+    assert_eq!(manifest["tracks"][1]["kind"], "specular");
+    assert_eq!(manifest["tracks"][0]["width"], 9 + 16);
+
+    page_matches_the_cpu_engine(&out);
+
+    fails(
+        &[
+            "export",
+            m,
+            "--out",
+            out.to_str().unwrap(),
+            "--example-res",
+            "300x300",
+        ],
+        &["at most 65,536 pixels"],
+    );
+    let nowhere = dir.join("nowhere");
+    fails(
+        &[
+            "export",
+            nowhere.to_str().unwrap(),
+            "--out",
+            out.to_str().unwrap(),
+        ],
+        &["nowhere", "not a model folder"],
+    );
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+/// Serves `export` from localhost, opens its example page in headless Chromium with WebGPU on
+/// SwiftShader, and checks what the page reports: every foreground pixel within 1e-4 of the
+/// brightest value of the CPU engine's image (SwiftShader: ~1e-5). The page's canvas is kept
+/// as `example/page.png` for a person to look at.
+fn page_matches_the_cpu_engine(export: &Path) {
+    let Some(chromium) = chromium() else { return };
+    let (port, results) = serve(export.to_path_buf());
+    let profile = export.join("chromium-profile");
+    let mut browser = std::process::Command::new(chromium)
+        .args([
+            "--headless",
+            "--no-sandbox",
+            "--enable-unsafe-webgpu",
+            "--enable-features=Vulkan",
+            "--use-vulkan=swiftshader",
+            "--use-angle=swiftshader",
+            "--enable-unsafe-swiftshader",
+            "--ignore-gpu-blocklist",
+        ])
+        .arg(format!("--user-data-dir={}", profile.display()))
+        .arg(format!("http://127.0.0.1:{port}/example/?report"))
+        .stdout(std::process::Stdio::null())
+        .stderr(std::process::Stdio::null())
+        .spawn()
+        .expect("start chromium");
+    let result = results.recv_timeout(Duration::from_secs(240));
+    browser.kill().ok();
+    browser.wait().ok();
+    let result: Value =
+        serde_json::from_str(&result.expect("the page reports within 4 minutes")).unwrap();
+    assert!(result["error"].is_f64(), "the page failed: {result}");
+    let error = result["error"].as_f64().unwrap();
+    let example: Value =
+        serde_json::from_slice(&std::fs::read(export.join("example/example.json")).unwrap())
+            .unwrap();
+    assert_eq!(
+        (example["width"].as_u64(), example["height"].as_u64()),
+        (Some(48), Some(36))
+    );
+    assert!(result["rows"].as_u64().unwrap() > 48 * 36 / 2, "{result}");
+    assert!(
+        error < 1e-4,
+        "the page's image is off by {error} of the brightest value"
+    );
+    let png = result["image"]
+        .as_str()
+        .unwrap()
+        .strip_prefix("data:image/png;base64,")
+        .unwrap();
+    let png = base64::engine::general_purpose::STANDARD
+        .decode(png)
+        .unwrap();
+    std::fs::write(export.join("example/page.png"), png).unwrap();
+    let page = image::open(export.join("example/page.png"))
+        .unwrap()
+        .to_rgb8();
+    assert_eq!(page.dimensions(), (48, 36));
+    assert!(
+        page.pixels().any(|p| p.0.iter().any(|&c| c > 8)),
+        "the canvas shows the room"
+    );
+    eprintln!("page: {result:.80}", result = result.to_string());
+}
+
+/// Debian's Chromium, or None (the page test skipped) where it is not installed and not required.
+fn chromium() -> Option<PathBuf> {
+    let found = std::env::var_os("PATH")
+        .into_iter()
+        .flat_map(|p| std::env::split_paths(&p).collect::<Vec<_>>())
+        .map(|d| d.join("chromium"))
+        .find(|p| p.is_file());
+    if found.is_none() {
+        assert!(
+            std::env::var_os("NPRT_REQUIRE_CHROMIUM").is_none(),
+            "NPRT_REQUIRE_CHROMIUM is set but chromium is not on PATH (scripts/chromium.sh installs it)"
+        );
+        eprintln!("skipped the WebGPU page: chromium is not installed (scripts/chromium.sh)");
+    }
+    found
+}
+
+/// A static file server on a free localhost port for `root`, which passes the body of every
+/// POST to /result to the receiver.
+fn serve(root: PathBuf) -> (u16, mpsc::Receiver<String>) {
+    let listener = TcpListener::bind("127.0.0.1:0").unwrap();
+    let port = listener.local_addr().unwrap().port();
+    let (tx, rx) = mpsc::channel();
+    std::thread::spawn(move || {
+        for stream in listener.incoming().flatten() {
+            let (root, tx) = (root.clone(), tx.clone());
+            std::thread::spawn(move || answer(stream, &root, &tx));
+        }
+    });
+    (port, rx)
+}
+
+fn answer(stream: TcpStream, root: &Path, results: &mpsc::Sender<String>) {
+    let deadline = Instant::now() + Duration::from_secs(30);
+    stream.set_read_timeout(Some(Duration::from_secs(30))).ok();
+    let mut reader = BufReader::new(stream.try_clone().unwrap());
+    let mut line = String::new();
+    if reader.read_line(&mut line).is_err() || Instant::now() > deadline {
+        return;
+    }
+    let mut parts = line.split_whitespace();
+    let (method, target) = (parts.next().unwrap_or(""), parts.next().unwrap_or("/"));
+    let mut length = 0;
+    loop {
+        let mut header = String::new();
+        if reader.read_line(&mut header).unwrap_or(0) == 0 || header.trim().is_empty() {
+            break;
+        }
+        if let Some((name, value)) = header.split_once(':') {
+            if name.eq_ignore_ascii_case("content-length") {
+                length = value.trim().parse().unwrap_or(0);
+            }
+        }
+    }
+    let mut stream = stream;
+    if method == "POST" {
+        let mut body = vec![0; length];
+        reader.read_exact(&mut body).ok();
+        results
+            .send(String::from_utf8_lossy(&body).into_owned())
+            .ok();
+        stream
+            .write_all(b"HTTP/1.1 200 OK\r\nContent-Length: 0\r\nConnection: close\r\n\r\n")
+            .ok();
+        return;
+    }
+    let path = target
+        .split('?')
+        .next()
+        .unwrap_or("/")
+        .trim_start_matches('/');
+    let path = if path.is_empty() || path.ends_with('/') {
+        format!("{path}index.html")
+    } else {
+        path.to_string()
+    };
+    let file = root.join(&path);
+    let (status, body) = match std::fs::read(&file) {
+        Ok(b) if !path.contains("..") => ("200 OK", b),
+        _ => ("404 Not Found", Vec::new()),
+    };
+    let kind = match file.extension().and_then(|e| e.to_str()) {
+        Some("html") => "text/html",
+        Some("js") => "text/javascript",
+        Some("json") => "application/json",
+        _ => "application/octet-stream",
+    };
+    let head = format!("HTTP/1.1 {status}\r\nContent-Type: {kind}\r\nContent-Length: {}\r\nConnection: close\r\n\r\n", body.len());
+    stream.write_all(head.as_bytes()).ok();
+    stream.write_all(&body).ok();
+}
