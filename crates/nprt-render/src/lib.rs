@@ -23,6 +23,7 @@
 //! ```
 
 mod animation;
+mod frame_bench;
 #[cfg(feature = "wgpu")]
 pub mod gpu;
 pub mod oidn;
@@ -33,6 +34,7 @@ pub mod schedule;
 mod sequence;
 
 pub use animation::{write_animation, Animation};
+pub use frame_bench::{bench_frame, FrameBenchOptions, FrameBenchRow};
 pub use path::CameraPath;
 pub use relight::{
     background, DirectSampling, FrameTimings, LightCode, Pixels, Relighter, DEFAULT_DIRECT_SPP,

@@ -105,20 +105,25 @@ impl Relighter {
     /// kernels (crate::gpu), with the weights read on the host; any other runs burn's
     /// network, through the CPU engine where it applies.
     pub fn load(dir: &Path, device: &Device) -> Result<Self> {
+        let on = Self::weights_device(device);
+        let (file, net) = load_model(dir, &on)?;
+        Self::new(file, net, device)
+    }
+
+    /// A model with `file`'s settings and the weights of `net` (which lives on
+    /// [`Self::weights_device`] of `device`), to run on `device`.
+    pub fn new(file: ModelFile, net: NprtNet, device: &Device) -> Result<Self> {
         #[cfg(feature = "wgpu")]
         if nprt_net::Backend::of(device) == nprt_net::Backend::Wgpu {
-            let host_device = Device::flex();
-            let (file, net) = load_model(dir, &host_device)?;
             let gpu = Some(crate::gpu::GpuNetwork::new(&net)?);
             return Ok(Relighter {
                 file,
                 net,
-                device: host_device,
+                device: Device::flex(),
                 host: None,
                 gpu,
             });
         }
-        let (file, net) = load_model(dir, device)?;
         let host = cpu::applies(&net, device).then(|| HostTransport::from_net(&net));
         Ok(Relighter {
             file,
@@ -128,6 +133,16 @@ impl Relighter {
             #[cfg(feature = "wgpu")]
             gpu: None,
         })
+    }
+
+    /// Where a model's weights are loaded to run on `device`: the host for the frame path's
+    /// kernels, which upload them themselves; `device` itself otherwise.
+    pub fn weights_device(device: &Device) -> Device {
+        if cfg!(feature = "wgpu") && nprt_net::Backend::of(device) == nprt_net::Backend::Wgpu {
+            Device::flex()
+        } else {
+            device.clone()
+        }
     }
 
     /// Where the networks run, for reports: "CPU engine", "GPU kernels on ADAPTER" or burn's

@@ -1,16 +1,16 @@
-//! `nprt bench train` and `nprt bench infer`: flags and tables; the measurements are
-//! `nprt_net::bench`.
+//! `nprt bench train`, `infer` and `frame`: flags and tables; the measurements are
+//! `nprt_net::bench` and `nprt_render::bench_frame`.
 
 use std::path::PathBuf;
 
 use anyhow::Result;
 use nprt_net::bench::pytorch_peer::{PeerRun, PeerScript};
 use nprt_net::{
-    device_name, is_cpu, measure_throughput, median, Activation, Backend, Design, Engine,
-    ModelConfig,
+    device_name, is_cpu, measure_throughput, median, Activation, Backend, Design, DirectLight,
+    Engine, ModelConfig,
 };
 
-use crate::flags::DeviceArg;
+use crate::flags::{DeviceArg, Resolution};
 
 #[derive(clap::Subcommand)]
 pub enum BenchCommand {
@@ -24,6 +24,36 @@ pub enum BenchCommand {
     /// under a still camera (transfer outputs kept), with achieved GFLOP/s beside the machine's
     /// f32 peak (measured with register-resident FMA chains on as many threads).
     Infer(BenchInferArgs),
+    /// What a relit frame costs, stage by stage (G-buffer, light encoder, networks, direct
+    /// light), per design and resolution, with untrained networks (the cost does not depend on
+    /// the weights): a frame from a new viewpoint under a new lighting, and a lighting change
+    /// under a still camera. `--device wgpu` runs the networks as nprt's GPU kernels on
+    /// whatever adapter wgpu finds.
+    Frame(BenchFrameArgs),
+}
+
+#[derive(clap::Args)]
+pub struct BenchFrameArgs {
+    #[command(flatten)]
+    designs: BenchDesigns,
+    /// Also time D/S with its direct light traced at run time (`--direct traced`), with this
+    /// many samples per pixel; 0 leaves it out.
+    #[arg(long, default_value_t = nprt_render::DEFAULT_DIRECT_SPP)]
+    direct_spp: u32,
+    /// Frame sizes, comma-separated, N or WxH (the paper's Table 3: 512; full HD 1920x1080).
+    #[arg(long, default_value = "512,1920x1080", value_delimiter = ',')]
+    res: Vec<Resolution>,
+    /// The scene (one with a camera volume: a built-in, or a file with its NAME.camera.json).
+    #[arg(long, default_value = "builtin:room")]
+    scene: String,
+    /// The lighting: an .exr/.hdr map or a built-in spec.
+    #[arg(long, default_value = "builtin:sky:30:250:3")]
+    map: String,
+    /// Timed frames per measurement, after one untimed; the median is reported.
+    #[arg(long, default_value_t = 5)]
+    repeats: usize,
+    #[command(flatten)]
+    device: DeviceArg,
 }
 
 /// The designs a benchmark measures.
@@ -87,7 +117,70 @@ pub fn run(cmd: BenchCommand) -> Result<()> {
     match cmd {
         BenchCommand::Train(a) => train(a),
         BenchCommand::Infer(a) => infer(a),
+        BenchCommand::Frame(a) => frame(a),
     }
+}
+
+fn frame(a: BenchFrameArgs) -> Result<()> {
+    let device = a.device.device()?;
+    let mut models: Vec<(Design, DirectLight)> = a
+        .designs
+        .arch
+        .iter()
+        .map(|&d| (d, DirectLight::Learned))
+        .collect();
+    if a.direct_spp > 0 {
+        models.push((Design::Dsep, DirectLight::Traced));
+    }
+    let opts = nprt_render::FrameBenchOptions {
+        scene: a.scene,
+        models,
+        resolutions: a.res.iter().map(|r| r.0).collect(),
+        repeats: a.repeats.max(1),
+        direct_spp: a.direct_spp,
+        map: a.map,
+    };
+    println!(
+        "relit frames of {} under {}, median of {} (ms; G-buffer and direct light on the CPU tracer, {} threads)",
+        opts.scene,
+        opts.map,
+        opts.repeats,
+        rayon::current_num_threads()
+    );
+    let mut header = true;
+    nprt_render::bench_frame(&opts, &device, |r| {
+        if header {
+            println!("networks on the {}", r.networks_on);
+            println!(
+                "{:<14} {:>10} {:>9} {:>9} {:>8} {:>9} {:>8} {:>9} {:>7} {:>11}",
+                "design",
+                "size",
+                "pixels",
+                "G-buffer",
+                "encoder",
+                "networks",
+                "direct",
+                "total",
+                "fps",
+                "relight ms"
+            );
+            header = false;
+        }
+        let t = &r.frame;
+        println!(
+            "{:<14} {:>10} {:>9} {:>9.1} {:>8.1} {:>9.1} {:>8.1} {:>9.1} {:>7.2} {:>11.1}",
+            r.label,
+            format!("{}×{}", r.resolution[0], r.resolution[1]),
+            r.foreground,
+            t.gbuffer_ms,
+            t.encoder_ms,
+            t.network_ms,
+            t.direct_ms,
+            t.total_ms(),
+            1e3 / t.total_ms(),
+            r.relight_ms
+        );
+    })
 }
 
 fn infer(a: BenchInferArgs) -> Result<()> {

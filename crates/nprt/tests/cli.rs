@@ -355,3 +355,61 @@ fn bench_train_alternates_rounds_with_the_peer_and_compares_medians() {
         &["PyTorch peer failed: boom"],
     );
 }
+
+#[test]
+fn bench_frame_times_every_stage_on_each_device() {
+    let mut devices = vec!["cpu"];
+    if common::wgpu_runs() {
+        devices.push("wgpu");
+    }
+    for device in devices {
+        let args = "bench frame --arch prt --res 48x32,32 --repeats 1 --direct-spp 16 --device";
+        let mut args: Vec<&str> = args.split(' ').collect();
+        args.push(device);
+        let out = common::ok(&args);
+        let rows: Vec<(&str, Vec<f64>)> = out
+            .lines()
+            .filter(|l| l.starts_with("prt") || l.starts_with("dsep+direct"))
+            .map(|l| {
+                (
+                    l,
+                    l.split_whitespace()
+                        .skip(2)
+                        .map(|c| c.parse().unwrap())
+                        .collect(),
+                )
+            })
+            .collect();
+        assert_eq!(rows.len(), 4, "{out}");
+        for (row, cols) in &rows {
+            let [pixels, gbuffer, encoder, networks, direct, total, _fps, relight] = cols[..]
+            else {
+                panic!("{row}")
+            };
+            assert!(
+                pixels > 0.0 && gbuffer > 0.0 && encoder > 0.0 && networks > 0.0 && relight > 0.0,
+                "{row}"
+            );
+            assert!(
+                (total - (gbuffer + encoder + networks + direct)).abs() < 0.2,
+                "{row}"
+            );
+        }
+        // At each size traced light costs more than filling the background.
+        for k in 0..2 {
+            let (learned, traced) = (&rows[k], &rows[k + 2]);
+            assert!(
+                traced.1[4] > 3.0 * learned.1[4].max(0.05),
+                "{} / {}",
+                learned.0,
+                traced.0
+            );
+        }
+        let on = if device == "cpu" {
+            "networks on the CPU engine"
+        } else {
+            "networks on the GPU kernels on"
+        };
+        assert!(out.contains(on), "{out}");
+    }
+}

@@ -50,6 +50,25 @@ pub struct ModelFile {
 }
 
 impl ModelFile {
+    /// The file of an untrained network `net` built from `config`, for a scene with these
+    /// bounds: what benchmarks time, whose cost does not depend on the weights.
+    pub fn untrained(config: ModelConfig, net: &NprtNet, bounds: [[f32; 3]; 2]) -> Self {
+        let transport_params = net.transport_params();
+        ModelFile {
+            format: MODEL_FORMAT.into(),
+            version: MODEL_VERSION,
+            config,
+            bounds,
+            scene: String::new(),
+            scene_hash: String::new(),
+            dataset_hash: String::new(),
+            transport_params,
+            encoder_params: net.total_params() - transport_params,
+            training: serde_json::Value::Null,
+            level_gain: None,
+        }
+    }
+
     /// The gain on each channel of the network's radiance (1 without calibration).
     pub fn output_gain(&self) -> [f32; 3] {
         self.level_gain.unwrap_or([1.0; 3])

@@ -1,0 +1,136 @@
+//! `nprt bench frame`: what a relit frame costs, stage by stage (G-buffer, light encoder,
+//! networks, direct light), per design and resolution, on the device the networks run on.
+//! Untrained networks are timed: a frame's cost does not depend on the weights.
+
+use std::time::Instant;
+
+use anyhow::{Context, Result};
+use nprt_net::model::folder::ModelFile;
+use nprt_net::{Design, Device, DirectLight, Init, ModelConfig};
+use nprt_scene::{load_scene, SceneOptions};
+use nprt_trace::{render_gbuffer, TraceScene};
+
+use crate::relight::{DirectSampling, FrameTimings, Relighter};
+use crate::CameraPath;
+
+/// What to time.
+pub struct FrameBenchOptions {
+    /// A scene with a camera volume (its sidecar, or a built-in scene's).
+    pub scene: String,
+    /// The models: a design and who supplies its direct light.
+    pub models: Vec<(Design, DirectLight)>,
+    pub resolutions: Vec<[u32; 2]>,
+    /// Timed frames per measurement, after one untimed; medians are reported.
+    pub repeats: usize,
+    /// Samples per pixel of traced direct light.
+    pub direct_spp: u32,
+    /// The lighting (a map file or built-in spec), turned by a different angle every frame so
+    /// that each runs the encoder.
+    pub map: String,
+}
+
+/// One model at one resolution.
+pub struct FrameBenchRow {
+    pub label: String,
+    pub resolution: [u32; 2],
+    /// Pixels the networks shade.
+    pub foreground: usize,
+    /// Medians of a frame from a new viewpoint under a new lighting.
+    pub frame: FrameTimings,
+    /// Median of a lighting change under a still camera: the encoder and the shading networks.
+    pub relight_ms: f64,
+    /// Where the networks ran.
+    pub networks_on: String,
+}
+
+/// Times every model at every resolution, calling `on_row` as each is done.
+pub fn bench_frame(
+    opts: &FrameBenchOptions,
+    device: &Device,
+    mut on_row: impl FnMut(&FrameBenchRow),
+) -> Result<()> {
+    let scene = load_scene(&opts.scene, &SceneOptions::default())?;
+    let volume = scene.camera_volume.as_ref().with_context(|| {
+        format!(
+            "scene '{}' has no camera volume (sidecar NAME.camera.json) to place the camera",
+            opts.scene
+        )
+    })?;
+    let path = CameraPath::through_volume(volume);
+    let map = &nprt_scene::open_envmap(&opts.map)?;
+    let (lo, hi) = scene.bounds();
+    let ts = TraceScene::new(&scene);
+    let ms = |t: Instant| t.elapsed().as_secs_f64() * 1e3;
+    let median = |v: Vec<f64>| nprt_net::median(v);
+    for &(design, direct) in &opts.models {
+        let config = ModelConfig {
+            direct,
+            ..ModelConfig::new(design, None)
+        };
+        let net = config.build(&mut Init::new(1, &Relighter::weights_device(device)));
+        let file = ModelFile::untrained(config.clone(), &net, [lo.to_array(), hi.to_array()]);
+        let model = Relighter::new(file, net, device)?;
+        for &[w, h] in &opts.resolutions {
+            nprt_trace::Frame::check_size(w, h, &format!("a {w}×{h} frame"))?;
+            let camera = path.camera(0.5, w, h);
+            let mut frames = Vec::new();
+            let mut relights = Vec::new();
+            let mut foreground = 0;
+            for i in 0..=opts.repeats {
+                let rotation = 10.0 * i as f32;
+                let mut t = FrameTimings::default();
+                let clock = Instant::now();
+                let g = render_gbuffer(&ts, &camera);
+                t.gbuffer_ms = ms(clock);
+                let clock = Instant::now();
+                let code = model.light_code(map, rotation);
+                t.encoder_ms = ms(clock);
+                let clock = Instant::now();
+                let px = model.pixels(&g);
+                let mut rgb = model.relight(&px, &code);
+                t.network_ms = ms(clock);
+                let clock = Instant::now();
+                let sampling = DirectSampling {
+                    spp: opts.direct_spp,
+                    seed: i as u64,
+                    denoiser: None,
+                };
+                model.complete(
+                    &ts,
+                    &camera,
+                    &map.rotated_y(rotation),
+                    &g,
+                    sampling,
+                    &mut rgb,
+                )?;
+                t.direct_ms = ms(clock);
+                // A lighting change under the still camera.
+                let clock = Instant::now();
+                let code = model.light_code(map, rotation + 5.0);
+                model.relight(&px, &code);
+                let relight = ms(clock);
+                foreground = g.mask.iter().filter(|&&m| m > 0.5).count();
+                // The first frame is untimed: a GPU compiles and allocates on first use.
+                if i > 0 {
+                    frames.push(t);
+                    relights.push(relight);
+                }
+            }
+            let stage = |f: fn(&FrameTimings) -> f64| median(frames.iter().map(f).collect());
+            on_row(&FrameBenchRow {
+                label: config.label(),
+                resolution: [w, h],
+                foreground,
+                frame: FrameTimings {
+                    gbuffer_ms: stage(|t| t.gbuffer_ms),
+                    encoder_ms: stage(|t| t.encoder_ms),
+                    network_ms: stage(|t| t.network_ms),
+                    direct_ms: stage(|t| t.direct_ms),
+                },
+                relight_ms: median(relights),
+                networks_on: model.networks_on(),
+            });
+        }
+    }
+    Ok(())
+}
