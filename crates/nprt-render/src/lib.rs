@@ -32,6 +32,8 @@ mod relight;
 mod render_job;
 pub mod schedule;
 mod sequence;
+#[cfg(feature = "view")]
+pub mod view;
 
 pub use animation::{write_animation, Animation};
 pub use frame_bench::{bench_frame, FrameBenchOptions, FrameBenchRow};

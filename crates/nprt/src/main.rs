@@ -18,6 +18,7 @@ mod reference;
 mod render;
 mod train;
 mod train_deep_shading;
+mod view;
 
 // Training allocates and frees large tensors every step; glibc's allocator returns that memory
 // to the OS and page-faults it back each time (measured: 8% of a training step).
@@ -79,6 +80,11 @@ enum Command {
     /// with GLSL and HLSL translations) and its weights in a documented layout
     /// (docs/export.md). Needs the `wgpu` feature.
     Export(export::ExportArgs),
+    /// A window that relights trained models as you go: orbit (drag), dolly (wheel) and fly
+    /// (WASDQE) the camera, turn the map (right-drag), switch maps (M) and models (Tab), a
+    /// progressive path-traced reference of the view (R), per-stage timings on screen, and
+    /// screenshots (P). Needs the `wgpu` feature and a display (Xvfb will do).
+    View(view::ViewArgs),
 }
 
 fn main() {
@@ -132,5 +138,6 @@ fn run(cli: Cli) -> Result<()> {
         Command::Eval(a) => eval::command(a),
         Command::TrainDeepShading(a) => train_deep_shading::command(a),
         Command::Export(a) => export::run(a),
+        Command::View(a) => view::run(a),
     }
 }

@@ -1,0 +1,168 @@
+//! `nprt view` opens its window on an X display (a private Xvfb when there is none; scripts/
+//! xvfb.sh installs it), draws through wgpu on Mesa's software Vulkan, and writes what it
+//! shows: the overlay over the frame, and without it the frame `nprt render` makes of the same
+//! camera and lighting. Without Xvfb and a display the test skips, unless NPRT_REQUIRE_XVFB is
+//! set (scripts/test sets it).
+#![cfg(feature = "wgpu")]
+
+mod common;
+
+use std::path::Path;
+use std::process::{Child, Command, Stdio};
+
+use common::{fresh_dir, ok, room_dataset};
+
+/// An X display for the viewer: the environment's, or a private Xvfb (killed on drop).
+struct Display {
+    name: String,
+    server: Option<Child>,
+}
+
+impl Drop for Display {
+    fn drop(&mut self) {
+        if let Some(server) = &mut self.server {
+            server.kill().ok();
+            server.wait().ok();
+        }
+    }
+}
+
+fn display() -> Option<Display> {
+    if let Ok(name) = std::env::var("DISPLAY") {
+        return Some(Display { name, server: None });
+    }
+    // A display number of this process's own, so that parallel runs do not collide.
+    let name = format!(":{}", 100 + std::process::id() % 800);
+    match Command::new("Xvfb")
+        .args([&name, "-screen", "0", "640x480x24", "-nolisten", "tcp"])
+        .stdout(Stdio::null())
+        .stderr(Stdio::null())
+        .spawn()
+    {
+        Ok(server) => {
+            let socket = format!("/tmp/.X11-unix/X{}", &name[1..]);
+            for _ in 0..100 {
+                if Path::new(&socket).exists() {
+                    break;
+                }
+                std::thread::sleep(std::time::Duration::from_millis(50));
+            }
+            Some(Display {
+                name,
+                server: Some(server),
+            })
+        }
+        Err(e) => {
+            assert!(
+                std::env::var_os("NPRT_REQUIRE_XVFB").is_none(),
+                "NPRT_REQUIRE_XVFB is set but Xvfb does not start: {e}"
+            );
+            eprintln!("skipped: no display and no Xvfb ({e}); scripts/xvfb.sh installs it");
+            None
+        }
+    }
+}
+
+/// Runs `nprt view` on `display`, expecting success.
+fn view(display: &Display, args: &[&str]) {
+    let out = Command::new(env!("CARGO_BIN_EXE_nprt"))
+        .arg("view")
+        .args(args)
+        .env("DISPLAY", &display.name)
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "nprt view {args:?}: {}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+}
+
+#[test]
+fn the_viewer_opens_a_window_and_shows_what_render_makes() {
+    let Some(display) = display() else { return };
+    let dir = fresh_dir("view");
+    let data = dir.join("data");
+    room_dataset(&data, [8, 2], 16, 4);
+    let model = dir.join("model");
+    let m = model.to_str().unwrap();
+    ok(&[
+        "train",
+        "--data",
+        data.to_str().unwrap(),
+        "--out",
+        m,
+        "--arch",
+        "prt",
+        "--epochs",
+        "1",
+    ]);
+
+    // With the overlay: text over the frame, in the top-left corner.
+    let shot = dir.join("overlay.png");
+    view(
+        &display,
+        &[
+            m,
+            "--res",
+            "160x120",
+            "--frames",
+            "3",
+            "--spin",
+            "30",
+            "--screenshot",
+            shot.to_str().unwrap(),
+        ],
+    );
+    let img = image::open(&shot).unwrap().to_rgb8();
+    assert_eq!(img.dimensions(), (160, 120));
+    let white = |x0: u32, y0: u32, x1: u32, y1: u32| {
+        (y0..y1)
+            .flat_map(|y| (x0..x1).map(move |x| (x, y)))
+            .filter(|&(x, y)| img.get_pixel(x, y).0 == [255; 3])
+            .count()
+    };
+    assert!(white(0, 0, 160, 20) > 40, "the overlay's first lines");
+
+    // Without it: the frame nprt render makes from the same camera (the default path's start)
+    // and lighting (its first map, unturned), to within rounding of the camera's frame.
+    let bare = dir.join("bare.png");
+    view(
+        &display,
+        &[
+            m,
+            "--res",
+            "160x120",
+            "--frames",
+            "1",
+            "--no-overlay",
+            "--screenshot",
+            bare.to_str().unwrap(),
+        ],
+    );
+    let r = dir.join("render");
+    ok(&[
+        "render",
+        "--model",
+        m,
+        "--out",
+        r.to_str().unwrap(),
+        "--frames",
+        "1",
+        "--res",
+        "160x120",
+    ]);
+    let shown = image::open(&bare).unwrap().to_rgb8();
+    let rendered = image::open(r.join("frames/0000.png")).unwrap().to_rgb8();
+    let (mut differ, mut lit) = (0, 0);
+    for (a, b) in shown.pixels().zip(rendered.pixels()) {
+        differ += usize::from(a.0.iter().zip(b.0).any(|(x, y)| x.abs_diff(y) > 2));
+        lit += usize::from(a.0.iter().any(|&c| c > 16));
+    }
+    assert!(
+        differ * 100 < 160 * 120,
+        "{differ} pixels differ from nprt render's frame"
+    );
+    assert!(lit * 2 > 160 * 120, "the frame shows the room");
+    std::fs::remove_dir_all(&dir).unwrap();
+}
