@@ -131,6 +131,10 @@ fn export_writes_kernels_weights_and_a_worked_example_that_webgpu_runs() {
         ],
         &["at most 65,536 pixels"],
     );
+    fails(
+        &["export", m, "--out", "/dev/null"],
+        &["'/dev/null' is not a folder"],
+    );
     let nowhere = dir.join("nowhere");
     fails(
         &[

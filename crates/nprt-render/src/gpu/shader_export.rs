@@ -84,6 +84,9 @@ impl WeightFile {
 /// each atomically), with a worked example relighting `view` of its scene.
 pub fn export_model(model_dir: &Path, out: &Path, view: &ExampleView) -> Result<ExportSummary> {
     let (file, net) = load_model(model_dir, &Device::flex())?;
+    if out.exists() && !out.is_dir() {
+        bail!("--out '{}' is not a folder", out.display());
+    }
     let mut files = Vec::new();
     let mut write = |name: &str, bytes: &[u8]| -> Result<()> {
         let path = out.join(name);
