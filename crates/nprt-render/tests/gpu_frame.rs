@@ -113,3 +113,25 @@ fn gpu_light_codes_and_radiance_match_the_cpu_engine_for_every_design() {
         }
     }
 }
+
+#[test]
+fn the_widest_encoder_input_gets_the_cpu_engines_light_code() {
+    if !gpu_present() {
+        return;
+    }
+    // 1024 wide: the first block's 65,536 workgroups need a second dimension.
+    let width = nprt_net::network::encoder::MAX_INPUT_WIDTH;
+    let config = ModelConfig {
+        encoder_width: width,
+        ..ModelConfig::new(Design::Prt, None)
+    };
+    let net = config.build(&mut Init::new(7, &Device::flex()));
+    let map = nprt_scene::open_envmap("builtin:indoor:4").unwrap();
+    let input = LightInput::new(&map, 0.0, width, MapNorm::Channel);
+    let code = GpuNetwork::new(&net).unwrap().light_code(&input);
+    let want = HostEncoder::from_burn(&net.encoder)
+        .forward(&input.pixels, width)
+        .codes;
+    let error = relative_difference(&code, &want);
+    assert!(error < 3e-6, "light code off by {error}");
+}

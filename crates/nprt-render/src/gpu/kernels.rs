@@ -116,7 +116,13 @@ impl Kernels {
     }
 }
 
-/// Workgroups for `n` threads of a one-dimensional kernel.
+/// Workgroups for `n` threads of a one-dimensional kernel: a second dimension where one would
+/// exceed the 65,535 workgroups every adapter allows (the first encoder block of a 1024-wide
+/// map has 65,536); the kernels number their threads x + y · (workgroups along x) · 64.
 pub fn groups_for(n: usize) -> [u32; 2] {
-    [(n as u32).div_ceil(GROUP), 1]
+    let groups = (n as u32).div_ceil(GROUP);
+    let rows = groups.div_ceil(MAX_GROUPS);
+    [groups.div_ceil(rows), rows]
 }
+
+const MAX_GROUPS: u32 = 65_535;

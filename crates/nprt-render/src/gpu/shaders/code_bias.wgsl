@@ -16,8 +16,9 @@ struct CodeBias {
 @group(0) @binding(4) var<storage, read_write> out: array<f32>;
 
 @compute @workgroup_size(64)
-fn main(@builtin(global_invocation_id) id: vec3<u32>) {
-    let o = id.x;
+fn main(@builtin(global_invocation_id) id: vec3<u32>, @builtin(num_workgroups) groups: vec3<u32>) {
+    // Rows of workgroups past the 65,535 one dimension allows.
+    let o = id.x + id.y * groups.x * 64u;
     if (o >= p.d_out) {
         return;
     }

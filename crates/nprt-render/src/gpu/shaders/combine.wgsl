@@ -43,8 +43,9 @@ fn outputs(kind: u32) -> u32 {
 }
 
 @compute @workgroup_size(64)
-fn main(@builtin(global_invocation_id) id: vec3<u32>) {
-    let r = id.x;
+fn main(@builtin(global_invocation_id) id: vec3<u32>, @builtin(num_workgroups) groups: vec3<u32>) {
+    // Rows of workgroups past the 65,535 one dimension allows.
+    let r = id.x + id.y * groups.x * 64u;
     if (r >= p.rows) {
         return;
     }

@@ -39,10 +39,11 @@ fn conv(c: u32, y: u32, x: u32) -> f32 {
 }
 
 @compute @workgroup_size(64)
-fn main(@builtin(global_invocation_id) id: vec3<u32>) {
+fn main(@builtin(global_invocation_id) id: vec3<u32>, @builtin(num_workgroups) groups: vec3<u32>) {
     let ho = p.h / 2u;
     let wo = p.w / 2u;
-    let i = id.x;
+    // Rows of workgroups past the 65,535 one dimension allows.
+    let i = id.x + id.y * groups.x * 64u;
     if (i >= CHANNELS * ho * wo) {
         return;
     }
