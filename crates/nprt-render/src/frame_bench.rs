@@ -2,15 +2,13 @@
 //! networks, direct light), per design and resolution, on the device the networks run on.
 //! Untrained networks are timed: a frame's cost does not depend on the weights.
 
-use std::time::Instant;
-
 use anyhow::{Context, Result};
 use nprt_net::model::folder::ModelFile;
 use nprt_net::{Design, Device, DirectLight, Init, ModelConfig};
 use nprt_scene::{load_scene, SceneOptions};
-use nprt_trace::{render_gbuffer, TraceScene};
+use nprt_trace::TraceScene;
 
-use crate::relight::{DirectSampling, FrameTimings, Relighter};
+use crate::relight::{DirectSampling, FrameCache, FrameTimings, Relighter};
 use crate::CameraPath;
 
 /// What to time.
@@ -60,7 +58,6 @@ pub fn bench_frame(
     let map = &nprt_scene::open_envmap(&opts.map)?;
     let (lo, hi) = scene.bounds();
     let ts = TraceScene::new(&scene);
-    let ms = |t: Instant| t.elapsed().as_secs_f64() * 1e3;
     let median = |v: Vec<f64>| nprt_net::median(v);
     for &(design, direct) in &opts.models {
         let config = ModelConfig {
@@ -78,42 +75,23 @@ pub fn bench_frame(
             let mut foreground = 0;
             for i in 0..=opts.repeats {
                 let rotation = 10.0 * i as f32;
-                let mut t = FrameTimings::default();
-                let clock = Instant::now();
-                let g = render_gbuffer(&ts, &camera);
-                t.gbuffer_ms = ms(clock);
-                let clock = Instant::now();
-                let code = model.light_code(map, rotation);
-                t.encoder_ms = ms(clock);
-                let clock = Instant::now();
-                let px = model.pixels(&g);
-                let mut rgb = model.relight(&px, &code);
-                t.network_ms = ms(clock);
-                let clock = Instant::now();
                 let sampling = DirectSampling {
                     spp: opts.direct_spp,
                     seed: i as u64,
                     denoiser: None,
                 };
-                model.complete(
-                    &ts,
-                    &camera,
-                    &map.rotated_y(rotation),
-                    &g,
-                    sampling,
-                    &mut rgb,
-                )?;
-                t.direct_ms = ms(clock);
+                // A new viewpoint under a new lighting: nothing kept from before.
+                let mut cache = FrameCache::default();
+                let (_, t) = model.frame(&mut cache, &ts, &camera, map, rotation, i, sampling)?;
                 // A lighting change under the still camera.
-                let clock = Instant::now();
-                let code = model.light_code(map, rotation + 5.0);
-                model.relight(&px, &code);
-                let relight = ms(clock);
-                foreground = g.mask.iter().filter(|&&m| m > 0.5).count();
+                let turned = rotation + 5.0;
+                let (_, change) =
+                    model.frame(&mut cache, &ts, &camera, map, turned, i + 1, sampling)?;
+                foreground = cache.foreground();
                 // The first frame is untimed: a GPU compiles and allocates on first use.
                 if i > 0 {
                     frames.push(t);
-                    relights.push(relight);
+                    relights.push(change.encoder_ms + change.network_ms);
                 }
             }
             let stage = |f: fn(&FrameTimings) -> f64| median(frames.iter().map(f).collect());

@@ -39,7 +39,8 @@ pub use animation::{write_animation, Animation};
 pub use frame_bench::{bench_frame, FrameBenchOptions, FrameBenchRow};
 pub use path::CameraPath;
 pub use relight::{
-    background, DirectSampling, FrameTimings, LightCode, Pixels, Relighter, DEFAULT_DIRECT_SPP,
+    background, DirectSampling, FrameCache, FrameTimings, LightCode, Pixels, Relighter,
+    DEFAULT_DIRECT_SPP,
 };
 pub use render_job::{RenderJob, RenderOptions, DEFAULT_LIGHTING};
 pub use schedule::LightingSchedule;

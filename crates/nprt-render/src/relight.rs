@@ -3,6 +3,7 @@
 //! lighting changes, and for models that leave direct light to the tracer, that light traced.
 
 use std::path::Path;
+use std::time::Instant;
 
 use anyhow::Result;
 use glam::{Vec2, Vec3};
@@ -11,7 +12,7 @@ use nprt_net::cpu::{self, HostTransport, TransferCodes};
 use nprt_net::gbuffer_features;
 use nprt_net::{load_model, Device, DirectLight, LightInput, ModelFile, NprtNet, FEATURES};
 use nprt_scene::{Camera, EnvMap};
-use nprt_trace::{render_direct, GBuffer, TraceScene};
+use nprt_trace::{render_direct, render_gbuffer, GBuffer, TraceScene};
 
 use crate::oidn::Oidn;
 use rayon::prelude::*;
@@ -64,6 +65,31 @@ pub struct DirectSampling {
     pub seed: u64,
     /// Denoises the traced light (with the G-buffer as auxiliaries) before it is added.
     pub denoiser: Option<&'static Oidn>,
+}
+
+/// What consecutive frames keep: the last camera's G-buffer and network inputs (with the
+/// light-independent networks' outputs), and the last lighting's code under its key `K`.
+pub struct FrameCache<K> {
+    still: Option<(Camera, GBuffer, Pixels)>,
+    light: Option<(K, LightCode)>,
+}
+
+impl<K> FrameCache<K> {
+    /// Foreground pixels of the kept G-buffer (none before a frame).
+    pub fn foreground(&self) -> usize {
+        self.still
+            .as_ref()
+            .map_or(0, |(_, _, px)| px.foreground.len())
+    }
+}
+
+impl<K> Default for FrameCache<K> {
+    fn default() -> Self {
+        FrameCache {
+            still: None,
+            light: None,
+        }
+    }
 }
 
 /// Milliseconds spent in each stage of one frame.
@@ -188,6 +214,62 @@ impl Relighter {
         }
         rgb.par_iter_mut().zip(direct).for_each(|(c, d)| *c += d);
         Ok(())
+    }
+
+    /// One frame through `camera` under `map` turned by `rotation_deg` (the lighting `key`
+    /// names): the G-buffer and the light-independent networks only when the camera moved
+    /// since the frame `cache` holds, the encoder only when the key changed, then the shading
+    /// networks and [`Self::complete`]. Returns the radiance and each stage's time.
+    #[allow(clippy::too_many_arguments)]
+    pub fn frame<K: PartialEq>(
+        &self,
+        cache: &mut FrameCache<K>,
+        ts: &TraceScene,
+        camera: &Camera,
+        map: &EnvMap,
+        rotation_deg: f32,
+        key: K,
+        sampling: DirectSampling,
+    ) -> Result<(Vec<Vec3>, FrameTimings)> {
+        let ms = |t: Instant| t.elapsed().as_secs_f64() * 1e3;
+        let mut t = FrameTimings::default();
+        let (g, px) = match cache.still.take() {
+            Some((c, g, px)) if c == *camera => (g, px),
+            _ => {
+                let clock = Instant::now();
+                let g = render_gbuffer(ts, camera);
+                t.gbuffer_ms = ms(clock);
+                let clock = Instant::now();
+                let px = self.pixels(&g);
+                t.network_ms = ms(clock);
+                (g, px)
+            }
+        };
+        let code = match cache.light.take() {
+            Some((k, code)) if k == key => code,
+            _ => {
+                let clock = Instant::now();
+                let code = self.light_code(map, rotation_deg);
+                t.encoder_ms = ms(clock);
+                code
+            }
+        };
+        let clock = Instant::now();
+        let mut rgb = self.relight(&px, &code);
+        t.network_ms += ms(clock);
+        let clock = Instant::now();
+        self.complete(
+            ts,
+            camera,
+            &map.rotated_y(rotation_deg),
+            &g,
+            sampling,
+            &mut rgb,
+        )?;
+        t.direct_ms = ms(clock);
+        cache.light = Some((key, code));
+        cache.still = Some((camera.clone(), g, px));
+        Ok((rgb, t))
     }
 
     /// Encodes `map` rotated by `rotation_deg` about +Y.
@@ -315,7 +397,7 @@ pub fn background(camera: &Camera, map: &EnvMap, mask: &[f32], rgb: &mut [Vec3])
 #[cfg(test)]
 mod tests {
     use super::*;
-    use nprt_net::model::folder::{save_model, MODEL_FORMAT, MODEL_VERSION};
+    use nprt_net::model::folder::save_model;
     use nprt_net::{Design, Init, ModelConfig};
     use nprt_trace::render_gbuffer;
 
@@ -356,17 +438,8 @@ mod tests {
         let device = Device::flex();
         let net = config.build(&mut Init::new(3, &device));
         let file = ModelFile {
-            format: MODEL_FORMAT.into(),
-            version: MODEL_VERSION,
-            config,
-            bounds: [[-3.0; 3], [3.0; 3]],
-            scene: "sphere".into(),
-            scene_hash: String::new(),
-            dataset_hash: String::new(),
-            transport_params: net.transport_params(),
-            encoder_params: 0,
-            training: serde_json::Value::Null,
             level_gain,
+            ..ModelFile::untrained(config, &net, [[-3.0; 3], [3.0; 3]])
         };
         // One folder per call: tests run in parallel.
         static CALLS: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);

@@ -6,15 +6,15 @@ use std::time::Instant;
 
 use anyhow::{bail, Context, Result};
 use glam::Vec3;
-use nprt_trace::{render_gbuffer, GBuffer, TraceScene};
+use nprt_trace::TraceScene;
 use serde::Serialize;
 
 use crate::oidn::Oidn;
 use nprt_io::write_png;
 
 use crate::{
-    write_animation, Animation, CameraPath, DirectSampling, FrameTimings, LightingSchedule,
-    Relighter,
+    write_animation, Animation, CameraPath, DirectSampling, FrameCache, FrameTimings,
+    LightingSchedule, Relighter,
 };
 
 /// What to render and where.
@@ -87,58 +87,23 @@ pub fn render_sequence(
     let mut csv = csv::Writer::from_writer(Vec::new());
     let mut pngs = Vec::new();
     let mut sum = FrameTimings::default();
-    let mut light: Option<((usize, f32), crate::LightCode)> = None;
-    let mut still: Option<(nprt_scene::Camera, GBuffer, crate::Pixels)> = None;
+    let mut cache = FrameCache::default();
     let start = Instant::now();
     for i in 0..seq.frames {
         let camera = seq
             .path
             .camera(i as f32 / (seq.frames.max(2) - 1) as f32, w, h);
-        let mut t = FrameTimings::default();
-        let (g, px) = match still.take() {
-            Some((c, g, px)) if c == camera => (g, px),
-            _ => {
-                let clock = Instant::now();
-                let g = render_gbuffer(scene, &camera);
-                t.gbuffer_ms = clock.elapsed().as_secs_f64() * 1e3;
-                let clock = Instant::now();
-                let px = model.pixels(&g);
-                t.network_ms = clock.elapsed().as_secs_f64() * 1e3;
-                (g, px)
-            }
-        };
         let (k, rot) = seq.lighting.at(i, seq.frames);
-        let code = match light.take() {
-            Some((key, code)) if key == (k, rot) => code,
-            _ => {
-                let clock = Instant::now();
-                let code = model.light_code(&seq.lighting.maps[k], rot);
-                t.encoder_ms = clock.elapsed().as_secs_f64() * 1e3;
-                code
-            }
+        let sampling = DirectSampling {
+            spp: seq.direct_spp,
+            seed: i as u64,
+            denoiser: seq.denoiser,
         };
-        let clock = Instant::now();
-        let mut rgb = model.relight(&px, &code);
-        t.network_ms += clock.elapsed().as_secs_f64() * 1e3;
-        light = Some(((k, rot), code));
-        let clock = Instant::now();
-        model.complete(
-            scene,
-            &camera,
-            &seq.lighting.maps[k].rotated_y(rot),
-            &g,
-            DirectSampling {
-                spp: seq.direct_spp,
-                seed: i as u64,
-                denoiser: seq.denoiser,
-            },
-            &mut rgb,
-        )?;
-        t.direct_ms = clock.elapsed().as_secs_f64() * 1e3;
+        let map = &seq.lighting.maps[k];
+        let (rgb, t) = model.frame(&mut cache, scene, &camera, map, rot, (k, rot), sampling)?;
         let png = frames_dir.join(format!("{i:04}.png"));
         write_frame(&rgb, [w as usize, h as usize], seq, &png)?;
         pngs.push(png);
-        still = Some((camera, g, px));
         csv.serialize(TimingRow {
             frame: i,
             map: &seq.lighting.segments[k].map,

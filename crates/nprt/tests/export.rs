@@ -13,7 +13,7 @@ use std::sync::mpsc;
 use std::time::{Duration, Instant};
 
 use base64::Engine;
-use common::{fails, fresh_dir, ok, room_dataset};
+use common::{fails, fresh_dir, ok, tiny_room_model};
 use serde_json::Value;
 
 const KERNELS: [&str; 5] = [
@@ -27,23 +27,8 @@ const KERNELS: [&str; 5] = [
 #[test]
 fn export_writes_kernels_weights_and_a_worked_example_that_webgpu_runs() {
     let dir = fresh_dir("export");
-    let data = dir.join("data");
-    room_dataset(&data, [8, 2], 16, 4);
-    let model = dir.join("model");
+    let model = tiny_room_model(&dir, "dsep", &["--encoding", "hash-grid"]);
     let m = model.to_str().unwrap();
-    ok(&[
-        "train",
-        "--data",
-        data.to_str().unwrap(),
-        "--out",
-        m,
-        "--arch",
-        "dsep",
-        "--epochs",
-        "1",
-        "--encoding",
-        "hash-grid",
-    ]);
     let out = dir.join("export");
     let printed = ok(&[
         "export",

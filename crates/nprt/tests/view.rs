@@ -10,7 +10,7 @@ mod common;
 use std::path::Path;
 use std::process::{Child, Command, Stdio};
 
-use common::{fresh_dir, ok, room_dataset};
+use common::{fresh_dir, ok, tiny_room_model};
 
 /// An X display for the viewer: the environment's, or a private Xvfb (killed on drop).
 struct Display {
@@ -82,21 +82,8 @@ fn view(display: &Display, args: &[&str]) {
 fn the_viewer_opens_a_window_and_shows_what_render_makes() {
     let Some(display) = display() else { return };
     let dir = fresh_dir("view");
-    let data = dir.join("data");
-    room_dataset(&data, [8, 2], 16, 4);
-    let model = dir.join("model");
+    let model = tiny_room_model(&dir, "prt", &[]);
     let m = model.to_str().unwrap();
-    ok(&[
-        "train",
-        "--data",
-        data.to_str().unwrap(),
-        "--out",
-        m,
-        "--arch",
-        "prt",
-        "--epochs",
-        "1",
-    ]);
 
     // With the overlay: text over the frame, in the top-left corner.
     let shot = dir.join("overlay.png");

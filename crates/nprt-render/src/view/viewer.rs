@@ -9,8 +9,8 @@ use std::time::Instant;
 use anyhow::{anyhow, bail, Context, Result};
 use glam::Vec3;
 use nprt_net::Device;
-use nprt_scene::{Camera, EnvMap, Scene};
-use nprt_trace::{render, render_gbuffer, GBuffer, PixelFilter, RenderSettings, TraceScene};
+use nprt_scene::{EnvMap, Scene};
+use nprt_trace::{render, PixelFilter, RenderSettings, TraceScene};
 use winit::application::ApplicationHandler;
 use winit::dpi::PhysicalSize;
 use winit::event::{ElementState, MouseButton, MouseScrollDelta, WindowEvent};
@@ -21,7 +21,7 @@ use winit::window::{Window, WindowId};
 use super::orbit_camera::OrbitCamera;
 use super::overlay::draw_lines;
 use super::presenter::Presenter;
-use crate::relight::{DirectSampling, FrameTimings, LightCode, Pixels, Relighter};
+use crate::relight::{DirectSampling, FrameCache, FrameTimings, Relighter};
 use crate::CameraPath;
 
 /// What `nprt view` shows and how.
@@ -87,9 +87,9 @@ struct Viewer<'a> {
     rotation: f32,
     exposure: f32,
     reference: Option<Reference>,
-    /// The camera, model and G-buffer (with its network inputs) of the last frame.
-    still: Option<(Camera, usize, GBuffer, Pixels)>,
-    light: Option<((usize, usize, u32), LightCode)>,
+    /// What the current model kept of the last frame: its camera's G-buffer and network
+    /// inputs, and the code of its lighting (map and rotation).
+    cache: FrameCache<(usize, u32)>,
     timings: FrameTimings,
     frames: usize,
     fps: f64,
@@ -178,8 +178,7 @@ impl<'a> Viewer<'a> {
             rotation: 0.0,
             exposure: opts.exposure,
             reference,
-            still: None,
-            light: None,
+            cache: FrameCache::default(),
             timings: FrameTimings::default(),
             frames: 0,
             fps: 0.0,
@@ -200,13 +199,13 @@ impl<'a> Viewer<'a> {
     fn radiance(&mut self) -> Result<Vec<Vec3>> {
         let [w, h] = self.opts.resolution;
         let camera = self.camera.camera(w, h);
-        let map = self.maps[self.map].1.rotated_y(self.rotation);
+        let map = &self.maps[self.map].1;
         if let Some(r) = &mut self.reference {
             let clock = Instant::now();
             let pass = render(
                 &self.ts,
                 &camera,
-                &map,
+                &map.rotated_y(self.rotation),
                 &RenderSettings {
                     spp: 1,
                     max_depth: self.scene.max_depth,
@@ -228,44 +227,22 @@ impl<'a> Viewer<'a> {
             let k = 1.0 / r.spp as f32;
             return Ok(r.sum.iter().map(|s| *s * k).collect());
         }
-        let model = &self.models[self.model];
-        let mut t = FrameTimings::default();
-        let (g, px) = match self.still.take() {
-            Some((c, m, g, px)) if c == camera && m == self.model => (g, px),
-            _ => {
-                let clock = Instant::now();
-                let g = render_gbuffer(&self.ts, &camera);
-                t.gbuffer_ms = clock.elapsed().as_secs_f64() * 1e3;
-                let clock = Instant::now();
-                let px = model.pixels(&g);
-                t.network_ms = clock.elapsed().as_secs_f64() * 1e3;
-                (g, px)
-            }
-        };
-        let key = (self.model, self.map, self.rotation.to_bits());
-        let code = match self.light.take() {
-            Some((k, code)) if k == key => code,
-            _ => {
-                let clock = Instant::now();
-                let code = model.light_code(&self.maps[self.map].1, self.rotation);
-                t.encoder_ms = clock.elapsed().as_secs_f64() * 1e3;
-                code
-            }
-        };
-        let clock = Instant::now();
-        let mut rgb = model.relight(&px, &code);
-        t.network_ms += clock.elapsed().as_secs_f64() * 1e3;
-        let clock = Instant::now();
         let sampling = DirectSampling {
             spp: self.opts.direct_spp,
             seed: self.frames as u64,
             denoiser: None,
         };
-        model.complete(&self.ts, &camera, &map, &g, sampling, &mut rgb)?;
-        t.direct_ms = clock.elapsed().as_secs_f64() * 1e3;
+        let key = (self.map, self.rotation.to_bits());
+        let (rgb, t) = self.models[self.model].frame(
+            &mut self.cache,
+            &self.ts,
+            &camera,
+            map,
+            self.rotation,
+            key,
+            sampling,
+        )?;
         self.timings = t;
-        self.light = Some((key, code));
-        self.still = Some((camera, self.model, g, px));
         Ok(rgb)
     }
 
@@ -373,7 +350,10 @@ impl<'a> Viewer<'a> {
     fn key(&mut self, key: &Key, el: &ActiveEventLoop) -> Result<()> {
         match key {
             Key::Named(NamedKey::Escape) => el.exit(),
-            Key::Named(NamedKey::Tab) => self.model = (self.model + 1) % self.models.len(),
+            Key::Named(NamedKey::Tab) => {
+                self.model = (self.model + 1) % self.models.len();
+                self.cache = FrameCache::default();
+            }
             Key::Named(NamedKey::F12) => self.take_screenshot()?,
             Key::Character(c) => match c.to_lowercase().as_str() {
                 "m" => self.map = (self.map + 1) % self.maps.len(),

@@ -64,6 +64,21 @@ pub fn room_dataset(dir: &Path, [train, test]: [u32; 2], res: u32, spp: u32) {
     ]);
 }
 
+/// A model of `arch` trained for one epoch on a tiny room dataset, both made in `dir`, with
+/// `flags` added to `nprt train`: what tests of the commands that read a model start from.
+pub fn tiny_room_model(dir: &Path, arch: &str, flags: &[&str]) -> PathBuf {
+    let data = dir.join("data");
+    room_dataset(&data, [8, 2], 16, 4);
+    let model = dir.join("model");
+    let (d, m) = (data.to_str().unwrap(), model.to_str().unwrap());
+    let mut args = vec![
+        "train", "--data", d, "--out", m, "--arch", arch, "--epochs", "1",
+    ];
+    args.extend_from_slice(flags);
+    ok(&args);
+    model
+}
+
 /// A fresh, empty (not yet created) folder path unique to this test process.
 pub fn fresh_dir(name: &str) -> PathBuf {
     let d = std::env::temp_dir().join(format!("nprt-it-{}-{name}", std::process::id()));
