@@ -4,7 +4,8 @@
 //! through (checkpoints, exact resume). Its folders keep the pieces apart, as tiny-cuda-nn
 //! does: `network` (layers, encoder, designs), `encoding` (what the networks see), `model`
 //! (config and folder), `training` (data, batches, loss, schedule, loop), `cpu` (the CPU
-//! engine, which takes plain slices), `deep_shading` and `bench`.
+//! engine, which takes plain slices), `gpu` (our own GPU kernels, feature `kernels`),
+//! `deep_shading` and `bench`.
 //! It reads datasets through nprt-data and environment maps through nprt-scene; it must not
 //! trace rays or write datasets, and it knows nothing of evaluation or frame rendering.
 //!
@@ -28,6 +29,8 @@ pub mod cpu;
 pub mod deep_shading;
 mod device;
 pub mod encoding;
+#[cfg(feature = "kernels")]
+pub mod gpu;
 pub mod model;
 pub mod network;
 pub mod training;

@@ -10,10 +10,10 @@ use nprt_net::cpu::{DenseStack, HostEncoder, HostTransport};
 use nprt_net::encoding::hash_grid;
 use nprt_net::network::encoder::{BLOCKS, CHANNELS, CODE_SIZE};
 use nprt_net::{Activation, LightInput, NprtNet, TrackKind, FEATURES, TRANSPORT_CODE};
-use wgpu::util::DeviceExt;
 
-use super::gpu_device::GpuDevice;
-use super::kernels::{groups_for, Kernel, DENSE_TILE};
+use nprt_net::gpu::{groups_for, GpuDevice};
+
+use super::kernels::{Kernel, DENSE_TILE};
 
 /// Rows per block of dispatches: a block's widest activations (256 f32 per row, 64 MiB) stay
 /// within WebGPU's 128 MiB storage-binding limit, and every kernel's workgroup count within
@@ -101,7 +101,7 @@ impl GpuNetwork {
         let gpu = GpuDevice::get()?;
         let host = HostTransport::from_net(net);
         let encoder = HostEncoder::from_burn(&net.encoder);
-        let storage = |data: &[f32]| upload(&gpu, bytemuck::cast_slice(data));
+        let storage = |data: &[f32]| gpu.upload(data);
         let dense = |d: &nprt_net::cpu::Dense| GpuDense {
             weight: storage(&d.weight),
             bias: storage(&d.bias),
@@ -119,7 +119,7 @@ impl GpuNetwork {
                 let index: Vec<u32> = t.kind.inputs().iter().map(|&i| i as u32).collect();
                 GpuTrack {
                     kind: t.kind,
-                    index: upload(&gpu, bytemuck::cast_slice(&index)),
+                    index: gpu.upload(&index),
                     count: index.len(),
                     width: index.len() + t.grid.as_ref().map_or(0, |_| hash_grid::OUTPUTS),
                     grid: t.grid.as_deref().map(storage),
@@ -137,8 +137,8 @@ impl GpuNetwork {
             convs,
             to_code: dense(&encoder.to_code),
             tracks,
-            resolutions: upload(&gpu, bytemuck::cast_slice(&hash_grid::resolutions())),
-            empty: upload(&gpu, &[0; 16]),
+            resolutions: gpu.upload(&hash_grid::resolutions()),
+            empty: gpu.upload(&[0u32; 4]),
             gpu,
         })
     }
@@ -152,17 +152,16 @@ impl GpuNetwork {
     pub fn light_code(&self, input: &LightInput) -> Vec<f32> {
         let gpu = &*self.gpu;
         let (mut h, mut w) = (input.width / 2, input.width);
-        let mut x = upload(gpu, bytemuck::cast_slice(&input.pixels));
-        let code = buffer(gpu, CODE_SIZE);
+        let mut x = gpu.upload(&input.pixels);
+        let code = gpu.buffer(CODE_SIZE);
         let mut encoder = gpu.device.create_command_encoder(&Default::default());
         {
             let mut pass = encoder.begin_compute_pass(&Default::default());
             for (weight, bias, c_in) in &self.convs {
-                let out = buffer(gpu, CHANNELS * (h / 2) * (w / 2));
-                gpu.kernels.dispatch(
-                    &gpu.device,
+                let out = gpu.buffer(CHANNELS * (h / 2) * (w / 2));
+                gpu.dispatch(
                     &mut pass,
-                    Kernel::EncoderBlock,
+                    Kernel::EncoderBlock.source(),
                     &[*c_in as u32, h as u32, w as u32, 0],
                     &[&x, weight, bias, &out],
                     groups_for(CHANNELS * (h / 2) * (w / 2)),
@@ -187,7 +186,7 @@ impl GpuNetwork {
             );
         }
         gpu.queue.submit([encoder.finish()]);
-        read(gpu, &code, CODE_SIZE)
+        gpu.read(&code, CODE_SIZE)
     }
 
     /// Uploads the network inputs of a camera's foreground pixels (`rows × FEATURES`) and runs
@@ -208,16 +207,11 @@ impl GpuNetwork {
             })
             .max()
             .expect("a network has layers");
-        let scratch = [0, 1].map(|_| buffer(gpu, largest * widest));
+        let scratch = [0, 1].map(|_| gpu.buffer(largest * widest));
         let outputs = self
             .tracks
             .iter()
-            .map(|t| {
-                buffer(
-                    gpu,
-                    largest * t.shading.layers.last().expect("layers").d_out,
-                )
-            })
+            .map(|t| gpu.buffer(largest * t.shading.layers.last().expect("layers").d_out))
             .collect();
         let mut encoder = gpu.device.create_command_encoder(&Default::default());
         let mut chunks = Vec::new();
@@ -225,17 +219,17 @@ impl GpuNetwork {
             let mut pass = encoder.begin_compute_pass(&Default::default());
             for (k, f) in features.chunks(CHUNK * FEATURES).enumerate() {
                 let n = f.len() / FEATURES;
-                let features = upload(gpu, bytemuck::cast_slice(f));
+                let features = gpu.upload(f);
                 let kept = self
                     .tracks
                     .iter()
                     .map(|t| {
                         let Some(transfer) = &t.transfer else {
-                            let x = buffer(gpu, n * t.width);
+                            let x = gpu.buffer(n * t.width);
                             self.track_inputs(&mut pass, t, &features, n, &x);
                             return x;
                         };
-                        let s = buffer(gpu, n * TRANSPORT_CODE);
+                        let s = gpu.buffer(n * TRANSPORT_CODE);
                         self.track_inputs(&mut pass, t, &features, n, &scratch[0]);
                         let first = FirstLayer {
                             x_stride: t.width,
@@ -269,7 +263,7 @@ impl GpuNetwork {
             chunks,
             scratch,
             outputs,
-            rgb: buffer(gpu, rows.max(1) * 3),
+            rgb: gpu.buffer(rows.max(1) * 3),
         }
     }
 
@@ -283,10 +277,9 @@ impl GpuNetwork {
     ) {
         let table = t.grid.as_ref().unwrap_or(&self.empty);
         let params = [rows, t.count, t.width, usize::from(t.grid.is_some())].map(|v| v as u32);
-        self.gpu.kernels.dispatch(
-            &self.gpu.device,
+        self.gpu.dispatch(
             pass,
-            Kernel::TrackInputs,
+            Kernel::TrackInputs.source(),
             &params,
             &[features, &t.index, table, &self.resolutions, x],
             groups_for(rows),
@@ -300,7 +293,7 @@ impl GpuNetwork {
             return Vec::new();
         }
         let gpu = &*self.gpu;
-        let code = upload(gpu, bytemuck::cast_slice(code));
+        let code = gpu.upload(code);
         let mut encoder = gpu.device.create_command_encoder(&Default::default());
         {
             let mut pass = encoder.begin_compute_pass(&Default::default());
@@ -315,12 +308,11 @@ impl GpuNetwork {
                     } else {
                         0
                     };
-                    let bias = buffer(gpu, first.d_out);
+                    let bias = gpu.buffer(first.d_out);
                     let params = [first.d_out, code_row, CODE_SIZE, 0].map(|v| v as u32);
-                    gpu.kernels.dispatch(
-                        &gpu.device,
+                    gpu.dispatch(
                         &mut pass,
-                        Kernel::CodeBias,
+                        Kernel::CodeBias.source(),
                         &params,
                         &[&code, &first.weight, &first.bias, &bias],
                         groups_for(first.d_out),
@@ -374,10 +366,9 @@ impl GpuNetwork {
                 params.extend(scale.map(f32::to_bits));
                 params.push(0);
                 let out1 = px.outputs.last().expect("a track");
-                gpu.kernels.dispatch(
-                    &gpu.device,
+                gpu.dispatch(
                     &mut pass,
-                    Kernel::Combine,
+                    Kernel::Combine.source(),
                     &params,
                     &[&chunk.features, &px.outputs[0], out1, &px.rgb],
                     groups_for(chunk.rows),
@@ -385,7 +376,7 @@ impl GpuNetwork {
             }
         }
         gpu.queue.submit([encoder.finish()]);
-        read(gpu, &px.rgb, px.rows * 3)
+        gpu.read(&px.rgb, px.rows * 3)
     }
 }
 
@@ -471,53 +462,11 @@ fn dense_layer(
         0,
     ];
     let tiles = |n: usize| (n as u32).div_ceil(DENSE_TILE);
-    gpu.kernels.dispatch(
-        &gpu.device,
+    gpu.dispatch(
         pass,
-        Kernel::Dense,
+        Kernel::Dense.source(),
         &params.map(|v| v as u32),
         &[x.x, &layer.weight, bias, y],
         [tiles(layer.d_out), tiles(x.rows)],
     );
-}
-
-/// A storage buffer holding `bytes`.
-fn upload(gpu: &GpuDevice, bytes: &[u8]) -> wgpu::Buffer {
-    gpu.device
-        .create_buffer_init(&wgpu::util::BufferInitDescriptor {
-            label: None,
-            contents: bytes,
-            usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
-        })
-}
-
-/// An uninitialised storage buffer of `floats` f32.
-fn buffer(gpu: &GpuDevice, floats: usize) -> wgpu::Buffer {
-    gpu.device.create_buffer(&wgpu::BufferDescriptor {
-        label: None,
-        size: (floats.max(4) * 4) as u64,
-        usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
-        mapped_at_creation: false,
-    })
-}
-
-/// The first `floats` values of `buffer`, once the queue's work is done.
-fn read(gpu: &GpuDevice, buffer: &wgpu::Buffer, floats: usize) -> Vec<f32> {
-    let size = (floats * 4) as u64;
-    let staging = gpu.device.create_buffer(&wgpu::BufferDescriptor {
-        label: Some("readback"),
-        size,
-        usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
-        mapped_at_creation: false,
-    });
-    let mut encoder = gpu.device.create_command_encoder(&Default::default());
-    encoder.copy_buffer_to_buffer(buffer, 0, &staging, 0, size);
-    gpu.queue.submit([encoder.finish()]);
-    let slice = staging.slice(..);
-    slice.map_async(wgpu::MapMode::Read, |r| {
-        r.expect("mapping a GPU buffer for reading")
-    });
-    gpu.wait();
-    let view = slice.get_mapped_range().expect("a mapped GPU buffer");
-    bytemuck::cast_slice(&view).to_vec()
 }

@@ -1,19 +1,20 @@
-//! The wgpu device the frame path runs on: one per process, opened at first use.
+//! The wgpu device our kernels run on (training and nprt-render's frame path): one per
+//! process, opened at first use.
 
 use std::sync::{Arc, OnceLock};
 
 use anyhow::{anyhow, Result};
 
-use super::kernels::Kernels;
+use super::kernel::Pipelines;
 
-/// A wgpu adapter's device and queue, and the frame path's kernels compiled for it.
+/// A wgpu adapter's device and queue, and the kernels compiled for it.
 pub struct GpuDevice {
     pub device: wgpu::Device,
     pub queue: wgpu::Queue,
     /// The adapter's name and driver, for reports ("llvmpipe (LLVM 19.1.7, 256 bits)" on
     /// Mesa's software Vulkan).
     pub adapter: String,
-    pub(super) kernels: Kernels,
+    pub(super) pipelines: Pipelines,
 }
 
 static DEVICE: OnceLock<Result<Arc<GpuDevice>, String>> = OnceLock::new();
@@ -41,7 +42,7 @@ impl GpuDevice {
         ))
         .map_err(|e| {
             anyhow!(
-                "no GPU adapter found ({e}): nprt's GPU frame path needs Vulkan, Metal or DX12; \
+                "no GPU adapter found ({e}): nprt's GPU kernels need Vulkan, Metal or DX12; \
                  on Linux install a Vulkan driver (scripts/vulkan.sh installs Mesa's software \
                  one), or use --device cpu"
             )
@@ -59,12 +60,11 @@ impl GpuDevice {
                 trace: wgpu::Trace::Off,
             }))
             .map_err(|e| anyhow!("the GPU adapter {} refused a device: {e}", info.name))?;
-        let kernels = Kernels::new(&device);
         Ok(GpuDevice {
             device,
             queue,
             adapter: format!("{} ({}, {:?})", info.name, info.driver_info, info.backend),
-            kernels,
+            pipelines: Pipelines::default(),
         })
     }
 

@@ -1,0 +1,70 @@
+//! Storage buffers on the device: made from host values, made empty, read back.
+
+use wgpu::util::DeviceExt;
+
+use super::GpuDevice;
+
+const STORAGE: wgpu::BufferUsages = wgpu::BufferUsages::STORAGE
+    .union(wgpu::BufferUsages::COPY_SRC)
+    .union(wgpu::BufferUsages::COPY_DST);
+
+impl GpuDevice {
+    /// A storage buffer holding `values` (f32, u32 or any plain words).
+    pub fn upload<T: bytemuck::Pod>(&self, values: &[T]) -> wgpu::Buffer {
+        // wgpu refuses empty bindings: an empty input still gets 16 bytes.
+        let bytes: &[u8] = bytemuck::cast_slice(values);
+        let padded;
+        let contents = if bytes.len() < 16 {
+            padded = [bytes, &[0; 16][bytes.len()..]].concat();
+            &padded
+        } else {
+            bytes
+        };
+        self.device
+            .create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                label: None,
+                contents,
+                usage: STORAGE,
+            })
+    }
+
+    /// A storage buffer of `floats` f32 (at least 4), zero.
+    pub fn buffer(&self, floats: usize) -> wgpu::Buffer {
+        self.device.create_buffer(&wgpu::BufferDescriptor {
+            label: None,
+            size: (floats.max(4) * 4) as u64,
+            usage: STORAGE,
+            mapped_at_creation: false,
+        })
+    }
+
+    /// Overwrites the start of `buffer` with `values`.
+    pub fn write<T: bytemuck::Pod>(&self, buffer: &wgpu::Buffer, values: &[T]) {
+        self.queue
+            .write_buffer(buffer, 0, bytemuck::cast_slice(values));
+    }
+
+    /// The first `floats` values of `buffer`, once the queue's work is done.
+    pub fn read(&self, buffer: &wgpu::Buffer, floats: usize) -> Vec<f32> {
+        let size = (floats * 4) as u64;
+        if size == 0 {
+            return Vec::new();
+        }
+        let staging = self.device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("readback"),
+            size,
+            usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        let mut encoder = self.device.create_command_encoder(&Default::default());
+        encoder.copy_buffer_to_buffer(buffer, 0, &staging, 0, size);
+        self.queue.submit([encoder.finish()]);
+        let slice = staging.slice(..);
+        slice.map_async(wgpu::MapMode::Read, |r| {
+            r.expect("mapping a GPU buffer for reading")
+        });
+        self.wait();
+        let view = slice.get_mapped_range().expect("a mapped GPU buffer");
+        bytemuck::cast_slice(&view).to_vec()
+    }
+}

@@ -1,0 +1,132 @@
+//! A compute kernel: its WGSL source, its pipeline (compiled once per device, at first use) and
+//! the one way a dispatch is recorded: a uniform block of parameters at binding 0, storage
+//! buffers after it.
+
+use std::collections::HashMap;
+use std::sync::Mutex;
+
+use wgpu::util::DeviceExt;
+
+use super::parameters::Span;
+
+/// A kernel's name and WGSL source: what the device compiles and `nprt export` writes.
+pub struct KernelSource {
+    pub name: &'static str,
+    pub wgsl: &'static str,
+}
+
+/// Threads per workgroup of the one-dimensional kernels.
+pub const GROUP: u32 = 64;
+
+/// A device's compiled pipelines, by kernel name.
+#[derive(Default)]
+pub(super) struct Pipelines {
+    compiled: Mutex<HashMap<&'static str, wgpu::ComputePipeline>>,
+}
+
+impl Pipelines {
+    /// `kernel`'s pipeline, compiled on first use.
+    fn get(&self, device: &wgpu::Device, kernel: &KernelSource) -> wgpu::ComputePipeline {
+        let mut compiled = self.compiled.lock().unwrap_or_else(|e| e.into_inner());
+        compiled
+            .entry(kernel.name)
+            .or_insert_with(|| {
+                let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
+                    label: Some(kernel.name),
+                    source: wgpu::ShaderSource::Wgsl(kernel.wgsl.into()),
+                });
+                device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+                    label: Some(kernel.name),
+                    layout: None,
+                    module: &module,
+                    entry_point: Some("main"),
+                    compilation_options: Default::default(),
+                    cache: None,
+                })
+            })
+            .clone()
+    }
+}
+
+impl super::GpuDevice {
+    /// Records one dispatch of `kernel` with `params` (the shader's uniform struct, as u32
+    /// words or f32 bit patterns) and `buffers` (whole buffers or parts) at bindings 1, 2, ….
+    pub fn dispatch(
+        &self,
+        pass: &mut wgpu::ComputePass,
+        kernel: &KernelSource,
+        params: &[u32],
+        buffers: &[&dyn Bind],
+        groups: [u32; 2],
+    ) {
+        let pipeline = self.pipelines.get(&self.device, kernel);
+        let uniform = self
+            .device
+            .create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                label: Some(kernel.name),
+                contents: bytemuck::cast_slice(params),
+                usage: wgpu::BufferUsages::UNIFORM,
+            });
+        let mut entries = vec![wgpu::BindGroupEntry {
+            binding: 0,
+            resource: uniform.as_entire_binding(),
+        }];
+        entries.extend(
+            buffers
+                .iter()
+                .enumerate()
+                .map(|(i, b)| wgpu::BindGroupEntry {
+                    binding: i as u32 + 1,
+                    resource: b.resource(),
+                }),
+        );
+        let group = self.device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some(kernel.name),
+            layout: &pipeline.get_bind_group_layout(0),
+            entries: &entries,
+        });
+        pass.set_pipeline(&pipeline);
+        pass.set_bind_group(0, &group, &[]);
+        pass.dispatch_workgroups(groups[0], groups[1], 1);
+    }
+}
+
+/// What a kernel binds: a whole storage buffer, or a [`Part`] of one.
+pub trait Bind {
+    fn resource(&self) -> wgpu::BindingResource<'_>;
+}
+
+impl Bind for wgpu::Buffer {
+    fn resource(&self) -> wgpu::BindingResource<'_> {
+        self.as_entire_binding()
+    }
+}
+
+/// One tensor of a flat buffer, bound on its own (its offset a multiple of the device's
+/// storage-binding alignment).
+pub struct Part<'a> {
+    pub buffer: &'a wgpu::Buffer,
+    pub span: Span,
+}
+
+impl Bind for Part<'_> {
+    fn resource(&self) -> wgpu::BindingResource<'_> {
+        let (offset, size) = self.span.bytes();
+        wgpu::BindingResource::Buffer(wgpu::BufferBinding {
+            buffer: self.buffer,
+            offset,
+            size: wgpu::BufferSize::new(size.max(4)),
+        })
+    }
+}
+
+/// Workgroups for `n` threads of a one-dimensional kernel: a second dimension where one would
+/// exceed the 65,535 workgroups every adapter allows (the first encoder block of a 1024-wide
+/// map has 65,536); the kernels number their threads x + y · (workgroups along x) · 64.
+pub fn groups_for(n: usize) -> [u32; 2] {
+    let groups = (n as u32).div_ceil(GROUP);
+    let rows = groups.div_ceil(MAX_GROUPS);
+    [groups.div_ceil(rows), rows]
+}
+
+const MAX_GROUPS: u32 = 65_535;
