@@ -169,7 +169,7 @@ pub fn run(job: &TrainJob, device: &Device) -> Result<()> {
         s.final_train,
         s.final_val
     );
-    println!("time: {}", s.split.describe());
+    println!("time: {} (steps on {})", s.split.describe(), s.steps_on);
     if let Some([r, g, b]) = file.level_gain {
         println!(
             "level gain (training targets' mean over the network's, per channel): R {r:.3} G {g:.3} B {b:.3}"

@@ -70,15 +70,16 @@ fn a_tiny_dataset_is_overfit() {
     );
 }
 
-/// The GPU code path (burn's GPU kernels, batches moved to the device) on wgpu, which CI runs
-/// on a software Vulkan device: it learns, and resumes exactly.
+/// The GPU training steps (nprt-net's own kernels, parameters and Adam's moments kept on the
+/// device) on wgpu, which CI runs on a software Vulkan device: it learns, and resumes exactly
+/// (the hash grid's gradient is summed in a fixed order for that).
 #[test]
 fn the_gpu_path_overfits_and_resumes_exactly() {
     if !common::wgpu_runs() {
         return;
     }
-    // A third of the CPU's epochs: the software device takes 0.4 s a step, and by then the
-    // loss has fallen to a tenth.
+    // A third of the CPU's epochs: the software device is about ten times slower than the CPU
+    // engine, and by then the loss has fallen to a tenth.
     overfits(&[("dsep", "hash-grid")], "wgpu", 100);
     resumes_exactly("wgpu");
 }

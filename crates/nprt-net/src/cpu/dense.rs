@@ -80,6 +80,20 @@ pub(super) fn host<const D: usize>(p: &Param<Tensor<D>>) -> Vec<f32> {
     crate::device::host_values(p.val().into_data())
 }
 
+/// Replaces `p`'s values with `values` (same shape), keeping its id (which keys Adam's state),
+/// its device and whether it takes gradients.
+pub(super) fn store<const D: usize>(p: &mut Param<Tensor<D>>, values: &[f32]) {
+    *p = p.clone().map(|t| {
+        let data = burn::tensor::TensorData::new(values.to_vec(), t.dims());
+        let stored = Tensor::from_data(data, (&t.device(), t.dtype()));
+        if t.is_require_grad() {
+            stored.require_grad()
+        } else {
+            stored
+        }
+    });
+}
+
 impl Dense {
     pub fn from_linear(l: &Linear) -> Self {
         let [d_in, d_out] = l.weight.val().dims();
@@ -88,6 +102,14 @@ impl Dense {
             bias: l.bias.as_ref().map_or(vec![0.0; d_out], host),
             d_in,
             d_out,
+        }
+    }
+
+    /// Writes these values into `l` (same shapes): the inverse of [`Self::from_linear`].
+    pub fn store_into(&self, l: &mut Linear) {
+        store(&mut l.weight, &self.weight);
+        if let Some(b) = &mut l.bias {
+            store(b, &self.bias);
         }
     }
 
@@ -130,6 +152,13 @@ impl DenseStack {
         DenseStack {
             layers: mlp.layers.iter().map(Dense::from_linear).collect(),
             activation: mlp.activation,
+        }
+    }
+
+    /// Writes these values into `mlp` (same shapes): the inverse of [`Self::from_mlp`].
+    pub fn store_into(&self, mlp: &mut Mlp) {
+        for (d, l) in self.layers.iter().zip(&mut mlp.layers) {
+            d.store_into(l);
         }
     }
 

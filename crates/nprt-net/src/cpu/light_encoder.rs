@@ -11,7 +11,7 @@ use burn::nn::conv::Conv2d;
 use rayon::prelude::*;
 
 use super::accumulate;
-use super::dense::{host, Dense};
+use super::dense::{host, store, Dense};
 use super::matmul::{matmul, MatRef, Op};
 use crate::network::encoder::{LightEncoder, CHANNELS, CODE_SIZE};
 
@@ -61,6 +61,14 @@ impl Conv {
             weight: host(&conv.weight),
             bias: conv.bias.as_ref().map_or(vec![0.0; c_out], host),
             c_in,
+        }
+    }
+
+    /// Writes these values into `conv` (same shapes): the inverse of [`Self::from_burn`].
+    fn store_into(&self, conv: &mut Conv2d) {
+        store(&mut conv.weight, &self.weight);
+        if let Some(b) = &mut conv.bias {
+            store(b, &self.bias);
         }
     }
 
@@ -126,6 +134,14 @@ impl HostEncoder {
             convs: encoder.convs.iter().map(Conv::from_burn).collect(),
             to_code: Dense::from_linear(&encoder.to_code),
         }
+    }
+
+    /// Writes these values into `encoder` (same shapes): the inverse of [`Self::from_burn`].
+    pub fn store_into(&self, encoder: &mut LightEncoder) {
+        for (c, conv) in self.convs.iter().zip(&mut encoder.convs) {
+            c.store_into(conv);
+        }
+        self.to_code.store_into(&mut encoder.to_code);
     }
 
     fn zeros_like(&self) -> Self {

@@ -367,6 +367,20 @@ impl HostTransport {
         HostTransport { tracks }
     }
 
+    /// Writes these values into `net`'s tracks (same shapes): the inverse of
+    /// [`Self::from_net`].
+    pub fn store_into(&self, net: &mut NprtNet) {
+        for (h, t) in self.tracks.iter().zip(&mut net.tracks) {
+            if let (Some(values), Some(grid)) = (&h.grid, &mut t.grid) {
+                super::dense::store(&mut grid.table, values);
+            }
+            if let (Some(values), Some(mlp)) = (&h.transfer, &mut t.transfer) {
+                values.store_into(mlp);
+            }
+            h.shading.store_into(&mut t.shading);
+        }
+    }
+
     /// The batch's mean `loss` and its gradients, for the light codes `codes`
     /// (`views × CODE_SIZE`, the encoder's output for the batch's maps).
     pub fn gradients(&self, batch: &Samples, codes: &[f32], loss: Loss) -> TransportGradients {

@@ -1,17 +1,24 @@
-//! A design's training step on the GPU: the transport networks' forward pass keeping what
-//! backward needs, the loss and its gradient, backward into every parameter's gradient, and
-//! one Adam step over all parameters, recorded as one queue submission of our own kernels (a
-//! handful of dispatches per layer) with no host round trip inside it.
+//! A design's training step on the GPU: the light encoder's and the transport networks'
+//! forward passes keeping what backward needs, the loss and its gradient, backward into every
+//! parameter's gradient, and one Adam step over all parameters, recorded as one queue
+//! submission of our own kernels (a handful of dispatches per layer) with no host round trip
+//! inside it.
 //!
-//! It computes what the CPU engine's [`HostTransport::gradients`] computes, in f32, and the
-//! tests hold the two together; Adam is burn's formulation, which the CPU path steps with.
+//! It computes what the CPU engine computes ([`HostEncoder`] and [`HostTransport`]), in f32,
+//! and the tests hold the two together; Adam is burn's formulation, which the CPU path steps
+//! with.
 
 use std::sync::Arc;
 
-use anyhow::Result;
+use std::collections::HashMap;
+use std::path::Path;
+
+use anyhow::{anyhow, Context, Result};
+use safetensors::{tensor::TensorView, Dtype, SafeTensors};
 
 use super::kernels::{
-    ACTIVATION_BACKWARD, ADAM, COLUMN_SUM, GEMM, GEMM_TILE, GRID_BACKWARD, RADIANCE_LOSS,
+    ACTIVATION_BACKWARD, ADAM, COLUMN_SUM, ENCODER_BLOCK, ENCODER_INPUT_BACKWARD,
+    ENCODER_POOL_BACKWARD, ENCODER_WEIGHT_BACKWARD, GEMM, GEMM_TILE, GRID_BACKWARD, RADIANCE_LOSS,
     TRACK_INPUTS,
 };
 use super::parameters::{ParameterLayout, Span};
@@ -20,13 +27,15 @@ use crate::cpu::{DenseStack, HostEncoder, HostTransport, Samples};
 use crate::encoding::hash_grid;
 use crate::network::activation::Activation;
 use crate::network::design::TRANSPORT_CODE;
-use crate::network::encoder::CODE_SIZE;
+use crate::network::encoder::{CHANNELS, CODE_SIZE};
 use crate::network::nprt_net::NprtNet;
 use crate::network::track::TrackKind;
 use crate::training::loss::Loss;
 use crate::training::training_loop::ADAM_EPSILON;
 
 const BETA_1: f32 = 0.9;
+/// Threads of `grid_backward`: one per 64 slots of each level's table.
+const GRID_BACKWARD_THREADS: usize = hash_grid::LEVELS * hash_grid::TABLE_SIZE / 64;
 const BETA_2: f32 = 0.999;
 
 /// One dense layer's place in the flat buffers.
@@ -75,11 +84,20 @@ impl TrackAt {
     }
 }
 
+/// One encoder block's convolution in the flat buffers.
+struct ConvAt {
+    weight: Span,
+    bias: Span,
+    c_in: usize,
+}
+
 /// A network's parameters, gradients and Adam moments on the device, and the step that trains
 /// them.
 pub struct GpuTrainer {
     gpu: Arc<GpuDevice>,
     layout: ParameterLayout,
+    convs: Vec<ConvAt>,
+    to_code: DenseAt,
     /// The network's shapes on the host (their values are the initial ones, not kept current).
     encoder: HostEncoder,
     transport: HostTransport,
@@ -162,6 +180,9 @@ struct FirstLayer<'a> {
     bias: Bias<'a>,
 }
 
+/// What takes a first layer's bias gradient, given the gradient at its pre-activation.
+type FirstLayerBias<'a> = &'a dyn Fn(&mut wgpu::ComputePass, &wgpu::Buffer);
+
 /// What an MLP's forward pass keeps: each layer's output and each hidden layer's
 /// pre-activation.
 struct MlpTape {
@@ -180,10 +201,21 @@ struct TrackTape {
     d_out: wgpu::Buffer,
 }
 
+/// What the encoder's forward pass keeps: each block's input, (h, w) and pooling tape, and
+/// the last block's output (the flattened input of the code layer).
+struct EncoderTape {
+    inputs: Vec<wgpu::Buffer>,
+    sizes: Vec<(usize, usize)>,
+    tapes: Vec<wgpu::Buffer>,
+    flat: wgpu::Buffer,
+}
+
 /// A batch on the device, and what its step computes besides gradients.
 struct BatchBuffers {
     rows: usize,
     views: usize,
+    light_width: usize,
+    lights: wgpu::Buffer,
     features: wgpu::Buffer,
     radiance: wgpu::Buffer,
     scale: wgpu::Buffer,
@@ -243,8 +275,23 @@ impl GpuTrainer {
         let transport = HostTransport::from_net(net);
         let align = gpu.device.limits().min_storage_buffer_offset_alignment as usize / 4;
         let (layout, flat) = ParameterLayout::pack(&encoder, &transport, align.max(1));
-        // The tracks' spans, in the order ParameterLayout walks them (after the encoder's).
-        let mut spans = layout.spans[2 * encoder.convs.len() + 2..].iter().copied();
+        // Spans in the order ParameterLayout walks the tensors: the encoder's, then the tracks'.
+        let mut spans = layout.spans.iter().copied();
+        let convs = encoder
+            .convs
+            .iter()
+            .map(|c| ConvAt {
+                weight: spans.next().expect("a span per tensor"),
+                bias: spans.next().expect("a span per tensor"),
+                c_in: c.c_in,
+            })
+            .collect();
+        let to_code = DenseAt {
+            weight: spans.next().expect("a span per tensor"),
+            bias: spans.next().expect("a span per tensor"),
+            d_in: encoder.to_code.d_in,
+            d_out: encoder.to_code.d_out,
+        };
         let tracks = transport
             .tracks
             .iter()
@@ -274,6 +321,8 @@ impl GpuTrainer {
             empty: gpu.upload(&[0u32; 4]),
             spare: gpu.buffer(4),
             tracks,
+            convs,
+            to_code,
             layout,
             encoder,
             transport,
@@ -298,28 +347,31 @@ impl GpuTrainer {
         self.layout.unpack(&flat, &self.encoder, &self.transport)
     }
 
-    /// The transport networks' loss on `batch` lit by the light `codes` (`views × CODE_SIZE`),
-    /// their gradients (kept on the device, [`Self::gradients`] reads them) and the gradient
-    /// at the codes.
-    pub fn transport_gradients(
-        &mut self,
-        batch: &Samples,
-        codes: &[f32],
-        loss: Loss,
-    ) -> (f64, Vec<f32>) {
-        let b = self.upload_batch(batch, codes.len() / CODE_SIZE);
-        self.gpu.write(&b.codes, codes);
+    /// The loss of `batch` and every parameter's gradient, kept on the device
+    /// ([`Self::gradients`] reads them): one submission of the encoder's and the transport
+    /// networks' forward and backward passes. Reading the loss back waits for it.
+    pub fn backward(&mut self, batch: &Samples, loss: Loss) -> f64 {
+        let views = batch.lights.len() / (3 * batch.light_width * batch.light_width / 2);
+        let b = self.upload_batch(batch, views);
         let mut encoder = self.gpu.device.create_command_encoder(&Default::default());
         encoder.clear_buffer(&self.grads, 0, None);
         encoder.clear_buffer(&b.d_codes, 0, None);
         {
             let mut pass = encoder.begin_compute_pass(&Default::default());
+            let tape = self.encoder_forward(&mut pass, &b);
             self.record_transport(&mut pass, &b, loss);
+            self.encoder_backward(&mut pass, &b, &tape);
         }
         self.gpu.queue.submit([encoder.finish()]);
         let total = self.gpu.read(&b.loss, 1)[0] as f64;
-        let d_codes = self.gpu.read(&b.d_codes, b.views * CODE_SIZE);
-        (total / (3 * b.rows.max(1)) as f64, d_codes)
+        total / (3 * b.rows.max(1)) as f64
+    }
+
+    /// One training step: [`Self::backward`], then [`Self::adam`] at learning rate `lr`.
+    pub fn step(&mut self, batch: &Samples, loss: Loss, lr: f64) -> f64 {
+        let value = self.backward(batch, loss);
+        self.adam(lr);
+        value
     }
 
     /// One Adam step at learning rate `lr` over every parameter, from the gradients of the
@@ -357,12 +409,69 @@ impl GpuTrainer {
         self.gpu.queue.submit([encoder.finish()]);
     }
 
+    /// Writes Adam's state (both moments, flat, and the step count) to `path` as safetensors.
+    pub fn save_state(&self, path: &Path) -> Result<()> {
+        let total = self.layout.total;
+        let moments = [&self.moment1, &self.moment2].map(|m| self.gpu.read(m, total));
+        let bytes = moments
+            .each_ref()
+            .map(|m| bytemuck::cast_slice::<f32, u8>(m));
+        let views = ["moment1", "moment2"]
+            .into_iter()
+            .zip(bytes)
+            .map(|(name, b)| Ok((name, TensorView::new(Dtype::F32, vec![total], b)?)))
+            .collect::<Result<Vec<_>, safetensors::SafeTensorError>>()?;
+        let metadata = HashMap::from([("steps".to_string(), self.steps.to_string())]);
+        let file = safetensors::serialize(views, Some(metadata))?;
+        nprt_io::write_file(path, &file)
+    }
+
+    /// Reads Adam's state back from `path` (written by [`Self::save_state`] for a network of
+    /// the same shapes).
+    pub fn load_state(&mut self, path: &Path) -> Result<()> {
+        let bytes = std::fs::read(path)
+            .with_context(|| format!("cannot read Adam's state '{}'", path.display()))?;
+        let bad = |why: String| anyhow!("Adam's state '{}' {why}", path.display());
+        let file =
+            SafeTensors::deserialize(&bytes).map_err(|e| bad(format!("is unreadable: {e}")))?;
+        let (_, metadata) = SafeTensors::read_metadata(&bytes).map_err(|e| bad(e.to_string()))?;
+        let steps = metadata
+            .metadata()
+            .as_ref()
+            .and_then(|m| m.get("steps"))
+            .and_then(|s| s.parse().ok())
+            .ok_or_else(|| bad("has no step count".into()))?;
+        for (name, buffer) in [("moment1", &self.moment1), ("moment2", &self.moment2)] {
+            let view = file
+                .tensor(name)
+                .map_err(|e| bad(format!("lacks {name}: {e}")))?;
+            if view.dtype() != Dtype::F32 || view.shape() != [self.layout.total] {
+                return Err(bad(format!(
+                    "holds {name} of {:?} {:?}, not this network's {} f32",
+                    view.dtype(),
+                    view.shape(),
+                    self.layout.total
+                )));
+            }
+            let values: Vec<f32> = view
+                .data()
+                .chunks_exact(4)
+                .map(|b| f32::from_le_bytes([b[0], b[1], b[2], b[3]]))
+                .collect();
+            self.gpu.write(buffer, &values);
+        }
+        self.steps = steps;
+        Ok(())
+    }
+
     fn upload_batch(&self, batch: &Samples, views: usize) -> BatchBuffers {
         let gpu = &self.gpu;
         let view: Vec<u32> = batch.view.iter().map(|&v| v as u32).collect();
         BatchBuffers {
             rows: batch.len(),
             views,
+            light_width: batch.light_width,
+            lights: gpu.upload(batch.lights),
             features: gpu.upload(batch.features),
             radiance: gpu.upload(batch.radiance),
             scale: gpu.upload(batch.scale),
@@ -425,6 +534,143 @@ impl GpuTrainer {
         }
     }
 
+    /// Records the light encoder over the batch's maps: their codes into `b.codes`.
+    fn encoder_forward(&self, pass: &mut wgpu::ComputePass, b: &BatchBuffers) -> EncoderTape {
+        let gpu = &self.gpu;
+        let (mut h, mut w) = (b.light_width / 2, b.light_width);
+        let mut x = b.lights.clone();
+        let mut tape = EncoderTape {
+            inputs: Vec::new(),
+            sizes: Vec::new(),
+            tapes: Vec::new(),
+            flat: x.clone(),
+        };
+        for conv in &self.convs {
+            let count = b.views * CHANNELS * (h / 2) * (w / 2);
+            let (out, taken) = (gpu.buffer(count), gpu.buffer(count));
+            let params = [conv.c_in, h, w, b.views, 1, 0, 0, 0].map(|v| v as u32);
+            gpu.dispatch(
+                pass,
+                &ENCODER_BLOCK,
+                &params,
+                &[
+                    &x,
+                    &self.part(conv.weight),
+                    &self.part(conv.bias),
+                    &out,
+                    &taken,
+                ],
+                groups_for(count),
+            );
+            tape.inputs.push(std::mem::replace(&mut x, out));
+            tape.sizes.push((h, w));
+            tape.tapes.push(taken);
+            (h, w) = (h / 2, w / 2);
+        }
+        let flat = self.to_code.d_in;
+        self.gemm(
+            pass,
+            [b.views, CODE_SIZE, flat],
+            Operand::plain(&x, 0, flat),
+            Operand::plain(&self.params, self.to_code.weight.offset, CODE_SIZE),
+            Bias::Column(&self.params, self.to_code.bias.offset),
+            0,
+            Output::to(&b.codes, 0, CODE_SIZE),
+            None,
+        );
+        tape.flat = x;
+        tape
+    }
+
+    /// Records the light encoder's backward pass from the gradient at the codes, `b.d_codes`.
+    fn encoder_backward(&self, pass: &mut wgpu::ComputePass, b: &BatchBuffers, tape: &EncoderTape) {
+        let gpu = &self.gpu;
+        let flat = self.to_code.d_in;
+        self.gemm(
+            pass,
+            [flat, CODE_SIZE, b.views],
+            Operand::transposed(&tape.flat, 0, flat),
+            Operand::plain(&b.d_codes, 0, CODE_SIZE),
+            Bias::None,
+            0,
+            Output::to(&self.grads, self.to_code.weight.offset, CODE_SIZE),
+            None,
+        );
+        self.column_sum(
+            pass,
+            &b.d_codes,
+            b.views,
+            CODE_SIZE,
+            None,
+            Output::to(&self.grads, self.to_code.bias.offset, CODE_SIZE),
+        );
+        let mut d = gpu.buffer(b.views * flat);
+        self.gemm(
+            pass,
+            [b.views, flat, CODE_SIZE],
+            Operand::plain(&b.d_codes, 0, CODE_SIZE),
+            Operand::transposed(&self.params, self.to_code.weight.offset, CODE_SIZE),
+            Bias::None,
+            0,
+            Output::to(&d, 0, flat),
+            None,
+        );
+        for (k, conv) in self.convs.iter().enumerate().rev() {
+            let (h, w) = tape.sizes[k];
+            let count = b.views * CHANNELS * h * w;
+            let dz = gpu.buffer(count);
+            // The gradient at the block's input; block 0's input is the map, which needs none.
+            let d_input = match k {
+                0 => self.spare.clone(),
+                _ => gpu.buffer(b.views * conv.c_in * h * w),
+            };
+            let params = [conv.c_in, h, w, b.views, usize::from(k > 0), 0, 0, 0];
+            gpu.dispatch(
+                pass,
+                &ENCODER_POOL_BACKWARD,
+                &params.map(|v| v as u32),
+                &[&tape.tapes[k], &d, &dz, &d_input],
+                groups_for(count),
+            );
+            let params = [
+                conv.c_in,
+                h,
+                w,
+                b.views,
+                conv.weight.offset,
+                conv.bias.offset,
+                0,
+                0,
+            ];
+            gpu.dispatch(
+                pass,
+                &ENCODER_WEIGHT_BACKWARD,
+                &params.map(|v| v as u32),
+                &[&tape.inputs[k], &dz, &self.grads],
+                groups_for(CHANNELS * (conv.c_in * 9 + 1)),
+            );
+            if k > 0 {
+                let params = [conv.c_in, h, w, b.views, conv.weight.offset, 0, 0, 0];
+                gpu.dispatch(
+                    pass,
+                    &ENCODER_INPUT_BACKWARD,
+                    &params.map(|v| v as u32),
+                    &[&self.params, &dz, &d_input],
+                    groups_for(b.views * conv.c_in * h * w),
+                );
+            }
+            d = d_input;
+        }
+    }
+
+    /// One tensor of the parameters, bound on its own.
+    fn part(&self, span: Span) -> Part<'_> {
+        Part {
+            buffer: &self.params,
+            span,
+        }
+    }
+
     /// A track's forward pass over the batch.
     fn track_forward(
         &self,
@@ -434,10 +680,7 @@ impl GpuTrainer {
     ) -> TrackTape {
         let gpu = &self.gpu;
         let x = gpu.buffer(b.rows * t.width);
-        let grid = t.grid.map(|span| Part {
-            buffer: &self.params,
-            span,
-        });
+        let grid = t.grid.map(|span| self.part(span));
         let table: &dyn Bind = match &grid {
             Some(part) => part,
             None => &self.empty,
@@ -595,7 +838,7 @@ impl GpuTrainer {
                 &GRID_BACKWARD,
                 &params,
                 &[&b.features, &self.resolutions, dx, &d_table],
-                groups_for(b.rows),
+                groups_for(GRID_BACKWARD_THREADS),
             );
         }
     }
@@ -676,7 +919,7 @@ impl GpuTrainer {
         input: (&wgpu::Buffer, usize, usize),
         d_last: &wgpu::Buffer,
         d_input: Option<&wgpu::Buffer>,
-        on_first: Option<&dyn Fn(&mut wgpu::ComputePass, &wgpu::Buffer)>,
+        on_first: Option<FirstLayerBias>,
     ) {
         let rows = tape.outputs[0].size() as usize / 4 / m.layers[0].d_out;
         let widest = m

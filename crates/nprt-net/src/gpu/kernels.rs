@@ -1,7 +1,27 @@
-//! The network kernels nprt-net owns: the track inputs (with the hash grid's encoding), which
-//! the frame path dispatches too, and the training step's.
+//! The network kernels nprt-net owns: the light encoder's blocks and the track inputs (with the
+//! hash grid's encoding), which the frame path dispatches too, and the training step's.
 
 use super::KernelSource;
+
+pub const ENCODER_BLOCK: KernelSource = KernelSource {
+    name: "encoder_block",
+    wgsl: include_str!("shaders/encoder_block.wgsl"),
+};
+
+pub const ENCODER_POOL_BACKWARD: KernelSource = KernelSource {
+    name: "encoder_pool_backward",
+    wgsl: include_str!("shaders/encoder_pool_backward.wgsl"),
+};
+
+pub const ENCODER_WEIGHT_BACKWARD: KernelSource = KernelSource {
+    name: "encoder_weight_backward",
+    wgsl: include_str!("shaders/encoder_weight_backward.wgsl"),
+};
+
+pub const ENCODER_INPUT_BACKWARD: KernelSource = KernelSource {
+    name: "encoder_input_backward",
+    wgsl: include_str!("shaders/encoder_input_backward.wgsl"),
+};
 
 pub const TRACK_INPUTS: KernelSource = KernelSource {
     name: "track_inputs",

@@ -10,10 +10,12 @@ mod gpu_buffer;
 mod gpu_device;
 mod gpu_trainer;
 mod kernel;
+mod kernel_steps;
 pub mod kernels;
 mod parameters;
 
 pub use gpu_device::GpuDevice;
 pub use gpu_trainer::GpuTrainer;
 pub use kernel::{groups_for, Bind, KernelSource, Part, GROUP};
+pub use kernel_steps::KernelSteps;
 pub use parameters::{ParameterLayout, Span};

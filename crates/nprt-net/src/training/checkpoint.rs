@@ -6,11 +6,11 @@ use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result};
 use burn::module::Module;
-use burn::optim::ModuleOptimizer;
 use serde::{Deserialize, Serialize};
 
 use crate::model::folder::{load_weights, save_weights};
 use crate::training::loss_curves::LossRow;
+use crate::training::optimiser::Optimiser;
 
 const DIR: &str = "checkpoint";
 const STATE_FILE: &str = "state.json";
@@ -63,46 +63,49 @@ pub(crate) fn read(out: &Path) -> Result<Option<Checkpoint>> {
     Ok(Some(ck))
 }
 
-/// Loads the checkpoint's weights into `net` and its optimiser state.
-pub(crate) fn restore<M: Module>(
+/// Loads the checkpoint's weights into `net`.
+pub(crate) fn restore_weights<M: Module>(
     out: &Path,
     ck: &Checkpoint,
     net: &mut M,
-    optim: ModuleOptimizer,
     tag: &str,
-) -> Result<ModuleOptimizer> {
-    let dir = dir(out);
-    load_weights(&dir.join(&ck.weights), net, tag)?;
+) -> Result<()> {
+    load_weights(&dir(out).join(&ck.weights), net, tag)?;
     if let Some(device) = net.devices().into_iter().next() {
         crate::device::make_default(&device);
     }
-    optim
-        .load(dir.join(&ck.optimizer))
-        .map_err(|e| anyhow::anyhow!("cannot read optimiser state in '{}': {e:?}", dir.display()))
+    Ok(())
+}
+
+/// `optim` with the checkpoint's optimiser state.
+pub(crate) fn restore_optimiser<M: Module, B>(
+    out: &Path,
+    ck: &Checkpoint,
+    optim: Optimiser<M, B>,
+) -> Result<Optimiser<M, B>> {
+    optim.load(&dir(out).join(&ck.optimizer))
 }
 
 /// Weights, optimiser state, then the state file that names them; older files are removed last.
-pub(crate) fn write<M: Module>(
+pub(crate) fn write<M: Module, B>(
     out: &Path,
     ck: &mut Checkpoint,
     net: &M,
-    optim: &ModuleOptimizer,
+    optim: &Optimiser<M, B>,
     tag: &str,
 ) -> Result<()> {
     let dir = dir(out);
     let weights = format!("weights-{:09}.safetensors", ck.state.step);
-    let optimizer = format!("optimizer-{:09}.bpk", ck.state.step);
+    let optimizer = optim.state_file(ck.state.step);
     save_weights(&dir.join(&weights), net, tag)?;
-    optim.save(dir.join(&optimizer)).map_err(|e| {
-        anyhow::anyhow!("cannot write optimiser state in '{}': {e:?}", dir.display())
-    })?;
+    optim.save(&dir.join(&optimizer))?;
     ck.weights = weights;
     ck.optimizer = optimizer;
     let json = serde_json::to_vec_pretty(ck)?;
     nprt_io::write_file(&dir.join(STATE_FILE), &json)?;
     for entry in std::fs::read_dir(&dir)?.flatten() {
         let name = entry.file_name().to_string_lossy().to_string();
-        if (name.starts_with("weights-") || name.starts_with("optimizer-"))
+        if (name.starts_with("weights-") || Optimiser::<M, B>::is_state_file(&name))
             && name != ck.weights
             && name != ck.optimizer
         {

@@ -10,6 +10,7 @@ pub mod loss;
 pub mod loss_curves;
 pub mod lr_schedule;
 pub mod nprt_objective;
+pub mod optimiser;
 pub mod run_length;
 pub mod train_options;
 pub mod training_loop;

@@ -14,6 +14,7 @@ use burn::module::Module;
 use burn::optim::GradientsParams;
 use burn::tensor::Device;
 
+use crate::device::Backend;
 use crate::model::config::ModelConfig;
 use crate::model::folder::{save_model, ModelFile, MODEL_FORMAT, MODEL_VERSION};
 use crate::network::init::Init;
@@ -22,6 +23,8 @@ use crate::training::batch::{Batch, Engine};
 use crate::training::calibration::{level_gain, Calibration, LEVEL_SAMPLES};
 use crate::training::checkpoint::RunState;
 use crate::training::epoch_plan::{group_batches, EpochPlan};
+#[cfg(feature = "kernels")]
+use crate::training::optimiser::DeviceSteps;
 use crate::training::train_options::TrainOptions;
 use crate::training::training_loop::{self, Objective, Schedule, TrainSummary, ADAM_EPSILON};
 use crate::training::training_set::{TrainingSet, ViewSamples};
@@ -34,6 +37,8 @@ struct PixelObjective<'a> {
     opts: &'a TrainOptions,
     /// The model file as last saved, returned to the caller.
     saved: Mutex<Option<ModelFile>>,
+    /// Whether the steps run on our own GPU kernels (`--device wgpu`).
+    kernels: bool,
 }
 
 impl Objective for PixelObjective<'_> {
@@ -107,6 +112,15 @@ impl Objective for PixelObjective<'_> {
     ) -> (f64, GradientsParams, u64) {
         let (loss, grads) = batch.gradients(net, device, Engine::Auto, self.opts.loss);
         (loss, grads, batch.len() as u64)
+    }
+
+    #[cfg(feature = "kernels")]
+    fn device_steps(&self, net: &NprtNet) -> Result<Option<Box<dyn DeviceSteps<NprtNet, Batch>>>> {
+        if !self.kernels {
+            return Ok(None);
+        }
+        let steps = crate::gpu::KernelSteps::new(net, self.opts.loss)?;
+        Ok(Some(Box::new(steps)))
     }
 
     fn validation_loss(&self, net: &NprtNet, device: &Device) -> f64 {
@@ -187,13 +201,22 @@ pub fn train(
     device: &Device,
 ) -> Result<(TrainSummary, ModelFile)> {
     opts.check()?;
+    // On wgpu the steps run on our own kernels, with the network's host copy (for validation
+    // and saving) on the CPU.
+    let kernels = cfg!(feature = "kernels") && Backend::of(device) == Backend::Wgpu;
     let objective = PixelObjective {
         set,
         config,
         opts,
         saved: Mutex::new(None),
+        kernels,
     };
-    let summary = training_loop::train(&objective, &opts.schedule, out, device)?;
+    let device = if kernels {
+        Device::flex()
+    } else {
+        device.clone()
+    };
+    let summary = training_loop::train(&objective, &opts.schedule, out, &device)?;
     // The loop saves the model on every path that returns a summary.
     let file = objective
         .saved

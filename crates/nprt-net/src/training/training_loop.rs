@@ -16,7 +16,7 @@ use std::time::Instant;
 
 use anyhow::{bail, Context, Result};
 use burn::module::Module;
-use burn::optim::{AdamConfig, GradientsParams, ModuleOptimizer};
+use burn::optim::GradientsParams;
 use burn::tensor::Device;
 use rand::SeedableRng;
 use rand_pcg::Pcg64Mcg;
@@ -26,6 +26,7 @@ use crate::network::init::Init;
 use crate::training::checkpoint::{self, Checkpoint, RunState};
 use crate::training::loss_curves::{self as curves, LossRow};
 use crate::training::lr_schedule::LrSchedule;
+use crate::training::optimiser::{DeviceSteps, Optimiser};
 
 pub const ADAM_EPSILON: f32 = 1e-8;
 /// Training-loss rows per epoch in loss.csv.
@@ -138,6 +139,15 @@ pub trait Objective: Sync {
         batch: &Self::Batch,
         device: &Device,
     ) -> (f64, GradientsParams, u64);
+    /// Steps on a device of the objective's own for `net` (its weights as they stand), in place
+    /// of burn's optimiser; none by default.
+    #[allow(clippy::type_complexity)]
+    fn device_steps(
+        &self,
+        _net: &Self::Net,
+    ) -> Result<Option<Box<dyn DeviceSteps<Self::Net, Self::Batch>>>> {
+        Ok(None)
+    }
     /// Loss on held-out data with a network off the autodiff device; NaN where there is none.
     fn validation_loss(&self, net: &Self::Net, device: &Device) -> f64;
     /// Writes the model folder's own files (config and weights) for the network as it stands;
@@ -162,6 +172,9 @@ pub struct TrainSummary {
     pub final_train: f64,
     pub final_val: f64,
     pub resumed_from_epoch: Option<f64>,
+    /// Where the steps ran: "GPU kernels on …" for a device's own steps, else the device's
+    /// name ("cpu", "cuda: …").
+    pub steps_on: String,
     /// Where this invocation's time went.
     pub split: TimeSplit,
 }
@@ -217,17 +230,24 @@ pub fn train<O: Objective>(
     let device = device.clone().autodiff();
     let inner = device.clone().inner();
     let mut net = objective.build(&mut Init::new(schedule.seed, &device));
-    let optim = AdamConfig::new().with_epsilon(ADAM_EPSILON).init();
     std::fs::create_dir_all(checkpoint::dir(out))
         .with_context(|| format!("cannot create model folder '{}'", out.display()))?;
     let _lock = lock_folder(out)?;
-    let (ck, resumed_from_epoch, mut optim) = start(objective, schedule, out, &mut net, optim)?;
+    let (ck, resumed_from_epoch) = start(objective, schedule, out, &mut net)?;
+    let mut optim = match objective.device_steps(&net)? {
+        Some(steps) => Optimiser::Device(steps),
+        None => Optimiser::burn(),
+    };
+    if resumed_from_epoch.is_some() {
+        optim = checkpoint::restore_optimiser(out, &ck, optim)?;
+    }
     let mut run = Run::new(objective, schedule, out, ck);
     let mut trained = false;
     while run.ck.state.epoch < schedule.epochs && !run.out_of_time() {
         trained = true;
         let total = run.steps_in(run.ck.state.epoch);
         net = run.epoch(total, &device, net, &mut optim)?;
+        optim.store(&mut net);
         // The epoch ended, or the budget ran out within it: validate and save either way.
         let validating = Instant::now();
         let val = objective.validation_loss(&net.valid(), &inner);
@@ -240,6 +260,10 @@ pub fn train<O: Objective>(
         run.save(&net, &optim, &inner)?;
     }
     run.bar.finish_and_clear();
+    run.steps_on = match &optim {
+        Optimiser::Device(steps) => steps.describe(),
+        Optimiser::Burn(_) => crate::device::device_name(&inner),
+    };
     if !trained {
         // A finished run asked again: its model files follow this invocation's options (the
         // output calibration, say), since nothing else will write them.
@@ -279,15 +303,14 @@ fn lock_folder(out: &Path) -> Result<std::fs::File> {
     Ok(file)
 }
 
-/// The run's checkpoint: the one in `out` (into `net`, with the optimiser's state) or a fresh
-/// one, and the epoch it resumes from.
+/// The run's checkpoint: the one in `out` (its weights loaded into `net`) or a fresh one, and
+/// the epoch it resumes from.
 fn start<O: Objective>(
     objective: &O,
     schedule: &Schedule,
     out: &Path,
     net: &mut O::Net,
-    optim: ModuleOptimizer,
-) -> Result<(Checkpoint, Option<f64>, ModuleOptimizer)> {
+) -> Result<(Checkpoint, Option<f64>)> {
     let Some(saved) = checkpoint::read(out)? else {
         let fresh = Checkpoint {
             run: run_key(objective, schedule),
@@ -296,16 +319,16 @@ fn start<O: Objective>(
             weights: String::new(),
             optimizer: String::new(),
         };
-        return Ok((fresh, None, optim));
+        return Ok((fresh, None));
     };
-    let optim = resume(objective, schedule, out, &saved, net, optim)?;
+    resume(objective, schedule, out, &saved, net)?;
     let s = &saved.state;
     let at =
         s.epoch as f64 + s.batch as f64 / objective.steps(schedule.seed, s.epoch).max(1) as f64;
     if schedule.progress {
         eprintln!("resuming '{}' from epoch {at:.2}", out.display());
     }
-    Ok((saved, Some(at), optim))
+    Ok((saved, Some(at)))
 }
 
 /// A run between steps: the checkpoint it builds, the loss-table row being summed, the
@@ -329,6 +352,7 @@ struct Run<'s, O: Objective> {
     last_train: f64,
     guard: DivergenceGuard,
     split: TimeSplit,
+    steps_on: String,
 }
 
 impl<'s, O: Objective> Run<'s, O> {
@@ -370,6 +394,7 @@ impl<'s, O: Objective> Run<'s, O> {
             last_train: f64::NAN,
             guard: DivergenceGuard::default(),
             split: TimeSplit::default(),
+            steps_on: String::new(),
             ck,
         }
     }
@@ -399,7 +424,7 @@ impl<'s, O: Objective> Run<'s, O> {
         total: usize,
         device: &Device,
         net: O::Net,
-        optim: &mut ModuleOptimizer,
+        optim: &mut Optimiser<O::Net, O::Batch>,
     ) -> Result<O::Net> {
         let (objective, epoch) = (self.objective, self.ck.state.epoch);
         let row_every = (total as u64).div_ceil(TRAIN_ROWS_PER_EPOCH).max(1);
@@ -423,15 +448,23 @@ impl<'s, O: Objective> Run<'s, O> {
                 self.split.batch_wait += since(waiting);
                 let stepping = Instant::now();
                 let lr = self.learning_rate();
-                let (value, grads, samples) = objective.gradients(&net, &batch, device);
-                self.check_divergence(value, epoch)?;
-                net = optim.step(lr, net, grads);
+                let (value, samples) = if let Optimiser::Device(steps) = optim {
+                    let (value, samples) = steps.step(&batch, lr)?;
+                    self.check_divergence(value, epoch)?;
+                    (value, samples)
+                } else {
+                    let (value, grads, samples) = objective.gradients(&net, &batch, device);
+                    self.check_divergence(value, epoch)?;
+                    net = optim.apply(lr, net, grads);
+                    (value, samples)
+                };
                 self.split.steps += since(stepping);
                 self.record_step(value, samples, epoch, total, row_every);
                 if self.out_of_time() {
                     break;
                 }
                 if self.last_checkpoint.elapsed().as_secs_f64() > self.schedule.checkpoint_secs {
+                    optim.store(&mut net);
                     self.save(&net, optim, &inner)?;
                 }
             }
@@ -539,7 +572,12 @@ impl<'s, O: Objective> Run<'s, O> {
     }
 
     /// Writes the checkpoint, the model files and the loss curves.
-    fn save(&mut self, net: &O::Net, optim: &ModuleOptimizer, device: &Device) -> Result<()> {
+    fn save(
+        &mut self,
+        net: &O::Net,
+        optim: &Optimiser<O::Net, O::Batch>,
+        device: &Device,
+    ) -> Result<()> {
         let saving = Instant::now();
         let (objective, out, ck) = (self.objective, self.out, &mut self.ck);
         checkpoint::write(out, ck, net, optim, &objective.tag())?;
@@ -563,6 +601,7 @@ impl<'s, O: Objective> Run<'s, O> {
             final_train: last(|r| r.train).unwrap_or(self.last_train),
             final_val: last(|r| r.val).unwrap_or(f64::NAN),
             resumed_from_epoch,
+            steps_on: self.steps_on.clone(),
             split: self.split,
         }
     }
@@ -587,22 +626,21 @@ fn run_key<O: Objective>(objective: &O, schedule: &Schedule) -> serde_json::Valu
     key
 }
 
-/// Checks that `saved` belongs to this run and loads its weights and optimiser state.
+/// Checks that `saved` belongs to this run and loads its weights.
 fn resume<O: Objective>(
     objective: &O,
     schedule: &Schedule,
     out: &Path,
     saved: &Checkpoint,
     net: &mut O::Net,
-    optim: ModuleOptimizer,
-) -> Result<ModuleOptimizer> {
+) -> Result<()> {
     if saved.run != run_key(objective, schedule) {
         bail!(
             "model folder '{}' holds a run with other settings (network, dataset or hyper-parameters; a run with a decaying --schedule also keeps its --epochs and --minutes); choose another --out or delete it",
             out.display()
         );
     }
-    checkpoint::restore(out, saved, net, optim, &objective.tag())
+    checkpoint::restore_weights(out, saved, net, &objective.tag())
 }
 
 /// Stops a run whose loss is not finite or whose running mean rose ten times above its best

@@ -162,8 +162,8 @@ impl GpuNetwork {
                 gpu.dispatch(
                     &mut pass,
                     Kernel::EncoderBlock.source(),
-                    &[*c_in as u32, h as u32, w as u32, 0],
-                    &[&x, weight, bias, &out],
+                    &[*c_in as u32, h as u32, w as u32, 1, 0, 0, 0, 0],
+                    &[&x, weight, bias, &out, &self.empty],
                     groups_for(CHANNELS * (h / 2) * (w / 2)),
                 );
                 (x, h, w) = (out, h / 2, w / 2);

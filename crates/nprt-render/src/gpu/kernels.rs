@@ -4,12 +4,10 @@
 use nprt_net::gpu::KernelSource;
 
 /// Every kernel of the frame path, in the order a frame first uses them. The track inputs
-/// (with the hash grid's encoding) are nprt-net's, which training shares.
+/// (with the hash grid's encoding) and the encoder's blocks are nprt-net's, which training
+/// shares.
 pub const SOURCES: [&KernelSource; 5] = [
-    &KernelSource {
-        name: "encoder_block",
-        wgsl: include_str!("shaders/encoder_block.wgsl"),
-    },
+    &nprt_net::gpu::kernels::ENCODER_BLOCK,
     &nprt_net::gpu::kernels::TRACK_INPUTS,
     &KernelSource {
         name: "dense",

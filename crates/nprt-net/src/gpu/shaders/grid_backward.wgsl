@@ -1,8 +1,12 @@
 // The hash grid's table gradient: each row's gradient at its encoding (the inputs after the
 // `count` features it reads, in dx) sent back to the 8 vertices around its position at every
-// level with their trilinear weights, as nprt-net's hash_grid::scatter (grid_corners). Rows share vertices,
-// so the additions are atomic: a compare-and-swap loop on the value's bits (WGSL has no float
-// atomics). Their order, and so the last bits of a sum, depends on scheduling.
+// level with their trilinear weights (grid_corners), as nprt-net's hash_grid::scatter.
+//
+// Rows share vertices, and float atomics would add in the device's order, so that no two runs
+// gave the same bits and a resumed run could not equal an uninterrupted one. Instead each
+// thread owns SLOTS consecutive slots of one level's table and adds, row by row in order,
+// what lands there: a fixed order, no atomics, at the price of every thread visiting every
+// row.
 
 struct GridBackward {
     rows: u32,
@@ -15,34 +19,31 @@ struct GridBackward {
 @group(0) @binding(1) var<storage, read> features: array<f32>;
 @group(0) @binding(2) var<storage, read> resolution: array<u32>;
 @group(0) @binding(3) var<storage, read> dx: array<f32>;
-@group(0) @binding(4) var<storage, read_write> d_table: array<atomic<u32>>;
+@group(0) @binding(4) var<storage, read_write> d_table: array<f32>;
 
-fn add(i: u32, v: f32) {
-    var old = atomicLoad(&d_table[i]);
-    loop {
-        let r = atomicCompareExchangeWeak(&d_table[i], old, bitcast<u32>(bitcast<f32>(old) + v));
-        if (r.exchanged) {
-            break;
-        }
-        old = r.old_value;
-    }
-}
+// Slots a thread owns: 8192 / 64 = 128 threads per level.
+const SLOTS: u32 = 64u;
 
 @compute @workgroup_size(64)
 fn main(@builtin(global_invocation_id) id: vec3<u32>, @builtin(num_workgroups) groups: vec3<u32>) {
     // Rows of workgroups past the 65,535 one dimension allows.
-    let r = id.x + id.y * groups.x * 64u;
-    if (r >= p.rows) {
+    let i = id.x + id.y * groups.x * 64u;
+    if (i >= LEVELS * TABLE_SIZE / SLOTS) {
         return;
     }
-    let o = r * p.width + p.count;
-    let position = row_position(r);
-    for (var level = 0u; level < LEVELS; level++) {
-        let c = grid_corners(position, level, resolution[level]);
-        let g = vec2<f32>(dx[o + level * LEVEL_FEATURES], dx[o + level * LEVEL_FEATURES + 1u]);
+    let level = i / (TABLE_SIZE / SLOTS);
+    let first = (level * TABLE_SIZE + (i % (TABLE_SIZE / SLOTS)) * SLOTS) * LEVEL_FEATURES;
+    let end = first + SLOTS * LEVEL_FEATURES;
+    let res = resolution[level];
+    for (var r = 0u; r < p.rows; r++) {
+        let c = grid_corners(row_position(r), level, res);
+        let o = r * p.width + p.count + level * LEVEL_FEATURES;
         for (var k = 0u; k < 8u; k++) {
-            add(c.row[k], c.weight[k] * g.x);
-            add(c.row[k] + 1u, c.weight[k] * g.y);
+            let row = c.row[k];
+            if (row >= first && row < end) {
+                d_table[row] += c.weight[k] * dx[o];
+                d_table[row + 1u] += c.weight[k] * dx[o + 1u];
+            }
         }
     }
 }

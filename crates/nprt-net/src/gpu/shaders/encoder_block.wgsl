@@ -1,12 +1,19 @@
-// One block of the light encoder: 3×3 convolution to 32 channels with zero padding, ReLU, the
-// block's input added (zero beyond its channels), 2×2 max-pool. Input c_in × h × w, output
-// 32 × h/2 × w/2, channel-major as burn's tensors; one thread per output value.
+// One block of the light encoder over `views` maps: 3×3 convolution to 32 channels with zero
+// padding, ReLU, the block's input added (zero beyond its channels), 2×2 max-pool (the first of
+// a window's maxima in row order). Input views × c_in × h × w, output views × 32 × h/2 × w/2,
+// channel-major as burn's tensors; one thread per output value. With keep = 1 (training) it
+// also writes, per output value, which of its window's four values it took (bits 0-1) and
+// whether that value's convolution passed the ReLU (bit 2): what backward needs.
 
 struct Block {
     c_in: u32,
     h: u32,
     w: u32,
-    _pad: u32,
+    views: u32,
+    keep: u32,
+    _pad0: u32,
+    _pad1: u32,
+    _pad2: u32,
 }
 
 @group(0) @binding(0) var<uniform> p: Block;
@@ -14,10 +21,11 @@ struct Block {
 @group(0) @binding(2) var<storage, read> weight: array<f32>;
 @group(0) @binding(3) var<storage, read> bias: array<f32>;
 @group(0) @binding(4) var<storage, read_write> out: array<f32>;
+@group(0) @binding(5) var<storage, read_write> tape: array<u32>;
 
 const CHANNELS: u32 = 32u;
 
-fn conv(c: u32, y: u32, x: u32) -> f32 {
+fn conv(base: u32, c: u32, y: u32, x: u32) -> f32 {
     var s = 0.0;
     for (var ci = 0u; ci < p.c_in; ci++) {
         for (var ky = 0u; ky < 3u; ky++) {
@@ -31,7 +39,7 @@ fn conv(c: u32, y: u32, x: u32) -> f32 {
                     continue;
                 }
                 s += weight[((c * p.c_in + ci) * 3u + ky) * 3u + kx]
-                    * input[(ci * p.h + u32(yy)) * p.w + u32(xx)];
+                    * input[base + (ci * p.h + u32(yy)) * p.w + u32(xx)];
             }
         }
     }
@@ -44,21 +52,31 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>, @builtin(num_workgroups) g
     let wo = p.w / 2u;
     // Rows of workgroups past the 65,535 one dimension allows.
     let i = id.x + id.y * groups.x * 64u;
-    if (i >= CHANNELS * ho * wo) {
+    if (i >= p.views * CHANNELS * ho * wo) {
         return;
     }
-    let c = i / (ho * wo);
+    let view = i / (CHANNELS * ho * wo);
+    let c = (i / (ho * wo)) % CHANNELS;
     let oy = (i / wo) % ho;
     let ox = i % wo;
+    let base = view * p.c_in * p.h * p.w;
     var m = -3.0e38;
+    var taken = 0u;
     for (var d = 0u; d < 4u; d++) {
         let y = 2u * oy + d / 2u;
         let x = 2u * ox + d % 2u;
-        var v = max(conv(c, y, x), 0.0);
+        let z = conv(base, c, y, x);
+        var v = max(z, 0.0);
         if (c < p.c_in) {
-            v += input[(c * p.h + y) * p.w + x];
+            v += input[base + (c * p.h + y) * p.w + x];
         }
-        m = max(m, v);
+        if (v > m) {
+            m = v;
+            taken = d | select(0u, 4u, z > 0.0);
+        }
     }
     out[i] = m;
+    if (p.keep == 1u) {
+        tape[i] = taken;
+    }
 }
