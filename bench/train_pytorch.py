@@ -4,7 +4,9 @@ Layers mirror crates/nprt-net (encoder: 5 x [3x3 conv 32, ReLU, zero-padded skip
 then a dense layer to 64; the four transport designs with SIREN or ReLU layers; log-radiance
 outputs through exp, scaled by the map mean; L1 on log(1 + x); Adam lr 1e-4, eps 1e-8).
 Prints one JSON line per design. `--device cuda` runs it on the GPU, in f32 without TF32 (as
-nprt computes), synchronising before the clock is read.
+nprt computes), synchronising before the clock is read; `--autocast bf16` runs the forward pass
+under bf16 autocast (f32 master weights), `--compile` compiles the forward pass and loss with
+torch.compile (compile time falls in the warm-up steps).
 """
 
 import argparse
@@ -106,6 +108,8 @@ def main():
     p.add_argument("--warmup", type=int, default=2)
     p.add_argument("--threads", type=int, default=0)
     p.add_argument("--device", default="cpu", help="cpu or cuda")
+    p.add_argument("--autocast", default="", help="bf16: forward under bf16 autocast")
+    p.add_argument("--compile", action="store_true", help="torch.compile the forward and loss")
     a = p.parse_args()
     dev = torch.device(a.device)
     torch.backends.cuda.matmul.allow_tf32 = False
@@ -125,10 +129,16 @@ def main():
         view = torch.randint(0, a.views, (b,), device=dev)
         scale = torch.rand(b, 1, device=dev) + 0.5
 
+        def loss_of():
+            with torch.autocast(dev.type, dtype=torch.bfloat16, enabled=a.autocast == "bf16"):
+                pred = net(f, light, view, scale)
+            return (torch.log1p(pred.float()) - torch.log1p(ref)).abs().mean()
+
+        loss_fn = torch.compile(loss_of) if a.compile else loss_of
+
         def step():
             opt.zero_grad(set_to_none=True)
-            loss = (torch.log1p(net(f, light, view, scale)) - torch.log1p(ref)).abs().mean()
-            loss.backward()
+            loss_fn().backward()
             opt.step()
 
         for _ in range(a.warmup):
@@ -148,6 +158,7 @@ def main():
             "torch": torch.__version__,
             "threads": torch.get_num_threads(),
             "device": str(dev),
+            "variant": ("compile" if a.compile else "eager") + "-" + (a.autocast or "f32"),
         }), flush=True)
 
 

@@ -4,7 +4,7 @@
 use std::path::PathBuf;
 
 use anyhow::Result;
-use nprt_net::bench::pytorch_peer::{PeerRun, PeerScript};
+use nprt_net::bench::pytorch_peer::{PeerRun, PeerScript, PeerVariant};
 use nprt_net::{
     device_name, is_cpu, measure_throughput, median, Activation, Backend, Design, DirectLight,
     Engine, ModelConfig,
@@ -15,9 +15,10 @@ use crate::flags::{DeviceArg, Resolution};
 #[derive(clap::Subcommand)]
 pub enum BenchCommand {
     /// Training samples/s of each design (forward, backward and Adam on one batch) with the CPU
-    /// engine and with burn's autodiff graph, beside the PyTorch peer (bench/train_pytorch.py,
+    /// engine and with burn's autodiff graph (or, with --device wgpu, nprt's own GPU kernels;
+    /// with --device gpu burn's CUDA backend), beside the PyTorch peer (bench/train_pytorch.py,
     /// embedded in nprt) running the same networks, batch and loss when --python is given; the
-    /// ratio is the engine's to PyTorch's.
+    /// ratio is the engine's to the fastest of the PyTorch variants asked for.
     Train(BenchTrainArgs),
     /// Inference speed of each design's transport networks on the CPU engine at a square
     /// resolution, every pixel foreground: a frame from a new viewpoint, and a lighting change
@@ -106,9 +107,15 @@ pub struct BenchTrainArgs {
     #[arg(long, default_value_t = 3)]
     rounds: usize,
     /// Python with PyTorch for the side-by-side peer (bench/train_vs_pytorch.sh installs one);
-    /// it runs on the same device (CUDA for a GPU).
+    /// it runs on the same device (CUDA for a GPU, wgpu's included: it is assumed to be an
+    /// NVIDIA card PyTorch reaches through CUDA).
     #[arg(long)]
     python: Option<PathBuf>,
+    /// How the peer runs, comma-separated: eager-f32, eager-bf16, compile-f32, compile-bf16
+    /// (torch.compile; bf16: forward under bf16 autocast). Each is timed in every round; the
+    /// fastest (by its median) is the peer compared with, and named in the last column.
+    #[arg(long, value_delimiter = ',', default_value = "eager-f32")]
+    peer_variants: Vec<PeerVariant>,
     #[command(flatten)]
     device: DeviceArg,
 }
@@ -238,14 +245,15 @@ fn train(a: BenchTrainArgs) -> Result<()> {
     );
     let peer = peer(a.python.as_ref(), &device)?;
     println!(
-        "{:<10} {:<6} {:>14} {:>18} {:>17} {:>8} {:>15}",
+        "{:<10} {:<6} {:>14} {:>18} {:>17} {:>8} {:>15}  {}",
         "design",
         "act",
         "nprt samples/s",
         "autodiff samples/s",
         "PyTorch samples/s",
         "ratio",
-        "rounds' ratios"
+        "rounds' ratios",
+        "peer"
     );
     for &arch in &a.designs.arch {
         let config = ModelConfig::new(arch, a.activation);
@@ -263,23 +271,32 @@ fn train(a: BenchTrainArgs) -> Result<()> {
         // Rounds alternate the peer and nprt, so that a drift in the machine's speed (identical
         // runs here differ by up to 30%) reaches both alike; medians are compared.
         let mut ours = Vec::new();
-        let mut theirs = Vec::new();
+        // Per variant, its rate in each round.
+        let mut variants: Vec<Vec<f64>> = vec![Vec::new(); a.peer_variants.len()];
         for _ in 0..rounds {
             if let Some((python, torch_device, script)) = &peer {
-                theirs.push(script.run(&PeerRun {
-                    python,
-                    design: arch,
-                    activation: a.activation,
-                    batch_size: a.batch_size,
-                    views: a.views,
-                    steps: a.steps,
-                    warmup: a.warmup,
-                    threads,
-                    torch_device,
-                })?);
+                for (&variant, rates) in a.peer_variants.iter().zip(&mut variants) {
+                    rates.push(script.run(&PeerRun {
+                        python,
+                        design: arch,
+                        activation: a.activation,
+                        batch_size: a.batch_size,
+                        views: a.views,
+                        steps: a.steps,
+                        warmup: a.warmup,
+                        threads,
+                        torch_device,
+                        variant,
+                    })?);
+                }
             }
             ours.push(measure(Engine::Auto));
         }
+        // The fastest variant by its median is the peer.
+        let best = (0..variants.len())
+            .filter(|&v| !variants[v].is_empty())
+            .max_by(|&x, &y| median(variants[x].clone()).total_cmp(&median(variants[y].clone())));
+        let theirs = best.map_or(Vec::new(), |v| variants[v].clone());
         let ratios: Vec<f64> = ours.iter().zip(&theirs).map(|(o, t)| o / t).collect();
         let ours = median(ours);
         // Off the CPU burn's autodiff is the only path, so the column would repeat the first.
@@ -293,37 +310,33 @@ fn train(a: BenchTrainArgs) -> Result<()> {
             None => "-".into(),
         };
         println!(
-            "{:<10} {:<6} {:>14.0} {:>18} {:>17} {:>8} {:>15}",
+            "{:<10} {:<6} {:>14.0} {:>18} {:>17} {:>8} {:>15}  {}",
             arch.name(),
             config.activation.name(),
             ours,
             autodiff.map_or("-".into(), |t| format!("{t:.0}")),
             theirs.map_or("-".into(), |t| format!("{t:.0}")),
             theirs.map_or("-".into(), |t| format!("{:.2}×", ours / t)),
-            spread
+            spread,
+            best.map_or("-".into(), |v| a.peer_variants[v].name())
         );
     }
     Ok(())
 }
 
-/// The PyTorch peer to compare with, if one was given and PyTorch has a device of this kind
-/// (none for wgpu): its Python, PyTorch's device name and the script written out.
+/// The PyTorch peer to compare with, if one was given: its Python, PyTorch's device name (CUDA
+/// for either GPU route) and the script written out.
 fn peer<'a>(
     python: Option<&'a PathBuf>,
     device: &nprt_net::Device,
 ) -> Result<Option<(&'a PathBuf, &'static str, PeerScript)>> {
     let torch_device = match Backend::of(device) {
-        Backend::Cpu => Some("cpu"),
-        Backend::Cuda => Some("cuda"),
-        Backend::Wgpu => None,
+        Backend::Cpu => "cpu",
+        Backend::Cuda | Backend::Wgpu => "cuda",
     };
-    Ok(match (python, torch_device) {
-        (Some(py), Some(torch_device)) => Some((py, torch_device, PeerScript::write()?)),
-        (Some(_), None) => {
-            println!("(PyTorch has no wgpu device: peer skipped)");
-            None
-        }
-        (None, _) => {
+    Ok(match python {
+        Some(py) => Some((py, torch_device, PeerScript::write()?)),
+        None => {
             println!(
                 "(no --python given: PyTorch peer skipped; bench/train_vs_pytorch.sh sets one up)"
             );

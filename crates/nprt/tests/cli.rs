@@ -356,6 +356,64 @@ fn bench_train_alternates_rounds_with_the_peer_and_compares_medians() {
     );
 }
 
+/// Several PyTorch variants: each runs every round with its own flags, and the fastest by its
+/// median is the peer, named in the last column.
+#[test]
+fn bench_train_compares_with_the_fastest_peer_variant() {
+    let dir = tmp("bench-variants");
+    let script = dir.join("python");
+    // compile-bf16 runs at 3000 samples/s, eager-f32 at 1000; the flags are logged.
+    std::fs::write(
+        &script,
+        format!(
+            "#!/usr/bin/env bash\necho \"$*\" >> '{}'\n\
+             case \"$*\" in *--compile*--autocast\\ bf16*) r=3000;; *) r=1000;; esac\n\
+             echo \"{{\\\"samples_per_s\\\": $r}}\"\n",
+            dir.join("calls").display()
+        ),
+    )
+    .unwrap();
+    use std::os::unix::fs::PermissionsExt;
+    std::fs::set_permissions(&script, std::fs::Permissions::from_mode(0o755)).unwrap();
+    let out = common::ok(&[
+        "bench",
+        "train",
+        "--arch",
+        "baseline",
+        "--batch-size",
+        "64",
+        "--views",
+        "1",
+        "--steps",
+        "1",
+        "--warmup",
+        "0",
+        "--rounds",
+        "2",
+        "--device",
+        "cpu",
+        "--python",
+        script.to_str().unwrap(),
+        "--peer-variants",
+        "eager-f32,compile-bf16",
+    ]);
+    let calls = std::fs::read_to_string(dir.join("calls")).unwrap();
+    assert_eq!(calls.lines().count(), 4, "{calls}");
+    assert_eq!(
+        calls.lines().filter(|l| l.contains("--compile")).count(),
+        2,
+        "{calls}"
+    );
+    let row: Vec<&str> = out
+        .lines()
+        .find(|l| l.starts_with("baseline"))
+        .unwrap_or_else(|| panic!("no baseline row in:\n{out}"))
+        .split_whitespace()
+        .collect();
+    assert_eq!(row[4], "3000", "{out}");
+    assert_eq!(row[7], "compile-bf16", "{out}");
+}
+
 #[test]
 fn bench_frame_times_every_stage_on_each_device() {
     let mut devices = vec!["cpu"];

@@ -24,6 +24,56 @@ pub struct PeerRun<'a> {
     pub threads: usize,
     /// PyTorch's name of the device ("cpu", "cuda").
     pub torch_device: &'a str,
+    pub variant: PeerVariant,
+}
+
+/// How PyTorch runs the step: eager or compiled (torch.compile), in f32 or under bf16
+/// autocast. Named "eager-f32", "compile-bf16" and so on.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct PeerVariant {
+    pub compile: bool,
+    pub bf16: bool,
+}
+
+impl PeerVariant {
+    pub const ALL: [PeerVariant; 4] = [
+        PeerVariant {
+            compile: false,
+            bf16: false,
+        },
+        PeerVariant {
+            compile: false,
+            bf16: true,
+        },
+        PeerVariant {
+            compile: true,
+            bf16: false,
+        },
+        PeerVariant {
+            compile: true,
+            bf16: true,
+        },
+    ];
+
+    pub fn name(self) -> String {
+        format!(
+            "{}-{}",
+            if self.compile { "compile" } else { "eager" },
+            if self.bf16 { "bf16" } else { "f32" }
+        )
+    }
+}
+
+impl std::str::FromStr for PeerVariant {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, String> {
+        Self::ALL
+            .into_iter()
+            .find(|v| v.name() == s)
+            .ok_or_else(|| {
+                format!("unknown PyTorch variant '{s}': eager-f32, eager-bf16, compile-f32 or compile-bf16")
+            })
+    }
 }
 
 /// The embedded script written out for one process's runs, removed when dropped.
@@ -49,6 +99,12 @@ impl PeerScript {
             .args(["--warmup", &r.warmup.to_string()])
             .args(["--threads", &r.threads.to_string()])
             .args(["--device", r.torch_device]);
+        if r.variant.compile {
+            cmd.arg("--compile");
+        }
+        if r.variant.bf16 {
+            cmd.args(["--autocast", "bf16"]);
+        }
         if let Some(act) = r.activation {
             cmd.args(["--activation", act.name()]);
         }

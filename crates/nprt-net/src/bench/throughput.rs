@@ -46,6 +46,10 @@ pub fn measure_throughput(
         lights: random(views * 3 * w * w / 2, 1.0),
         light_width: w,
     };
+    #[cfg(feature = "kernels")]
+    if crate::device::Backend::of(&device) == crate::device::Backend::Wgpu {
+        return kernel_throughput(config, &batch, steps, warmup);
+    }
     let mut timed = Instant::now();
     for step in 0..warmup + steps {
         if step == warmup {
@@ -57,6 +61,23 @@ pub fn measure_throughput(
     }
     device.sync().ok();
     (batch_size * steps) as f64 / timed.elapsed().as_secs_f64()
+}
+
+/// [`measure_throughput`] on our own GPU kernels (what `--device wgpu` trains with): each step
+/// reads its loss back, as a training run does.
+#[cfg(feature = "kernels")]
+fn kernel_throughput(config: &ModelConfig, batch: &Batch, steps: usize, warmup: usize) -> f64 {
+    let net = config.build(&mut Init::new(0, &Device::flex()));
+    let mut gpu = crate::gpu::GpuTrainer::new(&net).expect("the wgpu device opened already");
+    let samples = batch.samples();
+    let mut timed = Instant::now();
+    for step in 0..warmup + steps {
+        if step == warmup {
+            timed = Instant::now();
+        }
+        gpu.step(&samples, Loss::LogL1, 1e-4);
+    }
+    (batch.len() * steps) as f64 / timed.elapsed().as_secs_f64()
 }
 
 /// The median of timings (the upper one of an even count): what benchmarks report, since a
