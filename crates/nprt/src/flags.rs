@@ -9,11 +9,12 @@ use nprt_net::{Compute, Device, LrSchedule, RunLength};
 /// `--device`, shared by every command that runs the networks.
 #[derive(clap::Args, Clone, Copy)]
 pub struct DeviceArg {
-    /// Where the networks run: cpu, gpu (an NVIDIA GPU through CUDA; an error if none is found
-    /// or this nprt was built without the `cuda` feature), wgpu (any Vulkan or Metal GPU
-    /// through wgpu, Mesa's software Vulkan driver included, which is how the GPU path is
-    /// tested without a GPU; needs the `wgpu` feature) or auto (the CUDA GPU when one is
-    /// found, else the CPU). A model folder is the same whichever trained it.
+    /// Where the networks run: cpu, gpu (an NVIDIA GPU through burn's CUDA backend; an error
+    /// if none is found or this nprt was built without the `cuda` feature), wgpu (any Vulkan,
+    /// Metal or DX12 GPU through wgpu, running nprt's own kernels for training and frames;
+    /// Mesa's software Vulkan driver included, which is how the GPU code is tested without a
+    /// GPU; needs the `wgpu` feature) or auto (the CUDA GPU when one is found, else the CPU).
+    /// A model folder is the same whichever trained it.
     #[arg(long = "device", default_value_t = Compute::Auto)]
     pub compute: Compute,
 }

@@ -1,0 +1,128 @@
+#!/usr/bin/env bash
+# Every GPU measurement of nprt's training and frame goals in one go, on a machine with an
+# NVIDIA GPU, its Vulkan driver and PyTorch with CUDA (sized for 20 minutes on one H100 with the
+# KITCHEN part; not yet run on one). Writes one summary file (Markdown) with:
+#   1. `nprt bench train --device wgpu` (nprt's own kernels) per design beside PyTorch on CUDA,
+#      eager and torch.compile, each in f32 and bf16 autocast (the fastest is the peer), at
+#      batch 16,384 and 262,144;
+#   2. the paper's schedule (3000 views of 256², 500 epochs) projected from those rates;
+#   3. `nprt bench frame` (G-buffer, encoder, networks, total) per design at 512² and 1920×1080
+#      on the GPU kernels, beside the paper's Table 3;
+#   4. with --kitchen: D/S trained 10 minutes on the GPU on that dataset and evaluated with
+#      `nprt eval` beside --cpu-model (the same design trained 10 minutes on the CPU).
+#
+# usage: bench/gpu.sh [--nprt BIN] [--python PY] [--kitchen DATASET --cpu-model MODEL]
+#                     [--summary FILE] [--work DIR]
+#   --nprt       the nprt binary (default target/release/nprt, built with `--features gpu`
+#                when missing)
+#   --python     Python with PyTorch and CUDA (default python3)
+#   --kitchen    a KITCHEN dataset (`nprt generate --scene ../shared/kitchen/... --out DIR`)
+#   --cpu-model  D/S trained on it for 10 minutes on the CPU
+#                (`nprt train --data DIR --arch dsep --minutes 10 --device cpu --out MODEL`)
+#   --summary    the summary file (default bench-gpu-summary.md)
+#   --work       where models and reports go (default a temporary folder)
+set -euo pipefail
+cd "$(dirname "$0")/.."
+
+nprt=target/release/nprt
+python=python3
+kitchen=
+cpu_model=
+summary=bench-gpu-summary.md
+work=
+while [ $# -gt 0 ]; do
+  case "$1" in
+    --nprt) nprt=$2; shift 2 ;;
+    --python) python=$2; shift 2 ;;
+    --kitchen) kitchen=$2; shift 2 ;;
+    --cpu-model) cpu_model=$2; shift 2 ;;
+    --summary) summary=$2; shift 2 ;;
+    --work) work=$2; shift 2 ;;
+    -h | --help) sed -n '2,/^set -euo/p' "$0" | sed '$d; s/^# \{0,1\}//'; exit 0 ;;
+    *) echo "bench/gpu.sh: unknown argument '$1' (--help lists them)" >&2; exit 2 ;;
+  esac
+done
+if [ -n "$kitchen" ] && [ -z "$cpu_model" ]; then
+  echo "bench/gpu.sh: --kitchen needs --cpu-model (the same design trained 10 minutes on the CPU)" >&2
+  exit 2
+fi
+
+# What the run needs, each missing piece named.
+command -v nvidia-smi >/dev/null || { echo "bench/gpu.sh: no nvidia-smi: this needs an NVIDIA GPU" >&2; exit 1; }
+ldconfig -p | grep -q 'libvulkan\.so\.1' || {
+  echo "bench/gpu.sh: no Vulkan loader (libvulkan.so.1): nprt's GPU kernels run on wgpu over Vulkan; install libvulkan1 and the NVIDIA driver's Vulkan ICD" >&2
+  exit 1
+}
+"$python" -c 'import torch, sys; sys.exit(0 if torch.cuda.is_available() else 1)' || {
+  echo "bench/gpu.sh: '$python' has no PyTorch with CUDA (the peer)" >&2
+  exit 1
+}
+if [ ! -x "$nprt" ]; then
+  cargo build --release -p nprt --features gpu
+fi
+if [ -z "$work" ]; then
+  work=$(mktemp -d)
+fi
+mkdir -p "$work"
+
+designs=baseline,prt,albedo,dsep
+variants=eager-f32,eager-bf16,compile-f32,compile-bf16
+log() { echo "bench/gpu.sh: $*" >&2; }
+
+{
+  echo "# nprt on the GPU: $(date -u +%Y-%m-%dT%H:%MZ)"
+  echo
+  echo '```'
+  nvidia-smi --query-gpu=name,driver_version,memory.total --format=csv,noheader
+  "$python" -c 'import torch; print("PyTorch", torch.__version__, "CUDA", torch.version.cuda)'
+  echo "nprt $(git rev-parse --short HEAD 2>/dev/null || echo '(no git)'): $nprt"
+  echo '```'
+} >"$summary"
+
+section() { printf '\n## %s\n\n```\n' "$1" >>"$summary"; }
+end_section() { echo '```' >>"$summary"; }
+
+# 1. Training throughput beside PyTorch. One round: each variant's process compiles anew, and
+# torch.compile's compile falls in its warm-up steps.
+for batch in 16384 262144; do
+  steps=$([ "$batch" = 16384 ] && echo 20 || echo 5)
+  log "training throughput at batch $batch"
+  section "Training samples/s at batch $batch (nprt's kernels on wgpu; PyTorch on CUDA)"
+  "$nprt" bench train --device wgpu --python "$python" --peer-variants "$variants" \
+    --arch "$designs" --batch-size "$batch" --steps "$steps" --warmup 3 --rounds 1 \
+    | tee "$work/train-$batch.txt" >>"$summary"
+  end_section
+done
+
+# 2. The paper's schedule from the measured rates: 3000 views × 256² pixels × 500 epochs (every
+# pixel counted, as if all were foreground).
+section "The paper's schedule (3000 views of 256², 500 epochs) projected from the rates above"
+for batch in 16384 262144; do
+  awk -v batch="$batch" '$1 ~ /^(baseline|prt|albedo|dsep)$/ {
+      samples = 3000 * 256 * 256 * 500
+      printf "batch %6d  %-9s nprt %6.1f min   PyTorch %6s min\n", batch, $1, samples / $3 / 60,
+        ($5 == "-" ? "-" : sprintf("%.1f", samples / $5 / 60))
+    }' "$work/train-$batch.txt" >>"$summary"
+done
+end_section
+
+# 3. The frame, stage by stage.
+log "frame timings"
+section "Frame ms (nprt bench frame --device wgpu); the paper's Table 3 (RTX 3090, 512²): encoder 0.34 ms, networks 9.7-16 ms"
+"$nprt" bench frame --device wgpu --arch "$designs" --res 512,1920x1080 --repeats 10 >>"$summary"
+end_section
+
+# 4. KITCHEN: 10 minutes of training on the GPU against 10 on the CPU.
+if [ -n "$kitchen" ]; then
+  log "training D/S on '$kitchen' for 10 minutes"
+  section "KITCHEN: D/S trained 10 minutes on the GPU"
+  "$nprt" train --data "$kitchen" --arch dsep --minutes 10 --device wgpu --out "$work/kitchen-gpu" \
+    >>"$summary"
+  end_section
+  log "evaluating"
+  "$nprt" eval --model "$work/kitchen-gpu","$cpu_model" --data "$kitchen" --out "$work/kitchen-eval" \
+    --device wgpu >/dev/null
+  printf '\n## KITCHEN: nprt eval of the GPU model, then the CPU model\n\n' >>"$summary"
+  cat "$work/kitchen-eval/report.md" >>"$summary"
+fi
+log "summary in '$summary'"
