@@ -245,15 +245,14 @@ fn train(a: BenchTrainArgs) -> Result<()> {
     );
     let peer = peer(a.python.as_ref(), &device)?;
     println!(
-        "{:<10} {:<6} {:>14} {:>18} {:>17} {:>8} {:>15}  {}",
+        "{:<10} {:<6} {:>14} {:>18} {:>17} {:>8} {:>15}  peer",
         "design",
         "act",
         "nprt samples/s",
         "autodiff samples/s",
         "PyTorch samples/s",
         "ratio",
-        "rounds' ratios",
-        "peer"
+        "rounds' ratios"
     );
     for &arch in &a.designs.arch {
         let config = ModelConfig::new(arch, a.activation);

@@ -48,24 +48,41 @@ impl Pipelines {
     }
 }
 
+/// One dispatch ready to record: its pipeline, its bind group (which keeps its buffers alive)
+/// and its workgroups. A training step keeps its dispatches and records them again each step.
+pub struct Dispatch {
+    pipeline: wgpu::ComputePipeline,
+    group: wgpu::BindGroup,
+    groups: [u32; 2],
+    /// The parameter block, rewritable with `queue.write_buffer` (Adam's rate and step).
+    pub uniform: wgpu::Buffer,
+}
+
+impl Dispatch {
+    pub fn record(&self, pass: &mut wgpu::ComputePass) {
+        pass.set_pipeline(&self.pipeline);
+        pass.set_bind_group(0, &self.group, &[]);
+        pass.dispatch_workgroups(self.groups[0], self.groups[1], 1);
+    }
+}
+
 impl super::GpuDevice {
-    /// Records one dispatch of `kernel` with `params` (the shader's uniform struct, as u32
-    /// words or f32 bit patterns) and `buffers` (whole buffers or parts) at bindings 1, 2, ….
-    pub fn dispatch(
+    /// A dispatch of `kernel` with `params` (the shader's uniform struct, as u32 words or f32
+    /// bit patterns) and `buffers` (whole buffers or parts) at bindings 1, 2, ….
+    pub fn prepare(
         &self,
-        pass: &mut wgpu::ComputePass,
         kernel: &KernelSource,
         params: &[u32],
         buffers: &[&dyn Bind],
         groups: [u32; 2],
-    ) {
+    ) -> Dispatch {
         let pipeline = self.pipelines.get(&self.device, kernel);
         let uniform = self
             .device
             .create_buffer_init(&wgpu::util::BufferInitDescriptor {
                 label: Some(kernel.name),
                 contents: bytemuck::cast_slice(params),
-                usage: wgpu::BufferUsages::UNIFORM,
+                usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
             });
         let mut entries = vec![wgpu::BindGroupEntry {
             binding: 0,
@@ -85,9 +102,24 @@ impl super::GpuDevice {
             layout: &pipeline.get_bind_group_layout(0),
             entries: &entries,
         });
-        pass.set_pipeline(&pipeline);
-        pass.set_bind_group(0, &group, &[]);
-        pass.dispatch_workgroups(groups[0], groups[1], 1);
+        Dispatch {
+            pipeline,
+            group,
+            groups,
+            uniform,
+        }
+    }
+
+    /// Records one dispatch of `kernel` now (see [`Self::prepare`]).
+    pub fn dispatch(
+        &self,
+        pass: &mut wgpu::ComputePass,
+        kernel: &KernelSource,
+        params: &[u32],
+        buffers: &[&dyn Bind],
+        groups: [u32; 2],
+    ) {
+        self.prepare(kernel, params, buffers, groups).record(pass);
     }
 }
 

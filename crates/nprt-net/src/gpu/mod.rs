@@ -6,16 +6,20 @@
 //! tests hold the two together; layouts, designs and the hash grid stay defined where the CPU
 //! engine reads them.
 
+mod encoder_step;
 mod gpu_buffer;
 mod gpu_device;
 mod gpu_trainer;
 mod kernel;
 mod kernel_steps;
 pub mod kernels;
+mod network_layout;
 mod parameters;
+mod products;
+mod transport_step;
 
 pub use gpu_device::GpuDevice;
 pub use gpu_trainer::GpuTrainer;
-pub use kernel::{groups_for, Bind, KernelSource, Part, GROUP};
+pub use kernel::{groups_for, Bind, Dispatch, KernelSource, Part, GROUP};
 pub use kernel_steps::KernelSteps;
 pub use parameters::{ParameterLayout, Span};

@@ -1,0 +1,156 @@
+//! The light encoder's share of a training step: its blocks over the batch's maps keeping
+//! their pooling tapes, the code layer, and backward from the gradient at the codes into every
+//! encoder weight.
+
+use super::gpu_trainer::{BatchBuffers, GpuTrainer};
+use super::kernels::{
+    ENCODER_BLOCK, ENCODER_INPUT_BACKWARD, ENCODER_POOL_BACKWARD, ENCODER_WEIGHT_BACKWARD,
+};
+use super::products::{Bias, Operand, Output};
+use super::{groups_for, Dispatch};
+use crate::network::encoder::{CHANNELS, CODE_SIZE};
+
+/// What the encoder's forward pass keeps: each block's input, (h, w) and pooling tape, and
+/// the last block's output (the flattened input of the code layer).
+pub(super) struct EncoderTape {
+    inputs: Vec<wgpu::Buffer>,
+    sizes: Vec<(usize, usize)>,
+    tapes: Vec<wgpu::Buffer>,
+    flat: wgpu::Buffer,
+}
+
+impl GpuTrainer {
+    /// Records the light encoder over the batch's maps: their codes into `b.codes`.
+    pub(super) fn encoder_forward(
+        &self,
+        plan: &mut Vec<Dispatch>,
+        b: &BatchBuffers,
+    ) -> EncoderTape {
+        let gpu = &self.gpu;
+        let (mut h, mut w) = (b.light_width / 2, b.light_width);
+        let mut x = b.lights.clone();
+        let mut tape = EncoderTape {
+            inputs: Vec::new(),
+            sizes: Vec::new(),
+            tapes: Vec::new(),
+            flat: x.clone(),
+        };
+        for conv in &self.net.convs {
+            let count = b.views * CHANNELS * (h / 2) * (w / 2);
+            let (out, taken) = (gpu.buffer(count), gpu.buffer(count));
+            let params = [conv.c_in, h, w, b.views, 1, 0, 0, 0].map(|v| v as u32);
+            plan.push(gpu.prepare(
+                &ENCODER_BLOCK,
+                &params,
+                &[
+                    &x,
+                    &self.part(conv.weight),
+                    &self.part(conv.bias),
+                    &out,
+                    &taken,
+                ],
+                groups_for(count),
+            ));
+            tape.inputs.push(std::mem::replace(&mut x, out));
+            tape.sizes.push((h, w));
+            tape.tapes.push(taken);
+            (h, w) = (h / 2, w / 2);
+        }
+        let flat = self.net.to_code.d_in;
+        self.gemm(
+            plan,
+            [b.views, CODE_SIZE, flat],
+            Operand::plain(&x, 0, flat),
+            Operand::plain(&self.params, self.net.to_code.weight.offset, CODE_SIZE),
+            Bias::Column(&self.params, self.net.to_code.bias.offset),
+            0,
+            Output::to(&b.codes, 0, CODE_SIZE),
+            None,
+        );
+        tape.flat = x;
+        tape
+    }
+
+    /// Records the light encoder's backward pass from the gradient at the codes, `b.d_codes`.
+    pub(super) fn encoder_backward(
+        &self,
+        plan: &mut Vec<Dispatch>,
+        b: &BatchBuffers,
+        tape: &EncoderTape,
+    ) {
+        let gpu = &self.gpu;
+        let flat = self.net.to_code.d_in;
+        self.gemm(
+            plan,
+            [flat, CODE_SIZE, b.views],
+            Operand::transposed(&tape.flat, 0, flat),
+            Operand::plain(&b.d_codes, 0, CODE_SIZE),
+            Bias::None,
+            0,
+            Output::to(&self.grads, self.net.to_code.weight.offset, CODE_SIZE),
+            None,
+        );
+        self.column_sum(
+            plan,
+            &b.d_codes,
+            b.views,
+            CODE_SIZE,
+            None,
+            Output::to(&self.grads, self.net.to_code.bias.offset, CODE_SIZE),
+        );
+        let mut d = gpu.buffer(b.views * flat);
+        self.gemm(
+            plan,
+            [b.views, flat, CODE_SIZE],
+            Operand::plain(&b.d_codes, 0, CODE_SIZE),
+            Operand::transposed(&self.params, self.net.to_code.weight.offset, CODE_SIZE),
+            Bias::None,
+            0,
+            Output::to(&d, 0, flat),
+            None,
+        );
+        for (k, conv) in self.net.convs.iter().enumerate().rev() {
+            let (h, w) = tape.sizes[k];
+            let count = b.views * CHANNELS * h * w;
+            let dz = gpu.buffer(count);
+            // The gradient at the block's input; block 0's input is the map, which needs none.
+            let d_input = match k {
+                0 => self.spare.clone(),
+                _ => gpu.buffer(b.views * conv.c_in * h * w),
+            };
+            let params = [conv.c_in, h, w, b.views, usize::from(k > 0), 0, 0, 0];
+            plan.push(gpu.prepare(
+                &ENCODER_POOL_BACKWARD,
+                &params.map(|v| v as u32),
+                &[&tape.tapes[k], &d, &dz, &d_input],
+                groups_for(count),
+            ));
+            let params = [
+                conv.c_in,
+                h,
+                w,
+                b.views,
+                conv.weight.offset,
+                conv.bias.offset,
+                0,
+                0,
+            ];
+            plan.push(gpu.prepare(
+                &ENCODER_WEIGHT_BACKWARD,
+                &params.map(|v| v as u32),
+                &[&tape.inputs[k], &dz, &self.grads],
+                groups_for(CHANNELS * (conv.c_in * 9 + 1)),
+            ));
+            if k > 0 {
+                let params = [conv.c_in, h, w, b.views, conv.weight.offset, 0, 0, 0];
+                plan.push(gpu.prepare(
+                    &ENCODER_INPUT_BACKWARD,
+                    &params.map(|v| v as u32),
+                    &[&self.params, &dz, &d_input],
+                    groups_for(b.views * conv.c_in * h * w),
+                ));
+            }
+            d = d_input;
+        }
+    }
+}

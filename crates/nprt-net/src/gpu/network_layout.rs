@@ -1,0 +1,141 @@
+//! Where each tensor of a network lies in the flat parameter buffers, in the network's own
+//! structure (encoder blocks, tracks, layers), as the training step's dispatches address them.
+
+use super::parameters::{ParameterLayout, Span};
+use super::GpuDevice;
+use crate::cpu::{DenseStack, HostEncoder, HostTransport};
+use crate::encoding::hash_grid;
+use crate::network::activation::Activation;
+use crate::network::design::TRANSPORT_CODE;
+use crate::network::encoder::CODE_SIZE;
+use crate::network::track::TrackKind;
+
+/// One dense layer's place in the flat buffers.
+pub(super) struct DenseAt {
+    pub weight: Span,
+    pub bias: Span,
+    pub d_in: usize,
+    pub d_out: usize,
+}
+
+pub(super) struct MlpAt {
+    pub layers: Vec<DenseAt>,
+    pub activation: Activation,
+}
+
+/// One track's networks on the device.
+pub(super) struct TrackAt {
+    pub kind: TrackKind,
+    /// The feature indices the track reads, in its input order.
+    pub index: wgpu::Buffer,
+    pub count: usize,
+    /// Inputs per row: `count` plus the hash grid's encoding.
+    pub width: usize,
+    pub grid: Option<Span>,
+    pub transfer: Option<MlpAt>,
+    pub shading: MlpAt,
+}
+
+impl TrackAt {
+    /// The shading network's first weight row that multiplies the light code, and the first
+    /// that multiplies the per-row input: [ŝ, ê] after a transfer network, [ê, inputs] for the
+    /// baseline.
+    pub fn code_and_own_rows(&self) -> (usize, usize) {
+        match self.transfer {
+            Some(_) => (TRANSPORT_CODE, 0),
+            None => (0, CODE_SIZE),
+        }
+    }
+
+    /// Width of the shading network's per-row input.
+    pub fn own_width(&self) -> usize {
+        match self.transfer {
+            Some(_) => TRANSPORT_CODE,
+            None => self.width,
+        }
+    }
+}
+
+/// One encoder block's convolution in the flat buffers.
+pub(super) struct ConvAt {
+    pub weight: Span,
+    pub bias: Span,
+    pub c_in: usize,
+}
+
+/// A network's tensors in the flat buffers.
+pub(super) struct NetworkLayout {
+    pub convs: Vec<ConvAt>,
+    pub to_code: DenseAt,
+    pub tracks: Vec<TrackAt>,
+}
+
+impl NetworkLayout {
+    /// The places of `encoder`'s and `transport`'s tensors in `layout`; each track's input
+    /// indices are uploaded to `gpu`.
+    pub fn new(
+        gpu: &GpuDevice,
+        layout: &ParameterLayout,
+        encoder: &HostEncoder,
+        transport: &HostTransport,
+    ) -> Self {
+        // Spans in the order ParameterLayout walks the tensors: the encoder's, then the tracks'.
+        let mut spans = layout.spans.iter().copied();
+        let convs = encoder
+            .convs
+            .iter()
+            .map(|c| ConvAt {
+                weight: spans.next().expect("a span per tensor"),
+                bias: spans.next().expect("a span per tensor"),
+                c_in: c.c_in,
+            })
+            .collect();
+        let to_code = DenseAt {
+            weight: spans.next().expect("a span per tensor"),
+            bias: spans.next().expect("a span per tensor"),
+            d_in: encoder.to_code.d_in,
+            d_out: encoder.to_code.d_out,
+        };
+        let tracks = transport
+            .tracks
+            .iter()
+            .map(|t| {
+                let index: Vec<u32> = t.kind.inputs().iter().map(|&i| i as u32).collect();
+                let grid = t.grid.as_ref().map(|_| spans.next().expect("a grid span"));
+                let transfer = t.transfer.as_ref().map(|s| mlp_at(s, &mut spans));
+                TrackAt {
+                    kind: t.kind,
+                    index: gpu.upload(&index),
+                    count: index.len(),
+                    width: index.len() + grid.map_or(0, |_| hash_grid::OUTPUTS),
+                    grid,
+                    transfer,
+                    shading: mlp_at(&t.shading, &mut spans),
+                }
+            })
+            .collect();
+        NetworkLayout {
+            convs,
+            to_code,
+            tracks,
+        }
+    }
+}
+
+/// The layers of `stack`, their spans taken in order from `spans`.
+fn mlp_at(stack: &DenseStack, spans: &mut impl Iterator<Item = Span>) -> MlpAt {
+    let mut take = || spans.next().expect("a span per tensor");
+    MlpAt {
+        layers: stack
+            .layers
+            .iter()
+            .map(|l| DenseAt {
+                weight: take(),
+                bias: take(),
+                d_in: l.d_in,
+                d_out: l.d_out,
+            })
+            .collect(),
+        activation: stack.activation,
+    }
+}

@@ -1,0 +1,332 @@
+//! The training step's recording primitives: a strided matrix product with its epilogue, sums
+//! of columns, and an MLP's forward pass (keeping what backward needs) and backward pass, each
+//! a few dispatches appended to a step's plan.
+
+use super::gpu_trainer::GpuTrainer;
+use super::kernels::{ACTIVATION_BACKWARD, COLUMN_SUM, GEMM, GEMM_TILE};
+use super::network_layout::MlpAt;
+use super::parameters::Span;
+use super::{groups_for, Dispatch, Part};
+use crate::network::activation::Activation;
+
+/// One operand of a product: element (i, k) at `offset + i · rows + k · cols` of `buffer`.
+pub(super) struct Operand<'a> {
+    pub buffer: &'a wgpu::Buffer,
+    pub offset: usize,
+    pub rows: usize,
+    pub cols: usize,
+}
+
+impl<'a> Operand<'a> {
+    /// A row-major matrix with `stride` values per row, from `offset`.
+    pub(super) fn plain(buffer: &'a wgpu::Buffer, offset: usize, stride: usize) -> Self {
+        Operand {
+            buffer,
+            offset,
+            rows: stride,
+            cols: 1,
+        }
+    }
+
+    /// The transpose of a row-major matrix with `stride` values per row.
+    pub(super) fn transposed(buffer: &'a wgpu::Buffer, offset: usize, stride: usize) -> Self {
+        Operand {
+            buffer,
+            offset,
+            rows: 1,
+            cols: stride,
+        }
+    }
+}
+
+/// What a product adds before its activation.
+pub(super) enum Bias<'a> {
+    None,
+    /// `d_out` values from an offset of a buffer.
+    Column(&'a wgpu::Buffer, usize),
+    /// One row of `d_out` values per group, and each row's group.
+    Group(&'a wgpu::Buffer, &'a wgpu::Buffer),
+}
+
+/// A product's output: `rows` values apart from `offset` of `buffer`, written or added to.
+pub(super) struct Output<'a> {
+    pub buffer: &'a wgpu::Buffer,
+    pub offset: usize,
+    pub stride: usize,
+    pub accumulate: bool,
+}
+
+impl<'a> Output<'a> {
+    pub(super) fn to(buffer: &'a wgpu::Buffer, offset: usize, stride: usize) -> Self {
+        Output {
+            buffer,
+            offset,
+            stride,
+            accumulate: false,
+        }
+    }
+}
+
+/// How an MLP's first layer reads its input: from weight row `own_row`, `count` values per
+/// row, with `bias`.
+pub(super) struct FirstLayer<'a> {
+    pub own_row: usize,
+    pub count: usize,
+    pub bias: Bias<'a>,
+}
+
+/// What takes a first layer's bias gradient, given the gradient at its pre-activation.
+pub(super) type FirstLayerBias<'a> = &'a dyn Fn(&mut Vec<Dispatch>, &wgpu::Buffer);
+
+/// What an MLP's forward pass keeps: each layer's output and each hidden layer's
+/// pre-activation.
+pub(super) struct MlpTape {
+    pub outputs: Vec<wgpu::Buffer>,
+    pub pre: Vec<wgpu::Buffer>,
+}
+
+pub(super) fn activation_code(a: Activation) -> u32 {
+    match a {
+        Activation::Relu => 1,
+        Activation::Siren => 2,
+    }
+}
+
+impl GpuTrainer {
+    /// One tensor of the parameters, bound on its own.
+    pub(super) fn part(&self, span: Span) -> Part<'_> {
+        Part {
+            buffer: &self.params,
+            span,
+        }
+    }
+
+    /// Buffers for an MLP's forward pass over `rows` rows.
+    pub(super) fn tape(&self, m: &MlpAt, rows: usize) -> MlpTape {
+        let hidden = m.layers.len() - 1;
+        MlpTape {
+            outputs: m
+                .layers
+                .iter()
+                .map(|l| self.gpu.buffer(rows * l.d_out))
+                .collect(),
+            pre: m.layers[..hidden]
+                .iter()
+                .map(|l| self.gpu.buffer(rows * l.d_out))
+                .collect(),
+        }
+    }
+
+    /// Records `m` over `rows` rows of `x`, keeping each layer's output and each hidden
+    /// layer's pre-activation in `tape`.
+    pub(super) fn mlp_forward(
+        &self,
+        plan: &mut Vec<Dispatch>,
+        m: &MlpAt,
+        x: &wgpu::Buffer,
+        rows: usize,
+        first: FirstLayer,
+        tape: &MlpTape,
+    ) {
+        let last = m.layers.len() - 1;
+        let mut first = Some(first);
+        for (i, layer) in m.layers.iter().enumerate() {
+            let (input, own_row, count, bias) = match first.take() {
+                Some(f) => (x, f.own_row, f.count, f.bias),
+                None => (
+                    &tape.outputs[i - 1],
+                    0,
+                    layer.d_in,
+                    Bias::Column(&self.params, layer.bias.offset),
+                ),
+            };
+            let activation = if i == last {
+                0
+            } else {
+                activation_code(m.activation)
+            };
+            self.gemm(
+                plan,
+                [rows, layer.d_out, count],
+                Operand::plain(input, 0, count),
+                Operand::plain(
+                    &self.params,
+                    layer.weight.offset + own_row * layer.d_out,
+                    layer.d_out,
+                ),
+                bias,
+                activation,
+                Output::to(&tape.outputs[i], 0, layer.d_out),
+                tape.pre.get(i),
+            );
+        }
+    }
+
+    /// Records the backward pass of `m` from the gradient `d_last` at its output: every
+    /// layer's weight and bias gradient into `grads`, and the gradient at its input into
+    /// `d_input` where given. `input` is what the first layer read: the buffer, its first
+    /// weight row and its values per row. `on_first`, where given, takes the first layer's
+    /// bias gradient (it also receives the light code's share), given the gradient at that
+    /// layer's pre-activation.
+    #[allow(clippy::too_many_arguments)]
+    pub(super) fn mlp_backward(
+        &self,
+        plan: &mut Vec<Dispatch>,
+        m: &MlpAt,
+        tape: &MlpTape,
+        input: (&wgpu::Buffer, usize, usize),
+        d_last: &wgpu::Buffer,
+        d_input: Option<&wgpu::Buffer>,
+        on_first: Option<FirstLayerBias>,
+    ) {
+        let rows = tape.outputs[0].size() as usize / 4 / m.layers[0].d_out;
+        let widest = m
+            .layers
+            .iter()
+            .map(|l| l.d_in.max(l.d_out))
+            .max()
+            .unwrap_or(0);
+        let scratch = [0, 1].map(|_| self.gpu.buffer(rows * widest));
+        let last = m.layers.len() - 1;
+        for (i, layer) in m.layers.iter().enumerate().rev() {
+            let dz = if i == last { d_last } else { &scratch[i % 2] };
+            if i < last {
+                let count = rows * layer.d_out;
+                let params = [count as u32, activation_code(m.activation), 0, 0];
+                plan.push(self.gpu.prepare(
+                    &ACTIVATION_BACKWARD,
+                    &params,
+                    &[&tape.pre[i], dz],
+                    groups_for(count),
+                ));
+            }
+            let (x, own_row, count) = match i {
+                0 => input,
+                _ => (&tape.outputs[i - 1], 0, layer.d_in),
+            };
+            let weights = layer.weight.offset + own_row * layer.d_out;
+            self.gemm(
+                plan,
+                [count, layer.d_out, rows],
+                Operand::transposed(x, 0, count),
+                Operand::plain(dz, 0, layer.d_out),
+                Bias::None,
+                0,
+                Output::to(&self.grads, weights, layer.d_out),
+                None,
+            );
+            match (i, on_first) {
+                (0, Some(f)) => f(plan, dz),
+                _ => self.column_sum(
+                    plan,
+                    dz,
+                    rows,
+                    layer.d_out,
+                    None,
+                    Output::to(&self.grads, layer.bias.offset, layer.d_out),
+                ),
+            }
+            let dx = match i {
+                0 => match d_input {
+                    Some(d) => d,
+                    None => continue,
+                },
+                _ => &scratch[(i - 1) % 2],
+            };
+            self.gemm(
+                plan,
+                [rows, count, layer.d_out],
+                Operand::plain(dz, 0, layer.d_out),
+                Operand::transposed(&self.params, weights, layer.d_out),
+                Bias::None,
+                0,
+                Output::to(dx, 0, count),
+                None,
+            );
+        }
+    }
+
+    /// Records C = A·B for `[m, n, k]` (C m × n), with `bias` and `activation` (0 linear,
+    /// 1 ReLU, 2 SIREN) after, the pre-activation kept in `z` where given.
+    #[allow(clippy::too_many_arguments)]
+    pub(super) fn gemm(
+        &self,
+        plan: &mut Vec<Dispatch>,
+        [m, n, k]: [usize; 3],
+        a: Operand,
+        b: Operand,
+        bias: Bias,
+        activation: u32,
+        c: Output,
+        z: Option<&wgpu::Buffer>,
+    ) {
+        let (bias_mode, bias_buffer, bias_off, groups): (usize, &wgpu::Buffer, usize, _) =
+            match bias {
+                Bias::None => (0, &self.empty, 0, &self.empty),
+                Bias::Column(buffer, offset) => (1, buffer, offset, &self.empty),
+                Bias::Group(buffer, group) => (2, buffer, 0, group),
+            };
+        let params = [
+            m,
+            n,
+            k,
+            a.offset,
+            a.rows,
+            a.cols,
+            b.offset,
+            b.rows,
+            b.cols,
+            c.stride,
+            bias_mode,
+            activation as usize,
+            usize::from(c.accumulate),
+            usize::from(z.is_some()),
+            bias_off,
+            c.offset,
+        ];
+        let tiles = |v: usize| (v as u32).div_ceil(GEMM_TILE);
+        plan.push(self.gpu.prepare(
+            &GEMM,
+            &params.map(|v| v as u32),
+            &[
+                a.buffer,
+                b.buffer,
+                bias_buffer,
+                groups,
+                c.buffer,
+                z.unwrap_or(&self.spare),
+            ],
+            [tiles(n), tiles(m)],
+        ));
+    }
+
+    /// Records the sums over `rows` rows of the `n` columns of `x`, per group where `groups`
+    /// gives each row's group and their number, into `out`.
+    pub(super) fn column_sum(
+        &self,
+        plan: &mut Vec<Dispatch>,
+        x: &wgpu::Buffer,
+        rows: usize,
+        n: usize,
+        groups: Option<(&wgpu::Buffer, usize)>,
+        out: Output,
+    ) {
+        let (group_of, count) = groups.unwrap_or((&self.empty, 1));
+        let params = [
+            rows,
+            n,
+            count,
+            usize::from(out.accumulate),
+            out.offset,
+            0,
+            0,
+            0,
+        ];
+        plan.push(self.gpu.prepare(
+            &COLUMN_SUM,
+            &params.map(|v| v as u32),
+            &[x, group_of, out.buffer],
+            groups_for(count * n),
+        ));
+    }
+}

@@ -1,0 +1,263 @@
+//! The transport networks' share of a training step: each track's inputs (with its hash
+//! grid's encoding), transfer and shading networks with each view's light code folded into the
+//! first shading layer's bias, the loss and its gradient at the tracks' outputs, and backward
+//! into every parameter, the grids' tables and the light codes.
+
+use super::gpu_trainer::{BatchBuffers, GpuTrainer};
+use super::kernels::{GRID_BACKWARD, RADIANCE_LOSS, TRACK_INPUTS};
+use super::network_layout::TrackAt;
+use super::products::{Bias, FirstLayer, MlpTape, Operand, Output};
+use super::{groups_for, Bind, Dispatch, Part};
+use crate::encoding::hash_grid;
+use crate::network::design::TRANSPORT_CODE;
+use crate::network::encoder::CODE_SIZE;
+use crate::network::track::TrackKind;
+use crate::training::loss::Loss;
+
+/// Threads of `grid_backward`: one per 64 slots of each level's table.
+const GRID_BACKWARD_THREADS: usize = hash_grid::LEVELS * hash_grid::TABLE_SIZE / 64;
+
+/// One track's state over a batch.
+struct TrackTape {
+    x: wgpu::Buffer,
+    /// Gradient at `x`, for a track with a hash grid.
+    dx: Option<wgpu::Buffer>,
+    transfer: Option<MlpTape>,
+    shading: MlpTape,
+    /// Gradient at the shading network's outputs.
+    d_out: wgpu::Buffer,
+}
+
+fn kind_code(kind: TrackKind) -> u32 {
+    match kind {
+        TrackKind::Full => 0,
+        TrackKind::Albedo => 1,
+        TrackKind::Diffuse => 2,
+        TrackKind::Specular => 3,
+    }
+}
+
+fn loss_code(loss: Loss) -> u32 {
+    match loss {
+        Loss::LogL1 => 0,
+        Loss::RelL2 => 1,
+    }
+}
+
+impl GpuTrainer {
+    /// Records the transport networks' forward pass, loss and backward over batch `b` lit by
+    /// its `codes`: parameter gradients into `grads` (the grids' added to, so cleared before),
+    /// the codes' gradient added to `d_codes`, the loss summed into `loss`.
+    pub(super) fn record_transport(&self, plan: &mut Vec<Dispatch>, b: &BatchBuffers, loss: Loss) {
+        let tapes: Vec<TrackTape> = self
+            .net
+            .tracks
+            .iter()
+            .map(|t| self.track_forward(plan, t, b))
+            .collect();
+        let kinds: Vec<u32> = self.net.tracks.iter().map(|t| kind_code(t.kind)).collect();
+        let last = tapes.last().expect("a track");
+        let mut params = vec![
+            b.rows as u32,
+            kinds.len() as u32,
+            kinds[0],
+            *kinds.last().expect("a track"),
+            loss_code(loss),
+            0,
+            0,
+            0,
+        ];
+        params.extend([1.0 / (3 * b.rows.max(1)) as f32, 0.0, 0.0, 0.0].map(f32::to_bits));
+        plan.push(self.gpu.prepare(
+            &RADIANCE_LOSS,
+            &params,
+            &[
+                &b.features,
+                &b.radiance,
+                &b.scale,
+                tapes[0].shading.outputs.last().expect("a layer"),
+                last.shading.outputs.last().expect("a layer"),
+                &tapes[0].d_out,
+                &last.d_out,
+                &b.row_loss,
+            ],
+            groups_for(b.rows),
+        ));
+        self.column_sum(
+            plan,
+            &b.row_loss,
+            b.rows,
+            1,
+            None,
+            Output::to(&b.loss, 0, 1),
+        );
+        for (t, tape) in self.net.tracks.iter().zip(&tapes) {
+            self.track_backward(plan, t, tape, b);
+        }
+    }
+
+    /// A track's forward pass over the batch.
+    fn track_forward(&self, plan: &mut Vec<Dispatch>, t: &TrackAt, b: &BatchBuffers) -> TrackTape {
+        let gpu = &self.gpu;
+        let x = gpu.buffer(b.rows * t.width);
+        let grid = t.grid.map(|span| self.part(span));
+        let table: &dyn Bind = match &grid {
+            Some(part) => part,
+            None => &self.empty,
+        };
+        let params = [b.rows, t.count, t.width, usize::from(t.grid.is_some())].map(|v| v as u32);
+        plan.push(gpu.prepare(
+            &TRACK_INPUTS,
+            &params,
+            &[&b.features, &t.index, table, &self.resolutions, &x],
+            groups_for(b.rows),
+        ));
+        let transfer = t.transfer.as_ref().map(|m| {
+            let tape = self.tape(m, b.rows);
+            let first = FirstLayer {
+                own_row: 0,
+                count: t.width,
+                bias: Bias::Column(&self.params, m.layers[0].bias.offset),
+            };
+            self.mlp_forward(plan, m, &x, b.rows, first, &tape);
+            tape
+        });
+        // The light code's share of the first shading layer, once per view.
+        let first = &t.shading.layers[0];
+        let (code_row, own_row) = t.code_and_own_rows();
+        let group_bias = gpu.buffer(b.views * first.d_out);
+        self.gemm(
+            plan,
+            [b.views, first.d_out, CODE_SIZE],
+            Operand::plain(&b.codes, 0, CODE_SIZE),
+            Operand::plain(
+                &self.params,
+                first.weight.offset + code_row * first.d_out,
+                first.d_out,
+            ),
+            Bias::Column(&self.params, first.bias.offset),
+            0,
+            Output::to(&group_bias, 0, first.d_out),
+            None,
+        );
+        let shading = self.tape(&t.shading, b.rows);
+        let input = transfer
+            .as_ref()
+            .map_or(&x, |tape| tape.outputs.last().expect("a layer"));
+        let first_layer = FirstLayer {
+            own_row,
+            count: t.own_width(),
+            bias: Bias::Group(&group_bias, &b.view),
+        };
+        self.mlp_forward(plan, &t.shading, input, b.rows, first_layer, &shading);
+        TrackTape {
+            dx: t.grid.map(|_| gpu.buffer(b.rows * t.width)),
+            x,
+            transfer,
+            d_out: gpu.buffer(b.rows * t.shading.layers.last().expect("a layer").d_out),
+            shading,
+        }
+    }
+
+    /// A track's backward pass, from the gradient at its shading outputs in `tape.d_out`.
+    fn track_backward(
+        &self,
+        plan: &mut Vec<Dispatch>,
+        t: &TrackAt,
+        tape: &TrackTape,
+        b: &BatchBuffers,
+    ) {
+        let gpu = &self.gpu;
+        let first = &t.shading.layers[0];
+        let (code_row, own_row) = t.code_and_own_rows();
+        let code_weights = first.weight.offset + code_row * first.d_out;
+        // The shading network's input gradient: at ŝ, or at the baseline's inputs (needed only
+        // to train its grid).
+        let d_s = t
+            .transfer
+            .as_ref()
+            .map(|_| gpu.buffer(b.rows * TRANSPORT_CODE));
+        let d_input = d_s.as_ref().or(tape.dx.as_ref());
+        let input = tape
+            .transfer
+            .as_ref()
+            .map_or(&tape.x, |tr| tr.outputs.last().expect("a layer"));
+        // Each view's sum of the first layer's pre-activation gradients: its bias's, its code
+        // rows' and the code's gradients all follow from it.
+        let d_views = gpu.buffer(b.views * first.d_out);
+        let on_first = |plan: &mut Vec<Dispatch>, dz: &wgpu::Buffer| {
+            self.column_sum(
+                plan,
+                dz,
+                b.rows,
+                first.d_out,
+                Some((&b.view, b.views)),
+                Output::to(&d_views, 0, first.d_out),
+            );
+            self.column_sum(
+                plan,
+                &d_views,
+                b.views,
+                first.d_out,
+                None,
+                Output::to(&self.grads, first.bias.offset, first.d_out),
+            );
+            self.gemm(
+                plan,
+                [CODE_SIZE, first.d_out, b.views],
+                Operand::transposed(&b.codes, 0, CODE_SIZE),
+                Operand::plain(&d_views, 0, first.d_out),
+                Bias::None,
+                0,
+                Output::to(&self.grads, code_weights, first.d_out),
+                None,
+            );
+            self.gemm(
+                plan,
+                [b.views, CODE_SIZE, first.d_out],
+                Operand::plain(&d_views, 0, first.d_out),
+                Operand::transposed(&self.params, code_weights, first.d_out),
+                Bias::None,
+                0,
+                Output {
+                    accumulate: true,
+                    ..Output::to(&b.d_codes, 0, CODE_SIZE)
+                },
+                None,
+            );
+        };
+        self.mlp_backward(
+            plan,
+            &t.shading,
+            &tape.shading,
+            (input, own_row, t.own_width()),
+            &tape.d_out,
+            d_input,
+            Some(&on_first),
+        );
+        if let (Some(m), Some(tr), Some(d_s)) = (&t.transfer, &tape.transfer, &d_s) {
+            self.mlp_backward(
+                plan,
+                m,
+                tr,
+                (&tape.x, 0, t.width),
+                d_s,
+                tape.dx.as_ref(),
+                None,
+            );
+        }
+        if let (Some(span), Some(dx)) = (t.grid, &tape.dx) {
+            let d_table = Part {
+                buffer: &self.grads,
+                span,
+            };
+            let params = [b.rows, t.count, t.width, 0].map(|v| v as u32);
+            plan.push(gpu.prepare(
+                &GRID_BACKWARD,
+                &params,
+                &[&b.features, &self.resolutions, dx, &d_table],
+                groups_for(GRID_BACKWARD_THREADS),
+            ));
+        }
+    }
+}
