@@ -16,13 +16,7 @@ use base64::Engine;
 use common::{fails, fresh_dir, ok, tiny_room_model};
 use serde_json::Value;
 
-const KERNELS: [&str; 5] = [
-    "encoder_block",
-    "track_inputs",
-    "dense",
-    "code_bias",
-    "combine",
-];
+const KERNELS: [&str; 4] = ["encoder_block", "track_inputs", "gemm", "combine"];
 
 #[test]
 fn export_writes_kernels_weights_and_a_worked_example_that_webgpu_runs() {

@@ -57,8 +57,7 @@ impl GpuTrainer {
             (h, w) = (h / 2, w / 2);
         }
         let flat = self.net.to_code.d_in;
-        self.gemm(
-            plan,
+        plan.push(self.gpu.product(
             [b.views, CODE_SIZE, flat],
             Operand::plain(&x, 0, flat),
             Operand::plain(&self.params, self.net.to_code.weight.offset, CODE_SIZE),
@@ -66,7 +65,7 @@ impl GpuTrainer {
             0,
             Output::to(&b.codes, 0, CODE_SIZE),
             None,
-        );
+        ));
         tape.flat = x;
         tape
     }
@@ -80,8 +79,7 @@ impl GpuTrainer {
     ) {
         let gpu = &self.gpu;
         let flat = self.net.to_code.d_in;
-        self.gemm(
-            plan,
+        plan.push(self.gpu.product(
             [flat, CODE_SIZE, b.views],
             Operand::transposed(&tape.flat, 0, flat),
             Operand::plain(&b.d_codes, 0, CODE_SIZE),
@@ -89,7 +87,7 @@ impl GpuTrainer {
             0,
             Output::to(&self.grads, self.net.to_code.weight.offset, CODE_SIZE),
             None,
-        );
+        ));
         self.column_sum(
             plan,
             &b.d_codes,
@@ -99,8 +97,7 @@ impl GpuTrainer {
             Output::to(&self.grads, self.net.to_code.bias.offset, CODE_SIZE),
         );
         let mut d = gpu.buffer(b.views * flat);
-        self.gemm(
-            plan,
+        plan.push(self.gpu.product(
             [b.views, flat, CODE_SIZE],
             Operand::plain(&b.d_codes, 0, CODE_SIZE),
             Operand::transposed(&self.params, self.net.to_code.weight.offset, CODE_SIZE),
@@ -108,14 +105,14 @@ impl GpuTrainer {
             0,
             Output::to(&d, 0, flat),
             None,
-        );
+        ));
         for (k, conv) in self.net.convs.iter().enumerate().rev() {
             let (h, w) = tape.sizes[k];
             let count = b.views * CHANNELS * h * w;
             let dz = gpu.buffer(count);
             // The gradient at the block's input; block 0's input is the map, which needs none.
             let d_input = match k {
-                0 => self.spare.clone(),
+                0 => self.gpu.spare.clone(),
                 _ => gpu.buffer(b.views * conv.c_in * h * w),
             };
             let params = [conv.c_in, h, w, b.views, usize::from(k > 0), 0, 0, 0];

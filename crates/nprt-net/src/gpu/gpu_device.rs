@@ -15,6 +15,10 @@ pub struct GpuDevice {
     /// Mesa's software Vulkan).
     pub adapter: String,
     pub(super) pipelines: Pipelines,
+    /// Bound where a kernel's read-only input is unused, and where a written one is (two
+    /// buffers: one dispatch may not bind a buffer both ways).
+    pub empty: wgpu::Buffer,
+    pub spare: wgpu::Buffer,
 }
 
 static DEVICE: OnceLock<Result<Arc<GpuDevice>, String>> = OnceLock::new();
@@ -60,7 +64,17 @@ impl GpuDevice {
                 trace: wgpu::Trace::Off,
             }))
             .map_err(|e| anyhow!("the GPU adapter {} refused a device: {e}", info.name))?;
+        let placeholder = |label| {
+            device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some(label),
+                size: 16,
+                usage: wgpu::BufferUsages::STORAGE,
+                mapped_at_creation: false,
+            })
+        };
         Ok(GpuDevice {
+            empty: placeholder("empty"),
+            spare: placeholder("spare"),
             device,
             queue,
             adapter: format!("{} ({}, {:?})", info.name, info.driver_info, info.backend),

@@ -47,9 +47,6 @@ pub struct GpuTrainer {
     /// Adam steps taken.
     steps: u64,
     pub(super) resolutions: wgpu::Buffer,
-    /// Bound where a kernel's read-only input is unused, and where a written one is.
-    pub(super) empty: wgpu::Buffer,
-    pub(super) spare: wgpu::Buffer,
     /// The step's dispatches for the last batch shape, recorded again for every batch of it.
     plan: Option<StepPlan>,
     /// Adam over every parameter; its rate and bias corrections are rewritten each step.
@@ -131,8 +128,6 @@ impl GpuTrainer {
             plan: None,
             steps: 0,
             resolutions: gpu.upload(&hash_grid::resolutions()),
-            empty: gpu.upload(&[0u32; 4]),
-            spare: gpu.buffer(4),
             net,
             layout,
             encoder,

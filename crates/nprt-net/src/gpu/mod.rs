@@ -23,3 +23,4 @@ pub use gpu_trainer::GpuTrainer;
 pub use kernel::{groups_for, Bind, Dispatch, KernelSource, Part, GROUP};
 pub use kernel_steps::KernelSteps;
 pub use parameters::{ParameterLayout, Span};
+pub use products::{Bias, Operand, Output};

@@ -1,16 +1,16 @@
-//! The training step's recording primitives: a strided matrix product with its epilogue, sums
-//! of columns, and an MLP's forward pass (keeping what backward needs) and backward pass, each
-//! a few dispatches appended to a step's plan.
+//! Recording primitives: a strided matrix product with its epilogue (which the frame path's
+//! dense layers use too), and, for the training step, sums of columns and an MLP's forward pass
+//! (keeping what backward needs) and backward pass, each a few dispatches appended to a plan.
 
 use super::gpu_trainer::GpuTrainer;
 use super::kernels::{ACTIVATION_BACKWARD, COLUMN_SUM, GEMM, GEMM_TILE};
 use super::network_layout::MlpAt;
 use super::parameters::Span;
-use super::{groups_for, Dispatch, Part};
+use super::{groups_for, Dispatch, GpuDevice, Part};
 use crate::network::activation::Activation;
 
 /// One operand of a product: element (i, k) at `offset + i · rows + k · cols` of `buffer`.
-pub(super) struct Operand<'a> {
+pub struct Operand<'a> {
     pub buffer: &'a wgpu::Buffer,
     pub offset: usize,
     pub rows: usize,
@@ -19,7 +19,7 @@ pub(super) struct Operand<'a> {
 
 impl<'a> Operand<'a> {
     /// A row-major matrix with `stride` values per row, from `offset`.
-    pub(super) fn plain(buffer: &'a wgpu::Buffer, offset: usize, stride: usize) -> Self {
+    pub fn plain(buffer: &'a wgpu::Buffer, offset: usize, stride: usize) -> Self {
         Operand {
             buffer,
             offset,
@@ -29,7 +29,7 @@ impl<'a> Operand<'a> {
     }
 
     /// The transpose of a row-major matrix with `stride` values per row.
-    pub(super) fn transposed(buffer: &'a wgpu::Buffer, offset: usize, stride: usize) -> Self {
+    pub fn transposed(buffer: &'a wgpu::Buffer, offset: usize, stride: usize) -> Self {
         Operand {
             buffer,
             offset,
@@ -40,7 +40,7 @@ impl<'a> Operand<'a> {
 }
 
 /// What a product adds before its activation.
-pub(super) enum Bias<'a> {
+pub enum Bias<'a> {
     None,
     /// `d_out` values from an offset of a buffer.
     Column(&'a wgpu::Buffer, usize),
@@ -49,7 +49,7 @@ pub(super) enum Bias<'a> {
 }
 
 /// A product's output: `rows` values apart from `offset` of `buffer`, written or added to.
-pub(super) struct Output<'a> {
+pub struct Output<'a> {
     pub buffer: &'a wgpu::Buffer,
     pub offset: usize,
     pub stride: usize,
@@ -57,7 +57,7 @@ pub(super) struct Output<'a> {
 }
 
 impl<'a> Output<'a> {
-    pub(super) fn to(buffer: &'a wgpu::Buffer, offset: usize, stride: usize) -> Self {
+    pub fn to(buffer: &'a wgpu::Buffer, offset: usize, stride: usize) -> Self {
         Output {
             buffer,
             offset,
@@ -89,6 +89,62 @@ pub(super) fn activation_code(a: Activation) -> u32 {
     match a {
         Activation::Relu => 1,
         Activation::Siren => 2,
+    }
+}
+
+impl GpuDevice {
+    /// The dispatch of C = A·B for `[m, n, k]` (C m × n), with `bias` and `activation` (0
+    /// linear, 1 ReLU, 2 SIREN) after, the pre-activation kept in `z` where given: a dense
+    /// layer's forward pass, and every product of its backward pass.
+    #[allow(clippy::too_many_arguments)]
+    pub fn product(
+        &self,
+        [m, n, k]: [usize; 3],
+        a: Operand,
+        b: Operand,
+        bias: Bias,
+        activation: u32,
+        c: Output,
+        z: Option<&wgpu::Buffer>,
+    ) -> Dispatch {
+        let (bias_mode, bias_buffer, bias_off, groups): (usize, &wgpu::Buffer, usize, _) =
+            match bias {
+                Bias::None => (0, &self.empty, 0, &self.empty),
+                Bias::Column(buffer, offset) => (1, buffer, offset, &self.empty),
+                Bias::Group(buffer, group) => (2, buffer, 0, group),
+            };
+        let params = [
+            m,
+            n,
+            k,
+            a.offset,
+            a.rows,
+            a.cols,
+            b.offset,
+            b.rows,
+            b.cols,
+            c.stride,
+            bias_mode,
+            activation as usize,
+            usize::from(c.accumulate),
+            usize::from(z.is_some()),
+            bias_off,
+            c.offset,
+        ];
+        let tiles = |v: usize| (v as u32).div_ceil(GEMM_TILE);
+        self.prepare(
+            &GEMM,
+            &params.map(|v| v as u32),
+            &[
+                a.buffer,
+                b.buffer,
+                bias_buffer,
+                groups,
+                c.buffer,
+                z.unwrap_or(&self.spare),
+            ],
+            [tiles(n), tiles(m)],
+        )
     }
 }
 
@@ -145,8 +201,7 @@ impl GpuTrainer {
             } else {
                 activation_code(m.activation)
             };
-            self.gemm(
-                plan,
+            plan.push(self.gpu.product(
                 [rows, layer.d_out, count],
                 Operand::plain(input, 0, count),
                 Operand::plain(
@@ -158,7 +213,7 @@ impl GpuTrainer {
                 activation,
                 Output::to(&tape.outputs[i], 0, layer.d_out),
                 tape.pre.get(i),
-            );
+            ));
         }
     }
 
@@ -205,8 +260,7 @@ impl GpuTrainer {
                 _ => (&tape.outputs[i - 1], 0, layer.d_in),
             };
             let weights = layer.weight.offset + own_row * layer.d_out;
-            self.gemm(
-                plan,
+            plan.push(self.gpu.product(
                 [count, layer.d_out, rows],
                 Operand::transposed(x, 0, count),
                 Operand::plain(dz, 0, layer.d_out),
@@ -214,7 +268,7 @@ impl GpuTrainer {
                 0,
                 Output::to(&self.grads, weights, layer.d_out),
                 None,
-            );
+            ));
             match (i, on_first) {
                 (0, Some(f)) => f(plan, dz),
                 _ => self.column_sum(
@@ -233,8 +287,7 @@ impl GpuTrainer {
                 },
                 _ => &scratch[(i - 1) % 2],
             };
-            self.gemm(
-                plan,
+            plan.push(self.gpu.product(
                 [rows, count, layer.d_out],
                 Operand::plain(dz, 0, layer.d_out),
                 Operand::transposed(&self.params, weights, layer.d_out),
@@ -242,62 +295,8 @@ impl GpuTrainer {
                 0,
                 Output::to(dx, 0, count),
                 None,
-            );
+            ));
         }
-    }
-
-    /// Records C = A·B for `[m, n, k]` (C m × n), with `bias` and `activation` (0 linear,
-    /// 1 ReLU, 2 SIREN) after, the pre-activation kept in `z` where given.
-    #[allow(clippy::too_many_arguments)]
-    pub(super) fn gemm(
-        &self,
-        plan: &mut Vec<Dispatch>,
-        [m, n, k]: [usize; 3],
-        a: Operand,
-        b: Operand,
-        bias: Bias,
-        activation: u32,
-        c: Output,
-        z: Option<&wgpu::Buffer>,
-    ) {
-        let (bias_mode, bias_buffer, bias_off, groups): (usize, &wgpu::Buffer, usize, _) =
-            match bias {
-                Bias::None => (0, &self.empty, 0, &self.empty),
-                Bias::Column(buffer, offset) => (1, buffer, offset, &self.empty),
-                Bias::Group(buffer, group) => (2, buffer, 0, group),
-            };
-        let params = [
-            m,
-            n,
-            k,
-            a.offset,
-            a.rows,
-            a.cols,
-            b.offset,
-            b.rows,
-            b.cols,
-            c.stride,
-            bias_mode,
-            activation as usize,
-            usize::from(c.accumulate),
-            usize::from(z.is_some()),
-            bias_off,
-            c.offset,
-        ];
-        let tiles = |v: usize| (v as u32).div_ceil(GEMM_TILE);
-        plan.push(self.gpu.prepare(
-            &GEMM,
-            &params.map(|v| v as u32),
-            &[
-                a.buffer,
-                b.buffer,
-                bias_buffer,
-                groups,
-                c.buffer,
-                z.unwrap_or(&self.spare),
-            ],
-            [tiles(n), tiles(m)],
-        ));
     }
 
     /// Records the sums over `rows` rows of the `n` columns of `x`, per group where `groups`
@@ -311,7 +310,7 @@ impl GpuTrainer {
         groups: Option<(&wgpu::Buffer, usize)>,
         out: Output,
     ) {
-        let (group_of, count) = groups.unwrap_or((&self.empty, 1));
+        let (group_of, count) = groups.unwrap_or((&self.gpu.empty, 1));
         let params = [
             rows,
             n,

@@ -103,7 +103,7 @@ impl GpuTrainer {
         let grid = t.grid.map(|span| self.part(span));
         let table: &dyn Bind = match &grid {
             Some(part) => part,
-            None => &self.empty,
+            None => &self.gpu.empty,
         };
         let params = [b.rows, t.count, t.width, usize::from(t.grid.is_some())].map(|v| v as u32);
         plan.push(gpu.prepare(
@@ -126,8 +126,7 @@ impl GpuTrainer {
         let first = &t.shading.layers[0];
         let (code_row, own_row) = t.code_and_own_rows();
         let group_bias = gpu.buffer(b.views * first.d_out);
-        self.gemm(
-            plan,
+        plan.push(self.gpu.product(
             [b.views, first.d_out, CODE_SIZE],
             Operand::plain(&b.codes, 0, CODE_SIZE),
             Operand::plain(
@@ -139,7 +138,7 @@ impl GpuTrainer {
             0,
             Output::to(&group_bias, 0, first.d_out),
             None,
-        );
+        ));
         let shading = self.tape(&t.shading, b.rows);
         let input = transfer
             .as_ref()
@@ -202,8 +201,7 @@ impl GpuTrainer {
                 None,
                 Output::to(&self.grads, first.bias.offset, first.d_out),
             );
-            self.gemm(
-                plan,
+            plan.push(self.gpu.product(
                 [CODE_SIZE, first.d_out, b.views],
                 Operand::transposed(&b.codes, 0, CODE_SIZE),
                 Operand::plain(&d_views, 0, first.d_out),
@@ -211,9 +209,8 @@ impl GpuTrainer {
                 0,
                 Output::to(&self.grads, code_weights, first.d_out),
                 None,
-            );
-            self.gemm(
-                plan,
+            ));
+            plan.push(self.gpu.product(
                 [b.views, CODE_SIZE, first.d_out],
                 Operand::plain(&d_views, 0, first.d_out),
                 Operand::transposed(&self.params, code_weights, first.d_out),
@@ -224,7 +221,7 @@ impl GpuTrainer {
                     ..Output::to(&b.d_codes, 0, CODE_SIZE)
                 },
                 None,
-            );
+            ));
         };
         self.mlp_backward(
             plan,

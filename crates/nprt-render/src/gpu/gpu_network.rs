@@ -13,7 +13,11 @@ use nprt_net::{Activation, LightInput, NprtNet, TrackKind, FEATURES, TRANSPORT_C
 
 use nprt_net::gpu::{groups_for, GpuDevice};
 
-use super::kernels::{Kernel, DENSE_TILE};
+use nprt_net::gpu::{Bias, Operand, Output};
+
+use nprt_net::gpu::kernels::{ENCODER_BLOCK, TRACK_INPUTS};
+
+use super::kernels::COMBINE;
 
 /// Rows per block of dispatches: a block's widest activations (256 f32 per row, 64 MiB) stay
 /// within WebGPU's 128 MiB storage-binding limit, and every kernel's workgroup count within
@@ -54,8 +58,6 @@ pub struct GpuNetwork {
     to_code: GpuDense,
     tracks: Vec<GpuTrack>,
     resolutions: wgpu::Buffer,
-    /// Bound where a kernel's optional input is absent (a track without a grid).
-    empty: wgpu::Buffer,
 }
 
 /// A camera's foreground pixels on the device and what of the network does not depend on the
@@ -138,7 +140,6 @@ impl GpuNetwork {
             to_code: dense(&encoder.to_code),
             tracks,
             resolutions: gpu.upload(&hash_grid::resolutions()),
-            empty: gpu.upload(&[0u32; 4]),
             gpu,
         })
     }
@@ -161,9 +162,9 @@ impl GpuNetwork {
                 let out = gpu.buffer(CHANNELS * (h / 2) * (w / 2));
                 gpu.dispatch(
                     &mut pass,
-                    Kernel::EncoderBlock.source(),
+                    &ENCODER_BLOCK,
                     &[*c_in as u32, h as u32, w as u32, 1, 0, 0, 0, 0],
-                    &[&x, weight, bias, &out, &self.empty],
+                    &[&x, weight, bias, &out, &self.gpu.empty],
                     groups_for(CHANNELS * (h / 2) * (w / 2)),
                 );
                 (x, h, w) = (out, h / 2, w / 2);
@@ -275,11 +276,11 @@ impl GpuNetwork {
         rows: usize,
         x: &wgpu::Buffer,
     ) {
-        let table = t.grid.as_ref().unwrap_or(&self.empty);
+        let table = t.grid.as_ref().unwrap_or(&self.gpu.empty);
         let params = [rows, t.count, t.width, usize::from(t.grid.is_some())].map(|v| v as u32);
         self.gpu.dispatch(
             pass,
-            Kernel::TrackInputs.source(),
+            &TRACK_INPUTS,
             &params,
             &[features, &t.index, table, &self.resolutions, x],
             groups_for(rows),
@@ -309,14 +310,17 @@ impl GpuNetwork {
                         0
                     };
                     let bias = gpu.buffer(first.d_out);
-                    let params = [first.d_out, code_row, CODE_SIZE, 0].map(|v| v as u32);
-                    gpu.dispatch(
-                        &mut pass,
-                        Kernel::CodeBias.source(),
-                        &params,
-                        &[&code, &first.weight, &first.bias, &bias],
-                        groups_for(first.d_out),
-                    );
+                    // b' = b + ê·W[code rows]: one row through the first layer's code rows.
+                    gpu.product(
+                        [1, first.d_out, CODE_SIZE],
+                        Operand::plain(&code, 0, CODE_SIZE),
+                        Operand::plain(&first.weight, code_row * first.d_out, first.d_out),
+                        Bias::Column(&first.bias, 0),
+                        0,
+                        Output::to(&bias, 0, first.d_out),
+                        None,
+                    )
+                    .record(&mut pass);
                     bias
                 })
                 .collect();
@@ -368,7 +372,7 @@ impl GpuNetwork {
                 let out1 = px.outputs.last().expect("a track");
                 gpu.dispatch(
                     &mut pass,
-                    Kernel::Combine.source(),
+                    &COMBINE,
                     &params,
                     &[&chunk.features, &px.outputs[0], out1, &px.rgb],
                     groups_for(chunk.rows),
@@ -451,22 +455,14 @@ fn dense_layer(
     activation: u32,
     y: &wgpu::Buffer,
 ) {
-    let params = [
-        x.rows,
-        x.d_in,
-        layer.d_out,
-        activation as usize,
-        x.d_in,
-        x.w_row * layer.d_out,
-        0,
-        0,
-    ];
-    let tiles = |n: usize| (n as u32).div_ceil(DENSE_TILE);
-    gpu.dispatch(
-        pass,
-        Kernel::Dense.source(),
-        &params.map(|v| v as u32),
-        &[x.x, &layer.weight, bias, y],
-        [tiles(layer.d_out), tiles(x.rows)],
-    );
+    gpu.product(
+        [x.rows, layer.d_out, x.d_in],
+        Operand::plain(x.x, 0, x.d_in),
+        Operand::plain(&layer.weight, x.w_row * layer.d_out, layer.d_out),
+        Bias::Column(bias, 0),
+        activation,
+        Output::to(y, 0, layer.d_out),
+        None,
+    )
+    .record(pass);
 }

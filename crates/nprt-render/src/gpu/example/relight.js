@@ -71,10 +71,13 @@ async function main() {
     pass.dispatchWorkgroups(x, y);
   };
   const groups = (n) => Math.ceil(n / 64);
-  // y = act(x·W[wRow..] + bias) over `rows` rows of `dIn` inputs (dense.wgsl).
+  // y = act(x·W[wRow..] + bias) over `rows` rows of `dIn` inputs: gemm.wgsl with
+  // m = rows, n = d_out, k = dIn, A = x (row stride dIn), B = W from row wRow, a bias per column.
+  const spare = room(4);
   const denseLayer = (pass, layer, x, rows, dIn, wRow, bias, activation, y) =>
-    dispatch(pass, 'dense', [rows, dIn, layer.dOut, activation, dIn, wRow * layer.dOut, 0, 0],
-      [x, layer.weight, bias, y], groups(layer.dOut), groups(rows));
+    dispatch(pass, 'gemm',
+      [rows, layer.dOut, dIn, 0, dIn, 1, wRow * layer.dOut, layer.dOut, 1, layer.dOut, 1, activation, 0, 0, 0, 0],
+      [x, layer.weight, bias, empty, y, spare], Math.ceil(layer.dOut / 64), Math.ceil(rows / 64));
   // An MLP: hidden layers take its activation, the last is linear; ping-pongs through `scratch`.
   const runMlp = (pass, m, x, rows, first, scratch, out) => {
     const last = m.layers.length - 1;
@@ -153,7 +156,8 @@ async function main() {
     tracks.forEach((t, i) => {
       const first = t.shading.layers[0];
       const bias = room(first.dOut);
-      dispatch(pass, 'code_bias', [first.dOut, t.codeRows[0], 64, 0], [code, first.weight, first.bias, bias], groups(first.dOut));
+      // b' = b + ê·W[code rows]: the first layer's code rows over one row.
+      denseLayer(pass, first, code, 1, 64, t.codeRows[0], first.bias, 0, bias);
       // The rows that multiply the pixel's own inputs: before ê's (ŝ first), or after them.
       const codeFirst = t.codeRows[0] === 0;
       const dIn = first.dIn - 64;
