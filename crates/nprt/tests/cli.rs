@@ -314,6 +314,15 @@ fn fake_peer(dir: &std::path::Path, rates: &[u32]) -> std::path::PathBuf {
     script
 }
 
+/// The cells of `bench train`'s baseline row.
+fn baseline_row(out: &str) -> Vec<&str> {
+    out.lines()
+        .find(|l| l.starts_with("baseline"))
+        .unwrap_or_else(|| panic!("no baseline row in:\n{out}"))
+        .split_whitespace()
+        .collect()
+}
+
 #[test]
 fn bench_train_alternates_rounds_with_the_peer_and_compares_medians() {
     let dir = tmp("bench-peer");
@@ -333,12 +342,7 @@ fn bench_train_alternates_rounds_with_the_peer_and_compares_medians() {
     // the PyTorch column.
     let calls = std::fs::read_to_string(dir.join("calls")).unwrap();
     assert_eq!(calls.lines().count(), 3, "{out}");
-    let row: Vec<&str> = out
-        .lines()
-        .find(|l| l.starts_with("baseline"))
-        .unwrap_or_else(|| panic!("no baseline row in:\n{out}"))
-        .split_whitespace()
-        .collect();
+    let row = baseline_row(&out);
     assert_eq!(row[4], "2000", "{out}");
     let ours: f64 = row[2].parse().unwrap();
     let ratio: f64 = row[5].trim_end_matches('×').parse().unwrap();
@@ -404,12 +408,7 @@ fn bench_train_compares_with_the_fastest_peer_variant() {
         2,
         "{calls}"
     );
-    let row: Vec<&str> = out
-        .lines()
-        .find(|l| l.starts_with("baseline"))
-        .unwrap_or_else(|| panic!("no baseline row in:\n{out}"))
-        .split_whitespace()
-        .collect();
+    let row = baseline_row(&out);
     assert_eq!(row[4], "3000", "{out}");
     assert_eq!(row[7], "compile-bf16", "{out}");
 }

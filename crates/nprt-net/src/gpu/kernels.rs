@@ -1,68 +1,35 @@
-//! The network kernels nprt-net owns: the light encoder's blocks and the track inputs (with the
-//! hash grid's encoding), which the frame path dispatches too, and the training step's.
+//! The network kernels, by name: the light encoder's blocks, the track inputs (with the hash
+//! grid's encoding), the matrix product and the combination into radiance, which the frame
+//! path dispatches too, and the training step's own. A kernel's source is its file in
+//! `shaders/`, after the shared files it names (WGSL has no includes).
 
 use super::KernelSource;
 
-pub const ENCODER_BLOCK: KernelSource = KernelSource {
-    name: "encoder_block",
-    wgsl: include_str!("shaders/encoder_block.wgsl"),
-};
+/// The kernel in `shaders/NAME.wgsl`, after the shared `shaders/PART.wgsl` files listed.
+macro_rules! kernel {
+    ($name:literal $(, $part:literal)*) => {
+        KernelSource {
+            name: $name,
+            wgsl: concat!(
+                $(include_str!(concat!("shaders/", $part, ".wgsl")),)*
+                include_str!(concat!("shaders/", $name, ".wgsl"))
+            ),
+        }
+    };
+}
 
-pub const ENCODER_POOL_BACKWARD: KernelSource = KernelSource {
-    name: "encoder_pool_backward",
-    wgsl: include_str!("shaders/encoder_pool_backward.wgsl"),
-};
-
-pub const ENCODER_WEIGHT_BACKWARD: KernelSource = KernelSource {
-    name: "encoder_weight_backward",
-    wgsl: include_str!("shaders/encoder_weight_backward.wgsl"),
-};
-
-pub const ENCODER_INPUT_BACKWARD: KernelSource = KernelSource {
-    name: "encoder_input_backward",
-    wgsl: include_str!("shaders/encoder_input_backward.wgsl"),
-};
-
-pub const TRACK_INPUTS: KernelSource = KernelSource {
-    name: "track_inputs",
-    wgsl: concat!(
-        include_str!("shaders/hash_grid.wgsl"),
-        include_str!("shaders/track_inputs.wgsl")
-    ),
-};
-
-pub const GEMM: KernelSource = KernelSource {
-    name: "gemm",
-    wgsl: include_str!("shaders/gemm.wgsl"),
-};
-
-pub const COLUMN_SUM: KernelSource = KernelSource {
-    name: "column_sum",
-    wgsl: include_str!("shaders/column_sum.wgsl"),
-};
-
-pub const ACTIVATION_BACKWARD: KernelSource = KernelSource {
-    name: "activation_backward",
-    wgsl: include_str!("shaders/activation_backward.wgsl"),
-};
-
-pub const RADIANCE_LOSS: KernelSource = KernelSource {
-    name: "radiance_loss",
-    wgsl: include_str!("shaders/radiance_loss.wgsl"),
-};
-
-pub const GRID_BACKWARD: KernelSource = KernelSource {
-    name: "grid_backward",
-    wgsl: concat!(
-        include_str!("shaders/hash_grid.wgsl"),
-        include_str!("shaders/grid_backward.wgsl")
-    ),
-};
-
-pub const ADAM: KernelSource = KernelSource {
-    name: "adam",
-    wgsl: include_str!("shaders/adam.wgsl"),
-};
+pub const ENCODER_BLOCK: KernelSource = kernel!("encoder_block");
+pub const ENCODER_POOL_BACKWARD: KernelSource = kernel!("encoder_pool_backward");
+pub const ENCODER_WEIGHT_BACKWARD: KernelSource = kernel!("encoder_weight_backward");
+pub const ENCODER_INPUT_BACKWARD: KernelSource = kernel!("encoder_input_backward");
+pub const TRACK_INPUTS: KernelSource = kernel!("track_inputs", "hash_grid");
+pub const GRID_BACKWARD: KernelSource = kernel!("grid_backward", "hash_grid");
+pub const GEMM: KernelSource = kernel!("gemm");
+pub const COLUMN_SUM: KernelSource = kernel!("column_sum");
+pub const ACTIVATION_BACKWARD: KernelSource = kernel!("activation_backward");
+pub const COMBINE: KernelSource = kernel!("combine", "track_radiance");
+pub const RADIANCE_LOSS: KernelSource = kernel!("radiance_loss", "track_radiance");
+pub const ADAM: KernelSource = kernel!("adam");
 
 /// Rows and columns of the tile a `gemm` workgroup computes.
 pub const GEMM_TILE: u32 = 64;

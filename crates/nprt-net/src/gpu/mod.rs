@@ -6,6 +6,7 @@
 //! tests hold the two together; layouts, designs and the hash grid stay defined where the CPU
 //! engine reads them.
 
+mod codes;
 mod encoder_step;
 mod gpu_buffer;
 mod gpu_device;
@@ -18,6 +19,7 @@ mod parameters;
 mod products;
 mod transport_step;
 
+pub use codes::{activation_code, kind_code, loss_code};
 pub use gpu_device::GpuDevice;
 pub use gpu_trainer::GpuTrainer;
 pub use kernel::{groups_for, Bind, Dispatch, KernelSource, Part, GROUP};

@@ -2,12 +2,12 @@
 //! dense layers use too), and, for the training step, sums of columns and an MLP's forward pass
 //! (keeping what backward needs) and backward pass, each a few dispatches appended to a plan.
 
+use super::codes::activation_code;
 use super::gpu_trainer::GpuTrainer;
 use super::kernels::{ACTIVATION_BACKWARD, COLUMN_SUM, GEMM, GEMM_TILE};
 use super::network_layout::MlpAt;
 use super::parameters::Span;
 use super::{groups_for, Dispatch, GpuDevice, Part};
-use crate::network::activation::Activation;
 
 /// One operand of a product: element (i, k) at `offset + i · rows + k · cols` of `buffer`.
 pub struct Operand<'a> {
@@ -83,13 +83,6 @@ pub(super) type FirstLayerBias<'a> = &'a dyn Fn(&mut Vec<Dispatch>, &wgpu::Buffe
 pub(super) struct MlpTape {
     pub outputs: Vec<wgpu::Buffer>,
     pub pre: Vec<wgpu::Buffer>,
-}
-
-pub(super) fn activation_code(a: Activation) -> u32 {
-    match a {
-        Activation::Relu => 1,
-        Activation::Siren => 2,
-    }
 }
 
 impl GpuDevice {

@@ -3,6 +3,7 @@
 //! first shading layer's bias, the loss and its gradient at the tracks' outputs, and backward
 //! into every parameter, the grids' tables and the light codes.
 
+use super::codes::{kind_code, loss_code};
 use super::gpu_trainer::{BatchBuffers, GpuTrainer};
 use super::kernels::{GRID_BACKWARD, RADIANCE_LOSS, TRACK_INPUTS};
 use super::network_layout::TrackAt;
@@ -11,7 +12,6 @@ use super::{groups_for, Bind, Dispatch, Part};
 use crate::encoding::hash_grid;
 use crate::network::design::TRANSPORT_CODE;
 use crate::network::encoder::CODE_SIZE;
-use crate::network::track::TrackKind;
 use crate::training::loss::Loss;
 
 /// Threads of `grid_backward`: one per 64 slots of each level's table.
@@ -26,22 +26,6 @@ struct TrackTape {
     shading: MlpTape,
     /// Gradient at the shading network's outputs.
     d_out: wgpu::Buffer,
-}
-
-fn kind_code(kind: TrackKind) -> u32 {
-    match kind {
-        TrackKind::Full => 0,
-        TrackKind::Albedo => 1,
-        TrackKind::Diffuse => 2,
-        TrackKind::Specular => 3,
-    }
-}
-
-fn loss_code(loss: Loss) -> u32 {
-    match loss {
-        Loss::LogL1 => 0,
-        Loss::RelL2 => 1,
-    }
 }
 
 impl GpuTrainer {

@@ -15,9 +15,8 @@ use nprt_net::gpu::{groups_for, GpuDevice};
 
 use nprt_net::gpu::{Bias, Operand, Output};
 
-use nprt_net::gpu::kernels::{ENCODER_BLOCK, TRACK_INPUTS};
-
-use super::kernels::COMBINE;
+use nprt_net::gpu::kernels::{COMBINE, ENCODER_BLOCK, TRACK_INPUTS};
+use nprt_net::gpu::{activation_code, kind_code};
 
 /// Rows per block of dispatches: a block's widest activations (256 f32 per row, 64 MiB) stay
 /// within WebGPU's 128 MiB storage-binding limit, and every kernel's workgroup count within
@@ -79,22 +78,6 @@ struct PixelChunk {
     /// Per track, what its shading network's first layer reads besides the light code: ŝ
     /// (`rows × TRANSPORT_CODE`) or, for the baseline, the gathered inputs (`rows × width`).
     kept: Vec<wgpu::Buffer>,
-}
-
-fn activation_code(a: Activation) -> u32 {
-    match a {
-        Activation::Relu => 1,
-        Activation::Siren => 2,
-    }
-}
-
-fn kind_code(kind: TrackKind) -> u32 {
-    match kind {
-        TrackKind::Full => 0,
-        TrackKind::Albedo => 1,
-        TrackKind::Diffuse => 2,
-        TrackKind::Specular => 3,
-    }
 }
 
 impl GpuNetwork {

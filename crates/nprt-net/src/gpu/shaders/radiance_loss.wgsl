@@ -1,6 +1,6 @@
 // The training loss of each row and the gradient at its tracks' shading outputs. A row's
-// prediction is what the frame path's combine makes (exp of each track's outputs, weighted by
-// kd or ks as its kind says, summed over tracks, times the map's scale); its loss is the mean
+// prediction is what the frame path's combine makes (track_radiance summed over tracks, times
+// the map's scale); its loss is the mean
 // over the batch's values of log-L1 (|log(1 + p) − log(1 + r)|) or relative L2
 // ((p − r)² / (p² + ε), p held constant in the weight), as nprt-net's Loss::element.
 
@@ -32,48 +32,7 @@ struct RadianceLoss {
 @group(0) @binding(7) var<storage, read_write> d_out1: array<f32>;
 @group(0) @binding(8) var<storage, read_write> row_loss: array<f32>;
 
-const FEATURES: u32 = 19u;
-const KD: u32 = 12u;
-const KS: u32 = 15u;
 const RELATIVE_L2_EPS: f32 = 0.01;
-
-fn outputs(kind: u32) -> u32 {
-    return select(3u, 6u, kind == 1u);
-}
-
-fn kd(r: u32) -> vec3<f32> {
-    let f = r * FEATURES + KD;
-    return vec3<f32>(features[f], features[f + 1u], features[f + 2u]);
-}
-
-fn ks(r: u32) -> vec3<f32> {
-    let f = r * FEATURES + KS;
-    return vec3<f32>(features[f], features[f + 1u], features[f + 2u]);
-}
-
-// exp of a track's first three outputs, and of its next three for an albedo track.
-fn exps(kind: u32, out: u32, r: u32) -> array<vec3<f32>, 2> {
-    let n = outputs(kind) * r;
-    var e: array<vec3<f32>, 2>;
-    if (out == 0u) {
-        e[0] = exp(vec3<f32>(out0[n], out0[n + 1u], out0[n + 2u]));
-        if (kind == 1u) {
-            e[1] = exp(vec3<f32>(out0[n + 3u], out0[n + 4u], out0[n + 5u]));
-        }
-    } else {
-        e[0] = exp(vec3<f32>(out1[n], out1[n + 1u], out1[n + 2u]));
-    }
-    return e;
-}
-
-fn radiance(kind: u32, r: u32, e: array<vec3<f32>, 2>) -> vec3<f32> {
-    switch kind {
-        case 0u: { return e[0]; }
-        case 1u: { return kd(r) * e[0] + ks(r) * e[1]; }
-        case 2u: { return kd(r) * e[0]; }
-        default: { return ks(r) * e[0]; }
-    }
-}
 
 // The gradient at a track's outputs from the gradient dr at its radiance.
 fn store_gradient(kind: u32, out: u32, r: u32, e: array<vec3<f32>, 2>, dr: vec3<f32>) {
@@ -111,10 +70,10 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>, @builtin(num_workgroups) g
     }
     let e0 = exps(p.kind0, 0u, r);
     var e1: array<vec3<f32>, 2>;
-    var c = radiance(p.kind0, r, e0);
+    var c = track_radiance(p.kind0, r, e0);
     if (p.tracks == 2u) {
         e1 = exps(p.kind1, 1u, r);
-        c += radiance(p.kind1, r, e1);
+        c += track_radiance(p.kind1, r, e1);
     }
     let s = vec3<f32>(scale[3u * r], scale[3u * r + 1u], scale[3u * r + 2u]);
     let ref_ = vec3<f32>(reference[3u * r], reference[3u * r + 1u], reference[3u * r + 2u]);

@@ -1,0 +1,40 @@
+// A pixel's radiance: its tracks' radiance (track_radiance) summed and multiplied by the map's
+// per-channel scale (times the model's level gain).
+
+struct Combine {
+    rows: u32,
+    tracks: u32,
+    // Per track: 0 full (radiance), 1 albedo (kd·L^D + ks·L^S), 2 diffuse (kd·L), 3 specular (ks·L).
+    kind0: u32,
+    kind1: u32,
+    // Index of this block's first row in the frame's rgb.
+    first: u32,
+    _pad0: u32,
+    _pad1: u32,
+    _pad2: u32,
+    scale: vec4<f32>,
+}
+
+@group(0) @binding(0) var<uniform> p: Combine;
+@group(0) @binding(1) var<storage, read> features: array<f32>;
+@group(0) @binding(2) var<storage, read> out0: array<f32>;
+@group(0) @binding(3) var<storage, read> out1: array<f32>;
+@group(0) @binding(4) var<storage, read_write> rgb: array<f32>;
+
+@compute @workgroup_size(64)
+fn main(@builtin(global_invocation_id) id: vec3<u32>, @builtin(num_workgroups) groups: vec3<u32>) {
+    // Rows of workgroups past the 65,535 one dimension allows.
+    let r = id.x + id.y * groups.x * 64u;
+    if (r >= p.rows) {
+        return;
+    }
+    var c = track_radiance(p.kind0, r, exps(p.kind0, 0u, r));
+    if (p.tracks == 2u) {
+        c += track_radiance(p.kind1, r, exps(p.kind1, 1u, r));
+    }
+    c *= p.scale.xyz;
+    let o = 3u * (p.first + r);
+    rgb[o] = c.x;
+    rgb[o + 1u] = c.y;
+    rgb[o + 2u] = c.z;
+}
