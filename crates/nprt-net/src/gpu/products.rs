@@ -9,6 +9,9 @@ use super::network_layout::MlpAt;
 use super::parameters::Span;
 use super::{groups_for, Dispatch, GpuDevice, Part};
 
+/// Rows a `column_sum` thread adds before the chunks' sums are added in a second pass.
+const COLUMN_CHUNK: usize = 256;
+
 /// One operand of a product: element (i, k) at `offset + i · rows + k · cols` of `buffer`.
 pub struct Operand<'a> {
     pub buffer: &'a wgpu::Buffer,
@@ -293,7 +296,8 @@ impl GpuTrainer {
     }
 
     /// Records the sums over `rows` rows of the `n` columns of `x`, per group where `groups`
-    /// gives each row's group and their number, into `out`.
+    /// gives each row's group and their number, into `out`. Past [`COLUMN_CHUNK`] rows the sums
+    /// are made per chunk of rows, then over the chunks, in a fixed order either way.
     pub(super) fn column_sum(
         &self,
         plan: &mut Vec<Dispatch>,
@@ -304,21 +308,34 @@ impl GpuTrainer {
         out: Output,
     ) {
         let (group_of, count) = groups.unwrap_or((&self.gpu.empty, 1));
-        let params = [
-            rows,
-            n,
-            count,
-            usize::from(out.accumulate),
-            out.offset,
-            0,
-            0,
-            0,
-        ];
+        if rows <= COLUMN_CHUNK {
+            let params = [
+                rows,
+                n,
+                count,
+                usize::from(out.accumulate),
+                out.offset,
+                0,
+                0,
+                0,
+            ];
+            plan.push(self.gpu.prepare(
+                &COLUMN_SUM,
+                &params.map(|v| v as u32),
+                &[x, group_of, out.buffer],
+                groups_for(count * n),
+            ));
+            return;
+        }
+        let chunks = rows.div_ceil(COLUMN_CHUNK);
+        let partial = self.gpu.buffer(chunks * count * n);
+        let params = [rows, n, count, 0, 0, COLUMN_CHUNK, 0, 0];
         plan.push(self.gpu.prepare(
             &COLUMN_SUM,
             &params.map(|v| v as u32),
-            &[x, group_of, out.buffer],
-            groups_for(count * n),
+            &[x, group_of, &partial],
+            groups_for(chunks * count * n),
         ));
+        self.column_sum(plan, &partial, chunks, count * n, None, out);
     }
 }

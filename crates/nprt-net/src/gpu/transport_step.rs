@@ -8,14 +8,17 @@ use super::gpu_trainer::{BatchBuffers, GpuTrainer};
 use super::kernels::{GRID_BACKWARD, RADIANCE_LOSS, TRACK_INPUTS};
 use super::network_layout::TrackAt;
 use super::products::{Bias, FirstLayer, MlpTape, Operand, Output};
-use super::{groups_for, Bind, Dispatch, Part};
+use super::{groups_for, Bind, Dispatch};
 use crate::encoding::hash_grid;
 use crate::network::design::TRANSPORT_CODE;
 use crate::network::encoder::CODE_SIZE;
 use crate::training::loss::Loss;
 
-/// Threads of `grid_backward`: one per 64 slots of each level's table.
+/// Threads of `grid_backward` per chunk of rows: one per 64 slots of each level's table.
 const GRID_BACKWARD_THREADS: usize = hash_grid::LEVELS * hash_grid::TABLE_SIZE / 64;
+/// Chunks of rows `grid_backward` cuts a batch into at most, each with its own copy of the
+/// tables (512 KiB): 32 MiB at most.
+const GRID_CHUNKS: usize = 64;
 
 /// One track's state over a batch.
 struct TrackTape {
@@ -228,17 +231,19 @@ impl GpuTrainer {
             );
         }
         if let (Some(span), Some(dx)) = (t.grid, &tape.dx) {
-            let d_table = Part {
-                buffer: &self.grads,
-                span,
-            };
-            let params = [b.rows, t.count, t.width, 0].map(|v| v as u32);
+            // At most GRID_CHUNKS copies of the tables, each summing at least 256 rows.
+            let chunk = b.rows.div_ceil(GRID_CHUNKS).max(256);
+            let chunks = b.rows.div_ceil(chunk);
+            let partial = gpu.buffer(chunks * span.len);
+            let params = [b.rows, t.count, t.width, chunk].map(|v| v as u32);
             plan.push(gpu.prepare(
                 &GRID_BACKWARD,
                 &params,
-                &[&b.features, &self.resolutions, dx, &d_table],
-                groups_for(GRID_BACKWARD_THREADS),
+                &[&b.features, &self.resolutions, dx, &partial],
+                groups_for(chunks * GRID_BACKWARD_THREADS),
             ));
+            let d_table = Output::to(&self.grads, span.offset, span.len);
+            self.column_sum(plan, &partial, chunks, span.len, None, d_table);
         }
     }
 }

@@ -1,7 +1,10 @@
 // Sums of a matrix's columns over its rows, per row group: out[g · n + j] = Σ over rows i of
 // group g of x[i · n + j] (one group when groups is 1: the bias gradient; one per view: the
-// gradient at each view's light code). One thread per output value, adding its rows in order,
-// so the sum does not depend on the device's scheduling.
+// gradient at each view's light code). With chunk > 0 the rows are cut into chunks of that
+// many and each chunk's sums go to their own block of out (chunk c's at c · groups · n), which
+// a second pass sums over the chunks: a GPU then has chunks × groups × n threads to run
+// instead of groups × n. Each thread adds its rows in order, so no sum depends on the device's
+// scheduling.
 
 struct ColumnSum {
     rows: u32,
@@ -10,9 +13,10 @@ struct ColumnSum {
     accumulate: u32,
     // Where the sums start in out.
     out_off: u32,
+    // Rows per chunk; 0: all rows in one.
+    chunk: u32,
     _pad0: u32,
     _pad1: u32,
-    _pad2: u32,
 }
 
 @group(0) @binding(0) var<uniform> p: ColumnSum;
@@ -24,13 +28,16 @@ struct ColumnSum {
 fn main(@builtin(global_invocation_id) id: vec3<u32>, @builtin(num_workgroups) groups: vec3<u32>) {
     // Rows of workgroups past the 65,535 one dimension allows.
     let o = id.x + id.y * groups.x * 64u;
-    if (o >= p.groups * p.n) {
+    let per_chunk = select(p.rows, p.chunk, p.chunk > 0u);
+    let chunks = (p.rows + per_chunk - 1u) / per_chunk;
+    if (o >= max(chunks, 1u) * p.groups * p.n) {
         return;
     }
-    let g = o / p.n;
+    let c = o / (p.groups * p.n);
+    let g = (o / p.n) % p.groups;
     let j = o % p.n;
     var s = 0.0;
-    for (var i = 0u; i < p.rows; i++) {
+    for (var i = c * per_chunk; i < min(p.rows, (c + 1u) * per_chunk); i++) {
         if (p.groups == 1u || group_of[i] == g) {
             s += x[i * p.n + j];
         }
