@@ -53,7 +53,7 @@ impl Pipelines {
 pub struct Dispatch {
     pipeline: wgpu::ComputePipeline,
     group: wgpu::BindGroup,
-    groups: [u32; 2],
+    groups: [u32; 3],
     /// The parameter block, rewritable with `queue.write_buffer` (Adam's rate and step).
     pub uniform: wgpu::Buffer,
 }
@@ -62,7 +62,7 @@ impl Dispatch {
     pub fn record(&self, pass: &mut wgpu::ComputePass) {
         pass.set_pipeline(&self.pipeline);
         pass.set_bind_group(0, &self.group, &[]);
-        pass.dispatch_workgroups(self.groups[0], self.groups[1], 1);
+        pass.dispatch_workgroups(self.groups[0], self.groups[1], self.groups[2]);
     }
 }
 
@@ -74,7 +74,18 @@ impl super::GpuDevice {
         kernel: &KernelSource,
         params: &[u32],
         buffers: &[&dyn Bind],
-        groups: [u32; 2],
+        [x, y]: [u32; 2],
+    ) -> Dispatch {
+        self.prepare_grid(kernel, params, buffers, [x, y, 1])
+    }
+
+    /// [`Self::prepare`] over a three-dimensional grid of workgroups.
+    pub fn prepare_grid(
+        &self,
+        kernel: &KernelSource,
+        params: &[u32],
+        buffers: &[&dyn Bind],
+        groups: [u32; 3],
     ) -> Dispatch {
         let pipeline = self.pipelines.get(&self.device, kernel);
         let uniform = self

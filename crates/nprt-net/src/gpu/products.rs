@@ -11,6 +11,11 @@ use super::{groups_for, Dispatch, GpuDevice, Part};
 
 /// Rows a `column_sum` thread adds before the chunks' sums are added in a second pass.
 const COLUMN_CHUNK: usize = 256;
+/// A weight gradient's product is split into chunks of at least ROW_CHUNK rows, at most
+/// ROW_CHUNKS of them (a 256 × 256 layer at batch 16,384: 32 chunks of 512 rows, 512
+/// workgroups instead of 16).
+const ROW_CHUNK: usize = 256;
+const ROW_CHUNKS: usize = 32;
 
 /// One operand of a product: element (i, k) at `offset + i · rows + k · cols` of `buffer`.
 pub struct Operand<'a> {
@@ -95,7 +100,7 @@ impl GpuDevice {
     #[allow(clippy::too_many_arguments)]
     pub fn product(
         &self,
-        [m, n, k]: [usize; 3],
+        shape: [usize; 3],
         a: Operand,
         b: Operand,
         bias: Bias,
@@ -103,12 +108,53 @@ impl GpuDevice {
         c: Output,
         z: Option<&wgpu::Buffer>,
     ) -> Dispatch {
+        self.gemm(shape, a, b, bias, activation, c, z, None)
+    }
+
+    /// The dispatch of `chunks` products, each over `k_chunk` consecutive values of k (the last
+    /// over what is left), into consecutive m × n blocks of `c` (row stride n), which
+    /// [`GpuTrainer::column_sum`] then adds: a product over many k (a weight's gradient over a
+    /// batch) on chunks × tiles workgroups instead of tiles alone.
+    pub fn split_product(
+        &self,
+        [m, n, k]: [usize; 3],
+        a: Operand,
+        b: Operand,
+        [k_chunk, chunks]: [usize; 2],
+        c: &wgpu::Buffer,
+    ) -> Dispatch {
+        let out = Output::to(c, 0, n);
+        self.gemm(
+            [m, n, k],
+            a,
+            b,
+            Bias::None,
+            0,
+            out,
+            None,
+            Some([k_chunk, chunks]),
+        )
+    }
+
+    #[allow(clippy::too_many_arguments)]
+    fn gemm(
+        &self,
+        [m, n, k]: [usize; 3],
+        a: Operand,
+        b: Operand,
+        bias: Bias,
+        activation: u32,
+        c: Output,
+        z: Option<&wgpu::Buffer>,
+        split: Option<[usize; 2]>,
+    ) -> Dispatch {
         let (bias_mode, bias_buffer, bias_off, groups): (usize, &wgpu::Buffer, usize, _) =
             match bias {
                 Bias::None => (0, &self.empty, 0, &self.empty),
                 Bias::Column(buffer, offset) => (1, buffer, offset, &self.empty),
                 Bias::Group(buffer, group) => (2, buffer, 0, group),
             };
+        let [k_chunk, chunks] = split.unwrap_or([0, 1]);
         let params = [
             m,
             n,
@@ -126,9 +172,13 @@ impl GpuDevice {
             usize::from(z.is_some()),
             bias_off,
             c.offset,
+            k_chunk,
+            m * n,
+            0,
+            0,
         ];
         let tiles = |v: usize| (v as u32).div_ceil(GEMM_TILE);
-        self.prepare(
+        self.prepare_grid(
             &GEMM,
             &params.map(|v| v as u32),
             &[
@@ -139,7 +189,7 @@ impl GpuDevice {
                 c.buffer,
                 z.unwrap_or(&self.spare),
             ],
-            [tiles(n), tiles(m)],
+            [tiles(n), tiles(m), chunks as u32],
         )
     }
 }
@@ -256,15 +306,13 @@ impl GpuTrainer {
                 _ => (&tape.outputs[i - 1], 0, layer.d_in),
             };
             let weights = layer.weight.offset + own_row * layer.d_out;
-            plan.push(self.gpu.product(
+            self.sum_over_rows(
+                plan,
                 [count, layer.d_out, rows],
                 Operand::transposed(x, 0, count),
                 Operand::plain(dz, 0, layer.d_out),
-                Bias::None,
-                0,
-                Output::to(&self.grads, weights, layer.d_out),
-                None,
-            ));
+                weights,
+            );
             match (i, on_first) {
                 (0, Some(f)) => f(plan, dz),
                 _ => self.column_sum(
@@ -293,6 +341,35 @@ impl GpuTrainer {
                 None,
             ));
         }
+    }
+
+    /// Records the gradients of a weight, `[m, n, rows]`: Aᵀ·B summed over the batch's rows,
+    /// into `grads` from `offset` (row stride n). Past [`ROW_CHUNK`] rows the product is split
+    /// over chunks of rows (at most [`ROW_CHUNKS`]) and the chunks' products added in order.
+    fn sum_over_rows(
+        &self,
+        plan: &mut Vec<Dispatch>,
+        [m, n, rows]: [usize; 3],
+        a: Operand,
+        b: Operand,
+        offset: usize,
+    ) {
+        let chunk = rows.div_ceil(ROW_CHUNKS).max(ROW_CHUNK);
+        let chunks = rows.div_ceil(chunk);
+        let out = Output::to(&self.grads, offset, n);
+        if chunks <= 1 {
+            plan.push(
+                self.gpu
+                    .product([m, n, rows], a, b, Bias::None, 0, out, None),
+            );
+            return;
+        }
+        let partial = self.gpu.buffer(chunks * m * n);
+        plan.push(
+            self.gpu
+                .split_product([m, n, rows], a, b, [chunk, chunks], &partial),
+        );
+        self.column_sum(plan, &partial, chunks, m * n, None, out);
     }
 
     /// Records the sums over `rows` rows of the `n` columns of `x`, per group where `groups`

@@ -31,6 +31,12 @@ struct Gemm {
     // Where the bias starts in its buffer, and C in its.
     bias_off: u32,
     c_off: u32,
+    // Split over k (0: none): workgroup layer z sums k from z · k_chunk, k_chunk of them, into
+    // its own copy of C at c_off + z · c_chunk, which a column sum then adds in order.
+    k_chunk: u32,
+    c_chunk: u32,
+    _pad0: u32,
+    _pad1: u32,
 }
 
 @group(0) @binding(0) var<uniform> p: Gemm;
@@ -48,14 +54,14 @@ const OMEGA_0: f32 = 30.0;
 var<workgroup> as_: array<f32, 1024>;
 var<workgroup> bs: array<vec4<f32>, 256>;
 
-fn b_at(k: u32, j: u32) -> f32 {
-    if (k < p.k && j < p.n) {
+fn b_at(k: u32, j: u32, k_end: u32) -> f32 {
+    if (k < k_end && j < p.n) {
         return b[p.b_off + k * p.b_rs + j * p.b_cs];
     }
     return 0.0;
 }
 
-fn store(i: u32, j0: u32, acc: vec4<f32>) {
+fn store(i: u32, j0: u32, acc: vec4<f32>, layer: u32) {
     if (i >= p.m) {
         return;
     }
@@ -78,7 +84,7 @@ fn store(i: u32, j0: u32, acc: vec4<f32>) {
         } else if (p.activation == 2u) {
             v = sin(OMEGA_0 * v);
         }
-        let o = p.c_off + i * p.c_rs + j;
+        let o = p.c_off + layer * p.c_chunk + i * p.c_rs + j;
         if (p.accumulate == 1u) {
             v += c[o];
         }
@@ -98,20 +104,27 @@ fn main(
     var a1 = vec4<f32>(0.0);
     var a2 = vec4<f32>(0.0);
     var a3 = vec4<f32>(0.0);
-    for (var k0 = 0u; k0 < p.k; k0 += DEPTH) {
+    let k_begin = group.z * p.k_chunk;
+    let k_end = select(p.k, min(p.k, k_begin + p.k_chunk), p.k_chunk > 0u);
+    for (var k0 = k_begin; k0 < k_end; k0 += DEPTH) {
         for (var t = 0u; t < 4u; t++) {
             let e = thread + t * 256u;
             let i = row0 + e / DEPTH;
             let k = k0 + e % DEPTH;
             var v = 0.0;
-            if (i < p.m && k < p.k) {
+            if (i < p.m && k < k_end) {
                 v = a[p.a_off + i * p.a_rs + k * p.a_cs];
             }
             as_[e] = v;
         }
         let kb = k0 + thread / 16u;
         let j = col0 + 4u * (thread % 16u);
-        bs[thread] = vec4<f32>(b_at(kb, j), b_at(kb, j + 1u), b_at(kb, j + 2u), b_at(kb, j + 3u));
+        bs[thread] = vec4<f32>(
+            b_at(kb, j, k_end),
+            b_at(kb, j + 1u, k_end),
+            b_at(kb, j + 2u, k_end),
+            b_at(kb, j + 3u, k_end)
+        );
         workgroupBarrier();
         for (var k = 0u; k < DEPTH; k++) {
             let bk = bs[k * 16u + local.x];
@@ -123,8 +136,8 @@ fn main(
         workgroupBarrier();
     }
     let j = col0 + 4u * local.x;
-    store(row0 + local.y, j, a0);
-    store(row0 + local.y + 16u, j, a1);
-    store(row0 + local.y + 32u, j, a2);
-    store(row0 + local.y + 48u, j, a3);
+    store(row0 + local.y, j, a0, group.z);
+    store(row0 + local.y + 16u, j, a1, group.z);
+    store(row0 + local.y + 32u, j, a2, group.z);
+    store(row0 + local.y + 48u, j, a3, group.z);
 }

@@ -76,7 +76,7 @@ async function main() {
   const spare = room(4);
   const denseLayer = (pass, layer, x, rows, dIn, wRow, bias, activation, y) =>
     dispatch(pass, 'gemm',
-      [rows, layer.dOut, dIn, 0, dIn, 1, wRow * layer.dOut, layer.dOut, 1, layer.dOut, 1, activation, 0, 0, 0, 0],
+      [rows, layer.dOut, dIn, 0, dIn, 1, wRow * layer.dOut, layer.dOut, 1, layer.dOut, 1, activation, 0, 0, 0, 0, 0, 0, 0, 0],
       [x, layer.weight, bias, empty, y, spare], Math.ceil(layer.dOut / 64), Math.ceil(rows / 64));
   // An MLP: hidden layers take its activation, the last is linear; ping-pongs through `scratch`.
   const runMlp = (pass, m, x, rows, first, scratch, out) => {
