@@ -470,3 +470,50 @@ fn bench_frame_times_every_stage_on_each_device() {
         assert!(out.contains(on), "{out}");
     }
 }
+
+/// bench/gpu.sh explains itself, refuses bad arguments, and on a machine without an NVIDIA GPU
+/// (CI's) says so before it builds or measures anything.
+#[test]
+fn the_gpu_benchmark_script_explains_itself_and_names_what_it_lacks() {
+    let script = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../bench/gpu.sh");
+    let run = |args: &[&str]| {
+        std::process::Command::new("bash")
+            .arg(&script)
+            .args(args)
+            .output()
+            .unwrap()
+    };
+    let help = run(&["--help"]);
+    assert!(help.status.success());
+    let text = String::from_utf8_lossy(&help.stdout);
+    assert!(
+        text.contains("--kitchen") && text.contains("one summary file"),
+        "{text}"
+    );
+    for (args, why) in [
+        (&["--frobnicate"][..], "unknown argument '--frobnicate'"),
+        (&["--kitchen", "data"][..], "--kitchen needs --cpu-model"),
+    ] {
+        let out = run(args);
+        assert_eq!(out.status.code(), Some(2), "{args:?}");
+        assert!(
+            String::from_utf8_lossy(&out.stderr).contains(why),
+            "{args:?}"
+        );
+    }
+    let has_nvidia = std::process::Command::new("sh")
+        .args(["-c", "command -v nvidia-smi"])
+        .output()
+        .unwrap()
+        .status
+        .success();
+    if !has_nvidia {
+        let out = run(&["--summary", "/nonexistent/summary.md"]);
+        assert_eq!(out.status.code(), Some(1));
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert!(
+            err.contains("no nvidia-smi: this needs an NVIDIA GPU"),
+            "{err}"
+        );
+    }
+}
