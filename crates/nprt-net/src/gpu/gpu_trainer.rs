@@ -175,7 +175,7 @@ impl GpuTrainer {
         }
         let plan = self.plan.as_ref().expect("prepared");
         let mut encoder = self.gpu.device.create_command_encoder(&Default::default());
-        encoder.clear_buffer(&self.grads, 0, None);
+        // Every gradient is written whole each step; only the codes' is added to, per track.
         encoder.clear_buffer(&plan.batch.d_codes, 0, None);
         {
             let mut pass = encoder.begin_compute_pass(&Default::default());

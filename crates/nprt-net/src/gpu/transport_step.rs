@@ -33,8 +33,8 @@ struct TrackTape {
 
 impl GpuTrainer {
     /// Records the transport networks' forward pass, loss and backward over batch `b` lit by
-    /// its `codes`: parameter gradients into `grads` (the grids' added to, so cleared before),
-    /// the codes' gradient added to `d_codes`, the loss summed into `loss`.
+    /// its `codes`: parameter gradients into `grads`, the codes' gradient added to `d_codes`
+    /// (cleared before), the loss summed into `loss`.
     pub(super) fn record_transport(&self, plan: &mut Vec<Dispatch>, b: &BatchBuffers, loss: Loss) {
         let tapes: Vec<TrackTape> = self
             .net
