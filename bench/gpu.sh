@@ -12,7 +12,7 @@
 #      `nprt eval` beside --cpu-model (the same design trained 10 minutes on the CPU).
 #
 # usage: bench/gpu.sh [--nprt BIN] [--python PY] [--kitchen DATASET --cpu-model MODEL]
-#                     [--summary FILE] [--work DIR]
+#                     [--summary FILE] [--work DIR] [--batches "16384 262144"] [--res 512,1920x1080]
 #   --nprt       the nprt binary (default target/release/nprt, built with `--features gpu`
 #                when missing)
 #   --python     Python with PyTorch and CUDA (default python3)
@@ -21,6 +21,8 @@
 #                (`nprt train --data DIR --arch dsep --minutes 10 --device cpu --out MODEL`)
 #   --summary    the summary file (default bench-gpu-summary.md)
 #   --work       where models and reports go (default a temporary folder)
+#   --batches    the training batch sizes (default "16384 262144")
+#   --res        the frame sizes (default 512,1920x1080); both only to try the script small
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
@@ -30,6 +32,8 @@ kitchen=
 cpu_model=
 summary=bench-gpu-summary.md
 work=
+batches="16384 262144"
+res=512,1920x1080
 while [ $# -gt 0 ]; do
   case "$1" in
     --nprt) nprt=$2; shift 2 ;;
@@ -38,6 +42,8 @@ while [ $# -gt 0 ]; do
     --cpu-model) cpu_model=$2; shift 2 ;;
     --summary) summary=$2; shift 2 ;;
     --work) work=$2; shift 2 ;;
+    --batches) batches=$2; shift 2 ;;
+    --res) res=$2; shift 2 ;;
     -h | --help) sed -n '2,/^set -euo/p' "$0" | sed '$d; s/^# \{0,1\}//'; exit 0 ;;
     *) echo "bench/gpu.sh: unknown argument '$1' (--help lists them)" >&2; exit 2 ;;
   esac
@@ -84,8 +90,8 @@ end_section() { echo '```' >>"$summary"; }
 
 # 1. Training throughput beside PyTorch. One round: each variant's process compiles anew, and
 # torch.compile's compile falls in its warm-up steps.
-for batch in 16384 262144; do
-  steps=$([ "$batch" = 16384 ] && echo 20 || echo 5)
+for batch in $batches; do
+  steps=$([ "$batch" -le 16384 ] && echo 20 || echo 5)
   log "training throughput at batch $batch"
   section "Training samples/s at batch $batch (nprt's kernels on wgpu; PyTorch on CUDA)"
   "$nprt" bench train --device wgpu --python "$python" --peer-variants "$variants" \
@@ -97,7 +103,7 @@ done
 # 2. The paper's schedule from the measured rates: 3000 views × 256² pixels × 500 epochs (every
 # pixel counted, as if all were foreground).
 section "The paper's schedule (3000 views of 256², 500 epochs) projected from the rates above"
-for batch in 16384 262144; do
+for batch in $batches; do
   awk -v batch="$batch" '$1 ~ /^(baseline|prt|albedo|dsep)$/ {
       samples = 3000 * 256 * 256 * 500
       printf "batch %6d  %-9s nprt %6.1f min   PyTorch %6s min\n", batch, $1, samples / $3 / 60,
@@ -109,7 +115,7 @@ end_section
 # 3. The frame, stage by stage.
 log "frame timings"
 section "Frame ms (nprt bench frame --device wgpu); the paper's Table 3 (RTX 3090, 512²): encoder 0.34 ms, networks 9.7-16 ms"
-"$nprt" bench frame --device wgpu --arch "$designs" --res 512,1920x1080 --repeats 10 >>"$summary"
+"$nprt" bench frame --device wgpu --arch "$designs" --res "$res" --repeats 10 >>"$summary"
 end_section
 
 # 4. KITCHEN: 10 minutes of training on the GPU against 10 on the CPU.
