@@ -89,6 +89,7 @@ pub(super) type FirstLayerBias<'a> = &'a dyn Fn(&mut Vec<Dispatch>, &wgpu::Buffe
 /// What an MLP's forward pass keeps: each layer's output and each hidden layer's
 /// pre-activation.
 pub(super) struct MlpTape {
+    pub rows: usize,
     pub outputs: Vec<wgpu::Buffer>,
     pub pre: Vec<wgpu::Buffer>,
 }
@@ -207,6 +208,7 @@ impl GpuTrainer {
     pub(super) fn tape(&self, m: &MlpAt, rows: usize) -> MlpTape {
         let hidden = m.layers.len() - 1;
         MlpTape {
+            rows,
             outputs: m
                 .layers
                 .iter()
@@ -219,18 +221,17 @@ impl GpuTrainer {
         }
     }
 
-    /// Records `m` over `rows` rows of `x`, keeping each layer's output and each hidden
+    /// Records `m` over the tape's rows of `x`, keeping each layer's output and each hidden
     /// layer's pre-activation in `tape`.
     pub(super) fn mlp_forward(
         &self,
         plan: &mut Vec<Dispatch>,
         m: &MlpAt,
         x: &wgpu::Buffer,
-        rows: usize,
         first: FirstLayer,
         tape: &MlpTape,
     ) {
-        let last = m.layers.len() - 1;
+        let (rows, last) = (tape.rows, m.layers.len() - 1);
         let mut first = Some(first);
         for (i, layer) in m.layers.iter().enumerate() {
             let (input, own_row, count, bias) = match first.take() {
@@ -280,7 +281,7 @@ impl GpuTrainer {
         d_input: Option<&wgpu::Buffer>,
         on_first: Option<FirstLayerBias>,
     ) {
-        let rows = tape.outputs[0].size() as usize / 4 / m.layers[0].d_out;
+        let rows = tape.rows;
         let widest = m
             .layers
             .iter()

@@ -106,7 +106,7 @@ impl GpuTrainer {
                 count: t.width,
                 bias: Bias::Column(&self.params, m.layers[0].bias.offset),
             };
-            self.mlp_forward(plan, m, &x, b.rows, first, &tape);
+            self.mlp_forward(plan, m, &x, first, &tape);
             tape
         });
         // The light code's share of the first shading layer, once per view.
@@ -135,7 +135,7 @@ impl GpuTrainer {
             count: t.own_width(),
             bias: Bias::Group(&group_bias, &b.view),
         };
-        self.mlp_forward(plan, &t.shading, input, b.rows, first_layer, &shading);
+        self.mlp_forward(plan, &t.shading, input, first_layer, &shading);
         TrackTape {
             dx: t.grid.map(|_| gpu.buffer(b.rows * t.width)),
             x,

@@ -7,7 +7,7 @@ use std::path::Path;
 
 use anyhow::{anyhow, bail, Result};
 use burn::module::Module;
-use burn::optim::{AdamConfig, GradientsParams, ModuleOptimizer};
+use burn::optim::{AdamConfig, ModuleOptimizer};
 
 use crate::training::training_loop::ADAM_EPSILON;
 
@@ -52,14 +52,6 @@ impl<N: Module, B> Optimiser<N, B> {
         match self {
             Optimiser::Burn(_) => format!("{BURN_PREFIX}{step:09}.bpk"),
             Optimiser::Device(_) => format!("{DEVICE_PREFIX}{step:09}.safetensors"),
-        }
-    }
-
-    /// Burn's update of `net` with `grads` at learning rate `lr`.
-    pub fn apply(&mut self, lr: f64, net: N, grads: GradientsParams) -> N {
-        match self {
-            Optimiser::Burn(optim) => optim.step(lr, net, grads),
-            Optimiser::Device(_) => unreachable!("device steps apply their own updates"),
         }
     }
 

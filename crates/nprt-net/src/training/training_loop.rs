@@ -448,15 +448,18 @@ impl<'s, O: Objective> Run<'s, O> {
                 self.split.batch_wait += since(waiting);
                 let stepping = Instant::now();
                 let lr = self.learning_rate();
-                let (value, samples) = if let Optimiser::Device(steps) = optim {
-                    let (value, samples) = steps.step(&batch, lr)?;
-                    self.check_divergence(value, epoch)?;
-                    (value, samples)
-                } else {
-                    let (value, grads, samples) = objective.gradients(&net, &batch, device);
-                    self.check_divergence(value, epoch)?;
-                    net = optim.apply(lr, net, grads);
-                    (value, samples)
+                let (value, samples) = match optim {
+                    Optimiser::Device(steps) => {
+                        let (value, samples) = steps.step(&batch, lr)?;
+                        self.check_divergence(value, epoch)?;
+                        (value, samples)
+                    }
+                    Optimiser::Burn(adam) => {
+                        let (value, grads, samples) = objective.gradients(&net, &batch, device);
+                        self.check_divergence(value, epoch)?;
+                        net = adam.step(lr, net, grads);
+                        (value, samples)
+                    }
                 };
                 self.split.steps += since(stepping);
                 self.record_step(value, samples, epoch, total, row_every);
