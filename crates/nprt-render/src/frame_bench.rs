@@ -39,6 +39,8 @@ pub struct FrameBenchRow {
     pub relight_ms: f64,
     /// Where the networks ran.
     pub networks_on: String,
+    /// Where the G-buffer was made.
+    pub gbuffer_on: &'static str,
 }
 
 /// Times every model at every resolution, calling `on_row` as each is done.
@@ -107,6 +109,7 @@ pub fn bench_frame(
                 },
                 relight_ms: median(relights),
                 networks_on: model.networks_on(),
+                gbuffer_on: model.gbuffer_on(),
             });
         }
     }

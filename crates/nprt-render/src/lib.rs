@@ -1,7 +1,8 @@
 //! nprt-render: run-time Neural PRT. It owns turning a trained model plus a G-buffer and an
 //! environment map into a globally illuminated frame, camera paths and lighting schedules over
 //! time, and writing frames and animations. It reads models through nprt-net and traces only
-//! primary rays (for the G-buffer) through nprt-trace, and direct light for models that leave
+//! primary rays (for the G-buffer, which the GPU frame path rasterises instead) through
+//! nprt-trace, and direct light for models that leave
 //! it to the tracer, which it can denoise with Open Image Denoise (the one binding, which the
 //! evaluation's denoised baselines use too); it must not train networks, write datasets or
 //! compute error metrics.

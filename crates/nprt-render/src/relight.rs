@@ -35,6 +35,10 @@ pub struct Relighter {
     /// The encoder and transport networks as our own kernels, for `--device wgpu`.
     #[cfg(feature = "wgpu")]
     gpu: Option<crate::gpu::GpuNetwork>,
+    /// With the kernels, the scene of the last frame on the device (by its address: a model
+    /// renders the one scene it was trained on) for its rasterised G-buffers.
+    #[cfg(feature = "wgpu")]
+    raster: std::sync::Mutex<Option<(usize, std::sync::Arc<crate::gpu::RasterGBuffer>)>>,
 }
 
 /// What the encoder made of one lighting: the 64-d code ê and what the map's channels were
@@ -148,6 +152,7 @@ impl Relighter {
                 device: Device::flex(),
                 host: None,
                 gpu,
+                raster: Default::default(),
             });
         }
         let host = cpu::applies(&net, device).then(|| HostTransport::from_net(&net));
@@ -158,6 +163,8 @@ impl Relighter {
             host,
             #[cfg(feature = "wgpu")]
             gpu: None,
+            #[cfg(feature = "wgpu")]
+            raster: Default::default(),
         })
     }
 
@@ -182,6 +189,16 @@ impl Relighter {
             Some(_) => "CPU engine".into(),
             None => format!("burn on {}", nprt_net::device_name(&self.device)),
         }
+    }
+
+    /// Where the G-buffer is made, for reports: rasterised beside the GPU kernels, or the CPU
+    /// tracer's primary rays.
+    pub fn gbuffer_on(&self) -> &'static str {
+        #[cfg(feature = "wgpu")]
+        if self.gpu.is_some() {
+            return "rasterised on the GPU";
+        }
+        "traced on the CPU"
     }
 
     /// Whether the model leaves direct light to the tracer ([`Self::complete`] traces it).
@@ -248,7 +265,7 @@ impl Relighter {
             Some((c, g, px)) if c == *camera => (g, px),
             _ => {
                 let clock = Instant::now();
-                let g = render_gbuffer(ts, camera);
+                let g = self.gbuffer(ts, camera)?;
                 t.gbuffer_ms = ms(clock);
                 let clock = Instant::now();
                 let px = self.pixels(&g);
@@ -272,6 +289,28 @@ impl Relighter {
         cache.light = Some((key, code));
         cache.still = Some((camera.clone(), g, px));
         Ok((rgb, t))
+    }
+
+    /// The G-buffer of `camera`'s pixel centres: rasterised on the GPU with the kernels (the
+    /// scene uploaded at its first frame), traced otherwise.
+    pub fn gbuffer(&self, ts: &TraceScene, camera: &Camera) -> Result<GBuffer> {
+        #[cfg(feature = "wgpu")]
+        if self.gpu.is_some() {
+            let key = std::ptr::from_ref(ts.scene) as usize;
+            let raster = {
+                let mut kept = self.raster.lock().unwrap_or_else(|e| e.into_inner());
+                match &*kept {
+                    Some((k, r)) if *k == key => r.clone(),
+                    _ => {
+                        let r = std::sync::Arc::new(crate::gpu::RasterGBuffer::new(ts.scene)?);
+                        *kept = Some((key, r.clone()));
+                        r
+                    }
+                }
+            };
+            return Ok(raster.render(camera));
+        }
+        Ok(render_gbuffer(ts, camera))
     }
 
     /// Encodes `map` rotated by `rotation_deg` about +Y.

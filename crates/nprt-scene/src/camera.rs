@@ -138,7 +138,7 @@ impl Camera {
     }
 
     /// tan of half the horizontal field of view.
-    fn tan_half_x(&self) -> f32 {
+    pub fn tan_half_x(&self) -> f32 {
         let (w, h) = (self.width as f32, self.height as f32);
         let t = (self.fov_deg.to_radians() * 0.5).tan();
         let axis = match self.fov_axis {

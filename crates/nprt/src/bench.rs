@@ -147,17 +147,20 @@ fn frame(a: BenchFrameArgs) -> Result<()> {
         direct_spp: a.direct_spp,
         map: a.map,
     };
-    println!(
-        "relit frames of {} under {}, median of {} (ms; G-buffer and direct light on the CPU tracer, {} threads)",
-        opts.scene,
-        opts.map,
-        opts.repeats,
-        rayon::current_num_threads()
-    );
     let mut header = true;
     nprt_render::bench_frame(&opts, &device, |r| {
         if header {
-            println!("networks on the {}", r.networks_on);
+            println!(
+                "relit frames of {} under {}, median of {} (ms; direct light on the CPU tracer, {} threads)",
+                opts.scene,
+                opts.map,
+                opts.repeats,
+                rayon::current_num_threads()
+            );
+            println!(
+                "networks on the {}, G-buffer {}",
+                r.networks_on, r.gbuffer_on
+            );
             println!(
                 "{:<14} {:>10} {:>9} {:>9} {:>8} {:>9} {:>8} {:>9} {:>7} {:>11}",
                 "design",

@@ -97,10 +97,11 @@ pub fn run(opts: &RenderOptions, device: &Device) -> Result<()> {
     let job = RenderJob::prepare(opts, device)?;
     let [w, h] = opts.resolution;
     println!(
-        "nprt render: {} ({}, networks on the {}) on {}, {} frames at {w}×{h}, lighting {}",
+        "nprt render: {} ({}, networks on the {}, G-buffer {}) on {}, {} frames at {w}×{h}, lighting {}",
         opts.model.display(),
         job.model.file.config.label(),
         job.model.networks_on(),
+        job.model.gbuffer_on(),
         job.scene_spec,
         opts.frames,
         job.lighting

@@ -462,12 +462,15 @@ fn bench_frame_times_every_stage_on_each_device() {
                 traced.0
             );
         }
-        let on = if device == "cpu" {
-            "networks on the CPU engine"
+        let (networks, gbuffer) = if device == "cpu" {
+            ("networks on the CPU engine", "G-buffer traced on the CPU")
         } else {
-            "networks on the GPU kernels on"
+            (
+                "networks on the GPU kernels on",
+                "G-buffer rasterised on the GPU",
+            )
         };
-        assert!(out.contains(on), "{out}");
+        assert!(out.contains(networks) && out.contains(gbuffer), "{out}");
     }
 }
 

@@ -323,9 +323,11 @@ fn quick_demo_then_render_and_eval() {
     std::fs::remove_dir_all(&dir).ok();
 }
 
-/// `nprt render --device wgpu` (the GPU frame path's kernels, here on Mesa's software Vulkan)
-/// makes the frames `render` made with the CPU engine in `cpu_frames`, to within 1e-5 of each
-/// frame's brightest value (lavapipe: ~1e-6, the sums running in another order).
+/// `nprt render --device wgpu` (the GPU frame path: a rasterised G-buffer and the networks'
+/// kernels, here on Mesa's software Vulkan) makes the frames `render` made with the CPU tracer's
+/// G-buffer and engine in `cpu_frames`: at most 1% of the pixels (where a pixel centre on an
+/// edge takes the neighbour, or rounding moves a lookup across a texel) differ by more than
+/// 1e-5 of each frame's brightest value, and the median pixel by less than 1e-6 of it.
 fn gpu_frames_match(render: &dyn Fn(&Path, &str) -> String, cpu_frames: &Path) {
     if !common::wgpu_runs() {
         return;
@@ -341,11 +343,19 @@ fn gpu_frames_match(render: &dyn Fn(&Path, &str) -> String, cpu_frames: &Path) {
             .texels
             .iter()
             .fold(0.0f32, |m, p| m.max(p.max_element()));
-        let worst = (cpu.texels.iter().zip(&gpu.texels))
-            .fold(0.0f32, |m, (a, b)| m.max((*a - *b).abs().max_element()));
+        let mut off: Vec<f32> = (cpu.texels.iter().zip(&gpu.texels))
+            .map(|(a, b)| (*a - *b).abs().max_element() / peak)
+            .collect();
+        off.sort_by(f32::total_cmp);
+        let beyond = off.iter().filter(|&&d| d > 1e-5).count();
+        let median = off[off.len() / 2];
+        eprintln!(
+            "frame {frame}: {beyond} of {} pixels beyond 1e-5 of the peak, median {median:.1e}",
+            off.len()
+        );
         assert!(
-            worst <= 1e-5 * peak,
-            "frame {frame}: off by {worst} of {peak}"
+            beyond * 100 <= off.len() && median < 1e-6,
+            "frame {frame}: {beyond} pixels off, median {median}"
         );
     }
 }

@@ -1,16 +1,22 @@
-//! The GPU frame path: a trained model's light encoder and transport networks as WGSL compute
-//! shaders on wgpu (Vulkan, Metal, DX12; Mesa's software Vulkan in the tests), and the export
-//! of those shaders, translated to GLSL and HLSL, with the weights for engines.
+//! The GPU frame path: the scene rasterised into the G-buffer, and a trained model's light
+//! encoder and transport networks as WGSL compute shaders, on wgpu (Vulkan, Metal, DX12; Mesa's
+//! software Vulkan in the tests); and the export of those shaders, translated to GLSL and HLSL,
+//! with the weights for engines.
 //!
-//! Owns the frame's kernels (`shaders/`; the device they run on is nprt-net's), the upload of a model's weights and the order of dispatches
-//! of a frame. It computes what the CPU engine (nprt-net's `cpu`) computes, in the same f32
-//! operations, and a test holds the two together; it must not own network semantics of its
-//! own: layouts, designs and the hash grid are nprt-net's, read from there.
+//! Owns the frame's shaders (`shaders/`: the visibility pass and the G-buffer it resolves; the
+//! network kernels and the device they run on are nprt-net's), the scene's and a model's
+//! upload and the order of dispatches of a frame. It computes what the CPU does (nprt-trace's
+//! G-buffer, nprt-net's CPU engine) in the same f32 operations, and tests hold them together;
+//! it must not own semantics of its own: materials are nprt-scene's, layouts, designs and the
+//! hash grid nprt-net's.
 
 mod gpu_network;
+mod gpu_scene;
 mod kernels;
+mod raster_gbuffer;
 mod shader_export;
 
 pub use gpu_network::{GpuNetwork, GpuPixels};
 pub use nprt_net::gpu::GpuDevice;
+pub use raster_gbuffer::RasterGBuffer;
 pub use shader_export::{export_model, ExampleView, ExportSummary};

@@ -276,6 +276,7 @@ impl<'a> Viewer<'a> {
                 ));
                 lines.push(format!("total {:.1} ms", t.total_ms()));
                 lines.push(format!("networks on the {}", model.networks_on()));
+                lines.push(format!("G-buffer {}", model.gbuffer_on()));
             }
         }
         lines.push(format!("{:.1} fps, shown by {adapter}", self.fps));

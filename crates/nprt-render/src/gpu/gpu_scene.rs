@@ -1,0 +1,204 @@
+//! A scene's triangles, materials and textures on the GPU, uploaded once: what the rasterised
+//! G-buffer reads. The records' layouts are the contract with `shaders/gbuffer.wgsl`, which
+//! evaluates them as nprt-trace's `surface_point` and nprt-scene's materials do on the CPU.
+
+use std::collections::HashMap;
+use std::sync::Arc;
+
+use glam::Vec3;
+use nprt_scene::{BsdfParams, Material, Scene, Surface, Texture};
+
+use nprt_net::gpu::GpuDevice;
+
+/// Words per material record (see [`material_record`]).
+pub const MATERIAL_WORDS: usize = 16;
+/// Words per texture record (see [`texture_record`]).
+pub const TEXTURE_WORDS: usize = 16;
+
+/// Material flags, as `shaders/gbuffer.wgsl` reads them.
+const TWO_SIDED: u32 = 1;
+const BUMP: u32 = 2;
+const BUMP_MIRRORED_BEHIND: u32 = 4;
+const OPACITY: u32 = 8;
+const METALLIC_ROUGHNESS: u32 = 16;
+
+/// Per-vertex attribute flags of a mesh.
+const HAS_NORMALS: u32 = 1;
+const HAS_UVS: u32 = 2;
+
+/// The scene on the device.
+pub struct GpuScene {
+    /// Every mesh's vertex positions, 3 f32 each, meshes one after another.
+    pub positions: wgpu::Buffer,
+    /// Per vertex: shading normal (3) and uv (2); zero where the mesh has none.
+    pub attributes: wgpu::Buffer,
+    /// Per triangle: three vertex indices into `positions` and its mesh's flags and material
+    /// packed as `flags | material << 2`.
+    pub triangles: wgpu::Buffer,
+    pub materials: wgpu::Buffer,
+    pub textures: wgpu::Buffer,
+    /// Every bitmap's texels, 3 f32 each, top row first.
+    pub texels: wgpu::Buffer,
+    pub triangle_count: u32,
+    /// The scene's extent (the bounding box's diagonal), for the rasteriser's near plane.
+    pub extent: f32,
+}
+
+impl GpuScene {
+    pub fn new(gpu: &GpuDevice, scene: &Scene) -> Self {
+        let vertices: usize = scene.meshes.iter().map(|m| m.positions.len()).sum();
+        let mut positions = Vec::with_capacity(3 * vertices);
+        let mut attributes = Vec::with_capacity(5 * vertices);
+        let mut triangles = Vec::with_capacity(4 * scene.triangle_count());
+        for mesh in &scene.meshes {
+            let first = (positions.len() / 3) as u32;
+            let flags = if mesh.normals.is_empty() {
+                0
+            } else {
+                HAS_NORMALS
+            } | if mesh.uvs.is_empty() { 0 } else { HAS_UVS };
+            for (i, p) in mesh.positions.iter().enumerate() {
+                positions.extend_from_slice(&p.to_array());
+                let n = mesh.normals.get(i).copied().unwrap_or(Vec3::ZERO);
+                let uv = mesh.uvs.get(i).copied().unwrap_or_default();
+                attributes.extend_from_slice(&[n.x, n.y, n.z, uv.x, uv.y]);
+            }
+            for tri in &mesh.indices {
+                triangles.extend(tri.map(|i| first + i));
+                triangles.push(flags | (mesh.material as u32) << 2);
+            }
+        }
+        let mut bitmaps = TexelStore::default();
+        let mut textures = Vec::new();
+        let materials: Vec<u32> = scene
+            .materials
+            .iter()
+            .flat_map(|m| material_record(m, &mut textures, &mut bitmaps))
+            .collect();
+        let (lo, hi) = scene.bounds();
+        GpuScene {
+            positions: gpu.upload(&positions),
+            attributes: gpu.upload(&attributes),
+            triangles: gpu.upload(&triangles),
+            materials: gpu.upload(&materials),
+            textures: gpu.upload(&textures),
+            texels: gpu.upload(&bitmaps.texels),
+            triangle_count: scene.triangle_count() as u32,
+            extent: (hi - lo).length(),
+        }
+    }
+}
+
+/// Bitmaps' texels laid end to end, each bitmap once however many textures share it.
+#[derive(Default)]
+struct TexelStore {
+    texels: Vec<f32>,
+    offsets: HashMap<*const nprt_scene::Bitmap, u32>,
+}
+
+impl TexelStore {
+    /// The offset (in texels) of `bitmap`, stored on first sight.
+    fn offset(&mut self, bitmap: &Arc<nprt_scene::Bitmap>) -> u32 {
+        *self.offsets.entry(Arc::as_ptr(bitmap)).or_insert_with(|| {
+            let at = (self.texels.len() / 3) as u32;
+            self.texels
+                .extend(bitmap.texels.iter().flat_map(|t| t.to_array()));
+            at
+        })
+    }
+}
+
+/// A material's record: `[flags, texture ids (kd, ks, α) or (base, metallic-roughness, —),
+/// opacity texture, bump texture, bump scale, ks's factor at normal incidence (3), 0…]`. Its
+/// textures are appended to `textures`.
+fn material_record(m: &Material, textures: &mut Vec<u32>, bitmaps: &mut TexelStore) -> [u32; 16] {
+    let mut add = |t: &Texture| {
+        let id = (textures.len() / TEXTURE_WORDS) as u32;
+        textures.extend(texture_record(t, bitmaps));
+        id
+    };
+    let mut flags = if m.two_sided { TWO_SIDED } else { 0 };
+    let ids = match &m.surface {
+        Surface::Direct { kd, ks, alpha } => [add(kd), add(ks), add(alpha)],
+        Surface::MetallicRoughness {
+            base,
+            metallic_roughness,
+        } => {
+            flags |= METALLIC_ROUGHNESS;
+            [add(base), add(metallic_roughness), 0]
+        }
+    };
+    let opacity = m.opacity.as_ref().map_or(0, |o| {
+        flags |= OPACITY;
+        add(o)
+    });
+    let (bump, scale) = m.bump.as_ref().map_or((0, 0.0), |b| {
+        flags |= BUMP;
+        if b.mirrored_behind {
+            flags |= BUMP_MIRRORED_BEHIND;
+        }
+        (add(&b.height), b.scale)
+    });
+    // The G-buffer's ks is at normal incidence: the scattering's Fresnel factor there.
+    let fresnel = BsdfParams {
+        scattering: m.scattering,
+        ..BsdfParams::new(Vec3::ZERO, Vec3::ONE, 1.0)
+    }
+    .normal_incidence_ks();
+    let mut r = [0u32; MATERIAL_WORDS];
+    r[..7].copy_from_slice(&[
+        flags,
+        ids[0],
+        ids[1],
+        ids[2],
+        opacity,
+        bump,
+        scale.to_bits(),
+    ]);
+    r[7..10].copy_from_slice(&fresnel.to_array().map(f32::to_bits));
+    r
+}
+
+/// Texture kinds, as `shaders/gbuffer.wgsl` reads them.
+const CONSTANT: u32 = 0;
+const BITMAP: u32 = 1;
+const CHECKERBOARD: u32 = 2;
+
+/// A texture's record: `[kind, texel offset, width, height, colour (the constant, a bitmap's
+/// factor or the checkerboard's color0) (3), color1 (3), uv transform (x axis, y axis,
+/// translation: 6)]`.
+fn texture_record(t: &Texture, bitmaps: &mut TexelStore) -> [u32; TEXTURE_WORDS] {
+    let (kind, texels, size, colour, color1, to_uv) = match t {
+        Texture::Constant(c) => (CONSTANT, 0, [0, 0], *c, Vec3::ZERO, glam::Affine2::IDENTITY),
+        Texture::Bitmap {
+            image,
+            to_uv,
+            factor,
+        } => (
+            BITMAP,
+            bitmaps.offset(image),
+            [image.width as u32, image.height as u32],
+            *factor,
+            Vec3::ZERO,
+            *to_uv,
+        ),
+        Texture::Checkerboard {
+            color0,
+            color1,
+            to_uv,
+        } => (CHECKERBOARD, 0, [0, 0], *color0, *color1, *to_uv),
+    };
+    let mut r = [0u32; TEXTURE_WORDS];
+    r[..4].copy_from_slice(&[kind, texels, size[0], size[1]]);
+    let words: Vec<u32> = colour
+        .to_array()
+        .into_iter()
+        .chain(color1.to_array())
+        .chain(to_uv.matrix2.x_axis.to_array())
+        .chain(to_uv.matrix2.y_axis.to_array())
+        .chain(to_uv.translation.to_array())
+        .map(f32::to_bits)
+        .collect();
+    r[4..].copy_from_slice(&words);
+    r
+}
