@@ -64,7 +64,7 @@ pub fn measure_throughput(
 }
 
 /// [`measure_throughput`] on our own GPU kernels (what `--device wgpu` trains with): each step
-/// reads its loss back, as a training run does.
+/// reads the loss of the one before it back while it runs, as a training run does.
 #[cfg(feature = "kernels")]
 fn kernel_throughput(config: &ModelConfig, batch: &Batch, steps: usize, warmup: usize) -> f64 {
     let net = config.build(&mut Init::new(0, &Device::flex()));
@@ -75,8 +75,9 @@ fn kernel_throughput(config: &ModelConfig, batch: &Batch, steps: usize, warmup: 
         if step == warmup {
             timed = Instant::now();
         }
-        gpu.step(&samples, Loss::LogL1, 1e-4);
+        gpu.queue_step(&samples, Loss::LogL1, 1e-4);
     }
+    gpu.finish();
     (batch.len() * steps) as f64 / timed.elapsed().as_secs_f64()
 }
 

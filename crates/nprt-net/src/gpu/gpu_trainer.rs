@@ -51,6 +51,18 @@ pub struct GpuTrainer {
     plan: Option<StepPlan>,
     /// Adam over every parameter; its rate and bias corrections are rewritten each step.
     adam: Dispatch,
+    /// Two host-readable copies of a step's loss, used in turn: one step's is read while the
+    /// next one runs.
+    loss_copies: [wgpu::Buffer; 2],
+    /// The last queued step whose loss has not been read.
+    pending: Option<PendingLoss>,
+}
+
+/// A queued step's loss on its way back: its copy, its submission and its batch's rows.
+struct PendingLoss {
+    copy: usize,
+    submission: wgpu::SubmissionIndex,
+    rows: usize,
 }
 
 /// A training step's dispatches for one batch shape and loss, with the buffers its batches are
@@ -119,7 +131,17 @@ impl GpuTrainer {
             &[&grads, &params, &moment1, &moment2],
             groups_for(layout.total),
         );
+        let loss_copy = || {
+            gpu.device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some("loss"),
+                size: 4,
+                usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+                mapped_at_creation: false,
+            })
+        };
         Ok(GpuTrainer {
+            loss_copies: [loss_copy(), loss_copy()],
+            pending: None,
             params,
             grads,
             moment1,
@@ -157,16 +179,45 @@ impl GpuTrainer {
     /// ([`Self::gradients`] reads them): one submission of the encoder's and the transport
     /// networks' forward and backward passes. Reading the loss back waits for it.
     pub fn backward(&mut self, batch: &Samples, loss: Loss) -> f64 {
-        self.run(batch, loss, None)
+        self.queue(batch, loss, None);
+        self.finish().expect("a step was queued")
     }
 
-    /// One training step: [`Self::backward`] and Adam at learning rate `lr` over every
-    /// parameter, in one submission; the batch's loss.
+    /// One training step, waiting for it: [`Self::queue_step`] and [`Self::finish`].
     pub fn step(&mut self, batch: &Samples, loss: Loss, lr: f64) -> f64 {
-        self.run(batch, loss, Some(lr))
+        self.queue_step(batch, loss, lr);
+        self.finish().expect("a step was queued")
     }
 
-    fn run(&mut self, batch: &Samples, loss: Loss, lr: Option<f64>) -> f64 {
+    /// Queues one training step: [`Self::backward`] and Adam at learning rate `lr` over every
+    /// parameter, in one submission. Returns the loss of the step queued before it (None for
+    /// the first), read back while this one runs: the host waits for a step only once the
+    /// device has the next, so the device does not idle while the host writes a batch.
+    pub fn queue_step(&mut self, batch: &Samples, loss: Loss, lr: f64) -> Option<f64> {
+        self.queue(batch, loss, Some(lr))
+    }
+
+    /// The loss of the last queued step, once it is done (None if every loss was read).
+    pub fn finish(&mut self) -> Option<f64> {
+        let pending = self.pending.take()?;
+        let copy = &self.loss_copies[pending.copy];
+        let slice = copy.slice(..);
+        slice.map_async(wgpu::MapMode::Read, |r| {
+            r.expect("mapping a step's loss for reading")
+        });
+        self.gpu
+            .device
+            .poll(wgpu::PollType::Wait {
+                submission_index: Some(pending.submission),
+                timeout: None,
+            })
+            .expect("waiting for a training step");
+        let total = bytemuck::cast_slice::<u8, f32>(&slice.get_mapped_range().expect("mapped"))[0];
+        copy.unmap();
+        Some(total as f64 / (3 * pending.rows.max(1)) as f64)
+    }
+
+    fn queue(&mut self, batch: &Samples, loss: Loss, lr: Option<f64>) -> Option<f64> {
         self.prepare(batch, loss);
         if let Some(lr) = lr {
             self.steps += 1;
@@ -174,6 +225,7 @@ impl GpuTrainer {
             self.gpu.write(&self.adam.uniform, &params);
         }
         let plan = self.plan.as_ref().expect("prepared");
+        let copy = self.pending.as_ref().map_or(0, |p| 1 - p.copy);
         let mut encoder = self.gpu.device.create_command_encoder(&Default::default());
         // Every gradient is written whole each step; only the codes' is added to, per track.
         encoder.clear_buffer(&plan.batch.d_codes, 0, None);
@@ -184,9 +236,16 @@ impl GpuTrainer {
                 self.adam.record(&mut pass);
             }
         }
-        self.gpu.queue.submit([encoder.finish()]);
-        let total = self.gpu.read(&plan.batch.loss, 1)[0] as f64;
-        total / (3 * plan.batch.rows.max(1)) as f64
+        encoder.copy_buffer_to_buffer(&plan.batch.loss, 0, &self.loss_copies[copy], 0, 4);
+        let rows = plan.batch.rows;
+        let submission = self.gpu.queue.submit([encoder.finish()]);
+        let before = self.finish();
+        self.pending = Some(PendingLoss {
+            copy,
+            submission,
+            rows,
+        });
+        before
     }
 
     /// Makes the step's plan for `batch`'s shape and `loss` unless the last one fits, and

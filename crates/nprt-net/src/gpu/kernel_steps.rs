@@ -15,6 +15,8 @@ use crate::training::optimiser::DeviceSteps;
 pub struct KernelSteps {
     trainer: GpuTrainer,
     loss: Loss,
+    /// Samples of the queued steps whose losses are not yet read (at most two).
+    samples: std::collections::VecDeque<u64>,
 }
 
 impl KernelSteps {
@@ -23,14 +25,21 @@ impl KernelSteps {
         Ok(KernelSteps {
             trainer: GpuTrainer::new(net)?,
             loss,
+            samples: Default::default(),
         })
     }
 }
 
 impl DeviceSteps<NprtNet, Batch> for KernelSteps {
-    fn step(&mut self, batch: &Batch, lr: f64) -> Result<(f64, u64)> {
-        let loss = self.trainer.step(&batch.samples(), self.loss, lr);
-        Ok((loss, batch.len() as u64))
+    fn step(&mut self, batch: &Batch, lr: f64) -> Result<Option<(f64, u64)>> {
+        self.samples.push_back(batch.len() as u64);
+        let before = self.trainer.queue_step(&batch.samples(), self.loss, lr);
+        Ok(before.map(|loss| (loss, self.samples.pop_front().expect("queued"))))
+    }
+
+    fn finish(&mut self) -> Result<Option<(f64, u64)>> {
+        let last = self.trainer.finish();
+        Ok(last.map(|loss| (loss, self.samples.pop_front().expect("queued"))))
     }
 
     fn store(&self, net: &mut NprtNet) {

@@ -14,8 +14,11 @@ use crate::training::training_loop::ADAM_EPSILON;
 /// Steps taken on a device of their own: the parameters and Adam's moments live there, and a
 /// step is the batch's loss, gradients and Adam update together.
 pub trait DeviceSteps<N, B> {
-    /// One step on `batch` at learning rate `lr`: the batch's mean loss and its samples.
-    fn step(&mut self, batch: &B, lr: f64) -> Result<(f64, u64)>;
+    /// Queues one step on `batch` at learning rate `lr`. Returns the step queued before it
+    /// (None for the first): its batch's mean loss and its samples, read while this one runs.
+    fn step(&mut self, batch: &B, lr: f64) -> Result<Option<(f64, u64)>>;
+    /// The last queued step's loss and samples once it is done (None when none is pending).
+    fn finish(&mut self) -> Result<Option<(f64, u64)>>;
     /// Writes the current parameters into `net` (for validation and saving).
     fn store(&self, net: &mut N);
     /// Writes Adam's state (moments and step count) to `path`.

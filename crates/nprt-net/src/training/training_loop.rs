@@ -343,6 +343,9 @@ struct Run<'s, O: Objective> {
     budget: Option<f64>,
     total_batches: usize,
     done_batches: usize,
+    /// Steps queued on a device whose loss is not back yet (counted in the learning rate's
+    /// progress, so that it does not depend on when losses are read).
+    queued: usize,
     bar: nprt_io::ProgressBar,
     started: Instant,
     seconds_before: f64,
@@ -385,6 +388,7 @@ impl<'s, O: Objective> Run<'s, O> {
             budget,
             total_batches,
             done_batches,
+            queued: 0,
             bar,
             started: Instant::now(),
             seconds_before: ck.state.seconds,
@@ -412,7 +416,7 @@ impl<'s, O: Objective> Run<'s, O> {
     fn learning_rate(&self) -> f64 {
         let progress = match self.budget {
             Some(b) => self.ck.state.seconds / b,
-            None => self.done_batches as f64 / self.total_batches.max(1) as f64,
+            None => (self.done_batches + self.queued) as f64 / self.total_batches.max(1) as f64,
         };
         self.schedule.learning_rate * self.schedule.lr_schedule.factor(progress)
     }
@@ -448,29 +452,34 @@ impl<'s, O: Objective> Run<'s, O> {
                 self.split.batch_wait += since(waiting);
                 let stepping = Instant::now();
                 let lr = self.learning_rate();
-                let (value, samples) = match optim {
+                let done = match optim {
+                    // A device's step returns the one before it, so that the device does not
+                    // wait for the host.
                     Optimiser::Device(steps) => {
-                        let (value, samples) = steps.step(&batch, lr)?;
-                        self.check_divergence(value, epoch)?;
-                        (value, samples)
+                        self.queued += 1;
+                        steps.step(&batch, lr)?
                     }
                     Optimiser::Burn(adam) => {
                         let (value, grads, samples) = objective.gradients(&net, &batch, device);
-                        self.check_divergence(value, epoch)?;
                         net = adam.step(lr, net, grads);
-                        (value, samples)
+                        self.queued += 1;
+                        Some((value, samples))
                     }
                 };
                 self.split.steps += since(stepping);
-                self.record_step(value, samples, epoch, total, row_every);
+                if let Some((value, samples)) = done {
+                    self.record_step(value, samples, epoch, total, row_every)?;
+                }
                 if self.out_of_time() {
                     break;
                 }
                 if self.last_checkpoint.elapsed().as_secs_f64() > self.schedule.checkpoint_secs {
+                    self.settle(optim, epoch, total, row_every)?;
                     optim.store(&mut net);
                     self.save(&net, optim, &inner)?;
                 }
             }
+            self.settle(optim, epoch, total, row_every)?;
             Ok(net)
         })
     }
@@ -501,7 +510,25 @@ impl<'s, O: Objective> Run<'s, O> {
         )
     }
 
-    /// Counts a finished step and its loss, adding a loss-table row every `row_every` steps.
+    /// Waits for the last queued step on a device and counts it: before saving, and at the
+    /// end of an epoch.
+    fn settle(
+        &mut self,
+        optim: &mut Optimiser<O::Net, O::Batch>,
+        epoch: usize,
+        total: usize,
+        row_every: u64,
+    ) -> Result<()> {
+        if let Optimiser::Device(steps) = optim {
+            if let Some((value, samples)) = steps.finish()? {
+                self.record_step(value, samples, epoch, total, row_every)?;
+            }
+        }
+        Ok(())
+    }
+
+    /// Counts a finished step and its loss (stopping the run if the loss says it diverged),
+    /// adding a loss-table row every `row_every` steps.
     fn record_step(
         &mut self,
         value: f64,
@@ -509,7 +536,9 @@ impl<'s, O: Objective> Run<'s, O> {
         epoch: usize,
         total: usize,
         row_every: u64,
-    ) {
+    ) -> Result<()> {
+        self.check_divergence(value, epoch)?;
+        self.queued -= 1;
         self.done_batches += 1;
         let s = &mut self.ck.state;
         s.batch += 1;
@@ -540,6 +569,7 @@ impl<'s, O: Objective> Run<'s, O> {
             self.guard.ema,
             s.samples as f64 / s.seconds.max(1e-9) / 1e3
         ));
+        Ok(())
     }
 
     /// Closes the epoch of `total` batches (or the part of it the budget left) with its
