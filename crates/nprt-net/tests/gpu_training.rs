@@ -107,6 +107,9 @@ fn gpu_gradients_match_the_cpu_engine_for_every_design() {
                 worst(&errors) < 1e-4,
                 "{name}: a gradient off by {errors:?}"
             );
+            // The forward passes alone (validation) make the same loss, to the bit: they are
+            // the same dispatches.
+            assert_eq!(gpu.loss(&samples, loss), value, "{name}: forward-only loss");
         }
     }
 }

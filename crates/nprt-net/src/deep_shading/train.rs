@@ -22,6 +22,7 @@ use crate::network::encoder::{check_input_width, LightInput};
 use crate::network::init::Init;
 use crate::training::checkpoint::{self, RunState};
 use crate::training::loss::log_l1_map;
+use crate::training::optimiser::DeviceSteps;
 use crate::training::training_loop::{self, epoch_rng, Objective, Schedule, TrainSummary};
 use crate::training::training_set::{log_mean_level, open_recorded_maps};
 
@@ -210,14 +211,19 @@ impl Objective for UnetObjective {
         )
     }
 
-    fn validation_loss(&self, net: &DeepShading, device: &Device) -> f64 {
+    fn validation_loss(
+        &self,
+        net: &DeepShading,
+        device: &Device,
+        _steps: Option<&mut dyn DeviceSteps<DeepShading, Self::Batch>>,
+    ) -> Result<f64> {
         let n = self.test.samples.len();
         let views: Vec<usize> = (0..n).collect();
-        views
+        Ok(views
             .chunks(self.file.options.batch_views)
             .map(|c| self.test.loss(net, c, device).0.into_scalar::<f32>() as f64 * c.len() as f64)
             .sum::<f64>()
-            / n as f64
+            / n as f64)
     }
 
     fn save_model(

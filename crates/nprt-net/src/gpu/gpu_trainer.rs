@@ -47,8 +47,10 @@ pub struct GpuTrainer {
     /// Adam steps taken.
     steps: u64,
     pub(super) resolutions: wgpu::Buffer,
-    /// The step's dispatches for the last batch shape, recorded again for every batch of it.
-    plan: Option<StepPlan>,
+    /// The step's dispatches for the last batch shapes used (training's and validation's, and
+    /// their epochs' last, shorter batches), recorded again for every batch of the shape;
+    /// the most recently used last.
+    plans: Vec<StepPlan>,
     /// Adam over every parameter; its rate and bias corrections are rewritten each step.
     adam: Dispatch,
     /// Two host-readable copies of a step's loss, used in turn: one step's is read while the
@@ -71,6 +73,22 @@ struct StepPlan {
     loss: Loss,
     batch: BatchBuffers,
     dispatches: Vec<Dispatch>,
+    /// How many of the dispatches make the loss (the forward passes); the rest are backward.
+    forward: usize,
+}
+
+/// Batch shapes whose plans are kept.
+const PLANS: usize = 4;
+
+/// What a queued submission runs.
+#[derive(Clone, Copy)]
+enum Pass {
+    /// The loss alone.
+    Forward,
+    /// The loss and every gradient.
+    Backward,
+    /// The loss, every gradient and Adam at this learning rate.
+    Step(f64),
 }
 
 /// A batch on the device, and what its step computes besides gradients.
@@ -147,7 +165,7 @@ impl GpuTrainer {
             moment1,
             moment2,
             adam,
-            plan: None,
+            plans: Vec::new(),
             steps: 0,
             resolutions: gpu.upload(&hash_grid::resolutions()),
             net,
@@ -179,7 +197,7 @@ impl GpuTrainer {
     /// ([`Self::gradients`] reads them): one submission of the encoder's and the transport
     /// networks' forward and backward passes. Reading the loss back waits for it.
     pub fn backward(&mut self, batch: &Samples, loss: Loss) -> f64 {
-        self.queue(batch, loss, None);
+        self.queue(batch, loss, Pass::Backward);
         self.finish().expect("a step was queued")
     }
 
@@ -194,7 +212,7 @@ impl GpuTrainer {
     /// the first), read back while this one runs: the host waits for a step only once the
     /// device has the next, so the device does not idle while the host writes a batch.
     pub fn queue_step(&mut self, batch: &Samples, loss: Loss, lr: f64) -> Option<f64> {
-        self.queue(batch, loss, Some(lr))
+        self.queue(batch, loss, Pass::Step(lr))
     }
 
     /// The loss of the last queued step, once it is done (None if every loss was read).
@@ -217,23 +235,34 @@ impl GpuTrainer {
         Some(total as f64 / (3 * pending.rows.max(1)) as f64)
     }
 
-    fn queue(&mut self, batch: &Samples, loss: Loss, lr: Option<f64>) -> Option<f64> {
+    /// The mean `loss` of `batch` under the current parameters, waiting for it: the forward
+    /// passes alone (validation).
+    pub fn loss(&mut self, batch: &Samples, loss: Loss) -> f64 {
+        self.queue(batch, loss, Pass::Forward);
+        self.finish().expect("a pass was queued")
+    }
+
+    fn queue(&mut self, batch: &Samples, loss: Loss, pass: Pass) -> Option<f64> {
         self.prepare(batch, loss);
-        if let Some(lr) = lr {
+        if let Pass::Step(lr) = pass {
             self.steps += 1;
             let params = adam_params(self.layout.total, lr, self.steps);
             self.gpu.write(&self.adam.uniform, &params);
         }
-        let plan = self.plan.as_ref().expect("prepared");
+        let plan = self.plans.last().expect("prepared");
         let copy = self.pending.as_ref().map_or(0, |p| 1 - p.copy);
         let mut encoder = self.gpu.device.create_command_encoder(&Default::default());
         // Every gradient is written whole each step; only the codes' is added to, per track.
         encoder.clear_buffer(&plan.batch.d_codes, 0, None);
         {
-            let mut pass = encoder.begin_compute_pass(&Default::default());
-            plan.dispatches.iter().for_each(|d| d.record(&mut pass));
-            if lr.is_some() {
-                self.adam.record(&mut pass);
+            let mut compute = encoder.begin_compute_pass(&Default::default());
+            let dispatches = match pass {
+                Pass::Forward => &plan.dispatches[..plan.forward],
+                _ => &plan.dispatches[..],
+            };
+            dispatches.iter().for_each(|d| d.record(&mut compute));
+            if let Pass::Step(_) = pass {
+                self.adam.record(&mut compute);
             }
         }
         encoder.copy_buffer_to_buffer(&plan.batch.loss, 0, &self.loss_copies[copy], 0, 4);
@@ -248,28 +277,36 @@ impl GpuTrainer {
         before
     }
 
-    /// Makes the step's plan for `batch`'s shape and `loss` unless the last one fits, and
-    /// writes the batch into its buffers.
+    /// Makes the step's plan for `batch`'s shape and `loss` the last of the kept plans (made
+    /// unless one fits), and writes the batch into its buffers.
     fn prepare(&mut self, batch: &Samples, loss: Loss) {
         let views = batch.lights.len() / (3 * batch.light_width * batch.light_width / 2);
-        let fits = self.plan.as_ref().is_some_and(|p| {
+        let fits = self.plans.iter().position(|p| {
             let b = &p.batch;
             p.loss == loss
                 && (b.rows, b.views, b.light_width) == (batch.len(), views, batch.light_width)
         });
-        if !fits {
-            let b = self.batch_buffers(batch.len(), views, batch.light_width);
-            let mut dispatches = Vec::new();
-            let tape = self.encoder_forward(&mut dispatches, &b);
-            self.record_transport(&mut dispatches, &b, loss);
-            self.encoder_backward(&mut dispatches, &b, &tape);
-            self.plan = Some(StepPlan {
-                loss,
-                batch: b,
-                dispatches,
-            });
-        }
-        let b = &self.plan.as_ref().expect("made above").batch;
+        let plan = match fits {
+            Some(i) => self.plans.remove(i),
+            None => {
+                if self.plans.len() == PLANS {
+                    self.plans.remove(0);
+                }
+                let b = self.batch_buffers(batch.len(), views, batch.light_width);
+                let mut dispatches = Vec::new();
+                let tape = self.encoder_forward(&mut dispatches, &b);
+                let forward = self.record_transport(&mut dispatches, &b, loss);
+                self.encoder_backward(&mut dispatches, &b, &tape);
+                StepPlan {
+                    loss,
+                    batch: b,
+                    dispatches,
+                    forward,
+                }
+            }
+        };
+        self.plans.push(plan);
+        let b = &self.plans.last().expect("made above").batch;
         let view: Vec<u32> = batch.view.iter().map(|&v| v as u32).collect();
         self.gpu.write(&b.lights, batch.lights);
         self.gpu.write(&b.features, batch.features);

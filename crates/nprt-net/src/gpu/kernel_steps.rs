@@ -42,6 +42,10 @@ impl DeviceSteps<NprtNet, Batch> for KernelSteps {
         Ok(last.map(|loss| (loss, self.samples.pop_front().expect("queued"))))
     }
 
+    fn loss(&mut self, batch: &Batch) -> Result<f64> {
+        Ok(self.trainer.loss(&batch.samples(), Loss::LogL1))
+    }
+
     fn store(&self, net: &mut NprtNet) {
         let (encoder, transport) = self.trainer.parameters();
         encoder.store_into(&mut net.encoder);

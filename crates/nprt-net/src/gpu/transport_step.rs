@@ -35,7 +35,14 @@ impl GpuTrainer {
     /// Records the transport networks' forward pass, loss and backward over batch `b` lit by
     /// its `codes`: parameter gradients into `grads`, the codes' gradient added to `d_codes`
     /// (cleared before), the loss summed into `loss`.
-    pub(super) fn record_transport(&self, plan: &mut Vec<Dispatch>, b: &BatchBuffers, loss: Loss) {
+    /// Records the transport networks' forward pass, the loss and their backward pass;
+    /// returns how many of `plan`'s dispatches it holds once the loss is made.
+    pub(super) fn record_transport(
+        &self,
+        plan: &mut Vec<Dispatch>,
+        b: &BatchBuffers,
+        loss: Loss,
+    ) -> usize {
         let tapes: Vec<TrackTape> = self
             .net
             .tracks
@@ -78,9 +85,11 @@ impl GpuTrainer {
             None,
             Output::to(&b.loss, 0, 1),
         );
+        let forward = plan.len();
         for (t, tape) in self.net.tracks.iter().zip(&tapes) {
             self.track_backward(plan, t, tape, b);
         }
+        forward
     }
 
     /// A track's forward pass over the batch.

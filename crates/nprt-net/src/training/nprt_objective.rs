@@ -28,7 +28,7 @@ use crate::training::optimiser::DeviceSteps;
 use crate::training::train_options::TrainOptions;
 use crate::training::training_loop::{self, Objective, Schedule, TrainSummary, ADAM_EPSILON};
 use crate::training::training_set::{TrainingSet, ViewSamples};
-use crate::training::validation::validation_loss;
+use crate::training::validation::{forward_log_l1, validation_loss};
 
 /// A Neural PRT design learning a dataset's pixels.
 struct PixelObjective<'a> {
@@ -123,14 +123,19 @@ impl Objective for PixelObjective<'_> {
         Ok(Some(Box::new(steps)))
     }
 
-    fn validation_loss(&self, net: &NprtNet, device: &Device) -> f64 {
-        validation_loss(
-            net,
-            self.set,
-            self.opts.val_samples,
-            self.opts.batch_size,
-            device,
-        )
+    fn validation_loss(
+        &self,
+        net: &NprtNet,
+        device: &Device,
+        steps: Option<&mut dyn DeviceSteps<NprtNet, Batch>>,
+    ) -> Result<f64> {
+        let (samples, batch_size) = (self.opts.val_samples, self.opts.batch_size);
+        match steps {
+            Some(steps) => validation_loss(self.set, samples, batch_size, |b| steps.loss(b)),
+            None => validation_loss(self.set, samples, batch_size, |b| {
+                Ok(forward_log_l1(net, b, device))
+            }),
+        }
     }
 
     fn save_model(

@@ -19,6 +19,8 @@ pub trait DeviceSteps<N, B> {
     fn step(&mut self, batch: &B, lr: f64) -> Result<Option<(f64, u64)>>;
     /// The last queued step's loss and samples once it is done (None when none is pending).
     fn finish(&mut self) -> Result<Option<(f64, u64)>>;
+    /// `batch`'s mean log-L1 loss under the current parameters, without a step (validation).
+    fn loss(&mut self, batch: &B) -> Result<f64>;
     /// Writes the current parameters into `net` (for validation and saving).
     fn store(&self, net: &mut N);
     /// Writes Adam's state (moments and step count) to `path`.
@@ -55,6 +57,14 @@ impl<N: Module, B> Optimiser<N, B> {
         match self {
             Optimiser::Burn(_) => format!("{BURN_PREFIX}{step:09}.bpk"),
             Optimiser::Device(_) => format!("{DEVICE_PREFIX}{step:09}.safetensors"),
+        }
+    }
+
+    /// The device's own steps, if they are what this optimiser is.
+    pub fn device_steps(&mut self) -> Option<&mut dyn DeviceSteps<N, B>> {
+        match self {
+            Optimiser::Device(d) => Some(d.as_mut()),
+            Optimiser::Burn(_) => None,
         }
     }
 

@@ -148,8 +148,15 @@ pub trait Objective: Sync {
     ) -> Result<Option<Box<dyn DeviceSteps<Self::Net, Self::Batch>>>> {
         Ok(None)
     }
-    /// Loss on held-out data with a network off the autodiff device; NaN where there is none.
-    fn validation_loss(&self, net: &Self::Net, device: &Device) -> f64;
+    /// Loss on held-out data with a network off the autodiff device, or on `steps` (a
+    /// device's own, holding the same parameters) where the run has them; NaN where there is
+    /// no held-out data.
+    fn validation_loss(
+        &self,
+        net: &Self::Net,
+        device: &Device,
+        steps: Option<&mut dyn DeviceSteps<Self::Net, Self::Batch>>,
+    ) -> Result<f64>;
     /// Writes the model folder's own files (config and weights) for the network as it stands;
     /// `device` is the one [`Self::validation_loss`] runs on.
     fn save_model(
@@ -250,7 +257,7 @@ pub fn train<O: Objective>(
         optim.store(&mut net);
         // The epoch ended, or the budget ran out within it: validate and save either way.
         let validating = Instant::now();
-        let val = objective.validation_loss(&net.valid(), &inner);
+        let val = objective.validation_loss(&net.valid(), &inner, optim.device_steps())?;
         run.split.validation += since(validating);
         if !val.is_finite() {
             // The last step's update broke the weights after a finite loss: nothing is saved.

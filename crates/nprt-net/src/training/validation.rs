@@ -1,5 +1,6 @@
 //! The per-epoch validation loss of a Neural PRT network on held-out lighting.
 
+use anyhow::Result;
 use burn::tensor::Device;
 
 use crate::network::nprt_net::NprtNet;
@@ -8,24 +9,29 @@ use crate::training::loss::log_l1;
 use crate::training::training_set::{TrainingSet, ViewSamples};
 
 /// Mean log-L1 loss over a fixed, evenly strided subset of at most `max_samples` of the test
-/// views' pixels, in batches of `batch_size`; NaN without test pixels.
+/// views' pixels, in batches of `batch_size`, each batch's mean by `batch_loss`; NaN without
+/// test pixels.
 pub fn validation_loss(
-    net: &NprtNet,
     set: &TrainingSet,
     max_samples: usize,
     batch_size: usize,
-    device: &Device,
-) -> f64 {
+    mut batch_loss: impl FnMut(&Batch) -> Result<f64>,
+) -> Result<f64> {
     let views: Vec<&ViewSamples> = set.test.iter().filter(|v| !v.is_empty()).collect();
     let (mut sum, mut count) = (0.0, 0);
     for batch in Batch::strided(&views, max_samples, batch_size) {
-        let (pred, reference) = batch.forward(net, device);
-        sum += log_l1(pred, reference).into_scalar::<f32>() as f64 * batch.len() as f64;
+        sum += batch_loss(&batch)? * batch.len() as f64;
         count += batch.len();
     }
     views.iter().for_each(|v| v.release());
     if count == 0 {
-        return f64::NAN;
+        return Ok(f64::NAN);
     }
-    sum / count as f64
+    Ok(sum / count as f64)
+}
+
+/// `batch`'s mean log-L1 loss through burn's forward pass of `net` on `device`.
+pub fn forward_log_l1(net: &NprtNet, batch: &Batch, device: &Device) -> f64 {
+    let (pred, reference) = batch.forward(net, device);
+    log_l1(pred, reference).into_scalar::<f32>() as f64
 }
