@@ -60,6 +60,6 @@ pub use training::loss::{log_l1, Loss};
 pub use training::lr_schedule::LrSchedule;
 pub use training::nprt_objective::train;
 pub use training::run_length::RunLength;
-pub use training::train_options::{recipe_rate, TrainOptions};
+pub use training::train_options::{recipe_rate, Gather, TrainOptions};
 pub use training::training_loop::{Objective, Schedule, TrainSummary};
 pub use training::validation::validation_loss;

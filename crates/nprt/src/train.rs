@@ -6,7 +6,7 @@ use anyhow::{Context, Result};
 use nprt_net::network::encoder::check_input_width;
 use nprt_net::training::training_set::{TrainingSet, ViewSamples};
 use nprt_net::{
-    Activation, Calibration, Design, Device, DirectLight, Loss, MapNorm, ModelConfig,
+    Activation, Calibration, Design, Device, DirectLight, Gather, Loss, MapNorm, ModelConfig,
     PositionEncoding, TrainOptions, DEFAULT_ENCODER_WIDTH, DEFAULT_MAP_NORM,
 };
 
@@ -94,6 +94,12 @@ pub struct TrainArgs {
     /// Minutes between checkpoints within an epoch (one is always written at an epoch's end).
     #[arg(long, default_value_t = d().schedule.checkpoint_secs / 60.0)]
     checkpoint_minutes: f64,
+    /// With --device wgpu, where batches are gathered: device (the dataset's records, 40 bytes
+    /// a pixel, and maps are uploaded once, and each step gathers its batch there from the
+    /// picked samples) or host (each batch is gathered here and uploaded, for a dataset the
+    /// GPU has no room for). The batches are the same either way.
+    #[arg(long, default_value_t = d().gather)]
+    gather: Gather,
     #[command(flatten)]
     device: DeviceArg,
 }
@@ -128,6 +134,7 @@ impl TryFrom<TrainArgs> for TrainJob {
             val_samples: a.val_samples,
             loss: a.loss,
             calibration: a.calibrate,
+            gather: a.gather,
         }
         .with_run(a.arch, a.run.into(), a.lr);
         opts.check().context("bad training options")?;

@@ -45,6 +45,7 @@ pub fn measure_throughput(
             .collect(),
         lights: random(views * 3 * w * w / 2, 1.0),
         light_width: w,
+        picks: None,
     };
     #[cfg(feature = "kernels")]
     if crate::device::Backend::of(&device) == crate::device::Backend::Wgpu {

@@ -15,7 +15,8 @@ use std::sync::Arc;
 use anyhow::{anyhow, Context, Result};
 use safetensors::{tensor::TensorView, Dtype, SafeTensors};
 
-use super::kernels::ADAM;
+use super::device_dataset::DeviceDataset;
+use super::kernels::{ADAM, GATHER_SAMPLES};
 use super::network_layout::NetworkLayout;
 use super::parameters::ParameterLayout;
 use super::{groups_for, Dispatch, GpuDevice};
@@ -58,6 +59,40 @@ pub struct GpuTrainer {
     loss_copies: [wgpu::Buffer; 2],
     /// The last queued step whose loss has not been read.
     pending: Option<PendingLoss>,
+    /// The training set, where the device holds it: steps then gather their batches.
+    dataset: Option<DeviceDataset>,
+}
+
+/// Where a step's batch comes from.
+#[derive(Clone, Copy)]
+enum Inputs<'a> {
+    /// Gathered on the host.
+    Host(&'a Samples<'a>),
+    /// Picked on the host, gathered from the dataset on the device (see
+    /// [`GpuTrainer::queue_picked_step`]).
+    Picked {
+        records: &'a [u32],
+        views: &'a [u32],
+        light_width: usize,
+    },
+}
+
+impl Inputs<'_> {
+    /// Rows, views and the maps' width.
+    fn shape(&self) -> (usize, usize, usize) {
+        match *self {
+            Inputs::Host(b) => (
+                b.len(),
+                b.lights.len() / (3 * b.light_width * b.light_width / 2),
+                b.light_width,
+            ),
+            Inputs::Picked {
+                records,
+                views,
+                light_width,
+            } => (records.len() / 2, views.len(), light_width),
+        }
+    }
 }
 
 /// A queued step's loss on its way back: its copy, its submission and its batch's rows.
@@ -75,6 +110,8 @@ struct StepPlan {
     dispatches: Vec<Dispatch>,
     /// How many of the dispatches make the loss (the forward passes); the rest are backward.
     forward: usize,
+    /// With a dataset on the device: the batch's gather, one dispatch per shard of records.
+    gathers: Vec<Dispatch>,
 }
 
 /// Batch shapes whose plans are kept.
@@ -106,6 +143,9 @@ pub(super) struct BatchBuffers {
     pub d_codes: wgpu::Buffer,
     pub row_loss: wgpu::Buffer,
     pub loss: wgpu::Buffer,
+    /// A picked batch's records and views (u32; see [`GpuTrainer::queue_picked_step`]).
+    pub picks: wgpu::Buffer,
+    pub batch_views: wgpu::Buffer,
 }
 
 /// The parameter block of `adam.wgsl` for step `t` (from 1) at learning rate `lr`, over
@@ -160,6 +200,7 @@ impl GpuTrainer {
         Ok(GpuTrainer {
             loss_copies: [loss_copy(), loss_copy()],
             pending: None,
+            dataset: None,
             params,
             grads,
             moment1,
@@ -197,7 +238,7 @@ impl GpuTrainer {
     /// ([`Self::gradients`] reads them): one submission of the encoder's and the transport
     /// networks' forward and backward passes. Reading the loss back waits for it.
     pub fn backward(&mut self, batch: &Samples, loss: Loss) -> f64 {
-        self.queue(batch, loss, Pass::Backward);
+        self.queue(Inputs::Host(batch), loss, Pass::Backward);
         self.finish().expect("a step was queued")
     }
 
@@ -212,7 +253,33 @@ impl GpuTrainer {
     /// the first), read back while this one runs: the host waits for a step only once the
     /// device has the next, so the device does not idle while the host writes a batch.
     pub fn queue_step(&mut self, batch: &Samples, loss: Loss, lr: f64) -> Option<f64> {
-        self.queue(batch, loss, Pass::Step(lr))
+        self.queue(Inputs::Host(batch), loss, Pass::Step(lr))
+    }
+
+    /// Holds `dataset` on the device from now on, for [`Self::queue_picked_step`].
+    pub fn hold(&mut self, dataset: DeviceDataset) {
+        self.dataset = Some(dataset);
+        self.plans.clear();
+    }
+
+    /// [`Self::queue_step`] on a batch gathered on the device from the dataset it holds
+    /// ([`Self::hold`]): `records` holds each sample's record index in the pack and its view
+    /// within the batch, `views` each of the batch's views' index among the training views.
+    pub fn queue_picked_step(
+        &mut self,
+        records: &[u32],
+        views: &[u32],
+        light_width: usize,
+        loss: Loss,
+        lr: f64,
+    ) -> Option<f64> {
+        assert!(self.dataset.is_some(), "no dataset is held on the device");
+        let inputs = Inputs::Picked {
+            records,
+            views,
+            light_width,
+        };
+        self.queue(inputs, loss, Pass::Step(lr))
     }
 
     /// The loss of the last queued step, once it is done (None if every loss was read).
@@ -238,12 +305,12 @@ impl GpuTrainer {
     /// The mean `loss` of `batch` under the current parameters, waiting for it: the forward
     /// passes alone (validation).
     pub fn loss(&mut self, batch: &Samples, loss: Loss) -> f64 {
-        self.queue(batch, loss, Pass::Forward);
+        self.queue(Inputs::Host(batch), loss, Pass::Forward);
         self.finish().expect("a pass was queued")
     }
 
-    fn queue(&mut self, batch: &Samples, loss: Loss, pass: Pass) -> Option<f64> {
-        self.prepare(batch, loss);
+    fn queue(&mut self, inputs: Inputs, loss: Loss, pass: Pass) -> Option<f64> {
+        self.prepare(inputs, loss);
         if let Pass::Step(lr) = pass {
             self.steps += 1;
             let params = adam_params(self.layout.total, lr, self.steps);
@@ -254,8 +321,19 @@ impl GpuTrainer {
         let mut encoder = self.gpu.device.create_command_encoder(&Default::default());
         // Every gradient is written whole each step; only the codes' is added to, per track.
         encoder.clear_buffer(&plan.batch.d_codes, 0, None);
+        let picked = matches!(inputs, Inputs::Picked { .. });
+        if let (Inputs::Picked { views, .. }, Some(dataset)) = (inputs, &self.dataset) {
+            let size = (dataset.light_floats * 4) as u64;
+            for (k, &v) in views.iter().enumerate() {
+                let (from, to) = (v as u64 * size, k as u64 * size);
+                encoder.copy_buffer_to_buffer(&dataset.lights, from, &plan.batch.lights, to, size);
+            }
+        }
         {
             let mut compute = encoder.begin_compute_pass(&Default::default());
+            if picked {
+                plan.gathers.iter().for_each(|d| d.record(&mut compute));
+            }
             let dispatches = match pass {
                 Pass::Forward => &plan.dispatches[..plan.forward],
                 _ => &plan.dispatches[..],
@@ -277,14 +355,13 @@ impl GpuTrainer {
         before
     }
 
-    /// Makes the step's plan for `batch`'s shape and `loss` the last of the kept plans (made
-    /// unless one fits), and writes the batch into its buffers.
-    fn prepare(&mut self, batch: &Samples, loss: Loss) {
-        let views = batch.lights.len() / (3 * batch.light_width * batch.light_width / 2);
+    /// Makes the plan for `inputs`' shape and `loss` the last of the kept plans (made unless
+    /// one fits), and writes the batch (or its picks) into its buffers.
+    fn prepare(&mut self, inputs: Inputs, loss: Loss) {
+        let (rows, views, light_width) = inputs.shape();
         let fits = self.plans.iter().position(|p| {
             let b = &p.batch;
-            p.loss == loss
-                && (b.rows, b.views, b.light_width) == (batch.len(), views, batch.light_width)
+            p.loss == loss && (b.rows, b.views, b.light_width) == (rows, views, light_width)
         });
         let plan = match fits {
             Some(i) => self.plans.remove(i),
@@ -292,13 +369,14 @@ impl GpuTrainer {
                 if self.plans.len() == PLANS {
                     self.plans.remove(0);
                 }
-                let b = self.batch_buffers(batch.len(), views, batch.light_width);
+                let b = self.batch_buffers(rows, views, light_width);
                 let mut dispatches = Vec::new();
                 let tape = self.encoder_forward(&mut dispatches, &b);
                 let forward = self.record_transport(&mut dispatches, &b, loss);
                 self.encoder_backward(&mut dispatches, &b, &tape);
                 StepPlan {
                     loss,
+                    gathers: self.gathers(&b),
                     batch: b,
                     dispatches,
                     forward,
@@ -307,12 +385,51 @@ impl GpuTrainer {
         };
         self.plans.push(plan);
         let b = &self.plans.last().expect("made above").batch;
-        let view: Vec<u32> = batch.view.iter().map(|&v| v as u32).collect();
-        self.gpu.write(&b.lights, batch.lights);
-        self.gpu.write(&b.features, batch.features);
-        self.gpu.write(&b.radiance, batch.radiance);
-        self.gpu.write(&b.scale, batch.scale);
-        self.gpu.write(&b.view, &view);
+        match inputs {
+            Inputs::Host(batch) => {
+                let view: Vec<u32> = batch.view.iter().map(|&v| v as u32).collect();
+                self.gpu.write(&b.lights, batch.lights);
+                self.gpu.write(&b.features, batch.features);
+                self.gpu.write(&b.radiance, batch.radiance);
+                self.gpu.write(&b.scale, batch.scale);
+                self.gpu.write(&b.view, &view);
+            }
+            Inputs::Picked { records, views, .. } => {
+                self.gpu.write(&b.picks, records);
+                self.gpu.write(&b.batch_views, views);
+            }
+        }
+    }
+
+    /// The dispatches that gather a picked batch into `b` from the dataset the device holds
+    /// (none without one).
+    fn gathers(&self, b: &BatchBuffers) -> Vec<Dispatch> {
+        let Some(dataset) = &self.dataset else {
+            return Vec::new();
+        };
+        dataset
+            .shards
+            .iter()
+            .map(|shard| {
+                let mut params = vec![b.rows as u32, shard.first, shard.count, 0];
+                params.extend(dataset.bounds.map(f32::to_bits));
+                self.gpu.prepare(
+                    &GATHER_SAMPLES,
+                    &params,
+                    &[
+                        &shard.records,
+                        &b.picks,
+                        &b.batch_views,
+                        &dataset.scales,
+                        &b.features,
+                        &b.radiance,
+                        &b.scale,
+                        &b.view,
+                    ],
+                    groups_for(b.rows),
+                )
+            })
+            .collect()
     }
 
     /// Writes Adam's state (both moments, flat, and the step count) to `path` as safetensors.
@@ -386,6 +503,8 @@ impl GpuTrainer {
             d_codes: gpu.buffer(views * CODE_SIZE),
             row_loss: gpu.buffer(rows),
             loss: gpu.buffer(1),
+            picks: gpu.buffer(2 * rows),
+            batch_views: gpu.buffer(views),
         }
     }
 }

@@ -6,11 +6,12 @@ use std::path::Path;
 
 use anyhow::Result;
 
-use super::GpuTrainer;
+use super::{DeviceDataset, GpuTrainer};
 use crate::network::nprt_net::NprtNet;
 use crate::training::batch::Batch;
 use crate::training::loss::Loss;
 use crate::training::optimiser::DeviceSteps;
+use crate::training::training_set::TrainingSet;
 
 pub struct KernelSteps {
     trainer: GpuTrainer,
@@ -20,10 +21,15 @@ pub struct KernelSteps {
 }
 
 impl KernelSteps {
-    /// Uploads `net`'s weights; steps minimise `loss`.
-    pub fn new(net: &NprtNet, loss: Loss) -> Result<Self> {
+    /// Uploads `net`'s weights, and `dataset` where given (steps then take picked batches,
+    /// [`Batch::picked`]); steps minimise `loss`.
+    pub fn new(net: &NprtNet, loss: Loss, dataset: Option<&TrainingSet>) -> Result<Self> {
+        let mut trainer = GpuTrainer::new(net)?;
+        if let Some(set) = dataset {
+            trainer.hold(DeviceDataset::upload(&trainer.gpu, set)?);
+        }
         Ok(KernelSteps {
-            trainer: GpuTrainer::new(net)?,
+            trainer,
             loss,
             samples: Default::default(),
         })
@@ -33,7 +39,16 @@ impl KernelSteps {
 impl DeviceSteps<NprtNet, Batch> for KernelSteps {
     fn step(&mut self, batch: &Batch, lr: f64) -> Result<Option<(f64, u64)>> {
         self.samples.push_back(batch.len() as u64);
-        let before = self.trainer.queue_step(&batch.samples(), self.loss, lr);
+        let before = match &batch.picks {
+            Some(p) => self.trainer.queue_picked_step(
+                &p.records,
+                &p.views,
+                batch.light_width,
+                self.loss,
+                lr,
+            ),
+            None => self.trainer.queue_step(&batch.samples(), self.loss, lr),
+        };
         Ok(before.map(|loss| (loss, self.samples.pop_front().expect("queued"))))
     }
 

@@ -30,6 +30,7 @@ pub const ACTIVATION_BACKWARD: KernelSource = kernel!("activation_backward");
 pub const COMBINE: KernelSource = kernel!("combine", "track_radiance");
 pub const RADIANCE_LOSS: KernelSource = kernel!("radiance_loss", "track_radiance");
 pub const ADAM: KernelSource = kernel!("adam");
+pub const GATHER_SAMPLES: KernelSource = kernel!("gather_samples");
 
 /// Rows and columns of the tile a `gemm` workgroup computes.
 pub const GEMM_TILE: u32 = 64;

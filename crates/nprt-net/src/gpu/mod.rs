@@ -7,6 +7,7 @@
 //! engine reads them.
 
 mod codes;
+mod device_dataset;
 mod encoder_step;
 mod gpu_buffer;
 mod gpu_device;
@@ -20,6 +21,7 @@ mod products;
 mod transport_step;
 
 pub use codes::{activation_code, kind_code, loss_code};
+pub use device_dataset::DeviceDataset;
 pub use gpu_device::GpuDevice;
 pub use gpu_trainer::GpuTrainer;
 pub use kernel::{groups_for, Bind, Dispatch, KernelSource, Part, GROUP};

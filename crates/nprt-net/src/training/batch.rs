@@ -19,7 +19,8 @@ pub enum Engine {
     Autodiff,
 }
 
-/// Samples drawn from several views, and those views' maps.
+/// Samples drawn from several views, and those views' maps: gathered on the host, or only
+/// picked, for a device that holds the dataset to gather.
 pub struct Batch {
     pub features: Vec<f32>,
     pub radiance: Vec<f32>,
@@ -31,6 +32,16 @@ pub struct Batch {
     pub lights: Vec<f32>,
     /// W of the maps.
     pub light_width: usize,
+    /// What a device holding the dataset gathers (the host's inputs above are then empty).
+    pub picks: Option<Picks>,
+}
+
+/// A batch's samples by where they lie in the dataset.
+pub struct Picks {
+    /// Per sample: its record's index in the pack, and its view within the batch.
+    pub records: Vec<u32>,
+    /// Per view of the batch: its index among the training views.
+    pub views: Vec<u32>,
 }
 
 impl Batch {
@@ -46,6 +57,7 @@ impl Batch {
                 .flat_map(|v| v.light.pixels.iter().copied())
                 .collect(),
             light_width: views.first().map_or(0, |v| v.light.width),
+            picks: None,
         };
         for &(v, p) in samples {
             let view = views[v as usize];
@@ -56,6 +68,27 @@ impl Batch {
             b.scale.extend_from_slice(&view.light.scale);
         }
         b
+    }
+
+    /// Picks `samples` ((view position in `views`, pixel) pairs) from `views`, the training
+    /// views numbered `train` (in the same order), for a device that holds the dataset.
+    pub fn picked(train: &[usize], views: &[&ViewSamples], samples: &[(u32, u32)]) -> Self {
+        let records = samples
+            .iter()
+            .flat_map(|&(v, p)| [(views[v as usize].first_record() + p as u64) as u32, v])
+            .collect();
+        Batch {
+            features: Vec::new(),
+            radiance: Vec::new(),
+            view: samples.iter().map(|&(v, _)| v as i64).collect(),
+            scale: Vec::new(),
+            lights: Vec::new(),
+            light_width: views.first().map_or(0, |v| v.light.width),
+            picks: Some(Picks {
+                records,
+                views: train.iter().map(|&t| t as u32).collect(),
+            }),
+        }
     }
 
     /// Batches of at most `batch_size` over a fixed, evenly strided subset of at most

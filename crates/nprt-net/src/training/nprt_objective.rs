@@ -7,6 +7,7 @@
 //! `loss.png` and `checkpoint/`.
 
 use std::path::Path;
+use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Mutex;
 
 use anyhow::{Context, Result};
@@ -25,7 +26,7 @@ use crate::training::checkpoint::RunState;
 use crate::training::epoch_plan::{group_batches, EpochPlan};
 #[cfg(feature = "kernels")]
 use crate::training::optimiser::DeviceSteps;
-use crate::training::train_options::TrainOptions;
+use crate::training::train_options::{Gather, TrainOptions};
 use crate::training::training_loop::{self, Objective, Schedule, TrainSummary, ADAM_EPSILON};
 use crate::training::training_set::{TrainingSet, ViewSamples};
 use crate::training::validation::{forward_log_l1, validation_loss};
@@ -39,6 +40,8 @@ struct PixelObjective<'a> {
     saved: Mutex<Option<ModelFile>>,
     /// Whether the steps run on our own GPU kernels (`--device wgpu`).
     kernels: bool,
+    /// Whether those kernels hold the dataset, so that batches are only picked on the host.
+    resident: AtomicBool,
 }
 
 impl Objective for PixelObjective<'_> {
@@ -100,7 +103,10 @@ impl Objective for PixelObjective<'_> {
                 batches
                     .into_iter()
                     .skip(from.saturating_sub(start))
-                    .map(move |samples| Batch::gather(&views.0, &samples))
+                    .map(move |samples| match self.resident.load(Ordering::Relaxed) {
+                        true => Batch::picked(&group, &views.0, &samples),
+                        false => Batch::gather(&views.0, &samples),
+                    })
             })
     }
 
@@ -119,7 +125,10 @@ impl Objective for PixelObjective<'_> {
         if !self.kernels {
             return Ok(None);
         }
-        let steps = crate::gpu::KernelSteps::new(net, self.opts.loss)?;
+        let resident = self.opts.gather == Gather::Device;
+        let dataset = resident.then_some(self.set);
+        let steps = crate::gpu::KernelSteps::new(net, self.opts.loss, dataset)?;
+        self.resident.store(resident, Ordering::Relaxed);
         Ok(Some(Box::new(steps)))
     }
 
@@ -206,8 +215,8 @@ pub fn train(
     device: &Device,
 ) -> Result<(TrainSummary, ModelFile)> {
     opts.check()?;
-    // On wgpu the steps run on our own kernels, with the network's host copy (for validation
-    // and saving) on the CPU.
+    // On wgpu the steps run on our own kernels, with the network's host copy (for saving) on
+    // the CPU.
     let kernels = cfg!(feature = "kernels") && Backend::of(device) == Backend::Wgpu;
     let objective = PixelObjective {
         set,
@@ -215,6 +224,7 @@ pub fn train(
         opts,
         saved: Mutex::new(None),
         kernels,
+        resident: AtomicBool::new(false),
     };
     let device = if kernels {
         Device::flex()

@@ -4,6 +4,7 @@
 use anyhow::{bail, Result};
 use serde::{Deserialize, Serialize};
 
+use crate::choice::named_choice;
 use crate::network::design::Design;
 use crate::training::calibration::Calibration;
 use crate::training::loss::Loss;
@@ -27,7 +28,27 @@ pub struct TrainOptions {
     /// leaves training itself alone, so it is not part of the run's key.
     #[serde(default)]
     pub calibration: Calibration,
+    /// Where the batches of steps on our own GPU kernels are gathered; the same batches
+    /// either way, so not part of the run's key.
+    #[serde(default)]
+    pub gather: Gather,
 }
+
+/// Where a GPU step's batches are gathered.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Gather {
+    /// The dataset is uploaded once and each step gathers its batch there from the picks.
+    #[default]
+    Device,
+    /// Batches are gathered on the host and uploaded each step (for datasets the device has no
+    /// room for).
+    Host,
+}
+
+named_choice!(Gather, "gather", {
+    Device => "device",
+    Host => "host",
+});
 
 impl Default for TrainOptions {
     fn default() -> Self {
@@ -42,6 +63,7 @@ impl Default for TrainOptions {
             val_samples: 65_536,
             loss: Loss::LogL1,
             calibration: Calibration::None,
+            gather: Gather::Device,
         }
     }
 }

@@ -41,6 +41,11 @@ impl ViewSamples {
         self.pack.view(self.view)
     }
 
+    /// The index in the pack of the view's first record (its pixel p's is this plus p).
+    pub fn first_record(&self) -> u64 {
+        self.pack.header().views[self.view][0]
+    }
+
     /// Pixel `p`'s 19 network inputs and the radiance the network learns there.
     pub fn sample(&self, p: usize) -> ([f32; FEATURES], [f32; 3]) {
         let bounds = &self.pack.header().bounds;

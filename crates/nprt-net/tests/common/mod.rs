@@ -80,6 +80,7 @@ pub fn random_batch(n: usize, views: usize, seed: u64) -> Batch {
         scale: r(0.5, 1.5, n * 3),
         lights: r(0.0, 2.0, views * 3 * w * w / 2),
         light_width: w,
+        picks: None,
     }
 }
 
