@@ -58,6 +58,9 @@ pub struct Pixels {
     transfer: Option<TransferCodes>,
     #[cfg(feature = "wgpu")]
     gpu: Option<crate::gpu::GpuPixels>,
+    /// A G-buffer that stayed on the device (every pixel then has a row) and its camera.
+    #[cfg(feature = "wgpu")]
+    gbuffer: Option<(wgpu::Buffer, Camera)>,
 }
 
 /// How a frame's direct light is traced, for a model that leaves it to the tracer.
@@ -263,6 +266,12 @@ impl Relighter {
         };
         let (g, px) = match cache.still.take() {
             Some((c, g, px)) if c == *camera => (g, px),
+            #[cfg(feature = "wgpu")]
+            _ if self.frames_on_device() => {
+                let (px, gbuffer_ms, network_ms) = self.device_pixels(ts, camera)?;
+                (t.gbuffer_ms, t.network_ms) = (gbuffer_ms, network_ms);
+                (GBuffer::default(), px)
+            }
             _ => {
                 let clock = Instant::now();
                 let g = self.gbuffer(ts, camera)?;
@@ -273,18 +282,22 @@ impl Relighter {
                 (g, px)
             }
         };
+        let placed = map.rotated_y(rotation_deg);
+        #[cfg(feature = "wgpu")]
+        if px.gbuffer.is_some() {
+            // The whole frame on the device: the networks, then the background.
+            let clock = Instant::now();
+            let rgb = self.device_frame(&px, &code, &placed);
+            t.network_ms += ms(clock);
+            cache.light = Some((key, code));
+            cache.still = Some((camera.clone(), g, px));
+            return Ok((rgb, t));
+        }
         let clock = Instant::now();
         let mut rgb = self.relight(&px, &code);
         t.network_ms += ms(clock);
         let clock = Instant::now();
-        self.complete(
-            ts,
-            camera,
-            &map.rotated_y(rotation_deg),
-            &g,
-            sampling,
-            &mut rgb,
-        )?;
+        self.complete(ts, camera, &placed, &g, sampling, &mut rgb)?;
         t.direct_ms = ms(clock);
         cache.light = Some((key, code));
         cache.still = Some((camera.clone(), g, px));
@@ -296,21 +309,83 @@ impl Relighter {
     pub fn gbuffer(&self, ts: &TraceScene, camera: &Camera) -> Result<GBuffer> {
         #[cfg(feature = "wgpu")]
         if self.gpu.is_some() {
-            let key = std::ptr::from_ref(ts.scene) as usize;
-            let raster = {
-                let mut kept = self.raster.lock().unwrap_or_else(|e| e.into_inner());
-                match &*kept {
-                    Some((k, r)) if *k == key => r.clone(),
-                    _ => {
-                        let r = std::sync::Arc::new(crate::gpu::RasterGBuffer::new(ts.scene)?);
-                        *kept = Some((key, r.clone()));
-                        r
-                    }
-                }
-            };
-            return Ok(raster.render(camera));
+            return Ok(self.raster(ts)?.render(camera));
         }
         Ok(render_gbuffer(ts, camera))
+    }
+
+    /// The scene on the device, uploaded unless it was the last frame's.
+    #[cfg(feature = "wgpu")]
+    fn raster(&self, ts: &TraceScene) -> Result<std::sync::Arc<crate::gpu::RasterGBuffer>> {
+        let key = std::ptr::from_ref(ts.scene) as usize;
+        let mut kept = self.raster.lock().unwrap_or_else(|e| e.into_inner());
+        if let Some((k, r)) = &*kept {
+            if *k == key {
+                return Ok(r.clone());
+            }
+        }
+        let r = std::sync::Arc::new(crate::gpu::RasterGBuffer::new(ts.scene)?);
+        *kept = Some((key, r.clone()));
+        Ok(r)
+    }
+
+    /// Whether frames stay on the device from the G-buffer to the finished frame: on the
+    /// kernels, for a model whose networks give all the light (traced direct light and its
+    /// denoiser run on the host, from a G-buffer read back).
+    #[cfg(feature = "wgpu")]
+    fn frames_on_device(&self) -> bool {
+        self.gpu.is_some() && !self.traces_direct()
+    }
+
+    /// A camera's pixels with the G-buffer left on the device: rasterised, then every pixel's
+    /// inputs and the light-independent networks; with the milliseconds of each (the queue
+    /// waited for after each, so that the stages can be told apart).
+    #[cfg(feature = "wgpu")]
+    fn device_pixels(&self, ts: &TraceScene, camera: &Camera) -> Result<(Pixels, f64, f64)> {
+        let gpu = self
+            .gpu
+            .as_ref()
+            .expect("frames on the device have the kernels");
+        let device = crate::gpu::GpuDevice::get()?;
+        let ms = |t: Instant| t.elapsed().as_secs_f64() * 1e3;
+        let raster = self.raster(ts)?;
+        let clock = Instant::now();
+        let samples = raster.samples(camera);
+        device.wait();
+        let gbuffer_ms = ms(clock);
+        let clock = Instant::now();
+        let count = (camera.width * camera.height) as usize;
+        let pixels = gpu.pixels_of_gbuffer(&samples, count, &self.file.bounds);
+        device.wait();
+        let px = Pixels {
+            count,
+            foreground: (0..count).collect(),
+            features: Vec::new(),
+            transfer: None,
+            gpu: Some(pixels),
+            gbuffer: Some((samples, camera.clone())),
+        };
+        Ok((px, gbuffer_ms, ms(clock)))
+    }
+
+    /// The finished frame of pixels whose G-buffer stayed on the device, under `light` and
+    /// with `map` (as placed in the world) behind: made there, read back once.
+    #[cfg(feature = "wgpu")]
+    fn device_frame(&self, px: &Pixels, light: &LightCode, map: &EnvMap) -> Vec<Vec3> {
+        let (Some(gpu), Some(pixels), Some((samples, camera))) = (&self.gpu, &px.gpu, &px.gbuffer)
+        else {
+            unreachable!("a device frame's pixels are on the device");
+        };
+        let background = crate::gpu::Background {
+            samples,
+            camera,
+            map: Some(map),
+        };
+        let code = nprt_net::host_values(light.code.clone().into_data());
+        gpu.radiance(pixels, &code, light.scale, Some(&background))
+            .chunks_exact(3)
+            .map(Vec3::from_slice)
+            .collect()
     }
 
     /// Encodes `map` rotated by `rotation_deg` about +Y.
@@ -360,6 +435,8 @@ impl Relighter {
             foreground,
             #[cfg(feature = "wgpu")]
             gpu: self.gpu.as_ref().map(|gpu| gpu.pixels(&features)),
+            #[cfg(feature = "wgpu")]
+            gbuffer: None,
             features,
             transfer,
         }
@@ -396,7 +473,16 @@ impl Relighter {
         #[cfg(feature = "wgpu")]
         if let (Some(gpu), Some(pixels)) = (&self.gpu, &px.gpu) {
             let code = nprt_net::host_values(light.code.clone().into_data());
-            return gpu.radiance(pixels, &code, light.scale);
+            // A G-buffer on the device gives every pixel a row: the background's are zeroed.
+            let background = px
+                .gbuffer
+                .as_ref()
+                .map(|(samples, camera)| crate::gpu::Background {
+                    samples,
+                    camera,
+                    map: None,
+                });
+            return gpu.radiance(pixels, &code, light.scale, background.as_ref());
         }
         self.burn_radiance(&px.features, light)
     }

@@ -52,7 +52,8 @@ impl DeviceDataset {
             );
         }
         let limits = gpu.device.limits();
-        let per_shard = limits.max_storage_buffer_binding_size
+        let per_shard = limits
+            .max_storage_buffer_binding_size
             .min(limits.max_buffer_size)
             .div_euclid(PACKED_PIXEL_BYTES as u64) as usize;
         let light_floats = set.train.first().map_or(0, |v| v.light.pixels.len());

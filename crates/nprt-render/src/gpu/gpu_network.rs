@@ -6,6 +6,7 @@
 use std::sync::Arc;
 
 use anyhow::Result;
+use glam::Vec3;
 use nprt_net::cpu::{DenseStack, HostEncoder, HostTransport};
 use nprt_net::encoding::hash_grid;
 use nprt_net::network::encoder::{BLOCKS, CHANNELS, CODE_SIZE};
@@ -16,6 +17,9 @@ use nprt_net::gpu::{groups_for, GpuDevice};
 use nprt_net::gpu::{Bias, Operand, Output};
 
 use nprt_net::gpu::kernels::{COMBINE, ENCODER_BLOCK, TRACK_INPUTS};
+
+use super::frame_background::{Background, GpuMap};
+use super::kernels::FRAME_FEATURES;
 use nprt_net::gpu::{activation_code, kind_code};
 
 /// Rows per block of dispatches: a block's widest activations (256 f32 per row, 64 MiB) stay
@@ -57,12 +61,16 @@ pub struct GpuNetwork {
     to_code: GpuDense,
     tracks: Vec<GpuTrack>,
     resolutions: wgpu::Buffer,
+    /// The last map a frame's background came from.
+    map: GpuMap,
 }
 
 /// A camera's foreground pixels on the device and what of the network does not depend on the
 /// lighting, with the buffers a lighting change reuses.
 pub struct GpuPixels {
-    rows: usize,
+    /// Rows the networks run on: the foreground pixels, or every pixel of a G-buffer on the
+    /// device (see [`GpuNetwork::pixels_of_gbuffer`]).
+    pub rows: usize,
     chunks: Vec<PixelChunk>,
     /// Ping-pong activations and each track's shading outputs, for the largest chunk.
     scratch: [wgpu::Buffer; 2],
@@ -123,6 +131,7 @@ impl GpuNetwork {
             to_code: dense(&encoder.to_code),
             tracks,
             resolutions: gpu.upload(&hash_grid::resolutions()),
+            map: GpuMap::default(),
             gpu,
         })
     }
@@ -176,8 +185,52 @@ impl GpuNetwork {
     /// Uploads the network inputs of a camera's foreground pixels (`rows × FEATURES`) and runs
     /// what does not depend on the lighting.
     pub fn pixels(&self, features: &[f32]) -> GpuPixels {
-        let gpu = &*self.gpu;
         let rows = features.len() / FEATURES;
+        self.pixels_with(rows, |_, first, n| {
+            self.gpu
+                .upload(&features[first * FEATURES..(first + n) * FEATURES])
+        })
+    }
+
+    /// [`Self::pixels`] of every pixel of a G-buffer on the device (`pixels` samples of
+    /// `RasterGBuffer::samples`), their inputs made there with the model's `bounds`; a
+    /// background pixel's row runs too, on zero inputs, and the frame's background replaces
+    /// it.
+    pub fn pixels_of_gbuffer(
+        &self,
+        samples: &wgpu::Buffer,
+        pixels: usize,
+        bounds: &[[f32; 3]; 2],
+    ) -> GpuPixels {
+        let (lo, hi) = (Vec3::from(bounds[0]), Vec3::from(bounds[1]));
+        let extent = (hi - lo).max(Vec3::splat(1e-6));
+        self.pixels_with(pixels, |pass, first, n| {
+            let features = self.gpu.buffer(n * FEATURES);
+            let mut params = vec![n as u32, first as u32, 0, 0];
+            params.extend(
+                [lo.extend(0.0), extent.extend(0.0)]
+                    .iter()
+                    .flat_map(|v| v.to_array().map(f32::to_bits)),
+            );
+            self.gpu.dispatch(
+                pass,
+                &FRAME_FEATURES,
+                &params,
+                &[samples, &features],
+                groups_for(n),
+            );
+            features
+        })
+    }
+
+    /// Runs what does not depend on the lighting over `rows` rows, in blocks of [`CHUNK`]
+    /// whose inputs `inputs(pass, first row, rows)` makes.
+    fn pixels_with(
+        &self,
+        rows: usize,
+        mut inputs: impl FnMut(&mut wgpu::ComputePass, usize, usize) -> wgpu::Buffer,
+    ) -> GpuPixels {
+        let gpu = &*self.gpu;
         let largest = rows.clamp(1, CHUNK);
         let widest = self
             .tracks
@@ -201,9 +254,9 @@ impl GpuNetwork {
         let mut chunks = Vec::new();
         {
             let mut pass = encoder.begin_compute_pass(&Default::default());
-            for (k, f) in features.chunks(CHUNK * FEATURES).enumerate() {
-                let n = f.len() / FEATURES;
-                let features = gpu.upload(f);
+            for first in (0..rows).step_by(CHUNK) {
+                let n = CHUNK.min(rows - first);
+                let features = inputs(&mut pass, first, n);
                 let kept = self
                     .tracks
                     .iter()
@@ -234,7 +287,7 @@ impl GpuNetwork {
                     })
                     .collect();
                 chunks.push(PixelChunk {
-                    first: k * CHUNK,
+                    first,
                     rows: n,
                     features,
                     kept,
@@ -271,8 +324,16 @@ impl GpuNetwork {
     }
 
     /// Radiance (`rows × 3`) of `px` under the light `code`, each channel multiplied by
-    /// `scale` (the map's normalisation times the model's level gain).
-    pub fn radiance(&self, px: &GpuPixels, code: &[f32], scale: [f32; 3]) -> Vec<f32> {
+    /// `scale` (the map's normalisation times the model's level gain); with `background`
+    /// (pixels of a G-buffer on the device, [`Self::pixels_of_gbuffer`]), the frame's
+    /// background filled in.
+    pub fn radiance(
+        &self,
+        px: &GpuPixels,
+        code: &[f32],
+        scale: [f32; 3],
+        background: Option<&Background>,
+    ) -> Vec<f32> {
         if px.rows == 0 {
             return Vec::new();
         }
@@ -360,6 +421,9 @@ impl GpuNetwork {
                     &[&chunk.features, &px.outputs[0], out1, &px.rgb],
                     groups_for(chunk.rows),
                 );
+            }
+            if let Some(b) = background {
+                self.map.record(gpu, &mut pass, b, &px.rgb);
             }
         }
         gpu.queue.submit([encoder.finish()]);

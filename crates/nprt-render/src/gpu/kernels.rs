@@ -7,3 +7,9 @@ use nprt_net::gpu::KernelSource;
 
 /// Every kernel of the frame path, in the order a frame first uses them.
 pub const SOURCES: [&KernelSource; 4] = [&ENCODER_BLOCK, &TRACK_INPUTS, &GEMM, &COMBINE];
+
+/// The networks' inputs of a G-buffer on the device (the frame path's own; not exported).
+pub const FRAME_FEATURES: KernelSource = KernelSource {
+    name: "frame_features",
+    wgsl: include_str!("shaders/frame_features.wgsl"),
+};

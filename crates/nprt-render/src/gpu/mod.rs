@@ -10,12 +10,14 @@
 //! it must not own semantics of its own: materials are nprt-scene's, layouts, designs and the
 //! hash grid nprt-net's.
 
+mod frame_background;
 mod gpu_network;
 mod gpu_scene;
 mod kernels;
 mod raster_gbuffer;
 mod shader_export;
 
+pub use frame_background::Background;
 pub use gpu_network::{GpuNetwork, GpuPixels};
 pub use nprt_net::gpu::GpuDevice;
 pub use raster_gbuffer::RasterGBuffer;

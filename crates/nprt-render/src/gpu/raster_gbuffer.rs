@@ -17,11 +17,14 @@ use super::gpu_scene::GpuScene;
 /// The compute pass that turns kept triangles into G-buffer samples.
 pub const GBUFFER: KernelSource = KernelSource {
     name: "gbuffer",
-    wgsl: include_str!("shaders/gbuffer.wgsl"),
+    wgsl: concat!(
+        include_str!("shaders/camera_ray.wgsl"),
+        include_str!("shaders/gbuffer.wgsl")
+    ),
 };
 
 /// Floats per pixel of the resolved G-buffer: GSample's fields in order.
-const SAMPLE_FLOATS: usize = 17;
+pub const SAMPLE_FLOATS: usize = 17;
 
 /// The near plane, as a fraction of the scene's extent: the tracer sees everything in front
 /// of the camera, and a reversed f32 depth keeps its precision however near the plane is.
@@ -36,12 +39,11 @@ pub struct RasterGBuffer {
     targets: Mutex<Option<Targets>>,
 }
 
-/// What one frame size needs: the kept triangle per pixel, its depth, the resolved samples.
+/// What one frame size needs: the kept triangle per pixel and its depth.
 struct Targets {
     size: (u32, u32),
     visible: wgpu::Texture,
     depth: wgpu::TextureView,
-    samples: wgpu::Buffer,
 }
 
 /// A texture bound to a compute kernel (nprt-net's dispatch binds buffers and these).
@@ -101,8 +103,30 @@ impl RasterGBuffer {
         })
     }
 
-    /// The G-buffer of `camera`'s pixel centres.
+    /// The G-buffer of `camera`'s pixel centres, read back.
     pub fn render(&self, camera: &Camera) -> GBuffer {
+        let samples = self.samples(camera);
+        let pixels = (camera.width * camera.height) as usize;
+        let values = self.gpu.read(&samples, pixels * SAMPLE_FLOATS);
+        let mut g = GBuffer::default();
+        for s in values.chunks_exact(SAMPLE_FLOATS) {
+            let v = |k: usize| glam::Vec3::from_slice(&s[k..k + 3]);
+            g.push(GSample {
+                position: v(0),
+                normal: v(3),
+                view: v(6),
+                kd: v(9),
+                ks: v(12),
+                alpha: s[15],
+                mask: s[16],
+            });
+        }
+        g
+    }
+
+    /// The G-buffer of `camera`'s pixel centres on the device: GSample's fields, 17 f32 per
+    /// pixel in row order, in a buffer of its own (queued; later submissions may read it).
+    pub fn samples(&self, camera: &Camera) -> wgpu::Buffer {
         let gpu = &*self.gpu;
         let size = (camera.width, camera.height);
         let mut kept = self.targets.lock().unwrap_or_else(|e| e.into_inner());
@@ -136,6 +160,7 @@ impl RasterGBuffer {
             .collect::<Vec<_>>(),
         });
         let visible = TextureBinding(targets.visible.create_view(&Default::default()));
+        let samples = gpu.buffer((camera.width * camera.height) as usize * SAMPLE_FLOATS);
         let mut encoder = gpu.device.create_command_encoder(&Default::default());
         {
             let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
@@ -167,21 +192,8 @@ impl RasterGBuffer {
         }
         {
             let mut pass = encoder.begin_compute_pass(&Default::default());
-            let frame = camera.to_world;
-            let tx = camera.tan_half_x();
-            let ty = tx * camera.height as f32 / camera.width as f32;
             let mut params = vec![camera.width, camera.height, 0, 0];
-            params.extend(
-                [
-                    frame.x_axis,
-                    frame.y_axis,
-                    frame.z_axis,
-                    frame.w_axis,
-                    glam::Vec4::new(tx, ty, 0.0, 0.0),
-                ]
-                .iter()
-                .flat_map(|v| v.to_array().map(f32::to_bits)),
-            );
+            params.extend(camera_words(camera));
             gpu.dispatch(
                 &mut pass,
                 &GBUFFER,
@@ -194,29 +206,14 @@ impl RasterGBuffer {
                     &scene.materials,
                     &scene.textures,
                     &scene.texels,
-                    &targets.samples,
+                    &samples,
                 ],
                 [camera.width.div_ceil(8), camera.height.div_ceil(8)],
             );
         }
         gpu.queue.submit([encoder.finish()]);
-        let pixels = (camera.width * camera.height) as usize;
-        let values = gpu.read(&targets.samples, pixels * SAMPLE_FLOATS);
         *kept = Some(targets);
-        let mut g = GBuffer::default();
-        for s in values.chunks_exact(SAMPLE_FLOATS) {
-            let v = |k: usize| glam::Vec3::from_slice(&s[k..k + 3]);
-            g.push(GSample {
-                position: v(0),
-                normal: v(3),
-                view: v(6),
-                kd: v(9),
-                ks: v(12),
-                alpha: s[15],
-                mask: s[16],
-            });
-        }
-        g
+        samples
     }
 
     /// World to clip for `camera`: a point's pixel is where `camera.ray` through it would
@@ -263,9 +260,24 @@ impl RasterGBuffer {
             ),
             depth: texture(wgpu::TextureFormat::Depth32Float, attachment)
                 .create_view(&Default::default()),
-            samples: self
-                .gpu
-                .buffer(width as usize * height as usize * SAMPLE_FLOATS),
         }
     }
+}
+
+/// `camera` as `camera_ray.wgsl`'s kernels take it: its to_world's columns (x, y, z axes and
+/// the origin) and the tangents of its half field of view, five vec4s of f32 bits.
+pub fn camera_words(camera: &Camera) -> Vec<u32> {
+    let frame = camera.to_world;
+    let tx = camera.tan_half_x();
+    let ty = tx * camera.height as f32 / camera.width as f32;
+    [
+        frame.x_axis,
+        frame.y_axis,
+        frame.z_axis,
+        frame.w_axis,
+        glam::Vec4::new(tx, ty, 0.0, 0.0),
+    ]
+    .iter()
+    .flat_map(|v| v.to_array().map(f32::to_bits))
+    .collect()
 }

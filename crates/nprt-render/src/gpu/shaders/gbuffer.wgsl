@@ -3,7 +3,8 @@
 // then the surface point as nprt-trace's surface_point makes it (interpolated position and
 // normal, uv derivatives, two-sided flip, bump map) and the material's (kd, ks, α) as
 // BsdfParams::gbuffer records them. Writes GSample's fields, 17 f32 per pixel: position,
-// normal, ωo, kd, ks, α, mask; zeros on the background. Records: gpu_scene.rs.
+// normal, ωo, kd, ks, α, mask; zeros on the background. Records: gpu_scene.rs. After
+// camera_ray.wgsl.
 
 struct Params {
     width: u32,
@@ -191,10 +192,8 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
         return;
     }
     let tri = seen - 1u;
-    // Camera::ray through the pixel centre.
-    let s = (vec2<f32>(id.xy) + 0.5) / vec2<f32>(f32(params.width), f32(params.height));
-    let local = vec3<f32>((0.5 - s.x) * 2.0 * params.tangents.x, (0.5 - s.y) * 2.0 * params.tangents.y, 1.0);
-    let dir = normalize(params.x_axis.xyz * local.x + params.y_axis.xyz * local.y + params.z_axis.xyz * local.z);
+    let size = vec2<u32>(params.width, params.height);
+    let dir = camera_ray(id.xy, size, params.x_axis.xyz, params.y_axis.xyz, params.z_axis.xyz, params.tangents.xy);
     let i0 = triangles[4u * tri];
     let i1 = triangles[4u * tri + 1u];
     let i2 = triangles[4u * tri + 2u];

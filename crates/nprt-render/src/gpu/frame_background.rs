@@ -1,0 +1,84 @@
+//! A frame's background on the device: where the rasterised G-buffer sees nothing, the map
+//! along the pixel-centre ray (as `background` does on the host), or zero where direct light
+//! traced later brings the map there. The map's texels go up once per map, the rotation with
+//! each frame.
+
+use std::sync::Mutex;
+
+use nprt_net::gpu::{GpuDevice, KernelSource};
+use nprt_scene::{Camera, EnvMap};
+
+use super::raster_gbuffer::camera_words;
+
+pub const FRAME_BACKGROUND: KernelSource = KernelSource {
+    name: "frame_background",
+    wgsl: concat!(
+        include_str!("shaders/camera_ray.wgsl"),
+        include_str!("shaders/frame_background.wgsl")
+    ),
+};
+
+/// The last map's texels on the device, by the address and size of its texels on the host.
+#[derive(Default)]
+pub struct GpuMap {
+    kept: Mutex<Option<((usize, usize), wgpu::Buffer)>>,
+}
+
+/// What a frame's background needs: the G-buffer it fills the empty pixels of, its camera and
+/// the map as placed in the world (None: zero, for direct light traced later).
+pub struct Background<'a> {
+    pub samples: &'a wgpu::Buffer,
+    pub camera: &'a Camera,
+    pub map: Option<&'a EnvMap>,
+}
+
+impl GpuMap {
+    /// Records `background` into `rgb` (3 f32 per pixel).
+    pub fn record(
+        &self,
+        gpu: &GpuDevice,
+        pass: &mut wgpu::ComputePass,
+        background: &Background,
+        rgb: &wgpu::Buffer,
+    ) {
+        let camera = background.camera;
+        let (texels, size, to_local) = match background.map {
+            Some(map) => (
+                self.texels(gpu, map),
+                [map.width() as u32, map.height() as u32],
+                map.to_world().inverse(),
+            ),
+            None => (gpu.empty.clone(), [1, 2], glam::Mat3::IDENTITY),
+        };
+        let fill = u32::from(background.map.is_some());
+        let mut params = vec![camera.width, camera.height, size[0], size[1], fill, 0, 0, 0];
+        params.extend(camera_words(camera));
+        params.extend(
+            [to_local.x_axis, to_local.y_axis, to_local.z_axis]
+                .iter()
+                .flat_map(|c| c.extend(0.0).to_array().map(f32::to_bits)),
+        );
+        gpu.dispatch(
+            pass,
+            &FRAME_BACKGROUND,
+            &params,
+            &[background.samples, &texels, rgb],
+            [camera.width.div_ceil(8), camera.height.div_ceil(8)],
+        );
+    }
+
+    /// `map`'s texels on the device, uploaded unless they were the last map's.
+    fn texels(&self, gpu: &GpuDevice, map: &EnvMap) -> wgpu::Buffer {
+        let key = (map.texels().as_ptr() as usize, map.texels().len());
+        let mut kept = self.kept.lock().unwrap_or_else(|e| e.into_inner());
+        match &*kept {
+            Some((k, buffer)) if *k == key => buffer.clone(),
+            _ => {
+                let flat: Vec<f32> = map.texels().iter().flat_map(|t| t.to_array()).collect();
+                let buffer = gpu.upload(&flat);
+                *kept = Some((key, buffer.clone()));
+                buffer
+            }
+        }
+    }
+}

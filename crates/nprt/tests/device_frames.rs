@@ -1,0 +1,104 @@
+//! Frames that stay on the GPU from the G-buffer to the finished frame (nprt-render's
+//! `Relighter::frame` on the kernels, for models whose networks give all the light): the
+//! rasterised G-buffer, every pixel's inputs and networks, and the background from the map,
+//! against the CPU's frame (the tracer's G-buffer, the CPU engine, the map on the host) of the
+//! same model, camera and lighting, for a new viewpoint and for a lighting change under it.
+//! Runs on Mesa's software Vulkan in CI (gated as the other Vulkan tests).
+#![cfg(feature = "wgpu")]
+
+mod common;
+
+use glam::Vec3;
+use nprt_net::model::folder::ModelFile;
+use nprt_net::{Compute, Design, Device, Init, ModelConfig};
+use nprt_render::{DirectSampling, FrameCache, Relighter};
+use nprt_scene::{Camera, Material, Mesh, Scene};
+use nprt_trace::TraceScene;
+
+/// A glossy sphere on a floor, seen with sky around them: foreground and background pixels.
+fn scene() -> Scene {
+    let mut scene = Scene::empty("sphere on a floor");
+    scene.add(
+        Mesh::sphere(Vec3::new(0.0, 1.0, 0.0), 1.0, 32),
+        Material::glossy("ball", Vec3::new(0.6, 0.3, 0.2), Vec3::splat(0.2), 0.1),
+    );
+    let mut floor = Mesh::rectangle();
+    floor.transform(
+        glam::Mat4::from_scale(Vec3::splat(2.5))
+            * glam::Mat4::from_rotation_x(-std::f32::consts::FRAC_PI_2),
+    );
+    scene.add(floor, Material::diffuse("floor", Vec3::splat(0.5)));
+    scene
+}
+
+/// How far `gpu` is from `cpu`: the share of pixels beyond 1e-5 of the brightest value, and the
+/// median pixel's difference over it.
+fn compare(gpu: &[Vec3], cpu: &[Vec3]) -> (f64, f32) {
+    let peak = cpu.iter().fold(0.0f32, |m, c| m.max(c.max_element()));
+    let mut off: Vec<f32> = gpu
+        .iter()
+        .zip(cpu)
+        .map(|(a, b)| (*a - *b).abs().max_element() / peak)
+        .collect();
+    off.sort_by(f32::total_cmp);
+    let beyond = off.iter().filter(|&&d| d > 1e-5).count() as f64 / off.len() as f64;
+    (beyond, off[off.len() / 2])
+}
+
+#[test]
+fn frames_on_the_gpu_match_the_cpus_with_their_background() {
+    if !common::wgpu_runs() {
+        return;
+    }
+    let wgpu = Compute::Wgpu.device().unwrap();
+    let scene = scene();
+    let ts = TraceScene::new(&scene);
+    let (lo, hi) = scene.bounds();
+    let camera = Camera::look_at(
+        Vec3::new(0.5, 2.5, 5.0),
+        Vec3::new(0.0, 0.8, 0.0),
+        Vec3::Y,
+        60.0,
+        64,
+        48,
+    );
+    let map = nprt_scene::open_envmap("builtin:sky").unwrap();
+    let sampling = DirectSampling {
+        spp: 1,
+        seed: 0,
+        denoiser: None,
+    };
+    for design in [Design::Dsep, Design::Baseline] {
+        let config = ModelConfig {
+            encoder_width: 64,
+            ..ModelConfig::new(design, None)
+        };
+        let net = config.build(&mut Init::new(5, &Device::flex()));
+        let file = ModelFile::untrained(config, &net, [lo.to_array(), hi.to_array()]);
+        let cpu = Relighter::new(file.clone(), net.clone(), &Device::flex()).unwrap();
+        let gpu = Relighter::new(file, net, &wgpu).unwrap();
+        assert_eq!(gpu.gbuffer_on(), "rasterised on the GPU");
+        let (mut on_cpu, mut on_gpu) = (FrameCache::default(), FrameCache::default());
+        // A new viewpoint, then a lighting change under it (the transfer networks' outputs
+        // kept on the device).
+        for (key, rotation) in [(0, 30.0), (1, 100.0)] {
+            let (want, _) = cpu
+                .frame(&mut on_cpu, &ts, &camera, &map, rotation, key, sampling)
+                .unwrap();
+            let (got, t) = gpu
+                .frame(&mut on_gpu, &ts, &camera, &map, rotation, key, sampling)
+                .unwrap();
+            let background = on_cpu.foreground() < want.len();
+            assert!(background, "the view shows the sky");
+            assert_eq!(on_gpu.foreground(), want.len(), "every pixel has a row");
+            let (beyond, median) = compare(&got, &want);
+            eprintln!(
+                "{design:?} at rotation {rotation}: {:.2}% of pixels beyond 1e-5, median {median:.1e} (G-buffer {:.1} ms, networks {:.1} ms)",
+                100.0 * beyond,
+                t.gbuffer_ms,
+                t.network_ms
+            );
+            assert!(beyond <= 0.01 && median < 1e-6, "{design:?}");
+        }
+    }
+}
