@@ -18,21 +18,6 @@ use nprt_net::gpu::{GpuDevice, GpuTrainer, ParameterLayout};
 use nprt_net::training::training_loop::ADAM_EPSILON;
 use nprt_net::{Design, Device, Engine, Init, Loss, ModelConfig, NprtNet, PositionEncoding};
 
-/// Whether a GPU adapter is here; panics where one is required and missing.
-fn gpu_present() -> bool {
-    match GpuDevice::get() {
-        Ok(gpu) => {
-            eprintln!("adapter: {}", gpu.adapter);
-            true
-        }
-        Err(e) if std::env::var_os("NPRT_REQUIRE_VULKAN").is_none() => {
-            eprintln!("skipped: {e:#}");
-            false
-        }
-        Err(e) => panic!("NPRT_REQUIRE_VULKAN is set but {e:#}"),
-    }
-}
-
 /// Euclidean distance of `a` from `b` over b's norm.
 fn relative_error(a: &[f32], b: &[f32]) -> f64 {
     assert_eq!(a.len(), b.len());
@@ -78,7 +63,7 @@ fn cpu_gradients(
 
 #[test]
 fn gpu_gradients_match_the_cpu_engine_for_every_design() {
-    if !gpu_present() {
+    if !GpuDevice::probe() {
         return;
     }
     let batch = random_batch(300, 3, 22);
@@ -118,7 +103,7 @@ fn gpu_gradients_match_the_cpu_engine_for_every_design() {
 /// CPU training path): what each moved every tensor by.
 #[test]
 fn gpu_adam_steps_match_burns_adam_on_the_cpu_engine() {
-    if !gpu_present() {
+    if !GpuDevice::probe() {
         return;
     }
     let batch = random_batch(300, 3, 23);

@@ -15,21 +15,6 @@ use nprt_render::gpu::{GpuDevice, GpuNetwork};
 use nprt_scene::{load_scene, Camera, SceneOptions};
 use nprt_trace::{render_gbuffer, TraceScene};
 
-/// Whether a GPU adapter is here; panics where one is required and missing.
-fn gpu_present() -> bool {
-    match GpuDevice::get() {
-        Ok(gpu) => {
-            eprintln!("adapter: {}", gpu.adapter);
-            true
-        }
-        Err(e) if std::env::var_os("NPRT_REQUIRE_VULKAN").is_none() => {
-            eprintln!("skipped: {e:#}");
-            false
-        }
-        Err(e) => panic!("NPRT_REQUIRE_VULKAN is set but {e:#}"),
-    }
-}
-
 /// The network inputs of the foreground pixels of a 40 × 30 view of the built-in room.
 fn room_features() -> Vec<f32> {
     let scene = load_scene("builtin:room", &SceneOptions::default()).unwrap();
@@ -73,7 +58,7 @@ fn model(design: Design, activation: Activation, encoding: PositionEncoding, see
 
 #[test]
 fn gpu_light_codes_and_radiance_match_the_cpu_engine_for_every_design() {
-    if !gpu_present() {
+    if !GpuDevice::probe() {
         return;
     }
     let features = room_features();
@@ -116,7 +101,7 @@ fn gpu_light_codes_and_radiance_match_the_cpu_engine_for_every_design() {
 
 #[test]
 fn the_widest_encoder_input_gets_the_cpu_engines_light_code() {
-    if !gpu_present() {
+    if !GpuDevice::probe() {
         return;
     }
     // 1024 wide: the first block's 65,536 workgroups need a second dimension.

@@ -4,7 +4,9 @@
 //! `NPRT_MITSUBA_VARIANT` (default llvm_ad_rgb). Without `NPRT_PYTHON` the test fails, unless
 //! `NPRT_SKIP_MITSUBA=1` says to skip it on purpose.
 
-use std::path::{Path, PathBuf};
+mod common;
+
+use std::path::Path;
 use std::process::Command;
 
 use glam::Vec3;
@@ -12,14 +14,9 @@ use nprt_io::exr::{read_channels, write_channels};
 use nprt_scene::{load_scene, EnvMap, SceneOptions};
 use nprt_trace::{render, PixelFilter, RenderSettings, TraceScene};
 
-const SPP: u32 = 64;
+use common::{repo, shared};
 
-fn repo() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("../..")
-        .canonicalize()
-        .unwrap()
-}
+const SPP: u32 = 64;
 
 fn rgb(path: &Path) -> (usize, usize, Vec<Vec3>) {
     let (w, h, ch) = read_channels(path).unwrap();
@@ -220,29 +217,6 @@ fn named_conductors_are_mitsuba_s() {
             "{name}: ours {e} {kk}, Mitsuba {eta:?} {k:?}"
         );
     }
-}
-
-/// The folder of large optional data beside the repository (`NPRT_SHARED`, else `../shared`)
-/// when it holds `sub`. Absent, the test is skipped, unless `NPRT_REQUIRE_SHARED=1` (CI) makes
-/// that a failure.
-fn shared(sub: &str) -> Option<PathBuf> {
-    let root = std::env::var_os("NPRT_SHARED")
-        .map(PathBuf::from)
-        .unwrap_or_else(|| repo().join("../shared"));
-    let path = root.join(sub);
-    if path.exists() {
-        return Some(path);
-    }
-    assert!(
-        std::env::var("NPRT_REQUIRE_SHARED").as_deref() != Ok("1"),
-        "NPRT_REQUIRE_SHARED=1 but {} is missing",
-        path.display()
-    );
-    eprintln!(
-        "SKIPPED: {} is absent (set NPRT_SHARED to the shared data folder)",
-        path.display()
-    );
-    None
 }
 
 /// The paper's KITCHEN (Bitterli's Mitsuba 0.5 release, a million triangles) as both renderers

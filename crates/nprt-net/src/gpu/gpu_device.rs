@@ -34,6 +34,23 @@ impl GpuDevice {
             .map_err(|e| anyhow!(e))
     }
 
+    /// Whether the device opens here, for the tests and benchmarks that need one: where it
+    /// does not, says why and answers false, unless `NPRT_REQUIRE_VULKAN` is set (scripts/test
+    /// sets it once it has installed Mesa's software Vulkan), which makes that a panic.
+    pub fn probe() -> bool {
+        match Self::get() {
+            Ok(gpu) => {
+                eprintln!("adapter: {}", gpu.adapter);
+                true
+            }
+            Err(e) if std::env::var_os("NPRT_REQUIRE_VULKAN").is_none() => {
+                eprintln!("skipped: {e:#}");
+                false
+            }
+            Err(e) => panic!("NPRT_REQUIRE_VULKAN is set but {e:#}"),
+        }
+    }
+
     fn open() -> Result<GpuDevice> {
         let mut desc = wgpu::InstanceDescriptor::new_without_display_handle();
         desc.backends = wgpu::Backends::PRIMARY;

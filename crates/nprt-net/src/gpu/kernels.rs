@@ -1,6 +1,7 @@
 //! The network kernels, by name: the light encoder's blocks, the track inputs (with the hash
 //! grid's encoding), the matrix product and the combination into radiance, which the frame
-//! path dispatches too, and the training step's own. A kernel's source is its file in
+//! path dispatches too, the inputs made from a G-buffer on the device (the frame path's), and
+//! the training step's own, its batch gathered from a dataset on the device among them. A kernel's source is its file in
 //! `shaders/`, after the shared files it names (WGSL has no includes).
 
 use super::KernelSource;
@@ -30,7 +31,9 @@ pub const ACTIVATION_BACKWARD: KernelSource = kernel!("activation_backward");
 pub const COMBINE: KernelSource = kernel!("combine", "track_radiance");
 pub const RADIANCE_LOSS: KernelSource = kernel!("radiance_loss", "track_radiance");
 pub const ADAM: KernelSource = kernel!("adam");
-pub const GATHER_SAMPLES: KernelSource = kernel!("gather_samples");
+pub const GATHER_SAMPLES: KernelSource = kernel!("gather_samples", "pixel_features");
+/// The network inputs of a G-buffer left on the device (nprt-render's frame path).
+pub const GBUFFER_FEATURES: KernelSource = kernel!("gbuffer_features", "pixel_features");
 
 /// Rows and columns of the tile a `gemm` workgroup computes.
 pub const GEMM_TILE: u32 = 64;

@@ -16,10 +16,9 @@ use nprt_net::gpu::{groups_for, GpuDevice};
 
 use nprt_net::gpu::{Bias, Operand, Output};
 
-use nprt_net::gpu::kernels::{COMBINE, ENCODER_BLOCK, TRACK_INPUTS};
+use nprt_net::gpu::kernels::{COMBINE, ENCODER_BLOCK, GBUFFER_FEATURES, TRACK_INPUTS};
 
 use super::frame_background::{Background, GpuMap};
-use super::kernels::FRAME_FEATURES;
 use nprt_net::gpu::{activation_code, kind_code};
 
 /// Rows per block of dispatches: a block's widest activations (256 f32 per row, 64 MiB) stay
@@ -214,7 +213,7 @@ impl GpuNetwork {
             );
             self.gpu.dispatch(
                 pass,
-                &FRAME_FEATURES,
+                &GBUFFER_FEATURES,
                 &params,
                 &[samples, &features],
                 groups_for(n),

@@ -5,11 +5,6 @@
 use nprt_net::gpu::kernels::{COMBINE, ENCODER_BLOCK, GEMM, TRACK_INPUTS};
 use nprt_net::gpu::KernelSource;
 
-/// Every kernel of the frame path, in the order a frame first uses them.
+/// Every network kernel of the frame path, in the order a frame first uses them: what
+/// `nprt export` writes (an engine brings its own G-buffer and background).
 pub const SOURCES: [&KernelSource; 4] = [&ENCODER_BLOCK, &TRACK_INPUTS, &GEMM, &COMBINE];
-
-/// The networks' inputs of a G-buffer on the device (the frame path's own; not exported).
-pub const FRAME_FEATURES: KernelSource = KernelSource {
-    name: "frame_features",
-    wgsl: include_str!("shaders/frame_features.wgsl"),
-};

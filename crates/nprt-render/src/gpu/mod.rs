@@ -3,8 +3,9 @@
 //! software Vulkan in the tests); and the export of those shaders, translated to GLSL and HLSL,
 //! with the weights for engines.
 //!
-//! Owns the frame's shaders (`shaders/`: the visibility pass and the G-buffer it resolves; the
-//! network kernels and the device they run on are nprt-net's), the scene's and a model's
+//! Owns the frame's shaders (`shaders/`: the visibility pass, the G-buffer it resolves and the
+//! background; the network kernels, the inputs made from a G-buffer and the device they run on
+//! are nprt-net's), the scene's and a model's
 //! upload and the order of dispatches of a frame. It computes what the CPU does (nprt-trace's
 //! G-buffer, nprt-net's CPU engine) in the same f32 operations, and tests hold them together;
 //! it must not own semantics of its own: materials are nprt-scene's, layouts, designs and the

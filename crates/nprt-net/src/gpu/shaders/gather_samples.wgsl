@@ -3,7 +3,8 @@
 // and made into the 19 network inputs as nprt-net's pixel_features does (in the same f32
 // operations, rounded as the device rounds a division, a square root and a multiply-add), its radiance, its
 // view's map scale and its view within the batch. One dispatch per shard of records; a sample
-// whose record lies in another shard is left to that shard's dispatch.
+// whose record lies in another shard is left to that shard's dispatch. After
+// pixel_features.wgsl.
 
 struct Gather {
     rows: u32,
@@ -77,12 +78,6 @@ fn from_octahedral(base: u32, k: u32) -> vec3<f32> {
     return normalize(vec3<f32>(xy, z));
 }
 
-fn put3(i: u32, k: u32, v: vec3<f32>) {
-    features[19u * i + k] = v.x;
-    features[19u * i + k + 1u] = v.y;
-    features[19u * i + k + 2u] = v.z;
-}
-
 @compute @workgroup_size(64)
 fn main(@builtin(global_invocation_id) id: vec3<u32>, @builtin(num_workgroups) groups: vec3<u32>) {
     let i = id.x + id.y * groups.x * 64u;
@@ -96,15 +91,8 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>, @builtin(num_workgroups) g
     let base = 10u * (record - p.first);
     let unit = vec3<f32>(f32(half_word(base, 0u)), f32(half_word(base, 1u)), f32(half_word(base, 2u))) / 65535.0;
     let position = p.lo.xyz + unit * p.extent.xyz;
-    let normal = from_octahedral(base, 3u);
-    let towards = from_octahedral(base, 5u);
-    put3(i, 0u, (position - p.lo.xyz) / p.normaliser.xyz * 2.0 - 1.0);
-    put3(i, 3u, towards);
-    put3(i, 6u, 2.0 * dot(normal, towards) * normal - towards);
-    put3(i, 9u, normal);
-    put3(i, 12u, f16_vec3(base, 7u));
-    put3(i, 15u, f16_vec3(base, 10u));
-    features[19u * i + 18u] = f16_value(half_word(base, 13u));
+    let alpha = f16_value(half_word(base, 13u));
+    pixel_features(i, position, from_octahedral(base, 3u), from_octahedral(base, 5u), f16_vec3(base, 7u), f16_vec3(base, 10u), alpha, p.lo.xyz, p.normaliser.xyz);
     for (var c = 0u; c < 3u; c++) {
         radiance[3u * i + c] = bitcast<f32>(records[base + 7u + c]);
     }

@@ -1,7 +1,6 @@
-// The networks' 19 inputs of a block of G-buffer pixels (gbuffer.wgsl's samples, 17 f32 each),
-// as nprt-net's pixel_features makes them: the position normalised to [−1, 1] by the model's
-// bounds, ωo, ωr (ωo mirrored about n), n, kd, ks, α. Background pixels get zeros (the frame's
-// background kernel replaces their radiance).
+// The networks' 19 inputs of a block of G-buffer pixels (GSample's fields, 17 f32 each, as
+// nprt-render's rasterised G-buffer leaves them on the device), after pixel_features.wgsl.
+// Background pixels get zeros (the frame's background replaces their radiance).
 
 struct Inputs {
     rows: u32,
@@ -22,12 +21,6 @@ fn sample3(i: u32, k: u32) -> vec3<f32> {
     return vec3<f32>(samples[17u * i + k], samples[17u * i + k + 1u], samples[17u * i + k + 2u]);
 }
 
-fn put3(r: u32, k: u32, v: vec3<f32>) {
-    features[19u * r + k] = v.x;
-    features[19u * r + k + 1u] = v.y;
-    features[19u * r + k + 2u] = v.z;
-}
-
 @compute @workgroup_size(64)
 fn main(@builtin(global_invocation_id) id: vec3<u32>, @builtin(num_workgroups) groups: vec3<u32>) {
     let r = id.x + id.y * groups.x * 64u;
@@ -41,13 +34,5 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>, @builtin(num_workgroups) g
         }
         return;
     }
-    let n = sample3(i, 3u);
-    let v = sample3(i, 6u);
-    put3(r, 0u, (sample3(i, 0u) - p.lo.xyz) / p.extent.xyz * 2.0 - 1.0);
-    put3(r, 3u, v);
-    put3(r, 6u, 2.0 * dot(n, v) * n - v);
-    put3(r, 9u, n);
-    put3(r, 12u, sample3(i, 9u));
-    put3(r, 15u, sample3(i, 12u));
-    features[19u * r + 18u] = samples[17u * i + 15u];
+    pixel_features(r, sample3(i, 0u), sample3(i, 3u), sample3(i, 6u), sample3(i, 9u), sample3(i, 12u), samples[17u * i + 15u], p.lo.xyz, p.extent.xyz);
 }

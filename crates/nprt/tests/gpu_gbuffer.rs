@@ -1,12 +1,13 @@
-//! The rasterised G-buffer (crate::gpu::RasterGBuffer) against the tracer's pixel-centre
+//! The rasterised G-buffer (nprt-render's gpu::RasterGBuffer) against the tracer's pixel-centre
 //! G-buffer (`nprt_trace::render_gbuffer`), which it must reproduce: every material feature
 //! the G-buffer records (bitmaps through uv transforms, checkerboards, metallic-roughness,
 //! Fresnel at normal incidence, opacity masks, bump maps seen from either side, one- and
 //! two-sided surfaces, meshes without normals or uvs), the built-in room and, where the shared
-//! data is present, the KITCHEN. Gated as the other Vulkan tests are (gpu_frame.rs).
+//! data is present, the KITCHEN. Gated as the other Vulkan tests are.
 #![cfg(feature = "wgpu")]
 
-use std::path::PathBuf;
+mod common;
+
 use std::sync::Arc;
 
 use glam::{Affine2, Mat4, Vec2, Vec3};
@@ -16,21 +17,6 @@ use nprt_scene::{
     Texture,
 };
 use nprt_trace::{render_gbuffer, GBuffer, TraceScene};
-
-/// Whether a GPU adapter is here; panics where one is required and missing.
-fn gpu_present() -> bool {
-    match GpuDevice::get() {
-        Ok(gpu) => {
-            eprintln!("adapter: {}", gpu.adapter);
-            true
-        }
-        Err(e) if std::env::var_os("NPRT_REQUIRE_VULKAN").is_none() => {
-            eprintln!("skipped: {e:#}");
-            false
-        }
-        Err(e) => panic!("NPRT_REQUIRE_VULKAN is set but {e:#}"),
-    }
-}
 
 /// A `width` × `height` bitmap of values that vary from texel to texel (seeded by `salt`).
 fn bitmap(width: usize, height: usize, salt: u32) -> Arc<Bitmap> {
@@ -231,7 +217,7 @@ fn assert_matches(scene: &Scene, width: u32, height: u32, share: f64) {
 
 #[test]
 fn rasterised_gbuffer_matches_the_tracers_for_every_material_feature() {
-    if !gpu_present() {
+    if !GpuDevice::probe() {
         return;
     }
     let scene = features_scene();
@@ -242,39 +228,20 @@ fn rasterised_gbuffer_matches_the_tracers_for_every_material_feature() {
 
 #[test]
 fn rasterised_gbuffer_matches_the_tracers_on_the_builtin_room() {
-    if !gpu_present() {
+    if !GpuDevice::probe() {
         return;
     }
     let scene = load_scene("builtin:room", &SceneOptions::default()).unwrap();
     assert_matches(&scene, 128, 96, 0.003);
 }
 
-/// The shared data's `sub` folder (`NPRT_SHARED`, else `../shared` beside the repository);
-/// absent, the test is skipped unless `NPRT_REQUIRE_SHARED=1` (CI).
-fn shared(sub: &str) -> Option<PathBuf> {
-    let root = std::env::var_os("NPRT_SHARED")
-        .map(PathBuf::from)
-        .unwrap_or_else(|| PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../../shared"));
-    let path = root.join(sub);
-    if path.exists() {
-        return Some(path);
-    }
-    assert!(
-        std::env::var("NPRT_REQUIRE_SHARED").as_deref() != Ok("1"),
-        "NPRT_REQUIRE_SHARED=1 but {} is missing",
-        path.display()
-    );
-    eprintln!("SKIPPED: {} is absent", path.display());
-    None
-}
-
 /// The KITCHEN at scale: a million triangles, its textures, bump maps and the blinds' mask.
 #[test]
 fn rasterised_gbuffer_matches_the_tracers_on_the_kitchen() {
-    let Some(kitchen) = shared("scenes/kitchen/scene.xml") else {
+    let Some(kitchen) = common::shared("scenes/kitchen/scene.xml") else {
         return;
     };
-    if !gpu_present() {
+    if !GpuDevice::probe() {
         return;
     }
     let scene = load_scene(kitchen.to_str().unwrap(), &SceneOptions::default()).unwrap();
