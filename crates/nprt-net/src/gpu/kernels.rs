@@ -1,8 +1,9 @@
 //! The network kernels, by name: the light encoder's blocks, the track inputs (with the hash
 //! grid's encoding), the matrix product and the combination into radiance, which the frame
 //! path dispatches too, the inputs made from a G-buffer on the device (the frame path's), and
-//! the training step's own, its batch gathered from a dataset on the device among them. A kernel's source is its file in
-//! `shaders/`, after the shared files it names (WGSL has no includes).
+//! the training step's own, its batch gathered from a dataset on the device among them. A
+//! kernel's source is its file in `shaders/`, after the shared files it names (WGSL has no
+//! includes).
 
 use super::KernelSource;
 
