@@ -527,7 +527,11 @@ impl<'s, O: Objective> Run<'s, O> {
         row_every: u64,
     ) -> Result<()> {
         if let Optimiser::Device(steps) = optim {
-            if let Some((value, samples)) = steps.finish()? {
+            // Waiting for the step is the step's time.
+            let waiting = Instant::now();
+            let last = steps.finish()?;
+            self.split.steps += since(waiting);
+            if let Some((value, samples)) = last {
                 self.record_step(value, samples, epoch, total, row_every)?;
             }
         }
