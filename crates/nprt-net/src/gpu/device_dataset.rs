@@ -63,6 +63,8 @@ impl DeviceDataset {
             .flat_map(|v| v.light.pixels.iter().copied())
             .collect();
         let scales: Vec<f32> = set.train.iter().flat_map(|v| v.light.scale).collect();
+        gpu.check_binding(4 * lights.len(), "the training views' maps")
+            .context("train with --gather host or a smaller --encoder-width")?;
         let scope = gpu.device.push_error_scope(wgpu::ErrorFilter::OutOfMemory);
         let mut shards = Vec::new();
         for (k, chunk) in records.chunks(per_shard.max(1)).enumerate() {

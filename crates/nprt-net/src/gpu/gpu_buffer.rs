@@ -9,6 +9,22 @@ const STORAGE: wgpu::BufferUsages = wgpu::BufferUsages::STORAGE
     .union(wgpu::BufferUsages::COPY_DST);
 
 impl GpuDevice {
+    /// Refuses `bytes` of `what` where one storage buffer on this device cannot hold and bind
+    /// them, saying so (a kernel binds its inputs whole).
+    pub fn check_binding(&self, bytes: usize, what: &str) -> anyhow::Result<()> {
+        let limits = self.device.limits();
+        let most = (limits.max_storage_buffer_binding_size).min(limits.max_buffer_size);
+        if bytes as u64 > most {
+            anyhow::bail!(
+                "{what} take {:.2} GB, more than one buffer on the GPU ({}) holds ({:.2} GB)",
+                bytes as f64 / 1e9,
+                self.adapter,
+                most as f64 / 1e9
+            );
+        }
+        Ok(())
+    }
+
     /// A storage buffer holding `values` (f32, u32 or any plain words).
     pub fn upload<T: bytemuck::Pod>(&self, values: &[T]) -> wgpu::Buffer {
         // wgpu refuses empty bindings: an empty input still gets 16 bytes.

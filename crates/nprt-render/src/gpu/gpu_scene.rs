@@ -5,6 +5,7 @@
 use std::collections::HashMap;
 use std::sync::Arc;
 
+use anyhow::{Context, Result};
 use glam::Vec3;
 use nprt_scene::{BsdfParams, Material, Scene, Surface, Texture};
 
@@ -45,7 +46,8 @@ pub struct GpuScene {
 }
 
 impl GpuScene {
-    pub fn new(gpu: &GpuDevice, scene: &Scene) -> Self {
+    /// Uploads `scene`; refuses one whose triangles or textures a GPU buffer cannot hold.
+    pub fn new(gpu: &GpuDevice, scene: &Scene) -> Result<Self> {
         let vertices: usize = scene.meshes.iter().map(|m| m.positions.len()).sum();
         let mut positions = Vec::with_capacity(3 * vertices);
         let mut attributes = Vec::with_capacity(5 * vertices);
@@ -75,8 +77,18 @@ impl GpuScene {
             .iter()
             .flat_map(|m| material_record(m, &mut textures, &mut bitmaps))
             .collect();
+        let bytes = |v: usize| 4 * v;
+        for (words, what) in [
+            (positions.len(), "the scene's vertex positions"),
+            (attributes.len(), "the scene's vertex normals and uvs"),
+            (triangles.len(), "the scene's triangles"),
+            (bitmaps.texels.len(), "the scene's textures"),
+        ] {
+            gpu.check_binding(bytes(words), &format!("{what} ('{}')", scene.name))
+                .context("the GPU frame path cannot take the scene; use --device cpu")?;
+        }
         let (lo, hi) = scene.bounds();
-        GpuScene {
+        Ok(GpuScene {
             positions: gpu.upload(&positions),
             attributes: gpu.upload(&attributes),
             triangles: gpu.upload(&triangles),
@@ -85,7 +97,7 @@ impl GpuScene {
             texels: gpu.upload(&bitmaps.texels),
             triangle_count: scene.triangle_count() as u32,
             extent: (hi - lo).length(),
-        }
+        })
     }
 }
 

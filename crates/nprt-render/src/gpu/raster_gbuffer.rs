@@ -96,7 +96,7 @@ impl RasterGBuffer {
                 cache: None,
             });
         Ok(RasterGBuffer {
-            scene: GpuScene::new(&gpu, scene),
+            scene: GpuScene::new(&gpu, scene)?,
             gpu,
             visibility,
             targets: Mutex::new(None),
