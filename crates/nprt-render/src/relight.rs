@@ -309,7 +309,7 @@ impl Relighter {
     pub fn gbuffer(&self, ts: &TraceScene, camera: &Camera) -> Result<GBuffer> {
         #[cfg(feature = "wgpu")]
         if self.gpu.is_some() {
-            return Ok(self.raster(ts)?.render(camera));
+            return self.raster(ts)?.render(camera);
         }
         Ok(render_gbuffer(ts, camera))
     }
@@ -350,7 +350,7 @@ impl Relighter {
         let ms = |t: Instant| t.elapsed().as_secs_f64() * 1e3;
         let raster = self.raster(ts)?;
         let clock = Instant::now();
-        let samples = raster.samples(camera);
+        let samples = raster.samples(camera)?;
         device.wait();
         let gbuffer_ms = ms(clock);
         let clock = Instant::now();

@@ -193,7 +193,7 @@ fn assert_matches(scene: &Scene, width: u32, height: u32, share: f64) {
     let ts = TraceScene::new(scene);
     let raster = RasterGBuffer::new(scene).unwrap();
     for (k, camera) in views(scene, width, height).iter().enumerate() {
-        let gpu = raster.render(camera);
+        let gpu = raster.render(camera).unwrap();
         let cpu = render_gbuffer(&ts, camera);
         let foreground = cpu.mask.iter().filter(|&&m| m > 0.5).count();
         let d = differences(&gpu, &cpu);

@@ -18,6 +18,8 @@ pub struct KernelSteps {
     loss: Loss,
     /// Samples of the queued steps whose losses are not yet read (at most two).
     samples: std::collections::VecDeque<u64>,
+    /// Bytes of the dataset held on the device, where it is.
+    resident: Option<u64>,
 }
 
 impl KernelSteps {
@@ -25,13 +27,17 @@ impl KernelSteps {
     /// [`Batch::picked`]); steps minimise `loss`.
     pub fn new(net: &NprtNet, loss: Loss, dataset: Option<&TrainingSet>) -> Result<Self> {
         let mut trainer = GpuTrainer::new(net)?;
+        let mut resident = None;
         if let Some(set) = dataset {
-            trainer.hold(DeviceDataset::upload(&trainer.gpu, set)?);
+            let data = DeviceDataset::upload(&trainer.gpu, set)?;
+            resident = Some(data.bytes);
+            trainer.hold(data);
         }
         Ok(KernelSteps {
             trainer,
             loss,
             samples: Default::default(),
+            resident,
         })
     }
 }
@@ -76,6 +82,10 @@ impl DeviceSteps<NprtNet, Batch> for KernelSteps {
     }
 
     fn describe(&self) -> String {
-        format!("GPU kernels on {}", self.trainer.adapter())
+        let data = match self.resident {
+            Some(bytes) => format!("the dataset there ({:.1} MB)", bytes as f64 / 1e6),
+            None => "batches gathered here".into(),
+        };
+        format!("GPU kernels on {}, {data}", self.trainer.adapter())
     }
 }

@@ -104,8 +104,8 @@ impl RasterGBuffer {
     }
 
     /// The G-buffer of `camera`'s pixel centres, read back.
-    pub fn render(&self, camera: &Camera) -> GBuffer {
-        let samples = self.samples(camera);
+    pub fn render(&self, camera: &Camera) -> Result<GBuffer> {
+        let samples = self.samples(camera)?;
         let pixels = (camera.width * camera.height) as usize;
         let values = self.gpu.read(&samples, pixels * SAMPLE_FLOATS);
         let mut g = GBuffer::default();
@@ -121,13 +121,18 @@ impl RasterGBuffer {
                 mask: s[16],
             });
         }
-        g
+        Ok(g)
     }
 
     /// The G-buffer of `camera`'s pixel centres on the device: GSample's fields, 17 f32 per
     /// pixel in row order, in a buffer of its own (queued; later submissions may read it).
-    pub fn samples(&self, camera: &Camera) -> wgpu::Buffer {
+    pub fn samples(&self, camera: &Camera) -> Result<wgpu::Buffer> {
         let gpu = &*self.gpu;
+        let pixels = (camera.width * camera.height) as usize;
+        gpu.check_binding(
+            4 * SAMPLE_FLOATS * pixels,
+            &format!("the G-buffer of a {}×{} frame", camera.width, camera.height),
+        )?;
         let size = (camera.width, camera.height);
         let mut kept = self.targets.lock().unwrap_or_else(|e| e.into_inner());
         let targets = match kept.take() {
@@ -160,7 +165,7 @@ impl RasterGBuffer {
             .collect::<Vec<_>>(),
         });
         let visible = TextureBinding(targets.visible.create_view(&Default::default()));
-        let samples = gpu.buffer((camera.width * camera.height) as usize * SAMPLE_FLOATS);
+        let samples = gpu.buffer(pixels * SAMPLE_FLOATS);
         let mut encoder = gpu.device.create_command_encoder(&Default::default());
         {
             let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
@@ -213,7 +218,7 @@ impl RasterGBuffer {
         }
         gpu.queue.submit([encoder.finish()]);
         *kept = Some(targets);
-        samples
+        Ok(samples)
     }
 
     /// World to clip for `camera`: a point's pixel is where `camera.ray` through it would
