@@ -239,7 +239,9 @@ impl Relighter {
     /// One frame through `camera` under `map` turned by `rotation_deg` (the lighting `key`
     /// names): the G-buffer and the light-independent networks only when the camera moved
     /// since the frame `cache` holds, the encoder only when the key changed, then the shading
-    /// networks and [`Self::complete`]. Returns the radiance and each stage's time.
+    /// networks and [`Self::complete`] (on the kernels, for a model whose networks give all
+    /// the light, the whole frame on the device, its background included). Returns the
+    /// radiance and each stage's time.
     #[allow(clippy::too_many_arguments)]
     pub fn frame<K: PartialEq>(
         &self,
@@ -283,22 +285,16 @@ impl Relighter {
             }
         };
         let placed = map.rotated_y(rotation_deg);
-        #[cfg(feature = "wgpu")]
-        if px.gbuffer.is_some() {
-            // The whole frame on the device: the networks, then the background.
-            let clock = Instant::now();
-            let rgb = self.device_frame(&px, &code, &placed);
-            t.network_ms += ms(clock);
-            cache.light = Some((key, code));
-            cache.still = Some((camera.clone(), g, px));
-            return Ok((rgb, t));
-        }
         let clock = Instant::now();
-        let mut rgb = self.relight(&px, &code);
+        let finished = self.device_frame(&px, &code, &placed);
+        let on_device = finished.is_some();
+        let mut rgb = finished.unwrap_or_else(|| self.relight(&px, &code));
         t.network_ms += ms(clock);
-        let clock = Instant::now();
-        self.complete(ts, camera, &placed, &g, sampling, &mut rgb)?;
-        t.direct_ms = ms(clock);
+        if !on_device {
+            let clock = Instant::now();
+            self.complete(ts, camera, &placed, &g, sampling, &mut rgb)?;
+            t.direct_ms = ms(clock);
+        }
         cache.light = Some((key, code));
         cache.still = Some((camera.clone(), g, px));
         Ok((rgb, t))
@@ -369,23 +365,24 @@ impl Relighter {
     }
 
     /// The finished frame of pixels whose G-buffer stayed on the device, under `light` and
-    /// with `map` (as placed in the world) behind: made there, read back once.
-    #[cfg(feature = "wgpu")]
-    fn device_frame(&self, px: &Pixels, light: &LightCode, map: &EnvMap) -> Vec<Vec3> {
-        let (Some(gpu), Some(pixels), Some((samples, camera))) = (&self.gpu, &px.gpu, &px.gbuffer)
-        else {
-            unreachable!("a device frame's pixels are on the device");
-        };
-        let background = crate::gpu::Background {
-            samples,
-            camera,
-            map: Some(map),
-        };
-        let code = nprt_net::host_values(light.code.clone().into_data());
-        gpu.radiance(pixels, &code, light.scale, Some(&background))
-            .chunks_exact(3)
-            .map(Vec3::from_slice)
-            .collect()
+    /// with `map` (as placed in the world) behind: made there, read back once. None for
+    /// pixels on the host.
+    #[cfg_attr(not(feature = "wgpu"), allow(unused_variables))]
+    fn device_frame(&self, px: &Pixels, light: &LightCode, map: &EnvMap) -> Option<Vec<Vec3>> {
+        #[cfg(feature = "wgpu")]
+        if let (Some(gpu), Some(pixels), Some((samples, camera))) =
+            (&self.gpu, &px.gpu, &px.gbuffer)
+        {
+            let background = crate::gpu::Background {
+                samples,
+                camera,
+                map: Some(map),
+            };
+            let code = nprt_net::host_values(light.code.clone().into_data());
+            let rgb = gpu.radiance(pixels, &code, light.scale, Some(&background));
+            return Some(rgb.chunks_exact(3).map(Vec3::from_slice).collect());
+        }
+        None
     }
 
     /// Encodes `map` rotated by `rotation_deg` about +Y.

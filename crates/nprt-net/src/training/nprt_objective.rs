@@ -24,9 +24,8 @@ use crate::training::batch::{Batch, Engine};
 use crate::training::calibration::{level_gain, Calibration, LEVEL_SAMPLES};
 use crate::training::checkpoint::RunState;
 use crate::training::epoch_plan::{group_batches, EpochPlan};
-#[cfg(feature = "kernels")]
 use crate::training::optimiser::DeviceSteps;
-use crate::training::train_options::{Gather, TrainOptions};
+use crate::training::train_options::TrainOptions;
 use crate::training::training_loop::{self, Objective, Schedule, TrainSummary, ADAM_EPSILON};
 use crate::training::training_set::{TrainingSet, ViewSamples};
 use crate::training::validation::{forward_log_l1, validation_loss};
@@ -39,6 +38,7 @@ struct PixelObjective<'a> {
     /// The model file as last saved, returned to the caller.
     saved: Mutex<Option<ModelFile>>,
     /// Whether the steps run on our own GPU kernels (`--device wgpu`).
+    #[cfg_attr(not(feature = "kernels"), allow(dead_code))]
     kernels: bool,
     /// Whether those kernels hold the dataset, so that batches are only picked on the host.
     resident: AtomicBool,
@@ -125,7 +125,7 @@ impl Objective for PixelObjective<'_> {
         if !self.kernels {
             return Ok(None);
         }
-        let resident = self.opts.gather == Gather::Device;
+        let resident = self.opts.gather == crate::Gather::Device;
         let dataset = resident.then_some(self.set);
         let steps = crate::gpu::KernelSteps::new(net, self.opts.loss, dataset)?;
         self.resident.store(resident, Ordering::Relaxed);
