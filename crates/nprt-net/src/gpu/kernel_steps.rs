@@ -1,6 +1,7 @@
 //! Training steps of a Neural PRT design on our own GPU kernels, as the training loop takes
 //! them ([`DeviceSteps`]): the parameters and Adam's moments stay on the device between steps
-//! and come back to the host network only for validation and checkpoints.
+//! and come back to the host network only for checkpoints (validation runs on the device too),
+//! and the dataset may be held there as well.
 
 use std::path::Path;
 

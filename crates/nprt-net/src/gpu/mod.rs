@@ -1,8 +1,8 @@
 //! Our own GPU kernels: WGSL compute shaders on wgpu (Vulkan, Metal, DX12; Mesa's software
 //! Vulkan in the tests). This module owns the device (one per process), how a kernel is
-//! compiled and dispatched, storage buffers, and the training step of every design on the
-//! device ([`GpuTrainer`]). nprt-render's frame path dispatches its own kernels on the same
-//! device. The kernels compute what the CPU engine ([`crate::cpu`]) computes, in f32, and
+//! compiled and dispatched, storage buffers, the training step of every design on the device
+//! ([`GpuTrainer`]) and the training set held there ([`DeviceDataset`]). nprt-render's frame
+//! path dispatches these kernels and its own on the same device. The kernels compute what the CPU engine ([`crate::cpu`]) computes, in f32, and
 //! tests hold the two together; layouts, designs and the hash grid stay defined where the CPU
 //! engine reads them.
 
