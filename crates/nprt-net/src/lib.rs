@@ -39,7 +39,7 @@ pub use bench::throughput::{measure_inference, measure_throughput, median, Infer
 pub use burn;
 pub use burn::tensor::Device;
 pub use device::{device_name, finish, host_values, is_cpu, Backend, Compute};
-pub use encoding::features::{feature, gbuffer_features, pixel_features, FEATURES};
+pub use encoding::features::{feature, gbuffer_features, pixel_features, position_frame, FEATURES};
 pub use encoding::map_norm::MapNorm;
 pub use encoding::position_encoding::PositionEncoding;
 pub use model::config::{ModelConfig, DEFAULT_ENCODER_WIDTH, DEFAULT_MAP_NORM};

@@ -38,7 +38,7 @@ pub struct Relighter {
     /// With the kernels, the scene of the last frame on the device (by its address: a model
     /// renders the one scene it was trained on) for its rasterised G-buffers.
     #[cfg(feature = "wgpu")]
-    raster: std::sync::Mutex<Option<(usize, std::sync::Arc<crate::gpu::RasterGBuffer>)>>,
+    raster: crate::gpu::KeptLast<usize, std::sync::Arc<crate::gpu::RasterGBuffer>>,
 }
 
 /// What the encoder made of one lighting: the 64-d code ê and what the map's channels were
@@ -314,15 +314,9 @@ impl Relighter {
     #[cfg(feature = "wgpu")]
     fn raster(&self, ts: &TraceScene) -> Result<std::sync::Arc<crate::gpu::RasterGBuffer>> {
         let key = std::ptr::from_ref(ts.scene) as usize;
-        let mut kept = self.raster.lock().unwrap_or_else(|e| e.into_inner());
-        if let Some((k, r)) = &*kept {
-            if *k == key {
-                return Ok(r.clone());
-            }
-        }
-        let r = std::sync::Arc::new(crate::gpu::RasterGBuffer::new(ts.scene)?);
-        *kept = Some((key, r.clone()));
-        Ok(r)
+        self.raster.try_get(key, || {
+            crate::gpu::RasterGBuffer::new(ts.scene).map(std::sync::Arc::new)
+        })
     }
 
     /// Whether frames stay on the device from the G-buffer to the finished frame: on the

@@ -18,6 +18,14 @@ pub mod feature {
     pub const ALPHA: Range<usize> = 18..19;
 }
 
+/// How a position is normalised within `bounds`: x ↦ (x − lo) / extent · 2 − 1, with `lo` their
+/// minimum and `extent` their size, at least 1e-6 a side (a flat scene). The GPU kernels take
+/// the same two vectors.
+pub fn position_frame(bounds: &[[f32; 3]; 2]) -> (Vec3, Vec3) {
+    let (lo, hi) = (Vec3::from(bounds[0]), Vec3::from(bounds[1]));
+    (lo, (hi - lo).max(Vec3::splat(1e-6)))
+}
+
 /// The 19 network inputs of one surface point, in the order of [`feature`].
 /// `bounds` normalises the position to [−1, 1]; ωr is ωo mirrored about n.
 pub fn pixel_features(
@@ -29,8 +37,8 @@ pub fn pixel_features(
     ks: Vec3,
     alpha: f32,
 ) -> [f32; FEATURES] {
-    let (lo, hi) = (Vec3::from(bounds[0]), Vec3::from(bounds[1]));
-    let x = (position - lo) / (hi - lo).max(Vec3::splat(1e-6)) * 2.0 - 1.0;
+    let (lo, extent) = position_frame(bounds);
+    let x = (position - lo) / extent * 2.0 - 1.0;
     let mirror = 2.0 * normal.dot(view) * normal - view;
     let mut f = [0.0; FEATURES];
     for (i, v) in [x, view, mirror, normal, kd, ks].iter().enumerate() {

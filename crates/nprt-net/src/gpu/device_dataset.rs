@@ -6,7 +6,10 @@
 use anyhow::{bail, Context, Result};
 use nprt_data::dataset::PACKED_PIXEL_BYTES;
 
+use glam::Vec3;
+
 use super::GpuDevice;
+use crate::encoding::features::position_frame;
 use crate::training::training_set::TrainingSet;
 
 /// Records per upload: large enough to keep the queue's copies few, small enough that their
@@ -96,12 +99,13 @@ impl DeviceDataset {
                 set.train.len()
             ));
         }
-        let [lo, hi] = set.pack.header().bounds;
+        let pack_bounds = &set.pack.header().bounds;
+        let (lo, normaliser) = position_frame(pack_bounds);
+        // The records' positions are stored within the bounds' own extent, unclamped.
+        let extent = Vec3::from(pack_bounds[1]) - lo;
         let mut bounds = [0.0; 12];
-        for a in 0..3 {
-            bounds[a] = lo[a];
-            bounds[4 + a] = hi[a] - lo[a];
-            bounds[8 + a] = (hi[a] - lo[a]).max(1e-6);
+        for (k, v) in [lo, extent, normaliser].iter().enumerate() {
+            bounds[4 * k..4 * k + 3].copy_from_slice(&v.to_array());
         }
         Ok(DeviceDataset {
             shards,

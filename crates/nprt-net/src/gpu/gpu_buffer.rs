@@ -74,13 +74,29 @@ impl GpuDevice {
         });
         let mut encoder = self.device.create_command_encoder(&Default::default());
         encoder.copy_buffer_to_buffer(buffer, 0, &staging, 0, size);
-        self.queue.submit([encoder.finish()]);
+        let submission = self.queue.submit([encoder.finish()]);
+        self.read_mapped(&staging, submission)
+    }
+
+    /// The values of `staging` (a host-readable buffer) once `submission`, which fills it, is
+    /// done; `staging` is unmapped again after, to be filled anew.
+    pub(super) fn read_mapped(
+        &self,
+        staging: &wgpu::Buffer,
+        submission: wgpu::SubmissionIndex,
+    ) -> Vec<f32> {
         let slice = staging.slice(..);
         slice.map_async(wgpu::MapMode::Read, |r| {
             r.expect("mapping a GPU buffer for reading")
         });
-        self.wait();
-        let view = slice.get_mapped_range().expect("a mapped GPU buffer");
-        bytemuck::cast_slice(&view).to_vec()
+        self.device
+            .poll(wgpu::PollType::Wait {
+                submission_index: Some(submission),
+                timeout: None,
+            })
+            .expect("waiting for the GPU queue");
+        let values = bytemuck::cast_slice(&slice.get_mapped_range().expect("mapped")).to_vec();
+        staging.unmap();
+        values
     }
 }

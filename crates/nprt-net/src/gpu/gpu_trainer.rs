@@ -286,19 +286,7 @@ impl GpuTrainer {
     pub fn finish(&mut self) -> Option<f64> {
         let pending = self.pending.take()?;
         let copy = &self.loss_copies[pending.copy];
-        let slice = copy.slice(..);
-        slice.map_async(wgpu::MapMode::Read, |r| {
-            r.expect("mapping a step's loss for reading")
-        });
-        self.gpu
-            .device
-            .poll(wgpu::PollType::Wait {
-                submission_index: Some(pending.submission),
-                timeout: None,
-            })
-            .expect("waiting for a training step");
-        let total = bytemuck::cast_slice::<u8, f32>(&slice.get_mapped_range().expect("mapped"))[0];
-        copy.unmap();
+        let total = self.gpu.read_mapped(copy, pending.submission)[0];
         Some(total as f64 / (3 * pending.rows.max(1)) as f64)
     }
 

@@ -34,9 +34,8 @@ struct TrackTape {
 impl GpuTrainer {
     /// Records the transport networks' forward pass, loss and backward over batch `b` lit by
     /// its `codes`: parameter gradients into `grads`, the codes' gradient added to `d_codes`
-    /// (cleared before), the loss summed into `loss`.
-    /// Records the transport networks' forward pass, the loss and their backward pass;
-    /// returns how many of `plan`'s dispatches it holds once the loss is made.
+    /// (cleared before), the loss summed into `loss`. Returns how many of `plan`'s dispatches
+    /// it holds once the loss is made (the forward part).
     pub(super) fn record_transport(
         &self,
         plan: &mut Vec<Dispatch>,

@@ -7,7 +7,6 @@
 //! `loss.png` and `checkpoint/`.
 
 use std::path::Path;
-use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Mutex;
 
 use anyhow::{Context, Result};
@@ -25,7 +24,7 @@ use crate::training::calibration::{level_gain, Calibration, LEVEL_SAMPLES};
 use crate::training::checkpoint::RunState;
 use crate::training::epoch_plan::{group_batches, EpochPlan};
 use crate::training::optimiser::DeviceSteps;
-use crate::training::train_options::TrainOptions;
+use crate::training::train_options::{Gather, TrainOptions};
 use crate::training::training_loop::{self, Objective, Schedule, TrainSummary, ADAM_EPSILON};
 use crate::training::training_set::{TrainingSet, ViewSamples};
 use crate::training::validation::{forward_log_l1, validation_loss};
@@ -38,10 +37,15 @@ struct PixelObjective<'a> {
     /// The model file as last saved, returned to the caller.
     saved: Mutex<Option<ModelFile>>,
     /// Whether the steps run on our own GPU kernels (`--device wgpu`).
-    #[cfg_attr(not(feature = "kernels"), allow(dead_code))]
     kernels: bool,
-    /// Whether those kernels hold the dataset, so that batches are only picked on the host.
-    resident: AtomicBool,
+}
+
+impl PixelObjective<'_> {
+    /// Whether the kernels hold the dataset (their steps are refused where it cannot go up),
+    /// so that batches are only picked on the host.
+    fn resident(&self) -> bool {
+        self.kernels && self.opts.gather == Gather::Device
+    }
 }
 
 impl Objective for PixelObjective<'_> {
@@ -103,7 +107,7 @@ impl Objective for PixelObjective<'_> {
                 batches
                     .into_iter()
                     .skip(from.saturating_sub(start))
-                    .map(move |samples| match self.resident.load(Ordering::Relaxed) {
+                    .map(move |samples| match self.resident() {
                         true => Batch::picked(&group, &views.0, &samples),
                         false => Batch::gather(&views.0, &samples),
                     })
@@ -125,10 +129,8 @@ impl Objective for PixelObjective<'_> {
         if !self.kernels {
             return Ok(None);
         }
-        let resident = self.opts.gather == crate::Gather::Device;
-        let dataset = resident.then_some(self.set);
+        let dataset = self.resident().then_some(self.set);
         let steps = crate::gpu::KernelSteps::new(net, self.opts.loss, dataset)?;
-        self.resident.store(resident, Ordering::Relaxed);
         Ok(Some(Box::new(steps)))
     }
 
@@ -224,7 +226,6 @@ pub fn train(
         opts,
         saved: Mutex::new(None),
         kernels,
-        resident: AtomicBool::new(false),
     };
     let device = if kernels {
         Device::flex()

@@ -21,7 +21,7 @@ pub trait DeviceSteps<N, B> {
     fn finish(&mut self) -> Result<Option<(f64, u64)>>;
     /// `batch`'s mean log-L1 loss under the current parameters, without a step (validation).
     fn loss(&mut self, batch: &B) -> Result<f64>;
-    /// Writes the current parameters into `net` (for validation and saving).
+    /// Writes the current parameters into `net` (for saving).
     fn store(&self, net: &mut N);
     /// Writes Adam's state (moments and step count) to `path`.
     fn save(&self, path: &Path) -> Result<()>;

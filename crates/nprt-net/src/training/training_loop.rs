@@ -459,17 +459,14 @@ impl<'s, O: Objective> Run<'s, O> {
                 self.split.batch_wait += since(waiting);
                 let stepping = Instant::now();
                 let lr = self.learning_rate();
+                self.queued += 1;
                 let done = match optim {
                     // A device's step returns the one before it, so that the device does not
                     // wait for the host.
-                    Optimiser::Device(steps) => {
-                        self.queued += 1;
-                        steps.step(&batch, lr)?
-                    }
+                    Optimiser::Device(steps) => steps.step(&batch, lr)?,
                     Optimiser::Burn(adam) => {
                         let (value, grads, samples) = objective.gradients(&net, &batch, device);
                         net = adam.step(lr, net, grads);
-                        self.queued += 1;
                         Some((value, samples))
                     }
                 };

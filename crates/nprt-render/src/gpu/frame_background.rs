@@ -3,11 +3,10 @@
 //! traced later brings the map there. The map's texels go up once per map, the rotation with
 //! each frame.
 
-use std::sync::Mutex;
-
 use nprt_net::gpu::{GpuDevice, KernelSource};
 use nprt_scene::{Camera, EnvMap};
 
+use super::kept_last::KeptLast;
 use super::raster_gbuffer::camera_words;
 
 pub const FRAME_BACKGROUND: KernelSource = KernelSource {
@@ -21,7 +20,7 @@ pub const FRAME_BACKGROUND: KernelSource = KernelSource {
 /// The last map's texels on the device, by the address and size of its texels on the host.
 #[derive(Default)]
 pub struct GpuMap {
-    kept: Mutex<Option<((usize, usize), wgpu::Buffer)>>,
+    kept: KeptLast<(usize, usize), wgpu::Buffer>,
 }
 
 /// What a frame's background needs: the G-buffer it fills the empty pixels of, its camera and
@@ -70,15 +69,9 @@ impl GpuMap {
     /// `map`'s texels on the device, uploaded unless they were the last map's.
     fn texels(&self, gpu: &GpuDevice, map: &EnvMap) -> wgpu::Buffer {
         let key = (map.texels().as_ptr() as usize, map.texels().len());
-        let mut kept = self.kept.lock().unwrap_or_else(|e| e.into_inner());
-        match &*kept {
-            Some((k, buffer)) if *k == key => buffer.clone(),
-            _ => {
-                let flat: Vec<f32> = map.texels().iter().flat_map(|t| t.to_array()).collect();
-                let buffer = gpu.upload(&flat);
-                *kept = Some((key, buffer.clone()));
-                buffer
-            }
-        }
+        self.kept.get(key, || {
+            let flat: Vec<f32> = map.texels().iter().flat_map(|t| t.to_array()).collect();
+            gpu.upload(&flat)
+        })
     }
 }

@@ -6,7 +6,6 @@
 use std::sync::Arc;
 
 use anyhow::Result;
-use glam::Vec3;
 use nprt_net::cpu::{DenseStack, HostEncoder, HostTransport};
 use nprt_net::encoding::hash_grid;
 use nprt_net::network::encoder::{BLOCKS, CHANNELS, CODE_SIZE};
@@ -201,8 +200,7 @@ impl GpuNetwork {
         pixels: usize,
         bounds: &[[f32; 3]; 2],
     ) -> GpuPixels {
-        let (lo, hi) = (Vec3::from(bounds[0]), Vec3::from(bounds[1]));
-        let extent = (hi - lo).max(Vec3::splat(1e-6));
+        let (lo, extent) = nprt_net::position_frame(bounds);
         self.pixels_with(pixels, |pass, first, n| {
             let features = self.gpu.buffer(n * FEATURES);
             let mut params = vec![n as u32, first as u32, 0, 0];

@@ -77,14 +77,13 @@ impl GpuScene {
             .iter()
             .flat_map(|m| material_record(m, &mut textures, &mut bitmaps))
             .collect();
-        let bytes = |v: usize| 4 * v;
         for (words, what) in [
             (positions.len(), "the scene's vertex positions"),
             (attributes.len(), "the scene's vertex normals and uvs"),
             (triangles.len(), "the scene's triangles"),
             (bitmaps.texels.len(), "the scene's textures"),
         ] {
-            gpu.check_binding(bytes(words), &format!("{what} ('{}')", scene.name))
+            gpu.check_binding(4 * words, &format!("{what} ('{}')", scene.name))
                 .context("the GPU frame path cannot take the scene; use --device cpu")?;
         }
         let (lo, hi) = scene.bounds();
@@ -123,7 +122,11 @@ impl TexelStore {
 /// A material's record: `[flags, texture ids (kd, ks, α) or (base, metallic-roughness, —),
 /// opacity texture, bump texture, bump scale, ks's factor at normal incidence (3), 0…]`. Its
 /// textures are appended to `textures`.
-fn material_record(m: &Material, textures: &mut Vec<u32>, bitmaps: &mut TexelStore) -> [u32; 16] {
+fn material_record(
+    m: &Material,
+    textures: &mut Vec<u32>,
+    bitmaps: &mut TexelStore,
+) -> [u32; MATERIAL_WORDS] {
     let mut add = |t: &Texture| {
         let id = (textures.len() / TEXTURE_WORDS) as u32;
         textures.extend(texture_record(t, bitmaps));

@@ -14,12 +14,14 @@
 mod frame_background;
 mod gpu_network;
 mod gpu_scene;
+mod kept_last;
 mod kernels;
 mod raster_gbuffer;
 mod shader_export;
 
 pub use frame_background::Background;
 pub use gpu_network::{GpuNetwork, GpuPixels};
+pub(crate) use kept_last::KeptLast;
 pub use nprt_net::gpu::GpuDevice;
 pub use raster_gbuffer::RasterGBuffer;
 pub use shader_export::{export_model, ExampleView, ExportSummary};
