@@ -35,6 +35,8 @@ pub mod model;
 pub mod network;
 pub mod training;
 
+#[cfg(feature = "kernels")]
+pub use bench::throughput::profile_kernels;
 pub use bench::throughput::{measure_inference, measure_throughput, median, InferenceSpeed};
 pub use burn;
 pub use burn::tensor::Device;

@@ -151,3 +151,67 @@ fn host(net: &NprtNet) -> (HostEncoder, HostTransport) {
         HostTransport::from_net(net),
     )
 }
+
+/// A profiled step (`nprt bench train --profile`) is the step: the same loss and parameters to
+/// the bit as an untimed one, with each of its kernels timed, the plan's dispatches all
+/// counted. Where the adapter has no timestamp queries it says so.
+#[test]
+fn a_profiled_step_is_a_step_with_its_kernels_timed() {
+    if !GpuDevice::probe() {
+        return;
+    }
+    let batch = random_batch(300, 3, 29);
+    let samples = batch.samples();
+    let net = network(&ModelConfig::new(Design::Dsep, None));
+    let (mut plain, mut timed) = (
+        GpuTrainer::new(&net).unwrap(),
+        GpuTrainer::new(&net).unwrap(),
+    );
+    let lr = 1e-3;
+    plain.step(&samples, Loss::LogL1, lr);
+    let times = match timed.profile_step(&samples, Loss::LogL1, lr) {
+        Ok(t) => t,
+        Err(e) => {
+            assert!(format!("{e:#}").contains("timestamp"), "{e:#}");
+            eprintln!("skipped: {e:#}");
+            return;
+        }
+    };
+    let flat = |t: &GpuTrainer| {
+        let (encoder, transport) = t.parameters();
+        ParameterLayout::pack(&encoder, &transport, 1).1
+    };
+    assert_eq!(
+        flat(&plain),
+        flat(&timed),
+        "the profiled step computed something else"
+    );
+    let second = |t: &mut GpuTrainer| t.step(&samples, Loss::LogL1, lr);
+    assert_eq!(
+        second(&mut plain),
+        second(&mut timed),
+        "losses after the profiled step differ"
+    );
+    for kernel in ["gemm", "encoder_weight_backward", "adam", "radiance_loss"] {
+        assert!(
+            times.iter().any(|k| k.kernel == kernel),
+            "{kernel} untimed: {times:?}"
+        );
+    }
+    assert_eq!(
+        times
+            .iter()
+            .filter(|k| k.kernel == "adam")
+            .map(|k| k.dispatches)
+            .sum::<usize>(),
+        1
+    );
+    assert!(
+        times.iter().all(|k| k.ms >= 0.0) && times.iter().any(|k| k.ms > 0.0),
+        "{times:?}"
+    );
+    assert!(
+        times.windows(2).all(|w| w[0].ms >= w[1].ms),
+        "not longest first: {times:?}"
+    );
+}

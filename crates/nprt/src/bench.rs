@@ -116,6 +116,11 @@ pub struct BenchTrainArgs {
     /// fastest (by its median) is the peer compared with, and named in the last column.
     #[arg(long, value_delimiter = ',', default_value = "eager-f32")]
     peer_variants: Vec<PeerVariant>,
+    /// With --device wgpu: after each design's row, the GPU time of each of nprt's kernels in
+    /// one step after the warm-up (timestamp queries, each dispatch timed in a pass of its
+    /// own), beside the step's wall time at the measured rate: where a step's time goes.
+    #[arg(long)]
+    profile: bool,
     #[command(flatten)]
     device: DeviceArg,
 }
@@ -234,6 +239,10 @@ fn infer(a: BenchInferArgs) -> Result<()> {
 }
 
 fn train(a: BenchTrainArgs) -> Result<()> {
+    anyhow::ensure!(
+        !a.profile || matches!(a.device.compute, nprt_net::Compute::Wgpu),
+        "--profile times nprt's own kernels: it needs --device wgpu"
+    );
     let threads = rayon::current_num_threads();
     let device = a.device.device()?;
     let cpu = is_cpu(&device);
@@ -322,8 +331,38 @@ fn train(a: BenchTrainArgs) -> Result<()> {
             spread,
             best.map_or("-".into(), |v| a.peer_variants[v].name())
         );
+        if a.profile {
+            print_profile(&config, &a, 1e3 * a.batch_size as f64 / ours)?;
+        }
     }
     Ok(())
+}
+
+/// The `--profile` lines of one design: its kernels' GPU time in one step, longest first.
+#[cfg(feature = "wgpu")]
+fn print_profile(config: &ModelConfig, a: &BenchTrainArgs, step_ms: f64) -> Result<()> {
+    let times = nprt_net::profile_kernels(config, a.batch_size, a.views, a.warmup)?;
+    let sum: f64 = times.iter().map(|k| k.ms).sum();
+    println!(
+        "  one step's kernels: {sum:.2} ms of GPU time; a step at the rate above takes {step_ms:.2} ms"
+    );
+    for k in &times {
+        println!(
+            "    {:<26} {:>4} × {:>9.3} ms {:>6.1}%",
+            k.kernel,
+            k.dispatches,
+            k.ms,
+            100.0 * k.ms / sum.max(f64::MIN_POSITIVE)
+        );
+    }
+    Ok(())
+}
+
+#[cfg(not(feature = "wgpu"))]
+fn print_profile(_: &ModelConfig, _: &BenchTrainArgs, _: f64) -> Result<()> {
+    anyhow::bail!(
+        "--profile times nprt's own kernels: this nprt was built without the `wgpu` feature"
+    )
 }
 
 /// The PyTorch peer to compare with, if one was given: its Python, PyTorch's device name (CUDA

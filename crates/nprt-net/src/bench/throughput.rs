@@ -30,23 +30,7 @@ pub fn measure_throughput(
     let device = device.clone().autodiff();
     let mut net = config.build(&mut Init::new(0, &device));
     let mut optim = AdamConfig::new().with_epsilon(ADAM_EPSILON).init();
-    let mut rng = Pcg64Mcg::seed_from_u64(0);
-    let w = config.encoder_width;
-    let mut random = |n: usize, scale: f32| -> Vec<f32> {
-        (0..n).map(|_| rng.random::<f32>() * scale).collect()
-    };
-    let batch = Batch {
-        features: random(batch_size * FEATURES, 1.0),
-        radiance: random(batch_size * 3, 4.0),
-        view: (0..batch_size).map(|i| (i % views) as i64).collect(),
-        scale: random(batch_size * 3, 1.0)
-            .into_iter()
-            .map(|s| s + 0.5)
-            .collect(),
-        lights: random(views * 3 * w * w / 2, 1.0),
-        light_width: w,
-        picks: None,
-    };
+    let batch = synthetic_batch(config, batch_size, views);
     #[cfg(feature = "kernels")]
     if crate::device::Backend::of(&device) == crate::device::Backend::Wgpu {
         return kernel_throughput(config, &batch, steps, warmup);
@@ -62,6 +46,46 @@ pub fn measure_throughput(
     }
     device.sync().ok();
     (batch_size * steps) as f64 / timed.elapsed().as_secs_f64()
+}
+
+/// A batch of uniform random values (seeded): `batch_size` samples over `views` maps.
+fn synthetic_batch(config: &ModelConfig, batch_size: usize, views: usize) -> Batch {
+    let mut rng = Pcg64Mcg::seed_from_u64(0);
+    let w = config.encoder_width;
+    let mut random = |n: usize, scale: f32| -> Vec<f32> {
+        (0..n).map(|_| rng.random::<f32>() * scale).collect()
+    };
+    Batch {
+        features: random(batch_size * FEATURES, 1.0),
+        radiance: random(batch_size * 3, 4.0),
+        view: (0..batch_size).map(|i| (i % views) as i64).collect(),
+        scale: random(batch_size * 3, 1.0)
+            .into_iter()
+            .map(|s| s + 0.5)
+            .collect(),
+        lights: random(views * 3 * w * w / 2, 1.0),
+        light_width: w,
+        picks: None,
+    }
+}
+
+/// The GPU time of each of our kernels in one training step on the synthetic batch of
+/// [`measure_throughput`], after `warmup` untimed steps (`nprt bench train --profile`).
+#[cfg(feature = "kernels")]
+pub fn profile_kernels(
+    config: &ModelConfig,
+    batch_size: usize,
+    views: usize,
+    warmup: usize,
+) -> anyhow::Result<Vec<crate::gpu::KernelTime>> {
+    let net = config.build(&mut Init::new(0, &Device::flex()));
+    let mut gpu = crate::gpu::GpuTrainer::new(&net)?;
+    let batch = synthetic_batch(config, batch_size, views);
+    let samples = batch.samples();
+    for _ in 0..warmup {
+        gpu.queue_step(&samples, Loss::LogL1, 1e-4);
+    }
+    gpu.profile_step(&samples, Loss::LogL1, 1e-4)
 }
 
 /// [`measure_throughput`] on our own GPU kernels (what `--device wgpu` trains with): each step

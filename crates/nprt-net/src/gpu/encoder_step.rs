@@ -6,9 +6,15 @@ use super::gpu_trainer::{BatchBuffers, GpuTrainer};
 use super::kernels::{
     ENCODER_BLOCK, ENCODER_INPUT_BACKWARD, ENCODER_POOL_BACKWARD, ENCODER_WEIGHT_BACKWARD,
 };
+use super::network_layout::ConvAt;
 use super::products::{Bias, Operand, Output};
 use super::{groups_for, Dispatch};
 use crate::network::encoder::{CHANNELS, CODE_SIZE};
+
+/// Chunks of image rows a convolution's weight gradients are summed over, at most: enough
+/// threads for a GPU (a 128 × 64 map's first block at 8 maps: 256 chunks × 896 values), and
+/// few enough partial sums to add.
+const CONV_CHUNKS: usize = 256;
 
 /// What the encoder's forward pass keeps: each block's input, (h, w) and pooling tape, and
 /// the last block's output (the flattened input of the code layer).
@@ -122,22 +128,7 @@ impl GpuTrainer {
                 &[&tape.tapes[k], &d, &dz, &d_input],
                 groups_for(count),
             ));
-            let params = [
-                conv.c_in,
-                h,
-                w,
-                b.views,
-                conv.weight.offset,
-                conv.bias.offset,
-                0,
-                0,
-            ];
-            plan.push(gpu.prepare(
-                &ENCODER_WEIGHT_BACKWARD,
-                &params.map(|v| v as u32),
-                &[&tape.inputs[k], &dz, &self.grads],
-                groups_for(CHANNELS * (conv.c_in * 9 + 1)),
-            ));
+            self.conv_gradients(plan, conv, (h, w), b.views, &tape.inputs[k], &dz);
             if k > 0 {
                 let params = [conv.c_in, h, w, b.views, conv.weight.offset, 0, 0, 0];
                 plan.push(gpu.prepare(
@@ -148,6 +139,47 @@ impl GpuTrainer {
                 ));
             }
             d = d_input;
+        }
+    }
+
+    /// Records the gradients of a block's convolution weights and biases from its input and
+    /// the gradient at its pre-activation `dz`: sums over chunks of image rows, then over the
+    /// chunks in order.
+    fn conv_gradients(
+        &self,
+        plan: &mut Vec<Dispatch>,
+        conv: &ConvAt,
+        (h, w): (usize, usize),
+        views: usize,
+        input: &wgpu::Buffer,
+        dz: &wgpu::Buffer,
+    ) {
+        let rows = views * h;
+        let chunk_rows = rows.div_ceil(CONV_CHUNKS);
+        let chunks = rows.div_ceil(chunk_rows);
+        let taps = conv.c_in * 9;
+        let (weight_sums, bias_sums) = (
+            self.gpu.buffer(chunks * CHANNELS * taps),
+            self.gpu.buffer(chunks * CHANNELS),
+        );
+        let params = [conv.c_in, h, w, views, chunk_rows, chunks, 0, 0];
+        plan.push(self.gpu.prepare(
+            &ENCODER_WEIGHT_BACKWARD,
+            &params.map(|v| v as u32),
+            &[input, dz, &weight_sums, &bias_sums],
+            groups_for(chunks * CHANNELS * (taps + 1)),
+        ));
+        let sums = [(&weight_sums, conv.weight), (&bias_sums, conv.bias)];
+        for (partial, span) in sums {
+            let n = span.len;
+            self.column_sum(
+                plan,
+                partial,
+                chunks,
+                n,
+                None,
+                Output::to(&self.grads, span.offset, n),
+            );
         }
     }
 }

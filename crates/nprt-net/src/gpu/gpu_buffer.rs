@@ -80,11 +80,11 @@ impl GpuDevice {
 
     /// The values of `staging` (a host-readable buffer) once `submission`, which fills it, is
     /// done; `staging` is unmapped again after, to be filled anew.
-    pub(super) fn read_mapped(
+    pub(super) fn read_mapped<T: bytemuck::Pod>(
         &self,
         staging: &wgpu::Buffer,
         submission: wgpu::SubmissionIndex,
-    ) -> Vec<f32> {
+    ) -> Vec<T> {
         let slice = staging.slice(..);
         slice.map_async(wgpu::MapMode::Read, |r| {
             r.expect("mapping a GPU buffer for reading")

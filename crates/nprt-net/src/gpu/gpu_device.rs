@@ -72,7 +72,9 @@ impl GpuDevice {
         let (device, queue) =
             futures_lite::future::block_on(adapter.request_device(&wgpu::DeviceDescriptor {
                 label: Some("nprt"),
-                required_features: wgpu::Features::empty(),
+                // Timestamps only serve `nprt bench train --profile`; an adapter without them
+                // still trains.
+                required_features: adapter.features() & wgpu::Features::TIMESTAMP_QUERY,
                 // The adapter's own limits, not WebGPU's portable defaults (128 MiB per
                 // storage binding, which a chunk of activations approaches).
                 required_limits: adapter.limits(),

@@ -16,6 +16,7 @@ use anyhow::{anyhow, Context, Result};
 use safetensors::{tensor::TensorView, Dtype, SafeTensors};
 
 use super::device_dataset::DeviceDataset;
+use super::kernel_timer::{KernelTime, KernelTimer};
 use super::kernels::{ADAM, GATHER_SAMPLES};
 use super::network_layout::NetworkLayout;
 use super::parameters::ParameterLayout;
@@ -286,7 +287,7 @@ impl GpuTrainer {
     pub fn finish(&mut self) -> Option<f64> {
         let pending = self.pending.take()?;
         let copy = &self.loss_copies[pending.copy];
-        let total = self.gpu.read_mapped(copy, pending.submission)[0];
+        let total: f32 = self.gpu.read_mapped(copy, pending.submission)[0];
         Some(total as f64 / (3 * pending.rows.max(1)) as f64)
     }
 
@@ -297,8 +298,69 @@ impl GpuTrainer {
         self.finish().expect("a pass was queued")
     }
 
+    /// One training step on `batch` like [`Self::step`], each dispatch timed on the device:
+    /// the GPU time of each kernel, longest first (`nprt bench train --profile`). An error
+    /// where the adapter has no timestamp queries.
+    pub fn profile_step(
+        &mut self,
+        batch: &Samples,
+        loss: Loss,
+        lr: f64,
+    ) -> Result<Vec<KernelTime>> {
+        self.finish();
+        let inputs = Inputs::Host(batch);
+        let pass = Pass::Step(lr);
+        self.prepare(inputs, loss);
+        let mut timer = KernelTimer::new(&self.gpu, self.dispatches(inputs, pass).len())?;
+        let (submission, copy, rows) = self.submit(inputs, pass, Some(&mut timer));
+        self.pending = Some(PendingLoss {
+            copy,
+            submission: submission.clone(),
+            rows,
+        });
+        self.finish();
+        Ok(timer.read(&self.gpu, submission))
+    }
+
     fn queue(&mut self, inputs: Inputs, loss: Loss, pass: Pass) -> Option<f64> {
         self.prepare(inputs, loss);
+        let (submission, copy, rows) = self.submit(inputs, pass, None);
+        let before = self.finish();
+        self.pending = Some(PendingLoss {
+            copy,
+            submission,
+            rows,
+        });
+        before
+    }
+
+    /// What a submission of the last prepared plan runs, in order: the batch's gather (from a
+    /// dataset on the device), the plan's forward part or all of it, and Adam for a step.
+    fn dispatches(&self, inputs: Inputs, pass: Pass) -> Vec<&Dispatch> {
+        let plan = self.plans.last().expect("prepared");
+        let mut list: Vec<&Dispatch> = Vec::new();
+        if matches!(inputs, Inputs::Picked { .. }) {
+            list.extend(&plan.gathers);
+        }
+        list.extend(match pass {
+            Pass::Forward => &plan.dispatches[..plan.forward],
+            _ => &plan.dispatches[..],
+        });
+        if let Pass::Step(_) = pass {
+            list.push(&self.adam);
+        }
+        list
+    }
+
+    /// Submits the last prepared plan (in one compute pass, or each dispatch timed by
+    /// `timer`) with a copy of its loss into the loss copy not awaiting a read; returns the
+    /// submission, that copy and the batch's rows.
+    fn submit(
+        &mut self,
+        inputs: Inputs,
+        pass: Pass,
+        timer: Option<&mut KernelTimer>,
+    ) -> (wgpu::SubmissionIndex, usize, usize) {
         if let Pass::Step(lr) = pass {
             self.steps += 1;
             let params = adam_params(self.layout.total, lr, self.steps);
@@ -309,7 +371,6 @@ impl GpuTrainer {
         let mut encoder = self.gpu.device.create_command_encoder(&Default::default());
         // Every gradient is written whole each step; only the codes' is added to, per track.
         encoder.clear_buffer(&plan.batch.d_codes, 0, None);
-        let picked = matches!(inputs, Inputs::Picked { .. });
         if let (Inputs::Picked { views, .. }, Some(dataset)) = (inputs, &self.dataset) {
             let size = (dataset.light_floats * 4) as u64;
             for (k, &v) in views.iter().enumerate() {
@@ -317,30 +378,17 @@ impl GpuTrainer {
                 encoder.copy_buffer_to_buffer(&dataset.lights, from, &plan.batch.lights, to, size);
             }
         }
-        {
-            let mut compute = encoder.begin_compute_pass(&Default::default());
-            if picked {
-                plan.gathers.iter().for_each(|d| d.record(&mut compute));
-            }
-            let dispatches = match pass {
-                Pass::Forward => &plan.dispatches[..plan.forward],
-                _ => &plan.dispatches[..],
-            };
-            dispatches.iter().for_each(|d| d.record(&mut compute));
-            if let Pass::Step(_) = pass {
-                self.adam.record(&mut compute);
+        let dispatches = self.dispatches(inputs, pass);
+        match timer {
+            Some(timer) => timer.record(&mut encoder, &dispatches),
+            None => {
+                let mut compute = encoder.begin_compute_pass(&Default::default());
+                dispatches.iter().for_each(|d| d.record(&mut compute));
             }
         }
         encoder.copy_buffer_to_buffer(&plan.batch.loss, 0, &self.loss_copies[copy], 0, 4);
-        let rows = plan.batch.rows;
         let submission = self.gpu.queue.submit([encoder.finish()]);
-        let before = self.finish();
-        self.pending = Some(PendingLoss {
-            copy,
-            submission,
-            rows,
-        });
-        before
+        (submission, copy, plan.batch.rows)
     }
 
     /// Makes the plan for `inputs`' shape and `loss` the last of the kept plans (made unless

@@ -51,6 +51,8 @@ impl Pipelines {
 /// One dispatch ready to record: its pipeline, its bind group (which keeps its buffers alive)
 /// and its workgroups. A training step keeps its dispatches and records them again each step.
 pub struct Dispatch {
+    /// The kernel's name, for [`super::KernelTime`].
+    pub kernel: &'static str,
     pipeline: wgpu::ComputePipeline,
     group: wgpu::BindGroup,
     groups: [u32; 3],
@@ -114,6 +116,7 @@ impl super::GpuDevice {
             entries: &entries,
         });
         Dispatch {
+            kernel: kernel.name,
             pipeline,
             group,
             groups,
