@@ -1,10 +1,12 @@
 #!/usr/bin/env bash
 # Every GPU measurement of nprt's training and frame goals in one go, on a machine with an
-# NVIDIA GPU, its Vulkan driver and PyTorch with CUDA (sized for 20 minutes on one H100 with the
-# KITCHEN part; not yet run on one). Writes one summary file (Markdown) with:
-#   1. `nprt bench train --device wgpu` (nprt's own kernels) per design beside PyTorch on CUDA,
-#      eager and torch.compile, each in f32 and bf16 autocast (the fastest is the peer), at
-#      batch 16,384 and 262,144;
+# NVIDIA GPU, its Vulkan driver and PyTorch with CUDA. Its parts, as run on one H200
+# (2026-11-26): training at 16,384 with the eager peers about 70 s, with the torch.compile ones
+# 4 more minutes; at 262,144 with the eager peers about 60 s; frames about 50 s; with --kitchen
+# 10 minutes of training and an evaluation more. Writes one summary file (Markdown) with:
+#   1. `nprt bench train --device wgpu --profile` (nprt's own kernels, and each kernel's GPU
+#      time in a step) per design beside PyTorch on CUDA, eager and torch.compile, each in f32
+#      and bf16 autocast (the fastest is the peer), at batch 16,384 and 262,144;
 #   2. the paper's schedule (3000 views of 256², 500 epochs) projected from those rates;
 #   3. `nprt bench frame` (G-buffer, encoder, networks, total) per design at 512² and 1920×1080
 #      on the GPU kernels, beside the paper's Table 3;
@@ -13,6 +15,7 @@
 #
 # usage: bench/gpu.sh [--nprt BIN] [--python PY] [--kitchen DATASET --cpu-model MODEL]
 #                     [--summary FILE] [--work DIR] [--batches "16384 262144"] [--res 512,1920x1080]
+#                     [--peer-variants LIST]
 #   --nprt       the nprt binary (default target/release/nprt, built with `--features gpu`
 #                when missing)
 #   --python     Python with PyTorch and CUDA (default python3)
@@ -23,6 +26,8 @@
 #   --work       where models and reports go (default a temporary folder)
 #   --batches    the training batch sizes (default "16384 262144")
 #   --res        the frame sizes (default 512,1920x1080); both only to try the script small
+#   --peer-variants  the PyTorch variants (default eager-f32,eager-bf16,compile-f32,compile-bf16;
+#                eager-f32,eager-bf16 spares torch.compile's minutes on a short loan)
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
@@ -34,6 +39,7 @@ summary=bench-gpu-summary.md
 work=
 batches="16384 262144"
 res=512,1920x1080
+variants=eager-f32,eager-bf16,compile-f32,compile-bf16
 while [ $# -gt 0 ]; do
   case "$1" in
     --nprt) nprt=$2; shift 2 ;;
@@ -44,6 +50,7 @@ while [ $# -gt 0 ]; do
     --work) work=$2; shift 2 ;;
     --batches) batches=$2; shift 2 ;;
     --res) res=$2; shift 2 ;;
+    --peer-variants) variants=$2; shift 2 ;;
     -h | --help) sed -n '2,/^set -euo/p' "$0" | sed '$d; s/^# \{0,1\}//'; exit 0 ;;
     *) echo "bench/gpu.sh: unknown argument '$1' (--help lists them)" >&2; exit 2 ;;
   esac
@@ -72,7 +79,6 @@ fi
 mkdir -p "$work"
 
 designs=baseline,prt,albedo,dsep
-variants=eager-f32,eager-bf16,compile-f32,compile-bf16
 log() { echo "bench/gpu.sh: $*" >&2; }
 
 {
@@ -95,7 +101,7 @@ for batch in $batches; do
   log "training throughput at batch $batch"
   section "Training samples/s at batch $batch (nprt's kernels on wgpu; PyTorch on CUDA)"
   "$nprt" bench train --device wgpu --python "$python" --peer-variants "$variants" \
-    --arch "$designs" --batch-size "$batch" --steps "$steps" --warmup 3 --rounds 1 \
+    --arch "$designs" --batch-size "$batch" --steps "$steps" --warmup 3 --rounds 1 --profile \
     | tee "$work/train-$batch.txt" >>"$summary"
   end_section
 done

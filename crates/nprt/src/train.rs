@@ -91,7 +91,9 @@ pub struct TrainArgs {
     /// inputs; docs/model.md). The design's layers are otherwise unchanged.
     #[arg(long, default_value_t = PositionEncoding::default())]
     encoding: PositionEncoding,
-    /// Minutes between checkpoints within an epoch (one is always written at an epoch's end).
+    /// Minutes between checkpoints within an epoch. An epoch's end writes one once these
+    /// minutes or 10 seconds have passed since the last (0: at every epoch's end); the run's
+    /// end always does.
     #[arg(long, default_value_t = d().schedule.checkpoint_secs / 60.0)]
     checkpoint_minutes: f64,
     /// With --device wgpu, where batches are gathered: device (the dataset's records, 40 bytes

@@ -32,6 +32,11 @@ pub const ADAM_EPSILON: f32 = 1e-8;
 /// Training-loss rows per epoch in loss.csv.
 const TRAIN_ROWS_PER_EPOCH: u64 = 20;
 
+/// Seconds since the last checkpoint after which an epoch's end writes one (the run's end
+/// always does): a small dataset's epochs take a GPU milliseconds, and writing the checkpoint,
+/// the model and the plot after each took a quarter of a 30-second run on an H200.
+const EPOCH_CHECKPOINT_SECS: f64 = 10.0;
+
 /// The loop's own settings, shared by every network.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Schedule {
@@ -49,7 +54,8 @@ pub struct Schedule {
     pub minutes: Option<f64>,
     /// Seed of the initial weights and of the batch order.
     pub seed: u64,
-    /// Seconds between checkpoints inside an epoch (one is always written at each epoch end).
+    /// Seconds between checkpoints inside an epoch; an epoch's end writes one once this many
+    /// seconds or 10 have passed since the last, and the run's end always does.
     #[serde(skip)]
     pub checkpoint_secs: f64,
     #[serde(skip)]
@@ -264,7 +270,11 @@ pub fn train<O: Objective>(
             return Err(run.diverged(&format!("validation loss {val}"), run.ck.state.epoch));
         }
         run.end_epoch(val, total);
-        run.save(&net, &optim, &inner)?;
+        let finished = run.ck.state.epoch >= schedule.epochs || run.out_of_time();
+        let since_saved = run.last_checkpoint.elapsed().as_secs_f64();
+        if finished || since_saved >= schedule.checkpoint_secs.min(EPOCH_CHECKPOINT_SECS) {
+            run.save(&net, &optim, &inner)?;
+        }
     }
     run.bar.finish_and_clear();
     run.steps_on = match &optim {
