@@ -299,8 +299,9 @@ impl GpuTrainer {
     }
 
     /// One training step on `batch` like [`Self::step`], each dispatch timed on the device:
-    /// the GPU time of each kernel, longest first (`nprt bench train --profile`). An error
-    /// where the adapter has no timestamp queries.
+    /// the GPU time of each kernel, longest first (`nprt bench train --profile`). It waits for
+    /// a step still queued first and drops that step's loss, so it is for benchmarks, not for
+    /// a training loop. An error where the adapter has no timestamp queries.
     pub fn profile_step(
         &mut self,
         batch: &Samples,
