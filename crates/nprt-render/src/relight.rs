@@ -382,17 +382,19 @@ impl Relighter {
     /// Encodes `map` rotated by `rotation_deg` about +Y.
     pub fn light_code(&self, map: &EnvMap, rotation_deg: f32) -> LightCode {
         let config = &self.file.config;
-        let input = LightInput::new(map, rotation_deg, config.encoder_width, config.map_norm);
-        let scale = std::array::from_fn(|k| input.scale[k] * self.file.output_gain()[k]);
+        let gain = self.file.output_gain();
         #[cfg(feature = "wgpu")]
         if let Some(gpu) = &self.gpu {
-            let code = gpu.light_code(&input);
+            let input = gpu.light_input(map, rotation_deg, config.encoder_width, config.map_norm);
+            let (code, input_scale) = gpu.light_code(&input);
             let n = code.len();
             return LightCode {
                 code: Tensor::from_data(TensorData::new(code, [1, n]), &self.device),
-                scale,
+                scale: std::array::from_fn(|k| input_scale[k] * gain[k]),
             };
         }
+        let input = LightInput::new(map, rotation_deg, config.encoder_width, config.map_norm);
+        let scale = std::array::from_fn(|k| input.scale[k] * gain[k]);
         let w = input.width;
         let pixels = Tensor::from_data(
             TensorData::new(input.pixels, [1, 3, w / 2, w]),

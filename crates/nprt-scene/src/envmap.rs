@@ -149,6 +149,10 @@ impl EnvMap {
     pub fn height(&self) -> usize {
         self.data.height
     }
+    /// Whether `other` shares this map's texels (the same map, however placed).
+    pub fn same_texels(&self, other: &EnvMap) -> bool {
+        Arc::ptr_eq(&self.data, &other.data)
+    }
     /// Row-major texels in the map's own frame.
     pub fn texels(&self) -> &[Vec3] {
         &self.data.texels

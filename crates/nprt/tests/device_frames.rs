@@ -1,6 +1,7 @@
 //! Frames that stay on the GPU from the G-buffer to the finished frame (nprt-render's
 //! `Relighter::frame` on the kernels, for models whose networks give all the light): the
-//! rasterised G-buffer, every pixel's inputs and networks, and the background from the map,
+//! rasterised G-buffer, the encoder's input from the map, every pixel's inputs and networks,
+//! and the background from the map,
 //! against the CPU's frame (the tracer's G-buffer, the CPU engine, the map on the host) of the
 //! same model, camera and lighting, for a new viewpoint and for a lighting change under it.
 //! Runs on Mesa's software Vulkan in CI (gated as the other Vulkan tests).
@@ -98,7 +99,10 @@ fn frames_on_the_gpu_match_the_cpus_with_their_background() {
                 t.gbuffer_ms,
                 t.network_ms
             );
-            assert!(beyond <= 0.01 && median < 1e-6, "{design:?}");
+            // The median carries the encoder's input, made on the device from lookups whose
+            // trigonometry rounds its own way: within 5e-6 of the host's near a sun's edge,
+            // light codes within 1.0e-6 (nprt-render's tests/gpu_frame.rs); lavapipe: at most 1.0e-6.
+            assert!(beyond <= 0.01 && median < 3e-6, "{design:?}");
         }
     }
 }

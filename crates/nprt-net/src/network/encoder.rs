@@ -116,7 +116,10 @@ impl LightInput {
             }
             *out /= (ss * ss) as f32;
         });
-        let mean = [0, 1, 2].map(|k| rgb.iter().map(|c| c[k]).sum::<f32>() / rgb.len() as f32);
+        // Summed in f64: an f32 running sum over a map with a sun drifts by 10⁻⁵ or more,
+        // which the divisor, and every prediction with it, would carry.
+        let mean = [0, 1, 2]
+            .map(|k| (rgb.iter().map(|c| c[k] as f64).sum::<f64>() / rgb.len() as f64) as f32);
         let scale = norm.scale(mean);
         let mut pixels = vec![0.0; 3 * width * height];
         for (i, c) in rgb.iter().enumerate() {

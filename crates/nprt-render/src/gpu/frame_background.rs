@@ -13,14 +13,27 @@ pub const FRAME_BACKGROUND: KernelSource = KernelSource {
     name: "frame_background",
     wgsl: concat!(
         include_str!("shaders/camera_ray.wgsl"),
+        include_str!("shaders/map_lookup.wgsl"),
         include_str!("shaders/frame_background.wgsl")
     ),
 };
 
-/// The last map's texels on the device, by the address and size of its texels on the host.
+/// The last map's texels on the device (a frame's background and the encoder's input read
+/// them), kept with the map they came from.
 #[derive(Default)]
 pub struct GpuMap {
-    kept: KeptLast<(usize, usize), wgpu::Buffer>,
+    kept: KeptLast<SameTexels, wgpu::Buffer>,
+}
+
+/// A map as a key: equal to another sharing its texels. It holds the map, so its texels cannot
+/// be freed and another map's take their address while they are kept (an address alone as the
+/// key gave a map loaded after another was dropped the dropped one's texels).
+struct SameTexels(EnvMap);
+
+impl PartialEq for SameTexels {
+    fn eq(&self, other: &Self) -> bool {
+        self.0.same_texels(&other.0)
+    }
 }
 
 /// What a frame's background needs: the G-buffer it fills the empty pixels of, its camera and
@@ -67,9 +80,8 @@ impl GpuMap {
     }
 
     /// `map`'s texels on the device, uploaded unless they were the last map's.
-    fn texels(&self, gpu: &GpuDevice, map: &EnvMap) -> wgpu::Buffer {
-        let key = (map.texels().as_ptr() as usize, map.texels().len());
-        self.kept.get(key, || {
+    pub(super) fn texels(&self, gpu: &GpuDevice, map: &EnvMap) -> wgpu::Buffer {
+        self.kept.get(SameTexels(map.clone()), || {
             let flat: Vec<f32> = map.texels().iter().flat_map(|t| t.to_array()).collect();
             gpu.upload(&flat)
         })

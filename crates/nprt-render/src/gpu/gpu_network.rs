@@ -9,7 +9,8 @@ use anyhow::Result;
 use nprt_net::cpu::{DenseStack, HostEncoder, HostTransport};
 use nprt_net::encoding::hash_grid;
 use nprt_net::network::encoder::{BLOCKS, CHANNELS, CODE_SIZE};
-use nprt_net::{Activation, LightInput, NprtNet, TrackKind, FEATURES, TRANSPORT_CODE};
+use nprt_net::{Activation, MapNorm, NprtNet, TrackKind, FEATURES, TRANSPORT_CODE};
+use nprt_scene::EnvMap;
 
 use nprt_net::gpu::{groups_for, GpuDevice};
 
@@ -18,6 +19,7 @@ use nprt_net::gpu::{Bias, Operand, Output};
 use nprt_net::gpu::kernels::{COMBINE, ENCODER_BLOCK, GBUFFER_FEATURES, TRACK_INPUTS};
 
 use super::frame_background::{Background, GpuMap};
+use super::light_input::GpuLightInput;
 use nprt_net::gpu::{activation_code, kind_code};
 
 /// Rows per block of dispatches: a block's widest activations (256 f32 per row, 64 MiB) stay
@@ -52,14 +54,14 @@ struct GpuTrack {
     shading: GpuMlp,
 }
 
-/// A model's encoder and transport networks on the GPU.
+/// A model's encoder and transport networks on the GPU, and the last map it was lit by.
 pub struct GpuNetwork {
     gpu: Arc<GpuDevice>,
     convs: Vec<(wgpu::Buffer, wgpu::Buffer, usize)>,
     to_code: GpuDense,
     tracks: Vec<GpuTrack>,
     resolutions: wgpu::Buffer,
-    /// The last map a frame's background came from.
+    /// The last map a frame's background or encoder input came from.
     map: GpuMap,
 }
 
@@ -139,12 +141,25 @@ impl GpuNetwork {
         &self.gpu.adapter
     }
 
-    /// The light code ê (`CODE_SIZE` values) of a pre-processed map.
-    pub fn light_code(&self, input: &LightInput) -> Vec<f32> {
+    /// `map` under `rotation_deg` made into this model's encoder input on the device (see
+    /// [`GpuLightInput`]), its texels kept for the frame's background too.
+    pub fn light_input(
+        &self,
+        map: &EnvMap,
+        rotation_deg: f32,
+        width: usize,
+        norm: MapNorm,
+    ) -> GpuLightInput {
+        GpuLightInput::new(&self.gpu, &self.map, map, rotation_deg, width, norm)
+    }
+
+    /// The light code ê (`CODE_SIZE` values) of a map made into the encoder's input, and the
+    /// input's divisor per channel: one read back for both.
+    pub fn light_code(&self, input: &GpuLightInput) -> (Vec<f32>, [f32; 3]) {
         let gpu = &*self.gpu;
         let (mut h, mut w) = (input.width / 2, input.width);
-        let mut x = gpu.upload(&input.pixels);
-        let code = gpu.buffer(CODE_SIZE);
+        let mut x = input.pixels.clone();
+        let code = gpu.buffer(CODE_SIZE + 3);
         let mut encoder = gpu.device.create_command_encoder(&Default::default());
         {
             let mut pass = encoder.begin_compute_pass(&Default::default());
@@ -176,8 +191,12 @@ impl GpuNetwork {
                 &code,
             );
         }
+        encoder.copy_buffer_to_buffer(&input.scale, 0, &code, 4 * CODE_SIZE as u64, 12);
         gpu.queue.submit([encoder.finish()]);
-        gpu.read(&code, CODE_SIZE)
+        let mut code = gpu.read(&code, CODE_SIZE + 3);
+        let scale = [code[CODE_SIZE], code[CODE_SIZE + 1], code[CODE_SIZE + 2]];
+        code.truncate(CODE_SIZE);
+        (code, scale)
     }
 
     /// Uploads the network inputs of a camera's foreground pixels (`rows × FEATURES`) and runs

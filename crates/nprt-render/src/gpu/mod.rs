@@ -3,8 +3,8 @@
 //! software Vulkan in the tests); and the export of those shaders, translated to GLSL and HLSL,
 //! with the weights for engines.
 //!
-//! Owns the frame's shaders (`shaders/`: the visibility pass, the G-buffer it resolves and the
-//! background; the network kernels, the inputs made from a G-buffer and the device they run on
+//! Owns the frame's shaders (`shaders/`: the visibility pass, the G-buffer it resolves, the
+//! background and the encoder's input made from the map; the network kernels, the inputs made from a G-buffer and the device they run on
 //! are nprt-net's), the scene's and a model's
 //! upload and the order of dispatches of a frame. It computes what the CPU does (nprt-trace's
 //! G-buffer, nprt-net's CPU engine) in the same f32 operations, and tests hold them together;
@@ -16,12 +16,14 @@ mod gpu_network;
 mod gpu_scene;
 mod kept_last;
 mod kernels;
+mod light_input;
 mod raster_gbuffer;
 mod shader_export;
 
 pub use frame_background::Background;
 pub use gpu_network::{GpuNetwork, GpuPixels};
 pub(crate) use kept_last::KeptLast;
+pub use light_input::GpuLightInput;
 pub use nprt_net::gpu::GpuDevice;
 pub use raster_gbuffer::RasterGBuffer;
 pub use shader_export::{export_model, ExampleView, ExportSummary};
