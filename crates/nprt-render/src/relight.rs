@@ -383,27 +383,26 @@ impl Relighter {
     pub fn light_code(&self, map: &EnvMap, rotation_deg: f32) -> LightCode {
         let config = &self.file.config;
         let gain = self.file.output_gain();
+        // The map's divisor per channel, restored at the output with the model's gain.
+        let light = |code, input_scale: [f32; 3]| LightCode {
+            code,
+            scale: std::array::from_fn(|k| input_scale[k] * gain[k]),
+        };
         #[cfg(feature = "wgpu")]
         if let Some(gpu) = &self.gpu {
             let input = gpu.light_input(map, rotation_deg, config.encoder_width, config.map_norm);
             let (code, input_scale) = gpu.light_code(&input);
             let n = code.len();
-            return LightCode {
-                code: Tensor::from_data(TensorData::new(code, [1, n]), &self.device),
-                scale: std::array::from_fn(|k| input_scale[k] * gain[k]),
-            };
+            let code = Tensor::from_data(TensorData::new(code, [1, n]), &self.device);
+            return light(code, input_scale);
         }
         let input = LightInput::new(map, rotation_deg, config.encoder_width, config.map_norm);
-        let scale = std::array::from_fn(|k| input.scale[k] * gain[k]);
         let w = input.width;
         let pixels = Tensor::from_data(
             TensorData::new(input.pixels, [1, 3, w / 2, w]),
             &self.device,
         );
-        LightCode {
-            code: self.net.encoder.forward(pixels),
-            scale,
-        }
+        light(self.net.encoder.forward(pixels), input.scale)
     }
 
     /// Radiance of every pixel of `g` under `light`; background pixels are zero (see

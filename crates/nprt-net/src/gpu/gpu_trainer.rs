@@ -300,8 +300,8 @@ impl GpuTrainer {
 
     /// One training step on `batch` like [`Self::step`], each dispatch timed on the device:
     /// the GPU time of each kernel, longest first (`nprt bench train --profile`). It waits for
-    /// a step still queued first and drops that step's loss, so it is for benchmarks, not for
-    /// a training loop. An error where the adapter has no timestamp queries.
+    /// a step still queued first and drops that step's loss and its own, so it is for
+    /// benchmarks, not for a training loop. An error where the adapter has no timestamp queries.
     pub fn profile_step(
         &mut self,
         batch: &Samples,
@@ -313,13 +313,8 @@ impl GpuTrainer {
         let pass = Pass::Step(lr);
         self.prepare(inputs, loss);
         let mut timer = KernelTimer::new(&self.gpu, self.dispatches(inputs, pass).len())?;
-        let (submission, copy, rows) = self.submit(inputs, pass, Some(&mut timer));
-        self.pending = Some(PendingLoss {
-            copy,
-            submission: submission.clone(),
-            rows,
-        });
-        self.finish();
+        // Its loss is left unread: reading the timestamps waits for the submission.
+        let (submission, _, _) = self.submit(inputs, pass, Some(&mut timer));
         Ok(timer.read(&self.gpu, submission))
     }
 

@@ -36,6 +36,14 @@ impl PartialEq for SameTexels {
     }
 }
 
+/// A 3 × 3 matrix as map_lookup.wgsl's callers take it: its columns, each padded to a vec4,
+/// as u32 words of the parameter block (a map's world-to-local rotation).
+pub(super) fn matrix_words(m: glam::Mat3) -> impl Iterator<Item = u32> {
+    [m.x_axis, m.y_axis, m.z_axis]
+        .into_iter()
+        .flat_map(|c| c.extend(0.0).to_array().map(f32::to_bits))
+}
+
 /// What a frame's background needs: the G-buffer it fills the empty pixels of, its camera and
 /// the map as placed in the world (None: zero, for direct light traced later).
 pub struct Background<'a> {
@@ -65,11 +73,7 @@ impl GpuMap {
         let fill = u32::from(background.map.is_some());
         let mut params = vec![camera.width, camera.height, size[0], size[1], fill, 0, 0, 0];
         params.extend(camera_words(camera));
-        params.extend(
-            [to_local.x_axis, to_local.y_axis, to_local.z_axis]
-                .iter()
-                .flat_map(|c| c.extend(0.0).to_array().map(f32::to_bits)),
-        );
+        params.extend(matrix_words(to_local));
         gpu.dispatch(
             pass,
             &FRAME_BACKGROUND,

@@ -8,7 +8,7 @@ use nprt_net::gpu::{groups_for, GpuDevice, KernelSource};
 use nprt_net::{LightInput, MapNorm};
 use nprt_scene::EnvMap;
 
-use super::frame_background::GpuMap;
+use super::frame_background::{matrix_words, GpuMap};
 
 pub const LIGHT_TEXELS: KernelSource = KernelSource {
     name: "light_texels",
@@ -58,11 +58,7 @@ impl GpuLightInput {
         let mut params = [width, height, ss, map.width(), map.height(), 0, 0, 0]
             .map(|v| v as u32)
             .to_vec();
-        params.extend(
-            [to_local.x_axis, to_local.y_axis, to_local.z_axis]
-                .iter()
-                .flat_map(|c| c.extend(0.0).to_array().map(f32::to_bits)),
-        );
+        params.extend(matrix_words(to_local));
         let norm_code = match norm {
             MapNorm::Mean => 0,
             MapNorm::Channel => 1,
