@@ -12,7 +12,7 @@ use nprt_net::cpu::{self, HostTransport, TransferCodes};
 use nprt_net::gbuffer_features;
 use nprt_net::{load_model, Device, DirectLight, LightInput, ModelFile, NprtNet, FEATURES};
 use nprt_scene::{Camera, EnvMap};
-use nprt_trace::{render_direct, render_gbuffer, GBuffer, TraceScene};
+use nprt_trace::{render, render_direct, render_gbuffer, GBuffer, RenderSettings, TraceScene};
 
 use crate::oidn::Oidn;
 use rayon::prelude::*;
@@ -197,11 +197,28 @@ impl Relighter {
     /// Where the G-buffer is made, for reports: rasterised beside the GPU kernels, or the CPU
     /// tracer's primary rays.
     pub fn gbuffer_on(&self) -> &'static str {
+        if self.kernels_on_gpu() {
+            "rasterised on the GPU"
+        } else {
+            "traced on the CPU"
+        }
+    }
+
+    /// Where [`Self::path_trace`] and traced direct light run, for reports.
+    pub fn paths_on(&self) -> &'static str {
+        if self.kernels_on_gpu() {
+            "on the GPU"
+        } else {
+            "on the CPU"
+        }
+    }
+
+    fn kernels_on_gpu(&self) -> bool {
         #[cfg(feature = "wgpu")]
         if self.gpu.is_some() {
-            return "rasterised on the GPU";
+            return true;
         }
-        "traced on the CPU"
+        false
     }
 
     /// Whether the model leaves direct light to the tracer ([`Self::complete`] traces it).
@@ -269,7 +286,7 @@ impl Relighter {
         let (g, px) = match cache.still.take() {
             Some((c, g, px)) if c == *camera => (g, px),
             #[cfg(feature = "wgpu")]
-            _ if self.frames_on_device() => {
+            _ if self.frames_on_device(&sampling) => {
                 let (px, gbuffer_ms, network_ms) = self.device_pixels(ts, camera)?;
                 (t.gbuffer_ms, t.network_ms) = (gbuffer_ms, network_ms);
                 (GBuffer::default(), px)
@@ -286,10 +303,11 @@ impl Relighter {
         };
         let placed = map.rotated_y(rotation_deg);
         let clock = Instant::now();
-        let finished = self.device_frame(&px, &code, &placed);
+        let finished = self.device_frame(ts, &px, &code, &placed, &sampling)?;
         let on_device = finished.is_some();
-        let mut rgb = finished.unwrap_or_else(|| self.relight(&px, &code));
-        t.network_ms += ms(clock);
+        let (mut rgb, direct_ms) = finished.unwrap_or_else(|| (self.relight(&px, &code), 0.0));
+        t.network_ms += ms(clock) - direct_ms;
+        t.direct_ms = direct_ms;
         if !on_device {
             let clock = Instant::now();
             self.complete(ts, camera, &placed, &g, sampling, &mut rgb)?;
@@ -310,21 +328,46 @@ impl Relighter {
         Ok(render_gbuffer(ts, camera))
     }
 
+    /// One pass of path tracing of `camera`'s view under `map` (as placed in the world), as
+    /// `settings` says: on the device where this model's frames are made there (the scene's
+    /// upload shared with the rasterised G-buffer), on the CPU otherwise.
+    pub fn path_trace(
+        &self,
+        ts: &TraceScene,
+        camera: &Camera,
+        map: &EnvMap,
+        settings: &RenderSettings,
+    ) -> Result<Vec<Vec3>> {
+        #[cfg(feature = "wgpu")]
+        if self.gpu.is_some() {
+            let paths = crate::gpu::GpuPaths {
+                spp: settings.spp,
+                seed: settings.seed,
+                max_depth: settings.max_depth.unwrap_or(u32::MAX),
+                rr_depth: settings.rr_depth,
+                first_path: 0,
+                jitter: matches!(settings.filter, nprt_trace::PixelFilter::Box),
+            };
+            return self.raster(ts)?.trace(camera, map, &paths);
+        }
+        Ok(render(ts, camera, map, settings).radiance)
+    }
+
     /// The scene on the device, uploaded unless it was the last frame's.
     #[cfg(feature = "wgpu")]
     fn raster(&self, ts: &TraceScene) -> Result<std::sync::Arc<crate::gpu::RasterGBuffer>> {
         let key = std::ptr::from_ref(ts.scene) as usize;
         self.raster.try_get(key, || {
-            crate::gpu::RasterGBuffer::new(ts.scene).map(std::sync::Arc::new)
+            crate::gpu::RasterGBuffer::new(ts).map(std::sync::Arc::new)
         })
     }
 
     /// Whether frames stay on the device from the G-buffer to the finished frame: on the
-    /// kernels, for a model whose networks give all the light (traced direct light and its
-    /// denoiser run on the host, from a G-buffer read back).
+    /// kernels, with traced direct light traced there too, unless it is to be denoised (OIDN
+    /// runs on the host, from a G-buffer read back).
     #[cfg(feature = "wgpu")]
-    fn frames_on_device(&self) -> bool {
-        self.gpu.is_some() && !self.traces_direct()
+    fn frames_on_device(&self, sampling: &DirectSampling) -> bool {
+        self.gpu.is_some() && !(self.traces_direct() && sampling.denoiser.is_some())
     }
 
     /// A camera's pixels with the G-buffer left on the device: rasterised, then every pixel's
@@ -359,24 +402,43 @@ impl Relighter {
     }
 
     /// The finished frame of pixels whose G-buffer stayed on the device, under `light` and
-    /// with `map` (as placed in the world) behind: made there, read back once. None for
-    /// pixels on the host.
+    /// with `map` (as placed in the world) behind, or for a model that traces direct light,
+    /// that light traced there as `sampling` says: made there, read back once; with the
+    /// milliseconds of the traced light. None for pixels on the host.
     #[cfg_attr(not(feature = "wgpu"), allow(unused_variables))]
-    fn device_frame(&self, px: &Pixels, light: &LightCode, map: &EnvMap) -> Option<Vec<Vec3>> {
+    fn device_frame(
+        &self,
+        ts: &TraceScene,
+        px: &Pixels,
+        light: &LightCode,
+        map: &EnvMap,
+        sampling: &DirectSampling,
+    ) -> Result<Option<(Vec<Vec3>, f64)>> {
         #[cfg(feature = "wgpu")]
         if let (Some(gpu), Some(pixels), Some((samples, camera))) =
             (&self.gpu, &px.gpu, &px.gbuffer)
         {
+            let raster = self.raster(ts)?;
             let background = crate::gpu::Background {
                 samples,
                 camera,
-                map: Some(map),
+                fill: if self.traces_direct() {
+                    crate::gpu::Fill::TracedDirect {
+                        map,
+                        scene: &raster,
+                        spp: sampling.spp,
+                        seed: sampling.seed,
+                    }
+                } else {
+                    crate::gpu::Fill::Map(map)
+                },
             };
             let code = nprt_net::host_values(light.code.clone().into_data());
-            let rgb = gpu.radiance(pixels, &code, light.scale, Some(&background));
-            return Some(rgb.chunks_exact(3).map(Vec3::from_slice).collect());
+            let (rgb, direct_ms) = gpu.radiance(pixels, &code, light.scale, Some(&background));
+            let rgb = rgb.chunks_exact(3).map(Vec3::from_slice).collect();
+            return Ok(Some((rgb, direct_ms)));
         }
-        None
+        Ok(None)
     }
 
     /// Encodes `map` rotated by `rotation_deg` about +Y.
@@ -472,9 +534,11 @@ impl Relighter {
                 .map(|(samples, camera)| crate::gpu::Background {
                     samples,
                     camera,
-                    map: None,
+                    fill: crate::gpu::Fill::Zero,
                 });
-            return gpu.radiance(pixels, &code, light.scale, background.as_ref());
+            return gpu
+                .radiance(pixels, &code, light.scale, background.as_ref())
+                .0;
         }
         self.burn_radiance(&px.features, light)
     }

@@ -79,6 +79,17 @@ impl Distribution2D {
         (p.min(Vec2::splat(1.0 - f32::EPSILON)), self.density[cell])
     }
 
+    /// Cells per row and rows.
+    pub fn size(&self) -> (usize, usize) {
+        (self.width, self.height)
+    }
+
+    /// Per cell in row order: its density, the probability of keeping it and its alias, the
+    /// table [`Self::sample`] reads (a GPU's sampler reads the same).
+    pub fn cells(&self) -> impl Iterator<Item = (f32, f32, u32)> + '_ {
+        (0..self.density.len()).map(|i| (self.density[i], self.keep[i], self.alias[i]))
+    }
+
     pub fn pdf(&self, p: Vec2) -> f32 {
         let x = ((p.x * self.width as f32) as usize).min(self.width - 1);
         let y = ((p.y * self.height as f32) as usize).min(self.height - 1);

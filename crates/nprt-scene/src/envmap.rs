@@ -181,6 +181,12 @@ impl EnvMap {
         }
         warnings
     }
+    /// The distribution [`Self::sample`] draws lat-long patches from (one per texel column and
+    /// pair of rows, offset half a texel in u).
+    pub fn distribution(&self) -> &Distribution2D {
+        &self.data.dist
+    }
+
     pub fn to_world(&self) -> Mat3 {
         self.to_world
     }

@@ -41,6 +41,7 @@ pub use bump_map::BumpMap;
 pub use camera::{Camera, CameraVolume, FovAxis};
 pub use color::luminance;
 pub use conductor_ior::{conductor_names, named_conductor};
+pub use distribution::Distribution2D;
 pub use envmap::EnvMap;
 pub use envmap_spec::open_envmap;
 pub use fresnel::{fresnel_conductor, fresnel_dielectric, DielectricFresnel};

@@ -54,6 +54,11 @@ impl Coating {
         }
     }
 
+    /// The rough coat's transmittance table ([`Self::transmittance`] interpolates it).
+    pub fn table(&self) -> Option<&[f32; TABLE_LEN]> {
+        self.table.as_ref()
+    }
+
     pub fn is_rough(&self) -> bool {
         self.table.is_some()
     }

@@ -29,6 +29,7 @@
 mod accel;
 mod bsdf;
 mod coating;
+mod flat_bvh;
 mod frame;
 mod gbuffer_pass;
 mod integrator;
@@ -43,6 +44,7 @@ mod transport_pass;
 pub use accel::{Accel, Hit};
 pub use bsdf::Bsdf;
 pub use coating::Coating;
+pub use flat_bvh::{FlatBvh, NODE_WORDS};
 pub use frame::{Frame, GBuffer, GSample};
 pub use gbuffer_pass::{primary_sample, render_gbuffer};
 pub use reference::{render_reference, Reference, ReferenceOptions, DEFAULT_REFERENCE_SPP};

@@ -3,15 +3,18 @@
 //! rasterised G-buffer, the encoder's input from the map, every pixel's inputs and networks,
 //! and the background from the map,
 //! against the CPU's frame (the tracer's G-buffer, the CPU engine, the map on the host) of the
-//! same model, camera and lighting, for a new viewpoint and for a lighting change under it.
-//! Runs on Mesa's software Vulkan in CI (gated as the other Vulkan tests).
+//! same model, camera and lighting, for a new viewpoint and for a lighting change under it; and
+//! for a model that leaves direct light to the tracer, that light traced on the device, within
+//! noise of the CPU tracer's. Runs on Mesa's software Vulkan in CI (gated as the other Vulkan
+//! tests).
 #![cfg(feature = "wgpu")]
 
 mod common;
 
+use common::block_rms;
 use glam::Vec3;
 use nprt_net::model::folder::ModelFile;
-use nprt_net::{Compute, Design, Device, Init, ModelConfig};
+use nprt_net::{Compute, Design, Device, DirectLight, Init, ModelConfig};
 use nprt_render::{DirectSampling, FrameCache, Relighter};
 use nprt_scene::{Camera, Material, Mesh, Scene};
 use nprt_trace::TraceScene;
@@ -105,4 +108,65 @@ fn frames_on_the_gpu_match_the_cpus_with_their_background() {
             assert!(beyond <= 0.01 && median < 3e-6, "{design:?}");
         }
     }
+}
+
+/// A D/S model that traces its direct light: on the device the frame is the networks' plus
+/// direct light traced there, in one submission; it agrees with the CPU's frame (the CPU
+/// tracer's light) within the noise two CPU frames of different seeds show.
+#[test]
+fn traced_direct_light_stays_on_the_gpu_and_matches_the_cpus_within_noise() {
+    if !common::wgpu_runs() {
+        return;
+    }
+    let wgpu = Compute::Wgpu.device().unwrap();
+    let scene = scene();
+    let ts = TraceScene::new(&scene);
+    let (lo, hi) = scene.bounds();
+    let camera = Camera::look_at(
+        Vec3::new(0.5, 2.5, 5.0),
+        Vec3::new(0.0, 0.8, 0.0),
+        Vec3::Y,
+        60.0,
+        64,
+        48,
+    );
+    let map = nprt_scene::open_envmap("builtin:sky:30:50").unwrap();
+    let config = ModelConfig {
+        encoder_width: 64,
+        direct: DirectLight::Traced,
+        ..ModelConfig::new(Design::Dsep, None)
+    };
+    let net = config.build(&mut Init::new(5, &Device::flex()));
+    let file = ModelFile::untrained(config, &net, [lo.to_array(), hi.to_array()]);
+    let cpu = Relighter::new(file.clone(), net.clone(), &Device::flex()).unwrap();
+    let gpu = Relighter::new(file, net, &wgpu).unwrap();
+    let frame = |r: &Relighter, seed| {
+        let sampling = DirectSampling {
+            spp: 256,
+            seed,
+            denoiser: None,
+        };
+        r.frame(
+            &mut FrameCache::default(),
+            &ts,
+            &camera,
+            &map,
+            30.0,
+            0,
+            sampling,
+        )
+        .unwrap()
+    };
+    let ((cpu1, _), (cpu2, _), (got, t)) = (frame(&cpu, 1), frame(&cpu, 2), frame(&gpu, 3));
+    let width = camera.width as usize;
+    let (noise, error) = (
+        block_rms(&cpu1, &cpu2, width),
+        block_rms(&cpu1, &got, width),
+    );
+    eprintln!(
+        "block rms CPU vs CPU {noise:.4}, GPU vs CPU {error:.4} (G-buffer {:.1} ms, networks {:.1} ms, direct light {:.1} ms)",
+        t.gbuffer_ms, t.network_ms, t.direct_ms
+    );
+    assert!(t.direct_ms > 0.0, "the traced light timed apart");
+    assert!(error <= 1.5 * noise && noise < 0.05);
 }

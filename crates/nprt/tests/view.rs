@@ -10,7 +10,7 @@ mod common;
 use std::path::Path;
 use std::process::{Child, Command, Stdio};
 
-use common::{fresh_dir, ok, tiny_room_model};
+use common::{fresh_dir, ok, tiny_room_model, wgpu_runs};
 
 /// An X display for the viewer: the environment's, or a private Xvfb (killed on drop).
 struct Display {
@@ -151,5 +151,37 @@ fn the_viewer_opens_a_window_and_shows_what_render_makes() {
         "{differ} pixels differ from nprt render's frame"
     );
     assert!(lit * 2 > 160 * 120, "the frame shows the room");
+
+    // The progressive reference (the R key) on the GPU, where the kernels run: path traced on
+    // the device, it converges to what the CPU's tracer shows.
+    if wgpu_runs() {
+        let reference = |device: &str| {
+            let shot = dir.join(format!("reference-{device}.png"));
+            view(
+                &display,
+                &[
+                    m,
+                    "--res",
+                    "80x60",
+                    "--device",
+                    device,
+                    "--reference",
+                    "--frames",
+                    "32",
+                    "--no-overlay",
+                    "--screenshot",
+                    shot.to_str().unwrap(),
+                ],
+            );
+            let img = image::open(&shot).unwrap().to_rgb8();
+            img.pixels()
+                .map(|p| p.0.iter().map(|&c| c as f64).sum::<f64>())
+                .sum::<f64>()
+                / (80.0 * 60.0 * 3.0)
+        };
+        let (gpu, cpu) = (reference("wgpu"), reference("cpu"));
+        eprintln!("reference's mean 8-bit value: GPU {gpu:.2}, CPU {cpu:.2}");
+        assert!(cpu > 16.0 && (gpu / cpu - 1.0).abs() < 0.05);
+    }
     std::fs::remove_dir_all(&dir).unwrap();
 }

@@ -1,28 +1,32 @@
 //! A frame's background on the device: where the rasterised G-buffer sees nothing, the map
-//! along the pixel-centre ray (as `background` does on the host), or zero where direct light
-//! traced later brings the map there. The map's texels go up once per map, the rotation with
-//! each frame.
+//! along the pixel-centre ray (as `background` does on the host); or, for a model that leaves
+//! direct light to the tracer, zero there and that light traced on the device over every
+//! pixel. The map's texels go up once per map, the rotation with each frame.
 
 use nprt_net::gpu::{GpuDevice, KernelSource};
 use nprt_scene::{Camera, EnvMap};
 
 use super::kept_last::KeptLast;
-use super::raster_gbuffer::camera_words;
+use super::path_tracer::{record_paths, GpuPaths};
+use super::raster_gbuffer::{camera_words, RasterGBuffer};
 
 pub const FRAME_BACKGROUND: KernelSource = KernelSource {
     name: "frame_background",
     wgsl: concat!(
         include_str!("shaders/camera_ray.wgsl"),
+        include_str!("shaders/lerp.wgsl"),
         include_str!("shaders/map_lookup.wgsl"),
         include_str!("shaders/frame_background.wgsl")
     ),
 };
 
-/// The last map's texels on the device (a frame's background and the encoder's input read
-/// them), kept with the map they came from.
+/// The last map's texels on the device (a frame's background, the encoder's input and the path
+/// tracer read them) and its sampling table (the path tracer's), kept with the map they came
+/// from.
 #[derive(Default)]
 pub struct GpuMap {
     kept: KeptLast<SameTexels, wgpu::Buffer>,
+    table: KeptLast<SameTexels, wgpu::Buffer>,
 }
 
 /// A map as a key: equal to another sharing its texels. It holds the map, so its texels cannot
@@ -45,15 +49,33 @@ pub(super) fn matrix_words(m: glam::Mat3) -> impl Iterator<Item = u32> {
 }
 
 /// What a frame's background needs: the G-buffer it fills the empty pixels of, its camera and
-/// the map as placed in the world (None: zero, for direct light traced later).
+/// what goes there.
 pub struct Background<'a> {
     pub samples: &'a wgpu::Buffer,
     pub camera: &'a Camera,
-    pub map: Option<&'a EnvMap>,
+    pub fill: Fill<'a>,
+}
+
+/// What a frame adds to the networks' radiance.
+pub enum Fill<'a> {
+    /// Nothing: the empty pixels zero.
+    Zero,
+    /// The map (as placed in the world) seen through the empty pixels.
+    Map(&'a EnvMap),
+    /// For a model that leaves direct light to the tracer, that light under the map, traced on
+    /// the device: `spp` paths of two vertices through each pixel centre (which brings the
+    /// map to the empty pixels).
+    TracedDirect {
+        map: &'a EnvMap,
+        scene: &'a RasterGBuffer,
+        spp: u32,
+        seed: u64,
+    },
 }
 
 impl GpuMap {
-    /// Records `background` into `rgb` (3 f32 per pixel).
+    /// Records `background` into `rgb` (3 f32 per pixel, the networks' radiance on the
+    /// G-buffer's pixels).
     pub fn record(
         &self,
         gpu: &GpuDevice,
@@ -62,7 +84,12 @@ impl GpuMap {
         rgb: &wgpu::Buffer,
     ) {
         let camera = background.camera;
-        let (texels, size, to_local) = match background.map {
+        let (map, fill) = match background.fill {
+            Fill::Zero => (None, 0),
+            Fill::Map(map) => (Some(map), 1),
+            Fill::TracedDirect { map, .. } => (Some(map), 0),
+        };
+        let (texels, size, to_local) = match map {
             Some(map) => (
                 self.texels(gpu, map),
                 [map.width() as u32, map.height() as u32],
@@ -70,7 +97,6 @@ impl GpuMap {
             ),
             None => (gpu.empty.clone(), [1, 2], glam::Mat3::IDENTITY),
         };
-        let fill = u32::from(background.map.is_some());
         let mut params = vec![camera.width, camera.height, size[0], size[1], fill, 0, 0, 0];
         params.extend(camera_words(camera));
         params.extend(matrix_words(to_local));
@@ -81,6 +107,58 @@ impl GpuMap {
             &[background.samples, &texels, rgb],
             [camera.width.div_ceil(8), camera.height.div_ceil(8)],
         );
+    }
+
+    /// Records the traced direct light of `background` (a [`Fill::TracedDirect`]) onto `rgb`,
+    /// after [`Self::record`] zeroed its empty pixels.
+    pub fn record_direct(
+        &self,
+        gpu: &GpuDevice,
+        pass: &mut wgpu::ComputePass,
+        background: &Background,
+        rgb: &wgpu::Buffer,
+    ) {
+        if let Fill::TracedDirect {
+            map,
+            scene,
+            spp,
+            seed,
+        } = background.fill
+        {
+            let paths = GpuPaths {
+                spp,
+                seed,
+                max_depth: 2,
+                rr_depth: u32::MAX,
+                first_path: 0,
+                jitter: false,
+            };
+            let camera = background.camera;
+            record_paths(
+                gpu,
+                pass,
+                scene.scene(),
+                self,
+                camera,
+                map,
+                &paths,
+                rgb,
+                true,
+            );
+        }
+    }
+
+    /// `map`'s sampling table on the device ([`nprt_scene::Distribution2D::cells`], three
+    /// words a cell), uploaded unless it was the last map's.
+    pub(super) fn table(&self, gpu: &GpuDevice, map: &EnvMap) -> wgpu::Buffer {
+        self.table.get(SameTexels(map.clone()), || {
+            let words: Vec<u32> = map
+                .distribution()
+                .cells()
+                .flat_map(|(density, keep, alias)| [density.to_bits(), keep.to_bits(), alias])
+                .collect();
+            gpu.upload(&words)
+        })
     }
 
     /// `map`'s texels on the device, uploaded unless they were the last map's.

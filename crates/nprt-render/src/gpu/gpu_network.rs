@@ -18,7 +18,7 @@ use nprt_net::gpu::{Bias, Operand, Output};
 
 use nprt_net::gpu::kernels::{COMBINE, ENCODER_BLOCK, GBUFFER_FEATURES, TRACK_INPUTS};
 
-use super::frame_background::{Background, GpuMap};
+use super::frame_background::{Background, Fill, GpuMap};
 use super::light_input::GpuLightInput;
 use nprt_net::gpu::{activation_code, kind_code};
 
@@ -342,16 +342,18 @@ impl GpuNetwork {
     /// Radiance (`rows × 3`) of `px` under the light `code`, each channel multiplied by
     /// `scale` (the map's normalisation times the model's level gain); with `background`
     /// (pixels of a G-buffer on the device, [`Self::pixels_of_gbuffer`]), the frame's
-    /// background filled in.
+    /// background filled in, or traced direct light added. With the milliseconds the traced
+    /// light took (0 without): it is submitted once the networks are done, so that the two can
+    /// be told apart.
     pub fn radiance(
         &self,
         px: &GpuPixels,
         code: &[f32],
         scale: [f32; 3],
         background: Option<&Background>,
-    ) -> Vec<f32> {
+    ) -> (Vec<f32>, f64) {
         if px.rows == 0 {
-            return Vec::new();
+            return (Vec::new(), 0.0);
         }
         let gpu = &*self.gpu;
         let code = gpu.upload(code);
@@ -443,7 +445,24 @@ impl GpuNetwork {
             }
         }
         gpu.queue.submit([encoder.finish()]);
-        gpu.read(&px.rgb, px.rows * 3)
+        let mut direct_ms = 0.0;
+        if let Some(b) = background {
+            if matches!(b.fill, Fill::TracedDirect { .. }) {
+                gpu.wait();
+                let clock = std::time::Instant::now();
+                let mut encoder = gpu.device.create_command_encoder(&Default::default());
+                self.map.record_direct(
+                    gpu,
+                    &mut encoder.begin_compute_pass(&Default::default()),
+                    b,
+                    &px.rgb,
+                );
+                gpu.queue.submit([encoder.finish()]);
+                gpu.wait();
+                direct_ms = clock.elapsed().as_secs_f64() * 1e3;
+            }
+        }
+        (gpu.read(&px.rgb, px.rows * 3), direct_ms)
     }
 }
 

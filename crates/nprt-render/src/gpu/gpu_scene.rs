@@ -1,27 +1,37 @@
-//! A scene's triangles, materials and textures on the GPU, uploaded once: what the rasterised
-//! G-buffer reads. The records' layouts are the contract with `shaders/gbuffer.wgsl`, which
-//! evaluates them as nprt-trace's `surface_point` and nprt-scene's materials do on the CPU.
+//! A scene's triangles, materials and textures on the GPU, uploaded once, with a BVH over its
+//! triangles: what the rasterised G-buffer and the path tracer read. The records' layouts are
+//! the contract with `shaders/surface.wgsl` and `shaders/bsdf.wgsl`, which evaluate them as
+//! nprt-trace's `surface_point` and `Bsdf` and nprt-scene's materials do on the CPU.
 
 use std::collections::HashMap;
 use std::sync::Arc;
 
 use anyhow::{Context, Result};
 use glam::Vec3;
-use nprt_scene::{BsdfParams, Material, Scene, Surface, Texture};
+use nprt_scene::{BsdfParams, Material, Scattering, Surface, Texture};
+use nprt_trace::{Coating, FlatBvh, TraceScene};
 
 use nprt_net::gpu::GpuDevice;
 
 /// Words per material record (see [`material_record`]).
-pub const MATERIAL_WORDS: usize = 16;
+pub const MATERIAL_WORDS: usize = 32;
 /// Words per texture record (see [`texture_record`]).
 pub const TEXTURE_WORDS: usize = 16;
 
-/// Material flags, as `shaders/gbuffer.wgsl` reads them.
+/// Material flags, as `shaders/surface.wgsl` reads them.
 const TWO_SIDED: u32 = 1;
 const BUMP: u32 = 2;
 const BUMP_MIRRORED_BEHIND: u32 = 4;
 const OPACITY: u32 = 8;
 const METALLIC_ROUGHNESS: u32 = 16;
+
+/// Scattering kinds and their flags, as `shaders/bsdf.wgsl` reads them.
+const FRESNEL_FREE: u32 = 0;
+const CONDUCTOR: u32 = 1;
+const DIELECTRIC: u32 = 2;
+const PLASTIC: u32 = 3;
+const THIN: u32 = 1;
+const NONLINEAR: u32 = 2;
 
 /// Per-vertex attribute flags of a mesh.
 const HAS_NORMALS: u32 = 1;
@@ -39,15 +49,19 @@ pub struct GpuScene {
     pub materials: wgpu::Buffer,
     pub textures: wgpu::Buffer,
     /// Every bitmap's texels, 3 f32 each, top row first.
-    pub texels: wgpu::Buffer,
+    pub bitmaps: wgpu::Buffer,
+    /// The BVH's nodes and its leaves' triangles ([`FlatBvh`]).
+    pub bvh_nodes: wgpu::Buffer,
+    pub bvh_triangles: wgpu::Buffer,
     pub triangle_count: u32,
     /// The scene's extent (the bounding box's diagonal), for the rasteriser's near plane.
     pub extent: f32,
 }
 
 impl GpuScene {
-    /// Uploads `scene`; refuses one whose triangles or textures a GPU buffer cannot hold.
-    pub fn new(gpu: &GpuDevice, scene: &Scene) -> Result<Self> {
+    /// Uploads `ts`'s scene; refuses one whose triangles or textures a GPU buffer cannot hold.
+    pub fn new(gpu: &GpuDevice, ts: &TraceScene) -> Result<Self> {
+        let scene = ts.scene;
         let vertices: usize = scene.meshes.iter().map(|m| m.positions.len()).sum();
         let mut positions = Vec::with_capacity(3 * vertices);
         let mut attributes = Vec::with_capacity(5 * vertices);
@@ -72,16 +86,26 @@ impl GpuScene {
         }
         let mut bitmaps = TexelStore::default();
         let mut textures = Vec::new();
-        let materials: Vec<u32> = scene
+        let mut materials: Vec<u32> = scene
             .materials
             .iter()
             .flat_map(|m| material_record(m, &mut textures, &mut bitmaps))
             .collect();
+        // The plastics' coats after the records, each record pointing at its own.
+        for (m, coat) in ts.coatings.iter().enumerate() {
+            if let Some(coat) = coat {
+                let at = materials.len() as u32;
+                materials[MATERIAL_WORDS * m + 21] = at;
+                materials.extend(coat_record(coat));
+            }
+        }
+        let bvh = FlatBvh::new(scene);
         for (words, what) in [
             (positions.len(), "the scene's vertex positions"),
             (attributes.len(), "the scene's vertex normals and uvs"),
             (triangles.len(), "the scene's triangles"),
             (bitmaps.texels.len(), "the scene's textures"),
+            (bvh.nodes.len(), "the scene's BVH"),
         ] {
             gpu.check_binding(4 * words, &format!("{what} ('{}')", scene.name))
                 .context("the GPU frame path cannot take the scene; use --device cpu")?;
@@ -93,7 +117,14 @@ impl GpuScene {
             triangles: gpu.upload(&triangles),
             materials: gpu.upload(&materials),
             textures: gpu.upload(&textures),
-            texels: gpu.upload(&bitmaps.texels),
+            bitmaps: gpu.upload(&bitmaps.texels),
+            bvh_nodes: gpu.upload(&bvh.nodes),
+            // A buffer may not be empty.
+            bvh_triangles: gpu.upload(if bvh.triangles.is_empty() {
+                &[0]
+            } else {
+                &bvh.triangles
+            }),
             triangle_count: scene.triangle_count() as u32,
             extent: (hi - lo).length(),
         })
@@ -120,7 +151,9 @@ impl TexelStore {
 }
 
 /// A material's record: `[flags, texture ids (kd, ks, α) or (base, metallic-roughness, —),
-/// opacity texture, bump texture, bump scale, ks's factor at normal incidence (3), 0…]`. Its
+/// opacity texture, bump texture, bump scale, ks's factor at normal incidence (3), scattering
+/// kind, its flags, η (glass, plastic), the plastic's specular sampling weight, the conductor's
+/// η (3) and k (3), kt's texture, the coat's offset (see [`coat_record`]; 0: none), 0…]`. Its
 /// textures are appended to `textures`.
 fn material_record(
     m: &Material,
@@ -171,6 +204,51 @@ fn material_record(
         scale.to_bits(),
     ]);
     r[7..10].copy_from_slice(&fresnel.to_array().map(f32::to_bits));
+    let (kind, scatter_flags, eta, weight, conductor) = match m.scattering {
+        Scattering::FresnelFree => (FRESNEL_FREE, 0, 1.0, 0.0, [Vec3::ZERO; 2]),
+        Scattering::Conductor { eta, k } => (CONDUCTOR, 0, 1.0, 0.0, [eta, k]),
+        Scattering::Dielectric { eta, thin } => (
+            DIELECTRIC,
+            if thin { THIN } else { 0 },
+            eta,
+            0.0,
+            [Vec3::ZERO; 2],
+        ),
+        Scattering::Plastic {
+            eta,
+            nonlinear,
+            sampling_weight,
+            ..
+        } => (
+            PLASTIC,
+            if nonlinear { NONLINEAR } else { 0 },
+            eta,
+            sampling_weight,
+            [Vec3::ZERO; 2],
+        ),
+    };
+    r[10..14].copy_from_slice(&[kind, scatter_flags, eta.to_bits(), weight.to_bits()]);
+    for (k, v) in conductor.iter().enumerate() {
+        r[14 + 3 * k..17 + 3 * k].copy_from_slice(&v.to_array().map(f32::to_bits));
+    }
+    r[20] = add(&m.transmittance);
+    r
+}
+
+/// Words per coat record.
+const COAT_WORDS: usize = 66;
+
+/// A plastic's coat: `[the base's internal reflectance, rough (1) or smooth (0), the rough
+/// coat's transmittance table (64)]`.
+fn coat_record(coat: &Coating) -> [u32; COAT_WORDS] {
+    let mut r = [0u32; COAT_WORDS];
+    r[0] = coat.internal_reflectance.to_bits();
+    if let Some(table) = coat.table() {
+        r[1] = 1;
+        for (w, t) in r[2..].iter_mut().zip(table) {
+            *w = t.to_bits();
+        }
+    }
     r
 }
 

@@ -13,6 +13,7 @@ use super::frame_background::{matrix_words, GpuMap};
 pub const LIGHT_TEXELS: KernelSource = KernelSource {
     name: "light_texels",
     wgsl: concat!(
+        include_str!("shaders/lerp.wgsl"),
         include_str!("shaders/map_lookup.wgsl"),
         include_str!("shaders/light_texels.wgsl")
     ),

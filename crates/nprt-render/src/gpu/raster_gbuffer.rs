@@ -1,17 +1,19 @@
 //! The G-buffer rasterised on the GPU: a visibility pass (each pixel centre's nearest triangle,
 //! by the hardware rasteriser) and a compute pass that shades the kept triangle as the tracer
 //! would, so that the frame path's G-buffer matches `nprt_trace::render_gbuffer`'s (its
-//! pixel-centre rays) without tracing a ray.
+//! pixel-centre rays) without tracing a ray. The scene it uploads also serves the path tracer
+//! on the device (`path_tracer.rs`).
 
 use std::sync::{Arc, Mutex};
 
 use anyhow::Result;
 use glam::{DMat4, DVec4};
 use nprt_net::gpu::{Bind, GpuDevice, KernelSource};
-use nprt_scene::{Camera, Scene};
-use nprt_trace::{GBuffer, GSample};
+use nprt_scene::Camera;
+use nprt_trace::{GBuffer, GSample, TraceScene};
 use wgpu::util::DeviceExt;
 
+use super::frame_background::GpuMap;
 use super::gpu_scene::GpuScene;
 
 /// The compute pass that turns kept triangles into G-buffer samples.
@@ -19,6 +21,8 @@ pub const GBUFFER: KernelSource = KernelSource {
     name: "gbuffer",
     wgsl: concat!(
         include_str!("shaders/camera_ray.wgsl"),
+        include_str!("shaders/lerp.wgsl"),
+        include_str!("shaders/surface.wgsl"),
         include_str!("shaders/gbuffer.wgsl")
     ),
 };
@@ -34,6 +38,8 @@ const NEAR: f64 = 1e-6;
 pub struct RasterGBuffer {
     gpu: Arc<GpuDevice>,
     scene: GpuScene,
+    /// The last map [`Self::trace`] lit the scene by.
+    maps: GpuMap,
     visibility: wgpu::RenderPipeline,
     /// The last frame size's targets, reused while the size holds.
     targets: Mutex<Option<Targets>>,
@@ -56,8 +62,8 @@ impl Bind for TextureBinding {
 }
 
 impl RasterGBuffer {
-    /// Uploads `scene` to the process's GPU device.
-    pub fn new(scene: &Scene) -> Result<Self> {
+    /// Uploads `ts`'s scene to the process's GPU device.
+    pub fn new(ts: &TraceScene) -> Result<Self> {
         let gpu = GpuDevice::get()?;
         let module = gpu
             .device
@@ -96,11 +102,24 @@ impl RasterGBuffer {
                 cache: None,
             });
         Ok(RasterGBuffer {
-            scene: GpuScene::new(&gpu, scene)?,
+            scene: GpuScene::new(&gpu, ts)?,
+            maps: GpuMap::default(),
             gpu,
             visibility,
             targets: Mutex::new(None),
         })
+    }
+
+    pub(crate) fn device(&self) -> &GpuDevice {
+        &self.gpu
+    }
+
+    pub(crate) fn scene(&self) -> &GpuScene {
+        &self.scene
+    }
+
+    pub(crate) fn maps(&self) -> &GpuMap {
+        &self.maps
     }
 
     /// The G-buffer of `camera`'s pixel centres, read back.
@@ -210,7 +229,7 @@ impl RasterGBuffer {
                     &scene.triangles,
                     &scene.materials,
                     &scene.textures,
-                    &scene.texels,
+                    &scene.bitmaps,
                     &samples,
                 ],
                 [camera.width.div_ceil(8), camera.height.div_ceil(8)],

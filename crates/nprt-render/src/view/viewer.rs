@@ -10,7 +10,7 @@ use anyhow::{anyhow, bail, Context, Result};
 use glam::Vec3;
 use nprt_net::Device;
 use nprt_scene::{EnvMap, Scene};
-use nprt_trace::{render, PixelFilter, RenderSettings, TraceScene};
+use nprt_trace::{PixelFilter, RenderSettings, TraceScene};
 use winit::application::ApplicationHandler;
 use winit::dpi::PhysicalSize;
 use winit::event::{ElementState, MouseButton, MouseScrollDelta, WindowEvent};
@@ -202,7 +202,7 @@ impl<'a> Viewer<'a> {
         let map = &self.maps[self.map].1;
         if let Some(r) = &mut self.reference {
             let clock = Instant::now();
-            let pass = render(
+            let pass = self.models[self.model].path_trace(
                 &self.ts,
                 &camera,
                 &map.rotated_y(self.rotation),
@@ -214,15 +214,12 @@ impl<'a> Viewer<'a> {
                     filter: PixelFilter::Box,
                     progress: false,
                 },
-            );
+            )?;
             r.pass_ms = clock.elapsed().as_secs_f64() * 1e3;
-            if r.sum.len() != pass.radiance.len() {
-                r.sum = vec![Vec3::ZERO; pass.radiance.len()];
+            if r.sum.len() != pass.len() {
+                r.sum = vec![Vec3::ZERO; pass.len()];
             }
-            r.sum
-                .iter_mut()
-                .zip(&pass.radiance)
-                .for_each(|(s, p)| *s += *p);
+            r.sum.iter_mut().zip(&pass).for_each(|(s, p)| *s += *p);
             r.spp += 1;
             let k = 1.0 / r.spp as f32;
             return Ok(r.sum.iter().map(|s| *s * k).collect());
@@ -261,8 +258,10 @@ impl<'a> Viewer<'a> {
         ];
         match &self.reference {
             Some(r) => lines.push(format!(
-                "path-traced reference: {} spp, {:.0} ms per pass",
-                r.spp, r.pass_ms
+                "path-traced reference {}: {} spp, {:.0} ms per pass",
+                model.paths_on(),
+                r.spp,
+                r.pass_ms
             )),
             None => {
                 let t = &self.timings;

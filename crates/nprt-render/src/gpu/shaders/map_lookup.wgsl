@@ -1,17 +1,13 @@
 // An environment map's radiance along a direction, as EnvMap::eval computes it: Mitsuba's
 // lat-long mapping and bilinear lookup, from the map's texels (rgb f32, row by row) bound as
 // `texels` by the shader that includes this. Shared by a frame's background and the encoder's
-// input.
+// input. After lerp.wgsl.
 
 const PI: f32 = 3.14159265358979323846;
 
 fn texel(x: u32, y: u32, width: u32) -> vec3<f32> {
     let k = 3u * (y * width + x % width);
     return vec3<f32>(texels[k], texels[k + 1u], texels[k + 2u]);
-}
-
-fn lerp(a: vec3<f32>, b: vec3<f32>, s: f32) -> vec3<f32> {
-    return a * (1.0 - s) + b * s;
 }
 
 // Cephes' single-precision arctangent (a few ulp): the device's own atan2 and acos may be far
@@ -117,15 +113,13 @@ fn uv_direction(uv: vec2<f32>) -> vec3<f32> {
     return vec3<f32>(q.x * t.x, t.y, -q.y * t.x);
 }
 
-fn map_radiance(world: vec3<f32>, to_local: mat3x3<f32>, size: vec2<u32>) -> vec3<f32> {
-    let d = to_local[0] * world.x + to_local[1] * world.y + to_local[2] * world.z;
-    let u0 = precise_atan2(d.x, -d.z) / (2.0 * PI);
-    let v = precise_acos(clamp(d.y, -1.0, 1.0)) / PI;
+// EnvMap::eval_uv: the bilinear lookup at lat-long coordinates `uv`.
+fn map_radiance_uv(uv: vec2<f32>, size: vec2<u32>) -> vec3<f32> {
     let w = f32(size.x);
-    var u = (u0 - floor(u0)) - 0.5 / w;
+    var u = uv.x - 0.5 / w;
     u -= floor(u);
     let px = u * w;
-    let py = clamp(v, 0.0, 1.0) * f32(size.y - 1u);
+    let py = clamp(uv.y, 0.0, 1.0) * f32(size.y - 1u);
     let x0 = min(u32(px), size.x - 1u);
     let y0 = min(u32(py), size.y - 2u);
     let fx = px - f32(x0);
@@ -133,4 +127,15 @@ fn map_radiance(world: vec3<f32>, to_local: mat3x3<f32>, size: vec2<u32>) -> vec
     let top = lerp(texel(x0, y0, size.x), texel(x0 + 1u, y0, size.x), fx);
     let bottom = lerp(texel(x0, y0 + 1u, size.x), texel(x0 + 1u, y0 + 1u, size.x), fx);
     return lerp(top, bottom, fy);
+}
+
+// direction_to_uv of a direction in the map's own frame.
+fn map_uv(d: vec3<f32>) -> vec2<f32> {
+    let u = precise_atan2(d.x, -d.z) / (2.0 * PI);
+    return vec2<f32>(u - floor(u), precise_acos(clamp(d.y, -1.0, 1.0)) / PI);
+}
+
+fn map_radiance(world: vec3<f32>, to_local: mat3x3<f32>, size: vec2<u32>) -> vec3<f32> {
+    let d = to_local[0] * world.x + to_local[1] * world.y + to_local[2] * world.z;
+    return map_radiance_uv(map_uv(d), size);
 }

@@ -1,0 +1,147 @@
+//! nprt-trace's path tracer on the device (`shaders/path_trace.wgsl`): the scene's BVH walked
+//! in a compute shader, so it runs on every adapter. A frame's traced direct light (paths of
+//! two vertices) and the viewer's progressive reference (full paths) are the same kernel.
+
+use anyhow::Result;
+use glam::Vec3;
+use nprt_net::gpu::{GpuDevice, KernelSource};
+use nprt_scene::{Camera, EnvMap};
+
+use super::frame_background::{matrix_words, GpuMap};
+use super::gpu_scene::GpuScene;
+use super::raster_gbuffer::{camera_words, RasterGBuffer};
+
+pub const PATH_TRACE: KernelSource = KernelSource {
+    name: "path_trace",
+    wgsl: concat!(
+        include_str!("shaders/camera_ray.wgsl"),
+        include_str!("shaders/lerp.wgsl"),
+        include_str!("shaders/map_lookup.wgsl"),
+        include_str!("shaders/map_sampling.wgsl"),
+        include_str!("shaders/surface.wgsl"),
+        include_str!("shaders/bsdf.wgsl"),
+        include_str!("shaders/bvh.wgsl"),
+        include_str!("shaders/path_trace.wgsl")
+    ),
+};
+
+/// Paths per pixel in one dispatch: a long dispatch is cut short on Mesa's software Vulkan
+/// (one of 1,024 paths per pixel gave two thirds of the light; passes of 16 give it all) and
+/// risks a desktop driver's watchdog, so an estimate is split into dispatches of this many.
+const PATHS_PER_DISPATCH: u32 = 16;
+
+/// Which paths a pass traces: nprt-trace's `RenderSettings` for the device.
+#[derive(Clone, Copy, Debug)]
+pub struct GpuPaths {
+    /// Paths per pixel in this pass.
+    pub spp: u32,
+    pub seed: u64,
+    /// Path vertices, as Mitsuba counts them (2: direct light).
+    pub max_depth: u32,
+    pub rr_depth: u32,
+    /// The index of the pass's first path per pixel: a progressive render's passes draw fresh
+    /// paths by counting on.
+    pub first_path: u32,
+    /// Over the pixel (a reference's box filter) rather than through its centre (the
+    /// G-buffer's, and traced direct light's, convention).
+    pub jitter: bool,
+}
+
+/// Records a pass of `paths` through `camera` under `map` (as placed in the world) into `rgb`
+/// (3 f32 per pixel): their mean, written, or with `add` added to what `rgb` holds.
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn record_paths(
+    gpu: &GpuDevice,
+    pass: &mut wgpu::ComputePass,
+    scene: &GpuScene,
+    maps: &GpuMap,
+    camera: &Camera,
+    map: &EnvMap,
+    paths: &GpuPaths,
+    rgb: &wgpu::Buffer,
+    add: bool,
+) {
+    let texels = maps.texels(gpu, map);
+    let table = maps.table(gpu, map);
+    let (seed, triangles) = (
+        (paths.seed ^ (paths.seed >> 32)) as u32,
+        scene.triangle_count,
+    );
+    for first in (0..paths.spp).step_by(PATHS_PER_DISPATCH as usize) {
+        let mut params = vec![
+            camera.width,
+            camera.height,
+            map.width() as u32,
+            map.height() as u32,
+            PATHS_PER_DISPATCH.min(paths.spp - first),
+            paths.spp,
+            seed,
+            paths.max_depth,
+            paths.rr_depth,
+            paths.first_path + first,
+            u32::from(add || first > 0),
+            u32::from(paths.jitter),
+            triangles,
+            0,
+            0,
+            0,
+        ];
+        params.extend(camera_words(camera));
+        params.extend(matrix_words(map.to_world().inverse()));
+        params.extend(matrix_words(map.to_world()));
+        gpu.dispatch(
+            pass,
+            &PATH_TRACE,
+            &params,
+            &[
+                &scene.positions,
+                &scene.attributes,
+                &scene.triangles,
+                &scene.materials,
+                &scene.textures,
+                &scene.bitmaps,
+                &scene.bvh_nodes,
+                &scene.bvh_triangles,
+                &texels,
+                &table,
+                rgb,
+            ],
+            [camera.width.div_ceil(8), camera.height.div_ceil(8)],
+        );
+    }
+}
+
+impl RasterGBuffer {
+    /// The mean radiance of `paths` per pixel of `camera` under `map` (as placed in the world),
+    /// traced on the device and read back.
+    pub fn trace(&self, camera: &Camera, map: &EnvMap, paths: &GpuPaths) -> Result<Vec<Vec3>> {
+        let gpu = self.device();
+        let pixels = (camera.width * camera.height) as usize;
+        gpu.check_binding(
+            12 * pixels,
+            &format!("a {}×{} traced frame", camera.width, camera.height),
+        )?;
+        let rgb = gpu.buffer(3 * pixels);
+        let mut encoder = gpu.device.create_command_encoder(&Default::default());
+        {
+            let mut pass = encoder.begin_compute_pass(&Default::default());
+            record_paths(
+                gpu,
+                &mut pass,
+                self.scene(),
+                self.maps(),
+                camera,
+                map,
+                paths,
+                &rgb,
+                false,
+            );
+        }
+        gpu.queue.submit([encoder.finish()]);
+        Ok(gpu
+            .read(&rgb, 3 * pixels)
+            .chunks_exact(3)
+            .map(Vec3::from_slice)
+            .collect())
+    }
+}
