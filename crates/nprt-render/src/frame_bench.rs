@@ -41,6 +41,8 @@ pub struct FrameBenchRow {
     pub networks_on: String,
     /// Where the G-buffer was made.
     pub gbuffer_on: &'static str,
+    /// Where traced direct light ran.
+    pub paths_on: &'static str,
 }
 
 /// Times every model at every resolution, calling `on_row` as each is done.
@@ -110,6 +112,7 @@ pub fn bench_frame(
                 relight_ms: median(relights),
                 networks_on: model.networks_on(),
                 gbuffer_on: model.gbuffer_on(),
+                paths_on: model.paths_on(),
             });
         }
     }

@@ -156,10 +156,11 @@ fn frame(a: BenchFrameArgs) -> Result<()> {
     nprt_render::bench_frame(&opts, &device, |r| {
         if header {
             println!(
-                "relit frames of {} under {}, median of {} (ms; direct light on the CPU tracer, {} threads)",
+                "relit frames of {} under {}, median of {} (ms; direct light traced {}, {} host threads)",
                 opts.scene,
                 opts.map,
                 opts.repeats,
+                r.paths_on,
                 rayon::current_num_threads()
             );
             println!(
