@@ -1,7 +1,9 @@
 //! A binary BVH over a scene's triangles laid out flat for a GPU's stack walk (nprt-render's
 //! path tracer on the device): obvhs's Bvh2, whose inner nodes keep their two children side by
-//! side, as eight words a node. The CPU's [`crate::Accel`] stays on the wide BVH, which walks
-//! faster on a CPU; both answer the same closest hit.
+//! side, as eight words a node, and its leaves' triangles in leaf order, each laid out for
+//! Möller-Trumbore as [`crate::Accel`] lays its own, so that a test reads one record instead of
+//! following indices to the vertices. The CPU's Accel stays on the wide BVH, which walks faster
+//! on a CPU; both answer the same closest hit.
 
 use std::time::Duration;
 
@@ -16,10 +18,14 @@ use obvhs::BvhBuildParams;
 /// [`FlatBvh::triangles`].
 pub const NODE_WORDS: usize = 8;
 
+/// Words per triangle record: `[v0 (3 f32), the triangle's index among the scene's (counted
+/// mesh after mesh), e1 = v0 − v1 (3 f32), 0, e2 = v2 − v0 (3 f32), 0]`.
+pub const TRIANGLE_WORDS: usize = 12;
+
 pub struct FlatBvh {
     /// The nodes, the root first, f32 fields as their bits.
     pub nodes: Vec<u32>,
-    /// Leaves' triangles, as indices into the scene's triangles counted mesh after mesh.
+    /// The leaves' triangles in leaf order, [`TRIANGLE_WORDS`] each.
     pub triangles: Vec<u32>,
 }
 
@@ -58,10 +64,18 @@ impl FlatBvh {
             nodes.extend(n.aabb.max.to_array().map(f32::to_bits));
             nodes.push(n.first_index);
         }
-        FlatBvh {
-            nodes,
-            triangles: bvh.primitive_indices,
+        let mut triangles = Vec::with_capacity(TRIANGLE_WORDS * tris.len());
+        for &i in &bvh.primitive_indices {
+            let t = &tris[i as usize];
+            let words = |v: Vec3A, w: u32| {
+                let [x, y, z] = v.to_array().map(f32::to_bits);
+                [x, y, z, w]
+            };
+            triangles.extend(words(t.v0, i));
+            triangles.extend(words(t.v0 - t.v1, 0));
+            triangles.extend(words(t.v2 - t.v0, 0));
         }
+        FlatBvh { nodes, triangles }
     }
 }
 
@@ -102,7 +116,15 @@ mod tests {
                 stack.push((first + 1, boxes));
                 continue;
             }
-            for &t in &bvh.triangles[first..first + count as usize] {
+            for entry in first..first + count as usize {
+                let record = &bvh.triangles[TRIANGLE_WORDS * entry..TRIANGLE_WORDS * (entry + 1)];
+                let t = record[3];
+                let v0 = Vec3::new(
+                    f32::from_bits(record[0]),
+                    f32::from_bits(record[1]),
+                    f32::from_bits(record[2]),
+                );
+                assert_eq!(v0, corners[t as usize][0], "the record's first vertex");
                 seen[t as usize] += 1;
                 for (lo, hi) in &boxes {
                     for p in corners[t as usize] {

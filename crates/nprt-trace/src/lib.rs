@@ -44,7 +44,7 @@ mod transport_pass;
 pub use accel::{Accel, Hit};
 pub use bsdf::Bsdf;
 pub use coating::Coating;
-pub use flat_bvh::{FlatBvh, NODE_WORDS};
+pub use flat_bvh::{FlatBvh, NODE_WORDS, TRIANGLE_WORDS};
 pub use frame::{Frame, GBuffer, GSample};
 pub use gbuffer_pass::{primary_sample, render_gbuffer};
 pub use reference::{render_reference, Reference, ReferenceOptions, DEFAULT_REFERENCE_SPP};

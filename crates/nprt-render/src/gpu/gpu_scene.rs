@@ -106,6 +106,7 @@ impl GpuScene {
             (triangles.len(), "the scene's triangles"),
             (bitmaps.texels.len(), "the scene's textures"),
             (bvh.nodes.len(), "the scene's BVH"),
+            (bvh.triangles.len(), "the scene's triangles in BVH order"),
         ] {
             gpu.check_binding(4 * words, &format!("{what} ('{}')", scene.name))
                 .context("the GPU frame path cannot take the scene; use --device cpu")?;
@@ -121,7 +122,7 @@ impl GpuScene {
             bvh_nodes: gpu.upload(&bvh.nodes),
             // A buffer may not be empty.
             bvh_triangles: gpu.upload(if bvh.triangles.is_empty() {
-                &[0]
+                &[0; nprt_trace::TRIANGLE_WORDS]
             } else {
                 &bvh.triangles
             }),

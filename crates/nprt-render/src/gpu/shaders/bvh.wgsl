@@ -1,7 +1,7 @@
 // Rays against the scene's triangles on the device: a stack walk of nprt-trace's FlatBvh (the
 // nearer child first) with Möller-Trumbore as nprt-trace's Accel tests triangles, so that the
-// closest hit is the CPU's. The shader that includes this binds `bvh_nodes`, `bvh_triangles`
-// and surface.wgsl's records.
+// closest hit is the CPU's. The shader that includes this binds `bvh_nodes` and
+// `bvh_triangles` (the leaves' triangles, three vec4 each: v0 and the triangle's index, e1, e2).
 
 const NODE_WORDS: u32 = 8u;
 // Deeper than obvhs's Bvh2 builds for the scenes a GPU buffer holds (its default is 96; a
@@ -35,13 +35,12 @@ fn enter(k: u32, origin: vec3<f32>, inv: vec3<f32>, tmax: f32) -> f32 {
     return select(3.4e38, near, near <= far);
 }
 
-// Tri::intersect: (t, b1, b2) in x, y, z, or t = -1 where the ray misses within (0, tmax).
-fn hit_triangle(tri: u32, origin: vec3<f32>, dir: vec3<f32>, tmax: f32) -> vec3<f32> {
-    let v0 = position(triangles[4u * tri]);
-    let v1 = position(triangles[4u * tri + 1u]);
-    let v2 = position(triangles[4u * tri + 2u]);
-    let e1 = v0 - v1;
-    let e2 = v2 - v0;
+// Tri::intersect of leaf entry `j`: (t, b1, b2) in x, y, z, or t = -1 where the ray misses
+// within (0, tmax).
+fn hit_triangle(j: u32, origin: vec3<f32>, dir: vec3<f32>, tmax: f32) -> vec3<f32> {
+    let v0 = bvh_triangles[3u * j].xyz;
+    let e1 = bvh_triangles[3u * j + 1u].xyz;
+    let e2 = bvh_triangles[3u * j + 2u].xyz;
     let n = cross(e1, e2);
     let c = v0 - origin;
     let r = cross(dir, c);
@@ -80,10 +79,9 @@ fn trace_ray(origin: vec3<f32>, dir: vec3<f32>, tmax_in: f32, first_hit: bool) -
         let first = bvh_nodes[NODE_WORDS * k + 7u];
         if count > 0u {
             for (var j = first; j < first + count; j++) {
-                let tri = bvh_triangles[j];
-                let h = hit_triangle(tri, origin, dir, best.t);
+                let h = hit_triangle(j, origin, dir, best.t);
                 if h.x > 0.0 {
-                    best = Hit(h.x, tri, h.y, h.z, true);
+                    best = Hit(h.x, bitcast<u32>(bvh_triangles[3u * j].w), h.y, h.z, true);
                     if first_hit {
                         return best;
                     }

@@ -48,7 +48,7 @@ struct Params {
 @group(0) @binding(5) var<storage, read> textures: array<u32>;
 @group(0) @binding(6) var<storage, read> bitmaps: array<f32>;
 @group(0) @binding(7) var<storage, read> bvh_nodes: array<u32>;
-@group(0) @binding(8) var<storage, read> bvh_triangles: array<u32>;
+@group(0) @binding(8) var<storage, read> bvh_triangles: array<vec4<f32>>;
 @group(0) @binding(9) var<storage, read> texels: array<f32>;
 @group(0) @binding(10) var<storage, read> table: array<u32>;
 @group(0) @binding(11) var<storage, read_write> rgb: array<f32>;
@@ -160,7 +160,8 @@ fn trace_path(origin_in: vec3<f32>, dir_in: vec3<f32>, state: ptr<function, u32>
             }
             beta /= q;
         }
-        hit = scene_hit(origin, dir, false);
+        // Where the next vertex would end the path, only whether the ray leaves matters.
+        hit = scene_hit(origin, dir, depth + 1u >= params.max_depth);
     }
     return total;
 }
