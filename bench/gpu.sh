@@ -8,7 +8,8 @@
 #      time in a step) per design beside PyTorch on CUDA, eager and torch.compile, each in f32
 #      and bf16 autocast (the fastest is the peer), at batch 16,384 and 262,144;
 #   2. the paper's schedule (3000 views of 256², 500 epochs) projected from those rates;
-#   3. `nprt bench frame` (G-buffer, encoder, networks, total) per design at 512² and 1920×1080
+#   3. `nprt bench frame` (G-buffer, encoder, networks, direct light traced on the GPU, total)
+#      per design, and D/S with 16 spp of traced direct light, at 512² and 1920×1080
 #      on the GPU kernels, beside the paper's Table 3;
 #   4. with --kitchen: D/S trained 10 minutes on the GPU on that dataset and evaluated with
 #      `nprt eval` beside --cpu-model (the same design trained 10 minutes on the CPU).
