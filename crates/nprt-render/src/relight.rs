@@ -229,8 +229,8 @@ impl Relighter {
     /// Completes a frame the network shaded (`rgb`, background pixels zero) from G-buffer `g`
     /// under `map` (the lighting as placed in the world): for a model that traces direct light,
     /// adds every pixel's direct light, traced through the pixel centre as `sampling` says (on
-    /// background pixels that is the map itself); otherwise fills background pixels with the
-    /// map.
+    /// background pixels that is the map itself; on the device with the kernels, the CPU
+    /// tracer otherwise); otherwise fills background pixels with the map.
     pub fn complete(
         &self,
         ts: &TraceScene,
@@ -244,13 +244,29 @@ impl Relighter {
             background(camera, map, &g.mask, rgb);
             return Ok(());
         }
-        let mut direct = render_direct(ts, camera, map, sampling.spp, sampling.seed);
+        let mut direct = self.traced_direct(ts, camera, map, sampling)?;
         if let Some(oidn) = sampling.denoiser {
             let (w, h) = (camera.width as usize, camera.height as usize);
             direct = oidn.denoise_frame(&direct, g, w, h)?;
         }
         rgb.par_iter_mut().zip(direct).for_each(|(c, d)| *c += d);
         Ok(())
+    }
+
+    /// Every pixel's direct light through its centre, as `sampling` says (its denoiser aside).
+    fn traced_direct(
+        &self,
+        ts: &TraceScene,
+        camera: &Camera,
+        map: &EnvMap,
+        sampling: DirectSampling,
+    ) -> Result<Vec<Vec3>> {
+        #[cfg(feature = "wgpu")]
+        if self.gpu.is_some() {
+            let paths = crate::gpu::GpuPaths::direct(sampling.spp, sampling.seed);
+            return self.raster(ts)?.trace(camera, map, &paths);
+        }
+        Ok(render_direct(ts, camera, map, sampling.spp, sampling.seed))
     }
 
     /// One frame through `camera` under `map` turned by `rotation_deg` (the lighting `key`
@@ -364,7 +380,7 @@ impl Relighter {
 
     /// Whether frames stay on the device from the G-buffer to the finished frame: on the
     /// kernels, with traced direct light traced there too, unless it is to be denoised (OIDN
-    /// runs on the host, from a G-buffer read back).
+    /// runs on the host: the G-buffer and the traced light are read back for it).
     #[cfg(feature = "wgpu")]
     fn frames_on_device(&self, sampling: &DirectSampling) -> bool {
         self.gpu.is_some() && !(self.traces_direct() && sampling.denoiser.is_some())

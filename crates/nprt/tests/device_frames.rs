@@ -169,4 +169,64 @@ fn traced_direct_light_stays_on_the_gpu_and_matches_the_cpus_within_noise() {
     );
     assert!(t.direct_ms > 0.0, "the traced light timed apart");
     assert!(error <= 1.5 * noise && noise < 0.05);
+
+    // Denoised, the light traced on the device goes through OIDN on the host: a few paths per
+    // pixel come out closer to the converged frame than without it.
+    let oidn = match nprt_render::oidn::Oidn::open() {
+        Ok(o) => o,
+        Err(e) if std::env::var_os("NPRT_REQUIRE_OIDN").is_none() => {
+            eprintln!("skipped the denoised frame: {e:#}");
+            return;
+        }
+        Err(e) => panic!("NPRT_REQUIRE_OIDN is set but {e:#}"),
+    };
+    let few = |denoiser| {
+        let sampling = DirectSampling {
+            spp: 2,
+            seed: 4,
+            denoiser,
+        };
+        gpu.frame(
+            &mut FrameCache::default(),
+            &ts,
+            &camera,
+            &map,
+            30.0,
+            0,
+            sampling,
+        )
+        .unwrap()
+    };
+    let converged = {
+        let sampling = DirectSampling {
+            spp: 1024,
+            seed: 5,
+            denoiser: None,
+        };
+        cpu.frame(
+            &mut FrameCache::default(),
+            &ts,
+            &camera,
+            &map,
+            30.0,
+            0,
+            sampling,
+        )
+        .unwrap()
+        .0
+    };
+    let l1 = |f: &[Vec3]| {
+        f.iter()
+            .zip(&converged)
+            .map(|(a, b)| (*a - *b).abs().element_sum())
+            .sum::<f32>()
+    };
+    let ((raw, _), (denoised, t)) = (few(None), few(Some(oidn)));
+    eprintln!(
+        "L1 to the converged frame: raw {:.1}, denoised {:.1} (direct light {:.1} ms)",
+        l1(&raw),
+        l1(&denoised),
+        t.direct_ms
+    );
+    assert!(l1(&denoised) < 0.5 * l1(&raw));
 }

@@ -47,6 +47,21 @@ pub struct GpuPaths {
     pub jitter: bool,
 }
 
+impl GpuPaths {
+    /// Traced direct light's paths, as nprt-trace's `render_direct` traces them: `spp` paths
+    /// of two vertices through each pixel centre.
+    pub fn direct(spp: u32, seed: u64) -> Self {
+        GpuPaths {
+            spp,
+            seed,
+            max_depth: 2,
+            rr_depth: u32::MAX,
+            first_path: 0,
+            jitter: false,
+        }
+    }
+}
+
 /// Records a pass of `paths` through `camera` under `map` (as placed in the world) into `rgb`
 /// (3 f32 per pixel): their mean, written, or with `add` added to what `rgb` holds.
 #[allow(clippy::too_many_arguments)]
