@@ -37,4 +37,4 @@ pub const GATHER_SAMPLES: KernelSource = kernel!("gather_samples", "pixel_featur
 pub const GBUFFER_FEATURES: KernelSource = kernel!("gbuffer_features", "pixel_features");
 
 /// Rows and columns of the tile a `gemm` workgroup computes.
-pub const GEMM_TILE: u32 = 64;
+pub const GEMM_TILE: u32 = 128;

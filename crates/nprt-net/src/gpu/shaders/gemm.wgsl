@@ -6,8 +6,12 @@
 // one per view), applies linear/ReLU/SIREN, keeps the pre-activation in z (from 0) where
 // backward needs it, and writes or adds to C.
 //
-// A 16 × 16 workgroup computes a 64 × 64 tile of C, each thread 4 × 4 values strided by 16,
-// from 16-deep slices of A and B staged in 8 KiB of workgroup memory.
+// A 16 × 16 workgroup computes a 128 × 128 tile of C, each thread 8 × 8 values (rows 4·ty..
+// and 64 + 4·ty.., columns 4·tx.. and 64 + 4·tx..), from 8-deep slices of A and B staged in
+// workgroup memory as vec4s along the tile (k-major, rows padded by one vec4 so that a
+// transposing store does not fall on one bank): per k a thread reads two vec4s of A and two
+// of B for 64 multiply-adds, where a 4 × 4 block per thread read five values for 16 and was
+// bound by workgroup-memory reads.
 
 struct Gemm {
     m: u32,
@@ -47,19 +51,14 @@ struct Gemm {
 @group(0) @binding(5) var<storage, read_write> c: array<f32>;
 @group(0) @binding(6) var<storage, read_write> z: array<f32>;
 
-const TILE: u32 = 64u;
-const DEPTH: u32 = 16u;
+const TILE: u32 = 128u;
+const DEPTH: u32 = 8u;
+// vec4s per staged k row: 32 and one of padding.
+const ROW: u32 = 33u;
 const OMEGA_0: f32 = 30.0;
 
-var<workgroup> as_: array<f32, 1024>;
-var<workgroup> bs: array<vec4<f32>, 256>;
-
-fn b_at(k: u32, j: u32, k_end: u32) -> f32 {
-    if (k < k_end && j < p.n) {
-        return b[p.b_off + k * p.b_rs + j * p.b_cs];
-    }
-    return 0.0;
-}
+var<workgroup> as_: array<vec4<f32>, 264>;
+var<workgroup> bs: array<vec4<f32>, 264>;
 
 fn store(i: u32, j0: u32, acc: vec4<f32>, layer: u32) {
     if (i >= p.m) {
@@ -100,44 +99,97 @@ fn main(
 ) {
     let row0 = group.y * TILE;
     let col0 = group.x * TILE;
-    var a0 = vec4<f32>(0.0);
-    var a1 = vec4<f32>(0.0);
-    var a2 = vec4<f32>(0.0);
-    var a3 = vec4<f32>(0.0);
+    let tx = local.x;
+    let ty = local.y;
+    var c0 = vec4<f32>(0.0);
+    var c1 = vec4<f32>(0.0);
+    var c2 = vec4<f32>(0.0);
+    var c3 = vec4<f32>(0.0);
+    var c4 = vec4<f32>(0.0);
+    var c5 = vec4<f32>(0.0);
+    var c6 = vec4<f32>(0.0);
+    var c7 = vec4<f32>(0.0);
+    var d0 = vec4<f32>(0.0);
+    var d1 = vec4<f32>(0.0);
+    var d2 = vec4<f32>(0.0);
+    var d3 = vec4<f32>(0.0);
+    var d4 = vec4<f32>(0.0);
+    var d5 = vec4<f32>(0.0);
+    var d6 = vec4<f32>(0.0);
+    var d7 = vec4<f32>(0.0);
     let k_begin = group.z * p.k_chunk;
     let k_end = select(p.k, min(p.k, k_begin + p.k_chunk), p.k_chunk > 0u);
     for (var k0 = k_begin; k0 < k_end; k0 += DEPTH) {
+        // Each thread stages four values of A and four of B, neighbouring threads reading
+        // neighbouring addresses along whichever of the operand's strides is 1.
         for (var t = 0u; t < 4u; t++) {
             let e = thread + t * 256u;
-            let i = row0 + e / DEPTH;
-            let k = k0 + e % DEPTH;
-            var v = 0.0;
-            if (i < p.m && k < k_end) {
-                v = a[p.a_off + i * p.a_rs + k * p.a_cs];
+            var i = e / DEPTH;
+            var kk = e % DEPTH;
+            if (p.a_rs == 1u) {
+                i = e % TILE;
+                kk = e / TILE;
             }
-            as_[e] = v;
+            var v = 0.0;
+            if (row0 + i < p.m && k0 + kk < k_end) {
+                v = a[p.a_off + (row0 + i) * p.a_rs + (k0 + kk) * p.a_cs];
+            }
+            as_[kk * ROW + i / 4u][i % 4u] = v;
+            var j = e % TILE;
+            var kb = e / TILE;
+            if (p.b_cs != 1u) {
+                j = e / DEPTH;
+                kb = e % DEPTH;
+            }
+            var w = 0.0;
+            if (k0 + kb < k_end && col0 + j < p.n) {
+                w = b[p.b_off + (k0 + kb) * p.b_rs + (col0 + j) * p.b_cs];
+            }
+            bs[kb * ROW + j / 4u][j % 4u] = w;
         }
-        let kb = k0 + thread / 16u;
-        let j = col0 + 4u * (thread % 16u);
-        bs[thread] = vec4<f32>(
-            b_at(kb, j, k_end),
-            b_at(kb, j + 1u, k_end),
-            b_at(kb, j + 2u, k_end),
-            b_at(kb, j + 3u, k_end)
-        );
         workgroupBarrier();
         for (var k = 0u; k < DEPTH; k++) {
-            let bk = bs[k * 16u + local.x];
-            a0 += as_[local.y * DEPTH + k] * bk;
-            a1 += as_[(local.y + 16u) * DEPTH + k] * bk;
-            a2 += as_[(local.y + 32u) * DEPTH + k] * bk;
-            a3 += as_[(local.y + 48u) * DEPTH + k] * bk;
+            let a_lo = as_[k * ROW + ty];
+            let a_hi = as_[k * ROW + 16u + ty];
+            let b_lo = bs[k * ROW + tx];
+            let b_hi = bs[k * ROW + 16u + tx];
+            c0 += a_lo.x * b_lo;
+            c1 += a_lo.y * b_lo;
+            c2 += a_lo.z * b_lo;
+            c3 += a_lo.w * b_lo;
+            c4 += a_hi.x * b_lo;
+            c5 += a_hi.y * b_lo;
+            c6 += a_hi.z * b_lo;
+            c7 += a_hi.w * b_lo;
+            d0 += a_lo.x * b_hi;
+            d1 += a_lo.y * b_hi;
+            d2 += a_lo.z * b_hi;
+            d3 += a_lo.w * b_hi;
+            d4 += a_hi.x * b_hi;
+            d5 += a_hi.y * b_hi;
+            d6 += a_hi.z * b_hi;
+            d7 += a_hi.w * b_hi;
         }
         workgroupBarrier();
     }
-    let j = col0 + 4u * local.x;
-    store(row0 + local.y, j, a0, group.z);
-    store(row0 + local.y + 16u, j, a1, group.z);
-    store(row0 + local.y + 32u, j, a2, group.z);
-    store(row0 + local.y + 48u, j, a3, group.z);
+    let i_lo = row0 + 4u * ty;
+    let i_hi = row0 + 64u + 4u * ty;
+    let j_lo = col0 + 4u * tx;
+    let j_hi = col0 + 64u + 4u * tx;
+    store(i_lo, j_lo, c0, group.z);
+    store(i_lo + 1u, j_lo, c1, group.z);
+    store(i_lo + 2u, j_lo, c2, group.z);
+    store(i_lo + 3u, j_lo, c3, group.z);
+    store(i_hi, j_lo, c4, group.z);
+    store(i_hi + 1u, j_lo, c5, group.z);
+    store(i_hi + 2u, j_lo, c6, group.z);
+    store(i_hi + 3u, j_lo, c7, group.z);
+    store(i_lo, j_hi, d0, group.z);
+    store(i_lo + 1u, j_hi, d1, group.z);
+    store(i_lo + 2u, j_hi, d2, group.z);
+    store(i_lo + 3u, j_hi, d3, group.z);
+    store(i_hi, j_hi, d4, group.z);
+    store(i_hi + 1u, j_hi, d5, group.z);
+    store(i_hi + 2u, j_hi, d6, group.z);
+    store(i_hi + 3u, j_hi, d7, group.z);
 }

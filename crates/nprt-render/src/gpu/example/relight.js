@@ -71,13 +71,13 @@ async function main() {
     pass.dispatchWorkgroups(x, y);
   };
   const groups = (n) => Math.ceil(n / 64);
-  // y = act(x·W[wRow..] + bias) over `rows` rows of `dIn` inputs: gemm.wgsl with
+  // y = act(x·W[wRow..] + bias) over `rows` rows of `dIn` inputs: gemm.wgsl (128 × 128 tiles) with
   // m = rows, n = d_out, k = dIn, A = x (row stride dIn), B = W from row wRow, a bias per column.
   const spare = room(4);
   const denseLayer = (pass, layer, x, rows, dIn, wRow, bias, activation, y) =>
     dispatch(pass, 'gemm',
       [rows, layer.dOut, dIn, 0, dIn, 1, wRow * layer.dOut, layer.dOut, 1, layer.dOut, 1, activation, 0, 0, 0, 0, 0, 0, 0, 0],
-      [x, layer.weight, bias, empty, y, spare], Math.ceil(layer.dOut / 64), Math.ceil(rows / 64));
+      [x, layer.weight, bias, empty, y, spare], Math.ceil(layer.dOut / 128), Math.ceil(rows / 128));
   // An MLP: hidden layers take its activation, the last is linear; ping-pongs through `scratch`.
   const runMlp = (pass, m, x, rows, first, scratch, out) => {
     const last = m.layers.length - 1;
