@@ -55,19 +55,17 @@ fn sun() -> EnvMap {
 fn direct(scene: &Scene, size: [u32; 2], spp: u32) {
     let map = sun();
     let paths = GpuPaths {
-        spp,
         seed: 7,
-        max_depth: 2,
-        rr_depth: u32::MAX,
-        first_path: 0,
-        jitter: false,
+        ..GpuPaths::direct(spp, 0)
     };
     assert_unbiased(scene, &map, size, paths, |ts, camera, seed| {
         render_direct(ts, camera, &map, spp, seed)
     });
 }
 
-fn full_paths(scene: &Scene, size: [u32; 2], spp: u32) {
+/// Full paths through the pixel centres, or (`jitter`) uniformly over each pixel as the
+/// viewer's reference and `render`'s box filter take them.
+fn full_paths(scene: &Scene, size: [u32; 2], spp: u32, jitter: bool) {
     let map = sun();
     let max_depth = scene.max_depth.unwrap_or(8).min(8);
     let paths = GpuPaths {
@@ -76,7 +74,7 @@ fn full_paths(scene: &Scene, size: [u32; 2], spp: u32) {
         max_depth,
         rr_depth: scene.rr_depth,
         first_path: 0,
-        jitter: false,
+        jitter,
     };
     assert_unbiased(scene, &map, size, paths, |ts, camera, seed| {
         let settings = RenderSettings {
@@ -84,7 +82,11 @@ fn full_paths(scene: &Scene, size: [u32; 2], spp: u32) {
             max_depth: Some(max_depth),
             rr_depth: scene.rr_depth,
             seed,
-            filter: PixelFilter::Centre,
+            filter: if jitter {
+                PixelFilter::Box
+            } else {
+                PixelFilter::Centre
+            },
             progress: false,
         };
         render(ts, camera, &map, &settings).radiance
@@ -116,11 +118,11 @@ fn full_paths_match_the_cpus_for_every_material_feature() {
     if !GpuDevice::probe() {
         return;
     }
-    full_paths(&features_scene(), [48, 36], 256);
+    full_paths(&features_scene(), [48, 36], 256, false);
 }
 
 #[test]
-fn full_paths_match_the_cpus_on_the_builtin_room() {
+fn jittered_full_paths_match_the_cpus_on_the_builtin_room() {
     if !GpuDevice::probe() {
         return;
     }
@@ -128,5 +130,6 @@ fn full_paths_match_the_cpus_on_the_builtin_room() {
         &load_scene("builtin:room", &SceneOptions::default()).unwrap(),
         [48, 36],
         256,
+        true,
     );
 }
