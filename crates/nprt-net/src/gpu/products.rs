@@ -17,12 +17,17 @@ const COLUMN_CHUNK: usize = 256;
 const ROW_CHUNK: usize = 256;
 const ROW_CHUNKS: usize = 32;
 
-/// One operand of a product: element (i, k) at `offset + i · rows + k · cols` of `buffer`.
+/// "None" in a kernel's u32 parameter.
+const NONE: usize = u32::MAX as usize;
+
+/// One operand of a product: element (i, k) at `offset + i · rows + k · cols` of `buffer`;
+/// for a left operand, `ones_row`'s elements read as ones instead.
 pub struct Operand<'a> {
     pub buffer: &'a wgpu::Buffer,
     pub offset: usize,
     pub rows: usize,
     pub cols: usize,
+    pub ones_row: Option<usize>,
 }
 
 impl<'a> Operand<'a> {
@@ -33,6 +38,7 @@ impl<'a> Operand<'a> {
             offset,
             rows: stride,
             cols: 1,
+            ones_row: None,
         }
     }
 
@@ -43,6 +49,7 @@ impl<'a> Operand<'a> {
             offset,
             rows: 1,
             cols: stride,
+            ones_row: None,
         }
     }
 }
@@ -57,11 +64,14 @@ pub enum Bias<'a> {
 }
 
 /// A product's output: `rows` values apart from `offset` of `buffer`, written or added to.
+/// For a column sum, `tail` (`[at, offset]`) sends the sums from index `at` on to `offset` of
+/// the same buffer instead.
 pub struct Output<'a> {
     pub buffer: &'a wgpu::Buffer,
     pub offset: usize,
     pub stride: usize,
     pub accumulate: bool,
+    pub tail: Option<[usize; 2]>,
 }
 
 impl<'a> Output<'a> {
@@ -71,6 +81,7 @@ impl<'a> Output<'a> {
             offset,
             stride,
             accumulate: false,
+            tail: None,
         }
     }
 }
@@ -175,7 +186,7 @@ impl GpuDevice {
             c.offset,
             k_chunk,
             m * n,
-            0,
+            a.ones_row.unwrap_or(NONE),
             0,
         ];
         let tiles = |v: usize| (v as u32).div_ceil(GEMM_TILE);
@@ -307,23 +318,33 @@ impl GpuTrainer {
                 _ => (&tape.outputs[i - 1], 0, layer.d_in),
             };
             let weights = layer.weight.offset + own_row * layer.d_out;
+            // The bias's gradient (unless `on_first` takes it) rides on the weight's product as
+            // a row of ones in A where that product's last tile has a row to spare; otherwise
+            // the extra row would cost a row of tiles, and a column sum is cheaper.
+            let bias = match (i, on_first) {
+                (0, Some(_)) => None,
+                _ => Some(layer.bias.offset),
+            };
+            let spare_row = !count.is_multiple_of(GEMM_TILE as usize);
             self.sum_over_rows(
                 plan,
                 [count, layer.d_out, rows],
                 Operand::transposed(x, 0, count),
                 Operand::plain(dz, 0, layer.d_out),
                 weights,
+                bias.filter(|_| spare_row),
             );
-            match (i, on_first) {
-                (0, Some(f)) => f(plan, dz),
-                _ => self.column_sum(
+            match (on_first.filter(|_| i == 0), bias) {
+                (Some(f), _) => f(plan, dz),
+                (None, Some(at)) if !spare_row => self.column_sum(
                     plan,
                     dz,
                     rows,
                     layer.d_out,
                     None,
-                    Output::to(&self.grads, layer.bias.offset, layer.d_out),
+                    Output::to(&self.grads, at, layer.d_out),
                 ),
+                _ => {}
             }
             let dx = match i {
                 0 => match d_input {
@@ -345,32 +366,41 @@ impl GpuTrainer {
     }
 
     /// Records the gradients of a weight, `[m, n, rows]`: Aᵀ·B summed over the batch's rows,
-    /// into `grads` from `offset` (row stride n). Past [`ROW_CHUNK`] rows the product is split
-    /// over chunks of rows (at most [`ROW_CHUNKS`]) and the chunks' products added in order.
+    /// into `grads` from `offset` (row stride n), and with `bias` (its offset in `grads`) the
+    /// bias's, B's column sums, from an extra row of A that reads as ones. Past [`ROW_CHUNK`]
+    /// rows (or with a bias) the product is split over chunks of rows (at most
+    /// [`ROW_CHUNKS`]) and the chunks' products added in order.
     fn sum_over_rows(
         &self,
         plan: &mut Vec<Dispatch>,
         [m, n, rows]: [usize; 3],
-        a: Operand,
+        mut a: Operand,
         b: Operand,
         offset: usize,
+        bias: Option<usize>,
     ) {
         let chunk = rows.div_ceil(ROW_CHUNKS).max(ROW_CHUNK);
         let chunks = rows.div_ceil(chunk);
-        let out = Output::to(&self.grads, offset, n);
-        if chunks <= 1 {
+        let mut out = Output::to(&self.grads, offset, n);
+        if chunks <= 1 && bias.is_none() {
             plan.push(
                 self.gpu
                     .product([m, n, rows], a, b, Bias::None, 0, out, None),
             );
             return;
         }
-        let partial = self.gpu.buffer(chunks * m * n);
+        let mut rows_of_c = m;
+        if let Some(at) = bias {
+            a.ones_row = Some(m);
+            rows_of_c = m + 1;
+            out.tail = Some([m * n, at]);
+        }
+        let partial = self.gpu.buffer(chunks * rows_of_c * n);
         plan.push(
             self.gpu
-                .split_product([m, n, rows], a, b, [chunk, chunks], &partial),
+                .split_product([rows_of_c, n, rows], a, b, [chunk, chunks], &partial),
         );
-        self.column_sum(plan, &partial, chunks, m * n, None, out);
+        self.column_sum(plan, &partial, chunks, rows_of_c * n, None, out);
     }
 
     /// Records the sums over `rows` rows of the `n` columns of `x`, per group where `groups`
@@ -387,6 +417,7 @@ impl GpuTrainer {
     ) {
         let (group_of, count) = groups.unwrap_or((&self.gpu.empty, 1));
         if rows <= COLUMN_CHUNK {
+            let [tail_at, tail_off] = out.tail.unwrap_or([NONE, 0]);
             let params = [
                 rows,
                 n,
@@ -394,8 +425,8 @@ impl GpuTrainer {
                 usize::from(out.accumulate),
                 out.offset,
                 0,
-                0,
-                0,
+                tail_at,
+                tail_off,
             ];
             plan.push(self.gpu.prepare(
                 &COLUMN_SUM,
@@ -407,7 +438,7 @@ impl GpuTrainer {
         }
         let chunks = rows.div_ceil(COLUMN_CHUNK);
         let partial = self.gpu.buffer(chunks * count * n);
-        let params = [rows, n, count, 0, 0, COLUMN_CHUNK, 0, 0];
+        let params = [rows, n, count, 0, 0, COLUMN_CHUNK, NONE, 0];
         plan.push(self.gpu.prepare(
             &COLUMN_SUM,
             &params.map(|v| v as u32),

@@ -15,8 +15,10 @@ struct ColumnSum {
     out_off: u32,
     // Rows per chunk; 0: all rows in one.
     chunk: u32,
-    _pad0: u32,
-    _pad1: u32,
+    // Sums from index tail_at on go to out from tail_off instead (none: 0xffffffff): a weight's
+    // gradient summed over chunks with its bias's on an extra row, each to its own place.
+    tail_at: u32,
+    tail_off: u32,
 }
 
 @group(0) @binding(0) var<uniform> p: ColumnSum;
@@ -42,8 +44,12 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>, @builtin(num_workgroups) g
             s += x[i * p.n + j];
         }
     }
-    if (p.accumulate == 1u) {
-        s += out[p.out_off + o];
+    var at = p.out_off + o;
+    if (o >= p.tail_at) {
+        at = p.tail_off + (o - p.tail_at);
     }
-    out[p.out_off + o] = s;
+    if (p.accumulate == 1u) {
+        s += out[at];
+    }
+    out[at] = s;
 }

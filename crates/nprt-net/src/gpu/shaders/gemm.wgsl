@@ -39,7 +39,9 @@ struct Gemm {
     // its own copy of C at c_off + z · c_chunk, which a column sum then adds in order.
     k_chunk: u32,
     c_chunk: u32,
-    _pad0: u32,
+    // A row of A that reads as ones (none: 0xffffffff): a weight gradient's product then also
+    // sums its bias's gradient, Σ over rows of dz, on that row of C.
+    ones_row: u32,
     _pad1: u32,
 }
 
@@ -132,7 +134,11 @@ fn main(
             }
             var v = 0.0;
             if (row0 + i < p.m && k0 + kk < k_end) {
-                v = a[p.a_off + (row0 + i) * p.a_rs + (k0 + kk) * p.a_cs];
+                if (row0 + i == p.ones_row) {
+                    v = 1.0;
+                } else {
+                    v = a[p.a_off + (row0 + i) * p.a_rs + (k0 + kk) * p.a_cs];
+                }
             }
             as_[kk * ROW + i / 4u][i % 4u] = v;
             var j = e % TILE;
