@@ -5,8 +5,7 @@ use crate::network::activation::Activation;
 use crate::network::track::TrackKind;
 use crate::training::loss::Loss;
 
-/// A hidden layer's activation in `gemm` and `activation_backward`: 1 ReLU, 2 SIREN (0 is the
-/// linear last layer).
+/// A hidden layer's activation in `gemm`: 1 ReLU, 2 SIREN (0 is the linear last layer).
 pub fn activation_code(a: Activation) -> u32 {
     match a {
         Activation::Relu => 1,

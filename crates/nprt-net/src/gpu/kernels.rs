@@ -28,7 +28,6 @@ pub const TRACK_INPUTS: KernelSource = kernel!("track_inputs", "hash_grid");
 pub const GRID_BACKWARD: KernelSource = kernel!("grid_backward", "hash_grid");
 pub const GEMM: KernelSource = kernel!("gemm");
 pub const COLUMN_SUM: KernelSource = kernel!("column_sum");
-pub const ACTIVATION_BACKWARD: KernelSource = kernel!("activation_backward");
 pub const COMBINE: KernelSource = kernel!("combine", "track_radiance");
 pub const RADIANCE_LOSS: KernelSource = kernel!("radiance_loss", "track_radiance");
 pub const ADAM: KernelSource = kernel!("adam");

@@ -4,7 +4,7 @@
 
 use super::codes::activation_code;
 use super::gpu_trainer::GpuTrainer;
-use super::kernels::{ACTIVATION_BACKWARD, COLUMN_SUM, GEMM, GEMM_TILE};
+use super::kernels::{COLUMN_SUM, GEMM, GEMM_TILE};
 use super::network_layout::MlpAt;
 use super::parameters::Span;
 use super::{groups_for, Dispatch, GpuDevice, Part};
@@ -16,6 +16,9 @@ const COLUMN_CHUNK: usize = 256;
 /// workgroups instead of 16).
 const ROW_CHUNK: usize = 256;
 const ROW_CHUNKS: usize = 32;
+
+/// Added to an activation's code, `gemm`'s epilogue multiplies by its derivative at z instead.
+const BACKWARD: u32 = 2;
 
 /// "None" in a kernel's u32 parameter.
 const NONE: usize = u32::MAX as usize;
@@ -108,7 +111,9 @@ pub(super) struct MlpTape {
 impl GpuDevice {
     /// The dispatch of C = A·B for `[m, n, k]` (C m × n), with `bias` and `activation` (0
     /// linear, 1 ReLU, 2 SIREN) after, the pre-activation kept in `z` where given: a dense
-    /// layer's forward pass, and every product of its backward pass.
+    /// layer's forward pass, and every product of its backward pass; `activation` 3 or 4
+    /// multiplies by ReLU's or SIREN's derivative at the values `z` holds instead (the
+    /// gradient at a hidden layer's pre-activation).
     #[allow(clippy::too_many_arguments)]
     pub fn product(
         &self,
@@ -181,7 +186,8 @@ impl GpuDevice {
             bias_mode,
             activation as usize,
             usize::from(c.accumulate),
-            usize::from(z.is_some()),
+            // Backward z is read, not kept.
+            usize::from(z.is_some() && activation < 1 + BACKWARD),
             bias_off,
             c.offset,
             k_chunk,
@@ -302,17 +308,9 @@ impl GpuTrainer {
         let scratch = [0, 1].map(|_| self.gpu.buffer(rows * widest));
         let last = m.layers.len() - 1;
         for (i, layer) in m.layers.iter().enumerate().rev() {
+            // A hidden layer's dz is already the gradient at its pre-activation: the product
+            // that made it applied the activation's derivative.
             let dz = if i == last { d_last } else { &scratch[i % 2] };
-            if i < last {
-                let count = rows * layer.d_out;
-                let params = [count as u32, activation_code(m.activation), 0, 0];
-                plan.push(self.gpu.prepare(
-                    &ACTIVATION_BACKWARD,
-                    &params,
-                    &[&tape.pre[i], dz],
-                    groups_for(count),
-                ));
-            }
             let (x, own_row, count) = match i {
                 0 => input,
                 _ => (&tape.outputs[i - 1], 0, layer.d_in),
@@ -346,21 +344,27 @@ impl GpuTrainer {
                 ),
                 _ => {}
             }
-            let dx = match i {
+            // The gradient at the layer's input; below a hidden layer, times its activation's
+            // derivative at the pre-activation there (`gemm`'s backward epilogue).
+            let (dx, derivative, pre) = match i {
                 0 => match d_input {
-                    Some(d) => d,
+                    Some(d) => (d, 0, None),
                     None => continue,
                 },
-                _ => &scratch[(i - 1) % 2],
+                _ => (
+                    &scratch[(i - 1) % 2],
+                    activation_code(m.activation) + BACKWARD,
+                    Some(&tape.pre[i - 1]),
+                ),
             };
             plan.push(self.gpu.product(
                 [rows, count, layer.d_out],
                 Operand::plain(dz, 0, layer.d_out),
                 Operand::transposed(&self.params, weights, layer.d_out),
                 Bias::None,
-                0,
+                derivative,
                 Output::to(dx, 0, count),
-                None,
+                pre,
             ));
         }
     }

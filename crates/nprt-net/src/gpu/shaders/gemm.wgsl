@@ -4,7 +4,8 @@
 // m × n with row stride c_rs, from c_off. The epilogue adds a bias (none, per column, or per
 // row group: bias[group[i]·n + j], the light code's share of a shading network's first layer,
 // one per view), applies linear/ReLU/SIREN, keeps the pre-activation in z (from 0) where
-// backward needs it, and writes or adds to C.
+// backward needs it, and writes or adds to C. Backward, it instead multiplies by ReLU's or
+// SIREN's derivative at the pre-activation z holds: dx = (dz·Wᵀ) ⊙ f'(z) in one pass.
 //
 // A 16 × 16 workgroup computes a 128 × 128 tile of C, each thread 8 × 8 values (rows 4·ty..
 // and 64 + 4·ty.., columns 4·tx.. and 64 + 4·tx..), from 8-deep slices of A and B staged in
@@ -26,7 +27,7 @@ struct Gemm {
     c_rs: u32,
     // 0: none, 1: bias[j], 2: bias[group[i] · n + j].
     bias: u32,
-    // 0: linear, 1: ReLU, 2: SIREN, sin(30 v).
+    // 0: linear, 1: ReLU, 2: SIREN, sin(30 v); 3: v · (z > 0), 4: v · 30 cos(30 z).
     activation: u32,
     // 1: C += result instead of C = result.
     accumulate: u32,
@@ -84,6 +85,10 @@ fn store(i: u32, j0: u32, acc: vec4<f32>, layer: u32) {
             v = max(v, 0.0);
         } else if (p.activation == 2u) {
             v = sin(OMEGA_0 * v);
+        } else if (p.activation == 3u) {
+            v = select(0.0, v, z[i * p.c_rs + j] > 0.0);
+        } else if (p.activation == 4u) {
+            v *= OMEGA_0 * cos(OMEGA_0 * z[i * p.c_rs + j]);
         }
         let o = p.c_off + layer * p.c_chunk + i * p.c_rs + j;
         if (p.accumulate == 1u) {
