@@ -35,6 +35,29 @@ fn scene() -> Scene {
     scene
 }
 
+/// A 64 × 48 view of [`scene`] with sky above the sphere.
+fn camera() -> Camera {
+    Camera::look_at(
+        Vec3::new(0.5, 2.5, 5.0),
+        Vec3::new(0.0, 0.8, 0.0),
+        Vec3::Y,
+        60.0,
+        64,
+        48,
+    )
+}
+
+/// An untrained model of `config` for `scene` on the CPU engine and on the GPU kernels.
+fn relighters(config: ModelConfig, scene: &Scene) -> (Relighter, Relighter) {
+    let wgpu = Compute::Wgpu.device().unwrap();
+    let (lo, hi) = scene.bounds();
+    let net = config.build(&mut Init::new(5, &Device::flex()));
+    let file = ModelFile::untrained(config, &net, [lo.to_array(), hi.to_array()]);
+    let cpu = Relighter::new(file.clone(), net.clone(), &Device::flex()).unwrap();
+    let gpu = Relighter::new(file, net, &wgpu).unwrap();
+    (cpu, gpu)
+}
+
 /// How far `gpu` is from `cpu`: the share of pixels beyond 1e-5 of the brightest value, and the
 /// median pixel's difference over it.
 fn compare(gpu: &[Vec3], cpu: &[Vec3]) -> (f64, f32) {
@@ -54,18 +77,9 @@ fn frames_on_the_gpu_match_the_cpus_with_their_background() {
     if !common::wgpu_runs() {
         return;
     }
-    let wgpu = Compute::Wgpu.device().unwrap();
     let scene = scene();
     let ts = TraceScene::new(&scene);
-    let (lo, hi) = scene.bounds();
-    let camera = Camera::look_at(
-        Vec3::new(0.5, 2.5, 5.0),
-        Vec3::new(0.0, 0.8, 0.0),
-        Vec3::Y,
-        60.0,
-        64,
-        48,
-    );
+    let camera = camera();
     let map = nprt_scene::open_envmap("builtin:sky").unwrap();
     let sampling = DirectSampling {
         spp: 1,
@@ -77,10 +91,7 @@ fn frames_on_the_gpu_match_the_cpus_with_their_background() {
             encoder_width: 64,
             ..ModelConfig::new(design, None)
         };
-        let net = config.build(&mut Init::new(5, &Device::flex()));
-        let file = ModelFile::untrained(config, &net, [lo.to_array(), hi.to_array()]);
-        let cpu = Relighter::new(file.clone(), net.clone(), &Device::flex()).unwrap();
-        let gpu = Relighter::new(file, net, &wgpu).unwrap();
+        let (cpu, gpu) = relighters(config, &scene);
         assert_eq!(gpu.gbuffer_on(), "rasterised on the GPU");
         let (mut on_cpu, mut on_gpu) = (FrameCache::default(), FrameCache::default());
         // A new viewpoint, then a lighting change under it (the transfer networks' outputs
@@ -118,28 +129,16 @@ fn traced_direct_light_stays_on_the_gpu_and_matches_the_cpus_within_noise() {
     if !common::wgpu_runs() {
         return;
     }
-    let wgpu = Compute::Wgpu.device().unwrap();
     let scene = scene();
     let ts = TraceScene::new(&scene);
-    let (lo, hi) = scene.bounds();
-    let camera = Camera::look_at(
-        Vec3::new(0.5, 2.5, 5.0),
-        Vec3::new(0.0, 0.8, 0.0),
-        Vec3::Y,
-        60.0,
-        64,
-        48,
-    );
+    let camera = camera();
     let map = nprt_scene::open_envmap("builtin:sky:30:50").unwrap();
     let config = ModelConfig {
         encoder_width: 64,
         direct: DirectLight::Traced,
         ..ModelConfig::new(Design::Dsep, None)
     };
-    let net = config.build(&mut Init::new(5, &Device::flex()));
-    let file = ModelFile::untrained(config, &net, [lo.to_array(), hi.to_array()]);
-    let cpu = Relighter::new(file.clone(), net.clone(), &Device::flex()).unwrap();
-    let gpu = Relighter::new(file, net, &wgpu).unwrap();
+    let (cpu, gpu) = relighters(config, &scene);
     let frame = |r: &Relighter, seed| {
         let sampling = DirectSampling {
             spp: 256,

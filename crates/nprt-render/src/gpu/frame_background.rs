@@ -125,14 +125,7 @@ impl GpuMap {
             seed,
         } = background.fill
         {
-            let paths = GpuPaths {
-                spp,
-                seed,
-                max_depth: 2,
-                rr_depth: u32::MAX,
-                first_path: 0,
-                jitter: false,
-            };
+            let paths = GpuPaths::direct(spp, seed);
             let camera = background.camera;
             record_paths(
                 gpu,
