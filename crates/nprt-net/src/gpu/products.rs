@@ -192,7 +192,7 @@ impl GpuDevice {
             c.offset,
             k_chunk,
             m * n,
-            a.ones_row.unwrap_or(NONE),
+            a.ones_row.map_or(0, |r| r + 1),
             0,
         ];
         let tiles = |v: usize| (v as u32).div_ceil(GEMM_TILE);

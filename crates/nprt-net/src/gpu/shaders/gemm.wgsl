@@ -9,10 +9,9 @@
 //
 // A 16 × 16 workgroup computes a 128 × 128 tile of C, each thread 8 × 8 values (rows 4·ty..
 // and 64 + 4·ty.., columns 4·tx.. and 64 + 4·tx..), from 8-deep slices of A and B staged in
-// workgroup memory as vec4s along the tile (k-major, rows padded by one vec4 so that a
-// transposing store does not fall on one bank): per k a thread reads two vec4s of A and two
-// of B for 64 multiply-adds, where a 4 × 4 block per thread read five values for 16 and was
-// bound by workgroup-memory reads.
+// workgroup memory as vec4s along the tile (k-major, rows padded by one vec4): per k a thread
+// reads two vec4s of A and two of B for 64 multiply-adds, where a 4 × 4 block per thread read
+// five values for 16 and was bound by workgroup-memory reads.
 
 struct Gemm {
     m: u32,
@@ -40,8 +39,8 @@ struct Gemm {
     // its own copy of C at c_off + z · c_chunk, which a column sum then adds in order.
     k_chunk: u32,
     c_chunk: u32,
-    // A row of A that reads as ones (none: 0xffffffff): a weight gradient's product then also
-    // sums its bias's gradient, Σ over rows of dz, on that row of C.
+    // 1 + a row of A that reads as ones (0: none): a weight gradient's product then also sums
+    // its bias's gradient, Σ over rows of dz, on that row of C.
     ones_row: u32,
     _pad1: u32,
 }
@@ -62,6 +61,25 @@ const OMEGA_0: f32 = 30.0;
 
 var<workgroup> as_: array<vec4<f32>, 264>;
 var<workgroup> bs: array<vec4<f32>, 264>;
+
+// A's element (i, k) within the product (ones on `ones_row`), zero outside it.
+fn a_at(i: u32, k: u32, k_end: u32) -> f32 {
+    if (i >= p.m || k >= k_end) {
+        return 0.0;
+    }
+    if (i + 1u == p.ones_row) {
+        return 1.0;
+    }
+    return a[p.a_off + i * p.a_rs + k * p.a_cs];
+}
+
+// B's element (k, j) within the product, zero outside it.
+fn b_at(k: u32, j: u32, k_end: u32) -> f32 {
+    if (k >= k_end || j >= p.n) {
+        return 0.0;
+    }
+    return b[p.b_off + k * p.b_rs + j * p.b_cs];
+}
 
 fn store(i: u32, j0: u32, acc: vec4<f32>, layer: u32) {
     if (i >= p.m) {
@@ -127,37 +145,33 @@ fn main(
     let k_begin = group.z * p.k_chunk;
     let k_end = select(p.k, min(p.k, k_begin + p.k_chunk), p.k_chunk > 0u);
     for (var k0 = k_begin; k0 < k_end; k0 += DEPTH) {
-        // Each thread stages four values of A and four of B, neighbouring threads reading
-        // neighbouring addresses along whichever of the operand's strides is 1.
-        for (var t = 0u; t < 4u; t++) {
-            let e = thread + t * 256u;
-            var i = e / DEPTH;
-            var kk = e % DEPTH;
-            if (p.a_rs == 1u) {
-                i = e % TILE;
-                kk = e / TILE;
-            }
-            var v = 0.0;
-            if (row0 + i < p.m && k0 + kk < k_end) {
-                if (row0 + i == p.ones_row) {
-                    v = 1.0;
-                } else {
-                    v = a[p.a_off + (row0 + i) * p.a_rs + (k0 + kk) * p.a_cs];
-                }
-            }
-            as_[kk * ROW + i / 4u][i % 4u] = v;
-            var j = e % TILE;
-            var kb = e / TILE;
-            if (p.b_cs != 1u) {
-                j = e / DEPTH;
-                kb = e % DEPTH;
-            }
-            var w = 0.0;
-            if (k0 + kb < k_end && col0 + j < p.n) {
-                w = b[p.b_off + (k0 + kb) * p.b_rs + (col0 + j) * p.b_cs];
-            }
-            bs[kb * ROW + j / 4u][j % 4u] = w;
+        // Each thread stages one vec4 of A (four rows at one k) and one of B (four columns at
+        // one k), whole, so that no two threads write parts of one vector; neighbouring threads
+        // read neighbouring addresses along whichever stride is 1.
+        var kk = thread % DEPTH;
+        var i4 = thread / DEPTH;
+        if (p.a_rs == 1u) {
+            kk = thread / 32u;
+            i4 = thread % 32u;
         }
+        as_[kk * ROW + i4] = vec4<f32>(
+            a_at(row0 + 4u * i4, k0 + kk, k_end),
+            a_at(row0 + 4u * i4 + 1u, k0 + kk, k_end),
+            a_at(row0 + 4u * i4 + 2u, k0 + kk, k_end),
+            a_at(row0 + 4u * i4 + 3u, k0 + kk, k_end),
+        );
+        var kb = thread / 32u;
+        var j4 = thread % 32u;
+        if (p.b_cs != 1u) {
+            kb = thread % DEPTH;
+            j4 = thread / DEPTH;
+        }
+        bs[kb * ROW + j4] = vec4<f32>(
+            b_at(k0 + kb, col0 + 4u * j4, k_end),
+            b_at(k0 + kb, col0 + 4u * j4 + 1u, k_end),
+            b_at(k0 + kb, col0 + 4u * j4 + 2u, k_end),
+            b_at(k0 + kb, col0 + 4u * j4 + 3u, k_end),
+        );
         workgroupBarrier();
         for (var k = 0u; k < DEPTH; k++) {
             let a_lo = as_[k * ROW + ty];
