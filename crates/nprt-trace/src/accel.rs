@@ -13,14 +13,42 @@ use obvhs::BvhBuildParams;
 
 /// A triangle laid out for Möller-Trumbore: v0, e1 = v0 − v1, e2 = v2 − v0, n = e1 × e2.
 #[derive(Clone, Copy)]
-struct Tri {
-    v0: Vec3A,
-    e1: Vec3A,
-    e2: Vec3A,
+pub(crate) struct Tri {
+    pub v0: Vec3A,
+    pub e1: Vec3A,
+    pub e2: Vec3A,
     n: Vec3A,
 }
 
+/// Every triangle of `scene`, mesh after mesh, as obvhs builds over them.
+pub(crate) fn scene_triangles(scene: &Scene) -> Vec<Triangle> {
+    scene
+        .meshes
+        .iter()
+        .flat_map(|mesh| {
+            mesh.indices.iter().map(|t| {
+                let p = t.map(|i| Vec3A::from(mesh.positions[i as usize]));
+                Triangle {
+                    v0: p[0],
+                    v1: p[1],
+                    v2: p[2],
+                }
+            })
+        })
+        .collect()
+}
+
 impl Tri {
+    pub(crate) fn new(t: &Triangle) -> Self {
+        let (e1, e2) = (t.v0 - t.v1, t.v2 - t.v0);
+        Tri {
+            v0: t.v0,
+            e1,
+            e2,
+            n: e1.cross(e2),
+        }
+    }
+
     /// (t, b1, b2) with the hit at v0·(1−b1−b2) + v1·b1 + v2·b2, or None.
     #[inline(always)]
     fn intersect(&self, ray: &Ray) -> Option<(f32, f32, f32)> {
@@ -67,38 +95,20 @@ fn bvh_ray(origin: Vec3, dir: Vec3, tmax: f32) -> Ray {
 
 impl Accel {
     pub fn new(scene: &Scene) -> Self {
-        let mut tris = Vec::with_capacity(scene.triangle_count());
-        let mut refs = Vec::with_capacity(scene.triangle_count());
-        for (mi, mesh) in scene.meshes.iter().enumerate() {
-            for (ti, t) in mesh.indices.iter().enumerate() {
-                let p = t.map(|i| Vec3A::from(mesh.positions[i as usize]));
-                tris.push(Triangle {
-                    v0: p[0],
-                    v1: p[1],
-                    v2: p[2],
-                });
-                refs.push((mi as u32, ti as u32));
-            }
-        }
+        let tris = scene_triangles(scene);
+        let refs: Vec<(u32, u32)> = scene
+            .meshes
+            .iter()
+            .enumerate()
+            .flat_map(|(mi, mesh)| (0..mesh.indices.len() as u32).map(move |ti| (mi as u32, ti)))
+            .collect();
         let bvh = build_cwbvh_from_tris(
             &tris,
             BvhBuildParams::medium_build(),
             &mut Duration::default(),
         );
         let order = &bvh.primitive_indices;
-        let tris = order
-            .iter()
-            .map(|&i| {
-                let t = &tris[i as usize];
-                let (e1, e2) = (t.v0 - t.v1, t.v2 - t.v0);
-                Tri {
-                    v0: t.v0,
-                    e1,
-                    e2,
-                    n: e1.cross(e2),
-                }
-            })
-            .collect();
+        let tris = order.iter().map(|&i| Tri::new(&tris[i as usize])).collect();
         let refs = order.iter().map(|&i| refs[i as usize]).collect();
         Accel { bvh, tris, refs }
     }

@@ -10,8 +10,9 @@ use std::time::Duration;
 use glam::Vec3A;
 use nprt_scene::Scene;
 use obvhs::bvh2::builder::build_bvh2_from_tris;
-use obvhs::triangle::Triangle;
 use obvhs::BvhBuildParams;
+
+use crate::accel::{scene_triangles, Tri};
 
 /// Words per node: `[min (3 f32), triangle count, max (3 f32), first]` with `first` the first
 /// child's node (inner nodes: count 0; the second child follows it) or a leaf's first entry of
@@ -31,20 +32,7 @@ pub struct FlatBvh {
 
 impl FlatBvh {
     pub fn new(scene: &Scene) -> Self {
-        let tris: Vec<Triangle> = scene
-            .meshes
-            .iter()
-            .flat_map(|mesh| {
-                mesh.indices.iter().map(|t| {
-                    let p = t.map(|i| Vec3A::from(mesh.positions[i as usize]));
-                    Triangle {
-                        v0: p[0],
-                        v1: p[1],
-                        v2: p[2],
-                    }
-                })
-            })
-            .collect();
+        let tris = scene_triangles(scene);
         if tris.is_empty() {
             // A placeholder root: a walk must not start on a scene without triangles.
             return FlatBvh {
@@ -66,14 +54,14 @@ impl FlatBvh {
         }
         let mut triangles = Vec::with_capacity(TRIANGLE_WORDS * tris.len());
         for &i in &bvh.primitive_indices {
-            let t = &tris[i as usize];
+            let t = Tri::new(&tris[i as usize]);
             let words = |v: Vec3A, w: u32| {
                 let [x, y, z] = v.to_array().map(f32::to_bits);
                 [x, y, z, w]
             };
             triangles.extend(words(t.v0, i));
-            triangles.extend(words(t.v0 - t.v1, 0));
-            triangles.extend(words(t.v2 - t.v0, 0));
+            triangles.extend(words(t.e1, 0));
+            triangles.extend(words(t.e2, 0));
         }
         FlatBvh { nodes, triangles }
     }

@@ -20,9 +20,6 @@ const ROW_CHUNKS: usize = 32;
 /// Added to an activation's code, `gemm`'s epilogue multiplies by its derivative at z instead.
 const BACKWARD: u32 = 2;
 
-/// "None" in a kernel's u32 parameter.
-const NONE: usize = u32::MAX as usize;
-
 /// One operand of a product: element (i, k) at `offset + i · rows + k · cols` of `buffer`;
 /// for a left operand, `ones_row`'s elements read as ones instead.
 pub struct Operand<'a> {
@@ -67,8 +64,8 @@ pub enum Bias<'a> {
 }
 
 /// A product's output: `rows` values apart from `offset` of `buffer`, written or added to.
-/// For a column sum, `tail` (`[at, offset]`) sends the sums from index `at` on to `offset` of
-/// the same buffer instead.
+/// For a column sum, `tail` (`[at, offset]`, `at` > 0) sends the sums from index `at` on to
+/// `offset` of the same buffer instead.
 pub struct Output<'a> {
     pub buffer: &'a wgpu::Buffer,
     pub offset: usize,
@@ -319,30 +316,28 @@ impl GpuTrainer {
             // The bias's gradient (unless `on_first` takes it) rides on the weight's product as
             // a row of ones in A where that product's last tile has a row to spare; otherwise
             // the extra row would cost a row of tiles, and a column sum is cheaper.
-            let bias = match (i, on_first) {
-                (0, Some(_)) => None,
-                _ => Some(layer.bias.offset),
-            };
+            let first_bias = on_first.filter(|_| i == 0);
             let spare_row = !count.is_multiple_of(GEMM_TILE as usize);
+            let folded = first_bias.is_none() && spare_row;
             self.sum_over_rows(
                 plan,
                 [count, layer.d_out, rows],
                 Operand::transposed(x, 0, count),
                 Operand::plain(dz, 0, layer.d_out),
                 weights,
-                bias.filter(|_| spare_row),
+                folded.then_some(layer.bias.offset),
             );
-            match (on_first.filter(|_| i == 0), bias) {
-                (Some(f), _) => f(plan, dz),
-                (None, Some(at)) if !spare_row => self.column_sum(
+            match first_bias {
+                Some(f) => f(plan, dz),
+                None if !folded => self.column_sum(
                     plan,
                     dz,
                     rows,
                     layer.d_out,
                     None,
-                    Output::to(&self.grads, at, layer.d_out),
+                    Output::to(&self.grads, layer.bias.offset, layer.d_out),
                 ),
-                _ => {}
+                None => {}
             }
             // The gradient at the layer's input; below a hidden layer, times its activation's
             // derivative at the pre-activation there (`gemm`'s backward epilogue).
@@ -421,7 +416,7 @@ impl GpuTrainer {
     ) {
         let (group_of, count) = groups.unwrap_or((&self.gpu.empty, 1));
         if rows <= COLUMN_CHUNK {
-            let [tail_at, tail_off] = out.tail.unwrap_or([NONE, 0]);
+            let [tail_at, tail_off] = out.tail.unwrap_or([0, 0]);
             let params = [
                 rows,
                 n,
@@ -442,7 +437,7 @@ impl GpuTrainer {
         }
         let chunks = rows.div_ceil(COLUMN_CHUNK);
         let partial = self.gpu.buffer(chunks * count * n);
-        let params = [rows, n, count, 0, 0, COLUMN_CHUNK, NONE, 0];
+        let params = [rows, n, count, 0, 0, COLUMN_CHUNK, 0, 0];
         plan.push(self.gpu.prepare(
             &COLUMN_SUM,
             &params.map(|v| v as u32),

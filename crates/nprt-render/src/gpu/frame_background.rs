@@ -7,7 +7,6 @@ use nprt_net::gpu::{GpuDevice, KernelSource};
 use nprt_scene::{Camera, EnvMap};
 
 use super::kept_last::KeptLast;
-use super::path_tracer::{record_paths, GpuPaths};
 use super::raster_gbuffer::{camera_words, RasterGBuffer};
 
 pub const FRAME_BACKGROUND: KernelSource = KernelSource {
@@ -107,38 +106,6 @@ impl GpuMap {
             &[background.samples, &texels, rgb],
             [camera.width.div_ceil(8), camera.height.div_ceil(8)],
         );
-    }
-
-    /// Records the traced direct light of `background` (a [`Fill::TracedDirect`]) onto `rgb`,
-    /// after [`Self::record`] zeroed its empty pixels.
-    pub fn record_direct(
-        &self,
-        gpu: &GpuDevice,
-        pass: &mut wgpu::ComputePass,
-        background: &Background,
-        rgb: &wgpu::Buffer,
-    ) {
-        if let Fill::TracedDirect {
-            map,
-            scene,
-            spp,
-            seed,
-        } = background.fill
-        {
-            let paths = GpuPaths::direct(spp, seed);
-            let camera = background.camera;
-            record_paths(
-                gpu,
-                pass,
-                scene.scene(),
-                self,
-                camera,
-                map,
-                &paths,
-                rgb,
-                true,
-            );
-        }
     }
 
     /// `map`'s sampling table on the device ([`nprt_scene::Distribution2D::cells`], three

@@ -20,6 +20,7 @@ use nprt_net::gpu::kernels::{COMBINE, ENCODER_BLOCK, GBUFFER_FEATURES, TRACK_INP
 
 use super::frame_background::{Background, Fill, GpuMap};
 use super::light_input::GpuLightInput;
+use super::path_tracer::{record_paths, GpuPaths};
 use nprt_net::gpu::{activation_code, kind_code};
 
 /// Rows per block of dispatches: a block's widest activations (256 f32 per row, 64 MiB) stay
@@ -446,21 +447,35 @@ impl GpuNetwork {
         }
         gpu.queue.submit([encoder.finish()]);
         let mut direct_ms = 0.0;
-        if let Some(b) = background {
-            if matches!(b.fill, Fill::TracedDirect { .. }) {
-                gpu.wait();
-                let clock = std::time::Instant::now();
-                let mut encoder = gpu.device.create_command_encoder(&Default::default());
-                self.map.record_direct(
-                    gpu,
-                    &mut encoder.begin_compute_pass(&Default::default()),
-                    b,
-                    &px.rgb,
-                );
-                gpu.queue.submit([encoder.finish()]);
-                gpu.wait();
-                direct_ms = clock.elapsed().as_secs_f64() * 1e3;
-            }
+        if let Some(Background {
+            camera,
+            fill:
+                Fill::TracedDirect {
+                    map,
+                    scene,
+                    spp,
+                    seed,
+                },
+            ..
+        }) = background
+        {
+            gpu.wait();
+            let clock = std::time::Instant::now();
+            let mut encoder = gpu.device.create_command_encoder(&Default::default());
+            record_paths(
+                gpu,
+                &mut encoder.begin_compute_pass(&Default::default()),
+                scene.scene(),
+                &self.map,
+                camera,
+                map,
+                &GpuPaths::direct(*spp, *seed),
+                &px.rgb,
+                true,
+            );
+            gpu.queue.submit([encoder.finish()]);
+            gpu.wait();
+            direct_ms = clock.elapsed().as_secs_f64() * 1e3;
         }
         (gpu.read(&px.rgb, px.rows * 3), direct_ms)
     }

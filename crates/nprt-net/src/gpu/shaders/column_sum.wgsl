@@ -15,7 +15,7 @@ struct ColumnSum {
     out_off: u32,
     // Rows per chunk; 0: all rows in one.
     chunk: u32,
-    // Sums from index tail_at on go to out from tail_off instead (none: 0xffffffff): a weight's
+    // Sums from index tail_at on go to out from tail_off instead (0: none): a weight's
     // gradient summed over chunks with its bias's on an extra row, each to its own place.
     tail_at: u32,
     tail_off: u32,
@@ -45,7 +45,7 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>, @builtin(num_workgroups) g
         }
     }
     var at = p.out_off + o;
-    if (o >= p.tail_at) {
+    if (p.tail_at > 0u && o >= p.tail_at) {
         at = p.tail_off + (o - p.tail_at);
     }
     if (p.accumulate == 1u) {
