@@ -10,7 +10,8 @@
 #   2. the paper's schedule (3000 views of 256², 500 epochs) projected from those rates;
 #   3. `nprt bench frame` (G-buffer, encoder, networks, direct light traced on the GPU, total)
 #      per design, and D/S with 16 spp of traced direct light, at 512² and 1920×1080
-#      on the GPU kernels, beside the paper's Table 3;
+#      on the GPU kernels, in f32 and in f16 (tensor cores where the adapter has them),
+#      beside the paper's Table 3;
 #   4. with --kitchen: D/S trained 10 minutes on the GPU on that dataset and evaluated with
 #      `nprt eval` beside --cpu-model (the same design trained 10 minutes on the CPU).
 #
@@ -122,7 +123,8 @@ end_section
 # 3. The frame, stage by stage.
 log "frame timings"
 section "Frame ms (nprt bench frame --device wgpu); the paper's Table 3 (RTX 3090, 512²): encoder 0.34 ms, networks 9.7-16 ms"
-"$nprt" bench frame --device wgpu --arch "$designs" --res "$res" --repeats 10 >>"$summary"
+"$nprt" bench frame --device wgpu --arch "$designs" --res "$res" --repeats 10 --precision f32,f16 \
+  >>"$summary"
 end_section
 
 # 4. KITCHEN: 10 minutes of training on the GPU against 10 on the CPU.

@@ -9,7 +9,7 @@ use nprt_scene::{load_scene, SceneOptions};
 use nprt_trace::TraceScene;
 
 use crate::relight::{DirectSampling, FrameCache, FrameTimings, Relighter};
-use crate::CameraPath;
+use crate::{CameraPath, Precision};
 
 /// What to time.
 pub struct FrameBenchOptions {
@@ -17,6 +17,8 @@ pub struct FrameBenchOptions {
     pub scene: String,
     /// The models: a design and who supplies its direct light.
     pub models: Vec<(Design, DirectLight)>,
+    /// The precisions each model's networks run in (f16: GPU kernels only).
+    pub precisions: Vec<Precision>,
     pub resolutions: Vec<[u32; 2]>,
     /// Timed frames per measurement, after one untimed; medians are reported.
     pub repeats: usize,
@@ -25,6 +27,8 @@ pub struct FrameBenchOptions {
     /// The lighting (a map file or built-in spec), turned by a different angle every frame so
     /// that each runs the encoder.
     pub map: String,
+    /// Also time each kernel of a lighting change on the GPU (GPU kernels only).
+    pub profile: bool,
 }
 
 /// One model at one resolution.
@@ -43,6 +47,9 @@ pub struct FrameBenchRow {
     pub gbuffer_on: &'static str,
     /// Where traced direct light ran.
     pub paths_on: &'static str,
+    /// With `profile`: each kernel's GPU time in a lighting change, longest first.
+    #[cfg(feature = "wgpu")]
+    pub profile: Option<Vec<nprt_net::gpu::KernelTime>>,
 }
 
 /// Times every model at every resolution, calling `on_row` as each is done.
@@ -63,20 +70,32 @@ pub fn bench_frame(
     let (lo, hi) = scene.bounds();
     let ts = TraceScene::new(&scene);
     let median = |v: Vec<f64>| nprt_net::median(v);
-    for &(design, direct) in &opts.models {
+    let runs = opts
+        .models
+        .iter()
+        .flat_map(|&m| opts.precisions.iter().map(move |&p| (m, p)));
+    for ((design, direct), precision) in runs {
         let config = ModelConfig {
             direct,
             ..ModelConfig::new(design, None)
         };
         let net = config.build(&mut Init::new(1, &Relighter::weights_device(device)));
         let file = ModelFile::untrained(config.clone(), &net, [lo.to_array(), hi.to_array()]);
-        let model = Relighter::new(file, net, device)?;
+        let mut model = Relighter::new(file, net, device)?;
+        model.set_precision(precision)?;
+        let label = match precision {
+            Precision::F32 => config.label(),
+            Precision::F16 => format!("{} f16", config.label()),
+        };
         for &[w, h] in &opts.resolutions {
             nprt_trace::Frame::check_size(w, h, &format!("a {w}×{h} frame"))?;
             let camera = path.camera(0.5, w, h);
             let mut frames = Vec::new();
             let mut relights = Vec::new();
             let mut foreground = 0;
+            // The last frame's lighting change, timed kernel by kernel.
+            #[cfg(feature = "wgpu")]
+            let mut profile = None;
             for i in 0..=opts.repeats {
                 let rotation = 10.0 * i as f32;
                 let sampling = DirectSampling {
@@ -92,6 +111,10 @@ pub fn bench_frame(
                 let (_, change) =
                     model.frame(&mut cache, &ts, &camera, map, turned, i + 1, sampling)?;
                 foreground = cache.foreground();
+                #[cfg(feature = "wgpu")]
+                if opts.profile && i == opts.repeats {
+                    profile = model.profile_relight(&cache)?;
+                }
                 // The first frame is untimed: a GPU compiles and allocates on first use.
                 if i > 0 {
                     frames.push(t);
@@ -100,7 +123,7 @@ pub fn bench_frame(
             }
             let stage = |f: fn(&FrameTimings) -> f64| median(frames.iter().map(f).collect());
             on_row(&FrameBenchRow {
-                label: config.label(),
+                label: label.clone(),
                 resolution: [w, h],
                 foreground,
                 frame: FrameTimings {
@@ -113,6 +136,8 @@ pub fn bench_frame(
                 networks_on: model.networks_on(),
                 gbuffer_on: model.gbuffer_on(),
                 paths_on: model.paths_on(),
+                #[cfg(feature = "wgpu")]
+                profile,
             });
         }
     }

@@ -29,6 +29,7 @@ mod frame_bench;
 pub mod gpu;
 pub mod oidn;
 mod path;
+mod precision;
 mod relight;
 mod render_job;
 pub mod schedule;
@@ -39,6 +40,7 @@ pub mod view;
 pub use animation::{write_animation, Animation};
 pub use frame_bench::{bench_frame, FrameBenchOptions, FrameBenchRow};
 pub use path::CameraPath;
+pub use precision::Precision;
 pub use relight::{
     background, DirectSampling, FrameCache, FrameTimings, LightCode, Pixels, Relighter,
     DEFAULT_DIRECT_SPP,

@@ -14,6 +14,8 @@ use nprt_net::{load_model, Device, DirectLight, LightInput, ModelFile, NprtNet, 
 use nprt_scene::{Camera, EnvMap};
 use nprt_trace::{render, render_direct, render_gbuffer, GBuffer, RenderSettings, TraceScene};
 
+use crate::Precision;
+
 use crate::oidn::Oidn;
 use rayon::prelude::*;
 
@@ -171,6 +173,19 @@ impl Relighter {
         })
     }
 
+    /// Runs the networks in `precision`; f16 needs the GPU kernels (`--device wgpu`) and an
+    /// adapter with f16 in shaders. Frames made after use it, with a new [`FrameCache`].
+    pub fn set_precision(&mut self, precision: Precision) -> Result<()> {
+        #[cfg(feature = "wgpu")]
+        if let Some(gpu) = &mut self.gpu {
+            return gpu.set_half(precision == Precision::F16);
+        }
+        if precision == Precision::F16 {
+            anyhow::bail!("--precision f16 runs on the GPU kernels only (--device wgpu)");
+        }
+        Ok(())
+    }
+
     /// Where a model's weights are loaded to run on `device`: the host for the frame path's
     /// kernels, which upload them themselves; `device` itself otherwise.
     pub fn weights_device(device: &Device) -> Device {
@@ -186,7 +201,10 @@ impl Relighter {
     pub fn networks_on(&self) -> String {
         #[cfg(feature = "wgpu")]
         if let Some(gpu) = &self.gpu {
-            return format!("GPU kernels on {}", gpu.adapter());
+            return match gpu.precision() {
+                "f32" => format!("GPU kernels on {}", gpu.adapter()),
+                p => format!("GPU kernels on {} ({p})", gpu.adapter()),
+            };
         }
         match self.host {
             Some(_) => "CPU engine".into(),
@@ -455,6 +473,26 @@ impl Relighter {
             return Ok(Some((rgb, direct_ms)));
         }
         Ok(None)
+    }
+
+    /// The GPU time of each kernel of a lighting change of the pixels `cache` keeps, under the
+    /// lighting it keeps (`nprt bench frame --profile`): each dispatch timed in a pass of its
+    /// own. None where the networks do not run on the GPU kernels or no frame was made yet.
+    #[cfg(feature = "wgpu")]
+    pub fn profile_relight<K>(
+        &self,
+        cache: &FrameCache<K>,
+    ) -> Result<Option<Vec<nprt_net::gpu::KernelTime>>> {
+        let (Some(gpu), Some((_, _, px)), Some((_, light))) =
+            (&self.gpu, &cache.still, &cache.light)
+        else {
+            return Ok(None);
+        };
+        let Some(pixels) = &px.gpu else {
+            return Ok(None);
+        };
+        let code = nprt_net::host_values(light.code.clone().into_data());
+        gpu.profile_relight(pixels, &code, light.scale).map(Some)
     }
 
     /// Encodes `map` rotated by `rotation_deg` about +Y.

@@ -11,7 +11,7 @@ use nprt_trace::TraceScene;
 
 use crate::oidn::Oidn;
 use crate::{
-    render_sequence, CameraPath, FrameReport, LightingSchedule, Relighter, Sequence,
+    render_sequence, CameraPath, FrameReport, LightingSchedule, Precision, Relighter, Sequence,
     SequenceSummary, DEFAULT_DIRECT_SPP,
 };
 
@@ -44,6 +44,8 @@ pub struct RenderOptions {
     pub direct_spp: u32,
     /// Denoise that light with Open Image Denoise.
     pub denoise_direct: bool,
+    /// The networks' arithmetic (f16: GPU kernels only).
+    pub precision: Precision,
 }
 
 impl Default for RenderOptions {
@@ -63,6 +65,7 @@ impl Default for RenderOptions {
             exr: false,
             direct_spp: DEFAULT_DIRECT_SPP,
             denoise_direct: false,
+            precision: Precision::F32,
         }
     }
 }
@@ -87,7 +90,8 @@ impl RenderJob {
         }
         let [w, h] = opts.resolution;
         nprt_trace::Frame::check_size(w, h, &format!("a {w}×{h} frame"))?;
-        let model = Relighter::load(&opts.model, device)?;
+        let mut model = Relighter::load(&opts.model, device)?;
+        model.set_precision(opts.precision)?;
         let scene_spec = match (&opts.scene, model.file.scene.as_str()) {
             (Some(s), _) => s.clone(),
             (None, "") => bail!(

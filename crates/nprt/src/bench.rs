@@ -53,6 +53,16 @@ pub struct BenchFrameArgs {
     /// Timed frames per measurement, after one untimed; the median is reported.
     #[arg(long, default_value_t = 5)]
     repeats: usize,
+    /// Also print each kernel's GPU time in one lighting change (timestamp queries, each
+    /// dispatch timed in a pass of its own) after each row: where the networks' time goes.
+    /// Needs --device wgpu.
+    #[arg(long)]
+    profile: bool,
+    /// The networks' arithmetic, comma-separated: f32, and f16 (weights and activations in
+    /// f16, sums in f32, on tensor cores where the adapter has them; GPU kernels only), each
+    /// timed as a row of its own.
+    #[arg(long, default_value = "f32", value_delimiter = ',')]
+    precision: Vec<nprt_render::Precision>,
     #[command(flatten)]
     device: DeviceArg,
 }
@@ -134,6 +144,14 @@ pub fn run(cmd: BenchCommand) -> Result<()> {
 }
 
 fn frame(a: BenchFrameArgs) -> Result<()> {
+    anyhow::ensure!(
+        !a.profile || matches!(a.device.compute, nprt_net::Compute::Wgpu),
+        "--profile times nprt's own kernels: it needs --device wgpu"
+    );
+    anyhow::ensure!(
+        !a.profile || cfg!(feature = "wgpu"),
+        "--profile times nprt's own kernels: this nprt was built without the `wgpu` feature"
+    );
     let device = a.device.device()?;
     let mut models: Vec<(Design, DirectLight)> = a
         .designs
@@ -147,12 +165,15 @@ fn frame(a: BenchFrameArgs) -> Result<()> {
     let opts = nprt_render::FrameBenchOptions {
         scene: a.scene,
         models,
+        precisions: a.precision,
+        profile: a.profile,
         resolutions: a.res.iter().map(|r| r.0).collect(),
         repeats: a.repeats.max(1),
         direct_spp: a.direct_spp,
         map: a.map,
     };
     let mut header = true;
+    let mut networks_on = String::new();
     nprt_render::bench_frame(&opts, &device, |r| {
         if header {
             println!(
@@ -163,12 +184,18 @@ fn frame(a: BenchFrameArgs) -> Result<()> {
                 r.paths_on,
                 rayon::current_num_threads()
             );
+        }
+        // Said again where it changes (f16 rows after f32 ones).
+        if r.networks_on != networks_on {
             println!(
                 "networks on the {}, G-buffer {}",
                 r.networks_on, r.gbuffer_on
             );
+            networks_on = r.networks_on.clone();
+        }
+        if header {
             println!(
-                "{:<14} {:>10} {:>9} {:>9} {:>8} {:>9} {:>8} {:>9} {:>7} {:>11}",
+                "{:<16} {:>10} {:>9} {:>9} {:>8} {:>9} {:>8} {:>9} {:>7} {:>11}",
                 "design",
                 "size",
                 "pixels",
@@ -184,7 +211,7 @@ fn frame(a: BenchFrameArgs) -> Result<()> {
         }
         let t = &r.frame;
         println!(
-            "{:<14} {:>10} {:>9} {:>9.1} {:>8.1} {:>9.1} {:>8.1} {:>9.1} {:>7.2} {:>11.1}",
+            "{:<16} {:>10} {:>9} {:>9.1} {:>8.1} {:>9.1} {:>8.1} {:>9.1} {:>7.2} {:>11.1}",
             r.label,
             format!("{}×{}", r.resolution[0], r.resolution[1]),
             r.foreground,
@@ -196,6 +223,10 @@ fn frame(a: BenchFrameArgs) -> Result<()> {
             1e3 / t.total_ms(),
             r.relight_ms
         );
+        #[cfg(feature = "wgpu")]
+        if let Some(times) = &r.profile {
+            print_kernel_times("a lighting change's kernels", times, r.relight_ms);
+        }
     })
 }
 
@@ -343,11 +374,16 @@ fn train(a: BenchTrainArgs) -> Result<()> {
 #[cfg(feature = "wgpu")]
 fn print_profile(config: &ModelConfig, a: &BenchTrainArgs, step_ms: f64) -> Result<()> {
     let times = nprt_net::profile_kernels(config, a.batch_size, a.views, a.warmup)?;
+    print_kernel_times("one step's kernels", &times, step_ms);
+    Ok(())
+}
+
+/// `what`'s kernels' GPU times, longest first, beside the `wall_ms` it took at full speed.
+#[cfg(feature = "wgpu")]
+fn print_kernel_times(what: &str, times: &[nprt_net::gpu::KernelTime], wall_ms: f64) {
     let sum: f64 = times.iter().map(|k| k.ms).sum();
-    println!(
-        "  one step's kernels: {sum:.2} ms of GPU time; a step at the rate above takes {step_ms:.2} ms"
-    );
-    for k in &times {
+    println!("  {what}: {sum:.2} ms of GPU time; wall time {wall_ms:.2} ms");
+    for k in times {
         println!(
             "    {:<26} {:>4} × {:>9.3} ms {:>6.1}%",
             k.kernel,
@@ -356,7 +392,6 @@ fn print_profile(config: &ModelConfig, a: &BenchTrainArgs, step_ms: f64) -> Resu
             100.0 * k.ms / sum.max(f64::MIN_POSITIVE)
         );
     }
-    Ok(())
 }
 
 #[cfg(not(feature = "wgpu"))]

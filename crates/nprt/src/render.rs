@@ -62,6 +62,10 @@ pub struct RenderArgs {
     /// adding it: far less noise for a few ms per frame (docs/model.md#traced-direct-light).
     #[arg(long)]
     denoise_direct: bool,
+    /// The networks' arithmetic: f32, or f16 (weights and activations in f16, sums in f32, on
+    /// tensor cores where the adapter has them; --device wgpu only).
+    #[arg(long, default_value_t = d().precision)]
+    precision: nprt_render::Precision,
     #[command(flatten)]
     device: DeviceArg,
 }
@@ -83,6 +87,7 @@ impl From<RenderArgs> for RenderOptions {
             exr: a.exr,
             direct_spp: a.direct_spp,
             denoise_direct: a.denoise_direct,
+            precision: a.precision,
         }
     }
 }

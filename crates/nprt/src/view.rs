@@ -49,6 +49,10 @@ pub struct ViewArgs {
     /// With --frames: write the last frame, overlay included, to this PNG.
     #[arg(long, requires = "frames")]
     screenshot: Option<PathBuf>,
+    /// The networks' arithmetic: f32, or f16 (weights and activations in f16, sums in f32, on
+    /// tensor cores where the adapter has them).
+    #[arg(long, default_value = "f32")]
+    precision: nprt_render::Precision,
     #[command(flatten)]
     device: DeviceArg,
 }
@@ -72,6 +76,7 @@ pub fn run(a: ViewArgs) -> Result<()> {
         screenshot: a.screenshot,
         reference: a.reference,
         hide_overlay: a.no_overlay,
+        precision: a.precision,
     })
 }
 

@@ -474,6 +474,75 @@ fn bench_frame_times_every_stage_on_each_device() {
     }
 }
 
+/// `nprt bench frame --precision f32,f16 --profile` on the GPU kernels: a row per precision,
+/// the f16 ones saying where they ran, and each row followed by its lighting change's kernels
+/// (lavapipe's timestamps are not a GPU's, so only their presence is checked). Both flags are
+/// refused where the networks run on the CPU.
+#[test]
+fn bench_frame_times_half_precision_and_profiles_kernels_on_the_gpu() {
+    common::fails(
+        &[
+            "bench",
+            "frame",
+            "--arch",
+            "prt",
+            "--res",
+            "32",
+            "--device",
+            "cpu",
+            "--profile",
+        ],
+        &["--profile", "--device wgpu"],
+    );
+    common::fails(
+        &[
+            "bench",
+            "frame",
+            "--arch",
+            "prt",
+            "--res",
+            "32",
+            "--direct-spp",
+            "0",
+            "--device",
+            "cpu",
+            "--precision",
+            "f16",
+        ],
+        &["--precision f16", "--device wgpu"],
+    );
+    if !common::wgpu_runs() {
+        return;
+    }
+    let out = common::ok(&[
+        "bench",
+        "frame",
+        "--arch",
+        "dsep",
+        "--res",
+        "32",
+        "--repeats",
+        "1",
+        "--direct-spp",
+        "0",
+        "--device",
+        "wgpu",
+        "--precision",
+        "f32,f16",
+        "--profile",
+    ]);
+    let rows: Vec<&str> = out.lines().filter(|l| l.starts_with("dsep")).collect();
+    assert_eq!(rows.len(), 2, "{out}");
+    assert!(rows[1].starts_with("dsep f16 "), "{out}");
+    assert!(out.contains("(f16"), "{out}");
+    assert_eq!(
+        out.matches("a lighting change's kernels:").count(),
+        2,
+        "{out}"
+    );
+    assert!(out.contains("half_dense") && out.contains("gemm"), "{out}");
+}
+
 /// bench/gpu.sh explains itself, refuses bad arguments, and on a machine without an NVIDIA GPU
 /// (CI's) says so before it builds or measures anything.
 #[test]

@@ -14,6 +14,11 @@ pub struct GpuDevice {
     /// The adapter's name and driver, for reports ("llvmpipe (LLVM 19.1.7, 256 bits)" on
     /// Mesa's software Vulkan).
     pub adapter: String,
+    /// Whether kernels may hold f16 values (`half_layer`, the frame path's `--precision f16`).
+    pub half: bool,
+    /// Whether `half_layer`'s products run on cooperative matrices (tensor cores): 16 × 16 × 16
+    /// f16 products into f32, in subgroups of 32.
+    pub tensor_cores: bool,
     pub(super) pipelines: Pipelines,
     /// Bound where a kernel's read-only input is unused, and where a written one is (two
     /// buffers: one dispatch may not bind a buffer both ways).
@@ -69,16 +74,32 @@ impl GpuDevice {
             )
         })?;
         let info = adapter.get_info();
+        let half = adapter.features().contains(wgpu::Features::SHADER_F16);
+        let tensor_cores = half && tensor_cores(&adapter);
+        // Timestamps only serve `nprt bench train --profile`; an adapter without them still
+        // trains. f16 and tensor cores serve the frame path's `--precision f16`.
+        let mut features = adapter.features() & wgpu::Features::TIMESTAMP_QUERY;
+        features.set(wgpu::Features::SHADER_F16, half);
+        features.set(
+            wgpu::Features::EXPERIMENTAL_COOPERATIVE_MATRIX,
+            tensor_cores,
+        );
         let (device, queue) =
             futures_lite::future::block_on(adapter.request_device(&wgpu::DeviceDescriptor {
                 label: Some("nprt"),
-                // Timestamps only serve `nprt bench train --profile`; an adapter without them
-                // still trains.
-                required_features: adapter.features() & wgpu::Features::TIMESTAMP_QUERY,
+                required_features: features,
                 // The adapter's own limits, not WebGPU's portable defaults (128 MiB per
                 // storage binding, which a chunk of activations approaches).
                 required_limits: adapter.limits(),
-                experimental_features: wgpu::ExperimentalFeatures::disabled(),
+                // wgpu's cooperative matrices are experimental: asked for only where the
+                // adapter offers the one configuration `half_dense_coop` uses.
+                experimental_features: if tensor_cores {
+                    // SAFETY: the kernels use cooperative matrices only as naga validates them,
+                    // in the configuration the adapter reports.
+                    unsafe { wgpu::ExperimentalFeatures::enabled() }
+                } else {
+                    wgpu::ExperimentalFeatures::disabled()
+                },
                 memory_hints: wgpu::MemoryHints::Performance,
                 trace: wgpu::Trace::Off,
             }))
@@ -97,8 +118,23 @@ impl GpuDevice {
             device,
             queue,
             adapter: format!("{} ({}, {:?})", info.name, info.driver_info, info.backend),
+            half,
+            tensor_cores,
             pipelines: Pipelines::default(),
         })
+    }
+
+    /// Whether the frame path can run its networks in half precision here.
+    pub fn check_half(&self) -> Result<()> {
+        if self.half {
+            Ok(())
+        } else {
+            Err(anyhow!(
+                "--precision f16 needs f16 in shaders, which the GPU adapter {} lacks; use \
+                 --precision f32",
+                self.adapter
+            ))
+        }
     }
 
     /// Blocks until the queue's work is done.
@@ -107,4 +143,20 @@ impl GpuDevice {
             .poll(wgpu::PollType::wait_indefinitely())
             .expect("waiting for the GPU queue");
     }
+}
+
+/// Whether `adapter` offers cooperative matrices of 16 × 16 × 16 f16 products into f32 in
+/// subgroups of 32 (what `half_dense_coop` is written for).
+fn tensor_cores(adapter: &wgpu::Adapter) -> bool {
+    let info = adapter.get_info();
+    adapter
+        .features()
+        .contains(wgpu::Features::EXPERIMENTAL_COOPERATIVE_MATRIX)
+        && info.subgroup_min_size == 32
+        && info.subgroup_max_size == 32
+        && adapter.cooperative_matrix_properties().iter().any(|c| {
+            (c.m_size, c.n_size, c.k_size) == (16, 16, 16)
+                && c.ab_type == wgpu::CooperativeScalarType::F16
+                && c.cr_type == wgpu::CooperativeScalarType::F32
+        })
 }

@@ -111,3 +111,15 @@ impl KernelTimer {
         times
     }
 }
+
+impl GpuDevice {
+    /// The GPU time of each kernel of `dispatches`, run once in order, each in a pass of its
+    /// own (`nprt bench frame --profile`). An error where the adapter has no timestamp queries.
+    pub fn profile(&self, dispatches: &[&Dispatch]) -> Result<Vec<KernelTime>> {
+        let mut timer = KernelTimer::new(self, dispatches.len())?;
+        let mut encoder = self.device.create_command_encoder(&Default::default());
+        timer.record(&mut encoder, dispatches);
+        let submission = self.queue.submit([encoder.finish()]);
+        Ok(timer.read(self, submission))
+    }
+}

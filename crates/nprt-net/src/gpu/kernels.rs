@@ -35,5 +35,11 @@ pub const GATHER_SAMPLES: KernelSource = kernel!("gather_samples", "pixel_featur
 /// The network inputs of a G-buffer left on the device (nprt-render's frame path).
 pub const GBUFFER_FEATURES: KernelSource = kernel!("gbuffer_features", "pixel_features");
 
+/// The frame path's half-precision dense layers (`half_layers`): the input's conversion, and
+/// the product with tensor cores and without.
+pub const HALF_ROWS: KernelSource = kernel!("half_rows");
+pub const HALF_DENSE: KernelSource = kernel!("half_dense", "half_layer");
+pub const HALF_DENSE_COOP: KernelSource = kernel!("half_dense_coop", "coop_matrix", "half_layer");
+
 /// Rows and columns of the tile a `gemm` workgroup computes.
 pub const GEMM_TILE: u32 = 128;

@@ -2,8 +2,8 @@
 //! Vulkan in the tests). This module owns the device (one per process), how a kernel is
 //! compiled and dispatched, storage buffers, the training step of every design on the device
 //! ([`GpuTrainer`]) and the training set held there ([`DeviceDataset`]). nprt-render's frame
-//! path dispatches these kernels and its own on the same device. The kernels compute what the CPU engine ([`crate::cpu`]) computes, in f32, and
-//! tests hold the two together; layouts, designs and the hash grid stay defined where the CPU
+//! path dispatches these kernels and its own on the same device. The kernels compute what the CPU engine ([`crate::cpu`]) computes, in f32 (the frame
+//! path may also run its dense layers in f16: [`HalfWeight`]), and tests hold the two together; layouts, designs and the hash grid stay defined where the CPU
 //! engine reads them.
 
 mod codes;
@@ -12,6 +12,7 @@ mod encoder_step;
 mod gpu_buffer;
 mod gpu_device;
 mod gpu_trainer;
+mod half_layers;
 mod kernel;
 mod kernel_steps;
 mod kernel_timer;
@@ -25,6 +26,7 @@ pub use codes::{activation_code, kind_code, loss_code};
 pub use device_dataset::DeviceDataset;
 pub use gpu_device::GpuDevice;
 pub use gpu_trainer::GpuTrainer;
+pub use half_layers::{pad16, HalfWeight, Held, HALF_ROW_BLOCK};
 pub use kernel::{groups_for, Bind, Dispatch, KernelSource, Part, GROUP};
 pub use kernel_steps::KernelSteps;
 pub use kernel_timer::KernelTime;

@@ -3,7 +3,7 @@
 //! lighting (each track's transfer network ŝ, or the baseline's gathered inputs), kept on the
 //! device; each lighting then runs only the shading networks and the combination.
 
-use std::sync::Arc;
+use std::sync::{Arc, Mutex};
 
 use anyhow::Result;
 use nprt_net::cpu::{DenseStack, HostEncoder, HostTransport};
@@ -12,9 +12,9 @@ use nprt_net::network::encoder::{BLOCKS, CHANNELS, CODE_SIZE};
 use nprt_net::{Activation, MapNorm, NprtNet, TrackKind, FEATURES, TRANSPORT_CODE};
 use nprt_scene::EnvMap;
 
-use nprt_net::gpu::{groups_for, GpuDevice};
+use nprt_net::gpu::{groups_for, Dispatch, GpuDevice, KernelTime};
 
-use nprt_net::gpu::{Bias, Operand, Output};
+use nprt_net::gpu::{pad16, Bias, HalfWeight, Held, Operand, Output, HALF_ROW_BLOCK};
 
 use nprt_net::gpu::kernels::{COMBINE, ENCODER_BLOCK, GBUFFER_FEATURES, TRACK_INPUTS};
 
@@ -23,17 +23,21 @@ use super::light_input::GpuLightInput;
 use super::path_tracer::{record_paths, GpuPaths};
 use nprt_net::gpu::{activation_code, kind_code};
 
-/// Rows per block of dispatches: a block's widest activations (256 f32 per row, 64 MiB) stay
-/// within WebGPU's 128 MiB storage-binding limit, and every kernel's workgroup count within
-/// 65,535.
-const CHUNK: usize = 65_536;
+/// Most rows per block of dispatches. Fewer blocks mean fewer dispatches to prepare and record
+/// (at 65,536 rows a 1920 × 1080 D/S frame was 32 blocks of a dozen dispatches each). A
+/// block's widest activations (256 f32 per row, 512 MiB) must also fit one storage binding of
+/// the device ([`chunk_rows`]); its kernels' workgroups stay within 65,535 a dimension
+/// (`gemm`: 4,096 tiles of 128 rows).
+const MAX_CHUNK: usize = 1 << 19;
 
-/// One dense layer's weights (`d_in × d_out`, burn's layout) and bias on the device.
+/// One dense layer's weights (`d_in × d_out`, burn's layout) and bias on the device, and the
+/// weights in f16 where the networks run in half precision.
 struct GpuDense {
     weight: wgpu::Buffer,
     bias: wgpu::Buffer,
     d_in: usize,
     d_out: usize,
+    half: Option<HalfWeight>,
 }
 
 /// An MLP on the device: hidden layers take `activation`, the last is linear.
@@ -64,6 +68,24 @@ pub struct GpuNetwork {
     resolutions: wgpu::Buffer,
     /// The last map a frame's background or encoder input came from.
     map: GpuMap,
+    /// The activations every camera's pixels run through, grown as needed.
+    workspace: Mutex<Option<Arc<Workspace>>>,
+}
+
+/// The buffers a camera's pixels run their networks through, which the network keeps for the
+/// next camera: a new viewpoint then allocates only what it keeps (on an H200, allocating
+/// these afresh for every 512² frame cost more than its networks). Pixels share them: the
+/// queue runs one submission after another, and each writes them before reading.
+struct Workspace {
+    /// Rows they hold (the largest block), and whether the networks run in half precision.
+    rows: usize,
+    half: bool,
+    /// Ping-pong activations, f32 and, in half precision, f16 (rows padded to a multiple of
+    /// 256 and columns to 16).
+    scratch: [wgpu::Buffer; 2],
+    half_scratch: Option<[wgpu::Buffer; 2]>,
+    /// Each track's shading outputs.
+    outputs: Vec<wgpu::Buffer>,
 }
 
 /// A camera's foreground pixels on the device and what of the network does not depend on the
@@ -73,9 +95,7 @@ pub struct GpuPixels {
     /// device (see [`GpuNetwork::pixels_of_gbuffer`]).
     pub rows: usize,
     chunks: Vec<PixelChunk>,
-    /// Ping-pong activations and each track's shading outputs, for the largest chunk.
-    scratch: [wgpu::Buffer; 2],
-    outputs: Vec<wgpu::Buffer>,
+    work: Arc<Workspace>,
     /// Radiance of every row, `rows × 3`.
     rgb: wgpu::Buffer,
 }
@@ -85,7 +105,8 @@ struct PixelChunk {
     rows: usize,
     features: wgpu::Buffer,
     /// Per track, what its shading network's first layer reads besides the light code: ŝ
-    /// (`rows × TRANSPORT_CODE`) or, for the baseline, the gathered inputs (`rows × width`).
+    /// (`rows × TRANSPORT_CODE`) or, for the baseline, the gathered inputs (`rows × width`);
+    /// in f16 where the networks run in half precision.
     kept: Vec<wgpu::Buffer>,
 }
 
@@ -101,6 +122,7 @@ impl GpuNetwork {
             bias: storage(&d.bias),
             d_in: d.d_in,
             d_out: d.d_out,
+            half: None,
         };
         let mlp = |s: &DenseStack| GpuMlp {
             layers: s.layers.iter().map(dense).collect(),
@@ -133,8 +155,45 @@ impl GpuNetwork {
             tracks,
             resolutions: gpu.upload(&hash_grid::resolutions()),
             map: GpuMap::default(),
+            workspace: Mutex::new(None),
             gpu,
         })
+    }
+
+    /// Runs the dense layers in half precision (f16 weights and activations, f32 sums; on
+    /// tensor cores where the adapter has them) or, `false`, in f32. Pixels made before must be
+    /// made again.
+    pub fn set_half(&mut self, half: bool) -> Result<()> {
+        if half {
+            self.gpu.check_half()?;
+        }
+        let gpu = &self.gpu;
+        let layers = self.tracks.iter_mut().flat_map(|t| {
+            t.transfer
+                .iter_mut()
+                .flat_map(|m| m.layers.iter_mut())
+                .chain(t.shading.layers.iter_mut())
+        });
+        for layer in layers {
+            layer.half = half.then(|| {
+                let weight = gpu.read(&layer.weight, layer.d_in * layer.d_out);
+                gpu.upload_half_weight(&weight, layer.d_in, layer.d_out)
+            });
+        }
+        Ok(())
+    }
+
+    fn half(&self) -> bool {
+        self.tracks[0].shading.layers[0].half.is_some()
+    }
+
+    /// Where the dense layers run, for reports: "f32", "f16 on tensor cores" or "f16".
+    pub fn precision(&self) -> &'static str {
+        match (self.half(), self.gpu.tensor_cores) {
+            (false, _) => "f32",
+            (true, true) => "f16 on tensor cores",
+            (true, false) => "f16",
+        }
     }
 
     /// The device's adapter, for reports.
@@ -182,15 +241,7 @@ impl GpuNetwork {
                 d_in: self.to_code.d_in,
                 w_row: 0,
             };
-            dense_layer(
-                gpu,
-                &mut pass,
-                &self.to_code,
-                flat,
-                &self.to_code.bias,
-                0,
-                &code,
-            );
+            dense_layer(gpu, &self.to_code, flat, &self.to_code.bias, 0, &code).record(&mut pass);
         }
         encoder.copy_buffer_to_buffer(&input.scale, 0, &code, 4 * CODE_SIZE as u64, 12);
         gpu.queue.submit([encoder.finish()]);
@@ -240,15 +291,14 @@ impl GpuNetwork {
         })
     }
 
-    /// Runs what does not depend on the lighting over `rows` rows, in blocks of [`CHUNK`]
-    /// whose inputs `inputs(pass, first row, rows)` makes.
+    /// Runs what does not depend on the lighting over `rows` rows, in blocks of
+    /// [`chunk_rows`] whose inputs `inputs(pass, first row, rows)` makes.
     fn pixels_with(
         &self,
         rows: usize,
         mut inputs: impl FnMut(&mut wgpu::ComputePass, usize, usize) -> wgpu::Buffer,
     ) -> GpuPixels {
         let gpu = &*self.gpu;
-        let largest = rows.clamp(1, CHUNK);
         let widest = self
             .tracks
             .iter()
@@ -261,46 +311,55 @@ impl GpuNetwork {
             })
             .max()
             .expect("a network has layers");
-        let scratch = [0, 1].map(|_| gpu.buffer(largest * widest));
-        let outputs = self
-            .tracks
-            .iter()
-            .map(|t| gpu.buffer(largest * t.shading.layers.last().expect("layers").d_out))
-            .collect();
+        let chunk = chunk_rows(gpu, widest);
+        let work = self.workspace(rows.clamp(1, chunk), widest);
+        let half = work.half;
         let mut encoder = gpu.device.create_command_encoder(&Default::default());
         let mut chunks = Vec::new();
         {
             let mut pass = encoder.begin_compute_pass(&Default::default());
-            for first in (0..rows).step_by(CHUNK) {
-                let n = CHUNK.min(rows - first);
+            for first in (0..rows).step_by(chunk) {
+                let n = chunk.min(rows - first);
                 let features = inputs(&mut pass, first, n);
+                let mut list = Vec::new();
                 let kept = self
                     .tracks
                     .iter()
                     .map(|t| {
-                        let Some(transfer) = &t.transfer else {
-                            let x = gpu.buffer(n * t.width);
-                            self.track_inputs(&mut pass, t, &features, n, &x);
-                            return x;
+                        let width = t.transfer.as_ref().map_or(t.width, |_| TRANSPORT_CODE);
+                        let kept = match half {
+                            true => {
+                                let padded = n.next_multiple_of(HALF_ROW_BLOCK);
+                                gpu.half_buffer(padded * pad16(width))
+                            }
+                            false => gpu.buffer(n * width),
                         };
-                        let s = gpu.buffer(n * TRANSPORT_CODE);
-                        self.track_inputs(&mut pass, t, &features, n, &scratch[0]);
-                        let first = FirstLayer {
-                            x_stride: t.width,
-                            w_row: 0,
-                            bias: None,
-                        };
-                        mlp(
-                            gpu,
-                            &mut pass,
-                            transfer,
-                            &scratch[0],
-                            n,
-                            first,
-                            &scratch,
-                            &s,
-                        );
-                        s
+                        let gathered = &work.scratch[0];
+                        match (&t.transfer, half) {
+                            (None, false) => self.track_inputs(&mut pass, t, &features, n, &kept),
+                            (None, true) => {
+                                self.track_inputs(&mut pass, t, &features, n, gathered);
+                                list.push(gpu.half_rows([n, width, width], gathered, &kept));
+                            }
+                            (Some(transfer), _) => {
+                                self.track_inputs(&mut pass, t, &features, n, gathered);
+                                let first = FirstLayer {
+                                    x_stride: t.width,
+                                    w_row: 0,
+                                    bias: None,
+                                };
+                                let out = match half {
+                                    true => Held::F16(&kept),
+                                    false => Held::F32(&kept),
+                                };
+                                let x = Held::F32(gathered);
+                                mlp(gpu, &mut list, transfer, x, n, first, &work, out);
+                            }
+                        }
+                        for d in list.drain(..) {
+                            d.record(&mut pass);
+                        }
+                        kept
                     })
                     .collect();
                 chunks.push(PixelChunk {
@@ -315,10 +374,140 @@ impl GpuNetwork {
         GpuPixels {
             rows,
             chunks,
-            scratch,
-            outputs,
+            work,
             rgb: gpu.buffer(rows.max(1) * 3),
         }
+    }
+
+    /// The workspace for blocks of `rows` rows of activations at most `widest` wide: the kept
+    /// one where it is large enough and of this precision, else a new one, kept instead.
+    fn workspace(&self, rows: usize, widest: usize) -> Arc<Workspace> {
+        let mut kept = self.workspace.lock().unwrap_or_else(|e| e.into_inner());
+        let half = self.half();
+        if let Some(w) = kept.as_ref().filter(|w| w.rows >= rows && w.half == half) {
+            return w.clone();
+        }
+        let gpu = &*self.gpu;
+        let work = Arc::new(Workspace {
+            rows,
+            half,
+            scratch: [0, 1].map(|_| gpu.buffer(rows * widest)),
+            half_scratch: half.then(|| {
+                let padded = rows.next_multiple_of(HALF_ROW_BLOCK);
+                [0, 1].map(|_| gpu.half_buffer(padded * pad16(widest)))
+            }),
+            outputs: self
+                .tracks
+                .iter()
+                .map(|t| gpu.buffer(rows * t.shading.layers.last().expect("layers").d_out))
+                .collect(),
+        });
+        *kept = Some(work.clone());
+        work
+    }
+
+    /// What a lighting change runs on `px` under the light `code`: each track's shading
+    /// network with the code's share folded into its first bias, then the combination into
+    /// radiance (times `scale`).
+    fn relight_dispatches(&self, px: &GpuPixels, code: &[f32], scale: [f32; 3]) -> Vec<Dispatch> {
+        assert_eq!(
+            px.work.half,
+            self.half(),
+            "pixels made in one precision, relit in the other"
+        );
+        let gpu = &*self.gpu;
+        let code = gpu.upload(code);
+        let mut list = Vec::new();
+        // Each track's first shading layer with the light code's share folded into its bias.
+        let biases: Vec<wgpu::Buffer> = self
+            .tracks
+            .iter()
+            .map(|t| {
+                let first = &t.shading.layers[0];
+                let code_row = if t.transfer.is_some() {
+                    TRANSPORT_CODE
+                } else {
+                    0
+                };
+                let bias = gpu.buffer(first.d_out);
+                // b' = b + ê·W[code rows]: one row through the first layer's code rows.
+                list.push(gpu.product(
+                    [1, first.d_out, CODE_SIZE],
+                    Operand::plain(&code, 0, CODE_SIZE),
+                    Operand::plain(&first.weight, code_row * first.d_out, first.d_out),
+                    Bias::Column(&first.bias, 0),
+                    0,
+                    Output::to(&bias, 0, first.d_out),
+                    None,
+                ));
+                bias
+            })
+            .collect();
+        for chunk in &px.chunks {
+            for ((t, kept), (bias, out)) in self
+                .tracks
+                .iter()
+                .zip(&chunk.kept)
+                .zip(biases.iter().zip(&px.work.outputs))
+            {
+                let first = match t.transfer {
+                    // [ŝ, ê]: ŝ's rows come first.
+                    Some(_) => FirstLayer {
+                        x_stride: TRANSPORT_CODE,
+                        w_row: 0,
+                        bias: Some(bias),
+                    },
+                    // The baseline's [ê, inputs]: the inputs' rows follow ê's.
+                    None => FirstLayer {
+                        x_stride: t.width,
+                        w_row: CODE_SIZE,
+                        bias: Some(bias),
+                    },
+                };
+                let x = match px.work.half {
+                    true => Held::F16(kept),
+                    false => Held::F32(kept),
+                };
+                let out = Held::F32(out);
+                mlp(
+                    gpu, &mut list, &t.shading, x, chunk.rows, first, &px.work, out,
+                );
+            }
+            let kinds: Vec<u32> = self.tracks.iter().map(|t| kind_code(t.kind)).collect();
+            let mut params = vec![
+                chunk.rows as u32,
+                kinds.len() as u32,
+                kinds[0],
+                *kinds.last().expect("a track"),
+                chunk.first as u32,
+                0,
+                0,
+                0,
+            ];
+            params.extend(scale.map(f32::to_bits));
+            params.push(0);
+            let out1 = px.work.outputs.last().expect("a track");
+            list.push(gpu.prepare(
+                &COMBINE,
+                &params,
+                &[&chunk.features, &px.work.outputs[0], out1, &px.rgb],
+                groups_for(chunk.rows),
+            ));
+        }
+        list
+    }
+
+    /// The GPU time of each kernel of a lighting change on `px` (what [`Self::radiance`] runs
+    /// before the background), each dispatch timed in a pass of its own: `nprt bench frame
+    /// --profile`. An error where the adapter has no timestamp queries.
+    pub fn profile_relight(
+        &self,
+        px: &GpuPixels,
+        code: &[f32],
+        scale: [f32; 3],
+    ) -> Result<Vec<KernelTime>> {
+        let dispatches = self.relight_dispatches(px, code, scale);
+        self.gpu.profile(&dispatches.iter().collect::<Vec<_>>())
     }
 
     fn track_inputs(
@@ -357,89 +546,12 @@ impl GpuNetwork {
             return (Vec::new(), 0.0);
         }
         let gpu = &*self.gpu;
-        let code = gpu.upload(code);
+        let dispatches = self.relight_dispatches(px, code, scale);
         let mut encoder = gpu.device.create_command_encoder(&Default::default());
         {
             let mut pass = encoder.begin_compute_pass(&Default::default());
-            // Each track's first shading layer with the light code's share folded into its bias.
-            let biases: Vec<wgpu::Buffer> = self
-                .tracks
-                .iter()
-                .map(|t| {
-                    let first = &t.shading.layers[0];
-                    let code_row = if t.transfer.is_some() {
-                        TRANSPORT_CODE
-                    } else {
-                        0
-                    };
-                    let bias = gpu.buffer(first.d_out);
-                    // b' = b + ê·W[code rows]: one row through the first layer's code rows.
-                    gpu.product(
-                        [1, first.d_out, CODE_SIZE],
-                        Operand::plain(&code, 0, CODE_SIZE),
-                        Operand::plain(&first.weight, code_row * first.d_out, first.d_out),
-                        Bias::Column(&first.bias, 0),
-                        0,
-                        Output::to(&bias, 0, first.d_out),
-                        None,
-                    )
-                    .record(&mut pass);
-                    bias
-                })
-                .collect();
-            for chunk in &px.chunks {
-                for ((t, kept), (bias, out)) in self
-                    .tracks
-                    .iter()
-                    .zip(&chunk.kept)
-                    .zip(biases.iter().zip(&px.outputs))
-                {
-                    let first = match t.transfer {
-                        // [ŝ, ê]: ŝ's rows come first.
-                        Some(_) => FirstLayer {
-                            x_stride: TRANSPORT_CODE,
-                            w_row: 0,
-                            bias: Some(bias),
-                        },
-                        // The baseline's [ê, inputs]: the inputs' rows follow ê's.
-                        None => FirstLayer {
-                            x_stride: t.width,
-                            w_row: CODE_SIZE,
-                            bias: Some(bias),
-                        },
-                    };
-                    mlp(
-                        gpu,
-                        &mut pass,
-                        &t.shading,
-                        kept,
-                        chunk.rows,
-                        first,
-                        &px.scratch,
-                        out,
-                    );
-                }
-                let kinds: Vec<u32> = self.tracks.iter().map(|t| kind_code(t.kind)).collect();
-                let mut params = vec![
-                    chunk.rows as u32,
-                    kinds.len() as u32,
-                    kinds[0],
-                    *kinds.last().expect("a track"),
-                    chunk.first as u32,
-                    0,
-                    0,
-                    0,
-                ];
-                params.extend(scale.map(f32::to_bits));
-                params.push(0);
-                let out1 = px.outputs.last().expect("a track");
-                gpu.dispatch(
-                    &mut pass,
-                    &COMBINE,
-                    &params,
-                    &[&chunk.features, &px.outputs[0], out1, &px.rgb],
-                    groups_for(chunk.rows),
-                );
+            for d in &dispatches {
+                d.record(&mut pass);
             }
             if let Some(b) = background {
                 self.map.record(gpu, &mut pass, b, &px.rgb);
@@ -481,6 +593,18 @@ impl GpuNetwork {
     }
 }
 
+/// Rows per block of dispatches on `gpu` for activations `widest` f32 wide: [`MAX_CHUNK`], or
+/// fewer where one storage binding holds less (WebGPU's portable minimum is 128 MiB), a
+/// multiple of the half-precision layers' row blocks.
+fn chunk_rows(gpu: &GpuDevice, widest: usize) -> usize {
+    let limits = gpu.device.limits();
+    let bytes = limits
+        .max_storage_buffer_binding_size
+        .min(limits.max_buffer_size) as usize;
+    let fit = bytes / (4 * widest.next_multiple_of(16));
+    (fit / HALF_ROW_BLOCK * HALF_ROW_BLOCK).clamp(HALF_ROW_BLOCK, MAX_CHUNK)
+}
+
 /// How an MLP's first layer reads its input: the inputs per row (the row stride), the weight
 /// row they start at, and a bias in place of the layer's own (the light code's share folded
 /// in).
@@ -490,18 +614,27 @@ struct FirstLayer<'a> {
     bias: Option<&'a wgpu::Buffer>,
 }
 
-/// Records `m` over `rows` rows of `x` into `out`, through the two `scratch` buffers.
+/// The dispatches of `m` over `rows` rows of `x` into `out`, through `work`'s activations,
+/// added to `list`: in half precision where `work` is (then `out` may be f16, and `x` is made
+/// f16 first where it is not), else in f32.
 #[allow(clippy::too_many_arguments)]
 fn mlp(
     gpu: &GpuDevice,
-    pass: &mut wgpu::ComputePass,
+    list: &mut Vec<Dispatch>,
     m: &GpuMlp,
-    x: &wgpu::Buffer,
+    x: Held,
     rows: usize,
     first: FirstLayer,
-    scratch: &[wgpu::Buffer; 2],
-    out: &wgpu::Buffer,
+    work: &Workspace,
+    out: Held,
 ) {
+    if let Some(half) = &work.half_scratch {
+        return half_mlp(gpu, list, m, x, rows, first, half, out);
+    }
+    let (Held::F32(x), Held::F32(out)) = (x, out) else {
+        unreachable!("f16 rows outside half precision");
+    };
+    let scratch = &work.scratch;
     let last = m.layers.len() - 1;
     for (i, layer) in m.layers.iter().enumerate() {
         let activation = if i == last {
@@ -529,7 +662,49 @@ fn mlp(
             d_in,
             w_row,
         };
-        dense_layer(gpu, pass, layer, layer_in, bias, activation, output);
+        list.push(dense_layer(gpu, layer, layer_in, bias, activation, output));
+    }
+}
+
+/// [`mlp`] in half precision: `x` made f16 unless it is, then every layer f16 to f16 but the
+/// last, which writes `out`.
+#[allow(clippy::too_many_arguments)]
+fn half_mlp(
+    gpu: &GpuDevice,
+    list: &mut Vec<Dispatch>,
+    m: &GpuMlp,
+    x: Held,
+    rows: usize,
+    first: FirstLayer,
+    scratch: &[wgpu::Buffer; 2],
+    out: Held,
+) {
+    let x = match x {
+        Held::F16(x) => x,
+        Held::F32(x) => {
+            let stride = first.x_stride;
+            list.push(gpu.half_rows([rows, stride, stride], x, &scratch[0]));
+            &scratch[0]
+        }
+    };
+    let last = m.layers.len() - 1;
+    let mut k_pad = pad16(first.x_stride);
+    for (i, layer) in m.layers.iter().enumerate() {
+        let weight = layer.half.as_ref().expect("half-precision weights");
+        let (activation, y) = if i == last {
+            (0, out)
+        } else {
+            (
+                activation_code(m.activation),
+                Held::F16(&scratch[(i + 1) % 2]),
+            )
+        };
+        let (input, w_row, bias) = match i {
+            0 => (x, first.w_row, first.bias.unwrap_or(&layer.bias)),
+            _ => (&scratch[i % 2], 0, &layer.bias),
+        };
+        list.push(gpu.half_layer(rows, input, k_pad, weight, w_row, bias, activation, y));
+        k_pad = weight.n_pad;
     }
 }
 
@@ -542,16 +717,15 @@ struct Rows<'a> {
     w_row: usize,
 }
 
-/// Records one dense layer: `y = act(x·W[w_row..] + bias)`.
+/// One dense layer's dispatch: `y = act(x·W[w_row..] + bias)`.
 fn dense_layer(
     gpu: &GpuDevice,
-    pass: &mut wgpu::ComputePass,
     layer: &GpuDense,
     x: Rows,
     bias: &wgpu::Buffer,
     activation: u32,
     y: &wgpu::Buffer,
-) {
+) -> Dispatch {
     gpu.product(
         [x.rows, layer.d_out, x.d_in],
         Operand::plain(x.x, 0, x.d_in),
@@ -561,5 +735,4 @@ fn dense_layer(
         Output::to(y, 0, layer.d_out),
         None,
     )
-    .record(pass);
 }

@@ -23,6 +23,7 @@ use super::overlay::draw_lines;
 use super::presenter::Presenter;
 use crate::relight::{DirectSampling, FrameCache, FrameTimings, Relighter};
 use crate::CameraPath;
+use crate::Precision;
 
 /// What `nprt view` shows and how.
 pub struct ViewerOptions {
@@ -50,6 +51,8 @@ pub struct ViewerOptions {
     pub reference: bool,
     /// Start with the overlay hidden (the H key).
     pub hide_overlay: bool,
+    /// The networks' arithmetic.
+    pub precision: Precision,
 }
 
 /// Opens the window and runs until it is closed (or `frames` are drawn).
@@ -117,7 +120,11 @@ fn load(opts: &ViewerOptions) -> Result<(Vec<Relighter>, Scene)> {
     let models = opts
         .models
         .iter()
-        .map(|m| Relighter::load(m, &opts.device))
+        .map(|m| {
+            let mut model = Relighter::load(m, &opts.device)?;
+            model.set_precision(opts.precision)?;
+            Ok(model)
+        })
         .collect::<Result<Vec<_>>>()?;
     let first = &models[0].file;
     let spec = match (&opts.scene, first.scene.as_str()) {

@@ -1,0 +1,117 @@
+//! Dense layers in half precision, for the frame path's `--precision f16`: weights and
+//! activations held as f16, each row padded with zeros to a multiple of 16 values, the sums
+//! kept in f32 (`half_layer`). Where the adapter has cooperative matrices of 16 × 16 × 16 f16
+//! products into f32 (NVIDIA's tensor cores through Vulkan) the product runs on them
+//! (`half_dense_coop`); elsewhere a plain kernel computes the same sums (`half_dense`), which
+//! is what the tests run on Mesa's software Vulkan. Training stays in f32.
+
+use super::kernels::{HALF_DENSE, HALF_DENSE_COOP, HALF_ROWS};
+use super::{groups_for, Dispatch, GpuDevice};
+
+/// Rows a half-precision layer's workgroup covers: its inputs and outputs hold the rows up to
+/// the next multiple of this.
+pub const HALF_ROW_BLOCK: usize = 256;
+/// Columns a workgroup covers.
+const HALF_COLS: usize = 64;
+
+/// `n` rounded up to a multiple of 16, a cooperative matrix's side.
+pub fn pad16(n: usize) -> usize {
+    n.next_multiple_of(16)
+}
+
+/// A dense layer's weight (`d_in × d_out`, row-major) as f16 on the device: columns padded to
+/// `n_pad`, and 16 rows of zeros past the last, which a product over a padded k reads.
+pub struct HalfWeight {
+    pub buffer: wgpu::Buffer,
+    pub d_out: usize,
+    pub n_pad: usize,
+}
+
+/// How rows of activations are held: f32, `d` values a row, or f16 padded with zeros to
+/// `pad16(d)` values a row and to the next multiple of [`HALF_ROW_BLOCK`] rows (a
+/// half-precision layer's input, and its output where another layer reads it).
+#[derive(Clone, Copy)]
+pub enum Held<'a> {
+    F32(&'a wgpu::Buffer),
+    F16(&'a wgpu::Buffer),
+}
+
+impl GpuDevice {
+    /// `weight` (`d_in × d_out`) in the layout [`HalfWeight`] describes.
+    pub fn upload_half_weight(&self, weight: &[f32], d_in: usize, d_out: usize) -> HalfWeight {
+        let n_pad = pad16(d_out);
+        let mut padded = vec![0u16; (d_in + 16) * n_pad];
+        for (row, values) in padded.chunks_mut(n_pad).zip(weight.chunks(d_out)) {
+            for (h, &v) in row.iter_mut().zip(values) {
+                *h = half::f16::from_f32(v).to_bits();
+            }
+        }
+        HalfWeight {
+            buffer: self.upload(&padded),
+            d_out,
+            n_pad,
+        }
+    }
+
+    /// A storage buffer of `halves` f16 values, zero.
+    pub fn half_buffer(&self, halves: usize) -> wgpu::Buffer {
+        self.buffer(halves.div_ceil(2))
+    }
+
+    /// The dispatch that writes `rows` rows of `cols` f32 values of `src` (row stride
+    /// `stride`) to `dst` as f16 rows of `pad16(cols)` values, zeros in the padding and in the
+    /// rows up to the next multiple of [`HALF_ROW_BLOCK`].
+    pub fn half_rows(
+        &self,
+        [rows, cols, stride]: [usize; 3],
+        src: &wgpu::Buffer,
+        dst: &wgpu::Buffer,
+    ) -> Dispatch {
+        let padded = rows.next_multiple_of(HALF_ROW_BLOCK);
+        let k_pad = pad16(cols);
+        let params = [rows, padded, cols, stride, k_pad, 0, 0, 0].map(|v| v as u32);
+        self.prepare(&HALF_ROWS, &params, &[src, dst], groups_for(padded * k_pad))
+    }
+
+    /// The dispatch of one half-precision dense layer, `act(x·W[w_row..] + bias)` over `rows`
+    /// rows of `x` (f16 rows of `k_pad` values, a multiple of 16, held up to the next multiple
+    /// of [`HALF_ROW_BLOCK`] rows), `activation` 0 linear, 1 ReLU, 2 SIREN.
+    #[allow(clippy::too_many_arguments)]
+    pub fn half_layer(
+        &self,
+        rows: usize,
+        x: &wgpu::Buffer,
+        k_pad: usize,
+        w: &HalfWeight,
+        w_row: usize,
+        bias: &wgpu::Buffer,
+        activation: u32,
+        y: Held,
+    ) -> Dispatch {
+        let (y16, y32, half_out) = match y {
+            Held::F16(b) => (b, &self.spare, 1),
+            Held::F32(b) => (&self.spare, b, 0),
+        };
+        let params = [
+            rows,
+            w.d_out,
+            w.n_pad,
+            k_pad,
+            w_row * w.n_pad,
+            activation as usize,
+            half_out,
+            0,
+        ]
+        .map(|v| v as u32);
+        let kernel = if self.tensor_cores {
+            &HALF_DENSE_COOP
+        } else {
+            &HALF_DENSE
+        };
+        let groups = [
+            w.n_pad.div_ceil(HALF_COLS) as u32,
+            rows.div_ceil(HALF_ROW_BLOCK) as u32,
+        ];
+        self.prepare(kernel, &params, &[x, &w.buffer, bias, y16, y32], groups)
+    }
+}
