@@ -64,7 +64,7 @@ fi
 
 # What the run needs, each missing piece named.
 command -v nvidia-smi >/dev/null || { echo "bench/gpu.sh: no nvidia-smi: this needs an NVIDIA GPU" >&2; exit 1; }
-ldconfig -p | grep -q 'libvulkan\.so\.1' || {
+ldconfig -p | grep 'libvulkan\.so\.1' >/dev/null || {
   echo "bench/gpu.sh: no Vulkan loader (libvulkan.so.1): nprt's GPU kernels run on wgpu over Vulkan; install libvulkan1 and the NVIDIA driver's Vulkan ICD" >&2
   exit 1
 }

@@ -237,3 +237,39 @@ fn the_tensor_core_kernel_translates_to_spirv() {
     let words = naga::back::spv::write_vec(&module, &info, &Default::default(), None).unwrap();
     assert!(words.len() > 1000, "{} SPIR-V words", words.len());
 }
+
+/// A second viewpoint of the same size reuses the first one's buffers (features, ŝ, the frame,
+/// handed back when its pixels are dropped) and the network's activations, in f32 and in f16:
+/// its radiance is the radiance a fresh network gives it.
+#[test]
+fn a_new_viewpoint_reusing_the_last_ones_buffers_gets_its_own_radiance() {
+    if !GpuDevice::probe() {
+        return;
+    }
+    let first = room_features();
+    // Another view of as many pixels: the rows reversed.
+    let second: Vec<f32> = first
+        .chunks(nprt_net::FEATURES)
+        .rev()
+        .flatten()
+        .copied()
+        .collect();
+    let net = model(
+        Design::Dsep,
+        Activation::Siren,
+        PositionEncoding::HashGrid,
+        41,
+    );
+    let code = vec![0.25f32; nprt_net::network::encoder::CODE_SIZE];
+    let scale = [1.0, 2.0, 0.5];
+    for half in [false, true] {
+        let mut reused = GpuNetwork::new(&net).unwrap();
+        let mut fresh = GpuNetwork::new(&net).unwrap();
+        reused.set_half(half).unwrap();
+        fresh.set_half(half).unwrap();
+        drop(reused.pixels(&first));
+        let (got, _) = reused.radiance(&reused.pixels(&second), &code, scale, None);
+        let (want, _) = fresh.radiance(&fresh.pixels(&second), &code, scale, None);
+        assert_eq!(got, want, "half precision: {half}");
+    }
+}

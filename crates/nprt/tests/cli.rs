@@ -480,57 +480,19 @@ fn bench_frame_times_every_stage_on_each_device() {
 /// refused where the networks run on the CPU.
 #[test]
 fn bench_frame_times_half_precision_and_profiles_kernels_on_the_gpu() {
-    common::fails(
-        &[
-            "bench",
-            "frame",
-            "--arch",
-            "prt",
-            "--res",
-            "32",
-            "--device",
-            "cpu",
-            "--profile",
-        ],
-        &["--profile", "--device wgpu"],
-    );
-    common::fails(
-        &[
-            "bench",
-            "frame",
-            "--arch",
-            "prt",
-            "--res",
-            "32",
-            "--direct-spp",
-            "0",
-            "--device",
-            "cpu",
-            "--precision",
-            "f16",
-        ],
-        &["--precision f16", "--device wgpu"],
-    );
+    let on_cpu = "bench frame --arch prt --res 32 --direct-spp 0 --device cpu";
+    let profile = format!("{on_cpu} --profile");
+    let profile: Vec<&str> = profile.split(' ').collect();
+    common::fails(&profile, &["--profile", "--device wgpu"]);
+    let half = format!("{on_cpu} --precision f16");
+    let half: Vec<&str> = half.split(' ').collect();
+    common::fails(&half, &["--precision f16", "--device wgpu"]);
     if !common::wgpu_runs() {
         return;
     }
-    let out = common::ok(&[
-        "bench",
-        "frame",
-        "--arch",
-        "dsep",
-        "--res",
-        "32",
-        "--repeats",
-        "1",
-        "--direct-spp",
-        "0",
-        "--device",
-        "wgpu",
-        "--precision",
-        "f32,f16",
-        "--profile",
-    ]);
+    let both = "bench frame --arch dsep --res 32 --repeats 1 --direct-spp 0 --device wgpu \
+                --precision f32,f16 --profile";
+    let out = common::ok(&both.split(' ').collect::<Vec<_>>());
     let rows: Vec<&str> = out.lines().filter(|l| l.starts_with("dsep")).collect();
     assert_eq!(rows.len(), 2, "{out}");
     assert!(rows[1].starts_with("dsep f16 "), "{out}");

@@ -18,6 +18,7 @@ use nprt_net::gpu::{pad16, Bias, HalfWeight, Held, Operand, Output, HALF_ROW_BLO
 
 use nprt_net::gpu::kernels::{COMBINE, ENCODER_BLOCK, GBUFFER_FEATURES, TRACK_INPUTS};
 
+use super::buffer_pool::BufferPool;
 use super::frame_background::{Background, Fill, GpuMap};
 use super::light_input::GpuLightInput;
 use super::path_tracer::{record_paths, GpuPaths};
@@ -70,6 +71,8 @@ pub struct GpuNetwork {
     map: GpuMap,
     /// The activations every camera's pixels run through, grown as needed.
     workspace: Mutex<Option<Arc<Workspace>>>,
+    /// What dropped pixels handed back, for the next camera's.
+    pool: BufferPool,
 }
 
 /// The buffers a camera's pixels run their networks through, which the network keeps for the
@@ -96,8 +99,18 @@ pub struct GpuPixels {
     pub rows: usize,
     chunks: Vec<PixelChunk>,
     work: Arc<Workspace>,
+    /// Where the chunks' buffers and `rgb` go back when the pixels are dropped.
+    pool: BufferPool,
     /// Radiance of every row, `rows × 3`.
     rgb: wgpu::Buffer,
+}
+
+impl Drop for GpuPixels {
+    fn drop(&mut self) {
+        let chunks = self.chunks.drain(..);
+        let buffers = chunks.flat_map(|c| std::iter::once(c.features).chain(c.kept));
+        self.pool.give(buffers.chain([self.rgb.clone()]));
+    }
 }
 
 struct PixelChunk {
@@ -156,6 +169,7 @@ impl GpuNetwork {
             resolutions: gpu.upload(&hash_grid::resolutions()),
             map: GpuMap::default(),
             workspace: Mutex::new(None),
+            pool: BufferPool::default(),
             gpu,
         })
     }
@@ -273,7 +287,7 @@ impl GpuNetwork {
     ) -> GpuPixels {
         let (lo, extent) = nprt_net::position_frame(bounds);
         self.pixels_with(pixels, |pass, first, n| {
-            let features = self.gpu.buffer(n * FEATURES);
+            let features = self.pool.take(&self.gpu, n * FEATURES);
             let mut params = vec![n as u32, first as u32, 0, 0];
             params.extend(
                 [lo.extend(0.0), extent.extend(0.0)]
@@ -329,10 +343,10 @@ impl GpuNetwork {
                         let width = t.transfer.as_ref().map_or(t.width, |_| TRANSPORT_CODE);
                         let kept = match half {
                             true => {
-                                let padded = n.next_multiple_of(HALF_ROW_BLOCK);
-                                gpu.half_buffer(padded * pad16(width))
+                                let halves = n.next_multiple_of(HALF_ROW_BLOCK) * pad16(width);
+                                self.pool.take(gpu, halves.div_ceil(2))
                             }
-                            false => gpu.buffer(n * width),
+                            false => self.pool.take(gpu, n * width),
                         };
                         let gathered = &work.scratch[0];
                         match (&t.transfer, half) {
@@ -375,7 +389,8 @@ impl GpuNetwork {
             rows,
             chunks,
             work,
-            rgb: gpu.buffer(rows.max(1) * 3),
+            pool: self.pool.clone(),
+            rgb: self.pool.take(gpu, rows.max(1) * 3),
         }
     }
 

@@ -14,6 +14,7 @@
 //! it must not own semantics of its own: materials are nprt-scene's, layouts, designs and the
 //! hash grid nprt-net's.
 
+mod buffer_pool;
 mod frame_background;
 mod gpu_network;
 mod gpu_scene;
