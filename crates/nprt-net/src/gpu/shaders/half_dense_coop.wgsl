@@ -28,11 +28,12 @@ fn main(@builtin(workgroup_id) group: vec3<u32>, @builtin(local_invocation_index
     let col0 = group.x * COLS;
     let lda = p.k_pad;
     let ldw = p.n_pad;
-    // Column tiles past n_pad (in the last column of workgroups, and all but the first for a
-    // 3-output layer) are skipped: the conditions are the same for the whole workgroup.
-    let has1 = col0 + 16u < p.n_pad;
-    let has2 = col0 + 32u < p.n_pad;
-    let has3 = col0 + 48u < p.n_pad;
+    // Tiles past n_pad (the last column of workgroups) read the last tile again, and are not
+    // written: the loads stay in W.
+    let last = p.n_pad - 16u;
+    let j1 = min(col0 + 16u, last);
+    let j2 = min(col0 + 32u, last);
+    let j3 = min(col0 + 48u, last);
     var c00 = coop_mat16x16<f32, C>();
     var c01 = coop_mat16x16<f32, C>();
     var c02 = coop_mat16x16<f32, C>();
@@ -58,36 +59,31 @@ fn main(@builtin(workgroup_id) group: vec3<u32>, @builtin(local_invocation_index
         let a2 = coopLoadT<coop_mat16x16<f16, A>>(&x[xc], lda);
         let xd = xc + 16u * lda;
         let a3 = coopLoadT<coop_mat16x16<f16, A>>(&x[xd], lda);
-        let wk = p.w_off + k * ldw + col0;
-        let b0 = coopLoadT<coop_mat16x16<f16, B>>(&w[wk], ldw);
+        let wk = p.w_off + k * ldw;
+        let w0 = wk + col0;
+        let b0 = coopLoadT<coop_mat16x16<f16, B>>(&w[w0], ldw);
+        let w1 = wk + j1;
+        let b1 = coopLoadT<coop_mat16x16<f16, B>>(&w[w1], ldw);
+        let w2 = wk + j2;
+        let b2 = coopLoadT<coop_mat16x16<f16, B>>(&w[w2], ldw);
+        let w3 = wk + j3;
+        let b3 = coopLoadT<coop_mat16x16<f16, B>>(&w[w3], ldw);
         c00 = coopMultiplyAdd(a0, b0, c00);
+        c01 = coopMultiplyAdd(a0, b1, c01);
+        c02 = coopMultiplyAdd(a0, b2, c02);
+        c03 = coopMultiplyAdd(a0, b3, c03);
         c10 = coopMultiplyAdd(a1, b0, c10);
+        c11 = coopMultiplyAdd(a1, b1, c11);
+        c12 = coopMultiplyAdd(a1, b2, c12);
+        c13 = coopMultiplyAdd(a1, b3, c13);
         c20 = coopMultiplyAdd(a2, b0, c20);
+        c21 = coopMultiplyAdd(a2, b1, c21);
+        c22 = coopMultiplyAdd(a2, b2, c22);
+        c23 = coopMultiplyAdd(a2, b3, c23);
         c30 = coopMultiplyAdd(a3, b0, c30);
-        if (has1) {
-            let w1 = wk + 16u;
-            let b1 = coopLoadT<coop_mat16x16<f16, B>>(&w[w1], ldw);
-            c01 = coopMultiplyAdd(a0, b1, c01);
-            c11 = coopMultiplyAdd(a1, b1, c11);
-            c21 = coopMultiplyAdd(a2, b1, c21);
-            c31 = coopMultiplyAdd(a3, b1, c31);
-        }
-        if (has2) {
-            let w2 = wk + 32u;
-            let b2 = coopLoadT<coop_mat16x16<f16, B>>(&w[w2], ldw);
-            c02 = coopMultiplyAdd(a0, b2, c02);
-            c12 = coopMultiplyAdd(a1, b2, c12);
-            c22 = coopMultiplyAdd(a2, b2, c22);
-            c32 = coopMultiplyAdd(a3, b2, c32);
-        }
-        if (has3) {
-            let w3 = wk + 48u;
-            let b3 = coopLoadT<coop_mat16x16<f16, B>>(&w[w3], ldw);
-            c03 = coopMultiplyAdd(a0, b3, c03);
-            c13 = coopMultiplyAdd(a1, b3, c13);
-            c23 = coopMultiplyAdd(a2, b3, c23);
-            c33 = coopMultiplyAdd(a3, b3, c33);
-        }
+        c31 = coopMultiplyAdd(a3, b1, c31);
+        c32 = coopMultiplyAdd(a3, b2, c32);
+        c33 = coopMultiplyAdd(a3, b3, c33);
     }
     drain(c00, sg, lane, row0, col0);
     drain(c01, sg, lane, row0, col0 + 16u);
