@@ -186,6 +186,15 @@ impl Relighter {
         Ok(())
     }
 
+    /// The precision the networks run in.
+    pub fn precision(&self) -> Precision {
+        #[cfg(feature = "wgpu")]
+        if self.gpu.as_ref().is_some_and(|g| g.half()) {
+            return Precision::F16;
+        }
+        Precision::F32
+    }
+
     /// Where a model's weights are loaded to run on `device`: the host for the frame path's
     /// kernels, which upload them themselves; `device` itself otherwise.
     pub fn weights_device(device: &Device) -> Device {

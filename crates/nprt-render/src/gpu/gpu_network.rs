@@ -197,7 +197,8 @@ impl GpuNetwork {
         Ok(())
     }
 
-    fn half(&self) -> bool {
+    /// Whether the dense layers run in half precision ([`Self::set_half`]).
+    pub fn half(&self) -> bool {
         self.tracks[0].shading.layers[0].half.is_some()
     }
 

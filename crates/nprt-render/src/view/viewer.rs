@@ -287,7 +287,7 @@ impl<'a> Viewer<'a> {
         }
         lines.push(format!("{:.1} fps, shown by {adapter}", self.fps));
         lines.push("drag orbit, right-drag map, wheel dolly".into());
-        lines.push("WASDQE fly, Tab model, M map, R reference".into());
+        lines.push("WASDQE fly, Tab model, M map, R reference, F f16".into());
         lines.push("+/- exposure, P screenshot, H hide, Esc quit".into());
         if !self.message.is_empty() {
             lines.push(self.message.clone());
@@ -375,6 +375,17 @@ impl<'a> Viewer<'a> {
                     }
                 }
                 "p" => self.take_screenshot()?,
+                "f" => {
+                    // f16 ⇄ f32 on the GPU kernels; a model on the CPU stays f32.
+                    let model = &mut self.models[self.model];
+                    let other = match model.precision() {
+                        Precision::F32 => Precision::F16,
+                        Precision::F16 => Precision::F32,
+                    };
+                    if model.set_precision(other).is_ok() {
+                        self.cache = FrameCache::default();
+                    }
+                }
                 "h" => self.overlay = !self.overlay,
                 "+" | "=" => self.exposure += 0.5,
                 "-" => self.exposure -= 0.5,
