@@ -7,9 +7,10 @@
 
 use std::time::Duration;
 
-use glam::Vec3A;
+use glam::{Vec3, Vec3A};
 use nprt_scene::Scene;
 use obvhs::bvh2::builder::build_bvh2_from_tris;
+use obvhs::triangle::Triangle;
 use obvhs::BvhBuildParams;
 
 use crate::accel::{scene_triangles, Tri};
@@ -32,7 +33,24 @@ pub struct FlatBvh {
 
 impl FlatBvh {
     pub fn new(scene: &Scene) -> Self {
-        let tris = scene_triangles(scene);
+        Self::from_triangles(scene_triangles(scene))
+    }
+
+    /// Over triangles given by their corners, in the scene's order (mesh after mesh), which
+    /// the records' indices count.
+    pub fn from_corners(corners: impl Iterator<Item = [Vec3; 3]>) -> Self {
+        Self::from_triangles(
+            corners
+                .map(|[v0, v1, v2]| Triangle {
+                    v0: v0.into(),
+                    v1: v1.into(),
+                    v2: v2.into(),
+                })
+                .collect(),
+        )
+    }
+
+    fn from_triangles(tris: Vec<Triangle>) -> Self {
         if tris.is_empty() {
             // A placeholder root: a walk must not start on a scene without triangles.
             return FlatBvh {

@@ -4,7 +4,8 @@
 //! Russian roulette (as `render`), on a scene with every scattering and material feature and
 //! on the built-in room, under a sun. The two use different random numbers, so they agree
 //! within noise: over blocks of pixels, the GPU's frame is no further from one CPU frame than
-//! a second CPU frame of another seed is. Gated as the other Vulkan tests are.
+//! a second CPU frame of another seed is. The scene's BVH is built by the first path traced.
+//! Gated as the other Vulkan tests are.
 #![cfg(feature = "wgpu")]
 
 mod common;
@@ -28,8 +29,11 @@ fn assert_unbiased(
 ) {
     let ts = TraceScene::new(scene);
     let raster = RasterGBuffer::new(&ts).unwrap();
+    // The BVH is made by the first path, not with the scene's upload.
+    assert!(!raster.has_bvh());
     for (k, camera) in views(scene, size[0], size[1]).iter().enumerate() {
         let gpu = raster.trace(camera, map, &paths).unwrap();
+        assert!(raster.has_bvh());
         let (cpu1, cpu2) = (cpu(&ts, camera, 1), cpu(&ts, camera, 2));
         assert!(gpu.iter().all(|c| c.is_finite() && c.min_element() >= 0.0));
         let (noise, error) = (

@@ -78,6 +78,7 @@ pub(crate) fn record_paths(
 ) {
     let texels = maps.texels(gpu, map);
     let table = maps.table(gpu, map);
+    let bvh = scene.bvh(gpu);
     let (seed, triangles) = (
         (paths.seed ^ (paths.seed >> 32)) as u32,
         scene.triangle_count,
@@ -115,8 +116,8 @@ pub(crate) fn record_paths(
                 &scene.materials,
                 &scene.textures,
                 &scene.bitmaps,
-                &scene.bvh_nodes,
-                &scene.bvh_triangles,
+                &bvh.nodes,
+                &bvh.triangles,
                 &texels,
                 &table,
                 rgb,

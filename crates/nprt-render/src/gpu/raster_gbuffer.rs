@@ -118,6 +118,11 @@ impl RasterGBuffer {
         &self.scene
     }
 
+    /// Whether the scene's BVH was built yet: it is, by the first path traced on the device.
+    pub fn has_bvh(&self) -> bool {
+        self.scene.has_bvh()
+    }
+
     pub(crate) fn maps(&self) -> &GpuMap {
         &self.maps
     }
