@@ -210,9 +210,9 @@ impl Relighter {
     pub fn networks_on(&self) -> String {
         #[cfg(feature = "wgpu")]
         if let Some(gpu) = &self.gpu {
-            return match gpu.precision() {
-                "f32" => format!("GPU kernels on {}", gpu.adapter()),
-                p => format!("GPU kernels on {} ({p})", gpu.adapter()),
+            return match gpu.half() {
+                false => format!("GPU kernels on {}", gpu.adapter()),
+                true => format!("GPU kernels on {} ({})", gpu.adapter(), gpu.precision()),
             };
         }
         match self.host {

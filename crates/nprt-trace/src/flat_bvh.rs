@@ -8,12 +8,11 @@
 use std::time::Duration;
 
 use glam::{Vec3, Vec3A};
-use nprt_scene::Scene;
 use obvhs::bvh2::builder::build_bvh2_from_tris;
 use obvhs::triangle::Triangle;
 use obvhs::BvhBuildParams;
 
-use crate::accel::{scene_triangles, Tri};
+use crate::accel::Tri;
 
 /// Words per node: `[min (3 f32), triangle count, max (3 f32), first]` with `first` the first
 /// child's node (inner nodes: count 0; the second child follows it) or a leaf's first entry of
@@ -32,25 +31,16 @@ pub struct FlatBvh {
 }
 
 impl FlatBvh {
-    pub fn new(scene: &Scene) -> Self {
-        Self::from_triangles(scene_triangles(scene))
-    }
-
     /// Over triangles given by their corners, in the scene's order (mesh after mesh), which
     /// the records' indices count.
     pub fn from_corners(corners: impl Iterator<Item = [Vec3; 3]>) -> Self {
-        Self::from_triangles(
-            corners
-                .map(|[v0, v1, v2]| Triangle {
-                    v0: v0.into(),
-                    v1: v1.into(),
-                    v2: v2.into(),
-                })
-                .collect(),
-        )
-    }
-
-    fn from_triangles(tris: Vec<Triangle>) -> Self {
+        let tris: Vec<Triangle> = corners
+            .map(|[v0, v1, v2]| Triangle {
+                v0: v0.into(),
+                v1: v1.into(),
+                v2: v2.into(),
+            })
+            .collect();
         if tris.is_empty() {
             // A placeholder root: a walk must not start on a scene without triangles.
             return FlatBvh {
@@ -99,7 +89,7 @@ mod tests {
             .iter()
             .flat_map(|m| m.indices.iter().map(|t| t.map(|i| m.positions[i as usize])))
             .collect();
-        let bvh = FlatBvh::new(&scene);
+        let bvh = FlatBvh::from_corners(corners.iter().copied());
         let node = |k: usize| {
             let w = &bvh.nodes[NODE_WORDS * k..NODE_WORDS * (k + 1)];
             let v = |o: usize| {

@@ -143,15 +143,22 @@ pub fn run(cmd: BenchCommand) -> Result<()> {
     }
 }
 
-fn frame(a: BenchFrameArgs) -> Result<()> {
+/// Refuses `--profile` where nprt's own kernels do not run: another device, or a build
+/// without the `wgpu` feature.
+fn check_profile(profile: bool, device: &DeviceArg) -> Result<()> {
     anyhow::ensure!(
-        !a.profile || matches!(a.device.compute, nprt_net::Compute::Wgpu),
+        !profile || matches!(device.compute, nprt_net::Compute::Wgpu),
         "--profile times nprt's own kernels: it needs --device wgpu"
     );
     anyhow::ensure!(
-        !a.profile || cfg!(feature = "wgpu"),
+        !profile || cfg!(feature = "wgpu"),
         "--profile times nprt's own kernels: this nprt was built without the `wgpu` feature"
     );
+    Ok(())
+}
+
+fn frame(a: BenchFrameArgs) -> Result<()> {
+    check_profile(a.profile, &a.device)?;
     let device = a.device.device()?;
     let mut models: Vec<(Design, DirectLight)> = a
         .designs
@@ -271,10 +278,7 @@ fn infer(a: BenchInferArgs) -> Result<()> {
 }
 
 fn train(a: BenchTrainArgs) -> Result<()> {
-    anyhow::ensure!(
-        !a.profile || matches!(a.device.compute, nprt_net::Compute::Wgpu),
-        "--profile times nprt's own kernels: it needs --device wgpu"
-    );
+    check_profile(a.profile, &a.device)?;
     let threads = rayon::current_num_threads();
     let device = a.device.device()?;
     let cpu = is_cpu(&device);
@@ -396,9 +400,7 @@ fn print_kernel_times(what: &str, times: &[nprt_net::gpu::KernelTime], wall_ms: 
 
 #[cfg(not(feature = "wgpu"))]
 fn print_profile(_: &ModelConfig, _: &BenchTrainArgs, _: f64) -> Result<()> {
-    anyhow::bail!(
-        "--profile times nprt's own kernels: this nprt was built without the `wgpu` feature"
-    )
+    unreachable!("check_profile refuses --profile without the `wgpu` feature")
 }
 
 /// The PyTorch peer to compare with, if one was given: its Python, PyTorch's device name (CUDA

@@ -54,10 +54,8 @@ impl DeviceDataset {
                 records.len()
             );
         }
-        let limits = gpu.device.limits();
-        let per_shard = limits
-            .max_storage_buffer_binding_size
-            .min(limits.max_buffer_size)
+        let per_shard = gpu
+            .max_binding_bytes()
             .div_euclid(PACKED_PIXEL_BYTES as u64) as usize;
         let light_floats = set.train.first().map_or(0, |v| v.light.pixels.len());
         let lights: Vec<f32> = set

@@ -12,8 +12,7 @@ impl GpuDevice {
     /// Refuses `bytes` of `what` where one storage buffer on this device cannot hold and bind
     /// them, saying so (a kernel binds its inputs whole).
     pub fn check_binding(&self, bytes: usize, what: &str) -> anyhow::Result<()> {
-        let limits = self.device.limits();
-        let most = (limits.max_storage_buffer_binding_size).min(limits.max_buffer_size);
+        let most = self.max_binding_bytes();
         if bytes as u64 > most {
             anyhow::bail!(
                 "{what} take {:.2} GB, more than one buffer on the GPU ({}) holds ({:.2} GB)",
@@ -23,6 +22,14 @@ impl GpuDevice {
             );
         }
         Ok(())
+    }
+
+    /// The most bytes one storage buffer on this device holds and binds whole.
+    pub fn max_binding_bytes(&self) -> u64 {
+        let limits = self.device.limits();
+        limits
+            .max_storage_buffer_binding_size
+            .min(limits.max_buffer_size)
     }
 
     /// A storage buffer holding `values` (f32, u32 or any plain words).

@@ -19,6 +19,11 @@ pub fn pad16(n: usize) -> usize {
     n.next_multiple_of(16)
 }
 
+/// f16 values that `rows` rows of `cols` values take as [`Held::F16`] holds them.
+pub fn held_halves(rows: usize, cols: usize) -> usize {
+    rows.next_multiple_of(HALF_ROW_BLOCK) * pad16(cols)
+}
+
 /// A dense layer's weight (`d_in × d_out`, row-major) as f16 on the device: columns padded to
 /// `n_pad`, and 16 rows of zeros past the last, which a product over a padded k reads.
 pub struct HalfWeight {
@@ -68,9 +73,9 @@ impl GpuDevice {
         dst: &wgpu::Buffer,
     ) -> Dispatch {
         let padded = rows.next_multiple_of(HALF_ROW_BLOCK);
-        let k_pad = pad16(cols);
-        let params = [rows, padded, cols, stride, k_pad, 0, 0, 0].map(|v| v as u32);
-        self.prepare(&HALF_ROWS, &params, &[src, dst], groups_for(padded * k_pad))
+        let params = [rows, padded, cols, stride, pad16(cols), 0, 0, 0].map(|v| v as u32);
+        let groups = groups_for(held_halves(rows, cols));
+        self.prepare(&HALF_ROWS, &params, &[src, dst], groups)
     }
 
     /// The dispatch of one half-precision dense layer, `act(x·W[w_row..] + bias)` over `rows`

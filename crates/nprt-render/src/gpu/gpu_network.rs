@@ -14,7 +14,7 @@ use nprt_scene::EnvMap;
 
 use nprt_net::gpu::{groups_for, Dispatch, GpuDevice, KernelTime};
 
-use nprt_net::gpu::{pad16, Bias, HalfWeight, Held, Operand, Output, HALF_ROW_BLOCK};
+use nprt_net::gpu::{held_halves, pad16, Bias, HalfWeight, Held, Operand, Output, HALF_ROW_BLOCK};
 
 use nprt_net::gpu::kernels::{COMBINE, ENCODER_BLOCK, GBUFFER_FEATURES, TRACK_INPUTS};
 
@@ -80,15 +80,28 @@ pub struct GpuNetwork {
 /// these afresh for every 512² frame cost more than its networks). Pixels share them: the
 /// queue runs one submission after another, and each writes them before reading.
 struct Workspace {
-    /// Rows they hold (the largest block), and whether the networks run in half precision.
+    /// Rows they hold (the largest block).
     rows: usize,
-    half: bool,
-    /// Ping-pong activations, f32 and, in half precision, f16 (rows padded to a multiple of
-    /// 256 and columns to 16).
+    /// Ping-pong activations, f32 and, where the networks run in half precision, f16 (rows
+    /// padded to a multiple of 256 and columns to 16).
     scratch: [wgpu::Buffer; 2],
     half_scratch: Option<[wgpu::Buffer; 2]>,
     /// Each track's shading outputs.
     outputs: Vec<wgpu::Buffer>,
+}
+
+impl Workspace {
+    fn half(&self) -> bool {
+        self.half_scratch.is_some()
+    }
+
+    /// `buffer`'s rows as the networks run through this workspace hold them.
+    fn held<'a>(&self, buffer: &'a wgpu::Buffer) -> Held<'a> {
+        match self.half() {
+            true => Held::F16(buffer),
+            false => Held::F32(buffer),
+        }
+    }
 }
 
 /// A camera's foreground pixels on the device and what of the network does not depend on the
@@ -328,7 +341,7 @@ impl GpuNetwork {
             .expect("a network has layers");
         let chunk = chunk_rows(gpu, widest);
         let work = self.workspace(rows.clamp(1, chunk), widest);
-        let half = work.half;
+        let half = work.half();
         let mut encoder = gpu.device.create_command_encoder(&Default::default());
         let mut chunks = Vec::new();
         {
@@ -342,13 +355,11 @@ impl GpuNetwork {
                     .iter()
                     .map(|t| {
                         let width = t.transfer.as_ref().map_or(t.width, |_| TRANSPORT_CODE);
-                        let kept = match half {
-                            true => {
-                                let halves = n.next_multiple_of(HALF_ROW_BLOCK) * pad16(width);
-                                self.pool.take(gpu, halves.div_ceil(2))
-                            }
-                            false => self.pool.take(gpu, n * width),
+                        let floats = match half {
+                            true => held_halves(n, width).div_ceil(2),
+                            false => n * width,
                         };
+                        let kept = self.pool.take(gpu, floats);
                         let gathered = &work.scratch[0];
                         match (&t.transfer, half) {
                             (None, false) => self.track_inputs(&mut pass, t, &features, n, &kept),
@@ -363,11 +374,8 @@ impl GpuNetwork {
                                     w_row: 0,
                                     bias: None,
                                 };
-                                let out = match half {
-                                    true => Held::F16(&kept),
-                                    false => Held::F32(&kept),
-                                };
                                 let x = Held::F32(gathered);
+                                let out = work.held(&kept);
                                 mlp(gpu, &mut list, transfer, x, n, first, &work, out);
                             }
                         }
@@ -400,18 +408,14 @@ impl GpuNetwork {
     fn workspace(&self, rows: usize, widest: usize) -> Arc<Workspace> {
         let mut kept = self.workspace.lock().unwrap_or_else(|e| e.into_inner());
         let half = self.half();
-        if let Some(w) = kept.as_ref().filter(|w| w.rows >= rows && w.half == half) {
+        if let Some(w) = kept.as_ref().filter(|w| w.rows >= rows && w.half() == half) {
             return w.clone();
         }
         let gpu = &*self.gpu;
         let work = Arc::new(Workspace {
             rows,
-            half,
             scratch: [0, 1].map(|_| gpu.buffer(rows * widest)),
-            half_scratch: half.then(|| {
-                let padded = rows.next_multiple_of(HALF_ROW_BLOCK);
-                [0, 1].map(|_| gpu.half_buffer(padded * pad16(widest)))
-            }),
+            half_scratch: half.then(|| [0, 1].map(|_| gpu.half_buffer(held_halves(rows, widest)))),
             outputs: self
                 .tracks
                 .iter()
@@ -427,7 +431,7 @@ impl GpuNetwork {
     /// radiance (times `scale`).
     fn relight_dispatches(&self, px: &GpuPixels, code: &[f32], scale: [f32; 3]) -> Vec<Dispatch> {
         assert_eq!(
-            px.work.half,
+            px.work.half(),
             self.half(),
             "pixels made in one precision, relit in the other"
         );
@@ -480,10 +484,7 @@ impl GpuNetwork {
                         bias: Some(bias),
                     },
                 };
-                let x = match px.work.half {
-                    true => Held::F16(kept),
-                    false => Held::F32(kept),
-                };
+                let x = px.work.held(kept);
                 let out = Held::F32(out);
                 mlp(
                     gpu, &mut list, &t.shading, x, chunk.rows, first, &px.work, out,
@@ -613,11 +614,7 @@ impl GpuNetwork {
 /// fewer where one storage binding holds less (WebGPU's portable minimum is 128 MiB), a
 /// multiple of the half-precision layers' row blocks.
 fn chunk_rows(gpu: &GpuDevice, widest: usize) -> usize {
-    let limits = gpu.device.limits();
-    let bytes = limits
-        .max_storage_buffer_binding_size
-        .min(limits.max_buffer_size) as usize;
-    let fit = bytes / (4 * widest.next_multiple_of(16));
+    let fit = gpu.max_binding_bytes() as usize / (4 * widest.next_multiple_of(16));
     (fit / HALF_ROW_BLOCK * HALF_ROW_BLOCK).clamp(HALF_ROW_BLOCK, MAX_CHUNK)
 }
 
