@@ -74,6 +74,7 @@ impl Net {
             Net::Nprt(r, _) => {
                 let t = Instant::now();
                 let code = r.light_code(map, rotation);
+                r.settle()?;
                 let encoder_ms = ms(t);
                 let t = Instant::now();
                 let mut rgb = r.shade(g, &code);

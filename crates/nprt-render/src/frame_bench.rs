@@ -41,6 +41,8 @@ pub struct FrameBenchRow {
     pub frame: FrameTimings,
     /// Median of a lighting change under a still camera: the encoder and the shading networks.
     pub relight_ms: f64,
+    /// Times a lighting change made the host wait for the GPU queue (None off the GPU kernels).
+    pub relight_waits: Option<u64>,
     /// Where the networks ran.
     pub networks_on: String,
     /// Where the G-buffer was made.
@@ -93,6 +95,7 @@ pub fn bench_frame(
             let mut frames = Vec::new();
             let mut relights = Vec::new();
             let mut foreground = 0;
+            let mut relight_waits = None;
             // The last frame's lighting change, timed kernel by kernel.
             #[cfg(feature = "wgpu")]
             let mut profile = None;
@@ -108,8 +111,10 @@ pub fn bench_frame(
                 let (_, t) = model.frame(&mut cache, &ts, &camera, map, rotation, i, sampling)?;
                 // A lighting change under the still camera.
                 let turned = rotation + 5.0;
+                let waits = model.host_waits();
                 let (_, change) =
                     model.frame(&mut cache, &ts, &camera, map, turned, i + 1, sampling)?;
+                relight_waits = waits.zip(model.host_waits()).map(|(a, b)| b - a);
                 foreground = cache.foreground();
                 #[cfg(feature = "wgpu")]
                 if opts.profile && i == opts.repeats {
@@ -133,6 +138,7 @@ pub fn bench_frame(
                     direct_ms: stage(|t| t.direct_ms),
                 },
                 relight_ms: median(relights),
+                relight_waits,
                 networks_on: model.networks_on(),
                 gbuffer_on: model.gbuffer_on(),
                 paths_on: model.paths_on(),

@@ -44,11 +44,19 @@ pub struct Relighter {
 }
 
 /// What the encoder made of one lighting: the 64-d code ê and what the map's channels were
-/// divided by.
+/// divided by (the model's gain multiplies the radiance besides). On the frame path's kernels
+/// both stay on the device, where the encoder left them.
 #[derive(Clone)]
-pub struct LightCode {
-    code: Tensor<2>,
-    scale: [f32; 3],
+pub struct LightCode(Code);
+
+#[derive(Clone)]
+enum Code {
+    Host {
+        code: Vec<f32>,
+        divisor: [f32; 3],
+    },
+    #[cfg(feature = "wgpu")]
+    Device(crate::gpu::GpuLightCode),
 }
 
 /// A G-buffer's foreground pixels as network inputs, and what of the network does not depend
@@ -150,7 +158,7 @@ impl Relighter {
     pub fn new(file: ModelFile, net: NprtNet, device: &Device) -> Result<Self> {
         #[cfg(feature = "wgpu")]
         if nprt_net::Backend::of(device) == nprt_net::Backend::Wgpu {
-            let gpu = Some(crate::gpu::GpuNetwork::new(&net)?);
+            let gpu = Some(crate::gpu::GpuNetwork::new(&net, file.output_gain())?);
             return Ok(Relighter {
                 file,
                 net,
@@ -315,13 +323,18 @@ impl Relighter {
     ) -> Result<(Vec<Vec3>, FrameTimings)> {
         let ms = |t: Instant| t.elapsed().as_secs_f64() * 1e3;
         let mut t = FrameTimings::default();
-        // The code first: on the GPU kernels it waits for the queue, which would otherwise
-        // charge it with the transfer networks' time.
+        let moved = !matches!(&cache.still, Some((c, _, _)) if c == camera);
         let code = match cache.light.take() {
             Some((k, code)) if k == key => code,
             _ => {
                 let clock = Instant::now();
                 let code = self.light_code(map, rotation_deg);
+                // On the GPU kernels the code is only queued: before a new viewpoint's stages,
+                // which wait for the queue one by one, it is waited for, so that the G-buffer
+                // is not charged with it. A lighting change alone does not wait.
+                if moved {
+                    self.settle()?;
+                }
                 t.encoder_ms = ms(clock);
                 code
             }
@@ -476,8 +489,8 @@ impl Relighter {
                     crate::gpu::Fill::Map(map)
                 },
             };
-            let code = nprt_net::host_values(light.code.clone().into_data());
-            let (rgb, direct_ms) = gpu.radiance(pixels, &code, light.scale, Some(&background));
+            let code = self.device_light(light);
+            let (rgb, direct_ms) = gpu.radiance(pixels, &code, Some(&background));
             let rgb = rgb.chunks_exact(3).map(Vec3::from_slice).collect();
             return Ok(Some((rgb, direct_ms)));
         }
@@ -500,26 +513,18 @@ impl Relighter {
         let Some(pixels) = &px.gpu else {
             return Ok(None);
         };
-        let code = nprt_net::host_values(light.code.clone().into_data());
-        gpu.profile_relight(pixels, &code, light.scale).map(Some)
+        gpu.profile_relight(pixels, &self.device_light(light))
+            .map(Some)
     }
 
-    /// Encodes `map` rotated by `rotation_deg` about +Y.
+    /// Encodes `map` rotated by `rotation_deg` about +Y: on the GPU kernels, queued there and
+    /// left on the device.
     pub fn light_code(&self, map: &EnvMap, rotation_deg: f32) -> LightCode {
         let config = &self.file.config;
-        let gain = self.file.output_gain();
-        // The map's divisor per channel, restored at the output with the model's gain.
-        let light = |code, input_scale: [f32; 3]| LightCode {
-            code,
-            scale: std::array::from_fn(|k| input_scale[k] * gain[k]),
-        };
         #[cfg(feature = "wgpu")]
         if let Some(gpu) = &self.gpu {
-            let input = gpu.light_input(map, rotation_deg, config.encoder_width, config.map_norm);
-            let (code, input_scale) = gpu.light_code(&input);
-            let n = code.len();
-            let code = Tensor::from_data(TensorData::new(code, [1, n]), &self.device);
-            return light(code, input_scale);
+            let (width, norm) = (config.encoder_width, config.map_norm);
+            return LightCode(Code::Device(gpu.encode_map(map, rotation_deg, width, norm)));
         }
         let input = LightInput::new(map, rotation_deg, config.encoder_width, config.map_norm);
         let w = input.width;
@@ -527,7 +532,58 @@ impl Relighter {
             TensorData::new(input.pixels, [1, 3, w / 2, w]),
             &self.device,
         );
-        light(self.net.encoder.forward(pixels), input.scale)
+        LightCode(Code::Host {
+            code: nprt_net::host_values(self.net.encoder.forward(pixels).into_data()),
+            divisor: input.scale,
+        })
+    }
+
+    /// `light`'s code on the host, and the scale of each radiance channel: the map's divisor
+    /// times the model's gain.
+    fn host_light(&self, light: &LightCode) -> (Vec<f32>, [f32; 3]) {
+        let (code, divisor) = match &light.0 {
+            Code::Host { code, divisor } => (code.clone(), *divisor),
+            #[cfg(feature = "wgpu")]
+            Code::Device(code) => code.read(
+                &crate::gpu::GpuDevice::get().expect("a light code on the device has a device"),
+            ),
+        };
+        let gain = self.file.output_gain();
+        (code, std::array::from_fn(|k| divisor[k] * gain[k]))
+    }
+
+    /// `light` on the device, uploaded where it was made on the host.
+    #[cfg(feature = "wgpu")]
+    fn device_light(&self, light: &LightCode) -> crate::gpu::GpuLightCode {
+        match &light.0 {
+            Code::Device(code) => code.clone(),
+            Code::Host { code, divisor } => crate::gpu::GpuLightCode::upload(
+                &crate::gpu::GpuDevice::get().expect("frames on the device have a device"),
+                code,
+                *divisor,
+            ),
+        }
+    }
+
+    /// How many times the host has waited for the GPU kernels' queue so far (None off them):
+    /// `nprt bench frame` counts a lighting change's.
+    pub fn host_waits(&self) -> Option<u64> {
+        #[cfg(feature = "wgpu")]
+        if self.gpu.is_some() {
+            return crate::gpu::GpuDevice::get().ok().map(|d| d.host_waits());
+        }
+        None
+    }
+
+    /// Waits for the work the GPU kernels queued (a light code: [`Self::light_code`] does not
+    /// wait), so that a stage timed after is not charged with it; nothing to wait for
+    /// elsewhere.
+    pub fn settle(&self) -> Result<()> {
+        #[cfg(feature = "wgpu")]
+        if self.gpu.is_some() {
+            crate::gpu::GpuDevice::get()?.wait();
+        }
+        Ok(())
     }
 
     /// Radiance of every pixel of `g` under `light`; background pixels are zero (see
@@ -572,8 +628,8 @@ impl Relighter {
     pub fn relight(&self, px: &Pixels, light: &LightCode) -> Vec<Vec3> {
         let rgb = match &self.host {
             Some(host) => {
-                let code = nprt_net::host_values(light.code.clone().into_data());
-                host.radiance(&px.features, &code, light.scale, px.transfer.as_ref())
+                let (code, scale) = self.host_light(light);
+                host.radiance(&px.features, &code, scale, px.transfer.as_ref())
             }
             None => self.device_radiance(px, light),
         };
@@ -589,7 +645,7 @@ impl Relighter {
     fn device_radiance(&self, px: &Pixels, light: &LightCode) -> Vec<f32> {
         #[cfg(feature = "wgpu")]
         if let (Some(gpu), Some(pixels)) = (&self.gpu, &px.gpu) {
-            let code = nprt_net::host_values(light.code.clone().into_data());
+            let code = self.device_light(light);
             // A G-buffer on the device gives every pixel a row: the background's are zeroed.
             let background = px
                 .gbuffer
@@ -599,9 +655,7 @@ impl Relighter {
                     camera,
                     fill: crate::gpu::Fill::Zero,
                 });
-            return gpu
-                .radiance(pixels, &code, light.scale, background.as_ref())
-                .0;
+            return gpu.radiance(pixels, &code, background.as_ref()).0;
         }
         self.burn_radiance(&px.features, light)
     }
@@ -612,9 +666,12 @@ impl Relighter {
     fn burn_radiance(&self, features: &[f32], light: &LightCode) -> Vec<f32> {
         let rows = features.len() / FEATURES;
         let mut rgb = Vec::with_capacity(rows * 3);
-        let code = light.code.clone().expand([CHUNK, light.code.dims()[1]]);
+        let (code, scale) = self.host_light(light);
+        let n = code.len();
+        let code =
+            Tensor::<2>::from_data(TensorData::new(code, [1, n]), &self.device).expand([CHUNK, n]);
         let scale = Tensor::from_data(
-            TensorData::new(light.scale.repeat(CHUNK), [CHUNK, 3]),
+            TensorData::new(scale.repeat(CHUNK), [CHUNK, 3]),
             &self.device,
         );
         for chunk in features.chunks(CHUNK * FEATURES) {

@@ -11,7 +11,7 @@ use nprt_net::{
     gbuffer_features, Activation, Design, Device, Init, LightInput, MapNorm, ModelConfig, NprtNet,
     PositionEncoding,
 };
-use nprt_render::gpu::{GpuDevice, GpuLightInput, GpuNetwork};
+use nprt_render::gpu::{GpuDevice, GpuLightCode, GpuLightInput, GpuNetwork};
 use nprt_scene::{load_scene, Camera, SceneOptions};
 use nprt_trace::{render_gbuffer, TraceScene};
 
@@ -66,20 +66,24 @@ fn gpu_light_codes_and_radiance_match_the_cpu_engine_for_every_design() {
     assert!(features.len() > 19 * 500, "the view sees the room");
     let map = nprt_scene::open_envmap("builtin:sky:25:40").unwrap();
     let input = LightInput::new(&map, 30.0, 64, MapNorm::Channel);
-    let scale = [2.0, 1.0, 0.5];
+    // The radiance's scale per channel: a map's divisor times the model's gain.
+    let (divisor, gain) = ([0.5, 3.0, 1.0], [4.0, 1.0, 0.5]);
+    let scale = [2.0, 3.0, 0.5];
     let mut seed = 0;
     for design in [Design::Baseline, Design::Prt, Design::Albedo, Design::Dsep] {
         for activation in [Activation::Relu, Activation::Siren] {
             for encoding in [PositionEncoding::None, PositionEncoding::HashGrid] {
                 seed += 1;
                 let net = model(design, activation, encoding, seed);
-                let gpu = GpuNetwork::new(&net).unwrap();
-                let (code, _) = gpu.light_code(&GpuLightInput::upload(&device, &input));
+                let gpu = GpuNetwork::new(&net, gain).unwrap();
+                let there = gpu.light_code(&GpuLightInput::upload(&device, &input));
+                let (code, _) = there.read(&device);
                 let want_code = HostEncoder::from_burn(&net.encoder)
                     .forward(&input.pixels, 64)
                     .codes;
                 let code_error = relative_difference(&code, &want_code);
-                let (rgb, _) = gpu.radiance(&gpu.pixels(&features), &want_code, scale, None);
+                let light = GpuLightCode::upload(&device, &want_code, divisor);
+                let (rgb, _) = gpu.radiance(&gpu.pixels(&features), &light, None);
                 let host = HostTransport::from_net(&net);
                 let want = host.radiance(&features, &want_code, scale, None);
                 let error = relative_difference(&rgb, &want);
@@ -114,8 +118,10 @@ fn the_widest_encoder_input_gets_the_cpu_engines_light_code() {
     let net = config.build(&mut Init::new(7, &Device::flex()));
     let map = nprt_scene::open_envmap("builtin:indoor:4").unwrap();
     let input = LightInput::new(&map, 0.0, width, MapNorm::Channel);
-    let input_there = GpuLightInput::upload(&GpuDevice::get().unwrap(), &input);
-    let (code, _) = GpuNetwork::new(&net).unwrap().light_code(&input_there);
+    let device = GpuDevice::get().unwrap();
+    let input_there = GpuLightInput::upload(&device, &input);
+    let gpu = GpuNetwork::new(&net, [1.0; 3]).unwrap();
+    let (code, _) = gpu.light_code(&input_there).read(&device);
     let want = HostEncoder::from_burn(&net.encoder)
         .forward(&input.pixels, width)
         .codes;
@@ -136,7 +142,7 @@ fn the_encoder_input_made_on_the_device_is_the_hosts() {
     }
     let device = GpuDevice::get().unwrap();
     let net = model(Design::Dsep, Activation::Siren, PositionEncoding::None, 3);
-    let gpu = GpuNetwork::new(&net).unwrap();
+    let gpu = GpuNetwork::new(&net, [1.0; 3]).unwrap();
     let encoder = HostEncoder::from_burn(&net.encoder);
     let maps = [
         ("builtin:sky:25:40", false, 64, 30.0, MapNorm::Channel),
@@ -161,7 +167,7 @@ fn the_encoder_input_made_on_the_device_is_the_hosts() {
             "{spec}: pixels {pixels}, scale {scale}"
         );
         if width == 64 {
-            let (code, code_scale) = gpu.light_code(&there);
+            let (code, code_scale) = gpu.light_code(&there).read(&device);
             let want_code = encoder.forward(&want.pixels, 64).codes;
             let error = relative_difference(&code, &want_code);
             assert!(error < 1e-5, "{spec}: light code off by {error}");
@@ -185,6 +191,7 @@ fn half_precision_radiance_follows_the_cpu_engines_for_every_design() {
     let map = nprt_scene::open_envmap("builtin:sky:25:40").unwrap();
     let input = LightInput::new(&map, 30.0, 64, MapNorm::Channel);
     let scale = [2.0, 1.0, 0.5];
+    let device = GpuDevice::get().unwrap();
     let mut seed = 100;
     let mut worst = 0.0f32;
     for design in [Design::Baseline, Design::Prt, Design::Albedo, Design::Dsep] {
@@ -192,12 +199,13 @@ fn half_precision_radiance_follows_the_cpu_engines_for_every_design() {
             for encoding in [PositionEncoding::None, PositionEncoding::HashGrid] {
                 seed += 1;
                 let net = model(design, activation, encoding, seed);
-                let mut gpu = GpuNetwork::new(&net).unwrap();
+                let mut gpu = GpuNetwork::new(&net, [1.0; 3]).unwrap();
                 gpu.set_half(true).unwrap();
                 let code = HostEncoder::from_burn(&net.encoder)
                     .forward(&input.pixels, 64)
                     .codes;
-                let (rgb, _) = gpu.radiance(&gpu.pixels(&features), &code, scale, None);
+                let light = GpuLightCode::upload(&device, &code, scale);
+                let (rgb, _) = gpu.radiance(&gpu.pixels(&features), &light, None);
                 let want = HostTransport::from_net(&net).radiance(&features, &code, scale, None);
                 let error = mean_relative_difference(&rgb, &want);
                 eprintln!(
@@ -261,15 +269,15 @@ fn a_new_viewpoint_reusing_the_last_ones_buffers_gets_its_own_radiance() {
         41,
     );
     let code = vec![0.25f32; nprt_net::network::encoder::CODE_SIZE];
-    let scale = [1.0, 2.0, 0.5];
+    let light = GpuLightCode::upload(&GpuDevice::get().unwrap(), &code, [1.0, 2.0, 0.5]);
     for half in [false, true] {
-        let mut reused = GpuNetwork::new(&net).unwrap();
-        let mut fresh = GpuNetwork::new(&net).unwrap();
+        let mut reused = GpuNetwork::new(&net, [1.0; 3]).unwrap();
+        let mut fresh = GpuNetwork::new(&net, [1.0; 3]).unwrap();
         reused.set_half(half).unwrap();
         fresh.set_half(half).unwrap();
         drop(reused.pixels(&first));
-        let (got, _) = reused.radiance(&reused.pixels(&second), &code, scale, None);
-        let (want, _) = fresh.radiance(&fresh.pixels(&second), &code, scale, None);
+        let (got, _) = reused.radiance(&reused.pixels(&second), &light, None);
+        let (want, _) = fresh.radiance(&fresh.pixels(&second), &light, None);
         assert_eq!(got, want, "half precision: {half}");
     }
 }

@@ -230,6 +230,9 @@ fn frame(a: BenchFrameArgs) -> Result<()> {
             1e3 / t.total_ms(),
             r.relight_ms
         );
+        if let Some(waits) = r.relight_waits {
+            println!("  the host waited for the GPU {waits} time(s) in a lighting change");
+        }
         #[cfg(feature = "wgpu")]
         if let Some(times) = &r.profile {
             print_kernel_times("a lighting change's kernels", times, r.relight_ms);

@@ -1,7 +1,8 @@
 //! The wgpu device our kernels run on (training and nprt-render's frame path): one per
 //! process, opened at first use.
 
-use std::sync::{Arc, OnceLock};
+use std::sync::atomic::{AtomicU64, Ordering};
+use std::sync::{Arc, Mutex, OnceLock};
 
 use anyhow::{anyhow, Result};
 
@@ -24,6 +25,11 @@ pub struct GpuDevice {
     /// buffers: one dispatch may not bind a buffer both ways).
     pub empty: wgpu::Buffer,
     pub spare: wgpu::Buffer,
+    /// Host-readable buffers that reads copied into, kept for the next read of the same size
+    /// (a frame read back every lighting change otherwise allocated one of its size each time).
+    pub(super) staging: Mutex<Vec<wgpu::Buffer>>,
+    /// Times the host has waited for the queue ([`Self::host_waits`]).
+    waits: AtomicU64,
 }
 
 static DEVICE: OnceLock<Result<Arc<GpuDevice>, String>> = OnceLock::new();
@@ -121,6 +127,8 @@ impl GpuDevice {
             half,
             tensor_cores,
             pipelines: Pipelines::default(),
+            staging: Mutex::default(),
+            waits: AtomicU64::new(0),
         })
     }
 
@@ -139,9 +147,20 @@ impl GpuDevice {
 
     /// Blocks until the queue's work is done.
     pub fn wait(&self) {
+        self.counted_wait();
         self.device
             .poll(wgpu::PollType::wait_indefinitely())
             .expect("waiting for the GPU queue");
+    }
+
+    /// How many times the host has waited for the queue since the device opened (a wait, or a
+    /// read back): what `nprt bench frame` counts per lighting change, and tests bound.
+    pub fn host_waits(&self) -> u64 {
+        self.waits.load(Ordering::Relaxed)
+    }
+
+    pub(super) fn counted_wait(&self) {
+        self.waits.fetch_add(1, Ordering::Relaxed);
     }
 }
 

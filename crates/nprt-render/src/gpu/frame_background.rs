@@ -31,7 +31,7 @@ pub struct GpuMap {
 /// A map as a key: equal to another sharing its texels. It holds the map, so its texels cannot
 /// be freed and another map's take their address while they are kept (an address alone as the
 /// key gave a map loaded after another was dropped the dropped one's texels).
-struct SameTexels(EnvMap);
+pub(super) struct SameTexels(pub(super) EnvMap);
 
 impl PartialEq for SameTexels {
     fn eq(&self, other: &Self) -> bool {

@@ -1,9 +1,12 @@
 //! A trained model's networks on the GPU. The weights are uploaded once; a lighting's code is
-//! made by the encoder kernels; a camera's pixels go once through what does not depend on the
-//! lighting (each track's transfer network ŝ, or the baseline's gathered inputs), kept on the
-//! device; each lighting then runs only the shading networks and the combination.
+//! made by the encoder kernels and stays on the device; a camera's pixels go once through what
+//! does not depend on the lighting (each track's transfer network ŝ, or the baseline's gathered
+//! inputs), kept on the device; each lighting then runs only the shading networks and the
+//! combination, dispatches prepared at the camera's first lighting and recorded again at each
+//! later one: a lighting change waits for the queue once, to read the frame back.
 
-use std::sync::{Arc, Mutex};
+use std::sync::atomic::{AtomicU64, Ordering};
+use std::sync::{Arc, Mutex, OnceLock};
 
 use anyhow::Result;
 use nprt_net::cpu::{DenseStack, HostEncoder, HostTransport};
@@ -19,7 +22,9 @@ use nprt_net::gpu::{held_halves, pad16, Bias, HalfWeight, Held, Operand, Output,
 use nprt_net::gpu::kernels::{COMBINE, ENCODER_BLOCK, GBUFFER_FEATURES, TRACK_INPUTS};
 
 use super::buffer_pool::BufferPool;
-use super::frame_background::{Background, Fill, GpuMap};
+use super::frame_background::{Background, Fill, GpuMap, SameTexels};
+use super::kept_last::KeptLast;
+use super::light_code::{GpuLightCode, LIGHT_CODE_VALUES};
 use super::light_input::GpuLightInput;
 use super::path_tracer::{record_paths, GpuPaths};
 use nprt_net::gpu::{activation_code, kind_code};
@@ -73,6 +78,28 @@ pub struct GpuNetwork {
     workspace: Mutex<Option<Arc<Workspace>>>,
     /// What dropped pixels handed back, for the next camera's.
     pool: BufferPool,
+    /// The lighting the shading networks read: a [`GpuLightCode`]'s values, copied in at each
+    /// lighting change, then the model's gain per channel.
+    light: wgpu::Buffer,
+    /// Each track's first shading bias with the light code's share folded in, made anew from
+    /// `light` at each lighting change.
+    biases: Vec<wgpu::Buffer>,
+    /// The encoder's dispatches for inputs of the last width.
+    encoder: KeptLast<usize, Arc<EncoderRun>>,
+    /// The last map's input dispatches, by map, input width and normalisation.
+    inputs: KeptLast<(SameTexels, usize, MapNorm), Arc<GpuLightInput>>,
+    /// Tells the pixels this network made from another's (their kept dispatches read its
+    /// buffers).
+    id: u64,
+}
+
+/// The encoder's dispatches over inputs of one width, with the buffers they read and write.
+struct EncoderRun {
+    /// The input a lighting's map is copied into (`3 × width/2 × width`).
+    input: wgpu::Buffer,
+    /// The code the last dispatch writes.
+    code: wgpu::Buffer,
+    dispatches: Vec<Dispatch>,
 }
 
 /// The buffers a camera's pixels run their networks through, which the network keeps for the
@@ -116,6 +143,10 @@ pub struct GpuPixels {
     pool: BufferPool,
     /// Radiance of every row, `rows × 3`.
     rgb: wgpu::Buffer,
+    /// What a lighting change records (see [`GpuNetwork::radiance`]), prepared at the first.
+    relight: OnceLock<Vec<Dispatch>>,
+    /// The network that made these pixels, the one that may relight them.
+    network: u64,
 }
 
 impl Drop for GpuPixels {
@@ -137,8 +168,10 @@ struct PixelChunk {
 }
 
 impl GpuNetwork {
-    /// Uploads `net`'s weights to the process's GPU device.
-    pub fn new(net: &NprtNet) -> Result<Self> {
+    /// Uploads `net`'s weights to the process's GPU device; its radiance is multiplied by
+    /// `gain` per channel (the model's level gain).
+    pub fn new(net: &NprtNet, gain: [f32; 3]) -> Result<Self> {
+        static NETWORKS: AtomicU64 = AtomicU64::new(0);
         let gpu = GpuDevice::get()?;
         let host = HostTransport::from_net(net);
         let encoder = HostEncoder::from_burn(&net.encoder);
@@ -154,7 +187,7 @@ impl GpuNetwork {
             layers: s.layers.iter().map(dense).collect(),
             activation: s.activation,
         };
-        let tracks = host
+        let tracks: Vec<GpuTrack> = host
             .tracks
             .iter()
             .map(|t| {
@@ -175,7 +208,17 @@ impl GpuNetwork {
             .iter()
             .map(|c| (storage(&c.weight), storage(&c.bias), c.c_in))
             .collect();
+        let mut light = vec![0.0; LIGHT_CODE_VALUES];
+        light.extend(gain);
         Ok(GpuNetwork {
+            light: storage(&light),
+            biases: tracks
+                .iter()
+                .map(|t| gpu.buffer(t.shading.layers[0].d_out))
+                .collect(),
+            encoder: KeptLast::default(),
+            inputs: KeptLast::default(),
+            id: NETWORKS.fetch_add(1, Ordering::Relaxed),
             convs,
             to_code: dense(&encoder.to_code),
             tracks,
@@ -238,45 +281,110 @@ impl GpuNetwork {
         width: usize,
         norm: MapNorm,
     ) -> GpuLightInput {
-        GpuLightInput::new(&self.gpu, &self.map, map, rotation_deg, width, norm)
+        let gpu = &*self.gpu;
+        let input = GpuLightInput::for_map(gpu, &self.map, map, width, norm);
+        let mut encoder = gpu.device.create_command_encoder(&Default::default());
+        input.record(gpu, &mut encoder, map, rotation_deg);
+        gpu.queue.submit([encoder.finish()]);
+        input
     }
 
-    /// The light code ê (`CODE_SIZE` values) of a map made into the encoder's input, and the
-    /// input's divisor per channel: one read back for both.
-    pub fn light_code(&self, input: &GpuLightInput) -> (Vec<f32>, [f32; 3]) {
+    /// The light code of `map` under `rotation_deg`, made into a `width`-wide input under
+    /// `norm` and encoded, all queued in one submission and left on the device; the input's
+    /// and the encoder's dispatches are kept for the next rotation of the same map.
+    pub fn encode_map(
+        &self,
+        map: &EnvMap,
+        rotation_deg: f32,
+        width: usize,
+        norm: MapNorm,
+    ) -> GpuLightCode {
         let gpu = &*self.gpu;
-        let (mut h, mut w) = (input.width / 2, input.width);
-        let mut x = input.pixels.clone();
-        let code = gpu.buffer(CODE_SIZE + 3);
+        let key = (SameTexels(map.clone()), width, norm);
+        let input = self.inputs.get(key, || {
+            Arc::new(GpuLightInput::for_map(gpu, &self.map, map, width, norm))
+        });
         let mut encoder = gpu.device.create_command_encoder(&Default::default());
+        input.record(gpu, &mut encoder, map, rotation_deg);
+        let code = self.record_code(&mut encoder, &input);
+        gpu.queue.submit([encoder.finish()]);
+        code
+    }
+
+    /// The light code of an encoder input, with the input's divisor per channel, left on the
+    /// device: the encoder's dispatches are queued, nothing is waited for.
+    pub fn light_code(&self, input: &GpuLightInput) -> GpuLightCode {
+        let gpu = &*self.gpu;
+        let mut encoder = gpu.device.create_command_encoder(&Default::default());
+        let code = self.record_code(&mut encoder, input);
+        gpu.queue.submit([encoder.finish()]);
+        code
+    }
+
+    /// Records the encoder over `input` (its dispatches kept per input width) into a new
+    /// [`GpuLightCode`].
+    fn record_code(
+        &self,
+        encoder: &mut wgpu::CommandEncoder,
+        input: &GpuLightInput,
+    ) -> GpuLightCode {
+        let gpu = &*self.gpu;
+        let run = self
+            .encoder
+            .get(input.width, || Arc::new(self.encoder_run(input.width)));
+        let light = GpuLightCode::room(gpu);
+        let code_bytes = 4 * CODE_SIZE as u64;
+        encoder.copy_buffer_to_buffer(&input.pixels, 0, &run.input, 0, run.input.size());
         {
             let mut pass = encoder.begin_compute_pass(&Default::default());
-            for (weight, bias, c_in) in &self.convs {
-                let out = gpu.buffer(CHANNELS * (h / 2) * (w / 2));
-                gpu.dispatch(
-                    &mut pass,
-                    &ENCODER_BLOCK,
-                    &[*c_in as u32, h as u32, w as u32, 1, 0, 0, 0, 0],
-                    &[&x, weight, bias, &out, &self.gpu.empty],
-                    groups_for(CHANNELS * (h / 2) * (w / 2)),
-                );
-                (x, h, w) = (out, h / 2, w / 2);
+            for d in &run.dispatches {
+                d.record(&mut pass);
             }
-            debug_assert_eq!(self.convs.len(), BLOCKS);
-            let flat = Rows {
-                x: &x,
-                rows: 1,
-                d_in: self.to_code.d_in,
-                w_row: 0,
-            };
-            dense_layer(gpu, &self.to_code, flat, &self.to_code.bias, 0, &code).record(&mut pass);
         }
-        encoder.copy_buffer_to_buffer(&input.scale, 0, &code, 4 * CODE_SIZE as u64, 12);
-        gpu.queue.submit([encoder.finish()]);
-        let mut code = gpu.read(&code, CODE_SIZE + 3);
-        let scale = [code[CODE_SIZE], code[CODE_SIZE + 1], code[CODE_SIZE + 2]];
-        code.truncate(CODE_SIZE);
-        (code, scale)
+        encoder.copy_buffer_to_buffer(&run.code, 0, &light.buffer, 0, code_bytes);
+        encoder.copy_buffer_to_buffer(&input.scale, 0, &light.buffer, code_bytes, 12);
+        light
+    }
+
+    /// The encoder's dispatches over inputs `width` wide: its convolution blocks, each halving
+    /// the image, then the dense layer into the code.
+    fn encoder_run(&self, width: usize) -> EncoderRun {
+        let gpu = &*self.gpu;
+        let input = gpu.buffer(3 * width * (width / 2));
+        let code = gpu.buffer(CODE_SIZE);
+        let (mut h, mut w) = (width / 2, width);
+        let mut x = input.clone();
+        let mut dispatches = Vec::new();
+        for (weight, bias, c_in) in &self.convs {
+            let out = gpu.buffer(CHANNELS * (h / 2) * (w / 2));
+            dispatches.push(gpu.prepare(
+                &ENCODER_BLOCK,
+                &[*c_in as u32, h as u32, w as u32, 1, 0, 0, 0, 0],
+                &[&x, weight, bias, &out, &gpu.empty],
+                groups_for(CHANNELS * (h / 2) * (w / 2)),
+            ));
+            (x, h, w) = (out, h / 2, w / 2);
+        }
+        debug_assert_eq!(self.convs.len(), BLOCKS);
+        let flat = Rows {
+            x: &x,
+            rows: 1,
+            d_in: self.to_code.d_in,
+            w_row: 0,
+        };
+        dispatches.push(dense_layer(
+            gpu,
+            &self.to_code,
+            flat,
+            &self.to_code.bias,
+            0,
+            &code,
+        ));
+        EncoderRun {
+            input,
+            code,
+            dispatches,
+        }
     }
 
     /// Uploads the network inputs of a camera's foreground pixels (`rows × FEATURES`) and runs
@@ -400,6 +508,8 @@ impl GpuNetwork {
             work,
             pool: self.pool.clone(),
             rgb: self.pool.take(gpu, rows.max(1) * 3),
+            relight: OnceLock::new(),
+            network: self.id,
         }
     }
 
@@ -426,49 +536,49 @@ impl GpuNetwork {
         work
     }
 
-    /// What a lighting change runs on `px` under the light `code`: each track's shading
-    /// network with the code's share folded into its first bias, then the combination into
-    /// radiance (times `scale`).
-    fn relight_dispatches(&self, px: &GpuPixels, code: &[f32], scale: [f32; 3]) -> Vec<Dispatch> {
+    /// What a lighting change runs on `px`, prepared at its first: each track's shading
+    /// network with the light code's share folded into its first bias, then the combination
+    /// into radiance (times the map's divisor and the gain), all reading the light slot.
+    fn relight_dispatches<'p>(&self, px: &'p GpuPixels) -> &'p [Dispatch] {
+        assert_eq!(
+            px.network, self.id,
+            "pixels relit by a network other than the one that made them"
+        );
         assert_eq!(
             px.work.half(),
             self.half(),
             "pixels made in one precision, relit in the other"
         );
+        px.relight.get_or_init(|| self.prepare_relight(px))
+    }
+
+    fn prepare_relight(&self, px: &GpuPixels) -> Vec<Dispatch> {
         let gpu = &*self.gpu;
-        let code = gpu.upload(code);
         let mut list = Vec::new();
-        // Each track's first shading layer with the light code's share folded into its bias.
-        let biases: Vec<wgpu::Buffer> = self
-            .tracks
-            .iter()
-            .map(|t| {
-                let first = &t.shading.layers[0];
-                let code_row = if t.transfer.is_some() {
-                    TRANSPORT_CODE
-                } else {
-                    0
-                };
-                let bias = gpu.buffer(first.d_out);
-                // b' = b + ê·W[code rows]: one row through the first layer's code rows.
-                list.push(gpu.product(
-                    [1, first.d_out, CODE_SIZE],
-                    Operand::plain(&code, 0, CODE_SIZE),
-                    Operand::plain(&first.weight, code_row * first.d_out, first.d_out),
-                    Bias::Column(&first.bias, 0),
-                    0,
-                    Output::to(&bias, 0, first.d_out),
-                    None,
-                ));
-                bias
-            })
-            .collect();
+        for (t, bias) in self.tracks.iter().zip(&self.biases) {
+            let first = &t.shading.layers[0];
+            let code_row = if t.transfer.is_some() {
+                TRANSPORT_CODE
+            } else {
+                0
+            };
+            // b' = b + ê·W[code rows]: one row through the first layer's code rows.
+            list.push(gpu.product(
+                [1, first.d_out, CODE_SIZE],
+                Operand::plain(&self.light, 0, CODE_SIZE),
+                Operand::plain(&first.weight, code_row * first.d_out, first.d_out),
+                Bias::Column(&first.bias, 0),
+                0,
+                Output::to(bias, 0, first.d_out),
+                None,
+            ));
+        }
         for chunk in &px.chunks {
             for ((t, kept), (bias, out)) in self
                 .tracks
                 .iter()
                 .zip(&chunk.kept)
-                .zip(biases.iter().zip(&px.work.outputs))
+                .zip(self.biases.iter().zip(&px.work.outputs))
             {
                 let first = match t.transfer {
                     // [ŝ, ê]: ŝ's rows come first.
@@ -491,40 +601,51 @@ impl GpuNetwork {
                 );
             }
             let kinds: Vec<u32> = self.tracks.iter().map(|t| kind_code(t.kind)).collect();
-            let mut params = vec![
+            let params = [
                 chunk.rows as u32,
                 kinds.len() as u32,
                 kinds[0],
                 *kinds.last().expect("a track"),
                 chunk.first as u32,
-                0,
+                CODE_SIZE as u32,
                 0,
                 0,
             ];
-            params.extend(scale.map(f32::to_bits));
-            params.push(0);
             let out1 = px.work.outputs.last().expect("a track");
             list.push(gpu.prepare(
                 &COMBINE,
                 &params,
-                &[&chunk.features, &px.work.outputs[0], out1, &px.rgb],
+                &[
+                    &chunk.features,
+                    &px.work.outputs[0],
+                    out1,
+                    &self.light,
+                    &px.rgb,
+                ],
                 groups_for(chunk.rows),
             ));
         }
         list
     }
 
-    /// The GPU time of each kernel of a lighting change on `px` (what [`Self::radiance`] runs
-    /// before the background), each dispatch timed in a pass of its own: `nprt bench frame
-    /// --profile`. An error where the adapter has no timestamp queries.
-    pub fn profile_relight(
-        &self,
-        px: &GpuPixels,
-        code: &[f32],
-        scale: [f32; 3],
-    ) -> Result<Vec<KernelTime>> {
-        let dispatches = self.relight_dispatches(px, code, scale);
-        self.gpu.profile(&dispatches.iter().collect::<Vec<_>>())
+    /// The GPU time of each kernel of a lighting change on `px` under `code` (the encoder's
+    /// at the last input width and what [`Self::radiance`] runs before the background), each
+    /// dispatch timed in a pass of its own: `nprt bench frame --profile`. An error where the
+    /// adapter has no timestamp queries.
+    pub fn profile_relight(&self, px: &GpuPixels, code: &GpuLightCode) -> Result<Vec<KernelTime>> {
+        let mut encoder = self.gpu.device.create_command_encoder(&Default::default());
+        self.use_light(&mut encoder, code);
+        self.gpu.queue.submit([encoder.finish()]);
+        let run = self.encoder.kept();
+        let encoding = run.iter().flat_map(|r| &r.dispatches);
+        let dispatches: Vec<&Dispatch> = encoding.chain(self.relight_dispatches(px)).collect();
+        self.gpu.profile(&dispatches)
+    }
+
+    /// Records the copy of `code` into the light slot the shading networks read.
+    fn use_light(&self, encoder: &mut wgpu::CommandEncoder, code: &GpuLightCode) {
+        let bytes = 4 * LIGHT_CODE_VALUES as u64;
+        encoder.copy_buffer_to_buffer(&code.buffer, 0, &self.light, 0, bytes);
     }
 
     fn track_inputs(
@@ -546,8 +667,8 @@ impl GpuNetwork {
         );
     }
 
-    /// Radiance (`rows × 3`) of `px` under the light `code`, each channel multiplied by
-    /// `scale` (the map's normalisation times the model's level gain); with `background`
+    /// Radiance (`rows × 3`) of `px` under the light `code`, each channel multiplied by the
+    /// code's divisor (the map's normalisation) and the model's gain; with `background`
     /// (pixels of a G-buffer on the device, [`Self::pixels_of_gbuffer`]), the frame's
     /// background filled in, or traced direct light added. With the milliseconds the traced
     /// light took (0 without): it is submitted once the networks are done, so that the two can
@@ -555,19 +676,19 @@ impl GpuNetwork {
     pub fn radiance(
         &self,
         px: &GpuPixels,
-        code: &[f32],
-        scale: [f32; 3],
+        code: &GpuLightCode,
         background: Option<&Background>,
     ) -> (Vec<f32>, f64) {
         if px.rows == 0 {
             return (Vec::new(), 0.0);
         }
         let gpu = &*self.gpu;
-        let dispatches = self.relight_dispatches(px, code, scale);
+        let dispatches = self.relight_dispatches(px);
         let mut encoder = gpu.device.create_command_encoder(&Default::default());
+        self.use_light(&mut encoder, code);
         {
             let mut pass = encoder.begin_compute_pass(&Default::default());
-            for d in &dispatches {
+            for d in dispatches {
                 d.record(&mut pass);
             }
             if let Some(b) = background {

@@ -26,6 +26,12 @@ impl<K: PartialEq, V: Clone> KeptLast<K, V> {
         Ok(v)
     }
 
+    /// The value kept last, whatever its key.
+    pub fn kept(&self) -> Option<V> {
+        let kept = self.0.lock().unwrap_or_else(|e| e.into_inner());
+        kept.as_ref().map(|(_, v)| v.clone())
+    }
+
     /// [`Self::try_get`] where making cannot fail.
     pub fn get(&self, key: K, make: impl FnOnce() -> V) -> V {
         self.try_get(key, || Ok::<_, Infallible>(make()))

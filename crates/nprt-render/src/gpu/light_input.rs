@@ -1,10 +1,10 @@
 //! The encoder's input made on the device (what `LightInput::new` makes on the host): the map,
 //! rotated, looked up ss × ss times per input texel and averaged, then divided by its
 //! `MapNorm` divisor and taken through ln(1 + x). A lighting change on the GPU then sends only
-//! the map's rotation; on the host the lookups took a frame milliseconds (64 per texel of a
-//! 128-wide input from a 1024-wide map).
+//! the map's rotation, into dispatches prepared once per map; on the host the lookups took a
+//! frame milliseconds (64 per texel of a 128-wide input from a 1024-wide map).
 
-use nprt_net::gpu::{groups_for, GpuDevice, KernelSource};
+use nprt_net::gpu::{groups_for, Dispatch, GpuDevice, KernelSource};
 use nprt_net::{LightInput, MapNorm};
 use nprt_scene::EnvMap;
 
@@ -25,65 +25,77 @@ pub const LIGHT_NORMALISE: KernelSource = KernelSource {
 };
 
 /// A map made into the encoder's input on the device: `3 × width × width/2` values,
-/// channel-major, and the divisor of each channel.
+/// channel-major, and the divisor of each channel; with, for an input made from a map, the
+/// dispatches that make it, kept so that each rotation only rewrites their parameters.
 pub struct GpuLightInput {
     pub(super) pixels: wgpu::Buffer,
     pub(super) scale: wgpu::Buffer,
     pub width: usize,
+    /// The texel lookups (into a buffer of their own), then the normalisation; none for an
+    /// uploaded input.
+    made: Vec<Dispatch>,
 }
 
 impl GpuLightInput {
-    /// `map` under `rotation_deg` about the vertical axis, made into the input of a
-    /// `width`-wide encoder normalised by `norm` (its texels uploaded into `kept` unless they
-    /// are the last map's).
-    pub(super) fn new(
+    /// The dispatches that make `map`'s input for a `width`-wide encoder normalised by `norm`
+    /// (its texels uploaded into `kept` unless they are the last map's), prepared, not queued:
+    /// [`Self::record`] queues them for a rotation.
+    pub(super) fn for_map(
         gpu: &GpuDevice,
         kept: &GpuMap,
         map: &EnvMap,
-        rotation_deg: f32,
         width: usize,
         norm: MapNorm,
     ) -> Self {
-        let height = width / 2;
-        let count = width * height;
-        let rotated = map.rotated_y(rotation_deg);
-        let to_local = rotated.to_world().inverse();
-        let ss = map.width().div_ceil(width).max(2);
+        let count = width * (width / 2);
         let texels = kept.texels(gpu, map);
         let rgb = gpu.buffer(3 * count);
-        let input = GpuLightInput {
-            pixels: gpu.buffer(3 * count),
-            scale: gpu.buffer(3),
-            width,
-        };
-        let mut params = [width, height, ss, map.width(), map.height(), 0, 0, 0]
-            .map(|v| v as u32)
-            .to_vec();
-        params.extend(matrix_words(to_local));
+        let (pixels, scale) = (gpu.buffer(3 * count), gpu.buffer(3));
         let norm_code = match norm {
             MapNorm::Mean => 0,
             MapNorm::Channel => 1,
         };
-        let mut encoder = gpu.device.create_command_encoder(&Default::default());
-        {
-            let mut pass = encoder.begin_compute_pass(&Default::default());
-            gpu.dispatch(
-                &mut pass,
+        let made = vec![
+            gpu.prepare(
                 &LIGHT_TEXELS,
-                &params,
+                &texel_params(map, 0.0, width),
                 &[&texels, &rgb],
                 groups_for(count),
-            );
-            gpu.dispatch(
-                &mut pass,
+            ),
+            gpu.prepare(
                 &LIGHT_NORMALISE,
                 &[count as u32, norm_code, 0, 0],
-                &[&rgb, &input.pixels, &input.scale],
+                &[&rgb, &pixels, &scale],
                 [1, 1],
-            );
+            ),
+        ];
+        GpuLightInput {
+            pixels,
+            scale,
+            width,
+            made,
         }
-        gpu.queue.submit([encoder.finish()]);
-        input
+    }
+
+    /// Records the making of the input of `map` (the one it was prepared for) under
+    /// `rotation_deg` about the vertical axis. The rotation reaches the device with the queue's
+    /// next submission: submit before recording again.
+    pub(super) fn record(
+        &self,
+        gpu: &GpuDevice,
+        encoder: &mut wgpu::CommandEncoder,
+        map: &EnvMap,
+        rotation_deg: f32,
+    ) {
+        let texels = self.made.first().expect("an input made from a map");
+        gpu.write(
+            &texels.uniform,
+            &texel_params(map, rotation_deg, self.width),
+        );
+        let mut pass = encoder.begin_compute_pass(&Default::default());
+        for d in &self.made {
+            d.record(&mut pass);
+        }
     }
 
     /// A pre-processed map uploaded as it is (the encoder's input made on the host).
@@ -92,6 +104,7 @@ impl GpuLightInput {
             pixels: gpu.upload(&input.pixels),
             scale: gpu.upload(&input.scale),
             width: input.width,
+            made: Vec::new(),
         }
     }
 
@@ -105,4 +118,16 @@ impl GpuLightInput {
             width: self.width,
         }
     }
+}
+
+/// `light_texels`' parameters for `map` under `rotation_deg`, into an input `width` wide: its
+/// size, the lookups per texel side (ss) and the map's world-to-local rotation.
+fn texel_params(map: &EnvMap, rotation_deg: f32, width: usize) -> Vec<u32> {
+    let ss = map.width().div_ceil(width).max(2);
+    let to_local = map.rotated_y(rotation_deg).to_world().inverse();
+    let mut params = [width, width / 2, ss, map.width(), map.height(), 0, 0, 0]
+        .map(|v| v as u32)
+        .to_vec();
+    params.extend(matrix_words(to_local));
+    params
 }

@@ -122,7 +122,10 @@ async function main() {
   const rgb = room(rows * 3);
 
   // 1. The light code: 5 convolution blocks, then a dense layer (once per lighting change).
-  const code = room(64);
+  // After its 64 values, the factors combine.wgsl multiplies each channel by: the map's
+  // divisor times the model's gain (here already one product), then 1.
+  const code = room(64 + 6);
+  device.queue.writeBuffer(code, 64 * 4, new Float32Array([...ex.light.scale, 1, 1, 1]));
   let encoder = device.createCommandEncoder();
   let pass = encoder.beginComputePass();
   let [h, w] = [ex.light.shape[1], ex.light.shape[2]];
@@ -163,9 +166,8 @@ async function main() {
       const dIn = first.dIn - 64;
       runMlp(pass, t.shading, kept[i], rows, { dIn, wRow: codeFirst ? 64 : 0, bias }, scratch, outputs[i]);
     });
-    const params = new Uint32Array([rows, tracks.length, tracks[0].kind, tracks.at(-1).kind, 0, 0, 0, 0, 0, 0, 0, 0]);
-    new Float32Array(params.buffer, 32, 3).set(ex.light.scale);
-    dispatch(pass, 'combine', params, [features, outputs[0], outputs.at(-1), rgb], groups(rows));
+    const params = new Uint32Array([rows, tracks.length, tracks[0].kind, tracks.at(-1).kind, 0, 64, 0, 0]);
+    dispatch(pass, 'combine', params, [features, outputs[0], outputs.at(-1), code, rgb], groups(rows));
     pass.end();
     const readback = device.createBuffer({ size: rows * 12, usage: GPUBufferUsage.MAP_READ | GPUBufferUsage.COPY_DST });
     encoder.copyBufferToBuffer(rgb, 0, readback, 0, rows * 12);
