@@ -42,8 +42,8 @@ pub use frame_bench::{bench_frame, FrameBenchOptions, FrameBenchRow};
 pub use path::CameraPath;
 pub use precision::Precision;
 pub use relight::{
-    background, DirectSampling, FrameCache, FrameTimings, LightCode, Pixels, Relighter,
-    DEFAULT_DIRECT_SPP,
+    background, DirectSampling, FrameCache, FrameRadiance, FrameTimings, LightCode, Pixels,
+    Relighter, DEFAULT_DIRECT_SPP,
 };
 pub use render_job::{RenderJob, RenderOptions, DEFAULT_LIGHTING};
 pub use schedule::LightingSchedule;

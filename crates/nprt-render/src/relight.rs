@@ -59,6 +59,32 @@ enum Code {
     Device(crate::gpu::GpuLightCode),
 }
 
+/// A frame's radiance, 3 f32 a pixel in pixel order: on the host, or left on the device by
+/// the GPU kernels ([`Relighter::frame_shown`]).
+pub enum FrameRadiance {
+    Host(Vec<Vec3>),
+    #[cfg(feature = "wgpu")]
+    Device {
+        rgb: wgpu::Buffer,
+        pixels: usize,
+    },
+}
+
+impl FrameRadiance {
+    /// The radiance on the host, read back from the device if it is there.
+    pub fn into_host(self) -> Vec<Vec3> {
+        match self {
+            FrameRadiance::Host(rgb) => rgb,
+            #[cfg(feature = "wgpu")]
+            FrameRadiance::Device { rgb, pixels } => {
+                let gpu = crate::gpu::GpuDevice::get().expect("a frame on the device has one");
+                let rgb = gpu.read(&rgb, 3 * pixels);
+                rgb.chunks_exact(3).map(Vec3::from_slice).collect()
+            }
+        }
+    }
+}
+
 /// A G-buffer's foreground pixels as network inputs, and what of the network does not depend
 /// on the lighting: all a still camera needs to relight.
 pub struct Pixels {
@@ -321,6 +347,22 @@ impl Relighter {
         key: K,
         sampling: DirectSampling,
     ) -> Result<(Vec<Vec3>, FrameTimings)> {
+        let lit = (map, rotation_deg, key);
+        let (shown, t) = self.frame_shown(cache, ts, camera, lit, sampling, false)?;
+        Ok((shown.into_host(), t))
+    }
+
+    /// [`Self::frame`], its radiance left on the device where the GPU kernels made the whole
+    /// frame there and `keep` asks (what `nprt view` shows), read back otherwise.
+    pub fn frame_shown<K: PartialEq>(
+        &self,
+        cache: &mut FrameCache<K>,
+        ts: &TraceScene,
+        camera: &Camera,
+        (map, rotation_deg, key): (&EnvMap, f32, K),
+        sampling: DirectSampling,
+        keep: bool,
+    ) -> Result<(FrameRadiance, FrameTimings)> {
         let ms = |t: Instant| t.elapsed().as_secs_f64() * 1e3;
         let mut t = FrameTimings::default();
         let moved = !matches!(&cache.still, Some((c, _, _)) if c == camera);
@@ -359,19 +401,25 @@ impl Relighter {
         };
         let placed = map.rotated_y(rotation_deg);
         let clock = Instant::now();
-        let finished = self.device_frame(ts, &px, &code, &placed, &sampling)?;
-        let on_device = finished.is_some();
-        let (mut rgb, direct_ms) = finished.unwrap_or_else(|| (self.relight(&px, &code), 0.0));
-        t.network_ms += ms(clock) - direct_ms;
-        t.direct_ms = direct_ms;
-        if !on_device {
-            let clock = Instant::now();
-            self.complete(ts, camera, &placed, &g, sampling, &mut rgb)?;
-            t.direct_ms = ms(clock);
-        }
+        let finished = self.device_frame(ts, &px, &code, &placed, &sampling, keep)?;
+        let shown = match finished {
+            Some((shown, direct_ms)) => {
+                t.network_ms += ms(clock) - direct_ms;
+                t.direct_ms = direct_ms;
+                shown
+            }
+            None => {
+                let mut rgb = self.relight(&px, &code);
+                t.network_ms += ms(clock);
+                let clock = Instant::now();
+                self.complete(ts, camera, &placed, &g, sampling, &mut rgb)?;
+                t.direct_ms = ms(clock);
+                FrameRadiance::Host(rgb)
+            }
+        };
         cache.light = Some((key, code));
         cache.still = Some((camera.clone(), g, px));
-        Ok((rgb, t))
+        Ok((shown, t))
     }
 
     /// The G-buffer of `camera`'s pixel centres: rasterised on the GPU with the kernels (the
@@ -469,7 +517,8 @@ impl Relighter {
         light: &LightCode,
         map: &EnvMap,
         sampling: &DirectSampling,
-    ) -> Result<Option<(Vec<Vec3>, f64)>> {
+        keep: bool,
+    ) -> Result<Option<(FrameRadiance, f64)>> {
         #[cfg(feature = "wgpu")]
         if let (Some(gpu), Some(pixels), Some((samples, camera))) =
             (&self.gpu, &px.gpu, &px.gbuffer)
@@ -490,9 +539,17 @@ impl Relighter {
                 },
             };
             let code = self.device_light(light);
+            if keep {
+                let direct_ms = gpu.radiance_on_device(pixels, &code, Some(&background));
+                let shown = FrameRadiance::Device {
+                    rgb: pixels.rgb().clone(),
+                    pixels: pixels.rows,
+                };
+                return Ok(Some((shown, direct_ms)));
+            }
             let (rgb, direct_ms) = gpu.radiance(pixels, &code, Some(&background));
             let rgb = rgb.chunks_exact(3).map(Vec3::from_slice).collect();
-            return Ok(Some((rgb, direct_ms)));
+            return Ok(Some((FrameRadiance::Host(rgb), direct_ms)));
         }
         Ok(None)
     }

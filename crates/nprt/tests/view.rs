@@ -112,21 +112,27 @@ fn the_viewer_opens_a_window_and_shows_what_render_makes() {
     assert!(white(0, 0, 160, 20) > 40, "the overlay's first lines");
 
     // Without it: the frame nprt render makes from the same camera (the default path's start)
-    // and lighting (its first map, unturned), to within rounding of the camera's frame.
-    let bare = dir.join("bare.png");
-    view(
-        &display,
-        &[
-            m,
-            "--res",
-            "160x120",
-            "--frames",
-            "1",
-            "--no-overlay",
-            "--screenshot",
-            bare.to_str().unwrap(),
-        ],
-    );
+    // and lighting (its first map, unturned), to within rounding of the camera's frame; made on
+    // the CPU and uploaded, and where the GPU kernels run, made there and shown from there.
+    let bare = |device: &str| {
+        let shot = dir.join(format!("bare-{device}.png"));
+        view(
+            &display,
+            &[
+                m,
+                "--res",
+                "160x120",
+                "--device",
+                device,
+                "--frames",
+                "1",
+                "--no-overlay",
+                "--screenshot",
+                shot.to_str().unwrap(),
+            ],
+        );
+        image::open(&shot).unwrap().to_rgb8()
+    };
     let r = dir.join("render");
     ok(&[
         "render",
@@ -139,18 +145,26 @@ fn the_viewer_opens_a_window_and_shows_what_render_makes() {
         "--res",
         "160x120",
     ]);
-    let shown = image::open(&bare).unwrap().to_rgb8();
     let rendered = image::open(r.join("frames/0000.png")).unwrap().to_rgb8();
-    let (mut differ, mut lit) = (0, 0);
-    for (a, b) in shown.pixels().zip(rendered.pixels()) {
-        differ += usize::from(a.0.iter().zip(b.0).any(|(x, y)| x.abs_diff(y) > 2));
-        lit += usize::from(a.0.iter().any(|&c| c > 16));
+    let devices = if wgpu_runs() {
+        &["cpu", "wgpu"][..]
+    } else {
+        &["cpu"]
+    };
+    for device in devices {
+        let shown = bare(device);
+        let (mut differ, mut lit) = (0, 0);
+        for (a, b) in shown.pixels().zip(rendered.pixels()) {
+            differ += usize::from(a.0.iter().zip(b.0).any(|(x, y)| x.abs_diff(y) > 2));
+            lit += usize::from(a.0.iter().any(|&c| c > 16));
+        }
+        eprintln!("{device}: {differ} pixels more than 2 levels from nprt render's");
+        assert!(
+            differ * 100 < 160 * 120,
+            "{device}: {differ} pixels differ from nprt render's frame"
+        );
+        assert!(lit * 2 > 160 * 120, "{device}: the frame shows the room");
     }
-    assert!(
-        differ * 100 < 160 * 120,
-        "{differ} pixels differ from nprt render's frame"
-    );
-    assert!(lit * 2 > 160 * 120, "the frame shows the room");
 
     // The progressive reference (the R key) on the GPU, where the kernels run: path traced on
     // the device, it converges to what the CPU's tracer shows.

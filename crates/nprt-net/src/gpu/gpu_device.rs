@@ -12,6 +12,10 @@ use super::kernel::Pipelines;
 pub struct GpuDevice {
     pub device: wgpu::Device,
     pub queue: wgpu::Queue,
+    /// The instance and adapter it came from: `nprt view` draws into its window with this
+    /// device, so that frames the kernels leave on it are shown without a trip to the host.
+    pub instance: wgpu::Instance,
+    pub wgpu_adapter: wgpu::Adapter,
     /// The adapter's name and driver, for reports ("llvmpipe (LLVM 19.1.7, 256 bits)" on
     /// Mesa's software Vulkan).
     pub adapter: String,
@@ -123,6 +127,8 @@ impl GpuDevice {
             spare: placeholder("spare"),
             device,
             queue,
+            instance,
+            wgpu_adapter: adapter.clone(),
             adapter: format!("{} ({}, {:?})", info.name, info.driver_info, info.backend),
             half,
             tensor_cores,

@@ -149,6 +149,13 @@ pub struct GpuPixels {
     network: u64,
 }
 
+impl GpuPixels {
+    /// Radiance of every row (`rows × 3` f32), as the last radiance left it.
+    pub fn rgb(&self) -> &wgpu::Buffer {
+        &self.rgb
+    }
+}
+
 impl Drop for GpuPixels {
     fn drop(&mut self) {
         let chunks = self.chunks.drain(..);
@@ -682,6 +689,30 @@ impl GpuNetwork {
         if px.rows == 0 {
             return (Vec::new(), 0.0);
         }
+        let direct_ms = self.queue_radiance(px, code, background);
+        (self.gpu.read(&px.rgb, px.rows * 3), direct_ms)
+    }
+
+    /// [`Self::radiance`] left on the device, in [`GpuPixels::rgb`], and waited for (so that
+    /// a frame's timings hold its GPU work), not read back: what `nprt view` shows.
+    pub fn radiance_on_device(
+        &self,
+        px: &GpuPixels,
+        code: &GpuLightCode,
+        background: Option<&Background>,
+    ) -> f64 {
+        let direct_ms = self.queue_radiance(px, code, background);
+        self.gpu.wait();
+        direct_ms
+    }
+
+    /// Queues [`Self::radiance`]'s work; the milliseconds of the traced light.
+    fn queue_radiance(
+        &self,
+        px: &GpuPixels,
+        code: &GpuLightCode,
+        background: Option<&Background>,
+    ) -> f64 {
         let gpu = &*self.gpu;
         let dispatches = self.relight_dispatches(px);
         let mut encoder = gpu.device.create_command_encoder(&Default::default());
@@ -727,7 +758,7 @@ impl GpuNetwork {
             gpu.wait();
             direct_ms = clock.elapsed().as_secs_f64() * 1e3;
         }
-        (gpu.read(&px.rgb, px.rows * 3), direct_ms)
+        direct_ms
     }
 }
 

@@ -1,5 +1,6 @@
 //! Text drawn over the frame (timings, keys) in an 8×8 bitmap font, light on a dark shadow so
-//! that it reads over any image.
+//! that it reads over any image: into an RGBA8 image laid over the frame, opaque where it
+//! draws.
 
 use font8x8::UnicodeFonts;
 
@@ -12,7 +13,7 @@ pub fn draw_lines(rgba: &mut [u8], width: usize, lines: &[String], scale: usize)
     let mut put = |x: usize, y: usize, v: u8| {
         if x < width && y < height {
             let p = 4 * (y * width + x);
-            rgba[p..p + 3].fill(v);
+            rgba[p..p + 4].copy_from_slice(&[v, v, v, 255]);
         }
     };
     for (row, line) in lines.iter().enumerate() {

@@ -11,7 +11,6 @@ use glam::Vec3;
 use nprt_net::Device;
 use nprt_scene::{EnvMap, Scene};
 use nprt_trace::{PixelFilter, RenderSettings, TraceScene};
-use rayon::prelude::*;
 use winit::application::ApplicationHandler;
 use winit::dpi::PhysicalSize;
 use winit::event::{ElementState, MouseButton, MouseScrollDelta, WindowEvent};
@@ -21,8 +20,8 @@ use winit::window::{Window, WindowId};
 
 use super::orbit_camera::OrbitCamera;
 use super::overlay::draw_lines;
-use super::presenter::Presenter;
-use crate::relight::{DirectSampling, FrameCache, FrameTimings, Relighter};
+use super::presenter::{Presenter, Shown, OVERLAY_ROWS};
+use crate::relight::{DirectSampling, FrameCache, FrameRadiance, FrameTimings, Relighter};
 use crate::CameraPath;
 use crate::Precision;
 
@@ -100,7 +99,10 @@ struct Viewer<'a> {
     last_frame: Option<Instant>,
     drag: Option<(MouseButton, f64, f64)>,
     cursor: (f64, f64),
-    rgba: Vec<u8>,
+    /// The last frame drawn and its overlay (RGBA8 over the frame's top rows; empty when
+    /// hidden), for screenshots.
+    shown: Option<FrameRadiance>,
+    overlay_rgba: Vec<u8>,
     overlay: bool,
     message: String,
     window: Option<Arc<Window>>,
@@ -193,7 +195,8 @@ impl<'a> Viewer<'a> {
             last_frame: None,
             drag: None,
             cursor: (0.0, 0.0),
-            rgba: Vec::new(),
+            shown: None,
+            overlay_rgba: Vec::new(),
             overlay: !opts.hide_overlay,
             message: String::new(),
             window: None,
@@ -203,8 +206,9 @@ impl<'a> Viewer<'a> {
         })
     }
 
-    /// The frame's linear radiance: the model's relighting, or the reference's running mean.
-    fn radiance(&mut self) -> Result<Vec<Vec3>> {
+    /// The frame's linear radiance: the model's relighting (left on the device where the GPU
+    /// kernels made it there), or the reference's running mean.
+    fn radiance(&mut self) -> Result<FrameRadiance> {
         let [w, h] = self.opts.resolution;
         let camera = self.camera.camera(w, h);
         let map = &self.maps[self.map].1;
@@ -230,7 +234,7 @@ impl<'a> Viewer<'a> {
             r.sum.iter_mut().zip(&pass).for_each(|(s, p)| *s += *p);
             r.spp += 1;
             let k = 1.0 / r.spp as f32;
-            return Ok(r.sum.iter().map(|s| *s * k).collect());
+            return Ok(FrameRadiance::Host(r.sum.iter().map(|s| *s * k).collect()));
         }
         let sampling = DirectSampling {
             spp: self.opts.direct_spp,
@@ -238,17 +242,12 @@ impl<'a> Viewer<'a> {
             denoiser: None,
         };
         let key = (self.map, self.rotation.to_bits());
-        let (rgb, t) = self.models[self.model].frame(
-            &mut self.cache,
-            &self.ts,
-            &camera,
-            map,
-            self.rotation,
-            key,
-            sampling,
-        )?;
+        let lit = (map, self.rotation, key);
+        let model = &self.models[self.model];
+        let (shown, t) =
+            model.frame_shown(&mut self.cache, &self.ts, &camera, lit, sampling, true)?;
         self.timings = t;
-        Ok(rgb)
+        Ok(shown)
     }
 
     /// What the overlay says.
@@ -308,21 +307,22 @@ impl<'a> Viewer<'a> {
             };
         }
         self.last_frame = Some(now);
-        let [w, _] = self.opts.resolution;
-        // On every core: the sRGB curve's powf over a 1920 × 1080 frame took one core of this
-        // 2-core machine about 60 ms.
-        let exposure = self.exposure;
-        self.rgba.resize(rgb.len() * 4, 255);
-        self.rgba
-            .par_chunks_mut(4)
-            .zip(&rgb)
-            .for_each(|(px, c)| px[..3].copy_from_slice(&nprt_io::srgb8(*c, exposure)));
+        let [w, h] = self.opts.resolution;
+        self.overlay_rgba.clear();
         if self.overlay {
             let adapter = &self.presenter.as_ref().expect("a window is open").adapter;
             let lines = self.overlay(adapter);
-            draw_lines(&mut self.rgba, w as usize, &lines, 1);
+            let rows = h.min(OVERLAY_ROWS) as usize;
+            self.overlay_rgba.resize(4 * w as usize * rows, 0);
+            draw_lines(&mut self.overlay_rgba, w as usize, &lines, 1);
         }
-        self.presenter.as_mut().expect("open").present(&self.rgba)?;
+        let shown = Shown {
+            frame: &rgb,
+            exposure: self.exposure,
+            overlay: &self.overlay_rgba,
+        };
+        self.presenter.as_mut().expect("open").present(&shown)?;
+        self.shown = Some(rgb);
         self.frames += 1;
         self.rotation = (self.rotation + self.opts.spin_deg).rem_euclid(360.0);
         Ok(())
@@ -331,8 +331,15 @@ impl<'a> Viewer<'a> {
     /// Writes the frame on screen, overlay included, as a PNG.
     fn screenshot(&self, path: &std::path::Path) -> Result<()> {
         let [w, h] = self.opts.resolution;
+        let frame = self.shown.as_ref().context("no frame drawn yet")?;
+        let shown = Shown {
+            frame,
+            exposure: self.exposure,
+            overlay: &self.overlay_rgba,
+        };
+        let rgba = self.presenter.as_ref().expect("open").screenshot(&shown);
         let image =
-            image::RgbaImage::from_raw(w, h, self.rgba.clone()).context("no frame drawn yet")?;
+            image::RgbaImage::from_raw(w, h, rgba).context("a screenshot of the frame's size")?;
         nprt_io::write_atomically(path, |tmp| {
             image
                 .save_with_format(tmp, image::ImageFormat::Png)
