@@ -43,6 +43,9 @@ pub struct FrameBenchRow {
     pub relight_ms: f64,
     /// Times a lighting change made the host wait for the GPU queue (None off the GPU kernels).
     pub relight_waits: Option<u64>,
+    /// Median of a whole lighting change (direct light included) left on the device, not read
+    /// back, as `nprt view` shows it (None off the GPU kernels).
+    pub relight_shown_ms: Option<f64>,
     /// Where the networks ran.
     pub networks_on: String,
     /// Where the G-buffer was made.
@@ -96,6 +99,7 @@ pub fn bench_frame(
             let mut relights = Vec::new();
             let mut foreground = 0;
             let mut relight_waits = None;
+            let mut shown = Vec::new();
             // The last frame's lighting change, timed kernel by kernel.
             #[cfg(feature = "wgpu")]
             let mut profile = None;
@@ -116,6 +120,13 @@ pub fn bench_frame(
                     model.frame(&mut cache, &ts, &camera, map, turned, i + 1, sampling)?;
                 relight_waits = waits.zip(model.host_waits()).map(|(a, b)| b - a);
                 foreground = cache.foreground();
+                // Another, left on the device as the viewer leaves it.
+                if waits.is_some() && i > 0 {
+                    let lit = (map, turned + 5.0, i + 2);
+                    let (_, t) =
+                        model.frame_shown(&mut cache, &ts, &camera, lit, sampling, true)?;
+                    shown.push(t.total_ms());
+                }
                 #[cfg(feature = "wgpu")]
                 if opts.profile && i == opts.repeats {
                     profile = model.profile_relight(&cache)?;
@@ -139,6 +150,7 @@ pub fn bench_frame(
                 },
                 relight_ms: median(relights),
                 relight_waits,
+                relight_shown_ms: (!shown.is_empty()).then(|| median(shown)),
                 networks_on: model.networks_on(),
                 gbuffer_on: model.gbuffer_on(),
                 paths_on: model.paths_on(),

@@ -233,6 +233,13 @@ fn frame(a: BenchFrameArgs) -> Result<()> {
         if let Some(waits) = r.relight_waits {
             println!("  the host waited for the GPU {waits} time(s) in a lighting change");
         }
+        if let Some(ms) = r.relight_shown_ms {
+            println!(
+                "  a lighting change left on the device, as nprt view shows it (not read back): \
+                 {ms:.1} ms, {:.1} fps",
+                1e3 / ms
+            );
+        }
         #[cfg(feature = "wgpu")]
         if let Some(times) = &r.profile {
             print_kernel_times("a lighting change's kernels", times, r.relight_ms);

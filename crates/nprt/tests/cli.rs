@@ -476,6 +476,8 @@ fn bench_frame_times_every_stage_on_each_device() {
         let once = "the host waited for the GPU 1 time(s) in a lighting change";
         let expected = if device == "cpu" { 0 } else { 2 };
         assert_eq!(out.matches(once).count(), expected, "{out}");
+        let shown = "left on the device, as nprt view shows it";
+        assert_eq!(out.matches(shown).count(), 2 * expected, "{out}");
     }
 }
 
