@@ -94,6 +94,7 @@ fn export_writes_kernels_weights_and_a_worked_example_that_webgpu_runs() {
         tensor("track0.grid"),
         *host.tracks[0].grid.as_ref().unwrap()
     );
+    half_precision_kernels_and_weights(&out, &manifest, &tensor);
     assert_eq!(manifest["tracks"][1]["kind"], "specular");
     assert_eq!(manifest["tracks"][0]["width"], 9 + 16);
 
@@ -125,6 +126,76 @@ fn export_writes_kernels_weights_and_a_worked_example_that_webgpu_runs() {
         &["nowhere", "not a model folder"],
     );
     std::fs::remove_dir_all(&dir).unwrap();
+}
+
+/// The `--precision f16` kernels: WGSL, HLSL where naga writes it (not the tensor-core one),
+/// no GLSL (naga writes no f16 GLSL), each gap said in export.json; and every transport layer's
+/// weight in `weights_f16.bin` as the f32 weight rounded to f16, rows padded with zeros to a
+/// multiple of 16 values, then 16 rows of zeros.
+fn half_precision_kernels_and_weights(
+    out: &Path,
+    manifest: &Value,
+    f32_tensor: &dyn Fn(&str) -> Vec<f32>,
+) {
+    let kernels = manifest["kernels"].as_array().unwrap();
+    for (name, has_hlsl) in [
+        ("half_rows", true),
+        ("half_dense", true),
+        ("half_dense_coop", false),
+    ] {
+        let k = kernels.iter().find(|k| k["name"] == name).unwrap();
+        assert_eq!(k["precision"], "f16", "{k}");
+        assert!(out.join(format!("{name}.wgsl")).is_file());
+        assert!(k["glsl"].is_null() && k["glsl_missing"].is_string(), "{k}");
+        let hlsl = out.join(format!("{name}.hlsl"));
+        assert_eq!(hlsl.is_file(), has_hlsl, "{name}");
+        assert_eq!(k["hlsl"].is_null(), !has_hlsl, "{k}");
+        if has_hlsl {
+            assert!(std::fs::read_to_string(hlsl).unwrap().contains("half"));
+        }
+    }
+    let bytes = std::fs::read(out.join("weights_f16.bin")).unwrap();
+    let halves: Vec<u16> = bytes
+        .chunks_exact(2)
+        .map(|b| u16::from_le_bytes(b.try_into().unwrap()))
+        .collect();
+    let tensors = manifest["weights_f16"]["tensors"].as_array().unwrap();
+    // Two tracks of D/S: a transfer and a shading network each.
+    assert!(tensors.len() >= 8, "{tensors:?}");
+    let mut next = 0;
+    for t in tensors {
+        let dims = |key: &str| -> Vec<usize> {
+            t[key]
+                .as_array()
+                .unwrap()
+                .iter()
+                .map(|d| d.as_u64().unwrap() as usize)
+                .collect()
+        };
+        let (shape, weight_shape) = (dims("shape"), dims("weight_shape"));
+        let (&[rows, n_pad], &[d_in, d_out]) = (&shape[..], &weight_shape[..]) else {
+            panic!("{t}")
+        };
+        assert_eq!(
+            (rows, n_pad % 16, n_pad - d_out < 16),
+            (d_in + 16, 0, true),
+            "{t}"
+        );
+        assert_eq!(t["offset"].as_u64().unwrap() as usize, next, "{t}");
+        let weight = f32_tensor(t["name"].as_str().unwrap());
+        for i in 0..rows {
+            for j in 0..n_pad {
+                let got = halves[next + i * n_pad + j];
+                let want = match i < d_in && j < d_out {
+                    true => half::f16::from_f32(weight[i * d_out + j]).to_bits(),
+                    false => 0,
+                };
+                assert_eq!(got, want, "{t}: ({i}, {j})");
+            }
+        }
+        next += rows * n_pad;
+    }
+    assert_eq!(next, halves.len());
 }
 
 /// Serves `export` from localhost, opens its example page in headless Chromium with WebGPU on

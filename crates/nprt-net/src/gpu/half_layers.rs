@@ -41,20 +41,26 @@ pub enum Held<'a> {
     F16(&'a wgpu::Buffer),
 }
 
+/// `weight` (`d_in × d_out`, row-major) as the f16 bits [`HalfWeight`] holds: `d_in + 16` rows
+/// of `pad16(d_out)` values, zeros past the weight's (what `nprt export` writes too).
+pub fn half_weight_bits(weight: &[f32], d_in: usize, d_out: usize) -> Vec<u16> {
+    let n_pad = pad16(d_out);
+    let mut padded = vec![0u16; (d_in + 16) * n_pad];
+    for (row, values) in padded.chunks_mut(n_pad).zip(weight.chunks(d_out)) {
+        for (h, &v) in row.iter_mut().zip(values) {
+            *h = half::f16::from_f32(v).to_bits();
+        }
+    }
+    padded
+}
+
 impl GpuDevice {
     /// `weight` (`d_in × d_out`) in the layout [`HalfWeight`] describes.
     pub fn upload_half_weight(&self, weight: &[f32], d_in: usize, d_out: usize) -> HalfWeight {
-        let n_pad = pad16(d_out);
-        let mut padded = vec![0u16; (d_in + 16) * n_pad];
-        for (row, values) in padded.chunks_mut(n_pad).zip(weight.chunks(d_out)) {
-            for (h, &v) in row.iter_mut().zip(values) {
-                *h = half::f16::from_f32(v).to_bits();
-            }
-        }
         HalfWeight {
-            buffer: self.upload(&padded),
+            buffer: self.upload(&half_weight_bits(weight, d_in, d_out)),
             d_out,
-            n_pad,
+            n_pad: pad16(d_out),
         }
     }
 

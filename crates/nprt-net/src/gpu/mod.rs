@@ -26,7 +26,7 @@ pub use codes::{activation_code, kind_code, loss_code};
 pub use device_dataset::DeviceDataset;
 pub use gpu_device::GpuDevice;
 pub use gpu_trainer::GpuTrainer;
-pub use half_layers::{held_halves, pad16, HalfWeight, Held, HALF_ROW_BLOCK};
+pub use half_layers::{half_weight_bits, held_halves, pad16, HalfWeight, Held, HALF_ROW_BLOCK};
 pub use kernel::{groups_for, Bind, Dispatch, KernelSource, Part, GROUP};
 pub use kernel_steps::KernelSteps;
 pub use kernel_timer::KernelTime;

@@ -1,7 +1,9 @@
 //! `nprt export`: a trained model in the form an engine runs it. The frame path's WGSL kernels
 //! as the viewer runs them, validated and translated to GLSL (4.30 compute) and HLSL (shader
-//! model 5.1) by naga; every weight, little-endian f32, in one `weights.bin`; and
-//! `export.json`, which says where each tensor lies, how the networks are wired and how a
+//! model 5.1) by naga, with the half-precision ones (`--precision f16`) where naga can
+//! translate them; every weight, little-endian f32, in one `weights.bin`, and the transport
+//! networks' weights again as f16 in the half-precision kernels' layout, `weights_f16.bin`;
+//! and `export.json`, which says where each tensor lies, how the networks are wired and how a
 //! frame runs them (docs/export.md).
 
 use std::path::{Path, PathBuf};
@@ -14,11 +16,13 @@ use nprt_net::{gbuffer_features, load_model, Device, LightInput, FEATURES, TRANS
 use nprt_trace::{render_gbuffer, TraceScene};
 use serde_json::{json, Value};
 
-use super::kernels::SOURCES;
+use nprt_net::gpu::{half_weight_bits, pad16, KernelSource};
+
+use super::kernels::{HALF_SOURCES, SOURCES};
 use crate::{CameraPath, Relighter};
 
 /// Version of the export's layout, bumped whenever a reader would read it differently.
-pub const EXPORT_VERSION: u32 = 1;
+pub const EXPORT_VERSION: u32 = 2;
 
 /// The worked example's view: the model's scene from the start of `nprt render`'s default
 /// camera path, at this size, under this lighting.
@@ -44,11 +48,14 @@ const EXAMPLE_PAGE: [(&str, &str); 2] = [
 ];
 
 /// The weights in file order, each tensor recorded in `export.json` by name, offset (in f32
-/// values) and shape.
+/// values) and shape; and the transport networks' weights as f16 in the half-precision
+/// layout, recorded the same way (offsets in f16 values).
 #[derive(Default)]
 struct WeightFile {
     values: Vec<f32>,
     tensors: Vec<Value>,
+    halves: Vec<u16>,
+    half_tensors: Vec<Value>,
 }
 
 impl WeightFile {
@@ -72,9 +79,25 @@ impl WeightFile {
         })
     }
 
+    /// A transport layer's weight as f16, `d_in + 16` rows of `pad16(d_out)` values.
+    fn half_weight(&mut self, name: &str, d: &Dense) {
+        let bits = half_weight_bits(&d.weight, d.d_in, d.d_out);
+        self.half_tensors.push(json!({
+            "name": name,
+            "offset": self.halves.len(),
+            "shape": [d.d_in + 16, pad16(d.d_out)],
+            "weight_shape": [d.d_in, d.d_out],
+        }));
+        self.halves.extend(bits);
+    }
+
     fn mlp(&mut self, name: &str, m: &DenseStack) -> Value {
         let layers: Vec<Value> = (m.layers.iter().enumerate())
-            .map(|(i, l)| self.dense(&format!("{name}.{i}"), l))
+            .map(|(i, l)| {
+                let name = format!("{name}.{i}");
+                self.half_weight(&format!("{name}.weight"), l);
+                self.dense(&name, l)
+            })
             .collect();
         json!({ "hidden_activation": m.activation.to_string(), "layers": layers })
     }
@@ -95,18 +118,11 @@ pub fn export_model(model_dir: &Path, out: &Path, view: &ExampleView) -> Result<
         Ok(())
     };
     let mut kernels = Vec::new();
-    for k in &SOURCES {
-        let (glsl, hlsl) = translate(k.wgsl).with_context(|| format!("kernel {}", k.name))?;
-        write(&format!("{}.wgsl", k.name), k.wgsl.as_bytes())?;
-        write(&format!("{}.comp.glsl", k.name), glsl.as_bytes())?;
-        write(&format!("{}.hlsl", k.name), hlsl.as_bytes())?;
-        kernels.push(json!({
-            "name": k.name,
-            "wgsl": format!("{}.wgsl", k.name),
-            "glsl": format!("{}.comp.glsl", k.name),
-            "hlsl": format!("{}.hlsl", k.name),
-            "entry_point": "main",
-        }));
+    let all = SOURCES.iter().map(|k| (k, false));
+    for (k, half) in all.chain(HALF_SOURCES.iter().map(|k| (k, true))) {
+        kernels.push(
+            export_kernel(k, half, &mut write).with_context(|| format!("kernel {}", k.name))?,
+        );
     }
 
     let mut weights = WeightFile::default();
@@ -152,6 +168,14 @@ pub fn export_model(model_dir: &Path, out: &Path, view: &ExampleView) -> Result<
             .flat_map(|v| v.to_le_bytes())
             .collect::<Vec<u8>>(),
     )?;
+    write(
+        "weights_f16.bin",
+        &weights
+            .halves
+            .iter()
+            .flat_map(|v| v.to_le_bytes())
+            .collect::<Vec<u8>>(),
+    )?;
     let config = &file.config;
     let manifest = json!({
         "format": "nprt-export",
@@ -168,6 +192,12 @@ pub fn export_model(model_dir: &Path, out: &Path, view: &ExampleView) -> Result<
         "tracks": tracks,
         "kernels": kernels,
         "weights": { "file": "weights.bin", "dtype": "f32le", "tensors": weights.tensors },
+        "weights_f16": {
+            "file": "weights_f16.bin",
+            "dtype": "f16le",
+            "layout": "each transport layer's weight (d_in × d_out, row-major) with every row padded by zeros to a multiple of 16 values, then 16 rows of zeros: what half_dense and half_dense_coop read; biases stay f32 in weights.bin",
+            "tensors": weights.half_tensors,
+        },
     });
     write(
         "export.json",
@@ -269,17 +299,62 @@ fn example(model_dir: &Path, file: &nprt_net::ModelFile, view: &ExampleView) -> 
     ]))
 }
 
-/// `wgsl` validated and translated to GLSL 4.30 and HLSL 5.1.
-pub fn translate(wgsl: &str) -> Result<(String, String)> {
+/// Writes kernel `k` (WGSL) and its translations, and says in export.json where they are. A
+/// half-precision kernel (`half`) is translated where naga can (naga 30 writes no f16 GLSL,
+/// nor cooperative matrices in HLSL); the manifest says why one is missing. An f32 kernel must
+/// translate.
+fn export_kernel(
+    k: &KernelSource,
+    half: bool,
+    write: &mut impl FnMut(&str, &[u8]) -> Result<()>,
+) -> Result<Value> {
+    let caps = match half {
+        true => {
+            naga::valid::Capabilities::SHADER_FLOAT16
+                | naga::valid::Capabilities::COOPERATIVE_MATRIX
+        }
+        false => naga::valid::Capabilities::empty(),
+    };
+    let [glsl, hlsl] = translate(k.wgsl, caps)?;
+    write(&format!("{}.wgsl", k.name), k.wgsl.as_bytes())?;
+    let mut entry = json!({
+        "name": k.name,
+        "precision": if half { "f16" } else { "f32" },
+        "wgsl": format!("{}.wgsl", k.name),
+        "entry_point": "main",
+    });
+    for (language, file, text) in [
+        ("glsl", format!("{}.comp.glsl", k.name), glsl),
+        ("hlsl", format!("{}.hlsl", k.name), hlsl),
+    ] {
+        match text {
+            Ok(text) => {
+                write(&file, text.as_bytes())?;
+                entry[language] = json!(file);
+            }
+            Err(why) if half => {
+                entry[language] = Value::Null;
+                entry[format!("{language}_missing")] =
+                    json!(format!("naga cannot write it: {why}"));
+            }
+            Err(why) => bail!("naga cannot write its {language}: {why}"),
+        }
+    }
+    Ok(entry)
+}
+
+/// `wgsl` validated with `caps`, then its GLSL (4.30 compute, bindings as in WGSL) and HLSL
+/// translations, each or why naga could not write it.
+pub fn translate(
+    wgsl: &str,
+    caps: naga::valid::Capabilities,
+) -> Result<[std::result::Result<String, String>; 2]> {
     use naga::back::{glsl, hlsl};
     let module = naga::front::wgsl::parse_str(wgsl)
         .map_err(|e| anyhow::anyhow!("{}", e.emit_to_string(wgsl)))?;
-    let info = naga::valid::Validator::new(
-        naga::valid::ValidationFlags::all(),
-        naga::valid::Capabilities::empty(),
-    )
-    .validate(&module)
-    .map_err(|e| anyhow::anyhow!("{}", e.emit_to_string(wgsl)))?;
+    let info = naga::valid::Validator::new(naga::valid::ValidationFlags::all(), caps)
+        .validate(&module)
+        .map_err(|e| anyhow::anyhow!("{}", e.emit_to_string(wgsl)))?;
     let mut glsl_text = String::new();
     // Explicit `layout(binding = N)`, N the WGSL binding, so that an engine binds the GLSL
     // kernels exactly as the WGSL ones (HLSL's registers follow the bindings already).
@@ -299,18 +374,23 @@ pub fn translate(wgsl: &str) -> Result<(String, String)> {
         entry_point: "main".into(),
         multiview: None,
     };
-    glsl::Writer::new(
+    let glsl = glsl::Writer::new(
         &mut glsl_text,
         &module,
         &info,
         &options,
         &pipeline,
         Default::default(),
-    )?
-    .write()?;
+    )
+    .and_then(|mut w| w.write())
+    .map(|_| glsl_text)
+    .map_err(|e| format!("{e:?}"));
     let mut hlsl_text = String::new();
     let options = hlsl::Options::default();
     let pipeline = hlsl::PipelineOptions { entry_point: None };
-    hlsl::Writer::new(&mut hlsl_text, &options, &pipeline).write(&module, &info, None)?;
-    Ok((glsl_text, hlsl_text))
+    let hlsl = hlsl::Writer::new(&mut hlsl_text, &options, &pipeline)
+        .write(&module, &info, None)
+        .map(|_| hlsl_text)
+        .map_err(|e| format!("{e:?}"));
+    Ok([glsl, hlsl])
 }
