@@ -8,7 +8,8 @@
 #      time in a step) per design beside PyTorch on CUDA, eager and torch.compile, each in f32
 #      and bf16 autocast (the fastest is the peer), at batch 16,384 and 262,144;
 #   2. the paper's schedule (3000 views of 256², 500 epochs) projected from those rates;
-#   3. `nprt bench frame` (G-buffer, encoder, networks, direct light traced on the GPU, total)
+#   3. `nprt bench frame --profile` (G-buffer, encoder, networks, direct light traced on the GPU,
+#      total; each kernel of a lighting change)
 #      per design, and D/S with 16 spp of traced direct light, at 512² and 1920×1080
 #      on the GPU kernels, in f32 and in f16 (tensor cores where the adapter has them),
 #      beside the paper's Table 3;
@@ -124,7 +125,7 @@ end_section
 log "frame timings"
 section "Frame ms (nprt bench frame --device wgpu); the paper's Table 3 (RTX 3090, 512²): encoder 0.34 ms, networks 9.7-16 ms"
 "$nprt" bench frame --device wgpu --arch "$designs" --res "$res" --repeats 10 --precision f32,f16 \
-  >>"$summary"
+  --profile >>"$summary"
 end_section
 
 # 4. KITCHEN: 10 minutes of training on the GPU against 10 on the CPU.

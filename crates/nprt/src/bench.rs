@@ -233,11 +233,12 @@ fn frame(a: BenchFrameArgs) -> Result<()> {
         if let Some(waits) = r.relight_waits {
             println!("  the host waited for the GPU {waits} time(s) in a lighting change");
         }
-        if let Some(ms) = r.relight_shown_ms {
+        if let Some([frame, change]) = r.shown_ms {
             println!(
-                "  a lighting change left on the device, as nprt view shows it (not read back): \
-                 {ms:.1} ms, {:.1} fps",
-                1e3 / ms
+                "  left on the device, as nprt view shows it (not read back): a new viewpoint \
+                 {frame:.1} ms ({:.1} fps), a lighting change {change:.1} ms ({:.1} fps)",
+                1e3 / frame,
+                1e3 / change
             );
         }
         #[cfg(feature = "wgpu")]

@@ -635,16 +635,18 @@ impl GpuNetwork {
         list
     }
 
-    /// The GPU time of each kernel of a lighting change on `px` under `code` (the encoder's
-    /// at the last input width and what [`Self::radiance`] runs before the background), each
+    /// The GPU time of each kernel of a lighting change on `px` under `code` (the last map's
+    /// input and the encoder's at the last width, and what [`Self::radiance`] runs before the
+    /// background), each
     /// dispatch timed in a pass of its own: `nprt bench frame --profile`. An error where the
     /// adapter has no timestamp queries.
     pub fn profile_relight(&self, px: &GpuPixels, code: &GpuLightCode) -> Result<Vec<KernelTime>> {
         let mut encoder = self.gpu.device.create_command_encoder(&Default::default());
         self.use_light(&mut encoder, code);
         self.gpu.queue.submit([encoder.finish()]);
-        let run = self.encoder.kept();
-        let encoding = run.iter().flat_map(|r| &r.dispatches);
+        let (input, run) = (self.inputs.kept(), self.encoder.kept());
+        let encoding = input.iter().flat_map(|i| i.dispatches());
+        let encoding = encoding.chain(run.iter().flat_map(|r| &r.dispatches));
         let dispatches: Vec<&Dispatch> = encoding.chain(self.relight_dispatches(px)).collect();
         self.gpu.profile(&dispatches)
     }

@@ -98,6 +98,11 @@ impl GpuLightInput {
         }
     }
 
+    /// The dispatches that make the input from its map (none for an uploaded input).
+    pub(super) fn dispatches(&self) -> &[Dispatch] {
+        &self.made
+    }
+
     /// A pre-processed map uploaded as it is (the encoder's input made on the host).
     pub fn upload(gpu: &GpuDevice, input: &LightInput) -> Self {
         GpuLightInput {
