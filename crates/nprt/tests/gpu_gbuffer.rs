@@ -39,7 +39,8 @@ fn differences(gpu: &GBuffer, cpu: &GBuffer) -> Vec<f32> {
     d
 }
 
-/// Every view of `scene` rasterised and traced. Where the two see the same point they agree
+/// Every view of `scene` rasterised (each into the buffer the last one handed back) and traced.
+/// Where the two see the same point they agree
 /// to f32 rounding; they part where a pixel centre falls on an edge, so that each takes a
 /// neighbour (a silhouette, a uv seam), or where rounding moves a lookup across a texel
 /// boundary, at which a bump map's bilinear gradient jumps. So: at most `share` of the pixels

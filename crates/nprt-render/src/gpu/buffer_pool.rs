@@ -1,7 +1,8 @@
 //! Storage buffers a camera's pixels hand back when they are dropped, for the next viewpoint's
-//! pixels of the same size: a new viewpoint then reuses the features, ŝ and frame buffers the
-//! last one had instead of allocating them (and having wgpu zero them) anew; on an H200,
-//! allocating a 512² frame's activations anew for every viewpoint cost more than its networks.
+//! pixels of the same size: a new viewpoint then reuses the G-buffer, features, ŝ and frame
+//! buffers the last one had instead of allocating them (and having wgpu zero them) anew; on an
+//! H200, allocating a 512² frame's activations anew for every viewpoint cost more than its
+//! networks.
 
 use std::sync::{Arc, Mutex};
 
@@ -32,5 +33,33 @@ impl BufferPool {
         kept.extend(buffers);
         let over = kept.len().saturating_sub(KEPT);
         kept.drain(..over);
+    }
+
+    /// [`Self::take`], given back when the buffer is dropped.
+    pub fn take_pooled(&self, gpu: &GpuDevice, floats: usize) -> PooledBuffer {
+        PooledBuffer {
+            buffer: self.take(gpu, floats),
+            pool: self.clone(),
+        }
+    }
+}
+
+/// A buffer taken from a [`BufferPool`], handed back to it when dropped.
+pub struct PooledBuffer {
+    buffer: wgpu::Buffer,
+    pool: BufferPool,
+}
+
+impl std::ops::Deref for PooledBuffer {
+    type Target = wgpu::Buffer;
+
+    fn deref(&self) -> &wgpu::Buffer {
+        &self.buffer
+    }
+}
+
+impl Drop for PooledBuffer {
+    fn drop(&mut self) {
+        self.pool.give([self.buffer.clone()]);
     }
 }

@@ -26,6 +26,7 @@ mod path_tracer;
 mod raster_gbuffer;
 mod shader_export;
 
+pub use buffer_pool::PooledBuffer;
 pub use frame_background::{Background, Fill};
 pub use gpu_network::{GpuNetwork, GpuPixels};
 pub(crate) use kept_last::KeptLast;

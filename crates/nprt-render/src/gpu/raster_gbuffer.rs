@@ -13,6 +13,7 @@ use nprt_scene::Camera;
 use nprt_trace::{GBuffer, GSample, TraceScene};
 use wgpu::util::DeviceExt;
 
+use super::buffer_pool::{BufferPool, PooledBuffer};
 use super::frame_background::GpuMap;
 use super::gpu_scene::GpuScene;
 
@@ -43,6 +44,8 @@ pub struct RasterGBuffer {
     visibility: wgpu::RenderPipeline,
     /// The last frame size's targets, reused while the size holds.
     targets: Mutex<Option<Targets>>,
+    /// G-buffers dropped, for the next viewpoint's of the same size.
+    pool: BufferPool,
 }
 
 /// What one frame size needs: the kept triangle per pixel and its depth.
@@ -107,6 +110,7 @@ impl RasterGBuffer {
             gpu,
             visibility,
             targets: Mutex::new(None),
+            pool: BufferPool::default(),
         })
     }
 
@@ -150,7 +154,7 @@ impl RasterGBuffer {
 
     /// The G-buffer of `camera`'s pixel centres on the device: GSample's fields, 17 f32 per
     /// pixel in row order, in a buffer of its own (queued; later submissions may read it).
-    pub fn samples(&self, camera: &Camera) -> Result<wgpu::Buffer> {
+    pub fn samples(&self, camera: &Camera) -> Result<PooledBuffer> {
         let gpu = &*self.gpu;
         let pixels = (camera.width * camera.height) as usize;
         gpu.check_binding(
@@ -189,7 +193,7 @@ impl RasterGBuffer {
             .collect::<Vec<_>>(),
         });
         let visible = TextureBinding(targets.visible.create_view(&Default::default()));
-        let samples = gpu.buffer(pixels * SAMPLE_FLOATS);
+        let samples = self.pool.take_pooled(gpu, pixels * SAMPLE_FLOATS);
         let mut encoder = gpu.device.create_command_encoder(&Default::default());
         {
             let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
@@ -235,7 +239,7 @@ impl RasterGBuffer {
                     &scene.materials,
                     &scene.textures,
                     &scene.bitmaps,
-                    &samples,
+                    &*samples,
                 ],
                 [camera.width.div_ceil(8), camera.height.div_ceil(8)],
             );
