@@ -137,7 +137,7 @@ impl RasterGBuffer {
             12 * pixels,
             &format!("a {}×{} traced frame", camera.width, camera.height),
         )?;
-        let rgb = gpu.buffer(3 * pixels);
+        let rgb = self.pooled(3 * pixels);
         let mut encoder = gpu.device.create_command_encoder(&Default::default());
         {
             let mut pass = encoder.begin_compute_pass(&Default::default());

@@ -44,7 +44,7 @@ pub struct RasterGBuffer {
     visibility: wgpu::RenderPipeline,
     /// The last frame size's targets, reused while the size holds.
     targets: Mutex<Option<Targets>>,
-    /// G-buffers dropped, for the next viewpoint's of the same size.
+    /// G-buffers and traced frames dropped, for the next of the same size.
     pool: BufferPool,
 }
 
@@ -127,6 +127,12 @@ impl RasterGBuffer {
         self.scene.has_bvh()
     }
 
+    /// A buffer of `floats` f32 a dropped G-buffer or traced frame of that size handed back,
+    /// or a new one.
+    pub(crate) fn pooled(&self, floats: usize) -> PooledBuffer {
+        self.pool.take_pooled(&self.gpu, floats)
+    }
+
     pub(crate) fn maps(&self) -> &GpuMap {
         &self.maps
     }
@@ -193,7 +199,7 @@ impl RasterGBuffer {
             .collect::<Vec<_>>(),
         });
         let visible = TextureBinding(targets.visible.create_view(&Default::default()));
-        let samples = self.pool.take_pooled(gpu, pixels * SAMPLE_FLOATS);
+        let samples = self.pooled(pixels * SAMPLE_FLOATS);
         let mut encoder = gpu.device.create_command_encoder(&Default::default());
         {
             let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
