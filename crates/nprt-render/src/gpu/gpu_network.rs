@@ -88,6 +88,9 @@ pub struct GpuNetwork {
     encoder: KeptLast<usize, Arc<EncoderRun>>,
     /// The last map's input dispatches, by map, input width and normalisation.
     inputs: KeptLast<(SameTexels, usize, MapNorm), Arc<GpuLightInput>>,
+    /// Held from writing a rotation into the kept input's parameters to the submission that
+    /// reads it: two lightings made at once would otherwise both read the later one's.
+    encoding: Mutex<()>,
     /// Tells the pixels this network made from another's (their kept dispatches read its
     /// buffers).
     id: u64,
@@ -225,6 +228,7 @@ impl GpuNetwork {
                 .collect(),
             encoder: KeptLast::default(),
             inputs: KeptLast::default(),
+            encoding: Mutex::new(()),
             id: NETWORKS.fetch_add(1, Ordering::Relaxed),
             convs,
             to_code: dense(&encoder.to_code),
@@ -311,6 +315,7 @@ impl GpuNetwork {
         let input = self.inputs.get(key, || {
             Arc::new(GpuLightInput::for_map(gpu, &self.map, map, width, norm))
         });
+        let _one_at_a_time = self.encoding.lock().unwrap_or_else(|e| e.into_inner());
         let mut encoder = gpu.device.create_command_encoder(&Default::default());
         input.record(gpu, &mut encoder, map, rotation_deg);
         let code = self.record_code(&mut encoder, &input);
@@ -637,9 +642,8 @@ impl GpuNetwork {
 
     /// The GPU time of each kernel of a lighting change on `px` under `code` (the last map's
     /// input and the encoder's at the last width, and what [`Self::radiance`] runs before the
-    /// background), each
-    /// dispatch timed in a pass of its own: `nprt bench frame --profile`. An error where the
-    /// adapter has no timestamp queries.
+    /// background), each dispatch timed in a pass of its own: `nprt bench frame --profile`. An
+    /// error where the adapter has no timestamp queries.
     pub fn profile_relight(&self, px: &GpuPixels, code: &GpuLightCode) -> Result<Vec<KernelTime>> {
         let mut encoder = self.gpu.device.create_command_encoder(&Default::default());
         self.use_light(&mut encoder, code);
