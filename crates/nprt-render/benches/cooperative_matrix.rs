@@ -2,9 +2,14 @@
 //! and B f16, C f32, on wgpu's cooperative matrices (16 × 16 × 16 f16 products into f32),
 //! with four subgroups of 32 a workgroup, each computing TM × TN tiles, read straight from
 //! storage or staged through workgroup memory first (from f16, or from f32 converted), at a
-//! square size and at the frame's shapes (262,144 rows, 256 and 192 wide). Each variant's
-//! result is checked against the host at a few entries. Prints the adapter's cooperative
-//! matrix configurations first; where it has none, it stops there.
+//! square size and at the frame's shapes (262,144 rows, 256 and 192 wide). Then the two other
+//! products a training step on tensor cores would run (docs/model.md, "Not yet done"), read
+//! straight from storage: a layer's input gradient dz·Wᵀ, W read as stored (d_in × d_out) by
+//! column-major loads; and its weight gradient xᵀ·dz over a batch of 262,144 rows, x read as
+//! stored (rows × d_in) by column-major loads and the rows split into 32 chunks, each
+//! workgroup's sum written apart for a column sum to add. Each variant's result is checked
+//! against the host at a few entries. Prints the adapter's cooperative matrix configurations
+//! first; where it has none, it stops there.
 //!
 //! cargo bench -p nprt-render --features wgpu --bench cooperative_matrix [-- --validate]
 //!
@@ -12,15 +17,31 @@
 //! needs no GPU. On one H200 (driver 580.159.04, 2026-11-26), straight from storage, 4 × 4 tiles
 //! a subgroup ran 75.7 TFLOP/s at 4096³ and 59.6 at 262,144 × 256 × 256 (2 × 2: 38.3 and 35.1);
 //! staged through workgroup memory, 9.8–18.4; at 262,144 × 192 × 192 the best was 23.5
-//! (docs/export.md, "Half precision").
+//! (docs/export.md, "Half precision"). The training products have not yet run on a GPU.
 
 use std::time::Instant;
 
 use wgpu::util::DeviceExt;
 
+/// How a product's operands are stored: A as m × k row-major, or (`a_t`) as its transpose,
+/// k × m; B as k × n, or (`b_t`) n × k; and the chunks k is split into, each chunk's C written
+/// apart (`chunks` × m × n).
+#[derive(Clone, Copy)]
+struct Layout {
+    a_t: bool,
+    b_t: bool,
+    chunks: usize,
+}
+
+const PLAIN: Layout = Layout {
+    a_t: false,
+    b_t: false,
+    chunks: 1,
+};
+
 /// `src`: "direct" (coopLoad from f16 storage), "f16" (staged from f16 storage), "f32" (staged
-/// from f32 storage, converted).
-fn shader(tm: usize, tn: usize, src: &str) -> String {
+/// from f32 storage, converted); staged variants take the plain layout only.
+fn shader(tm: usize, tn: usize, src: &str, layout: Layout) -> String {
     let wm = 2 * tm * 16;
     let wn = 2 * tn * 16;
     let staged = src != "direct";
@@ -29,7 +50,7 @@ fn shader(tm: usize, tn: usize, src: &str) -> String {
          @group(0) @binding(0) var<storage, read> a: array<f16>;\n\
          @group(0) @binding(1) var<storage, read> b: array<f16>;\n\
          @group(0) @binding(2) var<storage, read_write> c: array<f32>;\n\
-         struct P { m: u32, n: u32, k: u32, pad: u32 }\n\
+         struct P { m: u32, n: u32, k: u32, kc: u32 }\n\
          @group(0) @binding(3) var<uniform> p: P;\n\
          @group(0) @binding(4) var<storage, read> af: array<f32>;\n\
          @group(0) @binding(5) var<storage, read> bf: array<f32>;\n",
@@ -42,7 +63,7 @@ fn shader(tm: usize, tn: usize, src: &str) -> String {
         );
     }
     s += "@compute @workgroup_size(128)\nfn main(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_index) li: u32) {\n";
-    s += "  let sg = li / 32u;\n  let ldc = p.n;\n";
+    s += "  let sg = li / 32u;\n  let ldc = p.n;\n  let c0 = wg.z * p.m * p.n;\n";
     s += &format!("  let row0 = wg.y * {wm}u + (sg / 2u) * {}u;\n  let col0 = wg.x * {wn}u + (sg % 2u) * {}u;\n", tm * 16, tn * 16);
     s += &format!(
         "  let lr0 = (sg / 2u) * {}u;\n  let lc0 = (sg % 2u) * {}u;\n",
@@ -55,7 +76,7 @@ fn shader(tm: usize, tn: usize, src: &str) -> String {
         }
     }
     let kstep = if staged { 32 } else { 16 };
-    s += &format!("  for (var k = 0u; k < p.k; k += {kstep}u) {{\n");
+    s += &format!("  for (var k = wg.z * p.kc; k < (wg.z + 1u) * p.kc; k += {kstep}u) {{\n");
     if staged {
         let (ra, rb) = if src == "f32" {
             ("f16(af", "f16(bf")
@@ -80,14 +101,19 @@ fn shader(tm: usize, tn: usize, src: &str) -> String {
         }
         s += "    workgroupBarrier();\n";
     } else {
+        // coopLoadT reads a row-major tile, coopLoad a column-major one: a transposed operand
+        // is its stored matrix's tile read column-major.
         for i in 0..tm {
-            s += &format!("    let a{i} = coopLoadT<coop_mat16x16<f16, A>>(&a[(row0 + {}u) * p.k + k], p.k);\n", i * 16);
+            s += &match layout.a_t {
+                false => format!("    let a{i} = coopLoadT<coop_mat16x16<f16, A>>(&a[(row0 + {}u) * p.k + k], p.k);\n", i * 16),
+                true => format!("    let a{i} = coopLoad<coop_mat16x16<f16, A>>(&a[k * p.m + row0 + {}u], p.m);\n", i * 16),
+            };
         }
         for j in 0..tn {
-            s += &format!(
-                "    let b{j} = coopLoadT<coop_mat16x16<f16, B>>(&b[k * p.n + col0 + {}u], p.n);\n",
-                j * 16
-            );
+            s += &match layout.b_t {
+                false => format!("    let b{j} = coopLoadT<coop_mat16x16<f16, B>>(&b[k * p.n + col0 + {}u], p.n);\n", j * 16),
+                true => format!("    let b{j} = coopLoad<coop_mat16x16<f16, B>>(&b[(col0 + {}u) * p.k + k], p.k);\n", j * 16),
+            };
         }
         for i in 0..tm {
             for j in 0..tn {
@@ -101,7 +127,7 @@ fn shader(tm: usize, tn: usize, src: &str) -> String {
     for i in 0..tm {
         for j in 0..tn {
             // naga 30's SPIR-V writer needs the stored matrix and the offset bound by `let`.
-            s += &format!("  let r{i}{j} = c{i}{j};\n  let o{i}{j} = (row0 + {}u) * ldc + col0 + {}u;\n  coopStoreT(r{i}{j}, &c[o{i}{j}], ldc);\n", i * 16, j * 16);
+            s += &format!("  let r{i}{j} = c{i}{j};\n  let o{i}{j} = c0 + (row0 + {}u) * ldc + col0 + {}u;\n  coopStoreT(r{i}{j}, &c[o{i}{j}], ldc);\n", i * 16, j * 16);
         }
     }
     s += "}\n";
@@ -118,31 +144,83 @@ const VARIANTS: [(usize, usize, &str); 7] = [
     (4, 4, "f32"),
 ];
 
+/// A training step's products on tensor cores: the name, the layout, and C's shapes
+/// `[m, n, k]`.
+const TRAINING: [(&str, Layout, [[usize; 3]; 2]); 2] = [
+    (
+        "dz·Wt",
+        Layout {
+            a_t: false,
+            b_t: true,
+            chunks: 1,
+        },
+        [[262_144, 256, 256], [262_144, 192, 192]],
+    ),
+    (
+        "xt·dz",
+        Layout {
+            a_t: true,
+            b_t: false,
+            chunks: 32,
+        },
+        [[256, 256, 262_144], [192, 192, 262_144]],
+    ),
+];
+
 fn main() {
+    let direct = [(2, 2), (4, 2), (4, 4)];
     if std::env::args().any(|a| a == "--validate") {
         for (tm, tn, v) in VARIANTS {
-            let words = spirv_words(&shader(tm, tn, v));
+            let words = spirv_words(&shader(tm, tn, v, PLAIN));
             println!("{tm}x{tn} {v}: valid, {words} SPIR-V words");
+        }
+        for (name, layout, _) in TRAINING {
+            for (tm, tn) in direct {
+                let words = spirv_words(&shader(tm, tn, "direct", layout));
+                println!("{name} {tm}x{tn}: valid, {words} SPIR-V words");
+            }
         }
         return;
     }
     let Some((device, queue)) = open_device() else {
         return;
     };
+    let fits = |[m, n]: [usize; 2], tm: usize, tn: usize| m % (32 * tm) == 0 && n % (32 * tn) == 0;
     for [m, n, k] in [[4096, 4096, 4096], [262_144, 256, 256], [262_144, 192, 192]] {
-        let product = Product::new(&device, [m, n, k]);
+        let product = Product::new(&device, [m, n, k], PLAIN);
         for (tm, tn, v) in VARIANTS
             .into_iter()
-            .filter(|&(_, tn, _)| n % (32 * tn) == 0)
+            .filter(|&(tm, tn, _)| fits([m, n], tm, tn))
         {
-            match product.time(&device, &queue, &shader(tm, tn, v), [tm, tn]) {
-                Ok((ms, worst)) => println!(
-                    "{m}x{n}x{k} {tm}x{tn} {v}: {ms:.3} ms, {:.1} TFLOP/s, worst error {worst}",
-                    2.0 * (m * n * k) as f64 / ms / 1e9
-                ),
-                Err(e) => println!("{m}x{n}x{k} {tm}x{tn} {v}: {e}"),
+            let result = product.time(&device, &queue, &shader(tm, tn, v, PLAIN), [tm, tn]);
+            report(&format!("{m}x{n}x{k} {tm}x{tn} {v}"), [m, n, k], result);
+        }
+    }
+    for (name, layout, shapes) in TRAINING {
+        for [m, n, k] in shapes {
+            let product = Product::new(&device, [m, n, k], layout);
+            for (tm, tn) in direct.into_iter().filter(|&(tm, tn)| fits([m, n], tm, tn)) {
+                let wgsl = shader(tm, tn, "direct", layout);
+                let result = product.time(&device, &queue, &wgsl, [tm, tn]);
+                let chunks = layout.chunks;
+                report(
+                    &format!("{name} {m}x{n}x{k} ({chunks} chunks of k) {tm}x{tn}"),
+                    [m, n, k],
+                    result,
+                );
             }
         }
+    }
+}
+
+/// One variant's line: its time and rate, or why it did not run.
+fn report(what: &str, [m, n, k]: [usize; 3], result: Result<(f64, f32), String>) {
+    match result {
+        Ok((ms, worst)) => println!(
+            "{what}: {ms:.3} ms, {:.1} TFLOP/s, worst error {worst}",
+            2.0 * (m * n * k) as f64 / ms / 1e9
+        ),
+        Err(e) => println!("{what}: {e}"),
     }
 }
 
@@ -197,16 +275,18 @@ fn open_device() -> Option<(wgpu::Device, wgpu::Queue)> {
     futures_lite::future::block_on(adapter.request_device(&descriptor)).ok()
 }
 
-/// One product's operands on the device (f16 and f32 copies), its output and its readback.
+/// One product's operands on the device as `layout` stores them (f16 and f32 copies), its
+/// output (a block per chunk of k) and its readback.
 struct Product {
     shape: [usize; 3],
+    layout: Layout,
     host: [Vec<f32>; 2],
     buffers: [wgpu::Buffer; 6],
     read: wgpu::Buffer,
 }
 
 impl Product {
-    fn new(device: &wgpu::Device, [m, n, k]: [usize; 3]) -> Self {
+    fn new(device: &wgpu::Device, [m, n, k]: [usize; 3], layout: Layout) -> Self {
         // Multiples of 1/8 in [-1, 1]: exact in f16, so every variant's sums are exact too.
         let mut seed = 1u32;
         let mut values = |count: usize| -> Vec<f32> {
@@ -231,7 +311,7 @@ impl Product {
                 .collect()
         };
         let storage = wgpu::BufferUsages::STORAGE;
-        let bytes = (m * n * 4) as u64;
+        let bytes = (layout.chunks * m * n * 4) as u64;
         let output = |usage| {
             device.create_buffer(&wgpu::BufferDescriptor {
                 label: None,
@@ -245,7 +325,7 @@ impl Product {
             init(bytemuck::cast_slice(&half(&host[1])), storage),
             output(storage | wgpu::BufferUsages::COPY_SRC),
             init(
-                bytemuck::cast_slice(&[m as u32, n as u32, k as u32, 0]),
+                bytemuck::cast_slice(&[m, n, k, k / layout.chunks].map(|v| v as u32)),
                 wgpu::BufferUsages::UNIFORM,
             ),
             init(bytemuck::cast_slice(&host[0]), storage),
@@ -254,6 +334,7 @@ impl Product {
         let read = output(wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST);
         Product {
             shape: [m, n, k],
+            layout,
             host,
             buffers,
             read,
@@ -270,6 +351,7 @@ impl Product {
         [tm, tn]: [usize; 2],
     ) -> Result<(f64, f32), String> {
         let [m, n, k] = self.shape;
+        let chunks = self.layout.chunks;
         let scope = device.push_error_scope(wgpu::ErrorFilter::Validation);
         let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
             label: None,
@@ -305,7 +387,8 @@ impl Product {
                 pass.set_pipeline(&pipeline);
                 pass.set_bind_group(0, &group, &[]);
                 for _ in 0..reps {
-                    pass.dispatch_workgroups((n / (32 * tn)) as u32, (m / (32 * tm)) as u32, 1);
+                    let groups = [n / (32 * tn), m / (32 * tm), chunks].map(|v| v as u32);
+                    pass.dispatch_workgroups(groups[0], groups[1], groups[2]);
                 }
             }
             queue.submit([encoder.finish()]);
@@ -318,7 +401,8 @@ impl Product {
         run(20);
         let ms = clock.elapsed().as_secs_f64() * 1e3 / 20.0;
         let mut encoder = device.create_command_encoder(&Default::default());
-        encoder.copy_buffer_to_buffer(&self.buffers[2], 0, &self.read, 0, (m * n * 4) as u64);
+        let bytes = (chunks * m * n * 4) as u64;
+        encoder.copy_buffer_to_buffer(&self.buffers[2], 0, &self.read, 0, bytes);
         queue.submit([encoder.finish()]);
         self.read.slice(..).map_async(wgpu::MapMode::Read, |_| {});
         device
@@ -330,17 +414,21 @@ impl Product {
         };
         self.read.unmap();
         let [a, b] = &self.host;
+        let Layout { a_t, b_t, .. } = self.layout;
+        let a_at = |i: usize, l: usize| if a_t { a[l * m + i] } else { a[i * k + l] };
+        let b_at = |l: usize, j: usize| if b_t { b[j * k + l] } else { b[l * n + j] };
         let worst = [
             (0, 0),
             (17, 101),
             (m - 1, n - 1),
-            (1234, 77),
+            (1234 % m, 77),
             (m / 2, n / 3),
         ]
         .iter()
         .map(|&(i, j)| {
-            let want: f32 = (0..k).map(|l| a[i * k + l] * b[l * n + j]).sum();
-            (got[i * n + j] - want).abs()
+            let want: f32 = (0..k).map(|l| a_at(i, l) * b_at(l, j)).sum();
+            let sum: f32 = (0..chunks).map(|c| got[(c * m + i) * n + j]).sum();
+            (sum - want).abs()
         })
         .fold(0.0, f32::max);
         Ok((ms, worst))
