@@ -96,7 +96,7 @@ pub struct Pixels {
     gpu: Option<crate::gpu::GpuPixels>,
     /// A G-buffer that stayed on the device (every pixel then has a row) and its camera.
     #[cfg(feature = "wgpu")]
-    gbuffer: Option<(crate::gpu::PooledBuffer, Camera)>,
+    gbuffer: Option<(nprt_net::gpu::PooledBuffer, Camera)>,
 }
 
 /// How a frame's direct light is traced, for a model that leaves it to the tracer.

@@ -8,9 +8,6 @@ const STORAGE: wgpu::BufferUsages = wgpu::BufferUsages::STORAGE
     .union(wgpu::BufferUsages::COPY_SRC)
     .union(wgpu::BufferUsages::COPY_DST);
 
-/// Host-readable buffers [`GpuDevice::read`] keeps at most; the oldest go first.
-const STAGING_KEPT: usize = 8;
-
 impl GpuDevice {
     /// Refuses `bytes` of `what` where one storage buffer on this device cannot hold and bind
     /// them, saying so (a kernel binds its inputs whole).
@@ -76,30 +73,20 @@ impl GpuDevice {
         if size == 0 {
             return Vec::new();
         }
-        let staging = self.take_staging(size);
-        let mut encoder = self.device.create_command_encoder(&Default::default());
-        encoder.copy_buffer_to_buffer(buffer, 0, &staging, 0, size);
-        let submission = self.queue.submit([encoder.finish()]);
-        let values = self.read_mapped(&staging, submission);
-        let mut kept = self.staging.lock().unwrap_or_else(|e| e.into_inner());
-        kept.push(staging);
-        let over = kept.len().saturating_sub(STAGING_KEPT);
-        kept.drain(..over);
-        values
-    }
-
-    /// A host-readable buffer of `size` bytes: one a read handed back, or a new one.
-    fn take_staging(&self, size: u64) -> wgpu::Buffer {
-        let mut kept = self.staging.lock().unwrap_or_else(|e| e.into_inner());
-        match kept.iter().position(|b| b.size() == size) {
-            Some(i) => kept.remove(i),
-            None => self.device.create_buffer(&wgpu::BufferDescriptor {
+        let staging = self.staging.take_or(size, || {
+            self.device.create_buffer(&wgpu::BufferDescriptor {
                 label: Some("readback"),
                 size,
                 usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
                 mapped_at_creation: false,
-            }),
-        }
+            })
+        });
+        let mut encoder = self.device.create_command_encoder(&Default::default());
+        encoder.copy_buffer_to_buffer(buffer, 0, &staging, 0, size);
+        let submission = self.queue.submit([encoder.finish()]);
+        let values = self.read_mapped(&staging, submission);
+        self.staging.give([staging]);
+        values
     }
 
     /// The values of `staging` (a host-readable buffer) once `submission`, which fills it, is

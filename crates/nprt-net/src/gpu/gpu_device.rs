@@ -2,11 +2,12 @@
 //! process, opened at first use.
 
 use std::sync::atomic::{AtomicU64, Ordering};
-use std::sync::{Arc, Mutex, OnceLock};
+use std::sync::{Arc, OnceLock};
 
 use anyhow::{anyhow, Result};
 
 use super::kernel::Pipelines;
+use super::BufferPool;
 
 /// A wgpu adapter's device and queue, and the kernels compiled for it.
 pub struct GpuDevice {
@@ -31,10 +32,13 @@ pub struct GpuDevice {
     pub spare: wgpu::Buffer,
     /// Host-readable buffers that reads copied into, kept for the next read of the same size
     /// (a frame read back every lighting change otherwise allocated one of its size each time).
-    pub(super) staging: Mutex<Vec<wgpu::Buffer>>,
+    pub(super) staging: BufferPool,
     /// Times the host has waited for the queue ([`Self::host_waits`]).
     waits: AtomicU64,
 }
+
+/// Host-readable buffers [`GpuDevice::read`] keeps at most.
+const STAGING_KEPT: usize = 8;
 
 static DEVICE: OnceLock<Result<Arc<GpuDevice>, String>> = OnceLock::new();
 
@@ -133,7 +137,7 @@ impl GpuDevice {
             half,
             tensor_cores,
             pipelines: Pipelines::default(),
-            staging: Mutex::default(),
+            staging: BufferPool::new(STAGING_KEPT),
             waits: AtomicU64::new(0),
         })
     }

@@ -6,6 +6,7 @@
 //! path may also run its dense layers in f16: [`HalfWeight`]), and tests hold the two together; layouts, designs and the hash grid stay defined where the CPU
 //! engine reads them.
 
+mod buffer_pool;
 mod codes;
 mod device_dataset;
 mod encoder_step;
@@ -22,6 +23,7 @@ mod parameters;
 mod products;
 mod transport_step;
 
+pub use buffer_pool::{BufferPool, PooledBuffer};
 pub use codes::{activation_code, kind_code, loss_code};
 pub use device_dataset::DeviceDataset;
 pub use gpu_device::GpuDevice;

@@ -15,13 +15,12 @@ use nprt_net::network::encoder::{BLOCKS, CHANNELS, CODE_SIZE};
 use nprt_net::{Activation, MapNorm, NprtNet, TrackKind, FEATURES, TRANSPORT_CODE};
 use nprt_scene::EnvMap;
 
-use nprt_net::gpu::{groups_for, Dispatch, GpuDevice, KernelTime};
+use nprt_net::gpu::{groups_for, BufferPool, Dispatch, GpuDevice, KernelTime, PooledBuffer};
 
 use nprt_net::gpu::{held_halves, pad16, Bias, HalfWeight, Held, Operand, Output, HALF_ROW_BLOCK};
 
 use nprt_net::gpu::kernels::{COMBINE, ENCODER_BLOCK, GBUFFER_FEATURES, TRACK_INPUTS};
 
-use super::buffer_pool::BufferPool;
 use super::frame_background::{Background, Fill, GpuMap, SameTexels};
 use super::kept_last::KeptLast;
 use super::light_code::{GpuLightCode, LIGHT_CODE_VALUES};
@@ -142,10 +141,8 @@ pub struct GpuPixels {
     pub rows: usize,
     chunks: Vec<PixelChunk>,
     work: Arc<Workspace>,
-    /// Where the chunks' buffers and `rgb` go back when the pixels are dropped.
-    pool: BufferPool,
     /// Radiance of every row, `rows × 3`.
-    rgb: wgpu::Buffer,
+    rgb: PooledBuffer,
     /// What a lighting change records (see [`GpuNetwork::radiance`]), prepared at the first.
     relight: OnceLock<Vec<Dispatch>>,
     /// The network that made these pixels, the one that may relight them.
@@ -159,22 +156,14 @@ impl GpuPixels {
     }
 }
 
-impl Drop for GpuPixels {
-    fn drop(&mut self) {
-        let chunks = self.chunks.drain(..);
-        let buffers = chunks.flat_map(|c| std::iter::once(c.features).chain(c.kept));
-        self.pool.give(buffers.chain([self.rgb.clone()]));
-    }
-}
-
 struct PixelChunk {
     first: usize,
     rows: usize,
-    features: wgpu::Buffer,
+    features: PooledBuffer,
     /// Per track, what its shading network's first layer reads besides the light code: ŝ
     /// (`rows × TRANSPORT_CODE`) or, for the baseline, the gathered inputs (`rows × width`);
     /// in f16 where the networks run in half precision.
-    kept: Vec<wgpu::Buffer>,
+    kept: Vec<PooledBuffer>,
 }
 
 impl GpuNetwork {
@@ -404,8 +393,8 @@ impl GpuNetwork {
     pub fn pixels(&self, features: &[f32]) -> GpuPixels {
         let rows = features.len() / FEATURES;
         self.pixels_with(rows, |_, first, n| {
-            self.gpu
-                .upload(&features[first * FEATURES..(first + n) * FEATURES])
+            let rows = &features[first * FEATURES..(first + n) * FEATURES];
+            self.pool.hold(self.gpu.upload(rows))
         })
     }
 
@@ -421,7 +410,7 @@ impl GpuNetwork {
     ) -> GpuPixels {
         let (lo, extent) = nprt_net::position_frame(bounds);
         self.pixels_with(pixels, |pass, first, n| {
-            let features = self.pool.take(&self.gpu, n * FEATURES);
+            let features = self.pool.take_pooled(&self.gpu, n * FEATURES);
             let mut params = vec![n as u32, first as u32, 0, 0];
             params.extend(
                 [lo.extend(0.0), extent.extend(0.0)]
@@ -444,7 +433,7 @@ impl GpuNetwork {
     fn pixels_with(
         &self,
         rows: usize,
-        mut inputs: impl FnMut(&mut wgpu::ComputePass, usize, usize) -> wgpu::Buffer,
+        mut inputs: impl FnMut(&mut wgpu::ComputePass, usize, usize) -> PooledBuffer,
     ) -> GpuPixels {
         let gpu = &*self.gpu;
         let widest = self
@@ -479,7 +468,7 @@ impl GpuNetwork {
                             true => held_halves(n, width).div_ceil(2),
                             false => n * width,
                         };
-                        let kept = self.pool.take(gpu, floats);
+                        let kept = self.pool.take_pooled(gpu, floats);
                         let gathered = &work.scratch[0];
                         match (&t.transfer, half) {
                             (None, false) => self.track_inputs(&mut pass, t, &features, n, &kept),
@@ -518,8 +507,7 @@ impl GpuNetwork {
             rows,
             chunks,
             work,
-            pool: self.pool.clone(),
-            rgb: self.pool.take(gpu, rows.max(1) * 3),
+            rgb: self.pool.take_pooled(gpu, rows.max(1) * 3),
             relight: OnceLock::new(),
             network: self.id,
         }

@@ -14,7 +14,6 @@
 //! it must not own semantics of its own: materials are nprt-scene's, layouts, designs and the
 //! hash grid nprt-net's.
 
-mod buffer_pool;
 mod frame_background;
 mod gpu_network;
 mod gpu_scene;
@@ -26,7 +25,6 @@ mod path_tracer;
 mod raster_gbuffer;
 mod shader_export;
 
-pub use buffer_pool::PooledBuffer;
 pub use frame_background::{Background, Fill};
 pub use gpu_network::{GpuNetwork, GpuPixels};
 pub(crate) use kept_last::KeptLast;

@@ -8,12 +8,11 @@ use std::sync::{Arc, Mutex};
 
 use anyhow::Result;
 use glam::{DMat4, DVec4};
-use nprt_net::gpu::{Bind, GpuDevice, KernelSource};
+use nprt_net::gpu::{Bind, BufferPool, GpuDevice, KernelSource, PooledBuffer};
 use nprt_scene::Camera;
 use nprt_trace::{GBuffer, GSample, TraceScene};
 use wgpu::util::DeviceExt;
 
-use super::buffer_pool::{BufferPool, PooledBuffer};
 use super::frame_background::GpuMap;
 use super::gpu_scene::GpuScene;
 
@@ -245,7 +244,7 @@ impl RasterGBuffer {
                     &scene.materials,
                     &scene.textures,
                     &scene.bitmaps,
-                    &*samples,
+                    &samples,
                 ],
                 [camera.width.div_ceil(8), camera.height.div_ceil(8)],
             );
