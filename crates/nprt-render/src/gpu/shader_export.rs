@@ -82,10 +82,11 @@ impl WeightFile {
     /// A transport layer's weight as f16, `d_in + 16` rows of `pad16(d_out)` values.
     fn half_weight(&mut self, name: &str, d: &Dense) {
         let bits = half_weight_bits(&d.weight, d.d_in, d.d_out);
+        let n_pad = pad16(d.d_out);
         self.half_tensors.push(json!({
             "name": name,
             "offset": self.halves.len(),
-            "shape": [d.d_in + 16, pad16(d.d_out)],
+            "shape": [bits.len() / n_pad, n_pad],
             "weight_shape": [d.d_in, d.d_out],
         }));
         self.halves.extend(bits);
@@ -160,21 +161,10 @@ pub fn export_model(model_dir: &Path, out: &Path, view: &ExampleView) -> Result<
             })
         })
         .collect();
-    write(
-        "weights.bin",
-        &weights
-            .values
-            .iter()
-            .flat_map(|v| v.to_le_bytes())
-            .collect::<Vec<u8>>(),
-    )?;
+    write("weights.bin", &le_bytes(&weights.values, f32::to_le_bytes))?;
     write(
         "weights_f16.bin",
-        &weights
-            .halves
-            .iter()
-            .flat_map(|v| v.to_le_bytes())
-            .collect::<Vec<u8>>(),
+        &le_bytes(&weights.halves, u16::to_le_bytes),
     )?;
     let config = &file.config;
     let manifest = json!({
@@ -220,6 +210,11 @@ pub fn export_model(model_dir: &Path, out: &Path, view: &ExampleView) -> Result<
         weights: weights.values.len(),
         no_example,
     })
+}
+
+/// `values` as the little-endian bytes `to_le` gives each: what the export's binary files hold.
+fn le_bytes<T: Copy, const N: usize>(values: &[T], to_le: fn(T) -> [u8; N]) -> Vec<u8> {
+    values.iter().flat_map(|&v| to_le(v)).collect()
 }
 
 /// The worked example's files (name in the export, contents), or why there is none.
@@ -275,7 +270,7 @@ fn example(model_dir: &Path, file: &nprt_net::ModelFile, view: &ExampleView) -> 
             f
         })
         .collect();
-    let bytes = |v: &[f32]| v.iter().flat_map(|x| x.to_le_bytes()).collect::<Vec<u8>>();
+    let bytes = |v: &[f32]| le_bytes(v, f32::to_le_bytes);
     let description = json!({
         "width": view.width,
         "height": view.height,
