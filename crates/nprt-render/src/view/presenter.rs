@@ -82,7 +82,6 @@ pub struct Presenter {
     config: wgpu::SurfaceConfiguration,
     /// The frame's size.
     size: [u32; 2],
-    layout: wgpu::BindGroupLayout,
     /// Drawing into the window's format, and into an RGBA8 screenshot.
     to_window: wgpu::RenderPipeline,
     to_image: wgpu::RenderPipeline,
@@ -132,55 +131,14 @@ impl Presenter {
         };
         surface.configure(&gpu.device, &config);
         let device = &gpu.device;
-        let fragment = wgpu::ShaderStages::FRAGMENT;
-        let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("show"),
-            entries: &[
-                wgpu::BindGroupLayoutEntry {
-                    binding: 0,
-                    visibility: fragment,
-                    ty: wgpu::BindingType::Buffer {
-                        ty: wgpu::BufferBindingType::Uniform,
-                        has_dynamic_offset: false,
-                        min_binding_size: None,
-                    },
-                    count: None,
-                },
-                wgpu::BindGroupLayoutEntry {
-                    binding: 1,
-                    visibility: fragment,
-                    ty: wgpu::BindingType::Buffer {
-                        ty: wgpu::BufferBindingType::Storage { read_only: true },
-                        has_dynamic_offset: false,
-                        min_binding_size: None,
-                    },
-                    count: None,
-                },
-                wgpu::BindGroupLayoutEntry {
-                    binding: 2,
-                    visibility: fragment,
-                    ty: wgpu::BindingType::Texture {
-                        sample_type: wgpu::TextureSampleType::Float { filterable: false },
-                        view_dimension: wgpu::TextureViewDimension::D2,
-                        multisampled: false,
-                    },
-                    count: None,
-                },
-            ],
-        });
         let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
             label: Some("show"),
             source: wgpu::ShaderSource::Wgsl(SHOW.into()),
         });
-        let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-            label: Some("show"),
-            bind_group_layouts: &[Some(&layout)],
-            immediate_size: 0,
-        });
         let pipeline = |format: wgpu::TextureFormat| {
             device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
                 label: Some("show"),
-                layout: Some(&pipeline_layout),
+                layout: None,
                 vertex: wgpu::VertexState {
                     module: &module,
                     entry_point: Some("vs"),
@@ -221,7 +179,6 @@ impl Presenter {
             host_rgb: gpu.buffer(3 * (width * height) as usize),
             adapter: format!("{} ({:?})", info.name, info.backend),
             overlay,
-            layout,
             size: [width, height],
             config,
             surface,
@@ -349,7 +306,7 @@ impl Presenter {
         let overlay = self.overlay.create_view(&Default::default());
         let group = gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("show"),
-            layout: &self.layout,
+            layout: &pipeline.get_bind_group_layout(0),
             entries: &[
                 wgpu::BindGroupEntry {
                     binding: 0,
