@@ -5,20 +5,22 @@
 # 4 more minutes; at 262,144 with the eager peers about 60 s; frames about 50 s; with --kitchen
 # 10 minutes of training and an evaluation more. Writes one summary file (Markdown) with:
 #   1. `nprt bench train --device wgpu --profile` (nprt's own kernels, and each kernel's GPU
-#      time in a step) per design beside PyTorch on CUDA, eager and torch.compile, each in f32
-#      and bf16 autocast (the fastest is the peer), at batch 16,384 and 262,144;
+#      time in a step) per design, in f32 and in mixed precision (f16 products on tensor cores),
+#      beside PyTorch on CUDA, eager and torch.compile, each in f32 and bf16 autocast (the
+#      fastest is the peer), at batch 16,384 and 262,144;
 #   2. the paper's schedule (3000 views of 256², 500 epochs) projected from those rates;
 #   3. `nprt bench frame --profile` (G-buffer, encoder, networks, direct light traced on the GPU,
 #      total; each kernel of a lighting change)
 #      per design, and D/S with 16 spp of traced direct light, at 512² and 1920×1080
 #      on the GPU kernels, in f32 and in f16 (tensor cores where the adapter has them),
 #      beside the paper's Table 3;
-#   4. with --kitchen: D/S trained 10 minutes on the GPU on that dataset and evaluated with
-#      `nprt eval` beside --cpu-model (the same design trained 10 minutes on the CPU).
+#   4. with --kitchen: D/S trained 10 minutes on the GPU on that dataset (in --kitchen-precision)
+#      and evaluated with `nprt eval` beside --cpu-model (the same design trained 10 minutes on
+#      the CPU).
 #
 # usage: bench/gpu.sh [--nprt BIN] [--python PY] [--kitchen DATASET --cpu-model MODEL]
 #                     [--summary FILE] [--work DIR] [--batches "16384 262144"] [--res 512,1920x1080]
-#                     [--peer-variants LIST]
+#                     [--peer-variants LIST] [--precision LIST] [--kitchen-precision P]
 #   --nprt       the nprt binary (default target/release/nprt, built with `--features gpu`
 #                when missing)
 #   --python     Python with PyTorch and CUDA (default python3)
@@ -31,6 +33,8 @@
 #   --res        the frame sizes (default 512,1920x1080); both only to try the script small
 #   --peer-variants  the PyTorch variants (default eager-f32,eager-bf16,compile-f32,compile-bf16;
 #                eager-f32,eager-bf16 spares torch.compile's minutes on a short loan)
+#   --precision  nprt's training precisions, a row each (default f32,f16)
+#   --kitchen-precision  the KITCHEN run's (default f32)
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
@@ -43,6 +47,8 @@ work=
 batches="16384 262144"
 res=512,1920x1080
 variants=eager-f32,eager-bf16,compile-f32,compile-bf16
+precisions=f32,f16
+kitchen_precision=f32
 while [ $# -gt 0 ]; do
   case "$1" in
     --nprt) nprt=$2; shift 2 ;;
@@ -54,6 +60,8 @@ while [ $# -gt 0 ]; do
     --batches) batches=$2; shift 2 ;;
     --res) res=$2; shift 2 ;;
     --peer-variants) variants=$2; shift 2 ;;
+    --precision) precisions=$2; shift 2 ;;
+    --kitchen-precision) kitchen_precision=$2; shift 2 ;;
     -h | --help) sed -n '2,/^set -euo/p' "$0" | sed '$d; s/^# \{0,1\}//'; exit 0 ;;
     *) echo "bench/gpu.sh: unknown argument '$1' (--help lists them)" >&2; exit 2 ;;
   esac
@@ -104,7 +112,8 @@ for batch in $batches; do
   log "training throughput at batch $batch"
   section "Training samples/s at batch $batch (nprt's kernels on wgpu; PyTorch on CUDA)"
   "$nprt" bench train --device wgpu --python "$python" --peer-variants "$variants" \
-    --arch "$designs" --batch-size "$batch" --steps "$steps" --warmup 3 --rounds 1 --profile \
+    --precision "$precisions" --arch "$designs" --batch-size "$batch" --steps "$steps" \
+    --warmup 3 --rounds 1 --profile \
     | tee "$work/train-$batch.txt" >>"$summary"
   end_section
 done
@@ -115,8 +124,8 @@ section "The paper's schedule (3000 views of 256², 500 epochs) projected from t
 for batch in $batches; do
   awk -v batch="$batch" '$1 ~ /^(baseline|prt|albedo|dsep)$/ {
       samples = 3000 * 256 * 256 * 500
-      printf "batch %6d  %-9s nprt %6.1f min   PyTorch %6s min\n", batch, $1, samples / $3 / 60,
-        ($5 == "-" ? "-" : sprintf("%.1f", samples / $5 / 60))
+      printf "batch %6d  %-9s %s nprt %6.1f min   PyTorch %6s min\n", batch, $1, $3,
+        samples / $4 / 60, ($6 == "-" ? "-" : sprintf("%.1f", samples / $6 / 60))
     }' "$work/train-$batch.txt" >>"$summary"
 done
 end_section
@@ -130,10 +139,10 @@ end_section
 
 # 4. KITCHEN: 10 minutes of training on the GPU against 10 on the CPU.
 if [ -n "$kitchen" ]; then
-  log "training D/S on '$kitchen' for 10 minutes"
-  section "KITCHEN: D/S trained 10 minutes on the GPU"
+  log "training D/S on '$kitchen' for 10 minutes ($kitchen_precision)"
+  section "KITCHEN: D/S trained 10 minutes on the GPU ($kitchen_precision)"
   "$nprt" train --data "$kitchen" --arch dsep --minutes 10 --device wgpu --out "$work/kitchen-gpu" \
-    >>"$summary"
+    --precision "$kitchen_precision" >>"$summary"
   end_section
   log "evaluating"
   "$nprt" eval --model "$work/kitchen-gpu","$cpu_model" --data "$kitchen" --out "$work/kitchen-eval" \

@@ -33,6 +33,7 @@ pub mod encoding;
 pub mod gpu;
 pub mod model;
 pub mod network;
+mod precision;
 pub mod training;
 
 #[cfg(feature = "kernels")]
@@ -55,6 +56,7 @@ pub use network::init::{conv2d, Init};
 pub use network::mlp::Mlp;
 pub use network::nprt_net::NprtNet;
 pub use network::track::{Track, TrackKind};
+pub use precision::Precision;
 pub use training::batch::{Batch, Engine};
 pub use training::calibration::{level_gain, Calibration, LEVEL_SAMPLES};
 pub use training::checkpoint::RunState;

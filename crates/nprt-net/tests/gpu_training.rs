@@ -16,7 +16,9 @@ use common::{loud_grids, random_batch, variants};
 use nprt_net::cpu::{HostEncoder, HostTransport, Samples};
 use nprt_net::gpu::{GpuDevice, GpuTrainer, ParameterLayout};
 use nprt_net::training::training_loop::ADAM_EPSILON;
-use nprt_net::{Design, Device, Engine, Init, Loss, ModelConfig, NprtNet, PositionEncoding};
+use nprt_net::{
+    Design, Device, Engine, Init, Loss, ModelConfig, NprtNet, PositionEncoding, Precision,
+};
 
 /// Euclidean distance of `a` from `b` over b's norm.
 fn relative_error(a: &[f32], b: &[f32]) -> f64 {
@@ -72,7 +74,7 @@ fn gpu_gradients_match_the_cpu_engine_for_every_design() {
         let net = network(&config);
         for loss in [Loss::LogL1, Loss::RelL2] {
             let (want_loss, enc, tr) = cpu_gradients(&net, &samples, loss);
-            let mut gpu = GpuTrainer::new(&net).unwrap();
+            let mut gpu = GpuTrainer::new(&net, Precision::F32).unwrap();
             let value = gpu.backward(&samples, loss);
             let errors = tensor_errors(&gpu.gradients(), &(enc, tr));
             let encoder_tensors = 2 * net.encoder.convs.len() + 2;
@@ -116,7 +118,7 @@ fn gpu_adam_steps_match_burns_adam_on_the_cpu_engine() {
     let device = Device::flex().autodiff();
     let mut net = loud_grids(config.build(&mut Init::new(4, &device)));
     let start = host(&net);
-    let mut gpu = GpuTrainer::new(&net).unwrap();
+    let mut gpu = GpuTrainer::new(&net, Precision::F32).unwrap();
     let mut optim = AdamConfig::new().with_epsilon(ADAM_EPSILON).init();
     let lr = 1e-3;
     for _ in 0..2 {
@@ -164,8 +166,8 @@ fn a_profiled_step_is_a_step_with_its_kernels_timed() {
     let samples = batch.samples();
     let net = network(&ModelConfig::new(Design::Dsep, None));
     let (mut plain, mut timed) = (
-        GpuTrainer::new(&net).unwrap(),
-        GpuTrainer::new(&net).unwrap(),
+        GpuTrainer::new(&net, Precision::F32).unwrap(),
+        GpuTrainer::new(&net, Precision::F32).unwrap(),
     );
     let lr = 1e-3;
     plain.step(&samples, Loss::LogL1, lr);
@@ -214,4 +216,96 @@ fn a_profiled_step_is_a_step_with_its_kernels_timed() {
         times.windows(2).all(|w| w[0].ms >= w[1].ms),
         "not longest first: {times:?}"
     );
+}
+
+/// Mixed precision (`Precision::F16`: the transport networks' products on f16 operands, sums
+/// in f32, the loss's gradient scaled) against the CPU engine's f32: loss and every
+/// parameter's gradient for every design, activation and encoding, both losses. Lavapipe runs
+/// the plain kernels, which compute the tensor-core kernels' sums (in another order).
+#[test]
+fn mixed_precision_gradients_follow_the_cpu_engine_for_every_design() {
+    if !GpuDevice::probe() {
+        return;
+    }
+    if !GpuDevice::get().unwrap().half {
+        eprintln!("skipped: the adapter has no f16 in shaders");
+        return;
+    }
+    let batch = random_batch(300, 3, 22);
+    let samples = batch.samples();
+    let mut worst_loss = 0.0f64;
+    let mut worst_gradient = 0.0f64;
+    for config in variants() {
+        let net = network(&config);
+        for loss in [Loss::LogL1, Loss::RelL2] {
+            let (want_loss, enc, tr) = cpu_gradients(&net, &samples, loss);
+            let mut gpu = GpuTrainer::new(&net, Precision::F16).unwrap();
+            let value = gpu.backward(&samples, loss);
+            let errors = tensor_errors(&gpu.gradients(), &(enc, tr));
+            let worst = errors.iter().fold(0.0f64, |m, &v| m.max(v));
+            let loss_error = (value - want_loss).abs() / want_loss;
+            let name = format!("{} {} {loss}", config.label(), config.activation);
+            eprintln!("{name}: loss {loss_error:.1e}, gradients {worst:.1e}");
+            worst_loss = worst_loss.max(loss_error);
+            worst_gradient = worst_gradient.max(worst);
+        }
+    }
+    eprintln!(
+        "mixed precision: loss within {worst_loss:.1e}, gradients within {worst_gradient:.1e}"
+    );
+    // Lavapipe: loss within 1.1e-2 (PRT, relative L2), gradients within 8.7e-2 (the first
+    // SIREN layer after a hash grid, whose ω0 = 30 magnifies its inputs' rounding; most
+    // tensors 1e-3 to 2e-2). A wrong layout or copy is off by the gradient's own size.
+    assert!(worst_loss < 2e-2, "loss off by {worst_loss}");
+    assert!(worst_gradient < 0.15, "a gradient off by {worst_gradient}");
+}
+
+/// Mixed-precision steps follow f32 steps: three Adam steps at a large rate from one network
+/// move the loss by far more than the two runs then differ by, and move the parameters alike.
+/// It also shows that the f16 copies of the weights follow Adam: stale copies would leave the
+/// mixed-precision loss where it started.
+#[test]
+fn mixed_precision_steps_follow_f32_steps() {
+    if !GpuDevice::probe() || !GpuDevice::get().unwrap().half {
+        return;
+    }
+    let batch = random_batch(300, 3, 24);
+    let samples = batch.samples();
+    let config = ModelConfig {
+        encoding: PositionEncoding::HashGrid,
+        ..ModelConfig::new(Design::Dsep, None)
+    };
+    let net = network(&config);
+    let start = host(&net);
+    let [mut full, mut mixed] =
+        [Precision::F32, Precision::F16].map(|p| GpuTrainer::new(&net, p).unwrap());
+    let before = full.loss(&samples, Loss::LogL1);
+    for _ in 0..3 {
+        full.step(&samples, Loss::LogL1, 1e-3);
+        mixed.step(&samples, Loss::LogL1, 1e-3);
+    }
+    let [after_full, after_mixed] = [&mut full, &mut mixed].map(|t| t.loss(&samples, Loss::LogL1));
+    let moved = (after_full - before).abs();
+    let apart = (after_mixed - after_full).abs();
+    let flat = |p: &(HostEncoder, HostTransport)| ParameterLayout::pack(&p.0, &p.1, 1).1;
+    let origin = flat(&start);
+    let update = |t: &GpuTrainer| -> Vec<f32> {
+        flat(&t.parameters())
+            .iter()
+            .zip(&origin)
+            .map(|(a, b)| a - b)
+            .collect()
+    };
+    let updates = relative_error(&update(&mixed), &update(&full));
+    eprintln!(
+        "loss {before:.5} → {after_full:.5} (f32), {after_mixed:.5} (mixed); updates apart by \
+         {updates:.1e}"
+    );
+    assert!(
+        apart < 0.01 * moved,
+        "the mixed-precision run went elsewhere"
+    );
+    // Lavapipe: the losses 7·10⁻⁴ of the move apart, the updates 6.6·10⁻²: Adam's update
+    // m/√v magnifies the rounding of gradients near zero.
+    assert!(updates < 0.2, "updates apart by {updates}");
 }

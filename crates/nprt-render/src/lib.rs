@@ -29,7 +29,6 @@ mod frame_bench;
 pub mod gpu;
 pub mod oidn;
 mod path;
-mod precision;
 mod relight;
 mod render_job;
 pub mod schedule;
@@ -39,8 +38,8 @@ pub mod view;
 
 pub use animation::{write_animation, Animation};
 pub use frame_bench::{bench_frame, FrameBenchOptions, FrameBenchRow};
+pub use nprt_net::Precision;
 pub use path::CameraPath;
-pub use precision::Precision;
 pub use relight::{
     background, DirectSampling, FrameCache, FrameRadiance, FrameTimings, LightCode, Pixels,
     Relighter, DEFAULT_DIRECT_SPP,

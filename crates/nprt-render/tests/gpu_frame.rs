@@ -226,24 +226,34 @@ fn mean_relative_difference(a: &[f32], b: &[f32]) -> f32 {
     diff / b.iter().map(|v| v.abs()).sum::<f32>()
 }
 
-/// The tensor-core product (`half_dense_coop`), which an adapter without cooperative matrices
-/// (Mesa's software Vulkan) cannot run, validated and translated to SPIR-V as wgpu does for a
-/// GPU that has them: naga 30's writer panicked on a stored matrix or an offset not bound by
-/// `let`, which the kernel avoids. Its arithmetic is checked against the CPU engine by
-/// `half_precision_radiance_follows_the_cpu_engines_for_every_design` on such a GPU.
+/// The tensor-core products, which an adapter without cooperative matrices (Mesa's software
+/// Vulkan) cannot run, validated and translated to SPIR-V as wgpu does for a GPU that has them:
+/// the frame path's (`half_dense_coop`) and a mixed-precision training step's (the same
+/// product under the training epilogue, and the weight gradient). naga 30's writer panicked on
+/// a stored matrix or an offset not bound by `let`, which the kernels avoid. Their arithmetic
+/// is checked against the CPU engine on such a GPU by
+/// `half_precision_radiance_follows_the_cpu_engines_for_every_design` and nprt-net's
+/// `mixed_precision_gradients_follow_the_cpu_engine_for_every_design`.
 #[test]
-fn the_tensor_core_kernel_translates_to_spirv() {
-    let kernel = &nprt_net::gpu::kernels::HALF_DENSE_COOP;
-    let module = naga::front::wgsl::parse_str(kernel.wgsl)
-        .unwrap_or_else(|e| panic!("{}", e.emit_to_string(kernel.wgsl)));
-    let info = naga::valid::Validator::new(
-        naga::valid::ValidationFlags::all(),
-        naga::valid::Capabilities::all(),
-    )
-    .validate(&module)
-    .unwrap_or_else(|e| panic!("{}", e.emit_to_string(kernel.wgsl)));
-    let words = naga::back::spv::write_vec(&module, &info, &Default::default(), None).unwrap();
-    assert!(words.len() > 1000, "{} SPIR-V words", words.len());
+fn the_tensor_core_kernels_translate_to_spirv() {
+    use nprt_net::gpu::kernels::{HALF_DENSE_COOP, HALF_TRAIN_COOP, HALF_WEIGHT_GRAD_COOP};
+    for kernel in [&HALF_DENSE_COOP, &HALF_TRAIN_COOP, &HALF_WEIGHT_GRAD_COOP] {
+        let module = naga::front::wgsl::parse_str(kernel.wgsl)
+            .unwrap_or_else(|e| panic!("{}: {}", kernel.name, e.emit_to_string(kernel.wgsl)));
+        let info = naga::valid::Validator::new(
+            naga::valid::ValidationFlags::all(),
+            naga::valid::Capabilities::all(),
+        )
+        .validate(&module)
+        .unwrap_or_else(|e| panic!("{}: {}", kernel.name, e.emit_to_string(kernel.wgsl)));
+        let words = naga::back::spv::write_vec(&module, &info, &Default::default(), None).unwrap();
+        assert!(
+            words.len() > 1000,
+            "{}: {} SPIR-V words",
+            kernel.name,
+            words.len()
+        );
+    }
 }
 
 /// A second viewpoint of the same size reuses the first one's buffers (features, ŝ, the frame,

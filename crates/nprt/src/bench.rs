@@ -7,7 +7,7 @@ use anyhow::Result;
 use nprt_net::bench::pytorch_peer::{PeerRun, PeerScript, PeerVariant};
 use nprt_net::{
     device_name, is_cpu, measure_throughput, median, Activation, Backend, Design, DirectLight,
-    Engine, ModelConfig,
+    Engine, ModelConfig, Precision,
 };
 
 use crate::flags::{DeviceArg, Resolution};
@@ -62,7 +62,7 @@ pub struct BenchFrameArgs {
     /// f16, sums in f32, on tensor cores where the adapter has them; GPU kernels only), each
     /// timed as a row of its own.
     #[arg(long, default_value = "f32", value_delimiter = ',')]
-    precision: Vec<nprt_render::Precision>,
+    precision: Vec<Precision>,
     #[command(flatten)]
     device: DeviceArg,
 }
@@ -131,6 +131,11 @@ pub struct BenchTrainArgs {
     /// own), beside the step's wall time at the measured rate: where a step's time goes.
     #[arg(long)]
     profile: bool,
+    /// The transport networks' products, comma-separated, a row each against the same peer:
+    /// f32, and f16 (mixed precision: f16 operands summed in f32, on tensor cores where the
+    /// adapter has them, f32 master weights; --device wgpu only).
+    #[arg(long, default_value = "f32", value_delimiter = ',')]
+    precision: Vec<Precision>,
     #[command(flatten)]
     device: DeviceArg,
 }
@@ -304,9 +309,10 @@ fn train(a: BenchTrainArgs) -> Result<()> {
     );
     let peer = peer(a.python.as_ref(), &device)?;
     println!(
-        "{:<10} {:<6} {:>14} {:>18} {:>17} {:>8} {:>15}  peer",
+        "{:<10} {:<6} {:<4} {:>14} {:>18} {:>17} {:>8} {:>15}  peer",
         "design",
         "act",
+        "prec",
         "nprt samples/s",
         "autodiff samples/s",
         "PyTorch samples/s",
@@ -315,7 +321,7 @@ fn train(a: BenchTrainArgs) -> Result<()> {
     );
     for &arch in &a.designs.arch {
         let config = ModelConfig::new(arch, a.activation);
-        let measure = |engine| {
+        let measure = |engine, precision| {
             measure_throughput(
                 &config,
                 engine,
@@ -323,12 +329,14 @@ fn train(a: BenchTrainArgs) -> Result<()> {
                 a.views,
                 a.steps,
                 a.warmup,
+                precision,
                 &device,
             )
         };
         // Rounds alternate the peer and nprt, so that a drift in the machine's speed (identical
         // runs here differ by up to 30%) reaches both alike; medians are compared.
-        let mut ours = Vec::new();
+        // Per precision, nprt's rate in each round.
+        let mut ours: Vec<Vec<f64>> = vec![Vec::new(); a.precision.len()];
         // Per variant, its rate in each round.
         let mut variants: Vec<Vec<f64>> = vec![Vec::new(); a.peer_variants.len()];
         for _ in 0..rounds {
@@ -348,38 +356,46 @@ fn train(a: BenchTrainArgs) -> Result<()> {
                     })?);
                 }
             }
-            ours.push(measure(Engine::Auto));
+            for (&precision, rates) in a.precision.iter().zip(&mut ours) {
+                rates.push(measure(Engine::Auto, precision)?);
+            }
         }
         // The fastest variant by its median is the peer.
         let best = (0..variants.len())
             .filter(|&v| !variants[v].is_empty())
             .max_by(|&x, &y| median(variants[x].clone()).total_cmp(&median(variants[y].clone())));
         let theirs = best.map_or(Vec::new(), |v| variants[v].clone());
-        let ratios: Vec<f64> = ours.iter().zip(&theirs).map(|(o, t)| o / t).collect();
-        let ours = median(ours);
         // Off the CPU burn's autodiff is the only path, so the column would repeat the first.
-        let autodiff = cpu.then(|| measure(Engine::Autodiff));
-        let theirs = (!theirs.is_empty()).then(|| median(theirs));
-        let spread = match ratios.iter().copied().reduce(f64::min) {
-            Some(low) => {
-                let high = ratios.iter().copied().fold(low, f64::max);
-                format!("{low:.2}–{high:.2}×")
-            }
-            None => "-".into(),
+        let autodiff = match cpu {
+            true => Some(measure(Engine::Autodiff, Precision::F32)?),
+            false => None,
         };
-        println!(
-            "{:<10} {:<6} {:>14.0} {:>18} {:>17} {:>8} {:>15}  {}",
-            arch.name(),
-            config.activation.name(),
-            ours,
-            autodiff.map_or("-".into(), |t| format!("{t:.0}")),
-            theirs.map_or("-".into(), |t| format!("{t:.0}")),
-            theirs.map_or("-".into(), |t| format!("{:.2}×", ours / t)),
-            spread,
-            best.map_or("-".into(), |v| a.peer_variants[v].name())
-        );
-        if a.profile {
-            print_profile(&config, &a, 1e3 * a.batch_size as f64 / ours)?;
+        for (&precision, ours) in a.precision.iter().zip(ours) {
+            let ratios: Vec<f64> = ours.iter().zip(&theirs).map(|(o, t)| o / t).collect();
+            let ours = median(ours);
+            let theirs = (!theirs.is_empty()).then(|| median(theirs.clone()));
+            let spread = match ratios.iter().copied().reduce(f64::min) {
+                Some(low) => {
+                    let high = ratios.iter().copied().fold(low, f64::max);
+                    format!("{low:.2}–{high:.2}×")
+                }
+                None => "-".into(),
+            };
+            println!(
+                "{:<10} {:<6} {:<4} {:>14.0} {:>18} {:>17} {:>8} {:>15}  {}",
+                arch.name(),
+                config.activation.name(),
+                precision.name(),
+                ours,
+                autodiff.map_or("-".into(), |t| format!("{t:.0}")),
+                theirs.map_or("-".into(), |t| format!("{t:.0}")),
+                theirs.map_or("-".into(), |t| format!("{:.2}×", ours / t)),
+                spread,
+                best.map_or("-".into(), |v| a.peer_variants[v].name())
+            );
+            if a.profile {
+                print_profile(&config, &a, precision, 1e3 * a.batch_size as f64 / ours)?;
+            }
         }
     }
     Ok(())
@@ -387,8 +403,13 @@ fn train(a: BenchTrainArgs) -> Result<()> {
 
 /// The `--profile` lines of one design: its kernels' GPU time in one step, longest first.
 #[cfg(feature = "wgpu")]
-fn print_profile(config: &ModelConfig, a: &BenchTrainArgs, step_ms: f64) -> Result<()> {
-    let times = nprt_net::profile_kernels(config, a.batch_size, a.views, a.warmup)?;
+fn print_profile(
+    config: &ModelConfig,
+    a: &BenchTrainArgs,
+    precision: Precision,
+    step_ms: f64,
+) -> Result<()> {
+    let times = nprt_net::profile_kernels(config, a.batch_size, a.views, a.warmup, precision)?;
     print_kernel_times("one step's kernels", &times, step_ms);
     Ok(())
 }
@@ -410,7 +431,7 @@ fn print_kernel_times(what: &str, times: &[nprt_net::gpu::KernelTime], wall_ms: 
 }
 
 #[cfg(not(feature = "wgpu"))]
-fn print_profile(_: &ModelConfig, _: &BenchTrainArgs, _: f64) -> Result<()> {
+fn print_profile(_: &ModelConfig, _: &BenchTrainArgs, _: Precision, _: f64) -> Result<()> {
     unreachable!("check_profile refuses --profile without the `wgpu` feature")
 }
 

@@ -7,7 +7,7 @@ use nprt_net::network::encoder::check_input_width;
 use nprt_net::training::training_set::{TrainingSet, ViewSamples};
 use nprt_net::{
     Activation, Calibration, Design, Device, DirectLight, Gather, Loss, MapNorm, ModelConfig,
-    PositionEncoding, TrainOptions, DEFAULT_ENCODER_WIDTH, DEFAULT_MAP_NORM,
+    PositionEncoding, Precision, TrainOptions, DEFAULT_ENCODER_WIDTH, DEFAULT_MAP_NORM,
 };
 
 use crate::flags::{DeviceArg, RunArgs};
@@ -102,6 +102,13 @@ pub struct TrainArgs {
     /// GPU has no room for). The batches are the same either way.
     #[arg(long, default_value_t = d().gather)]
     gather: Gather,
+    /// With --device wgpu, the transport networks' products: f32, or f16 (mixed precision:
+    /// weights, activations and gradients between layers held as f16 and summed in f32, on
+    /// tensor cores where the GPU has cooperative matrices; master weights, Adam, the light
+    /// encoder and the hash grids stay f32; the loss's gradient is scaled so that f16 keeps it;
+    /// docs/model.md). Elsewhere f32 only.
+    #[arg(long, default_value_t = d().precision)]
+    precision: Precision,
     #[command(flatten)]
     device: DeviceArg,
 }
@@ -137,6 +144,7 @@ impl TryFrom<TrainArgs> for TrainJob {
             loss: a.loss,
             calibration: a.calibrate,
             gather: a.gather,
+            precision: a.precision,
         }
         .with_run(a.arch, a.run.into(), a.lr);
         opts.check().context("bad training options")?;

@@ -14,10 +14,12 @@ use crate::network::init::Init;
 use crate::training::batch::{Batch, Engine};
 use crate::training::loss::Loss;
 use crate::training::training_loop::ADAM_EPSILON;
+use crate::Precision;
 
 /// Samples/s of `steps` full steps (forward, backward, Adam) on one synthetic batch of
 /// `batch_size` samples over `views` maps, after `warmup` untimed steps, gradients computed by
-/// `engine`.
+/// `engine`; on our own GPU kernels (wgpu) in `precision` (elsewhere f32 only).
+#[allow(clippy::too_many_arguments)]
 pub fn measure_throughput(
     config: &ModelConfig,
     engine: Engine,
@@ -25,16 +27,21 @@ pub fn measure_throughput(
     views: usize,
     steps: usize,
     warmup: usize,
+    precision: Precision,
     device: &Device,
-) -> f64 {
+) -> anyhow::Result<f64> {
     let device = device.clone().autodiff();
     let mut net = config.build(&mut Init::new(0, &device));
     let mut optim = AdamConfig::new().with_epsilon(ADAM_EPSILON).init();
     let batch = synthetic_batch(config, batch_size, views);
     #[cfg(feature = "kernels")]
     if crate::device::Backend::of(&device) == crate::device::Backend::Wgpu {
-        return kernel_throughput(config, &batch, steps, warmup);
+        return kernel_throughput(config, &batch, steps, warmup, precision);
     }
+    anyhow::ensure!(
+        precision == Precision::F32,
+        "--precision {precision} runs on nprt's own GPU kernels only: use --device wgpu"
+    );
     let mut timed = Instant::now();
     for step in 0..warmup + steps {
         if step == warmup {
@@ -45,7 +52,7 @@ pub fn measure_throughput(
         net = optim.step(1e-4, net, grads);
     }
     device.sync().ok();
-    (batch_size * steps) as f64 / timed.elapsed().as_secs_f64()
+    Ok((batch_size * steps) as f64 / timed.elapsed().as_secs_f64())
 }
 
 /// A batch of uniform random values (seeded): `batch_size` samples over `views` maps.
@@ -69,17 +76,19 @@ fn synthetic_batch(config: &ModelConfig, batch_size: usize, views: usize) -> Bat
     }
 }
 
-/// The GPU time of each of our kernels in one training step on the synthetic batch of
-/// [`measure_throughput`], after `warmup` untimed steps (`nprt bench train --profile`).
+/// The GPU time of each of our kernels in one training step in `precision` on the synthetic
+/// batch of [`measure_throughput`], after `warmup` untimed steps (`nprt bench train
+/// --profile`).
 #[cfg(feature = "kernels")]
 pub fn profile_kernels(
     config: &ModelConfig,
     batch_size: usize,
     views: usize,
     warmup: usize,
+    precision: Precision,
 ) -> anyhow::Result<Vec<crate::gpu::KernelTime>> {
     let net = config.build(&mut Init::new(0, &Device::flex()));
-    let mut gpu = crate::gpu::GpuTrainer::new(&net)?;
+    let mut gpu = crate::gpu::GpuTrainer::new(&net, precision)?;
     let batch = synthetic_batch(config, batch_size, views);
     let samples = batch.samples();
     for _ in 0..warmup {
@@ -91,9 +100,15 @@ pub fn profile_kernels(
 /// [`measure_throughput`] on our own GPU kernels (what `--device wgpu` trains with): each step
 /// reads the loss of the one before it back while it runs, as a training run does.
 #[cfg(feature = "kernels")]
-fn kernel_throughput(config: &ModelConfig, batch: &Batch, steps: usize, warmup: usize) -> f64 {
+fn kernel_throughput(
+    config: &ModelConfig,
+    batch: &Batch,
+    steps: usize,
+    warmup: usize,
+    precision: Precision,
+) -> anyhow::Result<f64> {
     let net = config.build(&mut Init::new(0, &Device::flex()));
-    let mut gpu = crate::gpu::GpuTrainer::new(&net).expect("the wgpu device opened already");
+    let mut gpu = crate::gpu::GpuTrainer::new(&net, precision)?;
     let samples = batch.samples();
     let mut timed = Instant::now();
     for step in 0..warmup + steps {
@@ -103,7 +118,7 @@ fn kernel_throughput(config: &ModelConfig, batch: &Batch, steps: usize, warmup: 
         gpu.queue_step(&samples, Loss::LogL1, 1e-4);
     }
     gpu.finish();
-    (batch.len() * steps) as f64 / timed.elapsed().as_secs_f64()
+    Ok((batch.len() * steps) as f64 / timed.elapsed().as_secs_f64())
 }
 
 /// The median of timings (the upper one of an even count): what benchmarks report, since a

@@ -6,7 +6,8 @@
 //!
 //! It computes what the CPU engine computes ([`HostEncoder`] and [`HostTransport`]), in f32,
 //! and the tests hold the two together; Adam is burn's formulation, which the CPU path steps
-//! with.
+//! with. In [`Precision::F16`] the transport networks' dense layers run in mixed precision
+//! (`half_products`), the master weights and Adam staying f32.
 
 use std::collections::HashMap;
 use std::path::Path;
@@ -28,6 +29,7 @@ use crate::network::encoder::CODE_SIZE;
 use crate::network::nprt_net::NprtNet;
 use crate::training::loss::Loss;
 use crate::training::training_loop::ADAM_EPSILON;
+use crate::Precision;
 
 const BETA_1: f32 = 0.9;
 const BETA_2: f32 = 0.999;
@@ -55,6 +57,10 @@ pub struct GpuTrainer {
     plans: Vec<StepPlan>,
     /// Adam over every parameter; its rate and bias corrections are rewritten each step.
     adam: Dispatch,
+    precision: Precision,
+    /// In mixed precision, the copies of the transport layers' weights into their f16 copies,
+    /// run after Adam (empty in f32).
+    half_refresh: Vec<Dispatch>,
     /// Two host-readable copies of a step's loss, used in turn: one step's is read while the
     /// next one runs.
     loss_copies: [wgpu::Buffer; 2],
@@ -132,6 +138,10 @@ enum Pass {
 /// A batch on the device, and what its step computes besides gradients.
 pub(super) struct BatchBuffers {
     pub rows: usize,
+    /// What the loss's gradient is multiplied by, and Adam divides by: 1 in f32; in mixed
+    /// precision 3 · rows rounded up to a power of two, which makes the gradient at the outputs
+    /// that of the loss summed over the batch's values, well within f16's range.
+    pub grad_scale: f32,
     pub views: usize,
     pub light_width: usize,
     pub lights: wgpu::Buffer,
@@ -150,8 +160,8 @@ pub(super) struct BatchBuffers {
 }
 
 /// The parameter block of `adam.wgsl` for step `t` (from 1) at learning rate `lr`, over
-/// `count` values.
-fn adam_params(count: usize, lr: f64, t: u64) -> Vec<u32> {
+/// `count` values whose gradients are scaled by `grad_scale`.
+fn adam_params(count: usize, lr: f64, t: u64, grad_scale: f32) -> Vec<u32> {
     let t = t as i32;
     let correction2 = (1.0 - BETA_2.powi(t)).sqrt();
     let factor = correction2 / (1.0 - BETA_1.powi(t));
@@ -163,7 +173,7 @@ fn adam_params(count: usize, lr: f64, t: u64) -> Vec<u32> {
             BETA_2,
             factor,
             ADAM_EPSILON * correction2,
-            0.0,
+            1.0 / grad_scale,
             0.0,
             0.0,
         ]
@@ -173,23 +183,42 @@ fn adam_params(count: usize, lr: f64, t: u64) -> Vec<u32> {
 }
 
 impl GpuTrainer {
-    /// Uploads `net`'s parameters to the process's GPU device, with zero Adam moments.
-    pub fn new(net: &NprtNet) -> Result<Self> {
+    /// Uploads `net`'s parameters to the process's GPU device, with zero Adam moments, to
+    /// train in `precision` (f16 needs f16 in the adapter's shaders).
+    pub fn new(net: &NprtNet, precision: Precision) -> Result<Self> {
         let gpu = GpuDevice::get()?;
+        let half = precision == Precision::F16;
+        if half {
+            gpu.check_half()?;
+        }
         let encoder = HostEncoder::from_burn(&net.encoder);
         let transport = HostTransport::from_net(net);
         let align = gpu.device.limits().min_storage_buffer_offset_alignment as usize / 4;
         let (layout, flat) = ParameterLayout::pack(&encoder, &transport, align.max(1));
-        let net = NetworkLayout::new(&gpu, &layout, &encoder, &transport);
+        let net = NetworkLayout::new(&gpu, &layout, &encoder, &transport, half);
         let zeros = vec![0.0f32; layout.total];
         let [params, grads, moment1, moment2] =
             [&flat, &zeros, &zeros, &zeros].map(|v| gpu.upload(v));
         let adam = gpu.prepare(
             &ADAM,
-            &adam_params(layout.total, 0.0, 1),
+            &adam_params(layout.total, 0.0, 1, 1.0),
             &[&grads, &params, &moment1, &moment2],
             groups_for(layout.total),
         );
+        let half_refresh: Vec<Dispatch> = net
+            .tracks
+            .iter()
+            .flat_map(|t| t.transfer.iter().chain([&t.shading]))
+            .flat_map(|m| m.half_layers())
+            .flat_map(|(layer, copies)| copies.refresh(&gpu, &params, layer))
+            .collect();
+        if !half_refresh.is_empty() {
+            let mut encoder = gpu.device.create_command_encoder(&Default::default());
+            let mut pass = encoder.begin_compute_pass(&Default::default());
+            half_refresh.iter().for_each(|d| d.record(&mut pass));
+            drop(pass);
+            gpu.queue.submit([encoder.finish()]);
+        }
         let loss_copy = || {
             gpu.device.create_buffer(&wgpu::BufferDescriptor {
                 label: Some("loss"),
@@ -207,6 +236,8 @@ impl GpuTrainer {
             moment1,
             moment2,
             adam,
+            precision,
+            half_refresh,
             plans: Vec::new(),
             steps: 0,
             resolutions: gpu.upload(&hash_grid::resolutions()),
@@ -229,9 +260,20 @@ impl GpuTrainer {
         self.layout.unpack(&flat, &self.encoder, &self.transport)
     }
 
-    /// The gradients of the last step, in the network's shapes.
+    /// Whether the transport networks' products run in f16 ([`Precision::F16`]).
+    pub fn precision(&self) -> Precision {
+        self.precision
+    }
+
+    /// The gradients of the last step, in the network's shapes (its loss scale divided out).
     pub fn gradients(&self) -> (HostEncoder, HostTransport) {
-        let flat = self.gpu.read(&self.grads, self.layout.total);
+        let scale = self.plans.last().map_or(1.0, |p| p.batch.grad_scale);
+        let flat: Vec<f32> = self
+            .gpu
+            .read(&self.grads, self.layout.total)
+            .into_iter()
+            .map(|g| g / scale)
+            .collect();
         self.layout.unpack(&flat, &self.encoder, &self.transport)
     }
 
@@ -344,6 +386,7 @@ impl GpuTrainer {
         });
         if let Pass::Step(_) = pass {
             list.push(&self.adam);
+            list.extend(&self.half_refresh);
         }
         list
     }
@@ -359,7 +402,8 @@ impl GpuTrainer {
     ) -> (wgpu::SubmissionIndex, usize, usize) {
         if let Pass::Step(lr) = pass {
             self.steps += 1;
-            let params = adam_params(self.layout.total, lr, self.steps);
+            let scale = self.plans.last().expect("prepared").batch.grad_scale;
+            let params = adam_params(self.layout.total, lr, self.steps, scale);
             self.gpu.write(&self.adam.uniform, &params);
         }
         let plan = self.plans.last().expect("prepared");
@@ -522,8 +566,13 @@ impl GpuTrainer {
     /// Buffers for batches of `rows` samples over `views` maps `light_width` wide.
     fn batch_buffers(&self, rows: usize, views: usize, light_width: usize) -> BatchBuffers {
         let gpu = &self.gpu;
+        let grad_scale = match self.precision() {
+            Precision::F32 => 1.0,
+            Precision::F16 => (3 * rows).next_power_of_two() as f32,
+        };
         BatchBuffers {
             rows,
+            grad_scale,
             views,
             light_width,
             lights: gpu.buffer(views * 3 * light_width * light_width / 2),

@@ -3,7 +3,8 @@
 //! kept in f32 (`half_layer`). Where the adapter has cooperative matrices of 16 × 16 × 16 f16
 //! products into f32 (NVIDIA's tensor cores through Vulkan) the product runs on them
 //! (`half_dense_coop`); elsewhere a plain kernel computes the same sums (`half_dense`), which
-//! is what the tests run on Mesa's software Vulkan. Training stays in f32.
+//! is what the tests run on Mesa's software Vulkan. Training's mixed-precision products
+//! (`half_products`) hold their operands in the same layout.
 
 use super::kernels::{HALF_DENSE, HALF_DENSE_COOP, HALF_ROWS};
 use super::{groups_for, Dispatch, GpuDevice};
@@ -79,8 +80,25 @@ impl GpuDevice {
         dst: &wgpu::Buffer,
     ) -> Dispatch {
         let padded = rows.next_multiple_of(HALF_ROW_BLOCK);
-        let params = [rows, padded, cols, stride, pad16(cols), 0, 0, 0].map(|v| v as u32);
-        let groups = groups_for(held_halves(rows, cols));
+        self.half_matrix([rows, cols], [stride, 1], 0, padded, src, dst)
+    }
+
+    /// The dispatch that writes the `rows` × `cols` matrix whose element (i, j) is
+    /// `src[offset + i · strides[0] + j · strides[1]]` to `dst` as f16 rows of `pad16(cols)`
+    /// values, zeros in the padding and in the rows up to `padded`: [`Self::half_rows`], and a
+    /// weight's f16 copies in a mixed-precision training step (transposed with other strides).
+    pub fn half_matrix(
+        &self,
+        [rows, cols]: [usize; 2],
+        [stride, col_stride]: [usize; 2],
+        offset: usize,
+        padded: usize,
+        src: &wgpu::Buffer,
+        dst: &wgpu::Buffer,
+    ) -> Dispatch {
+        let k_pad = pad16(cols);
+        let params = [rows, padded, cols, stride, k_pad, offset, col_stride, 0].map(|v| v as u32);
+        let groups = groups_for(padded * k_pad);
         self.prepare(&HALF_ROWS, &params, &[src, dst], groups)
     }
 

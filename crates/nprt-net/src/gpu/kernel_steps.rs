@@ -13,6 +13,7 @@ use crate::training::batch::Batch;
 use crate::training::loss::Loss;
 use crate::training::optimiser::DeviceSteps;
 use crate::training::training_set::TrainingSet;
+use crate::Precision;
 
 pub struct KernelSteps {
     trainer: GpuTrainer,
@@ -25,9 +26,14 @@ pub struct KernelSteps {
 
 impl KernelSteps {
     /// Uploads `net`'s weights, and `dataset` where given (steps then take picked batches,
-    /// [`Batch::picked`]); steps minimise `loss`.
-    pub fn new(net: &NprtNet, loss: Loss, dataset: Option<&TrainingSet>) -> Result<Self> {
-        let mut trainer = GpuTrainer::new(net)?;
+    /// [`Batch::picked`]); steps minimise `loss` in `precision`.
+    pub fn new(
+        net: &NprtNet,
+        loss: Loss,
+        precision: Precision,
+        dataset: Option<&TrainingSet>,
+    ) -> Result<Self> {
+        let mut trainer = GpuTrainer::new(net, precision)?;
         let mut resident = None;
         if let Some(set) = dataset {
             let data = DeviceDataset::upload(&trainer.gpu, set)?;
@@ -87,6 +93,16 @@ impl DeviceSteps<NprtNet, Batch> for KernelSteps {
             Some(bytes) => format!("the dataset there ({:.1} MB)", bytes as f64 / 1e6),
             None => "batches gathered here".into(),
         };
-        format!("GPU kernels on {}, {data}", self.trainer.adapter())
+        let products = match (self.trainer.precision(), self.trainer.gpu.tensor_cores) {
+            (Precision::F32, _) => "",
+            (Precision::F16, true) => ", mixed precision on tensor cores",
+            (Precision::F16, false) => {
+                ", mixed precision without tensor cores (the adapter has no cooperative matrices)"
+            }
+        };
+        format!(
+            "GPU kernels on {}{products}, {data}",
+            self.trainer.adapter()
+        )
     }
 }

@@ -7,14 +7,19 @@
 
 use super::KernelSource;
 
-/// The kernel in `shaders/NAME.wgsl`, after the shared `shaders/PART.wgsl` files listed.
+/// The kernel in `shaders/NAME.wgsl`, after the shared `shaders/PART.wgsl` files listed (those
+/// with `enable` directives first: WGSL takes them only before any declaration); with
+/// `as "OTHER"`, named OTHER (a main file under another epilogue).
 macro_rules! kernel {
     ($name:literal $(, $part:literal)*) => {
+        kernel!($name as $name $(, $part)*)
+    };
+    ($file:literal as $name:literal $(, $part:literal)*) => {
         KernelSource {
             name: $name,
             wgsl: concat!(
                 $(include_str!(concat!("shaders/", $part, ".wgsl")),)*
-                include_str!(concat!("shaders/", $name, ".wgsl"))
+                include_str!(concat!("shaders/", $file, ".wgsl"))
             ),
         }
     };
@@ -39,7 +44,26 @@ pub const GBUFFER_FEATURES: KernelSource = kernel!("gbuffer_features", "pixel_fe
 /// the product with tensor cores and without.
 pub const HALF_ROWS: KernelSource = kernel!("half_rows");
 pub const HALF_DENSE: KernelSource = kernel!("half_dense", "half_layer");
-pub const HALF_DENSE_COOP: KernelSource = kernel!("half_dense_coop", "coop_matrix", "half_layer");
+pub const HALF_DENSE_COOP: KernelSource =
+    kernel!("half_dense_coop", "coop_matrix", "half_layer", "coop_drain");
+
+/// A mixed-precision training step's products (`half_products`): the dense layers' forward
+/// and input-gradient products (the frame path's products under `half_train_layer`'s
+/// epilogue), and the weight gradients, each with tensor cores and without.
+pub const HALF_TRAIN: KernelSource = kernel!("half_dense" as "half_train", "half_train_layer");
+pub const HALF_TRAIN_COOP: KernelSource = kernel!(
+    "half_dense_coop" as "half_train_coop",
+    "coop_matrix",
+    "half_train_layer",
+    "coop_drain"
+);
+pub const HALF_WEIGHT_GRAD: KernelSource = kernel!("half_weight_grad", "half_weight_sums");
+pub const HALF_WEIGHT_GRAD_COOP: KernelSource = kernel!(
+    "half_weight_grad_coop",
+    "coop_matrix",
+    "half_weight_sums",
+    "coop_drain"
+);
 
 /// Rows and columns of the tile a `gemm` workgroup computes.
 pub const GEMM_TILE: u32 = 128;

@@ -2,8 +2,10 @@
 //! Vulkan in the tests). This module owns the device (one per process), how a kernel is
 //! compiled and dispatched, storage buffers, the training step of every design on the device
 //! ([`GpuTrainer`]) and the training set held there ([`DeviceDataset`]). nprt-render's frame
-//! path dispatches these kernels and its own on the same device. The kernels compute what the CPU engine ([`crate::cpu`]) computes, in f32 (the frame
-//! path may also run its dense layers in f16: [`HalfWeight`]), and tests hold the two together; layouts, designs and the hash grid stay defined where the CPU
+//! path dispatches these kernels and its own on the same device. The kernels compute what the
+//! CPU engine ([`crate::cpu`]) computes, in f32 (the frame path and training may also run the
+//! transport networks' dense layers on f16 operands: [`HalfWeight`], `half_products`), and
+//! tests hold the two together; layouts, designs and the hash grid stay defined where the CPU
 //! engine reads them.
 
 mod buffer_pool;
@@ -14,6 +16,7 @@ mod gpu_buffer;
 mod gpu_device;
 mod gpu_trainer;
 mod half_layers;
+mod half_products;
 mod kernel;
 mod kernel_steps;
 mod kernel_timer;

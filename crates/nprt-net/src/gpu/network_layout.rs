@@ -1,6 +1,7 @@
 //! Where each tensor of a network lies in the flat parameter buffers, in the network's own
 //! structure (encoder blocks, tracks, layers), as the training step's dispatches address them.
 
+use super::half_products::HalfCopies;
 use super::parameters::{ParameterLayout, Span};
 use super::GpuDevice;
 use crate::cpu::{DenseStack, HostEncoder, HostTransport};
@@ -21,6 +22,31 @@ pub(super) struct DenseAt {
 pub(super) struct MlpAt {
     pub layers: Vec<DenseAt>,
     pub activation: Activation,
+    /// In a mixed-precision step, each layer's f16 weights (empty in f32).
+    pub half: Vec<HalfCopies>,
+}
+
+impl MlpAt {
+    /// Gives each layer f16 copies of its weight: the first layer's rows `[row, row + count)`
+    /// (what it multiplies its input by), every other layer's whole.
+    fn hold_half(&mut self, gpu: &GpuDevice, [row, count]: [usize; 2]) {
+        self.half = self
+            .layers
+            .iter()
+            .enumerate()
+            .map(|(i, l)| match i {
+                0 => HalfCopies::new(gpu, l, row, count),
+                _ => HalfCopies::new(gpu, l, 0, l.d_in),
+            })
+            .collect();
+    }
+
+    /// Each layer with its f16 copies, in a mixed-precision step.
+    pub fn half_layers(
+        &self,
+    ) -> impl DoubleEndedIterator<Item = (&DenseAt, &HalfCopies)> + ExactSizeIterator {
+        self.layers.iter().zip(&self.half)
+    }
 }
 
 /// One track's networks on the device.
@@ -72,12 +98,14 @@ pub(super) struct NetworkLayout {
 
 impl NetworkLayout {
     /// The places of `encoder`'s and `transport`'s tensors in `layout`; each track's input
-    /// indices are uploaded to `gpu`.
+    /// indices are uploaded to `gpu`, and with `half` the transport networks' f16 weights are
+    /// made there (zero until refreshed).
     pub fn new(
         gpu: &GpuDevice,
         layout: &ParameterLayout,
         encoder: &HostEncoder,
         transport: &HostTransport,
+        half: bool,
     ) -> Self {
         // Spans in the order ParameterLayout walks the tensors: the encoder's, then the tracks'.
         let mut spans = layout.spans.iter().copied();
@@ -96,7 +124,7 @@ impl NetworkLayout {
             d_in: encoder.to_code.d_in,
             d_out: encoder.to_code.d_out,
         };
-        let tracks = transport
+        let mut tracks: Vec<TrackAt> = transport
             .tracks
             .iter()
             .map(|t| {
@@ -114,6 +142,16 @@ impl NetworkLayout {
                 }
             })
             .collect();
+        if half {
+            for t in &mut tracks {
+                let (_, own_row) = t.code_and_own_rows();
+                let own = [own_row, t.own_width()];
+                if let Some(m) = &mut t.transfer {
+                    m.hold_half(gpu, [0, t.width]);
+                }
+                t.shading.hold_half(gpu, own);
+            }
+        }
         NetworkLayout {
             convs,
             to_code,
@@ -137,5 +175,6 @@ fn mlp_at(stack: &DenseStack, spans: &mut impl Iterator<Item = Span>) -> MlpAt {
             })
             .collect(),
         activation: stack.activation,
+        half: Vec::new(),
     }
 }

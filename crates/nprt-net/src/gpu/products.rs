@@ -14,11 +14,11 @@ const COLUMN_CHUNK: usize = 256;
 /// A weight gradient's product is split into chunks of at least ROW_CHUNK rows, at most
 /// ROW_CHUNKS of them (a 256 × 256 layer at batch 16,384: 32 chunks of 512 rows, 512
 /// workgroups instead of 16).
-const ROW_CHUNK: usize = 256;
-const ROW_CHUNKS: usize = 32;
+pub(super) const ROW_CHUNK: usize = 256;
+pub(super) const ROW_CHUNKS: usize = 32;
 
 /// Added to an activation's code, `gemm`'s epilogue multiplies by its derivative at z instead.
-const BACKWARD: u32 = 2;
+pub(super) const BACKWARD: u32 = 2;
 
 /// One operand of a product: element (i, k) at `offset + i · rows + k · cols` of `buffer`;
 /// for a left operand, `ones_row`'s elements read as ones instead.
@@ -63,6 +63,21 @@ pub enum Bias<'a> {
     Group(&'a wgpu::Buffer, &'a wgpu::Buffer),
 }
 
+impl<'a> Bias<'a> {
+    /// What a kernel's epilogue takes: its mode (0 none, 1 column, 2 group), its buffer, its
+    /// offset there and the rows' groups (`gpu`'s empty buffer for what is unused).
+    pub(super) fn binding(
+        self,
+        gpu: &'a GpuDevice,
+    ) -> (usize, &'a wgpu::Buffer, usize, &'a wgpu::Buffer) {
+        match self {
+            Bias::None => (0, &gpu.empty, 0, &gpu.empty),
+            Bias::Column(buffer, offset) => (1, buffer, offset, &gpu.empty),
+            Bias::Group(buffer, group) => (2, buffer, 0, group),
+        }
+    }
+}
+
 /// A product's output: `rows` values apart from `offset` of `buffer`, written or added to.
 /// For a column sum, `tail` (`[at, offset]`, `at` > 0) sends the sums from index `at` on to
 /// `offset` of the same buffer instead.
@@ -98,9 +113,11 @@ pub(super) struct FirstLayer<'a> {
 pub(super) type FirstLayerBias<'a> = &'a dyn Fn(&mut Vec<Dispatch>, &wgpu::Buffer);
 
 /// What an MLP's forward pass keeps: each layer's output and each hidden layer's
-/// pre-activation.
+/// pre-activation; in a mixed-precision step also its input as f16 rows, and the hidden
+/// layers' outputs are f16 rows (`half_products`).
 pub(super) struct MlpTape {
     pub rows: usize,
+    pub input16: Option<wgpu::Buffer>,
     pub outputs: Vec<wgpu::Buffer>,
     pub pre: Vec<wgpu::Buffer>,
 }
@@ -162,12 +179,7 @@ impl GpuDevice {
         z: Option<&wgpu::Buffer>,
         split: Option<[usize; 2]>,
     ) -> Dispatch {
-        let (bias_mode, bias_buffer, bias_off, groups): (usize, &wgpu::Buffer, usize, _) =
-            match bias {
-                Bias::None => (0, &self.empty, 0, &self.empty),
-                Bias::Column(buffer, offset) => (1, buffer, offset, &self.empty),
-                Bias::Group(buffer, group) => (2, buffer, 0, group),
-            };
+        let (bias_mode, bias_buffer, bias_off, groups) = bias.binding(self);
         let [k_chunk, chunks] = split.unwrap_or([0, 1]);
         let params = [
             m,
@@ -220,9 +232,13 @@ impl GpuTrainer {
 
     /// Buffers for an MLP's forward pass over `rows` rows.
     pub(super) fn tape(&self, m: &MlpAt, rows: usize) -> MlpTape {
+        if !m.half.is_empty() {
+            return self.half_tape(m, rows);
+        }
         let hidden = m.layers.len() - 1;
         MlpTape {
             rows,
+            input16: None,
             outputs: m
                 .layers
                 .iter()
@@ -245,6 +261,9 @@ impl GpuTrainer {
         first: FirstLayer,
         tape: &MlpTape,
     ) {
+        if !m.half.is_empty() {
+            return self.half_mlp_forward(plan, m, x, first, tape);
+        }
         let (rows, last) = (tape.rows, m.layers.len() - 1);
         let mut first = Some(first);
         for (i, layer) in m.layers.iter().enumerate() {
@@ -295,6 +314,9 @@ impl GpuTrainer {
         d_input: Option<&wgpu::Buffer>,
         on_first: Option<FirstLayerBias>,
     ) {
+        if !m.half.is_empty() {
+            return self.half_mlp_backward(plan, m, tape, d_last, d_input, on_first);
+        }
         let rows = tape.rows;
         let widest = m
             .layers

@@ -60,7 +60,8 @@ impl GpuTrainer {
             0,
             0,
         ];
-        params.extend([1.0 / (3 * b.rows.max(1)) as f32, 0.0, 0.0, 0.0].map(f32::to_bits));
+        let norm = b.grad_scale / (3 * b.rows.max(1)) as f32;
+        params.extend([norm, 0.0, 0.0, 0.0].map(f32::to_bits));
         plan.push(self.gpu.prepare(
             &RADIANCE_LOSS,
             &params,

@@ -9,7 +9,7 @@
 use std::path::Path;
 use std::sync::Mutex;
 
-use anyhow::{Context, Result};
+use anyhow::{bail, Context, Result};
 use burn::module::Module;
 use burn::optim::GradientsParams;
 use burn::tensor::Device;
@@ -28,6 +28,7 @@ use crate::training::train_options::{Gather, TrainOptions};
 use crate::training::training_loop::{self, Objective, Schedule, TrainSummary, ADAM_EPSILON};
 use crate::training::training_set::{TrainingSet, ViewSamples};
 use crate::training::validation::{forward_log_l1, validation_loss};
+use crate::Precision;
 
 /// A Neural PRT design learning a dataset's pixels.
 struct PixelObjective<'a> {
@@ -65,14 +66,19 @@ impl Objective for PixelObjective<'_> {
     }
 
     fn run_key(&self) -> serde_json::Value {
-        serde_json::json!({
+        let mut key = serde_json::json!({
             "config": self.config,
             "dataset_hash": self.set.dataset_hash,
             "batch_size": self.opts.batch_size,
             "views_per_batch": self.opts.views_per_batch,
             "val_samples": self.opts.val_samples,
             "loss": self.opts.loss,
-        })
+        });
+        // Named only where it is not f32, so that runs from before the choice still resume.
+        if self.opts.precision != Precision::F32 {
+            key["precision"] = serde_json::json!(self.opts.precision);
+        }
+        key
     }
 
     fn build(&self, init: &mut Init) -> NprtNet {
@@ -130,7 +136,8 @@ impl Objective for PixelObjective<'_> {
             return Ok(None);
         }
         let dataset = self.resident().then_some(self.set);
-        let steps = crate::gpu::KernelSteps::new(net, self.opts.loss, dataset)?;
+        let steps =
+            crate::gpu::KernelSteps::new(net, self.opts.loss, self.opts.precision, dataset)?;
         Ok(Some(Box::new(steps)))
     }
 
@@ -220,6 +227,13 @@ pub fn train(
     // On wgpu the steps run on our own kernels, with the network's host copy (for saving) on
     // the CPU.
     let kernels = cfg!(feature = "kernels") && Backend::of(device) == Backend::Wgpu;
+    if opts.precision != Precision::F32 && !kernels {
+        bail!(
+            "--precision {} trains on nprt's own GPU kernels only: use --device wgpu (a build \
+             with the `gpu` feature)",
+            opts.precision
+        );
+    }
     let objective = PixelObjective {
         set,
         config,

@@ -11,6 +11,7 @@ use crate::training::loss::Loss;
 use crate::training::lr_schedule::LrSchedule;
 use crate::training::run_length::RunLength;
 use crate::training::training_loop::Schedule;
+use crate::Precision;
 
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct TrainOptions {
@@ -32,6 +33,10 @@ pub struct TrainOptions {
     /// either way, so not part of the run's key.
     #[serde(default)]
     pub gather: Gather,
+    /// The transport networks' products on our own GPU kernels: f32, or f16 operands summed in
+    /// f32 on tensor cores where the adapter has them, with f32 master weights.
+    #[serde(default)]
+    pub precision: Precision,
 }
 
 /// Where a GPU step's batches are gathered.
@@ -64,6 +69,7 @@ impl Default for TrainOptions {
             loss: Loss::LogL1,
             calibration: Calibration::None,
             gather: Gather::Device,
+            precision: Precision::F32,
         }
     }
 }

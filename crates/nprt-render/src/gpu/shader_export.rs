@@ -22,7 +22,7 @@ use super::kernels::{HALF_SOURCES, SOURCES};
 use crate::{CameraPath, Relighter};
 
 /// Version of the export's layout, bumped whenever a reader would read it differently.
-pub const EXPORT_VERSION: u32 = 2;
+pub const EXPORT_VERSION: u32 = 3;
 
 /// The worked example's view: the model's scene from the start of `nprt render`'s default
 /// camera path, at this size, under this lighting.

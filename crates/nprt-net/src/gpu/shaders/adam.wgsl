@@ -1,6 +1,8 @@
 // One Adam step over every parameter at once (burn's formulation, which the CPU path uses):
 // m ← β1 m + (1 − β1) g, v ← β2 v + (1 − β2) g², θ ← θ − lr · m · c / (√v + ε · √(1 − β2^t))
-// with c = √(1 − β2^t) / (1 − β1^t), the bias corrections made on the host.
+// with c = √(1 − β2^t) / (1 − β1^t), the bias corrections made on the host. The gradients
+// arrive multiplied by the step's loss scale (1, or a power of two in a mixed-precision step,
+// so that f16 keeps them) and are divided by it first.
 
 struct Adam {
     count: u32,
@@ -14,7 +16,8 @@ struct Adam {
     factor: f32,
     // ε · √(1 − β2^t).
     epsilon: f32,
-    _pad3: f32,
+    // 1 / the loss scale.
+    unscale: f32,
     _pad4: f32,
     _pad5: f32,
 }
@@ -32,7 +35,7 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>, @builtin(num_workgroups) g
     if (i >= p.count) {
         return;
     }
-    let g = grad[i];
+    let g = grad[i] * p.unscale;
     let m1 = p.beta1 * m[i] + (1.0 - p.beta1) * g;
     let v1 = p.beta2 * v[i] + (1.0 - p.beta2) * g * g;
     m[i] = m1;

@@ -1,4 +1,4 @@
-// `half_layer`'s product without tensor cores: a thread per column of the workgroup's tile,
+// `half_dense_coop`'s product without tensor cores (under the same epilogues): a thread per column of the workgroup's tile,
 // down its 256 rows. It serves adapters without cooperative matrices (Mesa's software Vulkan,
 // where the tests check the half-precision layout and epilogue), not speed.
 

@@ -1,24 +1,9 @@
-// `half_layer`'s product on tensor cores: 16 × 16 × 16 f16 products into f32 (cooperative
-// matrices). Four subgroups of 32 each compute 64 rows × 64 columns (4 × 4 tiles: every tile of
+// A half-precision dense layer's product on tensor cores: 16 × 16 × 16 f16 products into f32
+// (cooperative matrices), under the epilogue of `half_layer` (frames) or `half_train_layer`
+// (training's forward and input-gradient products). Four subgroups of 32 each compute 64 rows × 64 columns (4 × 4 tiles: every tile of
 // x and W loaded is used four times), read straight from storage: on an H200, a probe of this
 // shape ran 60-76 TFLOP/s where staging through workgroup memory ran 10-18. A tile leaves
-// through workgroup memory, where each lane applies the epilogue to 8 of its values.
-
-var<workgroup> staged: array<f32, 1024>;
-
-// One 16 × 16 tile of sums from (row, col) through the subgroup's staging.
-fn drain(m: coop_mat16x16<f32, C>, sg: u32, lane: u32, row: u32, col: u32) {
-    let base = sg * 256u;
-    workgroupBarrier();
-    coopStoreT(m, &staged[base], 16u);
-    workgroupBarrier();
-    if (col < p.n_pad) {
-        for (var e = 0u; e < 8u; e++) {
-            let v = lane + 32u * e;
-            finish(row + v / 16u, col + v % 16u, staged[base + v]);
-        }
-    }
-}
+// through `coop_drain`.
 
 @compute @workgroup_size(128)
 fn main(@builtin(workgroup_id) group: vec3<u32>, @builtin(local_invocation_index) t: u32) {

@@ -1,8 +1,10 @@
 enable f16;
 
-// f32 rows (rows × cols, row stride `stride`) as f16 rows padded with zeros to k_pad columns:
-// the input of a half-precision dense layer (`half_layer`), up to `padded` rows (the rows past
-// `rows`, which that layer's workgroups also read, get zeros).
+// f32 rows (rows × cols: element (i, j) at offset + i · stride + j · col_stride) as f16 rows
+// padded with zeros to k_pad columns, up to `padded` rows (the rows past `rows` get zeros): the
+// input of a half-precision dense layer (`half_layer`), whose workgroups also read the padding
+// rows, and in a mixed-precision training step a weight's f16 copies, as stored and transposed,
+// and the loss's gradient.
 
 struct HalfRows {
     rows: u32,
@@ -10,9 +12,9 @@ struct HalfRows {
     cols: u32,
     stride: u32,
     k_pad: u32,
-    _pad0: u32,
-    _pad1: u32,
-    _pad2: u32,
+    offset: u32,
+    col_stride: u32,
+    _pad: u32,
 }
 
 @group(0) @binding(0) var<uniform> p: HalfRows;
@@ -29,7 +31,8 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>, @builtin(num_workgroups) g
     let j = e % p.k_pad;
     var v = 0.0;
     if (i < p.rows && j < p.cols) {
-        v = src[i * p.stride + j];
+        v = src[p.offset + i * p.stride + j * p.col_stride];
     }
-    dst[e] = f16(v);
+    // Saturated: a gradient past f16's range would otherwise become infinite.
+    dst[e] = f16(clamp(v, -65504.0, 65504.0));
 }

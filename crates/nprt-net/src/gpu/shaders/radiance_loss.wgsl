@@ -15,7 +15,8 @@ struct RadianceLoss {
     _pad0: u32,
     _pad1: u32,
     _pad2: u32,
-    // d mean / d value: 1 / (3 · rows of the whole batch).
+    // d mean / d value: 1 / (3 · rows of the whole batch), times the step's loss scale (1,
+    // or a power of two in a mixed-precision step).
     norm: f32,
     _pad3: f32,
     _pad4: f32,

@@ -1,0 +1,355 @@
+//! A mixed-precision training step's dense layers (`--precision f16`): each transport layer's
+//! weight is also held as f16, as stored and transposed, copied from the f32 master weights
+//! after every Adam step; the activations and the gradients between layers are held as f16
+//! rows in the frame path's layout (`half_layers`); every product sums in f32, on tensor cores
+//! where the adapter has cooperative matrices, elsewhere on plain kernels that compute the
+//! same sums (what the tests run). A layer's three products are its forward pass (`half_train`
+//! with bias, activation and the pre-activation kept in f32), its input gradient dz·Wᵀ (the
+//! same kernel on the transposed copy, times the activation's derivative) and its weight
+//! gradient xᵀ·dz over chunks of rows (`half_weight_grad`), whose chunks and the biases'
+//! gradients are added in f32 as in an f32 step. The loss's gradient is multiplied by a power
+//! of two near the batch's values (`BatchBuffers::grad_scale`) so that f16 keeps the small
+//! gradients, and Adam divides it back out; f16 values saturate instead of overflowing. The
+//! light encoder, the hash grids and the light code's share stay in f32.
+
+use super::codes::activation_code;
+use super::gpu_trainer::GpuTrainer;
+use super::half_layers::{held_halves, pad16, HalfWeight};
+use super::kernels::{HALF_TRAIN, HALF_TRAIN_COOP, HALF_WEIGHT_GRAD, HALF_WEIGHT_GRAD_COOP};
+use super::network_layout::{DenseAt, MlpAt};
+use super::products::{
+    Bias, FirstLayer, FirstLayerBias, MlpTape, Output, BACKWARD, ROW_CHUNK, ROW_CHUNKS,
+};
+use super::{groups_for, Dispatch, GpuDevice};
+
+/// A dense layer's f16 copies of its weight rows `[row, row + count)`: as stored (the forward
+/// product's right operand) and transposed (the input gradient's).
+pub(super) struct HalfCopies {
+    pub row: usize,
+    pub count: usize,
+    pub stored: HalfWeight,
+    pub transposed: HalfWeight,
+}
+
+impl HalfCopies {
+    pub fn new(gpu: &GpuDevice, layer: &DenseAt, row: usize, count: usize) -> Self {
+        let held = |rows: usize, cols: usize| HalfWeight {
+            buffer: gpu.half_buffer((rows + 16) * pad16(cols)),
+            d_out: cols,
+            n_pad: pad16(cols),
+        };
+        HalfCopies {
+            row,
+            count,
+            stored: held(count, layer.d_out),
+            transposed: held(layer.d_out, count),
+        }
+    }
+
+    /// The dispatches that copy `layer`'s current weight from `params` into both copies.
+    pub fn refresh(
+        &self,
+        gpu: &GpuDevice,
+        params: &wgpu::Buffer,
+        layer: &DenseAt,
+    ) -> [Dispatch; 2] {
+        let (n, k) = (layer.d_out, self.count);
+        let offset = layer.weight.offset + self.row * n;
+        [
+            gpu.half_matrix([k, n], [n, 1], offset, k + 16, params, &self.stored.buffer),
+            gpu.half_matrix(
+                [n, k],
+                [1, n],
+                offset,
+                n + 16,
+                params,
+                &self.transposed.buffer,
+            ),
+        ]
+    }
+}
+
+/// Where a mixed-precision product's results go.
+pub(super) struct HalfOut<'a> {
+    /// The pre-activation: kept here by a forward product, read for the activation's
+    /// derivative by a backward one.
+    pub z: Option<&'a wgpu::Buffer>,
+    /// f16 rows padded as `half_layers` holds them (the next product's operand).
+    pub y16: Option<&'a wgpu::Buffer>,
+    /// f32 rows of the layer's width.
+    pub y32: Option<&'a wgpu::Buffer>,
+}
+
+impl GpuDevice {
+    /// The dispatch of `act(x·W + bias)` over `rows` rows of `x` (f16 rows of `k_pad` values)
+    /// with `w` from its first row; `activation` 3 or 4 multiplies by ReLU's or SIREN's
+    /// derivative at `out.z` instead (`half_train_layer.wgsl`).
+    fn half_train_layer(
+        &self,
+        rows: usize,
+        (x, k_pad): (&wgpu::Buffer, usize),
+        w: &HalfWeight,
+        bias: Bias,
+        activation: u32,
+        out: HalfOut,
+    ) -> Dispatch {
+        let (bias_mode, bias_buffer, bias_off, group_of) = bias.binding(self);
+        let keep_z = out.z.is_some() && activation < 1 + BACKWARD;
+        let params = [
+            rows,
+            w.d_out,
+            w.n_pad,
+            k_pad,
+            0,
+            activation as usize,
+            bias_mode,
+            bias_off,
+            usize::from(keep_z),
+            usize::from(out.y16.is_some()),
+            usize::from(out.y32.is_some()),
+            0,
+        ]
+        .map(|v| v as u32);
+        let kernel = if self.tensor_cores {
+            &HALF_TRAIN_COOP
+        } else {
+            &HALF_TRAIN
+        };
+        let groups = [
+            w.n_pad.div_ceil(64) as u32,
+            rows.div_ceil(super::HALF_ROW_BLOCK) as u32,
+        ];
+        self.prepare(
+            kernel,
+            &params,
+            &[
+                x,
+                &w.buffer,
+                bias_buffer,
+                group_of,
+                out.z.unwrap_or(&self.spare),
+                out.y16.unwrap_or(&self.spare),
+                out.y32.unwrap_or(&self.spare),
+            ],
+            groups,
+        )
+    }
+
+    /// The dispatch of xᵀ·dz, `[m, n]`, over `rows` rows cut into chunks of `chunk` rows, chunk
+    /// c's sums into `partial` from c · m · n (`half_weight_sums.wgsl`).
+    fn half_weight_grad(
+        &self,
+        [m, n, rows]: [usize; 3],
+        (x, k_pad): (&wgpu::Buffer, usize),
+        (dz, n_pad): (&wgpu::Buffer, usize),
+        [chunk, chunks]: [usize; 2],
+        partial: &wgpu::Buffer,
+    ) -> Dispatch {
+        let params = [rows.next_multiple_of(16), chunk, m, n, k_pad, n_pad, 0, 0].map(|v| v as u32);
+        let buffers: [&dyn super::Bind; 3] = [x, dz, partial];
+        if self.tensor_cores {
+            let groups = [
+                n_pad.div_ceil(64) as u32,
+                k_pad.div_ceil(256) as u32,
+                chunks as u32,
+            ];
+            self.prepare_grid(&HALF_WEIGHT_GRAD_COOP, &params, &buffers, groups)
+        } else {
+            let groups = groups_for(chunks * m * n);
+            self.prepare(&HALF_WEIGHT_GRAD, &params, &buffers, groups)
+        }
+    }
+}
+
+impl GpuTrainer {
+    /// The tape of `m` over `rows` rows in a mixed-precision step: its input and hidden
+    /// layers' outputs as f16 rows, its last layer's output and the pre-activations in f32.
+    pub(super) fn half_tape(&self, m: &MlpAt, rows: usize) -> MlpTape {
+        let gpu = &self.gpu;
+        let last = m.layers.len() - 1;
+        MlpTape {
+            rows,
+            input16: Some(gpu.half_buffer(held_halves(rows, m.half[0].count))),
+            outputs: m
+                .layers
+                .iter()
+                .enumerate()
+                .map(|(i, l)| match i == last {
+                    true => gpu.buffer(rows * l.d_out),
+                    false => gpu.half_buffer(held_halves(rows, l.d_out)),
+                })
+                .collect(),
+            pre: m.layers[..last]
+                .iter()
+                .map(|l| gpu.buffer(rows * l.d_out))
+                .collect(),
+        }
+    }
+
+    /// [`Self::mlp_forward`] in a mixed-precision step: `x` (f32, `first.count` values a row)
+    /// made f16 once, then each layer's product from the f16 output of the one before.
+    pub(super) fn half_mlp_forward(
+        &self,
+        plan: &mut Vec<Dispatch>,
+        m: &MlpAt,
+        x: &wgpu::Buffer,
+        first: FirstLayer,
+        tape: &MlpTape,
+    ) {
+        let rows = tape.rows;
+        let input = tape.input16.as_ref().expect("a mixed-precision tape");
+        plan.push(
+            self.gpu
+                .half_rows([rows, first.count, first.count], x, input),
+        );
+        let last = m.layers.len() - 1;
+        let mut first_bias = Some(first.bias);
+        for (i, (layer, copies)) in m.half_layers().enumerate() {
+            let (x16, bias) = match first_bias.take() {
+                Some(bias) => (input, bias),
+                None => (
+                    &tape.outputs[i - 1],
+                    Bias::Column(&self.params, layer.bias.offset),
+                ),
+            };
+            let hidden = i < last;
+            let out = HalfOut {
+                z: tape.pre.get(i),
+                y16: hidden.then_some(&tape.outputs[i]),
+                y32: (!hidden).then_some(&tape.outputs[i]),
+            };
+            let activation = if hidden {
+                activation_code(m.activation)
+            } else {
+                0
+            };
+            plan.push(self.gpu.half_train_layer(
+                rows,
+                (x16, pad16(copies.count)),
+                &copies.stored,
+                bias,
+                activation,
+                out,
+            ));
+        }
+    }
+
+    /// [`Self::mlp_backward`] in a mixed-precision step: the gradient at each layer's output
+    /// as f16 rows for the products and as f32 rows for the bias's gradient (and `on_first`),
+    /// the gradient at the first layer's input into `d_input` (f32) where given.
+    pub(super) fn half_mlp_backward(
+        &self,
+        plan: &mut Vec<Dispatch>,
+        m: &MlpAt,
+        tape: &MlpTape,
+        d_last: &wgpu::Buffer,
+        d_input: Option<&wgpu::Buffer>,
+        on_first: Option<FirstLayerBias>,
+    ) {
+        let (gpu, rows) = (&self.gpu, tape.rows);
+        let last = m.layers.len() - 1;
+        let widest = m
+            .layers
+            .iter()
+            .map(|l| l.d_in.max(l.d_out))
+            .max()
+            .unwrap_or(0);
+        let dz16 = [0, 1].map(|_| gpu.half_buffer(held_halves(rows, widest)));
+        let dz32 = [0, 1].map(|_| gpu.buffer(rows * widest));
+        let out_width = m.layers[last].d_out;
+        let d_last16 = gpu.half_buffer(held_halves(rows, out_width));
+        plan.push(gpu.half_rows([rows, out_width, out_width], d_last, &d_last16));
+        for (i, (layer, copies)) in m.half_layers().enumerate().rev() {
+            let (g16, g32) = match i == last {
+                true => (&d_last16, d_last),
+                false => (&dz16[i % 2], &dz32[i % 2]),
+            };
+            let x16 = match i {
+                0 => tape.input16.as_ref().expect("a mixed-precision tape"),
+                _ => &tape.outputs[i - 1],
+            };
+            let n_pad = pad16(layer.d_out);
+            self.half_weight_gradient(
+                plan,
+                [copies.count, layer.d_out, rows],
+                x16,
+                g16,
+                layer.weight.offset + copies.row * layer.d_out,
+            );
+            match on_first.filter(|_| i == 0) {
+                Some(f) => f(plan, g32),
+                None => self.column_sum(
+                    plan,
+                    g32,
+                    rows,
+                    layer.d_out,
+                    None,
+                    Output::to(&self.grads, layer.bias.offset, layer.d_out),
+                ),
+            }
+            let (derivative, out) = match i {
+                0 => match d_input {
+                    Some(d) => (
+                        0,
+                        HalfOut {
+                            z: None,
+                            y16: None,
+                            y32: Some(d),
+                        },
+                    ),
+                    None => continue,
+                },
+                _ => (
+                    activation_code(m.activation) + BACKWARD,
+                    HalfOut {
+                        z: Some(&tape.pre[i - 1]),
+                        y16: Some(&dz16[(i - 1) % 2]),
+                        y32: Some(&dz32[(i - 1) % 2]),
+                    },
+                ),
+            };
+            plan.push(gpu.half_train_layer(
+                rows,
+                (g16, n_pad),
+                &copies.transposed,
+                Bias::None,
+                derivative,
+                out,
+            ));
+        }
+    }
+
+    /// Records a weight's gradient, `[m, n, rows]`: xᵀ·dz over the rows (f16 operands), per
+    /// chunk of rows, the chunks added in order into `grads` from `offset`.
+    fn half_weight_gradient(
+        &self,
+        plan: &mut Vec<Dispatch>,
+        [m, n, rows]: [usize; 3],
+        x: &wgpu::Buffer,
+        dz: &wgpu::Buffer,
+        offset: usize,
+    ) {
+        let padded = rows.next_multiple_of(16);
+        let chunk = padded
+            .div_ceil(ROW_CHUNKS)
+            .next_multiple_of(16)
+            .max(ROW_CHUNK);
+        let chunks = padded.div_ceil(chunk);
+        let partial = self.gpu.buffer(chunks * m * n);
+        plan.push(self.gpu.half_weight_grad(
+            [m, n, rows],
+            (x, pad16(m)),
+            (dz, pad16(n)),
+            [chunk, chunks],
+            &partial,
+        ));
+        self.column_sum(
+            plan,
+            &partial,
+            chunks,
+            m * n,
+            None,
+            Output::to(&self.grads, offset, n),
+        );
+    }
+}
