@@ -162,30 +162,6 @@ impl GpuDevice {
 }
 
 impl GpuTrainer {
-    /// The tape of `m` over `rows` rows in a mixed-precision step: its input and hidden
-    /// layers' outputs as f16 rows, its last layer's output and the pre-activations in f32.
-    pub(super) fn half_tape(&self, m: &MlpAt, rows: usize) -> MlpTape {
-        let gpu = &self.gpu;
-        let last = m.layers.len() - 1;
-        MlpTape {
-            rows,
-            input16: Some(gpu.half_buffer(held_halves(rows, m.half[0].count))),
-            outputs: m
-                .layers
-                .iter()
-                .enumerate()
-                .map(|(i, l)| match i == last {
-                    true => gpu.buffer(rows * l.d_out),
-                    false => gpu.half_buffer(held_halves(rows, l.d_out)),
-                })
-                .collect(),
-            pre: m.layers[..last]
-                .iter()
-                .map(|l| gpu.buffer(rows * l.d_out))
-                .collect(),
-        }
-    }
-
     /// [`Self::mlp_forward`] in a mixed-precision step: `x` (f32, `first.count` values a row)
     /// made f16 once, then each layer's product from the f16 output of the one before.
     pub(super) fn half_mlp_forward(

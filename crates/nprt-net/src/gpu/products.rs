@@ -3,6 +3,7 @@
 //! (keeping what backward needs) and backward pass, each a few dispatches appended to a plan.
 
 use super::codes::activation_code;
+use super::half_layers::held_halves;
 use super::gpu_trainer::GpuTrainer;
 use super::kernels::{COLUMN_SUM, GEMM, GEMM_TILE};
 use super::network_layout::MlpAt;
@@ -230,21 +231,24 @@ impl GpuTrainer {
         }
     }
 
-    /// Buffers for an MLP's forward pass over `rows` rows.
+    /// Buffers for an MLP's forward pass over `rows` rows; in a mixed-precision step its input
+    /// and hidden layers' outputs as f16 rows (`half_products`).
     pub(super) fn tape(&self, m: &MlpAt, rows: usize) -> MlpTape {
-        if !m.half.is_empty() {
-            return self.half_tape(m, rows);
-        }
-        let hidden = m.layers.len() - 1;
+        let half = !m.half.is_empty();
+        let last = m.layers.len() - 1;
         MlpTape {
             rows,
-            input16: None,
+            input16: half.then(|| self.gpu.half_buffer(held_halves(rows, m.half[0].count))),
             outputs: m
                 .layers
                 .iter()
-                .map(|l| self.gpu.buffer(rows * l.d_out))
+                .enumerate()
+                .map(|(i, l)| match half && i < last {
+                    true => self.gpu.half_buffer(held_halves(rows, l.d_out)),
+                    false => self.gpu.buffer(rows * l.d_out),
+                })
                 .collect(),
-            pre: m.layers[..hidden]
+            pre: m.layers[..last]
                 .iter()
                 .map(|l| self.gpu.buffer(rows * l.d_out))
                 .collect(),
