@@ -58,8 +58,8 @@ pub struct GpuTrainer {
     /// Adam over every parameter; its rate and bias corrections are rewritten each step.
     adam: Dispatch,
     precision: Precision,
-    /// In mixed precision, the copies of the transport layers' weights into their f16 copies,
-    /// run after Adam (empty in f32).
+    /// In mixed precision, the dispatches that copy the transport layers' weights into their
+    /// f16 copies, run after Adam (none in f32).
     half_refresh: Vec<Dispatch>,
     /// Two host-readable copies of a step's loss, used in turn: one step's is read while the
     /// next one runs.
