@@ -7,7 +7,7 @@
 //! (`half_products`) hold their operands in the same layout.
 
 use super::kernels::{HALF_DENSE, HALF_DENSE_COOP, HALF_ROWS};
-use super::{groups_for, Dispatch, GpuDevice};
+use super::{groups_for, Bind, Dispatch, GpuDevice, KernelSource};
 
 /// Rows a half-precision layer's workgroup covers: its inputs and outputs hold the rows up to
 /// the next multiple of this.
@@ -42,11 +42,17 @@ pub enum Held<'a> {
     F16(&'a wgpu::Buffer),
 }
 
+/// f16 values a `d_in × d_out` weight takes as [`HalfWeight`] holds it: `d_in + 16` rows of
+/// `pad16(d_out)`.
+fn half_weight_halves(d_in: usize, d_out: usize) -> usize {
+    (d_in + 16) * pad16(d_out)
+}
+
 /// `weight` (`d_in × d_out`, row-major) as the f16 bits [`HalfWeight`] holds: `d_in + 16` rows
 /// of `pad16(d_out)` values, zeros past the weight's (what `nprt export` writes too).
 pub fn half_weight_bits(weight: &[f32], d_in: usize, d_out: usize) -> Vec<u16> {
     let n_pad = pad16(d_out);
-    let mut padded = vec![0u16; (d_in + 16) * n_pad];
+    let mut padded = vec![0u16; half_weight_halves(d_in, d_out)];
     for (row, values) in padded.chunks_mut(n_pad).zip(weight.chunks(d_out)) {
         for (h, &v) in row.iter_mut().zip(values) {
             *h = half::f16::from_f32(v).to_bits();
@@ -60,6 +66,16 @@ impl GpuDevice {
     pub fn upload_half_weight(&self, weight: &[f32], d_in: usize, d_out: usize) -> HalfWeight {
         HalfWeight {
             buffer: self.upload(&half_weight_bits(weight, d_in, d_out)),
+            d_out,
+            n_pad: pad16(d_out),
+        }
+    }
+
+    /// A `d_in × d_out` weight in the layout [`HalfWeight`] describes, zero (a mixed-precision
+    /// training step copies its weights in on the device).
+    pub fn half_weight(&self, d_in: usize, d_out: usize) -> HalfWeight {
+        HalfWeight {
+            buffer: self.half_buffer(half_weight_halves(d_in, d_out)),
             d_out,
             n_pad: pad16(d_out),
         }
@@ -132,15 +148,29 @@ impl GpuDevice {
             0,
         ]
         .map(|v| v as u32);
-        let kernel = if self.tensor_cores {
-            &HALF_DENSE_COOP
-        } else {
-            &HALF_DENSE
-        };
+        self.half_dense(
+            [&HALF_DENSE, &HALF_DENSE_COOP],
+            &params,
+            &[x, &w.buffer, bias, y16, y32],
+            [rows, w.n_pad],
+        )
+    }
+
+    /// The dispatch of a half-precision dense product (`half_dense`'s main, or on tensor cores
+    /// `half_dense_coop`'s: the first or second of `kernels`, each under its epilogue) over
+    /// `rows` rows and `n_pad` output columns, with the epilogue's `params` and `buffers`.
+    pub(super) fn half_dense(
+        &self,
+        [plain, coop]: [&KernelSource; 2],
+        params: &[u32],
+        buffers: &[&dyn Bind],
+        [rows, n_pad]: [usize; 2],
+    ) -> Dispatch {
+        let kernel = if self.tensor_cores { coop } else { plain };
         let groups = [
-            w.n_pad.div_ceil(HALF_COLS) as u32,
+            n_pad.div_ceil(HALF_COLS) as u32,
             rows.div_ceil(HALF_ROW_BLOCK) as u32,
         ];
-        self.prepare(kernel, &params, &[x, &w.buffer, bias, y16, y32], groups)
+        self.prepare(kernel, params, buffers, groups)
     }
 }

@@ -17,9 +17,7 @@ use super::gpu_trainer::GpuTrainer;
 use super::half_layers::{held_halves, pad16, HalfWeight};
 use super::kernels::{HALF_TRAIN, HALF_TRAIN_COOP, HALF_WEIGHT_GRAD, HALF_WEIGHT_GRAD_COOP};
 use super::network_layout::{DenseAt, MlpAt};
-use super::products::{
-    Bias, FirstLayer, FirstLayerBias, MlpTape, Output, BACKWARD, ROW_CHUNK, ROW_CHUNKS,
-};
+use super::products::{row_chunks, Bias, FirstLayer, FirstLayerBias, MlpTape, Output, BACKWARD};
 use super::{groups_for, Dispatch, GpuDevice};
 
 /// A dense layer's f16 copies of its weight rows `[row, row + count)`: as stored (the forward
@@ -33,16 +31,11 @@ pub(super) struct HalfCopies {
 
 impl HalfCopies {
     pub fn new(gpu: &GpuDevice, layer: &DenseAt, row: usize, count: usize) -> Self {
-        let held = |rows: usize, cols: usize| HalfWeight {
-            buffer: gpu.half_buffer((rows + 16) * pad16(cols)),
-            d_out: cols,
-            n_pad: pad16(cols),
-        };
         HalfCopies {
             row,
             count,
-            stored: held(count, layer.d_out),
-            transposed: held(layer.d_out, count),
+            stored: gpu.half_weight(count, layer.d_out),
+            transposed: gpu.half_weight(layer.d_out, count),
         }
     }
 
@@ -110,17 +103,8 @@ impl GpuDevice {
             0,
         ]
         .map(|v| v as u32);
-        let kernel = if self.tensor_cores {
-            &HALF_TRAIN_COOP
-        } else {
-            &HALF_TRAIN
-        };
-        let groups = [
-            w.n_pad.div_ceil(64) as u32,
-            rows.div_ceil(super::HALF_ROW_BLOCK) as u32,
-        ];
-        self.prepare(
-            kernel,
+        self.half_dense(
+            [&HALF_TRAIN, &HALF_TRAIN_COOP],
             &params,
             &[
                 x,
@@ -131,7 +115,7 @@ impl GpuDevice {
                 out.y16.unwrap_or(&self.spare),
                 out.y32.unwrap_or(&self.spare),
             ],
-            groups,
+            [rows, w.n_pad],
         )
     }
 
@@ -224,12 +208,7 @@ impl GpuTrainer {
     ) {
         let (gpu, rows) = (&self.gpu, tape.rows);
         let last = m.layers.len() - 1;
-        let widest = m
-            .layers
-            .iter()
-            .map(|l| l.d_in.max(l.d_out))
-            .max()
-            .unwrap_or(0);
+        let widest = m.widest();
         let dz16 = [0, 1].map(|_| gpu.half_buffer(held_halves(rows, widest)));
         let dz32 = [0, 1].map(|_| gpu.buffer(rows * widest));
         let out_width = m.layers[last].d_out;
@@ -305,12 +284,7 @@ impl GpuTrainer {
         dz: &wgpu::Buffer,
         offset: usize,
     ) {
-        let padded = rows.next_multiple_of(16);
-        let chunk = padded
-            .div_ceil(ROW_CHUNKS)
-            .next_multiple_of(16)
-            .max(ROW_CHUNK);
-        let chunks = padded.div_ceil(chunk);
+        let [chunk, chunks] = row_chunks(rows.next_multiple_of(16), 16);
         let partial = self.gpu.buffer(chunks * m * n);
         plan.push(self.gpu.half_weight_grad(
             [m, n, rows],

@@ -41,6 +41,16 @@ impl MlpAt {
             .collect();
     }
 
+    /// The widest of its layers' inputs and outputs: what a row of a gradient between layers
+    /// needs at most.
+    pub fn widest(&self) -> usize {
+        self.layers
+            .iter()
+            .map(|l| l.d_in.max(l.d_out))
+            .max()
+            .unwrap_or(0)
+    }
+
     /// Each layer with its f16 copies, in a mixed-precision step.
     pub fn half_layers(
         &self,

@@ -3,8 +3,8 @@
 //! (keeping what backward needs) and backward pass, each a few dispatches appended to a plan.
 
 use super::codes::activation_code;
-use super::half_layers::held_halves;
 use super::gpu_trainer::GpuTrainer;
+use super::half_layers::held_halves;
 use super::kernels::{COLUMN_SUM, GEMM, GEMM_TILE};
 use super::network_layout::MlpAt;
 use super::parameters::Span;
@@ -15,8 +15,18 @@ const COLUMN_CHUNK: usize = 256;
 /// A weight gradient's product is split into chunks of at least ROW_CHUNK rows, at most
 /// ROW_CHUNKS of them (a 256 × 256 layer at batch 16,384: 32 chunks of 512 rows, 512
 /// workgroups instead of 16).
-pub(super) const ROW_CHUNK: usize = 256;
-pub(super) const ROW_CHUNKS: usize = 32;
+const ROW_CHUNK: usize = 256;
+const ROW_CHUNKS: usize = 32;
+
+/// How a weight gradient's sum over `rows` rows is split: `[rows a chunk, chunks]`, each chunk
+/// a multiple of `align` rows (a tensor-core product's tile side; 1 for `gemm`).
+pub(super) fn row_chunks(rows: usize, align: usize) -> [usize; 2] {
+    let chunk = rows
+        .div_ceil(ROW_CHUNKS)
+        .next_multiple_of(align)
+        .max(ROW_CHUNK);
+    [chunk, rows.div_ceil(chunk)]
+}
 
 /// Added to an activation's code, `gemm`'s epilogue multiplies by its derivative at z instead.
 pub(super) const BACKWARD: u32 = 2;
@@ -322,13 +332,7 @@ impl GpuTrainer {
             return self.half_mlp_backward(plan, m, tape, d_last, d_input, on_first);
         }
         let rows = tape.rows;
-        let widest = m
-            .layers
-            .iter()
-            .map(|l| l.d_in.max(l.d_out))
-            .max()
-            .unwrap_or(0);
-        let scratch = [0, 1].map(|_| self.gpu.buffer(rows * widest));
+        let scratch = [0, 1].map(|_| self.gpu.buffer(rows * m.widest()));
         let last = m.layers.len() - 1;
         for (i, layer) in m.layers.iter().enumerate().rev() {
             // A hidden layer's dz is already the gradient at its pre-activation: the product
@@ -404,8 +408,7 @@ impl GpuTrainer {
         offset: usize,
         bias: Option<usize>,
     ) {
-        let chunk = rows.div_ceil(ROW_CHUNKS).max(ROW_CHUNK);
-        let chunks = rows.div_ceil(chunk);
+        let [chunk, chunks] = row_chunks(rows, 1);
         let mut out = Output::to(&self.grads, offset, n);
         if chunks <= 1 && bias.is_none() {
             plan.push(
