@@ -4,7 +4,7 @@
 # (2026-11-26): training at 16,384 with the eager peers about 70 s, with the torch.compile ones
 # 4 more minutes; at 262,144 with the eager peers about 60 s; frames about 50 s; with --kitchen
 # 10 minutes of training and an evaluation more. Writes one summary file (Markdown) with:
-#   1. `nprt bench train --device wgpu --profile` (nprt's own kernels, and each kernel's GPU
+#   1. `nprt bench train --device gpu --profile` (nprt's own kernels, and each kernel's GPU
 #      time in a step) per design, in f32 and in mixed precision (f16 products on tensor cores),
 #      beside PyTorch on CUDA, eager and torch.compile, each in f32 and bf16 autocast (the
 #      fastest is the peer), at batch 16,384 and 262,144;
@@ -111,7 +111,7 @@ for batch in $batches; do
   steps=$([ "$batch" -le 16384 ] && echo 20 || echo 5)
   log "training throughput at batch $batch"
   section "Training samples/s at batch $batch (nprt's kernels on wgpu; PyTorch on CUDA)"
-  "$nprt" bench train --device wgpu --python "$python" --peer-variants "$variants" \
+  "$nprt" bench train --device gpu --python "$python" --peer-variants "$variants" \
     --precision "$precisions" --arch "$designs" --batch-size "$batch" --steps "$steps" \
     --warmup 3 --rounds 1 --profile \
     | tee "$work/train-$batch.txt" >>"$summary"
@@ -132,8 +132,8 @@ end_section
 
 # 3. The frame, stage by stage.
 log "frame timings"
-section "Frame ms (nprt bench frame --device wgpu); the paper's Table 3 (RTX 3090, 512²): encoder 0.34 ms, networks 9.7-16 ms"
-"$nprt" bench frame --device wgpu --arch "$designs" --res "$res" --repeats 10 --precision f32,f16 \
+section "Frame ms (nprt bench frame --device gpu); the paper's Table 3 (RTX 3090, 512²): encoder 0.34 ms, networks 9.7-16 ms"
+"$nprt" bench frame --device gpu --arch "$designs" --res "$res" --repeats 10 --precision f32,f16 \
   --profile >>"$summary"
 end_section
 
@@ -141,12 +141,12 @@ end_section
 if [ -n "$kitchen" ]; then
   log "training D/S on '$kitchen' for 10 minutes ($kitchen_precision)"
   section "KITCHEN: D/S trained 10 minutes on the GPU ($kitchen_precision)"
-  "$nprt" train --data "$kitchen" --arch dsep --minutes 10 --device wgpu --out "$work/kitchen-gpu" \
+  "$nprt" train --data "$kitchen" --arch dsep --minutes 10 --device gpu --out "$work/kitchen-gpu" \
     --precision "$kitchen_precision" >>"$summary"
   end_section
   log "evaluating"
   "$nprt" eval --model "$work/kitchen-gpu","$cpu_model" --data "$kitchen" --out "$work/kitchen-eval" \
-    --device wgpu >/dev/null
+    --device gpu >/dev/null
   printf '\n## KITCHEN: nprt eval of the GPU model, then the CPU model\n\n' >>"$summary"
   cat "$work/kitchen-eval/report.md" >>"$summary"
 fi

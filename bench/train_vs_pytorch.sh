@@ -3,7 +3,7 @@
 # same layers, batch, maps per batch and loss) on this machine's cores; prints samples/s of
 # each design and the ratio. PyTorch goes into target/torch-venv on first use (about 5 GB,
 # since PyPI's wheel carries CUDA libraries).
-# For `--device gpu` build the CUDA backend in: NPRT_FEATURES=cuda bench/train_vs_pytorch.sh --device gpu
+# For `--device gpu` (nprt's GPU kernels) build them in: NPRT_FEATURES=gpu bench/train_vs_pytorch.sh --device gpu
 # usage: bench/train_vs_pytorch.sh [nprt bench train options, e.g. --steps 20 --arch prt]
 set -euo pipefail
 cd "$(dirname "$0")/.."

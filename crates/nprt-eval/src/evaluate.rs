@@ -10,9 +10,10 @@ use nprt_data::dataset::Manifest;
 use nprt_data::dataset::{load_checked_scene, load_manifest_hashed};
 use nprt_data::views::{load_views, ImageView};
 use nprt_net::training::training_set::open_recorded_map;
-use nprt_net::Device;
+use nprt_net::Engine;
 use nprt_render::oidn::Oidn;
 use nprt_render::DirectSampling;
+use nprt_scene::EnvMap;
 use nprt_trace::TraceScene;
 use serde::{Deserialize, Serialize};
 
@@ -59,7 +60,7 @@ pub struct Evaluation {
 
 /// Runs the whole evaluation: the networks first (the slowest Neural PRT design sets the
 /// equal-time sample count), then path tracing, denoised path tracing and SH PRT.
-pub fn evaluate(o: &EvalOptions, device: &Device) -> Result<Evaluation> {
+pub fn evaluate(o: &EvalOptions, engine: Engine) -> Result<Evaluation> {
     if o.sh_spp == 0 || o.timing_res < 8 {
         bail!("--sh-spp must be at least 1 and --timing-res at least 8");
     }
@@ -71,23 +72,11 @@ pub fn evaluate(o: &EvalOptions, device: &Device) -> Result<Evaluation> {
         &format!("dataset '{}' was rendered from", o.data.display()),
     )?;
     let views = test_views(o, &manifest)?;
-    // Only the maps of the views evaluated: a dataset with a fresh map per training view has
-    // thousands of others.
-    let maps = views
-        .iter()
-        .map(|v| v.record.map)
-        .collect::<BTreeSet<_>>()
-        .into_iter()
-        .map(|m| Ok((m, open_recorded_map(&manifest, m)?)))
-        .collect::<Result<BTreeMap<_, _>>>()?;
-    let nets = load_networks(o, device, &dataset_hash, &s.scene_hash)?;
+    let maps = views_maps(&manifest, &views)?;
+    let nets = load_networks(o, engine, &dataset_hash, &s.scene_hash)?;
     let ts = TraceScene::new(&scene);
     let oidn = Oidn::open();
-    let denoiser = match &oidn {
-        Ok(_) => "Intel Open Image Denoise 1.4.3 (RT filter, HDR, albedo and normal auxiliaries)"
-            .to_string(),
-        Err(e) => format!("unavailable: {e:#}"),
-    };
+    let denoiser = describe_denoiser(&oidn);
     let shown = views[..o.shown_views.min(views.len())]
         .iter()
         .map(ShownView::of)
@@ -160,6 +149,27 @@ pub fn evaluate(o: &EvalOptions, device: &Device) -> Result<Evaluation> {
         cpu_threads: rayon::current_num_threads(),
         shown: bench.shown,
     })
+}
+
+/// The maps of the views evaluated, by index: only those, since a dataset with a fresh map per
+/// training view has thousands of others.
+fn views_maps(manifest: &Manifest, views: &[ImageView]) -> Result<BTreeMap<usize, EnvMap>> {
+    views
+        .iter()
+        .map(|v| v.record.map)
+        .collect::<BTreeSet<_>>()
+        .into_iter()
+        .map(|m| Ok((m, open_recorded_map(manifest, m)?)))
+        .collect()
+}
+
+/// The denoiser for the report: OIDN's settings, or why it is unavailable.
+fn describe_denoiser(oidn: &Result<&'static Oidn>) -> String {
+    match oidn {
+        Ok(_) => "Intel Open Image Denoise 1.4.3 (RT filter, HDR, albedo and normal auxiliaries)"
+            .to_string(),
+        Err(e) => format!("unavailable: {e:#}"),
+    }
 }
 
 /// Stops at a metric that is not a finite number (it would be `null` in results.json and

@@ -6,7 +6,7 @@ use std::time::Instant;
 
 use anyhow::{bail, Result};
 use glam::Vec3;
-use nprt_net::Device;
+use nprt_net::Engine;
 use nprt_render::oidn::Oidn;
 use nprt_render::{DirectSampling, Relighter};
 use nprt_scene::{Camera, EnvMap};
@@ -131,13 +131,13 @@ impl Shaded {
 /// (two models of one design are told apart by their folders).
 pub fn load_networks(
     o: &EvalOptions,
-    device: &Device,
+    engine: Engine,
     dataset_hash: &str,
     scene_hash: &str,
 ) -> Result<Vec<(Net, String)>> {
     let mut nets = Vec::new();
     for dir in &o.models {
-        let r = Relighter::load(dir, device)?;
+        let r = Relighter::load(dir, engine)?;
         check_model(
             dir,
             dataset_hash,
@@ -148,7 +148,7 @@ pub fn load_networks(
         nets.push(Net::Nprt(Box::new(r), dir.clone()));
     }
     if let Some(dir) = &o.deep_shading {
-        let d = DeepShadingModel::load(dir, device)?;
+        let d = DeepShadingModel::load(dir)?;
         check_model(
             dir,
             dataset_hash,

@@ -9,10 +9,11 @@
 //! It reads datasets through nprt-data and environment maps through nprt-scene; it must not
 //! trace rays or write datasets, and it knows nothing of evaluation or frame rendering.
 //!
-//! Network code is device-generic: it runs on whatever burn `Device` its tensors live on
-//! (the flex CPU backend here; a GPU backend by enabling its burn feature). On the CPU in f32
-//! the transport networks train and infer through [`cpu`], a hand-written engine held to
-//! burn's autodiff by tests, because burn's graph was slower than PyTorch on SIREN layers.
+//! burn holds the networks as Modules on its CPU backend (flex): parameters, initialisation,
+//! the model folder, and the autodiff graph the engines are held to in tests. `--device`
+//! resolves into an [`Engine`] that runs the steps and frames: the CPU engine ([`cpu`]; burn's
+//! graph was slower than PyTorch on SIREN layers) or our own GPU kernels ([`gpu`], feature
+//! `kernels`), which read the host's parameters.
 //!
 //! ```
 //! use nprt_net::{Design, Device, Init, ModelConfig};
@@ -27,8 +28,8 @@ pub mod bench;
 mod choice;
 pub mod cpu;
 pub mod deep_shading;
-mod device;
 pub mod encoding;
+mod engine;
 #[cfg(feature = "kernels")]
 pub mod gpu;
 pub mod model;
@@ -41,10 +42,10 @@ pub use bench::throughput::profile_kernels;
 pub use bench::throughput::{measure_inference, measure_throughput, median, InferenceSpeed};
 pub use burn;
 pub use burn::tensor::Device;
-pub use device::{device_name, finish, host_values, is_cpu, Backend, Compute};
 pub use encoding::features::{feature, gbuffer_features, pixel_features, position_frame, FEATURES};
 pub use encoding::map_norm::MapNorm;
 pub use encoding::position_encoding::PositionEncoding;
+pub use engine::{finish, Compute, Engine};
 pub use model::config::{ModelConfig, DEFAULT_ENCODER_WIDTH, DEFAULT_MAP_NORM};
 pub use model::direct_light::DirectLight;
 pub use model::folder::{load_model, read_model_file, ModelFile};
@@ -52,18 +53,20 @@ pub use model::layer_table::layer_table;
 pub use network::activation::{Activation, OMEGA_0};
 pub use network::design::{Design, TRANSPORT_CODE};
 pub use network::encoder::{LightEncoder, LightInput};
+pub use network::host_values;
 pub use network::init::{conv2d, Init};
 pub use network::mlp::Mlp;
 pub use network::nprt_net::NprtNet;
 pub use network::track::{Track, TrackKind};
 pub use precision::Precision;
-pub use training::batch::{Batch, Engine};
+pub use training::batch::{Batch, GradientPath};
 pub use training::calibration::{level_gain, Calibration, LEVEL_SAMPLES};
 pub use training::checkpoint::RunState;
 pub use training::loss::{log_l1, Loss};
 pub use training::lr_schedule::LrSchedule;
 pub use training::nprt_objective::train;
 pub use training::run_length::RunLength;
+pub use training::schedule::Schedule;
 pub use training::train_options::{recipe_rate, Gather, TrainOptions};
-pub use training::training_loop::{Objective, Schedule, TrainSummary};
+pub use training::training_loop::{Objective, TrainSummary};
 pub use training::validation::validation_loss;

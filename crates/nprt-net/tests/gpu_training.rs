@@ -15,9 +15,9 @@ use burn::optim::AdamConfig;
 use common::{loud_grids, random_batch, variants};
 use nprt_net::cpu::{HostEncoder, HostTransport, Samples};
 use nprt_net::gpu::{GpuDevice, GpuTrainer, ParameterLayout};
-use nprt_net::training::training_loop::ADAM_EPSILON;
+use nprt_net::training::optimiser::ADAM_EPSILON;
 use nprt_net::{
-    Design, Device, Engine, Init, Loss, ModelConfig, NprtNet, PositionEncoding, Precision,
+    Design, Device, GradientPath, Init, Loss, ModelConfig, NprtNet, PositionEncoding, Precision,
 };
 
 /// Euclidean distance of `a` from `b` over b's norm.
@@ -122,7 +122,7 @@ fn gpu_adam_steps_match_burns_adam_on_the_cpu_engine() {
     let mut optim = AdamConfig::new().with_epsilon(ADAM_EPSILON).init();
     let lr = 1e-3;
     for _ in 0..2 {
-        let (_, grads) = batch.gradients(&net, &device, Engine::Auto, Loss::LogL1);
+        let (_, grads) = batch.gradients(&net, &device, GradientPath::Auto, Loss::LogL1);
         net = optim.step(lr, net, grads);
         gpu.step(&samples, Loss::LogL1, lr);
     }

@@ -309,9 +309,9 @@ fn cpu_engine_matches_autodiff() {
         };
         for objective in Loss::ALL {
             let net = loud_grids(config.build(&mut Init::new(4, &device)));
-            assert!(nprt_net::cpu::applies(&net, &device));
+            assert!(nprt_net::cpu::applies(&net));
             let (burn_loss, burn) =
-                batch.gradients(&net, &device, nprt_net::Engine::Autodiff, objective);
+                batch.gradients(&net, &device, nprt_net::GradientPath::Autodiff, objective);
             // The transport networks on burn's light codes, whose gradient at the codes burn
             // then carries through the encoder: every gradient held to f32 rounding.
             let codes = net.encoder.forward(batch.light_tensor(&device));

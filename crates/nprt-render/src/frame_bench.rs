@@ -4,11 +4,12 @@
 
 use anyhow::{Context, Result};
 use nprt_net::model::folder::ModelFile;
-use nprt_net::{Design, Device, DirectLight, Init, ModelConfig};
+use nprt_net::{Design, Device, DirectLight, Engine, Init, ModelConfig};
 use nprt_scene::{load_scene, SceneOptions};
 use nprt_trace::TraceScene;
 
-use crate::relight::{DirectSampling, FrameCache, FrameTimings, Relighter};
+use crate::frame_timings::FrameTimings;
+use crate::relight::{DirectSampling, FrameCache, Relighter};
 use crate::{CameraPath, Precision};
 
 /// What to time.
@@ -61,7 +62,7 @@ pub struct FrameBenchRow {
 /// Times every model at every resolution, calling `on_row` as each is done.
 pub fn bench_frame(
     opts: &FrameBenchOptions,
-    device: &Device,
+    engine: Engine,
     mut on_row: impl FnMut(&FrameBenchRow),
 ) -> Result<()> {
     let scene = load_scene(&opts.scene, &SceneOptions::default())?;
@@ -81,18 +82,8 @@ pub fn bench_frame(
         .iter()
         .flat_map(|&m| opts.precisions.iter().map(move |&p| (m, p)));
     for ((design, direct), precision) in runs {
-        let config = ModelConfig {
-            direct,
-            ..ModelConfig::new(design, None)
-        };
-        let net = config.build(&mut Init::new(1, &Relighter::weights_device(device)));
-        let file = ModelFile::untrained(config.clone(), &net, [lo.to_array(), hi.to_array()]);
-        let mut model = Relighter::new(file, net, device)?;
-        model.set_precision(precision)?;
-        let label = match precision {
-            Precision::F32 => config.label(),
-            Precision::F16 => format!("{} f16", config.label()),
-        };
+        let bounds = [lo.to_array(), hi.to_array()];
+        let (model, label) = untrained(design, direct, precision, bounds, engine)?;
         for &[w, h] in &opts.resolutions {
             nprt_trace::Frame::check_size(w, h, &format!("a {w}×{h} frame"))?;
             let camera = path.camera(0.5, w, h);
@@ -142,17 +133,11 @@ pub fn bench_frame(
                     relights.push(change.encoder_ms + change.network_ms);
                 }
             }
-            let stage = |f: fn(&FrameTimings) -> f64| median(frames.iter().map(f).collect());
             on_row(&FrameBenchRow {
                 label: label.clone(),
                 resolution: [w, h],
                 foreground,
-                frame: FrameTimings {
-                    gbuffer_ms: stage(|t| t.gbuffer_ms),
-                    encoder_ms: stage(|t| t.encoder_ms),
-                    network_ms: stage(|t| t.network_ms),
-                    direct_ms: stage(|t| t.direct_ms),
-                },
+                frame: FrameTimings::median(&frames),
                 relight_ms: median(relights),
                 relight_waits,
                 shown_ms: (!shown[0].is_empty()).then(|| shown.map(median)),
@@ -165,4 +150,28 @@ pub fn bench_frame(
         }
     }
     Ok(())
+}
+
+/// An untrained model of `design` (the cost does not depend on the weights) in `bounds`, on
+/// `engine` in `precision`, and its row's label.
+fn untrained(
+    design: Design,
+    direct: DirectLight,
+    precision: Precision,
+    bounds: [[f32; 3]; 2],
+    engine: Engine,
+) -> Result<(Relighter, String)> {
+    let config = ModelConfig {
+        direct,
+        ..ModelConfig::new(design, None)
+    };
+    let net = config.build(&mut Init::new(1, &Device::flex()));
+    let file = ModelFile::untrained(config.clone(), &net, bounds);
+    let mut model = Relighter::new(file, net, engine)?;
+    model.set_precision(precision)?;
+    let label = match precision {
+        Precision::F32 => config.label(),
+        Precision::F16 => format!("{} f16", config.label()),
+    };
+    Ok((model, label))
 }

@@ -25,6 +25,7 @@
 
 mod animation;
 mod frame_bench;
+mod frame_timings;
 #[cfg(feature = "wgpu")]
 pub mod gpu;
 pub mod oidn;
@@ -38,11 +39,12 @@ pub mod view;
 
 pub use animation::{write_animation, Animation};
 pub use frame_bench::{bench_frame, FrameBenchOptions, FrameBenchRow};
+pub use frame_timings::FrameTimings;
 pub use nprt_net::Precision;
 pub use path::CameraPath;
 pub use relight::{
-    background, DirectSampling, FrameCache, FrameRadiance, FrameTimings, LightCode, Pixels,
-    Relighter, DEFAULT_DIRECT_SPP,
+    background, DirectSampling, FrameCache, FrameRadiance, LightCode, Pixels, Relighter,
+    DEFAULT_DIRECT_SPP,
 };
 pub use render_job::{RenderJob, RenderOptions, DEFAULT_LIGHTING};
 pub use schedule::LightingSchedule;

@@ -10,10 +10,11 @@ use glam::{Vec2, Vec3};
 use nprt_net::burn::tensor::{Tensor, TensorData};
 use nprt_net::cpu::{self, HostTransport, TransferCodes};
 use nprt_net::gbuffer_features;
-use nprt_net::{load_model, Device, DirectLight, LightInput, ModelFile, NprtNet, FEATURES};
+use nprt_net::{load_model, Device, DirectLight, Engine, LightInput, ModelFile, NprtNet, FEATURES};
 use nprt_scene::{Camera, EnvMap};
 use nprt_trace::{render, render_direct, render_gbuffer, GBuffer, RenderSettings, TraceScene};
 
+use crate::frame_timings::FrameTimings;
 use crate::Precision;
 
 use crate::oidn::Oidn;
@@ -24,17 +25,13 @@ use rayon::prelude::*;
 /// that grows with the count; 16 takes most of it (docs/model.md#traced-direct-light).
 pub const DEFAULT_DIRECT_SPP: u32 = 16;
 
-/// Pixels per network call: large enough to amortise dispatch, small enough to bound memory.
-const CHUNK: usize = 65_536;
-
 /// A trained model ready to shade G-buffers.
 pub struct Relighter {
     pub file: ModelFile,
     net: NprtNet,
-    device: Device,
-    /// The transport networks on the CPU engine, where it applies.
+    /// The transport networks on the CPU engine, where frames are made on the CPU.
     host: Option<HostTransport>,
-    /// The encoder and transport networks as our own kernels, for `--device wgpu`.
+    /// The encoder and transport networks as our own kernels, where frames are made there.
     #[cfg(feature = "wgpu")]
     gpu: Option<crate::gpu::GpuNetwork>,
     /// With the kernels, the scene of the last frame on the device (by its address: a model
@@ -135,70 +132,37 @@ impl<K> Default for FrameCache<K> {
     }
 }
 
-/// Milliseconds spent in each stage of one frame.
-#[derive(Clone, Copy, Debug, Default)]
-pub struct FrameTimings {
-    pub gbuffer_ms: f64,
-    pub encoder_ms: f64,
-    pub network_ms: f64,
-    /// Traced direct light (models that trace it) or the background.
-    pub direct_ms: f64,
-}
-
-impl FrameTimings {
-    /// Adds `t`'s stages to these.
-    pub fn add(&mut self, t: &FrameTimings) {
-        self.gbuffer_ms += t.gbuffer_ms;
-        self.encoder_ms += t.encoder_ms;
-        self.network_ms += t.network_ms;
-        self.direct_ms += t.direct_ms;
-    }
-
-    /// Every stage times `k` (a mean from a sum).
-    pub fn scaled(&self, k: f64) -> FrameTimings {
-        FrameTimings {
-            gbuffer_ms: self.gbuffer_ms * k,
-            encoder_ms: self.encoder_ms * k,
-            network_ms: self.network_ms * k,
-            direct_ms: self.direct_ms * k,
-        }
-    }
-
-    pub fn total_ms(&self) -> f64 {
-        self.gbuffer_ms + self.encoder_ms + self.network_ms + self.direct_ms
-    }
-}
-
 impl Relighter {
-    /// Loads the model in `dir` to run on `device`. A wgpu device runs the frame path's own
-    /// kernels (crate::gpu), with the weights read on the host; any other runs burn's
-    /// network, through the CPU engine where it applies.
-    pub fn load(dir: &Path, device: &Device) -> Result<Self> {
-        let on = Self::weights_device(device);
-        let (file, net) = load_model(dir, &on)?;
-        Self::new(file, net, device)
+    /// Loads the model in `dir` to run on `engine`: the CPU engine, or the frame path's own
+    /// kernels (crate::gpu), which upload the weights read on the host.
+    pub fn load(dir: &Path, engine: Engine) -> Result<Self> {
+        let (file, net) = load_model(dir, &Device::flex())?;
+        Self::new(file, net, engine)
     }
 
-    /// A model with `file`'s settings and the weights of `net` (which lives on
-    /// [`Self::weights_device`] of `device`), to run on `device`.
-    pub fn new(file: ModelFile, net: NprtNet, device: &Device) -> Result<Self> {
+    /// A model with `file`'s settings and the weights of `net` (on the host), to run on
+    /// `engine`.
+    pub fn new(file: ModelFile, net: NprtNet, engine: Engine) -> Result<Self> {
         #[cfg(feature = "wgpu")]
-        if nprt_net::Backend::of(device) == nprt_net::Backend::Wgpu {
+        if engine.is_gpu() {
             let gpu = Some(crate::gpu::GpuNetwork::new(&net, file.output_gain())?);
             return Ok(Relighter {
                 file,
                 net,
-                device: Device::flex(),
                 host: None,
                 gpu,
                 raster: Default::default(),
             });
         }
-        let host = cpu::applies(&net, device).then(|| HostTransport::from_net(&net));
+        anyhow::ensure!(
+            !engine.is_gpu(),
+            "this nprt-render was built without its GPU kernels (feature `wgpu`)"
+        );
+        anyhow::ensure!(cpu::applies(&net), "the CPU engine runs f32 networks only");
+        let host = Some(HostTransport::from_net(&net));
         Ok(Relighter {
             file,
             net,
-            device: device.clone(),
             host,
             #[cfg(feature = "wgpu")]
             gpu: None,
@@ -207,7 +171,7 @@ impl Relighter {
         })
     }
 
-    /// Runs the networks in `precision`; f16 needs the GPU kernels (`--device wgpu`) and an
+    /// Runs the networks in `precision`; f16 needs the GPU kernels (`--device gpu`) and an
     /// adapter with f16 in shaders. Frames made after use it, with a new [`FrameCache`].
     pub fn set_precision(&mut self, precision: Precision) -> Result<()> {
         #[cfg(feature = "wgpu")]
@@ -215,7 +179,9 @@ impl Relighter {
             return gpu.set_half(precision == Precision::F16);
         }
         if precision == Precision::F16 {
-            anyhow::bail!("--precision f16 runs on the GPU kernels only (--device wgpu)");
+            anyhow::bail!(
+                "--precision f16 runs on the GPU kernels only (--device gpu or --device wgpu)"
+            );
         }
         Ok(())
     }
@@ -229,18 +195,7 @@ impl Relighter {
         Precision::F32
     }
 
-    /// Where a model's weights are loaded to run on `device`: the host for the frame path's
-    /// kernels, which upload them themselves; `device` itself otherwise.
-    pub fn weights_device(device: &Device) -> Device {
-        if cfg!(feature = "wgpu") && nprt_net::Backend::of(device) == nprt_net::Backend::Wgpu {
-            Device::flex()
-        } else {
-            device.clone()
-        }
-    }
-
-    /// Where the networks run, for reports: "CPU engine", "GPU kernels on ADAPTER" or burn's
-    /// device.
+    /// Where the networks run, for reports: "CPU engine" or "GPU kernels on ADAPTER".
     pub fn networks_on(&self) -> String {
         #[cfg(feature = "wgpu")]
         if let Some(gpu) = &self.gpu {
@@ -249,10 +204,7 @@ impl Relighter {
                 true => format!("GPU kernels on {} ({})", gpu.adapter(), gpu.precision()),
             };
         }
-        match self.host {
-            Some(_) => "CPU engine".into(),
-            None => format!("burn on {}", nprt_net::device_name(&self.device)),
-        }
+        "CPU engine".into()
     }
 
     /// Where the G-buffer is made, for reports: rasterised beside the GPU kernels, or the CPU
@@ -587,7 +539,7 @@ impl Relighter {
         let w = input.width;
         let pixels = Tensor::from_data(
             TensorData::new(input.pixels, [1, 3, w / 2, w]),
-            &self.device,
+            &Device::flex(),
         );
         LightCode(Code::Host {
             code: nprt_net::host_values(self.net.encoder.forward(pixels).into_data()),
@@ -697,8 +649,7 @@ impl Relighter {
         out
     }
 
-    /// Radiance (`n × 3`) of the pixels off the CPU engine: on the frame path's kernels where
-    /// the model runs on them, else through burn.
+    /// Radiance (`n × 3`) of the pixels on the frame path's kernels.
     fn device_radiance(&self, px: &Pixels, light: &LightCode) -> Vec<f32> {
         #[cfg(feature = "wgpu")]
         if let (Some(gpu), Some(pixels)) = (&self.gpu, &px.gpu) {
@@ -714,32 +665,8 @@ impl Relighter {
                 });
             return gpu.radiance(pixels, &code, background.as_ref()).0;
         }
-        self.burn_radiance(&px.features, light)
-    }
-
-    /// Radiance (`n × 3`) of feature rows through burn, in chunks of one fixed shape: a GPU
-    /// compiles and tunes kernels per shape (on an H100 the first frame takes about 1 s, later
-    /// ones 8 ms at 256²), so the tail is padded rather than given a new length every frame.
-    fn burn_radiance(&self, features: &[f32], light: &LightCode) -> Vec<f32> {
-        let rows = features.len() / FEATURES;
-        let mut rgb = Vec::with_capacity(rows * 3);
-        let (code, scale) = self.host_light(light);
-        let n = code.len();
-        let code =
-            Tensor::<2>::from_data(TensorData::new(code, [1, n]), &self.device).expand([CHUNK, n]);
-        let scale = Tensor::from_data(
-            TensorData::new(scale.repeat(CHUNK), [CHUNK, 3]),
-            &self.device,
-        );
-        for chunk in features.chunks(CHUNK * FEATURES) {
-            let mut padded = chunk.to_vec();
-            padded.resize(CHUNK * FEATURES, 0.0);
-            let f = Tensor::from_data(TensorData::new(padded, [CHUNK, FEATURES]), &self.device);
-            let out =
-                nprt_net::host_values(self.net.shade(f, code.clone(), scale.clone()).into_data());
-            rgb.extend_from_slice(&out[..chunk.len() / FEATURES * 3]);
-        }
-        rgb
+        let _ = (px, light);
+        unreachable!("a Relighter without the CPU engine has the GPU kernels")
     }
 }
 
@@ -806,7 +733,7 @@ mod tests {
         let call = CALLS.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
         let dir = std::env::temp_dir().join(format!("nprt-relight-{}-{call}", std::process::id()));
         save_model(&dir, &file, &net).unwrap();
-        let r = Relighter::load(&dir, &device).unwrap();
+        let r = Relighter::load(&dir, Engine::Cpu).unwrap();
         std::fs::remove_dir_all(&dir).unwrap();
         r
     }

@@ -5,7 +5,7 @@
 use std::path::PathBuf;
 
 use anyhow::{bail, Context, Result};
-use nprt_net::Device;
+use nprt_net::Engine;
 use nprt_scene::{CameraVolume, Scene};
 use nprt_trace::TraceScene;
 
@@ -84,13 +84,13 @@ pub struct RenderJob {
 
 impl RenderJob {
     /// Loads the model and its scene and makes every choice; errors say what to give.
-    pub fn prepare(opts: &RenderOptions, device: &Device) -> Result<Self> {
+    pub fn prepare(opts: &RenderOptions, engine: Engine) -> Result<Self> {
         if opts.frames == 0 || opts.fps == 0 {
             bail!("--frames and --fps must be at least 1");
         }
         let [w, h] = opts.resolution;
         nprt_trace::Frame::check_size(w, h, &format!("a {w}×{h} frame"))?;
-        let mut model = Relighter::load(&opts.model, device)?;
+        let mut model = Relighter::load(&opts.model, engine)?;
         model.set_precision(opts.precision)?;
         let scene_spec = match (&opts.scene, model.file.scene.as_str()) {
             (Some(s), _) => s.clone(),

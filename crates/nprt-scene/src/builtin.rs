@@ -74,7 +74,34 @@ fn plank_texture() -> Bitmap {
 
 fn room() -> Result<Scene> {
     let mut s = Scene::empty("builtin:room");
-    let (half, height) = (3.0f32, 3.0f32);
+    let half = 3.0f32;
+    room_shell(&mut s, half, 3.0);
+    room_objects(&mut s, half);
+    s.camera = Some(Camera::look_at(
+        Vec3::new(0.3, 1.5, 2.7),
+        Vec3::new(-0.2, 0.8, -1.2),
+        Vec3::Y,
+        70.0,
+        256,
+        256,
+    ));
+    // Standing and sitting eye heights over the open half of the room, looking at the back.
+    s.camera_volume = Some(CameraVolume {
+        min: Vec3::new(-2.2, 0.9, -0.2),
+        max: Vec3::new(2.2, 2.2, 2.8),
+        look: Vec3::new(0.0, -0.25, -1.0).normalize(),
+        spread_deg: 30.0,
+        fov_deg: 60.0,
+    });
+    s.envmap = Some(sky(SkyParams::default())?);
+    s.max_depth = Some(6);
+    s.spp = Some(64);
+    Ok(s)
+}
+
+/// The room's floor (planks), ceiling around the skylight and walls, the right one around the
+/// window: a box `2 half` wide and `height` tall.
+fn room_shell(s: &mut Scene, half: f32, height: f32) {
     let wall = || Material::diffuse("wall", Vec3::new(0.75, 0.72, 0.68));
     let up = Quat::from_rotation_x(-std::f32::consts::FRAC_PI_2);
     let down = Quat::from_rotation_x(std::f32::consts::FRAC_PI_2);
@@ -135,7 +162,10 @@ fn room() -> Result<Scene> {
     s.add(panel((6.0, 0.6), right, Vec3::new(half, 2.7, 0.0)), wall());
     s.add(panel((1.0, 1.6), right, Vec3::new(half, 1.6, -2.5)), wall());
     s.add(panel((2.0, 1.6), right, Vec3::new(half, 1.6, 2.0)), wall());
+}
 
+/// The room's objects, diffuse and glossy, and the mirror on the back wall (at z = -`half`).
+fn room_objects(s: &mut Scene, half: f32) {
     // Diffuse objects: an orange box and a blue-grey ball.
     let mut cube = Mesh::cube();
     cube.transform(
@@ -184,27 +214,6 @@ fn room() -> Result<Scene> {
         mirror,
         Material::glossy("mirror", Vec3::ZERO, Vec3::splat(0.9), 0.01),
     );
-
-    s.camera = Some(Camera::look_at(
-        Vec3::new(0.3, 1.5, 2.7),
-        Vec3::new(-0.2, 0.8, -1.2),
-        Vec3::Y,
-        70.0,
-        256,
-        256,
-    ));
-    // Standing and sitting eye heights over the open half of the room, looking at the back.
-    s.camera_volume = Some(CameraVolume {
-        min: Vec3::new(-2.2, 0.9, -0.2),
-        max: Vec3::new(2.2, 2.2, 2.8),
-        look: Vec3::new(0.0, -0.25, -1.0).normalize(),
-        spread_deg: 30.0,
-        fov_deg: 60.0,
-    });
-    s.envmap = Some(sky(SkyParams::default())?);
-    s.max_depth = Some(6);
-    s.spp = Some(64);
-    Ok(s)
 }
 
 #[cfg(test)]

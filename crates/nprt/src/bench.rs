@@ -6,8 +6,8 @@ use std::path::PathBuf;
 use anyhow::Result;
 use nprt_net::bench::pytorch_peer::{PeerRun, PeerScript, PeerVariant};
 use nprt_net::{
-    device_name, is_cpu, measure_throughput, median, Activation, Backend, Design, DirectLight,
-    Engine, ModelConfig, Precision,
+    measure_throughput, median, Activation, Design, DirectLight, Engine, GradientPath, ModelConfig,
+    Precision,
 };
 
 use crate::flags::{DeviceArg, Resolution};
@@ -15,8 +15,8 @@ use crate::flags::{DeviceArg, Resolution};
 #[derive(clap::Subcommand)]
 pub enum BenchCommand {
     /// Training samples/s of each design (forward, backward and Adam on one batch) with the CPU
-    /// engine and with burn's autodiff graph (or, with --device wgpu, nprt's own GPU kernels;
-    /// with --device gpu burn's CUDA backend), beside the PyTorch peer (bench/train_pytorch.py,
+    /// engine and with burn's autodiff graph (or, with --device gpu or wgpu, nprt's own GPU
+    /// kernels), beside the PyTorch peer (bench/train_pytorch.py,
     /// embedded in nprt) running the same networks, batch and loss when --python is given; the
     /// ratio is the engine's to the fastest of the PyTorch variants asked for.
     Train(BenchTrainArgs),
@@ -28,8 +28,8 @@ pub enum BenchCommand {
     /// What a relit frame costs, stage by stage (G-buffer, light encoder, networks, direct
     /// light), per design and resolution, with untrained networks (the cost does not depend on
     /// the weights): a frame from a new viewpoint under a new lighting, and a lighting change
-    /// under a still camera. `--device wgpu` runs the networks as nprt's GPU kernels on
-    /// whatever adapter wgpu finds.
+    /// under a still camera. `--device gpu` (or `wgpu`) runs the networks as nprt's GPU
+    /// kernels.
     Frame(BenchFrameArgs),
 }
 
@@ -55,7 +55,7 @@ pub struct BenchFrameArgs {
     repeats: usize,
     /// Also print each kernel's GPU time in one lighting change (timestamp queries, each
     /// dispatch timed in a pass of its own) after each row: where the networks' time goes.
-    /// Needs --device wgpu.
+    /// Needs the GPU kernels (--device gpu or wgpu).
     #[arg(long)]
     profile: bool,
     /// The networks' arithmetic, comma-separated: f32, and f16 (weights and activations in
@@ -89,8 +89,6 @@ pub struct BenchInferArgs {
     /// Runs per measurement; the median is reported.
     #[arg(long, default_value_t = 5)]
     repeats: usize,
-    #[command(flatten)]
-    device: DeviceArg,
 }
 
 #[derive(clap::Args)]
@@ -117,7 +115,7 @@ pub struct BenchTrainArgs {
     #[arg(long, default_value_t = 3)]
     rounds: usize,
     /// Python with PyTorch for the side-by-side peer (bench/train_vs_pytorch.sh installs one);
-    /// it runs on the same device (CUDA for a GPU, wgpu's included: it is assumed to be an
+    /// it runs on the same device (CUDA for the GPU kernels: the adapter is assumed to be an
     /// NVIDIA card PyTorch reaches through CUDA).
     #[arg(long)]
     python: Option<PathBuf>,
@@ -126,14 +124,14 @@ pub struct BenchTrainArgs {
     /// fastest (by its median) is the peer compared with, and named in the last column.
     #[arg(long, value_delimiter = ',', default_value = "eager-f32")]
     peer_variants: Vec<PeerVariant>,
-    /// With --device wgpu: after each design's row, the GPU time of each of nprt's kernels in
+    /// With the GPU kernels (--device gpu or wgpu): after each design's row, the GPU time of each of nprt's kernels in
     /// one step after the warm-up (timestamp queries, each dispatch timed in a pass of its
     /// own), beside the step's wall time at the measured rate: where a step's time goes.
     #[arg(long)]
     profile: bool,
     /// The transport networks' products, comma-separated, a row each against the same peer:
     /// f32, and f16 (mixed precision: f16 operands summed in f32, on tensor cores where the
-    /// adapter has them, f32 master weights; --device wgpu only).
+    /// adapter has them, f32 master weights; the GPU kernels only).
     #[arg(long, default_value = "f32", value_delimiter = ',')]
     precision: Vec<Precision>,
     #[command(flatten)]
@@ -148,23 +146,24 @@ pub fn run(cmd: BenchCommand) -> Result<()> {
     }
 }
 
-/// Refuses `--profile` where nprt's own kernels do not run: another device, or a build
-/// without the `wgpu` feature.
+/// Refuses `--profile` where nprt's own kernels do not run: the CPU, or a build without the
+/// `gpu` feature.
 fn check_profile(profile: bool, device: &DeviceArg) -> Result<()> {
+    use nprt_net::Compute;
     anyhow::ensure!(
-        !profile || matches!(device.compute, nprt_net::Compute::Wgpu),
-        "--profile times nprt's own kernels: it needs --device wgpu"
+        !profile || matches!(device.compute, Compute::Gpu | Compute::Wgpu),
+        "--profile times nprt's own kernels: it needs --device gpu or --device wgpu"
     );
     anyhow::ensure!(
-        !profile || cfg!(feature = "wgpu"),
-        "--profile times nprt's own kernels: this nprt was built without the `wgpu` feature"
+        !profile || cfg!(feature = "gpu"),
+        "--profile times nprt's own kernels: this nprt was built without the `gpu` feature"
     );
     Ok(())
 }
 
 fn frame(a: BenchFrameArgs) -> Result<()> {
     check_profile(a.profile, &a.device)?;
-    let device = a.device.device()?;
+    let engine = a.device.engine()?;
     let mut models: Vec<(Design, DirectLight)> = a
         .designs
         .arch
@@ -186,7 +185,7 @@ fn frame(a: BenchFrameArgs) -> Result<()> {
     };
     let mut header = true;
     let mut networks_on = String::new();
-    nprt_render::bench_frame(&opts, &device, |r| {
+    nprt_render::bench_frame(&opts, engine, |r| {
         if header {
             println!(
                 "relit frames of {} under {}, median of {} (ms; direct light traced {}, {} host threads)",
@@ -246,7 +245,7 @@ fn frame(a: BenchFrameArgs) -> Result<()> {
                 1e3 / change
             );
         }
-        #[cfg(feature = "wgpu")]
+        #[cfg(feature = "gpu")]
         if let Some(times) = &r.profile {
             print_kernel_times("a lighting change's kernels", times, r.relight_ms);
         }
@@ -254,16 +253,13 @@ fn frame(a: BenchFrameArgs) -> Result<()> {
 }
 
 fn infer(a: BenchInferArgs) -> Result<()> {
-    let device = a.device.device()?;
-    // A peak is measured only for the CPU; on a GPU the column is left empty.
-    let peak = is_cpu(&device).then(|| nprt_net::cpu::measured_peak(rayon::current_num_threads()));
+    let p = nprt_net::cpu::measured_peak(rayon::current_num_threads());
     println!(
-        "inference at {r}×{r} on {}, every pixel foreground, encoder not counted{}",
-        device_name(&device),
-        peak.as_ref().map_or(String::new(), |p| format!(
-            "; f32 peak {:.0} GFLOP/s ({} threads, {}-lane FMA chains, measured)",
-            p.gflops, p.threads, p.lanes
-        )),
+        "inference at {r}×{r} on the CPU engine, every pixel foreground, encoder not counted; \
+         f32 peak {:.0} GFLOP/s ({} threads, {}-lane FMA chains, measured)",
+        p.gflops,
+        p.threads,
+        p.lanes,
         r = a.resolution
     );
     println!(
@@ -272,12 +268,8 @@ fn infer(a: BenchInferArgs) -> Result<()> {
     );
     for &arch in &a.designs.arch {
         let config = ModelConfig::new(arch, None);
-        let s =
-            nprt_net::measure_inference(&config, a.resolution * a.resolution, a.repeats, &device);
-        let pct = |g: f64| {
-            peak.as_ref()
-                .map_or("-".into(), |p| format!("{:.0}%", 100.0 * g / p.gflops))
-        };
+        let s = nprt_net::measure_inference(&config, a.resolution * a.resolution, a.repeats);
+        let pct = |g: f64| format!("{:.0}%", 100.0 * g / p.gflops);
         println!(
             "{:<10} {:>9.1} {:>8.1} {:>6} {:>11.1} {:>8.1} {:>6} {:>7.2}×",
             arch.name(),
@@ -296,18 +288,18 @@ fn infer(a: BenchInferArgs) -> Result<()> {
 fn train(a: BenchTrainArgs) -> Result<()> {
     check_profile(a.profile, &a.device)?;
     let threads = rayon::current_num_threads();
-    let device = a.device.device()?;
-    let cpu = is_cpu(&device);
+    let engine = a.device.engine()?;
+    let cpu = !engine.is_gpu();
     let rounds = a.rounds.max(1);
     println!(
         "training throughput on {}, batch {}, {} maps per batch, {} timed steps, {threads} threads, \
          median of {rounds} rounds",
-        device_name(&device),
+        engine.name(),
         a.batch_size,
         a.views,
         a.steps
     );
-    let peer = peer(a.python.as_ref(), &device)?;
+    let peer = peer(a.python.as_ref(), engine)?;
     println!(
         "{:<10} {:<6} {:<4} {:>14} {:>18} {:>17} {:>8} {:>15}  peer",
         "design",
@@ -321,16 +313,16 @@ fn train(a: BenchTrainArgs) -> Result<()> {
     );
     for &arch in &a.designs.arch {
         let config = ModelConfig::new(arch, a.activation);
-        let measure = |engine, precision| {
+        let measure = |path, precision| {
             measure_throughput(
                 &config,
-                engine,
+                path,
                 a.batch_size,
                 a.views,
                 a.steps,
                 a.warmup,
                 precision,
-                &device,
+                engine,
             )
         };
         // Rounds alternate the peer and nprt, so that a drift in the machine's speed (identical
@@ -357,30 +349,21 @@ fn train(a: BenchTrainArgs) -> Result<()> {
                 }
             }
             for (&precision, rates) in a.precision.iter().zip(&mut ours) {
-                rates.push(measure(Engine::Auto, precision)?);
+                rates.push(measure(GradientPath::Auto, precision)?);
             }
         }
-        // The fastest variant by its median is the peer.
-        let best = (0..variants.len())
-            .filter(|&v| !variants[v].is_empty())
-            .max_by(|&x, &y| median(variants[x].clone()).total_cmp(&median(variants[y].clone())));
+        let best = fastest(&variants);
         let theirs = best.map_or(Vec::new(), |v| variants[v].clone());
         // Off the CPU burn's autodiff is the only path, so the column would repeat the first.
         let autodiff = match cpu {
-            true => Some(measure(Engine::Autodiff, Precision::F32)?),
+            true => Some(measure(GradientPath::Autodiff, Precision::F32)?),
             false => None,
         };
         for (&precision, ours) in a.precision.iter().zip(ours) {
             let ratios: Vec<f64> = ours.iter().zip(&theirs).map(|(o, t)| o / t).collect();
             let ours = median(ours);
             let theirs = (!theirs.is_empty()).then(|| median(theirs.clone()));
-            let spread = match ratios.iter().copied().reduce(f64::min) {
-                Some(low) => {
-                    let high = ratios.iter().copied().fold(low, f64::max);
-                    format!("{low:.2}–{high:.2}×")
-                }
-                None => "-".into(),
-            };
+            let spread = ratio_range(&ratios);
             println!(
                 "{:<10} {:<6} {:<4} {:>14.0} {:>18} {:>17} {:>8} {:>15}  {}",
                 arch.name(),
@@ -401,8 +384,26 @@ fn train(a: BenchTrainArgs) -> Result<()> {
     Ok(())
 }
 
+/// The fastest peer variant by its median rate, among those that ran.
+fn fastest(variants: &[Vec<f64>]) -> Option<usize> {
+    (0..variants.len())
+        .filter(|&v| !variants[v].is_empty())
+        .max_by(|&x, &y| median(variants[x].clone()).total_cmp(&median(variants[y].clone())))
+}
+
+/// "low–high×" of the rounds' ratios, or "-" without a peer.
+fn ratio_range(ratios: &[f64]) -> String {
+    match ratios.iter().copied().reduce(f64::min) {
+        Some(low) => {
+            let high = ratios.iter().copied().fold(low, f64::max);
+            format!("{low:.2}–{high:.2}×")
+        }
+        None => "-".into(),
+    }
+}
+
 /// The `--profile` lines of one design: its kernels' GPU time in one step, longest first.
-#[cfg(feature = "wgpu")]
+#[cfg(feature = "gpu")]
 fn print_profile(
     config: &ModelConfig,
     a: &BenchTrainArgs,
@@ -415,7 +416,7 @@ fn print_profile(
 }
 
 /// `what`'s kernels' GPU times, longest first, beside the `wall_ms` it took at full speed.
-#[cfg(feature = "wgpu")]
+#[cfg(feature = "gpu")]
 fn print_kernel_times(what: &str, times: &[nprt_net::gpu::KernelTime], wall_ms: f64) {
     let sum: f64 = times.iter().map(|k| k.ms).sum();
     println!("  {what}: {sum:.2} ms of GPU time; wall time {wall_ms:.2} ms");
@@ -430,20 +431,20 @@ fn print_kernel_times(what: &str, times: &[nprt_net::gpu::KernelTime], wall_ms: 
     }
 }
 
-#[cfg(not(feature = "wgpu"))]
+#[cfg(not(feature = "gpu"))]
 fn print_profile(_: &ModelConfig, _: &BenchTrainArgs, _: Precision, _: f64) -> Result<()> {
-    unreachable!("check_profile refuses --profile without the `wgpu` feature")
+    unreachable!("check_profile refuses --profile without the `gpu` feature")
 }
 
 /// The PyTorch peer to compare with, if one was given: its Python, PyTorch's device name (CUDA
-/// for either GPU route) and the script written out.
+/// for the GPU kernels) and the script written out.
 fn peer<'a>(
     python: Option<&'a PathBuf>,
-    device: &nprt_net::Device,
+    engine: Engine,
 ) -> Result<Option<(&'a PathBuf, &'static str, PeerScript)>> {
-    let torch_device = match Backend::of(device) {
-        Backend::Cpu => "cpu",
-        Backend::Cuda | Backend::Wgpu => "cuda",
+    let torch_device = match engine {
+        Engine::Cpu => "cpu",
+        Engine::Gpu => "cuda",
     };
     Ok(match python {
         Some(py) => Some((py, torch_device, PeerScript::write()?)),

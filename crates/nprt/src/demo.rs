@@ -9,7 +9,7 @@ use nprt_data::GenerateOptions;
 use nprt_eval::claim::Verdict;
 use nprt_eval::{EvalOptions, Evaluation};
 use nprt_net::deep_shading::DeepShadingOptions;
-use nprt_net::{Design, Device, DirectLight, ModelConfig, RunLength, TrainOptions};
+use nprt_net::{Design, DirectLight, Engine, ModelConfig, RunLength, TrainOptions};
 use nprt_render::oidn::Oidn;
 use nprt_render::RenderOptions;
 
@@ -95,7 +95,7 @@ impl Steps {
 
 pub fn run(a: DemoArgs) -> Result<()> {
     let p = if a.quick { QUICK } else { FULL };
-    let device = a.device.device()?;
+    let engine = a.device.engine()?;
     let steps = Steps(Instant::now());
     let data = a.out.join("dataset");
     steps
@@ -112,21 +112,18 @@ pub fn run(a: DemoArgs) -> Result<()> {
         test_spp: p.test_spp,
         ..GenerateOptions::default()
     })?;
-    let models = train_designs(&p, &data, &a.out, &device, &steps)?;
+    let models = train_designs(&p, &data, &a.out, engine, &steps)?;
     steps.begin("3/5 training the Deep Shading baseline");
     let deep = a.out.join("models").join("deep-shading");
     let defaults = DeepShadingOptions::default();
-    crate::train_deep_shading::run(
-        &DeepShadingJob {
-            data: data.clone(),
-            opts: DeepShadingOptions {
-                schedule: p.deep_shading.apply(defaults.schedule.clone()),
-                ..defaults
-            },
-            out: deep.clone(),
+    crate::train_deep_shading::run(&DeepShadingJob {
+        data: data.clone(),
+        opts: DeepShadingOptions {
+            schedule: p.deep_shading.apply(defaults.schedule.clone()),
+            ..defaults
         },
-        &device,
-    )?;
+        out: deep.clone(),
+    })?;
     steps.begin("4/5 evaluating against the baselines");
     let report = a.out.join("report");
     let e = crate::eval::run(
@@ -141,7 +138,7 @@ pub fn run(a: DemoArgs) -> Result<()> {
             },
             out: report.clone(),
         },
-        &device,
+        engine,
     )?;
     steps.begin("5/5 relighting a camera path under held-out lighting");
     let frames = a.out.join("relit");
@@ -150,7 +147,7 @@ pub fn run(a: DemoArgs) -> Result<()> {
         &data,
         models.last().expect("five models"),
         &frames,
-        &device,
+        engine,
     )?;
     println!(
         "\n== nprt demo done in {:.0} s",
@@ -168,7 +165,7 @@ fn train_designs(
     p: &Plan,
     data: &Path,
     out: &Path,
-    device: &Device,
+    engine: Engine,
     steps: &Steps,
 ) -> Result<Vec<PathBuf>> {
     let runs: Vec<ModelConfig> = Design::ALL
@@ -193,14 +190,14 @@ fn train_designs(
             opts: TrainOptions::default().with_run(config.design, p.training, None),
             out: out.join("models").join(config.label()),
         };
-        crate::train::run(&job, device)?;
+        crate::train::run(&job, engine)?;
         models.push(job.out);
     }
     Ok(models)
 }
 
 /// A camera path through the scene, relit by `model` under the dataset's held-out maps.
-fn relight(p: &Plan, data: &Path, model: &Path, frames: &Path, device: &Device) -> Result<()> {
+fn relight(p: &Plan, data: &Path, model: &Path, frames: &Path, engine: Engine) -> Result<()> {
     let manifest = nprt_data::dataset::load_manifest(data)?;
     let s = &manifest.settings;
     let held_out: Vec<&str> = s
@@ -219,7 +216,7 @@ fn relight(p: &Plan, data: &Path, model: &Path, frames: &Path, device: &Device) 
             denoise_direct: Oidn::open().is_ok(),
             ..RenderOptions::default()
         },
-        device,
+        engine,
     )
 }
 

@@ -5,7 +5,7 @@ use std::path::PathBuf;
 
 use anyhow::Result;
 use nprt_eval::{evaluate, write_report, EvalOptions, Evaluation};
-use nprt_net::Device;
+use nprt_net::Engine;
 
 use crate::flags::DeviceArg;
 
@@ -78,13 +78,13 @@ impl From<EvalArgs> for EvalJob {
 }
 
 pub fn command(a: EvalArgs) -> Result<()> {
-    let device = a.device.device()?;
-    run(&a.into(), &device).map(|_| ())
+    let engine = a.device.engine()?;
+    run(&a.into(), engine).map(|_| ())
 }
 
 /// Runs the evaluation and writes the report; prints where it is and the headline figures.
-pub fn run(job: &EvalJob, device: &Device) -> Result<Evaluation> {
-    let e = evaluate(&job.opts, device)?;
+pub fn run(job: &EvalJob, engine: Engine) -> Result<Evaluation> {
+    let e = evaluate(&job.opts, engine)?;
     let (md, html) = write_report(&e, &job.out)?;
     println!(
         "{:<32} {:>10} {:>10} {:>10} {:>12}",

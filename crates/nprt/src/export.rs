@@ -25,7 +25,7 @@ pub struct ExportArgs {
     example_map: String,
 }
 
-#[cfg(feature = "wgpu")]
+#[cfg(feature = "gpu")]
 pub fn run(a: ExportArgs) -> Result<()> {
     let [width, height] = a.example_res.0;
     let view = nprt_render::gpu::ExampleView {
@@ -52,10 +52,10 @@ pub fn run(a: ExportArgs) -> Result<()> {
     Ok(())
 }
 
-#[cfg(not(feature = "wgpu"))]
+#[cfg(not(feature = "gpu"))]
 pub fn run(_: ExportArgs) -> Result<()> {
     anyhow::bail!(
         "nprt export: this nprt was built without the GPU frame path; rebuild it with \
-         `cargo build --release --features wgpu` (docs/building.md)"
+         `cargo build --release --features gpu` (docs/building.md)"
     )
 }

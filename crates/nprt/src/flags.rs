@@ -4,24 +4,24 @@ use std::fmt;
 use std::str::FromStr;
 
 use anyhow::{bail, Result};
-use nprt_net::{Compute, Device, LrSchedule, RunLength};
+use nprt_net::{Compute, Engine, LrSchedule, RunLength};
 
 /// `--device`, shared by every command that runs the networks.
 #[derive(clap::Args, Clone, Copy)]
 pub struct DeviceArg {
-    /// Where the networks run: cpu, gpu (an NVIDIA GPU through burn's CUDA backend; an error
-    /// if none is found or this nprt was built without the `cuda` feature), wgpu (any Vulkan,
-    /// Metal or DX12 GPU through wgpu, running nprt's own kernels for training and frames;
-    /// Mesa's software Vulkan driver included, which is how the GPU code is tested without a
-    /// GPU; needs the `wgpu` feature) or auto (the CUDA GPU when one is found, else the CPU).
+    /// Where the networks run: cpu (the CPU engine), gpu (nprt's own kernels on the best GPU
+    /// adapter wgpu finds, Vulkan, Metal or DX12, a discrete one first; an error if there is
+    /// none or this nprt was built without the `gpu` feature), wgpu (the same kernels on any
+    /// adapter, software ones such as Mesa's lavapipe included: how the GPU code is tested
+    /// without a GPU) or auto (gpu when a hardware adapter is found, else the CPU, saying why).
     /// A model folder is the same whichever trained it.
     #[arg(long = "device", default_value_t = Compute::Auto)]
     pub compute: Compute,
 }
 
 impl DeviceArg {
-    pub fn device(self) -> Result<Device> {
-        self.compute.device()
+    pub fn engine(self) -> Result<Engine> {
+        self.compute.engine()
     }
 }
 

@@ -78,12 +78,12 @@ enum Command {
     TrainDeepShading(train_deep_shading::DeepShadingArgs),
     /// Write a trained model as an engine runs it: the GPU frame path's compute kernels (WGSL,
     /// with GLSL and HLSL translations) and its weights in a documented layout
-    /// (docs/export.md). Needs the `wgpu` feature.
+    /// (docs/export.md). Needs the `gpu` feature.
     Export(export::ExportArgs),
     /// A window that relights trained models as you go: orbit (drag), dolly (wheel) and fly
     /// (WASDQE) the camera, turn the map (right-drag), switch maps (M) and models (Tab), a
     /// progressive path-traced reference of the view (R), the networks in f16 or f32 on the GPU
-    /// kernels (F), per-stage timings on screen, and screenshots (P). Needs the `wgpu` feature
+    /// kernels (F), per-stage timings on screen, and screenshots (P). Needs the `gpu` feature
     /// and a display (Xvfb will do).
     View(view::ViewArgs),
 }

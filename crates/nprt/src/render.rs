@@ -3,7 +3,7 @@
 use std::path::PathBuf;
 
 use anyhow::Result;
-use nprt_net::Device;
+use nprt_net::Engine;
 use nprt_render::{Animation, RenderJob, RenderOptions};
 
 use crate::flags::{DeviceArg, Resolution};
@@ -63,7 +63,7 @@ pub struct RenderArgs {
     #[arg(long)]
     denoise_direct: bool,
     /// The networks' arithmetic: f32, or f16 (weights and activations in f16, sums in f32, on
-    /// tensor cores where the adapter has them; --device wgpu only).
+    /// tensor cores where the adapter has them; the GPU kernels only: --device gpu or wgpu).
     #[arg(long, default_value_t = d().precision)]
     precision: nprt_render::Precision,
     #[command(flatten)]
@@ -93,13 +93,13 @@ impl From<RenderArgs> for RenderOptions {
 }
 
 pub fn command(a: RenderArgs) -> Result<()> {
-    let device = a.device.device()?;
-    run(&a.into(), &device)
+    let engine = a.device.engine()?;
+    run(&a.into(), engine)
 }
 
 /// Renders the sequence, printing each frame's time split and the means.
-pub fn run(opts: &RenderOptions, device: &Device) -> Result<()> {
-    let job = RenderJob::prepare(opts, device)?;
+pub fn run(opts: &RenderOptions, engine: Engine) -> Result<()> {
+    let job = RenderJob::prepare(opts, engine)?;
     let [w, h] = opts.resolution;
     println!(
         "nprt render: {} ({}, networks on the {}, G-buffer {}) on {}, {} frames at {w}×{h}, lighting {}",

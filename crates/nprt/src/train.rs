@@ -6,7 +6,7 @@ use anyhow::{Context, Result};
 use nprt_net::network::encoder::check_input_width;
 use nprt_net::training::training_set::{TrainingSet, ViewSamples};
 use nprt_net::{
-    Activation, Calibration, Design, Device, DirectLight, Gather, Loss, MapNorm, ModelConfig,
+    Activation, Calibration, Design, DirectLight, Engine, Gather, Loss, MapNorm, ModelConfig,
     PositionEncoding, Precision, TrainOptions, DEFAULT_ENCODER_WIDTH, DEFAULT_MAP_NORM,
 };
 
@@ -96,14 +96,15 @@ pub struct TrainArgs {
     /// end always does.
     #[arg(long, default_value_t = d().schedule.checkpoint_secs / 60.0)]
     checkpoint_minutes: f64,
-    /// With --device wgpu, where batches are gathered: device (the dataset's records, 40 bytes
-    /// a pixel, and maps are uploaded once, and each step gathers its batch there from the
-    /// picked samples) or host (each batch is gathered here and uploaded, for a dataset the
+    /// On the GPU kernels (--device gpu or wgpu), where batches are gathered: device (the
+    /// dataset's records, 40 bytes a pixel, and maps are uploaded once, and each step gathers
+    /// its batch there from the picked samples) or host (each batch is gathered here and uploaded, for a dataset the
     /// GPU has no room for). The batches are the same either way.
     #[arg(long, default_value_t = d().gather)]
     gather: Gather,
-    /// With --device wgpu, the transport networks' products: f32, or f16 (mixed precision:
-    /// weights, activations and gradients between layers held as f16 and summed in f32, on
+    /// On the GPU kernels (--device gpu or wgpu), the transport networks' products: f32, or f16
+    /// (mixed precision: weights, activations and gradients between layers held as f16 and
+    /// summed in f32, on
     /// tensor cores where the GPU has cooperative matrices; master weights, Adam, the light
     /// encoder and the hash grids stay f32; the loss's gradient is scaled so that f16 keeps it;
     /// docs/model.md). Elsewhere f32 only.
@@ -158,18 +159,18 @@ impl TryFrom<TrainArgs> for TrainJob {
 }
 
 pub fn command(a: TrainArgs) -> Result<()> {
-    let device = a.device.device()?;
-    run(&TrainJob::try_from(a)?, &device)
+    let engine = a.device.engine()?;
+    run(&TrainJob::try_from(a)?, engine)
 }
 
 /// Loads the dataset, trains and prints what the run did.
-pub fn run(job: &TrainJob, device: &Device) -> Result<()> {
+pub fn run(job: &TrainJob, engine: Engine) -> Result<()> {
     let t0 = std::time::Instant::now();
     let set = TrainingSet::load(&job.data, &job.config, job.opts.schedule.progress, |why| {
         eprintln!("{why}")
     })?;
     print_dataset(&job.data, &set, t0.elapsed().as_secs_f64());
-    let (s, file) = nprt_net::train(&set, &job.config, &job.opts, &job.out, device)?;
+    let (s, file) = nprt_net::train(&set, &job.config, &job.opts, &job.out, engine)?;
     if let Some(e) = s.resumed_from_epoch {
         println!("resumed from epoch {e:.2}");
     }

@@ -1,13 +1,14 @@
 //! `nprt train-deep-shading`: flags for training the Deep Shading baseline; the work is
-//! `nprt_net::deep_shading::train`.
+//! `nprt_net::deep_shading::train`. It has no `--device`: the U-Net trains on the CPU (burn),
+//! since the GPU kernels do not have its up-sampling and skip connections yet.
 
 use std::path::PathBuf;
 
 use anyhow::Result;
 use nprt_net::deep_shading::{self, DeepShadingOptions};
-use nprt_net::{Device, MapNorm, Schedule};
+use nprt_net::{MapNorm, Schedule};
 
-use crate::flags::{DeviceArg, RunArgs};
+use crate::flags::RunArgs;
 
 /// The defaults every flag shows, from the one place that states them.
 fn d() -> DeepShadingOptions {
@@ -44,8 +45,6 @@ pub struct DeepShadingArgs {
     /// mean over channels), as `nprt train --map-norm`.
     #[arg(long, default_value_t = d().map_norm)]
     map_norm: MapNorm,
-    #[command(flatten)]
-    device: DeviceArg,
 }
 
 /// One Deep Shading training run as the library takes it.
@@ -77,13 +76,12 @@ impl From<DeepShadingArgs> for DeepShadingJob {
 }
 
 pub fn command(a: DeepShadingArgs) -> Result<()> {
-    let device = a.device.device()?;
-    run(&a.into(), &device)
+    run(&a.into())
 }
 
 /// Trains and prints what the run did.
-pub fn run(job: &DeepShadingJob, device: &Device) -> Result<()> {
-    let (s, f) = deep_shading::train(&job.data, &job.opts, &job.out, device)?;
+pub fn run(job: &DeepShadingJob) -> Result<()> {
+    let (s, f) = deep_shading::train(&job.data, &job.opts, &job.out)?;
     if let Some(e) = s.resumed_from_epoch {
         println!("resumed from epoch {e:.2}");
     }

@@ -57,7 +57,7 @@ pub struct ViewArgs {
     device: DeviceArg,
 }
 
-#[cfg(feature = "wgpu")]
+#[cfg(feature = "gpu")]
 pub fn run(a: ViewArgs) -> Result<()> {
     if let Some(path) = &a.screenshot {
         nprt_io::check_writable(path)?;
@@ -67,7 +67,7 @@ pub fn run(a: ViewArgs) -> Result<()> {
         scene: a.scene,
         maps: a.maps,
         resolution: a.res.0,
-        device: a.device.device()?,
+        engine: a.device.engine()?,
         direct_spp: a.direct_spp,
         exposure: a.exposure,
         spin_deg: a.spin,
@@ -80,10 +80,10 @@ pub fn run(a: ViewArgs) -> Result<()> {
     })
 }
 
-#[cfg(not(feature = "wgpu"))]
+#[cfg(not(feature = "gpu"))]
 pub fn run(_: ViewArgs) -> Result<()> {
     anyhow::bail!(
         "nprt view: this nprt was built without the window and GPU frame path; rebuild it with \
-         `cargo build --release --features wgpu` (docs/building.md)"
+         `cargo build --release --features gpu` (docs/building.md)"
     )
 }

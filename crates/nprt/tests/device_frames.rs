@@ -7,14 +7,14 @@
 //! for a model that leaves direct light to the tracer, that light traced on the device, within
 //! noise of the CPU tracer's. Runs on Mesa's software Vulkan in CI (gated as the other Vulkan
 //! tests).
-#![cfg(feature = "wgpu")]
+#![cfg(feature = "gpu")]
 
 mod common;
 
 use common::block_rms;
 use glam::Vec3;
 use nprt_net::model::folder::ModelFile;
-use nprt_net::{Compute, Design, Device, DirectLight, Init, ModelConfig};
+use nprt_net::{Compute, Design, Device, DirectLight, Engine, Init, ModelConfig};
 use nprt_render::{DirectSampling, FrameCache, Relighter};
 use nprt_scene::{Camera, Material, Mesh, Scene};
 use nprt_trace::TraceScene;
@@ -49,12 +49,12 @@ fn camera() -> Camera {
 
 /// An untrained model of `config` for `scene` on the CPU engine and on the GPU kernels.
 fn relighters(config: ModelConfig, scene: &Scene) -> (Relighter, Relighter) {
-    let wgpu = Compute::Wgpu.device().unwrap();
+    let wgpu = Compute::Wgpu.engine().unwrap();
     let (lo, hi) = scene.bounds();
     let net = config.build(&mut Init::new(5, &Device::flex()));
     let file = ModelFile::untrained(config, &net, [lo.to_array(), hi.to_array()]);
-    let cpu = Relighter::new(file.clone(), net.clone(), &Device::flex()).unwrap();
-    let gpu = Relighter::new(file, net, &wgpu).unwrap();
+    let cpu = Relighter::new(file.clone(), net.clone(), Engine::Cpu).unwrap();
+    let gpu = Relighter::new(file, net, wgpu).unwrap();
     (cpu, gpu)
 }
 

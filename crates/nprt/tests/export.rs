@@ -2,7 +2,7 @@
 //! and the worked example's WebGPU page, run in headless Chromium (Debian's, on its bundled
 //! SwiftShader; scripts/chromium.sh installs it), makes the CPU engine's image. Without
 //! Chromium that part skips, unless NPRT_REQUIRE_CHROMIUM is set (scripts/test sets it).
-#![cfg(feature = "wgpu")]
+#![cfg(feature = "gpu")]
 
 mod common;
 

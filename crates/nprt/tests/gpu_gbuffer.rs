@@ -4,7 +4,7 @@
 //! Fresnel at normal incidence, opacity masks, bump maps seen from either side, one- and
 //! two-sided surfaces, meshes without normals or uvs), the built-in room and, where the shared
 //! data is present, the KITCHEN. Gated as the other Vulkan tests are.
-#![cfg(feature = "wgpu")]
+#![cfg(feature = "gpu")]
 
 mod common;
 

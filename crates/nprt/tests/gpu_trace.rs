@@ -6,7 +6,7 @@
 //! within noise: over blocks of pixels, the GPU's frame is no further from one CPU frame than
 //! a second CPU frame of another seed is. The scene's BVH is built by the first path traced.
 //! Gated as the other Vulkan tests are.
-#![cfg(feature = "wgpu")]
+#![cfg(feature = "gpu")]
 
 mod common;
 

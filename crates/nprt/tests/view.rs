@@ -3,7 +3,7 @@
 //! shows: the overlay over the frame, and without it the frame `nprt render` makes of the same
 //! camera and lighting. Without Xvfb and a display the test skips, unless NPRT_REQUIRE_XVFB is
 //! set (scripts/test sets it).
-#![cfg(feature = "wgpu")]
+#![cfg(feature = "gpu")]
 
 mod common;
 

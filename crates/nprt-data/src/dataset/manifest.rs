@@ -167,67 +167,76 @@ impl Manifest {
             );
         }
         for v in &self.views {
-            let what = format!("view {} ('{}')", v.index, v.file);
-            let allowed = match v.split.as_str() {
-                "train" => &s.train_maps,
-                "test" => &s.test_maps,
-                other => bail!("{what}: split '{other}' is neither 'train' nor 'test'"),
-            };
-            if !allowed.contains(&v.map) {
-                bail!(
-                    "{what}: map {} is not one of its split's maps {allowed:?}",
-                    v.map
-                );
-            }
-            if v.width == 0 || v.height == 0 || v.width as u64 * v.height as u64 > 1 << 28 {
-                bail!(
-                    "{what}: size {}×{} is empty or implausibly large",
-                    v.width,
-                    v.height
-                );
-            }
-            if !(v.fov_x_deg > 0.0 && v.fov_x_deg < 180.0) {
-                bail!("{what}: fov_x_deg {} is not in (0, 180)", v.fov_x_deg);
-            }
-            if !v.camera_to_world.iter().all(|x| x.is_finite()) || !v.rotation_deg.is_finite() {
-                bail!("{what}: camera_to_world or rotation_deg holds a non-finite number");
-            }
-            if !is_rigid(&Mat4::from_cols_array(&v.camera_to_world)) {
-                bail!("{what}: camera_to_world is not a rotation and translation (orthonormal axes, last row 0 0 0 1)");
-            }
-            let resolution = if v.split == "train" {
-                s.train_resolution
-            } else {
-                s.test_resolution
-            };
-            if [v.width, v.height] != resolution {
-                bail!(
-                    "{what}: size {}×{} is not its split's resolution {}×{}",
-                    v.width,
-                    v.height,
-                    resolution[0],
-                    resolution[1]
-                );
-            }
-            if !v.gain.iter().all(|g| (1.0 / 64.0..=64.0).contains(g)) {
-                bail!("{what}: gain {:?} is not within [1/64, 64]", v.gain);
-            }
-            if v.split == "test" && !is_unit_gain(&v.gain) {
-                bail!(
-                    "{what}: a test view's map is never jittered, but its gain is {:?}",
-                    v.gain
-                );
-            }
-            let file = Path::new(&v.file);
-            if file.is_absolute()
-                || file
-                    .components()
-                    .any(|c| matches!(c, std::path::Component::ParentDir))
-            {
-                bail!("{what}: file must be a path inside the dataset folder");
-            }
+            self.check_view(v)?;
         }
         self.check_view_list()
+    }
+
+    /// One view against the settings: its split's maps and resolution, a plausible size and
+    /// field of view, a rigid camera, a gain in range (none for a test view) and a file inside
+    /// the dataset folder.
+    fn check_view(&self, v: &ViewRecord) -> Result<()> {
+        let s = &self.settings;
+        let what = format!("view {} ('{}')", v.index, v.file);
+        let allowed = match v.split.as_str() {
+            "train" => &s.train_maps,
+            "test" => &s.test_maps,
+            other => bail!("{what}: split '{other}' is neither 'train' nor 'test'"),
+        };
+        if !allowed.contains(&v.map) {
+            bail!(
+                "{what}: map {} is not one of its split's maps {allowed:?}",
+                v.map
+            );
+        }
+        if v.width == 0 || v.height == 0 || v.width as u64 * v.height as u64 > 1 << 28 {
+            bail!(
+                "{what}: size {}×{} is empty or implausibly large",
+                v.width,
+                v.height
+            );
+        }
+        if !(v.fov_x_deg > 0.0 && v.fov_x_deg < 180.0) {
+            bail!("{what}: fov_x_deg {} is not in (0, 180)", v.fov_x_deg);
+        }
+        if !v.camera_to_world.iter().all(|x| x.is_finite()) || !v.rotation_deg.is_finite() {
+            bail!("{what}: camera_to_world or rotation_deg holds a non-finite number");
+        }
+        if !is_rigid(&Mat4::from_cols_array(&v.camera_to_world)) {
+            bail!("{what}: camera_to_world is not a rotation and translation (orthonormal axes, last row 0 0 0 1)");
+        }
+        let resolution = if v.split == "train" {
+            s.train_resolution
+        } else {
+            s.test_resolution
+        };
+        if [v.width, v.height] != resolution {
+            bail!(
+                "{what}: size {}×{} is not its split's resolution {}×{}",
+                v.width,
+                v.height,
+                resolution[0],
+                resolution[1]
+            );
+        }
+        if !v.gain.iter().all(|g| (1.0 / 64.0..=64.0).contains(g)) {
+            bail!("{what}: gain {:?} is not within [1/64, 64]", v.gain);
+        }
+        if v.split == "test" && !is_unit_gain(&v.gain) {
+            bail!(
+                "{what}: a test view's map is never jittered, but its gain is {:?}",
+                v.gain
+            );
+        }
+        let file = Path::new(&v.file);
+        if file.is_absolute()
+            || file
+                .components()
+                .any(|c| matches!(c, std::path::Component::ParentDir))
+        {
+            bail!("{what}: file must be a path inside the dataset folder");
+        }
+        Ok(())
     }
 }
 

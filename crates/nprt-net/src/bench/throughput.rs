@@ -3,55 +3,54 @@
 use std::time::Instant;
 
 use burn::optim::AdamConfig;
-use burn::tensor::{Device, Tensor, TensorData};
+use burn::tensor::Device;
 use rand::{RngExt, SeedableRng};
 use rand_pcg::Pcg64Mcg;
 
 use crate::encoding::features::FEATURES;
+use crate::engine::Engine;
 use crate::model::config::ModelConfig;
 use crate::network::encoder::CODE_SIZE;
 use crate::network::init::Init;
-use crate::training::batch::{Batch, Engine};
+use crate::training::batch::{Batch, GradientPath};
 use crate::training::loss::Loss;
-use crate::training::training_loop::ADAM_EPSILON;
+use crate::training::optimiser::ADAM_EPSILON;
 use crate::Precision;
 
 /// Samples/s of `steps` full steps (forward, backward, Adam) on one synthetic batch of
-/// `batch_size` samples over `views` maps, after `warmup` untimed steps, gradients computed by
-/// `engine`; on our own GPU kernels (wgpu) in `precision` (elsewhere f32 only).
+/// `batch_size` samples over `views` maps, after `warmup` untimed steps: on the CPU with the
+/// gradients computed by `path`, on the GPU kernels in `precision` (elsewhere f32 only).
 #[allow(clippy::too_many_arguments)]
 pub fn measure_throughput(
     config: &ModelConfig,
-    engine: Engine,
+    path: GradientPath,
     batch_size: usize,
     views: usize,
     steps: usize,
     warmup: usize,
     precision: Precision,
-    device: &Device,
+    engine: Engine,
 ) -> anyhow::Result<f64> {
-    let device = device.clone().autodiff();
+    let device = Device::flex().autodiff();
     let mut net = config.build(&mut Init::new(0, &device));
     let mut optim = AdamConfig::new().with_epsilon(ADAM_EPSILON).init();
     let batch = synthetic_batch(config, batch_size, views);
     #[cfg(feature = "kernels")]
-    if crate::device::Backend::of(&device) == crate::device::Backend::Wgpu {
+    if engine.is_gpu() {
         return kernel_throughput(config, &batch, steps, warmup, precision);
     }
     anyhow::ensure!(
-        precision == Precision::F32,
-        "--precision {precision} runs on nprt's own GPU kernels only: use --device wgpu"
+        precision == Precision::F32 && !engine.is_gpu(),
+        "--precision {precision} runs on nprt's own GPU kernels only: use --device gpu"
     );
     let mut timed = Instant::now();
     for step in 0..warmup + steps {
         if step == warmup {
-            device.sync().ok();
             timed = Instant::now();
         }
-        let (_, grads) = batch.gradients(&net, &device, engine, Loss::LogL1);
+        let (_, grads) = batch.gradients(&net, &device, path, Loss::LogL1);
         net = optim.step(1e-4, net, grads);
     }
-    device.sync().ok();
     Ok((batch_size * steps) as f64 / timed.elapsed().as_secs_f64())
 }
 
@@ -97,7 +96,7 @@ pub fn profile_kernels(
     gpu.profile_step(&samples, Loss::LogL1, 1e-4)
 }
 
-/// [`measure_throughput`] on our own GPU kernels (what `--device wgpu` trains with): each step
+/// [`measure_throughput`] on our own GPU kernels (what `--device gpu` trains with): each step
 /// reads the loss of the one before it back while it runs, as a training run does.
 #[cfg(feature = "kernels")]
 fn kernel_throughput(
@@ -135,24 +134,17 @@ pub struct InferenceSpeed {
     /// A frame from a new viewpoint: transfer and shading networks.
     pub frame_ms: f64,
     /// A lighting change under a still camera: shading networks only (the transfer networks'
-    /// outputs kept); equal to `frame_ms` for the baseline, which has none, and off the CPU,
-    /// where the outputs are not kept.
+    /// outputs kept); equal to `frame_ms` for the baseline, which has none.
     pub relight_ms: f64,
     pub frame_gflops: f64,
     pub relight_gflops: f64,
 }
 
-/// Median over `repeats` runs of the transport networks on `pixels` synthetic foreground
-/// pixels on `device` (the encoder, once per lighting, is not counted). On the CPU the engine
-/// runs from host memory; elsewhere the features stay on the device and the timed work ends
-/// with the frame's radiance read back.
-pub fn measure_inference(
-    config: &ModelConfig,
-    pixels: usize,
-    repeats: usize,
-    device: &Device,
-) -> InferenceSpeed {
-    let net = config.build(&mut Init::new(0, device));
+/// Median over `repeats` runs of the CPU engine's transport networks on `pixels` synthetic
+/// foreground pixels in host memory (the encoder, once per lighting, is not counted). The GPU
+/// kernels' frames are timed by nprt-render's `bench frame`, which keeps them on the device.
+pub fn measure_inference(config: &ModelConfig, pixels: usize, repeats: usize) -> InferenceSpeed {
+    let net = config.build(&mut Init::new(0, &Device::flex()));
     let host = crate::cpu::HostTransport::from_net(&net);
     let mut rng = Pcg64Mcg::seed_from_u64(1);
     let features: Vec<f32> = (0..pixels * FEATURES)
@@ -171,34 +163,19 @@ pub fn measure_inference(
                 .collect(),
         )
     };
-    let (frame_ms, relight_ms, kept) = if crate::device::is_cpu(device) {
-        let kept = host.transfer_codes(&features);
-        let frame = median_ms(&|| {
-            host.radiance(&features, &code, [1.0; 3], None);
-        });
-        let relight = median_ms(&|| {
-            host.radiance(&features, &code, [1.0; 3], Some(&kept));
-        });
-        (frame, relight, true)
-    } else {
-        let f = Tensor::<2>::from_data(TensorData::new(features, [pixels, FEATURES]), device);
-        let code = Tensor::<2>::from_data(TensorData::new(code, [1, CODE_SIZE]), device)
-            .expand([pixels, CODE_SIZE]);
-        let scale = Tensor::<2>::ones([pixels, 1], device);
-        let frame = median_ms(&|| {
-            // The frame is read back whole, as a renderer does: a partial read let the
-            // backend skip work (measured: "400 TFLOP/s" on an H100).
-            net.shade(f.clone(), code.clone(), scale.clone())
-                .into_data();
-        });
-        (frame, frame, false)
-    };
+    let kept = host.transfer_codes(&features);
+    let frame_ms = median_ms(&|| {
+        host.radiance(&features, &code, [1.0; 3], None);
+    });
+    let relight_ms = median_ms(&|| {
+        host.radiance(&features, &code, [1.0; 3], Some(&kept));
+    });
     let gflops = |flops: f64, ms: f64| flops * pixels as f64 / (ms * 1e6);
     InferenceSpeed {
         pixels,
         frame_ms,
         relight_ms,
         frame_gflops: gflops(host.flops_per_pixel(false), frame_ms),
-        relight_gflops: gflops(host.flops_per_pixel(kept), relight_ms),
+        relight_gflops: gflops(host.flops_per_pixel(true), relight_ms),
     }
 }

@@ -77,7 +77,7 @@ impl Tape {
 }
 
 pub(super) fn host<const D: usize>(p: &Param<Tensor<D>>) -> Vec<f32> {
-    crate::device::host_values(p.val().into_data())
+    crate::network::host_values(p.val().into_data())
 }
 
 /// Replaces `p`'s values with `values` (same shape), keeping its id (which keys Adam's state),
@@ -312,45 +312,58 @@ impl DenseStack {
                 matmul(d_in, x.cols, false, dz, Op::Plain, w, Op::Transposed);
             }
             if let Some(s) = shared {
-                // Per group: the sum of its rows' gradients, then the same two products.
-                let width = layer.d_out;
-                dx.clear();
-                dx.resize(s.groups() * width, 0.0);
-                for (row, &grp) in dy.chunks_exact(width).zip(s.group) {
-                    let at = grp as usize * width;
-                    dx[at..at + width]
-                        .iter_mut()
-                        .zip(row)
-                        .for_each(|(a, d)| *a += d);
-                }
-                let sums = MatRef::new(&dx, s.groups(), width);
-                let values = MatRef::new(s.values, s.groups(), s.weight_rows.len());
-                let rows = s.weight_rows.clone();
-                let g_shared = &mut g.weight[rows.start * width..rows.end * width];
-                matmul(
-                    g_shared,
-                    width,
-                    true,
-                    values,
-                    Op::Transposed,
-                    sums,
-                    Op::Plain,
-                );
-                if let Some(d) = d_shared.as_deref_mut() {
-                    let w = layer.rows(s.weight_rows.clone());
-                    matmul(
-                        d,
-                        s.weight_rows.len(),
-                        true,
-                        sums,
-                        Op::Plain,
-                        w,
-                        Op::Transposed,
-                    );
-                }
+                shared_backward(layer, s, &dy, &mut dx, g, d_shared.as_deref_mut());
             }
         }
         *d_output = dy;
         tape.scratch = dx;
+    }
+}
+
+/// The first layer's backward pass through a shared input `s`: per group the sum of its rows'
+/// gradients `dy` (into the scratch `dx`), then the weight gradient of the shared rows (added
+/// to `g`) and, if asked, the gradient at the shared input (added to `d_shared`).
+fn shared_backward(
+    layer: &Dense,
+    s: &SharedInput,
+    dy: &[f32],
+    dx: &mut Vec<f32>,
+    g: &mut Dense,
+    d_shared: Option<&mut [f32]>,
+) {
+    let width = layer.d_out;
+    dx.clear();
+    dx.resize(s.groups() * width, 0.0);
+    for (row, &grp) in dy.chunks_exact(width).zip(s.group) {
+        let at = grp as usize * width;
+        dx[at..at + width]
+            .iter_mut()
+            .zip(row)
+            .for_each(|(a, d)| *a += d);
+    }
+    let sums = MatRef::new(dx, s.groups(), width);
+    let values = MatRef::new(s.values, s.groups(), s.weight_rows.len());
+    let rows = s.weight_rows.clone();
+    let g_shared = &mut g.weight[rows.start * width..rows.end * width];
+    matmul(
+        g_shared,
+        width,
+        true,
+        values,
+        Op::Transposed,
+        sums,
+        Op::Plain,
+    );
+    if let Some(d) = d_shared {
+        let w = layer.rows(s.weight_rows.clone());
+        matmul(
+            d,
+            s.weight_rows.len(),
+            true,
+            sums,
+            Op::Plain,
+            w,
+            Op::Transposed,
+        );
     }
 }

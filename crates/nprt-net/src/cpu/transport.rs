@@ -359,7 +359,7 @@ impl HostTransport {
                 grid: t
                     .grid
                     .as_ref()
-                    .map(|g| crate::device::host_values(g.table.val().into_data())),
+                    .map(|g| crate::network::host_values(g.table.val().into_data())),
                 transfer: t.transfer.as_ref().map(DenseStack::from_mlp),
                 shading: DenseStack::from_mlp(&t.shading),
             })

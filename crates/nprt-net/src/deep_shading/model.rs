@@ -40,7 +40,6 @@ pub struct DeepShadingFile {
 pub struct DeepShadingModel {
     pub file: DeepShadingFile,
     net: DeepShading,
-    device: Device,
 }
 
 /// Reads a Deep Shading folder's config, refusing an encoder width no network can have.
@@ -52,15 +51,12 @@ pub fn read_file(dir: &Path) -> Result<DeepShadingFile> {
 }
 
 impl DeepShadingModel {
-    pub fn load(dir: &Path, device: &Device) -> Result<Self> {
+    /// Loads the network in `dir`; it runs on the CPU (burn), whatever the engine.
+    pub fn load(dir: &Path) -> Result<Self> {
         let file = read_file(dir)?;
-        let mut net = DeepShading::new(&mut Init::new(0, device), file.encoder_width);
+        let mut net = DeepShading::new(&mut Init::new(0, &Device::flex()), file.encoder_width);
         load_weights(&dir.join(WEIGHTS_FILE), &mut net, TAG)?;
-        Ok(DeepShadingModel {
-            file,
-            net,
-            device: device.clone(),
-        })
+        Ok(DeepShadingModel { file, net })
     }
 
     /// Radiance of every pixel of a `width`×`height` G-buffer under `map` rotated by
@@ -82,12 +78,15 @@ impl DeepShadingModel {
         );
         let lw = light.width;
         let out = self.net.forward(
-            Tensor::from_data(TensorData::new(img, [1, FEATURES, ph, pw]), &self.device),
+            Tensor::from_data(TensorData::new(img, [1, FEATURES, ph, pw]), &Device::flex()),
             Tensor::from_data(
                 TensorData::new(light.pixels, [1, 3, lw / 2, lw]),
-                &self.device,
+                &Device::flex(),
             ),
-            Tensor::from_data(TensorData::new(light.scale.to_vec(), [1, 3]), &self.device),
+            Tensor::from_data(
+                TensorData::new(light.scale.to_vec(), [1, 3]),
+                &Device::flex(),
+            ),
         );
         let data = out.into_data();
         let v = data.as_slice::<f32>().expect("f32 output");

@@ -4,7 +4,7 @@ use serde::{Deserialize, Serialize};
 
 use crate::encoding::map_norm::MapNorm;
 use crate::model::config::{DEFAULT_ENCODER_WIDTH, DEFAULT_MAP_NORM};
-use crate::training::training_loop::Schedule;
+use crate::training::schedule::Schedule;
 
 /// The Deep Shading run's settings (saved in its config).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]

@@ -23,7 +23,8 @@ use crate::network::init::Init;
 use crate::training::checkpoint::{self, RunState};
 use crate::training::loss::log_l1_map;
 use crate::training::optimiser::DeviceSteps;
-use crate::training::training_loop::{self, epoch_rng, Objective, Schedule, TrainSummary};
+use crate::training::schedule::Schedule;
+use crate::training::training_loop::{self, epoch_rng, Objective, TrainSummary};
 use crate::training::training_set::{log_mean_level, open_recorded_maps};
 
 /// What training needs of each view, padded to multiples of 8.
@@ -247,12 +248,12 @@ impl Objective for UnetObjective {
 
 /// Trains (or resumes exactly, Adam's moments included) a Deep Shading network on the dataset
 /// in `data`, with the validation loss on its test views after every epoch. Returns the run's
-/// summary and the model's config as saved.
+/// summary and the model's config as saved. The U-Net trains on the CPU (burn) whatever the
+/// engine: the GPU kernels do not have its up-sampling and skip connections yet.
 pub fn train(
     data: &Path,
     opts: &DeepShadingOptions,
     out: &Path,
-    device: &Device,
 ) -> Result<(TrainSummary, DeepShadingFile)> {
     opts.schedule.check()?;
     check_input_width(opts.encoder_width)?;
@@ -298,6 +299,6 @@ pub fn train(
         seconds: 0.0,
     };
     let objective = UnetObjective { train, test, file };
-    let summary = training_loop::train(&objective, &opts.schedule, out, device)?;
+    let summary = training_loop::train(&objective, &opts.schedule, out)?;
     Ok((summary, read_file(out)?))
 }

@@ -139,7 +139,7 @@ impl HashGrid {
     pub fn forward(&self, features: &Tensor<2>) -> Tensor<2> {
         let n = features.dims()[0];
         let device = features.device();
-        let positions = crate::device::host_values(features.clone().narrow(1, 0, 3).into_data());
+        let positions = crate::network::host_values(features.clone().narrow(1, 0, 3).into_data());
         let mut rows = Vec::with_capacity(n * LEVELS * CORNERS);
         let mut weights = Vec::with_capacity(n * LEVELS * CORNERS);
         for p in positions.chunks_exact(3) {

@@ -20,6 +20,9 @@ pub struct GpuDevice {
     /// The adapter's name and driver, for reports ("llvmpipe (LLVM 19.1.7, 256 bits)" on
     /// Mesa's software Vulkan).
     pub adapter: String,
+    /// Whether the adapter is a software rasteriser (lavapipe, WARP), which `--device gpu` and
+    /// `auto` pass over.
+    pub software: bool,
     /// Whether kernels may hold f16 values (`half_layer`, the frame path's `--precision f16`).
     pub half: bool,
     /// Whether `half_layer`'s products run on cooperative matrices (tensor cores): 16 × 16 × 16
@@ -43,14 +46,19 @@ const STAGING_KEPT: usize = 8;
 static DEVICE: OnceLock<Result<Arc<GpuDevice>, String>> = OnceLock::new();
 
 impl GpuDevice {
-    /// The process's GPU device, opened on first use: the first adapter wgpu finds on its
-    /// native backends (Vulkan, Metal, DX12), preferring a high-performance one. An error
-    /// says what is missing.
+    /// The process's GPU device, opened on first use: the best adapter wgpu finds on its
+    /// native backends (Vulkan, Metal, DX12), a discrete GPU first and a software one last. An
+    /// error says what is missing.
     pub fn get() -> Result<Arc<GpuDevice>> {
         DEVICE
             .get_or_init(|| Self::open().map(Arc::new).map_err(|e| format!("{e:#}")))
             .clone()
             .map_err(|e| anyhow!(e))
+    }
+
+    /// The device if this process has opened it.
+    pub fn opened() -> Option<Arc<GpuDevice>> {
+        DEVICE.get()?.as_ref().ok().cloned()
     }
 
     /// Whether the device opens here, for the tests and benchmarks that need one: where it
@@ -74,19 +82,18 @@ impl GpuDevice {
         let mut desc = wgpu::InstanceDescriptor::new_without_display_handle();
         desc.backends = wgpu::Backends::PRIMARY;
         let instance = wgpu::Instance::new(desc);
-        let adapter = futures_lite::future::block_on(instance.request_adapter(
-            &wgpu::RequestAdapterOptions {
-                power_preference: wgpu::PowerPreference::HighPerformance,
-                ..Default::default()
-            },
-        ))
-        .map_err(|e| {
-            anyhow!(
-                "no GPU adapter found ({e}): nprt's GPU kernels need Vulkan, Metal or DX12; \
-                 on Linux install a Vulkan driver (scripts/vulkan.sh installs Mesa's software \
-                 one), or use --device cpu"
-            )
-        })?;
+        let adapters =
+            futures_lite::future::block_on(instance.enumerate_adapters(wgpu::Backends::PRIMARY));
+        let adapter = adapters
+            .into_iter()
+            .min_by_key(|a| adapter_rank(a.get_info().device_type))
+            .ok_or_else(|| {
+                anyhow!(
+                    "no GPU adapter found: nprt's GPU kernels need Vulkan, Metal or DX12; on \
+                     Linux install a Vulkan driver (scripts/vulkan.sh installs Mesa's software \
+                     one), or use --device cpu"
+                )
+            })?;
         let info = adapter.get_info();
         let half = adapter.features().contains(wgpu::Features::SHADER_F16);
         let tensor_cores = half && tensor_cores(&adapter);
@@ -134,6 +141,7 @@ impl GpuDevice {
             instance,
             wgpu_adapter: adapter.clone(),
             adapter: format!("{} ({}, {:?})", info.name, info.driver_info, info.backend),
+            software: info.device_type == wgpu::DeviceType::Cpu,
             half,
             tensor_cores,
             pipelines: Pipelines::default(),
@@ -171,6 +179,17 @@ impl GpuDevice {
 
     pub(super) fn counted_wait(&self) {
         self.waits.fetch_add(1, Ordering::Relaxed);
+    }
+}
+
+/// The order adapters are preferred in: a discrete GPU first, a software one last.
+fn adapter_rank(kind: wgpu::DeviceType) -> u8 {
+    match kind {
+        wgpu::DeviceType::DiscreteGpu => 0,
+        wgpu::DeviceType::IntegratedGpu => 1,
+        wgpu::DeviceType::VirtualGpu => 2,
+        wgpu::DeviceType::Other => 3,
+        wgpu::DeviceType::Cpu => 4,
     }
 }
 

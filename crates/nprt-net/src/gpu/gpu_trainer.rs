@@ -28,7 +28,7 @@ use crate::encoding::hash_grid;
 use crate::network::encoder::CODE_SIZE;
 use crate::network::nprt_net::NprtNet;
 use crate::training::loss::Loss;
-use crate::training::training_loop::ADAM_EPSILON;
+use crate::training::optimiser::ADAM_EPSILON;
 use crate::Precision;
 
 const BETA_1: f32 = 0.9;

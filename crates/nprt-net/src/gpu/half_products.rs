@@ -16,51 +16,9 @@ use super::codes::activation_code;
 use super::gpu_trainer::GpuTrainer;
 use super::half_layers::{held_halves, pad16, HalfWeight};
 use super::kernels::{HALF_TRAIN, HALF_TRAIN_COOP, HALF_WEIGHT_GRAD, HALF_WEIGHT_GRAD_COOP};
-use super::network_layout::{DenseAt, MlpAt};
+use super::network_layout::MlpAt;
 use super::products::{row_chunks, Bias, FirstLayer, FirstLayerBias, MlpTape, Output, BACKWARD};
 use super::{groups_for, Dispatch, GpuDevice};
-
-/// A dense layer's f16 copies of its weight rows `[row, row + count)`: as stored (the forward
-/// product's right operand) and transposed (the input gradient's).
-pub(super) struct HalfCopies {
-    pub row: usize,
-    pub count: usize,
-    pub stored: HalfWeight,
-    pub transposed: HalfWeight,
-}
-
-impl HalfCopies {
-    pub fn new(gpu: &GpuDevice, layer: &DenseAt, row: usize, count: usize) -> Self {
-        HalfCopies {
-            row,
-            count,
-            stored: gpu.half_weight(count, layer.d_out),
-            transposed: gpu.half_weight(layer.d_out, count),
-        }
-    }
-
-    /// The dispatches that copy `layer`'s current weight from `params` into both copies.
-    pub fn refresh(
-        &self,
-        gpu: &GpuDevice,
-        params: &wgpu::Buffer,
-        layer: &DenseAt,
-    ) -> [Dispatch; 2] {
-        let (n, k) = (layer.d_out, self.count);
-        let offset = layer.weight.offset + self.row * n;
-        [
-            gpu.half_matrix([k, n], [n, 1], offset, k + 16, params, &self.stored.buffer),
-            gpu.half_matrix(
-                [n, k],
-                [1, n],
-                offset,
-                n + 16,
-                params,
-                &self.transposed.buffer,
-            ),
-        ]
-    }
-}
 
 /// Where a mixed-precision product's results go.
 pub(super) struct HalfOut<'a> {

@@ -1,9 +1,9 @@
 //! Where each tensor of a network lies in the flat parameter buffers, in the network's own
 //! structure (encoder blocks, tracks, layers), as the training step's dispatches address them.
 
-use super::half_products::HalfCopies;
+use super::half_layers::HalfWeight;
 use super::parameters::{ParameterLayout, Span};
-use super::GpuDevice;
+use super::{Dispatch, GpuDevice};
 use crate::cpu::{DenseStack, HostEncoder, HostTransport};
 use crate::encoding::hash_grid;
 use crate::network::activation::Activation;
@@ -186,5 +186,47 @@ fn mlp_at(stack: &DenseStack, spans: &mut impl Iterator<Item = Span>) -> MlpAt {
             .collect(),
         activation: stack.activation,
         half: Vec::new(),
+    }
+}
+
+/// A dense layer's f16 copies of its weight rows `[row, row + count)`: as stored (the forward
+/// product's right operand) and transposed (the input gradient's).
+pub(super) struct HalfCopies {
+    pub row: usize,
+    pub count: usize,
+    pub stored: HalfWeight,
+    pub transposed: HalfWeight,
+}
+
+impl HalfCopies {
+    pub fn new(gpu: &GpuDevice, layer: &DenseAt, row: usize, count: usize) -> Self {
+        HalfCopies {
+            row,
+            count,
+            stored: gpu.half_weight(count, layer.d_out),
+            transposed: gpu.half_weight(layer.d_out, count),
+        }
+    }
+
+    /// The dispatches that copy `layer`'s current weight from `params` into both copies.
+    pub fn refresh(
+        &self,
+        gpu: &GpuDevice,
+        params: &wgpu::Buffer,
+        layer: &DenseAt,
+    ) -> [Dispatch; 2] {
+        let (n, k) = (layer.d_out, self.count);
+        let offset = layer.weight.offset + self.row * n;
+        [
+            gpu.half_matrix([k, n], [n, 1], offset, k + 16, params, &self.stored.buffer),
+            gpu.half_matrix(
+                [n, k],
+                [1, n],
+                offset,
+                n + 16,
+                params,
+                &self.transposed.buffer,
+            ),
+        ]
     }
 }

@@ -12,10 +12,10 @@ use crate::training::training_set::ViewSamples;
 
 /// Which code computes a batch's gradients.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Engine {
+pub enum GradientPath {
     /// The CPU engine where it applies (burn's CPU backend, f32), else burn's autodiff.
     Auto,
-    /// burn's autodiff graph on any device: the reference the CPU engine is held to.
+    /// burn's autodiff graph: the reference the CPU engine is held to.
     Autodiff,
 }
 
@@ -162,15 +162,15 @@ impl Batch {
     }
 
     /// `loss` on this batch and every parameter's gradient (`device` is an autodiff device),
-    /// computed by `engine`.
+    /// computed by `path`.
     pub fn gradients(
         &self,
         net: &NprtNet,
         device: &Device,
-        engine: Engine,
+        path: GradientPath,
         loss: Loss,
     ) -> (f64, GradientsParams) {
-        if engine == Engine::Auto && crate::cpu::applies(net, device) {
+        if path == GradientPath::Auto && crate::cpu::applies(net) {
             return crate::cpu::gradients(net, &self.samples(), device, loss);
         }
         let (pred, reference) = self.forward(net, device);

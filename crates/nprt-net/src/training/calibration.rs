@@ -12,7 +12,7 @@
 use burn::tensor::Device;
 
 use crate::choice::named_choice;
-use crate::device::host_values;
+use crate::network::host_values;
 use crate::network::nprt_net::NprtNet;
 use crate::training::batch::Batch;
 use crate::training::training_set::ViewSamples;

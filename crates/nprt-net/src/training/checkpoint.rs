@@ -70,11 +70,7 @@ pub(crate) fn restore_weights<M: Module>(
     net: &mut M,
     tag: &str,
 ) -> Result<()> {
-    load_weights(&dir(out).join(&ck.weights), net, tag)?;
-    if let Some(device) = net.devices().into_iter().next() {
-        crate::device::make_default(&device);
-    }
-    Ok(())
+    load_weights(&dir(out).join(&ck.weights), net, tag)
 }
 
 /// `optim` with the checkpoint's optimiser state.

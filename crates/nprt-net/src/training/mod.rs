@@ -12,6 +12,7 @@ pub mod lr_schedule;
 pub mod nprt_objective;
 pub mod optimiser;
 pub mod run_length;
+pub mod schedule;
 pub mod train_options;
 pub mod training_loop;
 pub mod training_set;

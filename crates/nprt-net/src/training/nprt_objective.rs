@@ -14,18 +14,19 @@ use burn::module::Module;
 use burn::optim::GradientsParams;
 use burn::tensor::Device;
 
-use crate::device::Backend;
+use crate::engine::Engine;
 use crate::model::config::ModelConfig;
 use crate::model::folder::{save_model, ModelFile, MODEL_FORMAT, MODEL_VERSION};
 use crate::network::init::Init;
 use crate::network::nprt_net::NprtNet;
-use crate::training::batch::{Batch, Engine};
+use crate::training::batch::{Batch, GradientPath};
 use crate::training::calibration::{level_gain, Calibration, LEVEL_SAMPLES};
 use crate::training::checkpoint::RunState;
 use crate::training::epoch_plan::{group_batches, EpochPlan};
-use crate::training::optimiser::DeviceSteps;
+use crate::training::optimiser::{DeviceSteps, ADAM_EPSILON};
+use crate::training::schedule::Schedule;
 use crate::training::train_options::{Gather, TrainOptions};
-use crate::training::training_loop::{self, Objective, Schedule, TrainSummary, ADAM_EPSILON};
+use crate::training::training_loop::{self, Objective, TrainSummary};
 use crate::training::training_set::{TrainingSet, ViewSamples};
 use crate::training::validation::{forward_log_l1, validation_loss};
 use crate::Precision;
@@ -37,7 +38,7 @@ struct PixelObjective<'a> {
     opts: &'a TrainOptions,
     /// The model file as last saved, returned to the caller.
     saved: Mutex<Option<ModelFile>>,
-    /// Whether the steps run on our own GPU kernels (`--device wgpu`).
+    /// Whether the steps run on our own GPU kernels (`--device gpu` or `wgpu`).
     kernels: bool,
 }
 
@@ -126,7 +127,7 @@ impl Objective for PixelObjective<'_> {
         batch: &Batch,
         device: &Device,
     ) -> (f64, GradientsParams, u64) {
-        let (loss, grads) = batch.gradients(net, device, Engine::Auto, self.opts.loss);
+        let (loss, grads) = batch.gradients(net, device, GradientPath::Auto, self.opts.loss);
         (loss, grads, batch.len() as u64)
     }
 
@@ -221,15 +222,15 @@ pub fn train(
     config: &ModelConfig,
     opts: &TrainOptions,
     out: &Path,
-    device: &Device,
+    engine: Engine,
 ) -> Result<(TrainSummary, ModelFile)> {
     opts.check()?;
-    // On wgpu the steps run on our own kernels, with the network's host copy (for saving) on
-    // the CPU.
-    let kernels = cfg!(feature = "kernels") && Backend::of(device) == Backend::Wgpu;
+    // On the GPU the steps run on our own kernels, with the network's host copy (for saving)
+    // on the CPU.
+    let kernels = cfg!(feature = "kernels") && engine.is_gpu();
     if opts.precision != Precision::F32 && !kernels {
         bail!(
-            "--precision {} trains on nprt's own GPU kernels only: use --device wgpu (a build \
+            "--precision {} trains on nprt's own GPU kernels only: use --device gpu (a build \
              with the `gpu` feature)",
             opts.precision
         );
@@ -241,12 +242,7 @@ pub fn train(
         saved: Mutex::new(None),
         kernels,
     };
-    let device = if kernels {
-        Device::flex()
-    } else {
-        device.clone()
-    };
-    let summary = training_loop::train(&objective, &opts.schedule, out, &device)?;
+    let summary = training_loop::train(&objective, &opts.schedule, out)?;
     // The loop saves the model on every path that returns a summary.
     let file = objective
         .saved

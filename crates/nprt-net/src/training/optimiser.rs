@@ -9,7 +9,8 @@ use anyhow::{anyhow, bail, Result};
 use burn::module::Module;
 use burn::optim::{AdamConfig, ModuleOptimizer};
 
-use crate::training::training_loop::ADAM_EPSILON;
+/// Adam's ε, on every engine.
+pub const ADAM_EPSILON: f32 = 1e-8;
 
 /// Steps taken on a device of their own: the parameters and Adam's moments live there, and a
 /// step is the batch's loss, gradients and Adam update together.
@@ -98,9 +99,9 @@ impl<N: Module, B> Optimiser<N, B> {
                 "checkpoint '{}' holds Adam's state of {}; resume it with the --device that wrote it, or start over in another --out",
                 path.display(),
                 if name.starts_with(DEVICE_PREFIX) {
-                    "nprt's own GPU kernels (--device wgpu)"
+                    "nprt's own GPU kernels (--device gpu or wgpu)"
                 } else {
-                    "burn's optimiser (--device cpu, or burn's CUDA backend)"
+                    "the CPU engine (--device cpu)"
                 }
             );
         }

@@ -2,7 +2,7 @@
 //! part left unset keeps the run's default.
 
 use crate::training::lr_schedule::LrSchedule;
-use crate::training::training_loop::Schedule;
+use crate::training::schedule::Schedule;
 
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct RunLength {

@@ -10,7 +10,7 @@ use crate::training::calibration::Calibration;
 use crate::training::loss::Loss;
 use crate::training::lr_schedule::LrSchedule;
 use crate::training::run_length::RunLength;
-use crate::training::training_loop::Schedule;
+use crate::training::schedule::Schedule;
 use crate::Precision;
 
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]

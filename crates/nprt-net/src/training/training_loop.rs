@@ -20,15 +20,13 @@ use burn::optim::GradientsParams;
 use burn::tensor::Device;
 use rand::SeedableRng;
 use rand_pcg::Pcg64Mcg;
-use serde::{Deserialize, Serialize};
 
 use crate::network::init::Init;
 use crate::training::checkpoint::{self, Checkpoint, RunState};
 use crate::training::loss_curves::{self as curves, LossRow};
-use crate::training::lr_schedule::LrSchedule;
 use crate::training::optimiser::{DeviceSteps, Optimiser};
+use crate::training::schedule::Schedule;
 
-pub const ADAM_EPSILON: f32 = 1e-8;
 /// Training-loss rows per epoch in loss.csv.
 const TRAIN_ROWS_PER_EPOCH: u64 = 20;
 
@@ -36,81 +34,6 @@ const TRAIN_ROWS_PER_EPOCH: u64 = 20;
 /// always does): a small dataset's epochs take a GPU milliseconds, and writing the checkpoint,
 /// the model and the plot after each took a quarter of a 30-second run on an H200.
 const EPOCH_CHECKPOINT_SECS: f64 = 10.0;
-
-/// The loop's own settings, shared by every network.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-pub struct Schedule {
-    /// Passes over the data; with a time budget, the most the run may do.
-    pub epochs: usize,
-    /// The peak learning rate.
-    pub learning_rate: f64,
-    /// How the rate moves over the run (the paper: constant).
-    #[serde(default)]
-    pub lr_schedule: LrSchedule,
-    /// Wall-clock budget of training time, minutes: the run stops when its accumulated time
-    /// reaches it (or after `epochs`, whichever comes first), and a decaying schedule decays
-    /// over it instead of over the epochs.
-    #[serde(default)]
-    pub minutes: Option<f64>,
-    /// Seed of the initial weights and of the batch order.
-    pub seed: u64,
-    /// Seconds between checkpoints inside an epoch; an epoch's end writes one once this many
-    /// seconds or 10 have passed since the last, and the run's end always does.
-    #[serde(skip)]
-    pub checkpoint_secs: f64,
-    #[serde(skip)]
-    pub progress: bool,
-}
-
-impl Default for Schedule {
-    /// The paper's learning rate; a checkpoint every 5 minutes within an epoch.
-    fn default() -> Self {
-        Schedule {
-            epochs: 20,
-            learning_rate: 1e-4,
-            lr_schedule: LrSchedule::Paper,
-            minutes: None,
-            seed: 0,
-            checkpoint_secs: 300.0,
-            progress: true,
-        }
-    }
-}
-
-impl Schedule {
-    /// Refuses settings no run can use.
-    pub fn check(&self) -> Result<()> {
-        if self.epochs == 0 {
-            bail!("the number of epochs must be positive");
-        }
-        if !(self.learning_rate > 0.0 && self.learning_rate.is_finite()) {
-            bail!(
-                "the learning rate must be a positive number, got {}",
-                self.learning_rate
-            );
-        }
-        if let Some(m) = self.minutes {
-            if !(m > 0.0 && m.is_finite()) {
-                bail!("the time budget must be a positive number of minutes, got {m}");
-            }
-        }
-        Ok(())
-    }
-
-    /// The budget in seconds, if the run has one.
-    fn budget_secs(&self) -> Option<f64> {
-        self.minutes.map(|m| m * 60.0)
-    }
-
-    /// "epoch 3/20", or "epoch 3" for a run bounded by its time budget alone.
-    fn epoch_label(&self, epoch: usize) -> String {
-        if self.epochs == usize::MAX {
-            format!("epoch {epoch}")
-        } else {
-            format!("epoch {epoch}/{}", self.epochs)
-        }
-    }
-}
 
 /// Batches built ahead of the step that takes them.
 const BATCHES_AHEAD: usize = 2;
@@ -185,8 +108,7 @@ pub struct TrainSummary {
     pub final_train: f64,
     pub final_val: f64,
     pub resumed_from_epoch: Option<f64>,
-    /// Where the steps ran: "GPU kernels on …" for a device's own steps, else the device's
-    /// name ("cpu", "cuda: …").
+    /// Where the steps ran: "GPU kernels on …" for a device's own steps, else "cpu".
     pub steps_on: String,
     /// Where this invocation's time went.
     pub split: TimeSplit,
@@ -233,14 +155,10 @@ pub fn epoch_rng(seed: u64, epoch: u64, stream: u64) -> Pcg64Mcg {
 }
 
 /// Trains (or resumes training of) `objective`'s network in the model folder `out`.
-pub fn train<O: Objective>(
-    objective: &O,
-    schedule: &Schedule,
-    out: &Path,
-    device: &Device,
-) -> Result<TrainSummary> {
+pub fn train<O: Objective>(objective: &O, schedule: &Schedule, out: &Path) -> Result<TrainSummary> {
     schedule.check()?;
-    let device = device.clone().autodiff();
+    // burn keeps the parameters on the host; a device's own steps read them from there.
+    let device = Device::flex().autodiff();
     let inner = device.clone().inner();
     let mut net = objective.build(&mut Init::new(schedule.seed, &device));
     std::fs::create_dir_all(checkpoint::dir(out))
@@ -279,7 +197,7 @@ pub fn train<O: Objective>(
     run.bar.finish_and_clear();
     run.steps_on = match &optim {
         Optimiser::Device(steps) => steps.describe(),
-        Optimiser::Burn(_) => crate::device::device_name(&inner),
+        Optimiser::Burn(_) => "cpu".into(),
     };
     if !trained {
         // A finished run asked again: its model files follow this invocation's options (the

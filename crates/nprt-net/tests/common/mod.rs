@@ -94,7 +94,7 @@ pub fn exact_gradients(
     let device = Device::flex().autodiff();
     let mut init = Init::with_dtype(4, &device, DType::F64);
     let net = loud_grids(config.build(&mut init));
-    assert!(!nprt_net::cpu::applies(&net, &device));
+    assert!(!nprt_net::cpu::applies(&net));
     let (n, w) = (batch.len(), batch.light_width);
     let views = batch.lights.len() / (3 * w * w / 2);
     let pred = net.forward(

@@ -11,22 +11,25 @@ use std::sync::{Arc, Mutex, OnceLock};
 use anyhow::Result;
 use nprt_net::cpu::{DenseStack, HostEncoder, HostTransport};
 use nprt_net::encoding::hash_grid;
-use nprt_net::network::encoder::{BLOCKS, CHANNELS, CODE_SIZE};
-use nprt_net::{Activation, MapNorm, NprtNet, TrackKind, FEATURES, TRANSPORT_CODE};
+use nprt_net::network::encoder::CODE_SIZE;
+use nprt_net::{MapNorm, NprtNet, TrackKind, FEATURES, TRANSPORT_CODE};
 use nprt_scene::EnvMap;
 
 use nprt_net::gpu::{groups_for, BufferPool, Dispatch, GpuDevice, KernelTime, PooledBuffer};
 
-use nprt_net::gpu::{held_halves, pad16, Bias, HalfWeight, Held, Operand, Output, HALF_ROW_BLOCK};
+use nprt_net::gpu::{held_halves, Bias, Held, Operand, Output, HALF_ROW_BLOCK};
 
-use nprt_net::gpu::kernels::{COMBINE, ENCODER_BLOCK, GBUFFER_FEATURES, TRACK_INPUTS};
+use nprt_net::gpu::kernels::{COMBINE, GBUFFER_FEATURES, TRACK_INPUTS};
 
-use super::frame_background::{Background, Fill, GpuMap, SameTexels};
+use super::frame_background::{Background, Fill};
+use super::gpu_encoder::GpuEncoder;
+use super::gpu_map::{GpuMap, SameTexels};
+use super::gpu_mlp::{FirstLayer, GpuMlp, Scratch};
 use super::kept_last::KeptLast;
 use super::light_code::{GpuLightCode, LIGHT_CODE_VALUES};
 use super::light_input::GpuLightInput;
 use super::path_tracer::{record_paths, GpuPaths};
-use nprt_net::gpu::{activation_code, kind_code};
+use nprt_net::gpu::kind_code;
 
 /// Most rows per block of dispatches. Fewer blocks mean fewer dispatches to prepare and record
 /// (at 65,536 rows a 1920 × 1080 D/S frame was 32 blocks of a dozen dispatches each). A
@@ -34,22 +37,6 @@ use nprt_net::gpu::{activation_code, kind_code};
 /// the device ([`chunk_rows`]); its kernels' workgroups stay within 65,535 a dimension
 /// (`gemm`: 4,096 tiles of 128 rows).
 const MAX_CHUNK: usize = 1 << 19;
-
-/// One dense layer's weights (`d_in × d_out`, burn's layout) and bias on the device, and the
-/// weights in f16 where the networks run in half precision.
-struct GpuDense {
-    weight: wgpu::Buffer,
-    bias: wgpu::Buffer,
-    d_in: usize,
-    d_out: usize,
-    half: Option<HalfWeight>,
-}
-
-/// An MLP on the device: hidden layers take `activation`, the last is linear.
-struct GpuMlp {
-    layers: Vec<GpuDense>,
-    activation: Activation,
-}
 
 /// One transport track on the device.
 struct GpuTrack {
@@ -67,8 +54,7 @@ struct GpuTrack {
 /// A model's encoder and transport networks on the GPU, and the last map it was lit by.
 pub struct GpuNetwork {
     gpu: Arc<GpuDevice>,
-    convs: Vec<(wgpu::Buffer, wgpu::Buffer, usize)>,
-    to_code: GpuDense,
+    encoder: GpuEncoder,
     tracks: Vec<GpuTrack>,
     resolutions: wgpu::Buffer,
     /// The last map a frame's background or encoder input came from.
@@ -83,8 +69,6 @@ pub struct GpuNetwork {
     /// Each track's first shading bias with the light code's share folded in, made anew from
     /// `light` at each lighting change.
     biases: Vec<wgpu::Buffer>,
-    /// The encoder's dispatches for inputs of the last width.
-    encoder: KeptLast<usize, Arc<EncoderRun>>,
     /// The last map's input dispatches, by map, input width and normalisation.
     inputs: KeptLast<(SameTexels, usize, MapNorm), Arc<GpuLightInput>>,
     /// Held from writing a rotation into the kept input's parameters to the submission that
@@ -95,15 +79,6 @@ pub struct GpuNetwork {
     id: u64,
 }
 
-/// The encoder's dispatches over inputs of one width, with the buffers they read and write.
-struct EncoderRun {
-    /// The input a lighting's map is copied into (`3 × width/2 × width`).
-    input: wgpu::Buffer,
-    /// The code the last dispatch writes.
-    code: wgpu::Buffer,
-    dispatches: Vec<Dispatch>,
-}
-
 /// The buffers a camera's pixels run their networks through, which the network keeps for the
 /// next camera: a new viewpoint then allocates only what it keeps (on an H200, allocating
 /// these afresh for every 512² frame cost more than its networks). Pixels share them: the
@@ -111,17 +86,15 @@ struct EncoderRun {
 struct Workspace {
     /// Rows they hold (the largest block).
     rows: usize,
-    /// Ping-pong activations, f32 and, where the networks run in half precision, f16 (rows
-    /// padded to a multiple of 256 and columns to 16).
-    scratch: [wgpu::Buffer; 2],
-    half_scratch: Option<[wgpu::Buffer; 2]>,
+    /// Ping-pong activations.
+    scratch: Scratch,
     /// Each track's shading outputs.
     outputs: Vec<wgpu::Buffer>,
 }
 
 impl Workspace {
     fn half(&self) -> bool {
-        self.half_scratch.is_some()
+        self.scratch.f16.is_some()
     }
 
     /// `buffer`'s rows as the networks run through this workspace hold them.
@@ -175,17 +148,7 @@ impl GpuNetwork {
         let host = HostTransport::from_net(net);
         let encoder = HostEncoder::from_burn(&net.encoder);
         let storage = |data: &[f32]| gpu.upload(data);
-        let dense = |d: &nprt_net::cpu::Dense| GpuDense {
-            weight: storage(&d.weight),
-            bias: storage(&d.bias),
-            d_in: d.d_in,
-            d_out: d.d_out,
-            half: None,
-        };
-        let mlp = |s: &DenseStack| GpuMlp {
-            layers: s.layers.iter().map(dense).collect(),
-            activation: s.activation,
-        };
+        let mlp = |s: &DenseStack| GpuMlp::upload(&gpu, s);
         let tracks: Vec<GpuTrack> = host
             .tracks
             .iter()
@@ -202,11 +165,6 @@ impl GpuNetwork {
                 }
             })
             .collect();
-        let convs = encoder
-            .convs
-            .iter()
-            .map(|c| (storage(&c.weight), storage(&c.bias), c.c_in))
-            .collect();
         let mut light = vec![0.0; LIGHT_CODE_VALUES];
         light.extend(gain);
         Ok(GpuNetwork {
@@ -215,12 +173,10 @@ impl GpuNetwork {
                 .iter()
                 .map(|t| gpu.buffer(t.shading.layers[0].d_out))
                 .collect(),
-            encoder: KeptLast::default(),
             inputs: KeptLast::default(),
             encoding: Mutex::new(()),
             id: NETWORKS.fetch_add(1, Ordering::Relaxed),
-            convs,
-            to_code: dense(&encoder.to_code),
+            encoder: GpuEncoder::upload(&gpu, &encoder),
             tracks,
             resolutions: gpu.upload(&hash_grid::resolutions()),
             map: GpuMap::default(),
@@ -307,7 +263,7 @@ impl GpuNetwork {
         let _one_at_a_time = self.encoding.lock().unwrap_or_else(|e| e.into_inner());
         let mut encoder = gpu.device.create_command_encoder(&Default::default());
         input.record(gpu, &mut encoder, map, rotation_deg);
-        let code = self.record_code(&mut encoder, &input);
+        let code = self.encoder.record_code(&self.gpu, &mut encoder, &input);
         gpu.queue.submit([encoder.finish()]);
         code
     }
@@ -317,75 +273,9 @@ impl GpuNetwork {
     pub fn light_code(&self, input: &GpuLightInput) -> GpuLightCode {
         let gpu = &*self.gpu;
         let mut encoder = gpu.device.create_command_encoder(&Default::default());
-        let code = self.record_code(&mut encoder, input);
+        let code = self.encoder.record_code(gpu, &mut encoder, input);
         gpu.queue.submit([encoder.finish()]);
         code
-    }
-
-    /// Records the encoder over `input` (its dispatches kept per input width) into a new
-    /// [`GpuLightCode`].
-    fn record_code(
-        &self,
-        encoder: &mut wgpu::CommandEncoder,
-        input: &GpuLightInput,
-    ) -> GpuLightCode {
-        let gpu = &*self.gpu;
-        let run = self
-            .encoder
-            .get(input.width, || Arc::new(self.encoder_run(input.width)));
-        let light = GpuLightCode::room(gpu);
-        let code_bytes = 4 * CODE_SIZE as u64;
-        encoder.copy_buffer_to_buffer(&input.pixels, 0, &run.input, 0, run.input.size());
-        {
-            let mut pass = encoder.begin_compute_pass(&Default::default());
-            for d in &run.dispatches {
-                d.record(&mut pass);
-            }
-        }
-        encoder.copy_buffer_to_buffer(&run.code, 0, &light.buffer, 0, code_bytes);
-        encoder.copy_buffer_to_buffer(&input.scale, 0, &light.buffer, code_bytes, 12);
-        light
-    }
-
-    /// The encoder's dispatches over inputs `width` wide: its convolution blocks, each halving
-    /// the image, then the dense layer into the code.
-    fn encoder_run(&self, width: usize) -> EncoderRun {
-        let gpu = &*self.gpu;
-        let input = gpu.buffer(3 * width * (width / 2));
-        let code = gpu.buffer(CODE_SIZE);
-        let (mut h, mut w) = (width / 2, width);
-        let mut x = input.clone();
-        let mut dispatches = Vec::new();
-        for (weight, bias, c_in) in &self.convs {
-            let out = gpu.buffer(CHANNELS * (h / 2) * (w / 2));
-            dispatches.push(gpu.prepare(
-                &ENCODER_BLOCK,
-                &[*c_in as u32, h as u32, w as u32, 1, 0, 0, 0, 0],
-                &[&x, weight, bias, &out, &gpu.empty],
-                groups_for(CHANNELS * (h / 2) * (w / 2)),
-            ));
-            (x, h, w) = (out, h / 2, w / 2);
-        }
-        debug_assert_eq!(self.convs.len(), BLOCKS);
-        let flat = Rows {
-            x: &x,
-            rows: 1,
-            d_in: self.to_code.d_in,
-            w_row: 0,
-        };
-        dispatches.push(dense_layer(
-            gpu,
-            &self.to_code,
-            flat,
-            &self.to_code.bias,
-            0,
-            &code,
-        ));
-        EncoderRun {
-            input,
-            code,
-            dispatches,
-        }
     }
 
     /// Uploads the network inputs of a camera's foreground pixels (`rows × FEATURES`) and runs
@@ -469,7 +359,7 @@ impl GpuNetwork {
                             false => n * width,
                         };
                         let kept = self.pool.take_pooled(gpu, floats);
-                        let gathered = &work.scratch[0];
+                        let gathered = &work.scratch.f32[0];
                         match (&t.transfer, half) {
                             (None, false) => self.track_inputs(&mut pass, t, &features, n, &kept),
                             (None, true) => {
@@ -485,7 +375,7 @@ impl GpuNetwork {
                                 };
                                 let x = Held::F32(gathered);
                                 let out = work.held(&kept);
-                                mlp(gpu, &mut list, transfer, x, n, first, &work, out);
+                                transfer.record(gpu, &mut list, x, n, first, &work.scratch, out);
                             }
                         }
                         for d in list.drain(..) {
@@ -524,8 +414,10 @@ impl GpuNetwork {
         let gpu = &*self.gpu;
         let work = Arc::new(Workspace {
             rows,
-            scratch: [0, 1].map(|_| gpu.buffer(rows * widest)),
-            half_scratch: half.then(|| [0, 1].map(|_| gpu.half_buffer(held_halves(rows, widest)))),
+            scratch: Scratch {
+                f32: [0, 1].map(|_| gpu.buffer(rows * widest)),
+                f16: half.then(|| [0, 1].map(|_| gpu.half_buffer(held_halves(rows, widest)))),
+            },
             outputs: self
                 .tracks
                 .iter()
@@ -596,9 +488,8 @@ impl GpuNetwork {
                 };
                 let x = px.work.held(kept);
                 let out = Held::F32(out);
-                mlp(
-                    gpu, &mut list, &t.shading, x, chunk.rows, first, &px.work, out,
-                );
+                t.shading
+                    .record(gpu, &mut list, x, chunk.rows, first, &px.work.scratch, out);
             }
             let kinds: Vec<u32> = self.tracks.iter().map(|t| kind_code(t.kind)).collect();
             let params = [
@@ -636,9 +527,10 @@ impl GpuNetwork {
         let mut encoder = self.gpu.device.create_command_encoder(&Default::default());
         self.use_light(&mut encoder, code);
         self.gpu.queue.submit([encoder.finish()]);
-        let (input, run) = (self.inputs.kept(), self.encoder.kept());
+        let input = self.inputs.kept();
+        let run = self.encoder.kept();
         let encoding = input.iter().flat_map(|i| i.dispatches());
-        let encoding = encoding.chain(run.iter().flat_map(|r| &r.dispatches));
+        let encoding = encoding.chain(run.iter().flat_map(|r| r.dispatches()));
         let dispatches: Vec<&Dispatch> = encoding.chain(self.relight_dispatches(px)).collect();
         self.gpu.profile(&dispatches)
     }
@@ -717,7 +609,7 @@ impl GpuNetwork {
                 d.record(&mut pass);
             }
             if let Some(b) = background {
-                self.map.record(gpu, &mut pass, b, &px.rgb);
+                self.map.record_background(gpu, &mut pass, b, &px.rgb);
             }
         }
         gpu.queue.submit([encoder.finish()]);
@@ -762,136 +654,4 @@ impl GpuNetwork {
 fn chunk_rows(gpu: &GpuDevice, widest: usize) -> usize {
     let fit = gpu.max_binding_bytes() as usize / (4 * widest.next_multiple_of(16));
     (fit / HALF_ROW_BLOCK * HALF_ROW_BLOCK).clamp(HALF_ROW_BLOCK, MAX_CHUNK)
-}
-
-/// How an MLP's first layer reads its input: the inputs per row (the row stride), the weight
-/// row they start at, and a bias in place of the layer's own (the light code's share folded
-/// in).
-struct FirstLayer<'a> {
-    x_stride: usize,
-    w_row: usize,
-    bias: Option<&'a wgpu::Buffer>,
-}
-
-/// The dispatches of `m` over `rows` rows of `x` into `out`, through `work`'s activations,
-/// added to `list`: in half precision where `work` is (then `out` may be f16, and `x` is made
-/// f16 first where it is not), else in f32.
-#[allow(clippy::too_many_arguments)]
-fn mlp(
-    gpu: &GpuDevice,
-    list: &mut Vec<Dispatch>,
-    m: &GpuMlp,
-    x: Held,
-    rows: usize,
-    first: FirstLayer,
-    work: &Workspace,
-    out: Held,
-) {
-    if let Some(half) = &work.half_scratch {
-        return half_mlp(gpu, list, m, x, rows, first, half, out);
-    }
-    let (Held::F32(x), Held::F32(out)) = (x, out) else {
-        unreachable!("f16 rows outside half precision");
-    };
-    let scratch = &work.scratch;
-    let last = m.layers.len() - 1;
-    for (i, layer) in m.layers.iter().enumerate() {
-        let activation = if i == last {
-            0
-        } else {
-            activation_code(m.activation)
-        };
-        let output = if i == last {
-            out
-        } else {
-            &scratch[(i + 1) % 2]
-        };
-        let (input, d_in, w_row, bias) = match i {
-            0 => (
-                x,
-                first.x_stride,
-                first.w_row,
-                first.bias.unwrap_or(&layer.bias),
-            ),
-            _ => (&scratch[i % 2], layer.d_in, 0, &layer.bias),
-        };
-        let layer_in = Rows {
-            x: input,
-            rows,
-            d_in,
-            w_row,
-        };
-        list.push(dense_layer(gpu, layer, layer_in, bias, activation, output));
-    }
-}
-
-/// [`mlp`] in half precision: `x` made f16 unless it is, then every layer f16 to f16 but the
-/// last, which writes `out`.
-#[allow(clippy::too_many_arguments)]
-fn half_mlp(
-    gpu: &GpuDevice,
-    list: &mut Vec<Dispatch>,
-    m: &GpuMlp,
-    x: Held,
-    rows: usize,
-    first: FirstLayer,
-    scratch: &[wgpu::Buffer; 2],
-    out: Held,
-) {
-    let x = match x {
-        Held::F16(x) => x,
-        Held::F32(x) => {
-            let stride = first.x_stride;
-            list.push(gpu.half_rows([rows, stride, stride], x, &scratch[0]));
-            &scratch[0]
-        }
-    };
-    let last = m.layers.len() - 1;
-    let mut k_pad = pad16(first.x_stride);
-    for (i, layer) in m.layers.iter().enumerate() {
-        let weight = layer.half.as_ref().expect("half-precision weights");
-        let (activation, y) = if i == last {
-            (0, out)
-        } else {
-            (
-                activation_code(m.activation),
-                Held::F16(&scratch[(i + 1) % 2]),
-            )
-        };
-        let (input, w_row, bias) = match i {
-            0 => (x, first.w_row, first.bias.unwrap_or(&layer.bias)),
-            _ => (&scratch[i % 2], 0, &layer.bias),
-        };
-        list.push(gpu.half_layer(rows, input, k_pad, weight, w_row, bias, activation, y));
-        k_pad = weight.n_pad;
-    }
-}
-
-/// The rows a dense layer reads: `rows × d_in` values of `x`, multiplied by the weight rows
-/// from `w_row`.
-struct Rows<'a> {
-    x: &'a wgpu::Buffer,
-    rows: usize,
-    d_in: usize,
-    w_row: usize,
-}
-
-/// One dense layer's dispatch: `y = act(x·W[w_row..] + bias)`.
-fn dense_layer(
-    gpu: &GpuDevice,
-    layer: &GpuDense,
-    x: Rows,
-    bias: &wgpu::Buffer,
-    activation: u32,
-    y: &wgpu::Buffer,
-) -> Dispatch {
-    gpu.product(
-        [x.rows, layer.d_out, x.d_in],
-        Operand::plain(x.x, 0, x.d_in),
-        Operand::plain(&layer.weight, x.w_row * layer.d_out, layer.d_out),
-        Bias::Column(bias, 0),
-        activation,
-        Output::to(y, 0, layer.d_out),
-        None,
-    )
 }

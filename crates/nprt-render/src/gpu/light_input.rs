@@ -8,7 +8,7 @@ use nprt_net::gpu::{groups_for, Dispatch, GpuDevice, KernelSource};
 use nprt_net::{LightInput, MapNorm};
 use nprt_scene::EnvMap;
 
-use super::frame_background::{matrix_words, GpuMap};
+use super::gpu_map::{matrix_words, GpuMap};
 
 pub const LIGHT_TEXELS: KernelSource = KernelSource {
     name: "light_texels",

@@ -15,6 +15,9 @@
 //! hash grid nprt-net's.
 
 mod frame_background;
+mod gpu_encoder;
+mod gpu_map;
+mod gpu_mlp;
 mod gpu_network;
 mod gpu_scene;
 mod kept_last;

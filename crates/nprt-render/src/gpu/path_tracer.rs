@@ -7,7 +7,7 @@ use glam::Vec3;
 use nprt_net::gpu::{GpuDevice, KernelSource};
 use nprt_scene::{Camera, EnvMap};
 
-use super::frame_background::{matrix_words, GpuMap};
+use super::gpu_map::{matrix_words, GpuMap};
 use super::gpu_scene::GpuScene;
 use super::raster_gbuffer::{camera_words, RasterGBuffer};
 

@@ -13,7 +13,7 @@ use nprt_scene::Camera;
 use nprt_trace::{GBuffer, GSample, TraceScene};
 use wgpu::util::DeviceExt;
 
-use super::frame_background::GpuMap;
+use super::gpu_map::GpuMap;
 use super::gpu_scene::GpuScene;
 
 /// The compute pass that turns kept triangles into G-buffer samples.

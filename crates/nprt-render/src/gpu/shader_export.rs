@@ -102,6 +102,48 @@ impl WeightFile {
             .collect();
         json!({ "hidden_activation": m.activation.to_string(), "layers": layers })
     }
+
+    /// The encoder's blocks and its dense layer into the code, their tensors added.
+    fn encoder(&mut self, encoder: &HostEncoder) -> (Vec<Value>, Value) {
+        let convs: Vec<Value> = (encoder.convs.iter().enumerate())
+            .map(|(i, c)| {
+                json!({
+                    "in_channels": c.c_in,
+                    "weight": self.add(&format!("encoder.conv{i}.weight"), &[c.bias.len(), c.c_in, 3, 3], &c.weight),
+                    "bias": self.add(&format!("encoder.conv{i}.bias"), &[c.bias.len()], &c.bias),
+                })
+            })
+            .collect();
+        let to_code = self.dense("encoder.to_code", &encoder.to_code);
+        (convs, to_code)
+    }
+
+    /// Each transport track: its kind, inputs, grid and networks, their tensors added.
+    fn tracks(&mut self, transport: &HostTransport) -> Vec<Value> {
+        transport.tracks.iter().enumerate()
+            .map(|(i, t)| {
+                let grid = t.grid.as_ref().map(|g| {
+                    let rows = g.len() / hash_grid::LEVEL_FEATURES;
+                    json!({
+                        "table": self.add(&format!("track{i}.grid"), &[rows, hash_grid::LEVEL_FEATURES], g),
+                        "resolutions": hash_grid::resolutions(),
+                    })
+                });
+                let transfer = t.transfer.as_ref().map(|m| self.mlp(&format!("track{i}.transfer"), m));
+                json!({
+                    "kind": format!("{:?}", t.kind).to_lowercase(),
+                    "inputs": t.kind.inputs(),
+                    "width": t.kind.inputs().len() + t.grid.as_ref().map_or(0, |_| hash_grid::OUTPUTS),
+                    "grid": grid,
+                    "transfer": transfer,
+                    "shading": self.mlp(&format!("track{i}.shading"), &t.shading),
+                    // Which weight rows of the shading network's first layer multiply the light
+                    // code: after ŝ, or first for the baseline's [ê, inputs].
+                    "code_rows": if t.transfer.is_some() { [TRANSPORT_CODE, TRANSPORT_CODE + CODE_SIZE] } else { [0, CODE_SIZE] },
+                })
+            })
+            .collect()
+    }
 }
 
 /// Exports the model in `model_dir` into `out` (created if need be; files in it are replaced,
@@ -127,40 +169,8 @@ pub fn export_model(model_dir: &Path, out: &Path, view: &ExampleView) -> Result<
     }
 
     let mut weights = WeightFile::default();
-    let encoder = HostEncoder::from_burn(&net.encoder);
-    let convs: Vec<Value> = (encoder.convs.iter().enumerate())
-        .map(|(i, c)| {
-            json!({
-                "in_channels": c.c_in,
-                "weight": weights.add(&format!("encoder.conv{i}.weight"), &[c.bias.len(), c.c_in, 3, 3], &c.weight),
-                "bias": weights.add(&format!("encoder.conv{i}.bias"), &[c.bias.len()], &c.bias),
-            })
-        })
-        .collect();
-    let to_code = weights.dense("encoder.to_code", &encoder.to_code);
-    let tracks: Vec<Value> = (HostTransport::from_net(&net).tracks.iter().enumerate())
-        .map(|(i, t)| {
-            let grid = t.grid.as_ref().map(|g| {
-                let rows = g.len() / hash_grid::LEVEL_FEATURES;
-                json!({
-                    "table": weights.add(&format!("track{i}.grid"), &[rows, hash_grid::LEVEL_FEATURES], g),
-                    "resolutions": hash_grid::resolutions(),
-                })
-            });
-            let transfer = t.transfer.as_ref().map(|m| weights.mlp(&format!("track{i}.transfer"), m));
-            json!({
-                "kind": format!("{:?}", t.kind).to_lowercase(),
-                "inputs": t.kind.inputs(),
-                "width": t.kind.inputs().len() + t.grid.as_ref().map_or(0, |_| hash_grid::OUTPUTS),
-                "grid": grid,
-                "transfer": transfer,
-                "shading": weights.mlp(&format!("track{i}.shading"), &t.shading),
-                // Which weight rows of the shading network's first layer multiply the light
-                // code: after ŝ, or first for the baseline's [ê, inputs].
-                "code_rows": if t.transfer.is_some() { [TRANSPORT_CODE, TRANSPORT_CODE + CODE_SIZE] } else { [0, CODE_SIZE] },
-            })
-        })
-        .collect();
+    let (convs, to_code) = weights.encoder(&HostEncoder::from_burn(&net.encoder));
+    let tracks = weights.tracks(&HostTransport::from_net(&net));
     write("weights.bin", &le_bytes(&weights.values, f32::to_le_bytes))?;
     write(
         "weights_f16.bin",
@@ -257,7 +267,7 @@ fn example(model_dir: &Path, file: &nprt_net::ModelFile, view: &ExampleView) -> 
     let ts = TraceScene::new(&scene);
     let g = render_gbuffer(&ts, &camera);
     let map = nprt_scene::open_envmap(&view.map)?;
-    let relighter = Relighter::load(model_dir, &Device::flex())?;
+    let relighter = Relighter::load(model_dir, nprt_net::Engine::Cpu)?;
     let reference = relighter.shade(&g, &relighter.light_code(&map, 0.0));
     let config = &file.config;
     let input = LightInput::new(&map, 0.0, config.encoder_width, config.map_norm);

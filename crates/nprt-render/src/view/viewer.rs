@@ -8,7 +8,7 @@ use std::time::Instant;
 
 use anyhow::{anyhow, bail, Context, Result};
 use glam::Vec3;
-use nprt_net::Device;
+use nprt_net::Engine;
 use nprt_scene::{EnvMap, Scene};
 use nprt_trace::{PixelFilter, RenderSettings, TraceScene};
 use winit::application::ApplicationHandler;
@@ -21,7 +21,8 @@ use winit::window::{Window, WindowId};
 use super::orbit_camera::OrbitCamera;
 use super::overlay::draw_lines;
 use super::presenter::{Presenter, Shown, OVERLAY_ROWS};
-use crate::relight::{DirectSampling, FrameCache, FrameRadiance, FrameTimings, Relighter};
+use crate::frame_timings::FrameTimings;
+use crate::relight::{DirectSampling, FrameCache, FrameRadiance, Relighter};
 use crate::CameraPath;
 use crate::Precision;
 
@@ -35,7 +36,7 @@ pub struct ViewerOptions {
     pub maps: Vec<String>,
     pub resolution: [u32; 2],
     /// Where the networks run.
-    pub device: Device,
+    pub engine: Engine,
     /// Samples per pixel of traced direct light, for models that trace it.
     pub direct_spp: u32,
     /// Exposure in stops.
@@ -124,7 +125,7 @@ fn load(opts: &ViewerOptions) -> Result<(Vec<Relighter>, Scene)> {
         .models
         .iter()
         .map(|m| {
-            let mut model = Relighter::load(m, &opts.device)?;
+            let mut model = Relighter::load(m, opts.engine)?;
             model.set_precision(opts.precision)?;
             Ok(model)
         })

@@ -63,6 +63,65 @@ pub fn sky(p: SkyParams) -> Result<EnvMap> {
     }
     let t = p.turbidity;
     let theta_s = (90.0 - p.elevation).to_radians();
+    let sun_dir = uv_to_direction(Vec2::new(p.azimuth / 360.0, theta_s / std::f32::consts::PI));
+    let (w, h) = (p.width, p.width / 2);
+    let mut texels = perez_sky(t, theta_s, sun_dir, w, h);
+    // Horizontal sky irradiance (Riemann sum over texels), which sets the sun and ground.
+    let solid = |y: usize| {
+        let th = y as f32 / (h - 1) as f32 * std::f32::consts::PI;
+        th.sin() * (std::f32::consts::PI / (h - 1) as f32) * (2.0 * std::f32::consts::PI / w as f32)
+    };
+    let mut e_sky = Vec3::ZERO;
+    for y in 0..h {
+        for x in 0..w {
+            let d = texel_direction(x, y, w, h);
+            if d.y > 0.0 {
+                e_sky += texels[y * w + x] * d.y * solid(y);
+            }
+        }
+    }
+    // Sun: direct normal irradiance ~4× the sky's horizontal irradiance for a clear sky,
+    // reddened by a Rayleigh-like transmittance along the air mass (Kasten-Young).
+    let elev = p.elevation;
+    let air_mass = 1.0 / (elev.to_radians().sin() + 0.50572 * (elev + 6.07995).powf(-1.6364));
+    let tau = Vec3::new(0.06, 0.11, 0.24) * (t / 3.0);
+    let transmittance = Vec3::new(
+        (-tau.x * air_mass).exp(),
+        (-tau.y * air_mass).exp(),
+        (-tau.z * air_mass).exp(),
+    );
+    let sun_omega = 2.0 * std::f32::consts::PI * (1.0 - SUN_RADIUS_DEG.to_radians().cos());
+    let sun_radiance =
+        transmittance * (4.0 * luminance(e_sky) / (sun_omega * luminance(transmittance)));
+    let ground = e_sky * (0.3 / std::f32::consts::PI);
+    for y in 0..h {
+        for x in 0..w {
+            let d = texel_direction(x, y, w, h);
+            let texel = &mut texels[y * w + x];
+            if d.y < 0.0 {
+                *texel = ground;
+            }
+            if d.dot(sun_dir).clamp(-1.0, 1.0).acos() < SUN_RADIUS_DEG.to_radians() {
+                *texel += sun_radiance;
+            }
+        }
+    }
+    // Guarantee the sun lands on at least one texel whatever the resolution.
+    let uv = direction_to_uv(sun_dir);
+    let (sx, sy) = (
+        ((uv.x * w as f32) as usize).min(w - 1),
+        ((uv.y * (h - 1) as f32).round() as usize).min(h - 1),
+    );
+    if luminance(texels[sy * w + sx]) < luminance(sun_radiance) {
+        texels[sy * w + sx] += sun_radiance;
+    }
+    let name = format!("builtin:sky:{}:{}:{}", p.elevation, p.azimuth, p.turbidity);
+    EnvMap::from_texels(&name, w, h, texels)
+}
+
+/// The Perez et al. sky of turbidity `t` with the sun at zenith angle `theta_s` towards
+/// `sun_dir` on a `w × h` lat-long grid, in scene units (no sun disc, no ground).
+fn perez_sky(t: f32, theta_s: f32, sun_dir: Vec3, w: usize, h: usize) -> Vec<Vec3> {
     let coef_y = [
         0.1787 * t - 1.4630,
         -0.3554 * t + 0.4275,
@@ -101,18 +160,12 @@ pub fn sky(p: SkyParams) -> Result<EnvMap> {
         [-0.04214, 0.08970, -0.04153, 0.00516],
         [0.15346, -0.26756, 0.06670, 0.26688],
     ]);
-
-    let sun_dir = uv_to_direction(Vec2::new(p.azimuth / 360.0, theta_s / std::f32::consts::PI));
     // kcd/m² to scene units: a clear zenith comes out near 1.
     let unit = 1.0 / 8.0;
-    let (w, h) = (p.width, p.width / 2);
     let mut texels = vec![Vec3::ZERO; w * h];
     for y in 0..h {
         for x in 0..w {
-            let d = uv_to_direction(Vec2::new(
-                (x as f32 + 0.5) / w as f32,
-                y as f32 / (h - 1) as f32,
-            ));
+            let d = texel_direction(x, y, w, h);
             let cos_theta = d.y.max(0.0);
             let gamma = d.dot(sun_dir).clamp(-1.0, 1.0).acos();
             let f = |c: [f32; 5], z: f32| z * perez(c, cos_theta, gamma) / perez(c, 1.0, theta_s);
@@ -123,63 +176,16 @@ pub fn sky(p: SkyParams) -> Result<EnvMap> {
             ) * unit;
         }
     }
-    // Horizontal sky irradiance (Riemann sum over texels), which sets the sun and ground.
-    let solid = |y: usize| {
-        let th = y as f32 / (h - 1) as f32 * std::f32::consts::PI;
-        th.sin() * (std::f32::consts::PI / (h - 1) as f32) * (2.0 * std::f32::consts::PI / w as f32)
-    };
-    let mut e_sky = Vec3::ZERO;
-    for y in 0..h {
-        for x in 0..w {
-            let d = uv_to_direction(Vec2::new(
-                (x as f32 + 0.5) / w as f32,
-                y as f32 / (h - 1) as f32,
-            ));
-            if d.y > 0.0 {
-                e_sky += texels[y * w + x] * d.y * solid(y);
-            }
-        }
-    }
-    // Sun: direct normal irradiance ~4× the sky's horizontal irradiance for a clear sky,
-    // reddened by a Rayleigh-like transmittance along the air mass (Kasten-Young).
-    let elev = p.elevation;
-    let air_mass = 1.0 / (elev.to_radians().sin() + 0.50572 * (elev + 6.07995).powf(-1.6364));
-    let tau = Vec3::new(0.06, 0.11, 0.24) * (t / 3.0);
-    let transmittance = Vec3::new(
-        (-tau.x * air_mass).exp(),
-        (-tau.y * air_mass).exp(),
-        (-tau.z * air_mass).exp(),
-    );
-    let sun_omega = 2.0 * std::f32::consts::PI * (1.0 - SUN_RADIUS_DEG.to_radians().cos());
-    let sun_radiance =
-        transmittance * (4.0 * luminance(e_sky) / (sun_omega * luminance(transmittance)));
-    let ground = e_sky * (0.3 / std::f32::consts::PI);
-    for y in 0..h {
-        for x in 0..w {
-            let d = uv_to_direction(Vec2::new(
-                (x as f32 + 0.5) / w as f32,
-                y as f32 / (h - 1) as f32,
-            ));
-            let texel = &mut texels[y * w + x];
-            if d.y < 0.0 {
-                *texel = ground;
-            }
-            if d.dot(sun_dir).clamp(-1.0, 1.0).acos() < SUN_RADIUS_DEG.to_radians() {
-                *texel += sun_radiance;
-            }
-        }
-    }
-    // Guarantee the sun lands on at least one texel whatever the resolution.
-    let uv = direction_to_uv(sun_dir);
-    let (sx, sy) = (
-        ((uv.x * w as f32) as usize).min(w - 1),
-        ((uv.y * (h - 1) as f32).round() as usize).min(h - 1),
-    );
-    if luminance(texels[sy * w + sx]) < luminance(sun_radiance) {
-        texels[sy * w + sx] += sun_radiance;
-    }
-    let name = format!("builtin:sky:{}:{}:{}", p.elevation, p.azimuth, p.turbidity);
-    EnvMap::from_texels(&name, w, h, texels)
+    texels
+}
+
+/// The direction through texel (`x`, `y`) of a `w × h` lat-long map: its centre in u, its row
+/// from pole to pole in v.
+fn texel_direction(x: usize, y: usize, w: usize, h: usize) -> Vec3 {
+    uv_to_direction(Vec2::new(
+        (x as f32 + 0.5) / w as f32,
+        y as f32 / (h - 1) as f32,
+    ))
 }
 
 #[cfg(test)]

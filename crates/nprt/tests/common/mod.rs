@@ -93,17 +93,19 @@ pub fn assets() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("../../tests/assets")
 }
 
-/// One tiny inference benchmark (an 8×8 frame of the baseline design) on `device`.
-pub fn tiny_inference(device: &str) -> Output {
+/// One tiny frame benchmark (an 8×8 frame of the baseline design) on `device`.
+pub fn tiny_frame(device: &str) -> Output {
     nprt(&[
         "bench",
-        "infer",
+        "frame",
         "--arch",
         "baseline",
-        "--resolution",
+        "--res",
         "8",
         "--repeats",
         "1",
+        "--direct-spp",
+        "0",
         "--device",
         device,
     ])
@@ -112,7 +114,7 @@ pub fn tiny_inference(device: &str) -> Output {
 /// Whether `--device wgpu` runs here (a Vulkan driver, e.g. the software one scripts/vulkan.sh
 /// installs). Where NPRT_REQUIRE_VULKAN is set (scripts/test sets it) it must.
 pub fn wgpu_runs() -> bool {
-    let o = tiny_inference("wgpu");
+    let o = tiny_frame("wgpu");
     let err = String::from_utf8_lossy(&o.stderr);
     if o.status.success() {
         return true;
@@ -121,10 +123,10 @@ pub fn wgpu_runs() -> bool {
         std::env::var_os("NPRT_REQUIRE_VULKAN").is_none(),
         "NPRT_REQUIRE_VULKAN is set but --device wgpu failed: {err}"
     );
-    let why = if cfg!(feature = "wgpu") {
-        "--device wgpu: no Vulkan"
+    let why = if cfg!(feature = "gpu") {
+        "no GPU adapter found"
     } else {
-        "--device wgpu: this nprt was built without wgpu support"
+        "this nprt was built without its GPU kernels"
     };
     assert!(err.contains(why), "{err}");
     eprintln!("skipped: {err}");

@@ -1,0 +1,160 @@
+//! Where the networks run: the `--device` choice of every command that trains or infers,
+//! resolved once into an [`Engine`]: the CPU engine, or nprt's own GPU kernels on wgpu (any
+//! Vulkan, Metal or DX12 adapter; Mesa's software Vulkan driver, lavapipe, when asked for by
+//! name, which is how CI tests the kernels without a GPU). burn holds the parameters on the
+//! host whichever engine steps them, so a model folder is the same whichever trained it.
+
+use anyhow::{bail, Result};
+
+use crate::choice::named_choice;
+
+/// `--device`: the CPU, a GPU (hardware adapters only), any wgpu adapter (software ones
+/// included), or a GPU when one is present.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum Compute {
+    Cpu,
+    Gpu,
+    Wgpu,
+    #[default]
+    Auto,
+}
+
+named_choice!(Compute, "device", {
+    Cpu => "cpu",
+    Gpu => "gpu",
+    Wgpu => "wgpu",
+    Auto => "auto",
+});
+
+/// What runs the networks: the CPU engine (`crate::cpu`) or the GPU kernels (`crate::gpu`, on
+/// the process's one wgpu device).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Engine {
+    Cpu,
+    Gpu,
+}
+
+impl Compute {
+    /// The engine `--device` names. `gpu` without a hardware adapter, or `gpu`/`wgpu` in a
+    /// build without the kernels, is an error naming what is missing; `auto` takes a hardware
+    /// adapter when there is one, else the CPU, and says why on standard error in a build with
+    /// the kernels (where a GPU could have been meant).
+    pub fn engine(self) -> Result<Engine> {
+        match self {
+            Compute::Cpu => Ok(Engine::Cpu),
+            Compute::Wgpu => any_adapter(),
+            Compute::Gpu => match no_hardware_gpu() {
+                None => Ok(Engine::Gpu),
+                Some(why) => bail!("--device gpu: {why}"),
+            },
+            Compute::Auto => Ok(match no_hardware_gpu() {
+                None => Engine::Gpu,
+                Some(why) => {
+                    if cfg!(feature = "kernels") {
+                        eprintln!("--device auto: running on the CPU: {why}");
+                    }
+                    Engine::Cpu
+                }
+            }),
+        }
+    }
+}
+
+/// Why the GPU kernels cannot run on a hardware adapter here, or None when they can.
+#[cfg(feature = "kernels")]
+fn no_hardware_gpu() -> Option<String> {
+    match crate::gpu::GpuDevice::get() {
+        Err(e) => Some(format!("{e:#}")),
+        Ok(gpu) if gpu.software => Some(format!(
+            "the only GPU adapter is a software one ({}); --device wgpu runs the GPU kernels \
+             on it, --device cpu the CPU engine",
+            gpu.adapter
+        )),
+        Ok(_) => None,
+    }
+}
+
+#[cfg(not(feature = "kernels"))]
+fn no_hardware_gpu() -> Option<String> {
+    Some(WITHOUT_KERNELS.into())
+}
+
+/// The GPU kernels on whatever adapter wgpu finds, software ones included.
+#[cfg(feature = "kernels")]
+fn any_adapter() -> Result<Engine> {
+    crate::gpu::GpuDevice::get().map(|_| Engine::Gpu)
+}
+
+#[cfg(not(feature = "kernels"))]
+fn any_adapter() -> Result<Engine> {
+    bail!("--device wgpu: {WITHOUT_KERNELS}")
+}
+
+#[cfg(not(feature = "kernels"))]
+const WITHOUT_KERNELS: &str = "this nprt was built without its GPU kernels; rebuild it with \
+    `cargo build --release --features gpu` (docs/building.md), or use --device cpu";
+
+impl Engine {
+    pub fn is_gpu(self) -> bool {
+        self == Engine::Gpu
+    }
+
+    /// A short name for progress lines and reports: "cpu", or "gpu: " and the adapter's name
+    /// ("gpu: llvmpipe (LLVM 19.1.7, 256 bits)").
+    pub fn name(self) -> String {
+        match self {
+            Engine::Cpu => "cpu".into(),
+            #[cfg(feature = "kernels")]
+            Engine::Gpu => match crate::gpu::GpuDevice::get() {
+                Ok(gpu) => format!("gpu: {}", gpu.adapter),
+                Err(_) => "gpu".into(),
+            },
+            #[cfg(not(feature = "kernels"))]
+            Engine::Gpu => "gpu".into(),
+        }
+    }
+}
+
+/// Waits for the work queued on the GPU, if this process opened it. Called once a command is
+/// done: work still running at exit would run after the driver had shut down.
+pub fn finish() {
+    #[cfg(feature = "kernels")]
+    if let Some(gpu) = crate::gpu::GpuDevice::opened() {
+        gpu.wait();
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn devices_resolve_to_engines_and_auto_falls_back_to_the_cpu() {
+        assert_eq!(Compute::Cpu.engine().unwrap(), Engine::Cpu);
+        match Compute::Gpu.engine() {
+            Ok(engine) => assert!(engine.is_gpu()),
+            Err(e) if cfg!(feature = "kernels") => {
+                let e = format!("{e:#}");
+                assert!(
+                    e.contains("software one") || e.contains("no GPU adapter"),
+                    "{e}"
+                );
+                assert_eq!(Compute::Auto.engine().unwrap(), Engine::Cpu);
+            }
+            Err(e) => {
+                assert!(
+                    e.to_string().contains("built without its GPU kernels"),
+                    "{e}"
+                );
+                assert_eq!(Compute::Auto.engine().unwrap(), Engine::Cpu);
+                assert!(Compute::Wgpu.engine().is_err());
+            }
+        }
+        assert_eq!("gpu".parse::<Compute>(), Ok(Compute::Gpu));
+        assert!("tpu"
+            .parse::<Compute>()
+            .unwrap_err()
+            .contains("cpu, gpu, wgpu or auto"));
+        assert_eq!("wgpu".parse::<Compute>(), Ok(Compute::Wgpu));
+    }
+}
