@@ -11,12 +11,12 @@ use super::accumulate;
 use super::dense::{DenseStack, Pass, SharedInput, Tape};
 use super::matmul::MatRef;
 use super::samples::Samples;
-use crate::encoding::features::{feature, FEATURES};
+use crate::encoding::features::FEATURES;
 use crate::encoding::hash_grid;
 use crate::network::design::TRANSPORT_CODE;
 use crate::network::encoder::CODE_SIZE;
 use crate::network::nprt_net::NprtNet;
-use crate::network::track::TrackKind;
+use crate::network::track_kind::TrackKind;
 use crate::training::loss::Loss;
 
 /// Rows per block: small enough that a block's activations stay in the caches, large enough
@@ -247,14 +247,7 @@ impl HostTrack {
     fn radiance(&self, pass: &TrackPass, features: &[f32], r: usize) -> [f32; 3] {
         let f = &features[r * FEATURES..];
         let e = &pass.exps[r * self.shading.d_out()..];
-        std::array::from_fn(|c| match self.kind {
-            TrackKind::Full => e[c],
-            TrackKind::Albedo => {
-                f[feature::KD.start + c] * e[c] + f[feature::KS.start + c] * e[3 + c]
-            }
-            TrackKind::Diffuse => f[feature::KD.start + c] * e[c],
-            TrackKind::Specular => f[feature::KS.start + c] * e[c],
-        })
+        self.kind.radiance(f, e)
     }
 
     /// The gradient at the shading network's outputs, into `pass.d_out`, from the gradient
@@ -269,18 +262,7 @@ impl HostTrack {
             .enumerate()
         {
             let f = &features[r * FEATURES..];
-            for c in 0..3 {
-                let g = dr[r * 3 + c];
-                match self.kind {
-                    TrackKind::Full => d[c] = g * e[c],
-                    TrackKind::Albedo => {
-                        d[c] = g * f[feature::KD.start + c] * e[c];
-                        d[3 + c] = g * f[feature::KS.start + c] * e[3 + c];
-                    }
-                    TrackKind::Diffuse => d[c] = g * f[feature::KD.start + c] * e[c],
-                    TrackKind::Specular => d[c] = g * f[feature::KS.start + c] * e[c],
-                }
-            }
+            self.kind.output_gradients(f, e, &dr[r * 3..r * 3 + 3], d);
         }
     }
 

@@ -3,9 +3,13 @@
 //! path dispatches too, the inputs made from a G-buffer on the device (the frame path's), and
 //! the training step's own, its batch gathered from a dataset on the device among them. A
 //! kernel's source is its file in `shaders/`, after the shared files it names (WGSL has no
-//! includes).
+//! includes); those that read the track kinds begin with their table, generated from
+//! `TrackKind` at first use.
+
+use std::sync::LazyLock;
 
 use super::KernelSource;
+use crate::network::track_kind::kind_table_wgsl;
 
 /// The kernel in `shaders/NAME.wgsl`, after the shared `shaders/PART.wgsl` files listed (those
 /// with `enable` directives first: WGSL takes them only before any declaration); with
@@ -33,8 +37,10 @@ pub const TRACK_INPUTS: KernelSource = kernel!("track_inputs", "hash_grid");
 pub const GRID_BACKWARD: KernelSource = kernel!("grid_backward", "hash_grid");
 pub const GEMM: KernelSource = kernel!("gemm");
 pub const COLUMN_SUM: KernelSource = kernel!("column_sum");
-pub const COMBINE: KernelSource = kernel!("combine", "track_radiance");
-pub const RADIANCE_LOSS: KernelSource = kernel!("radiance_loss", "track_radiance");
+pub static COMBINE: LazyLock<KernelSource> =
+    LazyLock::new(|| with_kinds(kernel!("combine", "track_radiance")));
+pub static RADIANCE_LOSS: LazyLock<KernelSource> =
+    LazyLock::new(|| with_kinds(kernel!("radiance_loss", "track_radiance")));
 pub const ADAM: KernelSource = kernel!("adam");
 pub const GATHER_SAMPLES: KernelSource = kernel!("gather_samples", "pixel_features");
 /// The network inputs of a G-buffer left on the device (nprt-render's frame path).
@@ -64,6 +70,16 @@ pub const HALF_WEIGHT_GRAD_COOP: KernelSource = kernel!(
     "half_weight_sums",
     "coop_drain"
 );
+
+/// `kernel` after the track kinds' table, made once per process (a kernel's source lives as
+/// long as the process).
+fn with_kinds(kernel: KernelSource) -> KernelSource {
+    let wgsl = format!("{}{}", kind_table_wgsl(), kernel.wgsl);
+    KernelSource {
+        name: kernel.name,
+        wgsl: Box::leak(wgsl.into_boxed_str()),
+    }
+}
 
 /// Rows and columns of the tile a `gemm` workgroup computes.
 pub const GEMM_TILE: u32 = 128;

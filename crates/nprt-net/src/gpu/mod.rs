@@ -27,7 +27,7 @@ mod products;
 mod transport_step;
 
 pub use buffer_pool::{BufferPool, PooledBuffer};
-pub use codes::{activation_code, kind_code, loss_code};
+pub use codes::{activation_code, loss_code};
 pub use device_dataset::DeviceDataset;
 pub use gpu_device::GpuDevice;
 pub use gpu_trainer::GpuTrainer;

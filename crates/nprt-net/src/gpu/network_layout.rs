@@ -9,7 +9,7 @@ use crate::encoding::hash_grid;
 use crate::network::activation::Activation;
 use crate::network::design::TRANSPORT_CODE;
 use crate::network::encoder::CODE_SIZE;
-use crate::network::track::TrackKind;
+use crate::network::track_kind::TrackKind;
 
 /// One dense layer's place in the flat buffers.
 pub(super) struct DenseAt {

@@ -3,7 +3,7 @@
 //! first shading layer's bias, the loss and its gradient at the tracks' outputs, and backward
 //! into every parameter, the grids' tables and the light codes.
 
-use super::codes::{kind_code, loss_code};
+use super::codes::loss_code;
 use super::gpu_trainer::{BatchBuffers, GpuTrainer};
 use super::kernels::{GRID_BACKWARD, RADIANCE_LOSS, TRACK_INPUTS};
 use super::network_layout::TrackAt;
@@ -48,7 +48,7 @@ impl GpuTrainer {
             .iter()
             .map(|t| self.track_forward(plan, t, b))
             .collect();
-        let kinds: Vec<u32> = self.net.tracks.iter().map(|t| kind_code(t.kind)).collect();
+        let kinds: Vec<u32> = self.net.tracks.iter().map(|t| t.kind.code()).collect();
         let last = tapes.last().expect("a track");
         let mut params = vec![
             b.rows as u32,

@@ -1,5 +1,5 @@
-//! The networks: the light encoder, dense layers and their activations, the transport tracks, the
-//! four designs, the whole network, and how their weights start.
+//! The networks: the light encoder, dense layers and their activations, the transport tracks and
+//! their kinds, the four designs, the whole network, and how their weights start.
 
 pub mod activation;
 pub mod design;
@@ -8,6 +8,7 @@ pub mod init;
 pub mod mlp;
 pub mod nprt_net;
 pub mod track;
+pub mod track_kind;
 
 /// A tensor's values as f32 on the host.
 pub fn host_values(data: burn::tensor::TensorData) -> Vec<f32> {

@@ -8,7 +8,8 @@ use crate::network::activation::Activation;
 use crate::network::design::Design;
 use crate::network::encoder::LightEncoder;
 use crate::network::init::{shifted_bias, Init};
-use crate::network::track::{Track, TrackKind};
+use crate::network::track::Track;
+use crate::network::track_kind::TrackKind;
 
 /// Encoder plus transport: G-buffer features and a light code in, radiance out.
 #[derive(Module, Debug)]

@@ -4,7 +4,6 @@
 use burn::module::Module;
 use burn::tensor::{Int, Tensor, TensorData};
 
-use crate::encoding::features::{feature, FEATURES};
 use crate::encoding::hash_grid::HashGrid;
 use crate::encoding::position_encoding::PositionEncoding;
 use crate::network::activation::Activation;
@@ -12,33 +11,7 @@ use crate::network::design::{Design, TRANSPORT_CODE};
 use crate::network::encoder::CODE_SIZE;
 use crate::network::init::Init;
 use crate::network::mlp::Mlp;
-
-/// Which pixel inputs a track reads, and how its outputs weight into radiance.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum TrackKind {
-    /// All 19 inputs; outputs are radiance.
-    Full,
-    /// All 19 inputs; 6 outputs, kd·exp(first 3) + ks·exp(last 3).
-    Albedo,
-    /// x, n, kd; weighted by kd.
-    Diffuse,
-    /// x, n, ks, ωo, ωr, α; weighted by ks.
-    Specular,
-}
-
-impl TrackKind {
-    pub fn inputs(self) -> Vec<usize> {
-        use feature::*;
-        match self {
-            TrackKind::Full | TrackKind::Albedo => (0..FEATURES).collect(),
-            TrackKind::Diffuse => [POSITION, NORMAL, KD].into_iter().flatten().collect(),
-            TrackKind::Specular => [POSITION, NORMAL, KS, VIEW, MIRROR, ALPHA]
-                .into_iter()
-                .flatten()
-                .collect(),
-        }
-    }
-}
+use crate::network::track_kind::{TrackKind, Weight};
 
 /// One transport track: an optional transfer network F_T on the pixel inputs, and the shading
 /// network Φ on [ŝ, ê] (or, for the baseline, on [ê, inputs]). With a hash grid, the inputs
@@ -61,7 +34,7 @@ impl Track {
         encoding: PositionEncoding,
     ) -> Self {
         let n_in = kind.inputs().len() + encoding.extra_inputs();
-        let outputs = if kind == TrackKind::Albedo { 6 } else { 3 };
+        let outputs = kind.outputs();
         let grid = match encoding {
             PositionEncoding::None => None,
             PositionEncoding::HashGrid => Some(HashGrid::new(init)),
@@ -91,7 +64,7 @@ impl Track {
 
     /// Radiance of this track (before the map's scale) for features [B, 19] and codes [B, 64].
     pub fn forward(&self, features: &Tensor<2>, code: &Tensor<2>) -> Tensor<2> {
-        let inputs = if self.kind == TrackKind::Full || self.kind == TrackKind::Albedo {
+        let inputs = if self.kind.reads_all() {
             features.clone()
         } else {
             let idx: Vec<i64> = self.kind.inputs().into_iter().map(|i| i as i64).collect();
@@ -112,16 +85,14 @@ impl Track {
                 self.shading.forward(Tensor::cat(vec![s, code.clone()], 1))
             }
         };
-        // Outputs are log-radiance: exp keeps radiance positive over its high dynamic range.
-        let slice = |r: std::ops::Range<usize>| features.clone().narrow(1, r.start, r.len());
-        match self.kind {
-            TrackKind::Full => out.exp(),
-            TrackKind::Albedo => {
-                slice(feature::KD) * out.clone().narrow(1, 0, 3).exp()
-                    + slice(feature::KS) * out.narrow(1, 3, 3).exp()
+        // The kind's terms (network/track_kind): each a weight times exp of three outputs.
+        let terms = self.kind.spec().terms.iter().enumerate().map(|(k, w)| {
+            let e = out.clone().narrow(1, 3 * k, 3).exp();
+            match *w {
+                Weight::One => e,
+                Weight::Albedo(at) => features.clone().narrow(1, at, 3) * e,
             }
-            TrackKind::Diffuse => slice(feature::KD) * out.exp(),
-            TrackKind::Specular => slice(feature::KS) * out.exp(),
-        }
+        });
+        terms.reduce(|sum, t| sum + t).expect("a kind has terms")
     }
 }

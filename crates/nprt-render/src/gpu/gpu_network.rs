@@ -29,7 +29,6 @@ use super::kept_last::KeptLast;
 use super::light_code::{GpuLightCode, LIGHT_CODE_VALUES};
 use super::light_input::GpuLightInput;
 use super::path_tracer::{record_paths, GpuPaths};
-use nprt_net::gpu::kind_code;
 
 /// Most rows per block of dispatches. Fewer blocks mean fewer dispatches to prepare and record
 /// (at 65,536 rows a 1920 × 1080 D/S frame was 32 blocks of a dozen dispatches each). A
@@ -491,7 +490,7 @@ impl GpuNetwork {
                 t.shading
                     .record(gpu, &mut list, x, chunk.rows, first, &px.work.scratch, out);
             }
-            let kinds: Vec<u32> = self.tracks.iter().map(|t| kind_code(t.kind)).collect();
+            let kinds: Vec<u32> = self.tracks.iter().map(|t| t.kind.code()).collect();
             let params = [
                 chunk.rows as u32,
                 kinds.len() as u32,

@@ -9,7 +9,9 @@ use nprt_net::gpu::KernelSource;
 
 /// Every network kernel of the frame path, in the order a frame first uses them: what
 /// `nprt export` writes (an engine brings its own G-buffer and background).
-pub const SOURCES: [&KernelSource; 4] = [&ENCODER_BLOCK, &TRACK_INPUTS, &GEMM, &COMBINE];
+pub fn sources() -> [&'static KernelSource; 4] {
+    [&ENCODER_BLOCK, &TRACK_INPUTS, &GEMM, &COMBINE]
+}
 
 /// The kernels `--precision f16` runs the transport networks' dense layers with instead of
 /// `gemm`: the input made f16, and the product on tensor cores (cooperative matrices) or

@@ -18,11 +18,11 @@ use serde_json::{json, Value};
 
 use nprt_net::gpu::{half_weight_bits, pad16, KernelSource};
 
-use super::kernels::{HALF_SOURCES, SOURCES};
+use super::kernels::{sources, HALF_SOURCES};
 use crate::{CameraPath, Relighter};
 
 /// Version of the export's layout, bumped whenever a reader would read it differently.
-pub const EXPORT_VERSION: u32 = 3;
+pub const EXPORT_VERSION: u32 = 4;
 
 /// The worked example's view: the model's scene from the start of `nprt render`'s default
 /// camera path, at this size, under this lighting.
@@ -131,7 +131,8 @@ impl WeightFile {
                 });
                 let transfer = t.transfer.as_ref().map(|m| self.mlp(&format!("track{i}.transfer"), m));
                 json!({
-                    "kind": format!("{:?}", t.kind).to_lowercase(),
+                    "kind": t.kind.spec().name,
+                    "kind_code": t.kind.code(),
                     "inputs": t.kind.inputs(),
                     "width": t.kind.inputs().len() + t.grid.as_ref().map_or(0, |_| hash_grid::OUTPUTS),
                     "grid": grid,
@@ -161,8 +162,8 @@ pub fn export_model(model_dir: &Path, out: &Path, view: &ExampleView) -> Result<
         Ok(())
     };
     let mut kernels = Vec::new();
-    let all = SOURCES.iter().map(|k| (k, false));
-    for (k, half) in all.chain(HALF_SOURCES.iter().map(|k| (k, true))) {
+    let all = sources().into_iter().map(|k| (k, false));
+    for (k, half) in all.chain(HALF_SOURCES.into_iter().map(|k| (k, true))) {
         kernels.push(
             export_kernel(k, half, &mut write).with_context(|| format!("kernel {}", k.name))?,
         );

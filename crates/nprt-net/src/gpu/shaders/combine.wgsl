@@ -5,7 +5,7 @@
 struct Combine {
     rows: u32,
     tracks: u32,
-    // Per track: 0 full (radiance), 1 albedo (kd·L^D + ks·L^S), 2 diffuse (kd·L), 3 specular (ks·L).
+    // Per track: its kind's code (the kind table's index).
     kind0: u32,
     kind1: u32,
     // Index of this block's first row in the frame's rgb.

@@ -7,7 +7,7 @@
 struct RadianceLoss {
     rows: u32,
     tracks: u32,
-    // Per track: 0 full (radiance), 1 albedo (kd·L^D + ks·L^S), 2 diffuse (kd·L), 3 specular (ks·L).
+    // Per track: its kind's code (the kind table's index).
     kind0: u32,
     kind1: u32,
     // 0: log-L1, 1: relative L2.
@@ -36,29 +36,20 @@ struct RadianceLoss {
 const RELATIVE_L2_EPS: f32 = 0.01;
 
 // The gradient at a track's outputs from the gradient dr at its radiance.
-fn store_gradient(kind: u32, out: u32, r: u32, e: array<vec3<f32>, 2>, dr: vec3<f32>) {
+fn store_gradient(kind: u32, out: u32, r: u32, e: array<vec3<f32>, MAX_TERMS>, dr: vec3<f32>) {
     let n = outputs(kind) * r;
-    var d: vec3<f32>;
-    switch kind {
-        case 0u: { d = dr * e[0]; }
-        case 2u: { d = dr * kd(r) * e[0]; }
-        case 3u: { d = dr * ks(r) * e[0]; }
-        default: {
-            d = dr * kd(r) * e[0];
-            let s = dr * ks(r) * e[1];
-            d_out0[n + 3u] = s.x;
-            d_out0[n + 4u] = s.y;
-            d_out0[n + 5u] = s.z;
+    for (var t = 0u; t < KIND_TERMS[kind]; t++) {
+        let d = dr * term_weight(kind, t, r) * e[t];
+        let i = n + 3u * t;
+        if (out == 0u) {
+            d_out0[i] = d.x;
+            d_out0[i + 1u] = d.y;
+            d_out0[i + 2u] = d.z;
+        } else {
+            d_out1[i] = d.x;
+            d_out1[i + 1u] = d.y;
+            d_out1[i + 2u] = d.z;
         }
-    }
-    if (out == 0u) {
-        d_out0[n] = d.x;
-        d_out0[n + 1u] = d.y;
-        d_out0[n + 2u] = d.z;
-    } else {
-        d_out1[n] = d.x;
-        d_out1[n + 1u] = d.y;
-        d_out1[n + 2u] = d.z;
     }
 }
 
@@ -70,7 +61,7 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>, @builtin(num_workgroups) g
         return;
     }
     let e0 = exps(p.kind0, 0u, r);
-    var e1: array<vec3<f32>, 2>;
+    var e1: array<vec3<f32>, MAX_TERMS>;
     var c = track_radiance(p.kind0, r, e0);
     if (p.tracks == 2u) {
         e1 = exps(p.kind1, 1u, r);

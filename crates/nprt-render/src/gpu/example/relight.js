@@ -93,10 +93,9 @@ async function main() {
   // The networks.
   const blocks = exp.encoder.blocks.map((b) => ({ cIn: b.in_channels, weight: tensor(b.weight).buffer, bias: tensor(b.bias).buffer }));
   const toCode = dense(exp.encoder.to_code);
-  const kinds = { full: 0, albedo: 1, diffuse: 2, specular: 3 };
   const resolutions = upload(new Uint32Array(exp.tracks.find((t) => t.grid)?.grid.resolutions ?? [0, 0, 0, 0]));
   const tracks = exp.tracks.map((t) => ({
-    kind: kinds[t.kind],
+    kind: t.kind_code,
     index: upload(new Uint32Array(t.inputs)),
     count: t.inputs.length,
     width: t.width,
