@@ -1,6 +1,6 @@
 //! What a transport track reads and how its outputs make radiance: one file per kind states its
 //! inputs and its combine rule once ([`KindSpec`]), and everything else derives from that
-//! table: the burn forward pass ([`crate::network::track`]), the CPU engine's forward and
+//! table: the burn forward pass (`Track::forward`), the CPU engine's forward and
 //! backward ([`TrackKind::radiance`], [`TrackKind::output_gradients`]) and the WGSL table
 //! that the training and frame kernels and the export read ([`kind_table_wgsl`]).
 //!
