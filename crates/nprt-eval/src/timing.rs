@@ -154,7 +154,7 @@ impl TimedFrame<'_> {
                 ));
             }
         }
-        if r.file.config.design != nprt_net::Design::Baseline {
+        if r.file.config.design.has_transfer() {
             let px = r.pixels(g);
             let code = r.light_code(map, 0.0);
             let relight_ms = median_of_runs(|| {

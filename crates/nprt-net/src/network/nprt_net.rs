@@ -9,7 +9,6 @@ use crate::network::design::Design;
 use crate::network::encoder::LightEncoder;
 use crate::network::init::{shifted_bias, Init};
 use crate::network::track::Track;
-use crate::network::track_kind::TrackKind;
 
 /// Encoder plus transport: G-buffer features and a light code in, radiance out.
 #[derive(Module, Debug)]
@@ -27,13 +26,7 @@ impl NprtNet {
         encoding: PositionEncoding,
     ) -> Self {
         let encoder = LightEncoder::new(init, encoder_width);
-        let kinds: &[TrackKind] = match design {
-            Design::Baseline | Design::Prt => &[TrackKind::Full],
-            Design::Albedo => &[TrackKind::Albedo],
-            Design::Dsep => &[TrackKind::Diffuse, TrackKind::Specular],
-        };
-        let tracks = kinds
-            .iter()
+        let tracks = (design.spec().tracks.iter())
             .map(|&k| Track::new(init, design, k, activation, encoding))
             .collect();
         NprtNet { encoder, tracks }

@@ -7,7 +7,7 @@ use burn::tensor::{Int, Tensor, TensorData};
 use crate::encoding::hash_grid::HashGrid;
 use crate::encoding::position_encoding::PositionEncoding;
 use crate::network::activation::Activation;
-use crate::network::design::{Design, TRANSPORT_CODE};
+use crate::network::design::{Design, Layout, TRANSPORT_CODE};
 use crate::network::encoder::CODE_SIZE;
 use crate::network::init::Init;
 use crate::network::mlp::Mlp;
@@ -39,26 +39,29 @@ impl Track {
             PositionEncoding::None => None,
             PositionEncoding::HashGrid => Some(HashGrid::new(init)),
         };
-        match design {
-            Design::Baseline => Track {
-                grid,
-                transfer: None,
-                shading: Mlp::new(init, &[CODE_SIZE + n_in, 256, 256, 256, 256, 3], activation),
-                kind,
-            },
-            _ => {
-                let w = if design == Design::Dsep { 172 } else { 256 };
+        match design.spec().layout {
+            Layout::Direct { hidden } => {
+                let widths: Vec<usize> = std::iter::once(CODE_SIZE + n_in)
+                    .chain(hidden.iter().copied())
+                    .chain([outputs])
+                    .collect();
                 Track {
                     grid,
-                    transfer: Some(Mlp::new(init, &[n_in, w, w, TRANSPORT_CODE], activation)),
-                    shading: Mlp::new(
-                        init,
-                        &[TRANSPORT_CODE + CODE_SIZE, w, w, outputs],
-                        Activation::Relu,
-                    ),
+                    transfer: None,
+                    shading: Mlp::new(init, &widths, activation),
                     kind,
                 }
             }
+            Layout::Transfer { width: w } => Track {
+                grid,
+                transfer: Some(Mlp::new(init, &[n_in, w, w, TRANSPORT_CODE], activation)),
+                shading: Mlp::new(
+                    init,
+                    &[TRANSPORT_CODE + CODE_SIZE, w, w, outputs],
+                    Activation::Relu,
+                ),
+                kind,
+            },
         }
     }
 

@@ -81,10 +81,9 @@ impl Default for TrainOptions {
 /// whose deep ReLU stack collapses to a constant at 1e-3. The paper's constant schedule keeps
 /// the paper's 1e-4.
 pub fn recipe_rate(design: Design, schedule: LrSchedule) -> f64 {
-    match (schedule, design) {
-        (LrSchedule::Paper, _) => 1e-4,
-        (LrSchedule::Cosine, Design::Baseline) => 3e-4,
-        (LrSchedule::Cosine, Design::Prt | Design::Albedo | Design::Dsep) => 5e-4,
+    match schedule {
+        LrSchedule::Paper => 1e-4,
+        LrSchedule::Cosine => design.spec().cosine_rate,
     }
 }
 

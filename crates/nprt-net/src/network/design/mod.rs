@@ -1,0 +1,99 @@
+//! The transport designs: the paper's four (its Table 1) and any beyond them. One file per
+//! design states everything that is its own ([`DesignSpec`]): its tracks, its networks' sizes,
+//! its default activation, the paper's parameter count and the measured learning rate; the
+//! networks, the engines and the training recipe read it from there.
+
+mod albedo;
+mod baseline;
+mod dsep;
+mod prt;
+
+use crate::choice::named_choice;
+use crate::network::activation::Activation;
+use crate::network::track_kind::TrackKind;
+
+/// Size of the transport code ŝ.
+pub const TRANSPORT_CODE: usize = 64;
+
+/// How a design's tracks turn pixel inputs and the light code into outputs.
+pub enum Layout {
+    /// One MLP on [ê, inputs] with these hidden widths.
+    Direct { hidden: &'static [usize] },
+    /// A transfer network F_T(inputs) → ŝ and a shading network Φ(ŝ, ê), both two hidden
+    /// layers of `width` (F_T with the design's activation, Φ with ReLU).
+    Transfer { width: usize },
+}
+
+/// One design, as its file states it.
+pub struct DesignSpec {
+    pub name: &'static str,
+    /// Its tracks, each with networks of its own; radiance is their sum.
+    pub tracks: &'static [TrackKind],
+    pub layout: Layout,
+    /// The activation of the layers that see the pixel inputs, unless asked otherwise.
+    pub default_activation: Activation,
+    /// Transport parameters the paper gives (Table 1); 0 for a design beyond the paper.
+    pub paper_params: usize,
+    /// The peak learning rate measured best under the cosine schedule (`recipe_rate`).
+    pub cosine_rate: f64,
+}
+
+/// The transport design (the paper's Table 1).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Design {
+    /// One MLP on [ê, inputs]: 83 → 256 ×4 → 3.
+    Baseline,
+    /// PRT-inspired: F_T(inputs) = ŝ, then Φ(ŝ, ê) → radiance.
+    Prt,
+    /// As PRT, but Φ outputs L^D and L^S and L = kd·L^D + ks·L^S.
+    Albedo,
+    /// Two tracks of width 172: diffuse F_T^D(x, n, kd) and specular F_T^S(x, n, ks, ωo, ωr, α),
+    /// each with its own Φ; L = kd·Φ^D + ks·Φ^S.
+    Dsep,
+}
+
+named_choice!(Design, "design", {
+    Baseline => "baseline",
+    Prt => "prt",
+    Albedo => "albedo",
+    Dsep => "dsep",
+});
+
+impl Design {
+    pub fn spec(self) -> &'static DesignSpec {
+        match self {
+            Design::Baseline => &baseline::SPEC,
+            Design::Prt => &prt::SPEC,
+            Design::Albedo => &albedo::SPEC,
+            Design::Dsep => &dsep::SPEC,
+        }
+    }
+
+    /// Transport parameter count the paper gives (Table 1).
+    pub fn paper_params(self) -> usize {
+        self.spec().paper_params
+    }
+
+    /// The paper's activation for the layers that see the pixel inputs: ReLU for the baseline,
+    /// SIREN for the transport networks F_T of the other designs.
+    pub fn default_activation(self) -> Activation {
+        self.spec().default_activation
+    }
+
+    /// Whether the design splits transport from shading (a still camera then keeps ŝ).
+    pub fn has_transfer(self) -> bool {
+        matches!(self.spec().layout, Layout::Transfer { .. })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn each_design_file_names_its_design() {
+        for d in Design::ALL {
+            assert_eq!(d.spec().name, d.name());
+        }
+    }
+}
