@@ -50,7 +50,7 @@ impl Metrics {
                 m.l2 += d * d;
                 m.mape += d.abs() / (r.abs() + RELATIVE_EPS as f64);
                 m.mrse += d * d / (r * r + RELATIVE_EPS as f64);
-                m.log_l1 += nprt_net::training::loss::log_l1_error(p, r);
+                m.log_l1 += nprt_net::loss::log_l1_error(p, r);
             }
             n += 3;
         }

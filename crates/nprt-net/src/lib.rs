@@ -1,11 +1,17 @@
 //! nprt-net: the learned part of Neural PRT. It owns the light encoder, the four transport
 //! designs and the hash-grid position encoding beyond them, the Deep Shading baseline network,
 //! the model folder format (weights plus config) and the one training loop every network goes
-//! through (checkpoints, exact resume). Its folders keep the pieces apart, as tiny-cuda-nn
-//! does: `network` (layers, encoder, designs), `encoding` (what the networks see), `model`
-//! (config and folder), `training` (data, batches, loss, schedule, loop), `cpu` (the CPU
-//! engine, which takes plain slices), `gpu` (our own GPU kernels, feature `kernels`),
-//! `deep_shading` and `bench`.
+//! through (checkpoints, exact resume). Its modules keep the pieces apart, as tiny-cuda-nn
+//! does, in layers, each using only those before it:
+//! 1. the shared pieces: `precision`, `init` (how parameters start), `loss`, `optimiser`
+//!    (Adam's settings, and the steps an engine takes);
+//! 2. `encoding` (what the networks see), then `network` (layers, encoder, track kinds,
+//!    designs), then `model` (config and folder);
+//! 3. the engines: `cpu` (the CPU engine, on plain slices), `gpu` (our own GPU kernels,
+//!    feature `kernels`, which read the CPU engine's weight structs) and `engine` (what
+//!    `--device` resolves to);
+//! 4. `training` (data, batches, schedule, the loop, each engine's steps);
+//! 5. `deep_shading` and `bench`.
 //! It reads datasets through nprt-data and environment maps through nprt-scene; it must not
 //! trace rays or write datasets, and it knows nothing of evaluation or frame rendering.
 //!
@@ -32,8 +38,12 @@ pub mod encoding;
 mod engine;
 #[cfg(feature = "kernels")]
 pub mod gpu;
+mod host_values;
+pub mod init;
+pub mod loss;
 pub mod model;
 pub mod network;
+pub mod optimiser;
 mod precision;
 pub mod training;
 
@@ -46,6 +56,9 @@ pub use encoding::features::{feature, gbuffer_features, pixel_features, position
 pub use encoding::map_norm::MapNorm;
 pub use encoding::position_encoding::PositionEncoding;
 pub use engine::{finish, Compute, Engine};
+pub use host_values::host_values;
+pub use init::{conv2d, Init};
+pub use loss::{log_l1, Loss};
 pub use model::config::{ModelConfig, DEFAULT_ENCODER_WIDTH, DEFAULT_MAP_NORM};
 pub use model::direct_light::DirectLight;
 pub use model::folder::{load_model, read_model_file, ModelFile};
@@ -53,8 +66,6 @@ pub use model::layer_table::layer_table;
 pub use network::activation::{Activation, OMEGA_0};
 pub use network::design::{Design, TRANSPORT_CODE};
 pub use network::encoder::{LightEncoder, LightInput};
-pub use network::host_values;
-pub use network::init::{conv2d, Init};
 pub use network::mlp::Mlp;
 pub use network::nprt_net::NprtNet;
 pub use network::track::Track;
@@ -63,7 +74,6 @@ pub use precision::Precision;
 pub use training::batch::{Batch, GradientPath};
 pub use training::calibration::{level_gain, Calibration, LEVEL_SAMPLES};
 pub use training::checkpoint::RunState;
-pub use training::loss::{log_l1, Loss};
 pub use training::lr_schedule::LrSchedule;
 pub use training::nprt_objective::train;
 pub use training::run_length::RunLength;

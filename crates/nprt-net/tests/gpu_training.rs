@@ -15,7 +15,7 @@ use burn::optim::AdamConfig;
 use common::{loud_grids, random_batch, variants};
 use nprt_net::cpu::{HostEncoder, HostTransport, Samples};
 use nprt_net::gpu::{GpuDevice, GpuTrainer, ParameterLayout};
-use nprt_net::training::optimiser::ADAM_EPSILON;
+use nprt_net::optimiser::ADAM_EPSILON;
 use nprt_net::{
     Design, Device, GradientPath, Init, Loss, ModelConfig, NprtNet, PositionEncoding, Precision,
 };

@@ -9,12 +9,12 @@ use rand_pcg::Pcg64Mcg;
 
 use crate::encoding::features::FEATURES;
 use crate::engine::Engine;
+use crate::init::Init;
+use crate::loss::Loss;
 use crate::model::config::ModelConfig;
 use crate::network::encoder::CODE_SIZE;
-use crate::network::init::Init;
+use crate::optimiser::ADAM_EPSILON;
 use crate::training::batch::{Batch, GradientPath};
-use crate::training::loss::Loss;
-use crate::training::optimiser::ADAM_EPSILON;
 use crate::Precision;
 
 /// Samples/s of `steps` full steps (forward, backward, Adam) on one synthetic batch of

@@ -77,7 +77,7 @@ impl Tape {
 }
 
 pub(super) fn host<const D: usize>(p: &Param<Tensor<D>>) -> Vec<f32> {
-    crate::network::host_values(p.val().into_data())
+    crate::host_values::host_values(p.val().into_data())
 }
 
 /// Replaces `p`'s values with `values` (same shape), keeping its id (which keys Adam's state),

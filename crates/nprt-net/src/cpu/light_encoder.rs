@@ -159,7 +159,7 @@ impl HostEncoder {
         self.to_code.add(&other.to_code);
     }
 
-    /// The codes of `lights` (views × [3, W/2, W], channel-major, as [`crate::training::batch::Batch`]
+    /// The codes of `lights` (views × [3, W/2, W], channel-major, as a training `Batch`
     /// keeps them) for a map width `width`.
     pub fn forward(&self, lights: &[f32], width: usize) -> EncoderPass {
         let per_view = 3 * width * width / 2;

@@ -19,10 +19,10 @@ use burn::nn::Linear;
 use burn::optim::GradientsParams;
 use burn::tensor::{DType, Device, Tensor, TensorData};
 
+use crate::loss::Loss;
 use crate::network::encoder::LightEncoder;
 use crate::network::mlp::Mlp;
 use crate::network::nprt_net::NprtNet;
-use crate::training::loss::Loss;
 pub use dense::{Dense, DenseStack};
 pub use light_encoder::{EncoderPass, HostEncoder};
 pub use peak::{measured_peak, Peak};

@@ -1,7 +1,7 @@
 //! The transport tracks of a design on the host: forward, the training loss and backward for a
 //! whole batch, block by block on all cores, given the light codes the encoder made.
 //!
-//! Computes exactly what [`crate::network::nprt_net::NprtNet::shade`] and [`crate::training::loss::Loss::mean`] compute
+//! Computes exactly what [`crate::network::nprt_net::NprtNet::shade`] and [`crate::loss::Loss::mean`] compute
 //! (same operations in f32), so that burn's autodiff and this path agree to rounding; a test
 //! holds them to that.
 
@@ -13,11 +13,11 @@ use super::matmul::MatRef;
 use super::samples::Samples;
 use crate::encoding::features::FEATURES;
 use crate::encoding::hash_grid;
+use crate::loss::Loss;
 use crate::network::design::TRANSPORT_CODE;
 use crate::network::encoder::CODE_SIZE;
 use crate::network::nprt_net::NprtNet;
 use crate::network::track_kind::TrackKind;
-use crate::training::loss::Loss;
 
 /// Rows per block: small enough that a block's activations stay in the caches, large enough
 /// for efficient matrix products.
@@ -341,7 +341,7 @@ impl HostTransport {
                 grid: t
                     .grid
                     .as_ref()
-                    .map(|g| crate::network::host_values(g.table.val().into_data())),
+                    .map(|g| crate::host_values::host_values(g.table.val().into_data())),
                 transfer: t.transfer.as_ref().map(DenseStack::from_mlp),
                 shading: DenseStack::from_mlp(&t.shading),
             })

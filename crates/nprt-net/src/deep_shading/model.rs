@@ -12,9 +12,9 @@ use serde::{Deserialize, Serialize};
 use super::options::DeepShadingOptions;
 use super::unet::{feature_image, DeepShading};
 use crate::encoding::features::FEATURES;
+use crate::init::Init;
 use crate::model::folder::{load_weights, read_config, WEIGHTS_FILE};
 use crate::network::encoder::{check_input_width, LightInput};
-use crate::network::init::Init;
 
 pub const TAG: &str = "deep-shading";
 pub const CONFIG_FILE: &str = "deep-shading.json";

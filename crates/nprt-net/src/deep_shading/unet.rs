@@ -11,9 +11,9 @@ use nprt_trace::GBuffer;
 
 use crate::encoding::features::gbuffer_features;
 use crate::encoding::features::FEATURES;
+use crate::init::{conv2d, shifted_bias, Init};
 use crate::network::activation::Activation;
 use crate::network::encoder::{LightEncoder, CODE_SIZE};
-use crate::network::init::{conv2d, shifted_bias, Init};
 use crate::network::mlp::Mlp;
 
 /// Channels of the encoder levels (full, ½, ¼ resolution) and of the ⅛-resolution bottleneck.

@@ -14,7 +14,7 @@ use burn::module::{Module, Param};
 use burn::tensor::{Int, Tensor, TensorData};
 
 use crate::encoding::features::feature;
-use crate::network::init::Init;
+use crate::init::Init;
 
 /// Grid resolutions, from [`MIN_RES`] to [`MAX_RES`] cells along each side of the scene's box
 /// in a geometric progression.
@@ -139,7 +139,8 @@ impl HashGrid {
     pub fn forward(&self, features: &Tensor<2>) -> Tensor<2> {
         let n = features.dims()[0];
         let device = features.device();
-        let positions = crate::network::host_values(features.clone().narrow(1, 0, 3).into_data());
+        let positions =
+            crate::host_values::host_values(features.clone().narrow(1, 0, 3).into_data());
         let mut rows = Vec::with_capacity(n * LEVELS * CORNERS);
         let mut weights = Vec::with_capacity(n * LEVELS * CORNERS);
         for p in positions.chunks_exact(3) {

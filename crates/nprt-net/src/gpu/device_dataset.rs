@@ -10,7 +10,8 @@ use glam::Vec3;
 
 use super::GpuDevice;
 use crate::encoding::features::position_frame;
-use crate::training::training_set::TrainingSet;
+use crate::network::encoder::LightInput;
+use nprt_data::dataset::PackedDataset;
 
 /// Records per upload: large enough to keep the queue's copies few, small enough that their
 /// staging stays modest.
@@ -44,10 +45,10 @@ pub struct DeviceDataset {
 }
 
 impl DeviceDataset {
-    /// Uploads `set`'s pack and training maps to `gpu`; says so where the device lacks the
-    /// memory.
-    pub fn upload(gpu: &GpuDevice, set: &TrainingSet) -> Result<Self> {
-        let records = set.pack.records();
+    /// Uploads a training set's pack and its training views' maps to `gpu`; says so where the
+    /// device lacks the memory.
+    pub fn upload(gpu: &GpuDevice, pack: &PackedDataset, maps: &[&LightInput]) -> Result<Self> {
+        let records = pack.records();
         if records.len() > u32::MAX as usize {
             bail!(
                 "the pack holds {} records, more than a GPU step indexes (2³²)",
@@ -57,13 +58,9 @@ impl DeviceDataset {
         let per_shard = gpu
             .max_binding_bytes()
             .div_euclid(PACKED_PIXEL_BYTES as u64) as usize;
-        let light_floats = set.train.first().map_or(0, |v| v.light.pixels.len());
-        let lights: Vec<f32> = set
-            .train
-            .iter()
-            .flat_map(|v| v.light.pixels.iter().copied())
-            .collect();
-        let scales: Vec<f32> = set.train.iter().flat_map(|v| v.light.scale).collect();
+        let light_floats = maps.first().map_or(0, |m| m.pixels.len());
+        let lights: Vec<f32> = maps.iter().flat_map(|m| m.pixels.iter().copied()).collect();
+        let scales: Vec<f32> = maps.iter().flat_map(|m| m.scale).collect();
         gpu.check_binding(4 * lights.len(), "the training views' maps")
             .context("train with --gather host or a smaller --encoder-width")?;
         let scope = gpu.device.push_error_scope(wgpu::ErrorFilter::OutOfMemory);
@@ -94,10 +91,10 @@ impl DeviceDataset {
                  --gather host",
                 gpu.adapter,
                 records.len(),
-                set.train.len()
+                maps.len()
             ));
         }
-        let pack_bounds = &set.pack.header().bounds;
+        let pack_bounds = &pack.header().bounds;
         let (lo, normaliser) = position_frame(pack_bounds);
         // The records' positions are stored within the bounds' own extent, unclamped.
         let extent = Vec3::from(pack_bounds[1]) - lo;
@@ -109,8 +106,7 @@ impl DeviceDataset {
             shards,
             light_floats,
             bounds,
-            bytes: (std::mem::size_of_val(records) + 4 * (light_floats + 3) * set.train.len())
-                as u64,
+            bytes: (std::mem::size_of_val(records) + 4 * (light_floats + 3) * maps.len()) as u64,
             lights,
             scales,
         })

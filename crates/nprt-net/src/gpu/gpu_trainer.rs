@@ -25,10 +25,10 @@ use super::{groups_for, Dispatch, GpuDevice};
 use crate::cpu::{HostEncoder, HostTransport, Samples};
 use crate::encoding::features::FEATURES;
 use crate::encoding::hash_grid;
+use crate::loss::Loss;
 use crate::network::encoder::CODE_SIZE;
 use crate::network::nprt_net::NprtNet;
-use crate::training::loss::Loss;
-use crate::training::optimiser::ADAM_EPSILON;
+use crate::optimiser::ADAM_EPSILON;
 use crate::Precision;
 
 const BETA_1: f32 = 0.9;
@@ -297,6 +297,11 @@ impl GpuTrainer {
     /// device has the next, so the device does not idle while the host writes a batch.
     pub fn queue_step(&mut self, batch: &Samples, loss: Loss, lr: f64) -> Option<f64> {
         self.queue(Inputs::Host(batch), loss, Pass::Step(lr))
+    }
+
+    /// The device the steps run on.
+    pub fn gpu(&self) -> &GpuDevice {
+        &self.gpu
     }
 
     /// Holds `dataset` on the device from now on, for [`Self::queue_picked_step`].

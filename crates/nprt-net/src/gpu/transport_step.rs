@@ -10,9 +10,9 @@ use super::network_layout::TrackAt;
 use super::products::{Bias, FirstLayer, MlpTape, Operand, Output};
 use super::{groups_for, Bind, Dispatch};
 use crate::encoding::hash_grid;
+use crate::loss::Loss;
 use crate::network::design::TRANSPORT_CODE;
 use crate::network::encoder::CODE_SIZE;
-use crate::training::loss::Loss;
 
 /// Threads of `grid_backward` per chunk of rows: one per 64 slots of each level's table.
 const GRID_BACKWARD_THREADS: usize = hash_grid::LEVELS * hash_grid::TABLE_SIZE / 64;

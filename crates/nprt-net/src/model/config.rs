@@ -5,10 +5,10 @@ use serde::{Deserialize, Serialize};
 
 use crate::encoding::map_norm::MapNorm;
 use crate::encoding::position_encoding::PositionEncoding;
+use crate::init::Init;
 use crate::model::direct_light::DirectLight;
 use crate::network::activation::Activation;
 use crate::network::design::Design;
-use crate::network::init::Init;
 use crate::network::nprt_net::NprtNet;
 
 /// Everything needed to rebuild a network, besides its weights.

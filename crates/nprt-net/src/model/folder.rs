@@ -11,9 +11,9 @@ use burn::tensor::Device;
 use serde::de::DeserializeOwned;
 use serde::{Deserialize, Serialize};
 
+use crate::init::Init;
 use crate::model::config::ModelConfig;
 use crate::network::encoder::check_input_width;
-use crate::network::init::Init;
 use crate::network::nprt_net::NprtNet;
 
 /// Identifies a model folder's config file.
@@ -44,7 +44,7 @@ pub struct ModelFile {
     /// Training settings and progress (informative).
     pub training: serde_json::Value,
     /// What the network's radiance is multiplied by, per channel, to have its training targets'
-    /// level (`nprt train --calibrate level`, crate::training::calibration); absent: as the network says.
+    /// level (`nprt train --calibrate level`, training::calibration); absent: as the network says.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub level_gain: Option<[f32; 3]>,
 }

@@ -11,8 +11,8 @@ use nprt_scene::envmap::{uv_to_direction, EnvMap};
 use rayon::prelude::*;
 
 use crate::encoding::map_norm::MapNorm;
+use crate::init::{conv2d, Init};
 use crate::network::activation::Activation;
-use crate::network::init::{conv2d, Init};
 use crate::network::mlp::Mlp;
 
 /// Convolution blocks of the paper's encoder.

@@ -5,8 +5,8 @@ use burn::nn::Linear;
 use burn::tensor::activation::relu;
 use burn::tensor::Tensor;
 
+use crate::init::{dense, Init};
 use crate::network::activation::{Activation, OMEGA_0};
-use crate::network::init::{dense, Init};
 
 /// A multilayer perceptron: every layer but the last is followed by the activation; the last
 /// one is linear.

@@ -4,10 +4,10 @@ use burn::module::Module;
 use burn::tensor::{Int, Tensor};
 
 use crate::encoding::position_encoding::PositionEncoding;
+use crate::init::{shifted_bias, Init};
 use crate::network::activation::Activation;
 use crate::network::design::Design;
 use crate::network::encoder::LightEncoder;
-use crate::network::init::{shifted_bias, Init};
 use crate::network::track::Track;
 
 /// Encoder plus transport: G-buffer features and a light code in, radiance out.

@@ -6,10 +6,10 @@ use burn::tensor::{Int, Tensor, TensorData};
 
 use crate::encoding::hash_grid::HashGrid;
 use crate::encoding::position_encoding::PositionEncoding;
+use crate::init::Init;
 use crate::network::activation::Activation;
 use crate::network::design::{Design, Layout, TRANSPORT_CODE};
 use crate::network::encoder::CODE_SIZE;
-use crate::network::init::Init;
 use crate::network::mlp::Mlp;
 use crate::network::track_kind::{TrackKind, Weight};
 

@@ -6,8 +6,8 @@ use burn::tensor::{Device, Int, Tensor, TensorData};
 use crate::cpu::Samples;
 
 use crate::encoding::features::FEATURES;
+use crate::loss::Loss;
 use crate::network::nprt_net::NprtNet;
-use crate::training::loss::Loss;
 use crate::training::training_set::ViewSamples;
 
 /// Which code computes a batch's gradients.

@@ -12,7 +12,7 @@
 use burn::tensor::Device;
 
 use crate::choice::named_choice;
-use crate::network::host_values;
+use crate::host_values::host_values;
 use crate::network::nprt_net::NprtNet;
 use crate::training::batch::Batch;
 use crate::training::training_set::ViewSamples;
@@ -76,9 +76,9 @@ mod tests {
 
     use super::*;
     use crate::encoding::map_norm::MapNorm;
+    use crate::init::Init;
     use crate::model::config::ModelConfig;
     use crate::network::encoder::LightInput;
-    use crate::network::init::Init;
     use crate::Design;
     use glam::Vec3;
     use nprt_data::dataset::{PackedDataset, PackedPixel, PackedTarget};

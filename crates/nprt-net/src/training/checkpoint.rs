@@ -9,8 +9,8 @@ use burn::module::Module;
 use serde::{Deserialize, Serialize};
 
 use crate::model::folder::{load_weights, save_weights};
+use crate::optimiser::Optimiser;
 use crate::training::loss_curves::LossRow;
-use crate::training::optimiser::Optimiser;
 
 const DIR: &str = "checkpoint";
 const STATE_FILE: &str = "state.json";

@@ -1,16 +1,16 @@
-//! Training: the training set in memory, batches, the loss, the learning-rate schedule, the one
-//! training loop with checkpoints and exact resume, the Neural PRT objective run through it,
-//! validation, calibration and loss curves.
+//! Training: the training set in memory, batches, the learning-rate schedule, the one training
+//! loop with checkpoints and exact resume, the GPU kernels' steps as the loop takes them, the
+//! Neural PRT objective run through it, validation, calibration and loss curves.
 
 pub mod batch;
 pub mod calibration;
 pub mod checkpoint;
 pub mod epoch_plan;
-pub mod loss;
+#[cfg(feature = "kernels")]
+pub mod kernel_steps;
 pub mod loss_curves;
 pub mod lr_schedule;
 pub mod nprt_objective;
-pub mod optimiser;
 pub mod run_length;
 pub mod schedule;
 pub mod train_options;

@@ -15,15 +15,15 @@ use burn::optim::GradientsParams;
 use burn::tensor::Device;
 
 use crate::engine::Engine;
+use crate::init::Init;
 use crate::model::config::ModelConfig;
 use crate::model::folder::{save_model, ModelFile, MODEL_FORMAT, MODEL_VERSION};
-use crate::network::init::Init;
 use crate::network::nprt_net::NprtNet;
+use crate::optimiser::{DeviceSteps, ADAM_EPSILON};
 use crate::training::batch::{Batch, GradientPath};
 use crate::training::calibration::{level_gain, Calibration, LEVEL_SAMPLES};
 use crate::training::checkpoint::RunState;
 use crate::training::epoch_plan::{group_batches, EpochPlan};
-use crate::training::optimiser::{DeviceSteps, ADAM_EPSILON};
 use crate::training::schedule::Schedule;
 use crate::training::train_options::{Gather, TrainOptions};
 use crate::training::training_loop::{self, Objective, TrainSummary};
@@ -137,8 +137,12 @@ impl Objective for PixelObjective<'_> {
             return Ok(None);
         }
         let dataset = self.resident().then_some(self.set);
-        let steps =
-            crate::gpu::KernelSteps::new(net, self.opts.loss, self.opts.precision, dataset)?;
+        let steps = crate::training::kernel_steps::KernelSteps::new(
+            net,
+            self.opts.loss,
+            self.opts.precision,
+            dataset,
+        )?;
         Ok(Some(Box::new(steps)))
     }
 

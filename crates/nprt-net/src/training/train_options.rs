@@ -5,9 +5,9 @@ use anyhow::{bail, Result};
 use serde::{Deserialize, Serialize};
 
 use crate::choice::named_choice;
+use crate::loss::Loss;
 use crate::network::design::Design;
 use crate::training::calibration::Calibration;
-use crate::training::loss::Loss;
 use crate::training::lr_schedule::LrSchedule;
 use crate::training::run_length::RunLength;
 use crate::training::schedule::Schedule;

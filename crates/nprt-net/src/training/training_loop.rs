@@ -21,10 +21,10 @@ use burn::tensor::Device;
 use rand::SeedableRng;
 use rand_pcg::Pcg64Mcg;
 
-use crate::network::init::Init;
+use crate::init::Init;
+use crate::optimiser::{DeviceSteps, Optimiser};
 use crate::training::checkpoint::{self, Checkpoint, RunState};
 use crate::training::loss_curves::{self as curves, LossRow};
-use crate::training::optimiser::{DeviceSteps, Optimiser};
 use crate::training::schedule::Schedule;
 
 /// Training-loss rows per epoch in loss.csv.

@@ -3,9 +3,9 @@
 use anyhow::Result;
 use burn::tensor::Device;
 
+use crate::loss::log_l1;
 use crate::network::nprt_net::NprtNet;
 use crate::training::batch::Batch;
-use crate::training::loss::log_l1;
 use crate::training::training_set::{TrainingSet, ViewSamples};
 
 /// Mean log-L1 loss over a fixed, evenly strided subset of at most `max_samples` of the test

@@ -7,11 +7,11 @@ use std::path::Path;
 
 use anyhow::Result;
 
-use super::{DeviceDataset, GpuTrainer};
+use crate::gpu::{DeviceDataset, GpuTrainer};
+use crate::loss::Loss;
 use crate::network::nprt_net::NprtNet;
+use crate::optimiser::DeviceSteps;
 use crate::training::batch::Batch;
-use crate::training::loss::Loss;
-use crate::training::optimiser::DeviceSteps;
 use crate::training::training_set::TrainingSet;
 use crate::Precision;
 
@@ -36,7 +36,8 @@ impl KernelSteps {
         let mut trainer = GpuTrainer::new(net, precision)?;
         let mut resident = None;
         if let Some(set) = dataset {
-            let data = DeviceDataset::upload(&trainer.gpu, set)?;
+            let maps: Vec<_> = set.train.iter().map(|v| &v.light).collect();
+            let data = DeviceDataset::upload(trainer.gpu(), &set.pack, &maps)?;
             resident = Some(data.bytes);
             trainer.hold(data);
         }
@@ -93,7 +94,7 @@ impl DeviceSteps<NprtNet, Batch> for KernelSteps {
             Some(bytes) => format!("the dataset there ({:.1} MB)", bytes as f64 / 1e6),
             None => "batches gathered here".into(),
         };
-        let products = match (self.trainer.precision(), self.trainer.gpu.tensor_cores) {
+        let products = match (self.trainer.precision(), self.trainer.gpu().tensor_cores) {
             (Precision::F32, _) => "",
             (Precision::F16, true) => ", mixed precision on tensor cores",
             (Precision::F16, false) => {
