@@ -12,6 +12,7 @@
 //!    `--device` resolves to);
 //! 4. `training` (data, batches, schedule, the loop, each engine's steps);
 //! 5. `deep_shading` and `bench`.
+//!
 //! It reads datasets through nprt-data and environment maps through nprt-scene; it must not
 //! trace rays or write datasets, and it knows nothing of evaluation or frame rendering.
 //!

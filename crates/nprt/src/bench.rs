@@ -438,10 +438,10 @@ fn print_profile(_: &ModelConfig, _: &BenchTrainArgs, _: Precision, _: f64) -> R
 
 /// The PyTorch peer to compare with, if one was given: its Python, PyTorch's device name (CUDA
 /// for the GPU kernels) and the script written out.
-fn peer<'a>(
-    python: Option<&'a PathBuf>,
+fn peer(
+    python: Option<&PathBuf>,
     engine: Engine,
-) -> Result<Option<(&'a PathBuf, &'static str, PeerScript)>> {
+) -> Result<Option<(&PathBuf, &'static str, PeerScript)>> {
     let torch_device = match engine {
         Engine::Cpu => "cpu",
         Engine::Gpu => "cuda",

@@ -1,11 +1,10 @@
 //! The full track: every pixel input, its three outputs radiance itself (the baseline and
 //! PRT-inspired designs).
 
-use super::{KindSpec, Weight};
-use crate::encoding::features::FEATURES;
+use super::{KindSpec, Weight, ALL_INPUTS};
 
 pub const SPEC: KindSpec = KindSpec {
     name: "full",
-    inputs: &[0..FEATURES],
+    inputs: ALL_INPUTS,
     terms: &[Weight::One],
 };

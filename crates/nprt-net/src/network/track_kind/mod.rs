@@ -25,6 +25,12 @@ pub enum Weight {
     Albedo(usize),
 }
 
+/// Every pixel input, in the order of [`feature`](crate::encoding::features::feature).
+pub const ALL_INPUTS: &[Range<usize>] = {
+    use crate::encoding::features::feature::*;
+    &[POSITION, VIEW, MIRROR, NORMAL, KD, KS, ALPHA]
+};
+
 /// One kind of track, as its file states it.
 pub struct KindSpec {
     /// Its name in the export.
