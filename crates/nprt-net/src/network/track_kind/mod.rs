@@ -25,6 +25,16 @@ pub enum Weight {
     Albedo(usize),
 }
 
+impl Weight {
+    /// The weight of channel `c` for the pixel inputs `f`.
+    fn of(self, f: &[f32], c: usize) -> f32 {
+        match self {
+            Weight::One => 1.0,
+            Weight::Albedo(at) => f[at + c],
+        }
+    }
+}
+
 /// Every pixel input, in the order of [`feature`](crate::encoding::features::feature).
 pub const ALL_INPUTS: &[Range<usize>] = {
     use crate::encoding::features::feature::*;
@@ -84,7 +94,7 @@ impl TrackKind {
 
     /// Whether the track reads every pixel input in order (no gather needed).
     pub fn reads_all(self) -> bool {
-        self.inputs() == (0..FEATURES).collect::<Vec<_>>()
+        self.spec().inputs.iter().cloned().flatten().eq(0..FEATURES)
     }
 
     /// The shading network's outputs: three per term.
@@ -92,30 +102,22 @@ impl TrackKind {
         3 * self.spec().terms.len()
     }
 
-    /// Term `k`'s weight of channel `c` for the pixel inputs `f`.
-    fn weight(self, k: usize, f: &[f32], c: usize) -> f32 {
-        match self.spec().terms[k] {
-            Weight::One => 1.0,
-            Weight::Albedo(at) => f[at + c],
-        }
-    }
-
     /// Radiance (before the map's scale) of a pixel with inputs `f` from the exp of its
     /// shading outputs `e`.
     pub fn radiance(self, f: &[f32], e: &[f32]) -> [f32; 3] {
+        let terms = self.spec().terms;
         std::array::from_fn(|c| {
-            (1..self.spec().terms.len()).fold(self.weight(0, f, c) * e[c], |sum, k| {
-                sum + self.weight(k, f, c) * e[3 * k + c]
-            })
+            let term = |k: usize| terms[k].of(f, c) * e[3 * k + c];
+            (1..terms.len()).fold(term(0), |sum, k| sum + term(k))
         })
     }
 
     /// The gradient at the shading outputs `d` from the gradient `dr` at the radiance of a
     /// pixel with inputs `f` and output exps `e`.
     pub fn output_gradients(self, f: &[f32], e: &[f32], dr: &[f32], d: &mut [f32]) {
-        for k in 0..self.spec().terms.len() {
+        for (k, w) in self.spec().terms.iter().enumerate() {
             for c in 0..3 {
-                d[3 * k + c] = dr[c] * self.weight(k, f, c) * e[3 * k + c];
+                d[3 * k + c] = dr[c] * w.of(f, c) * e[3 * k + c];
             }
         }
     }
