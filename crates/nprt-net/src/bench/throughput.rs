@@ -21,6 +21,8 @@ use crate::Precision;
 /// `batch_size` samples over `views` maps, after `warmup` untimed steps: on the CPU with the
 /// gradients computed by `path`, on the GPU kernels in `precision` (elsewhere f32 only).
 #[allow(clippy::too_many_arguments)]
+// Without the kernels `engine` is always the CPU.
+#[cfg_attr(not(feature = "kernels"), allow(unused_variables))]
 pub fn measure_throughput(
     config: &ModelConfig,
     path: GradientPath,
