@@ -1,8 +1,9 @@
 //! Where the networks run: the `--device` choice of every command that trains or infers,
 //! resolved once into an [`Engine`]: the CPU engine, or nprt's own GPU kernels on wgpu (any
 //! Vulkan, Metal or DX12 adapter; Mesa's software Vulkan driver, lavapipe, when asked for by
-//! name, which is how CI tests the kernels without a GPU). burn holds the parameters on the
-//! host whichever engine steps them, so a model folder is the same whichever trained it.
+//! name, which is how CI tests the kernels without a GPU). Both read and write the weights
+//! `network` defines, so a model folder, and a checkpoint with Adam's state, is the same
+//! whichever trained it.
 
 use anyhow::{bail, Result};
 

@@ -3,30 +3,28 @@
 //! the model folder format (weights plus config) and the one training loop every network goes
 //! through (checkpoints, exact resume). Its modules keep the pieces apart, as tiny-cuda-nn
 //! does, in layers, each using only those before it:
-//! 1. the shared pieces: `precision`, `init` (how parameters start), `loss`, `optimiser`
-//!    (Adam's settings, and the steps an engine takes);
+//! 1. the shared pieces: `precision`, `init` (how parameters start), `loss`;
 //! 2. `encoding` (what the networks see), then `network` (layers, encoder, track kinds,
-//!    designs), then `model` (config and folder);
-//! 3. the engines: `cpu` (the CPU engine, on plain slices), `gpu` (our own GPU kernels,
-//!    feature `kernels`, which read the CPU engine's weight structs) and `engine` (what
-//!    `--device` resolves to);
+//!    designs, the U-Net, and `parameters`: the one weight type every network is), then
+//!    `optimiser` (Adam, and the steps an engine takes) and `model` (config and folder);
+//! 3. the engines: `cpu` (the CPU engine, on the networks' own weights), `gpu` (our own GPU
+//!    kernels, feature `kernels`, which read the same weights) and `engine` (what `--device`
+//!    resolves to);
 //! 4. `training` (data, batches, schedule, the loop, each engine's steps);
 //! 5. `deep_shading` and `bench`.
 //!
 //! It reads datasets through nprt-data and environment maps through nprt-scene; it must not
 //! trace rays or write datasets, and it knows nothing of evaluation or frame rendering.
 //!
-//! burn holds the networks as Modules on its CPU backend (flex): parameters, initialisation,
-//! the model folder, and the autodiff graph the engines are held to in tests. `--device`
-//! resolves into an [`Engine`] that runs the steps and frames: the CPU engine ([`cpu`]; burn's
-//! graph was slower than PyTorch on SIREN layers) or our own GPU kernels ([`gpu`], feature
-//! `kernels`), which read the host's parameters.
+//! No framework: `--device` resolves into an [`Engine`] that runs the steps and frames, the
+//! CPU engine ([`cpu`]) or our own GPU kernels ([`gpu`], feature `kernels`), both on the
+//! weights [`network`] defines. The gradient checks hold them to f64 finite differences.
 //!
 //! ```
-//! use nprt_net::{Design, Device, Init, ModelConfig};
+//! use nprt_net::{Design, Init, ModelConfig};
 //!
 //! // The paper's diffuse/specular design, with its own default activation (SIREN).
-//! let net = ModelConfig::new(Design::Dsep, None).build(&mut Init::new(0, &Device::flex()));
+//! let net = ModelConfig::new(Design::Dsep, None).build(&mut Init::new(0));
 //! let paper = Design::Dsep.paper_params() as f64;
 //! assert!((net.transport_params() as f64 / paper - 1.0).abs() < 0.05);
 //! ```
@@ -39,7 +37,6 @@ pub mod encoding;
 mod engine;
 #[cfg(feature = "kernels")]
 pub mod gpu;
-mod host_values;
 pub mod init;
 pub mod loss;
 pub mod model;
@@ -51,15 +48,12 @@ pub mod training;
 #[cfg(feature = "kernels")]
 pub use bench::throughput::profile_kernels;
 pub use bench::throughput::{measure_inference, measure_throughput, median, InferenceSpeed};
-pub use burn;
-pub use burn::tensor::Device;
 pub use encoding::features::{feature, gbuffer_features, pixel_features, position_frame, FEATURES};
 pub use encoding::map_norm::MapNorm;
 pub use encoding::position_encoding::PositionEncoding;
 pub use engine::{finish, Compute, Engine};
-pub use host_values::host_values;
-pub use init::{conv2d, Init};
-pub use loss::{log_l1, Loss};
+pub use init::Init;
+pub use loss::Loss;
 pub use model::config::{ModelConfig, DEFAULT_ENCODER_WIDTH, DEFAULT_MAP_NORM};
 pub use model::direct_light::DirectLight;
 pub use model::folder::{load_model, read_model_file, ModelFile};
@@ -69,10 +63,11 @@ pub use network::design::{Design, TRANSPORT_CODE};
 pub use network::encoder::{LightEncoder, LightInput};
 pub use network::mlp::Mlp;
 pub use network::nprt_net::NprtNet;
+pub use network::parameters::Parameters;
 pub use network::track::Track;
 pub use network::track_kind::TrackKind;
 pub use precision::Precision;
-pub use training::batch::{Batch, GradientPath};
+pub use training::batch::Batch;
 pub use training::calibration::{level_gain, Calibration, LEVEL_SAMPLES};
 pub use training::checkpoint::RunState;
 pub use training::lr_schedule::LrSchedule;

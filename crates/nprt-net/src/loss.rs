@@ -1,8 +1,7 @@
 //! The training losses: the paper's L1 distance between log(1 + x) of predicted and reference
 //! radiance, and a relative L2 whose minimiser on noisy targets is their mean. One definition
-//! serves training (burn and the CPU engine), validation and the log-L1 metric.
-
-use burn::tensor::Tensor;
+//! serves training on every engine (the GPU kernels restate it and are tested against it),
+//! validation and the log-L1 metric.
 
 use crate::choice::named_choice;
 
@@ -27,22 +26,15 @@ named_choice!(Loss, "loss", {
 });
 
 impl Loss {
-    /// The mean loss of `prediction` against `reference` ([B, 3]), differentiable.
-    pub fn mean(self, prediction: Tensor<2>, reference: Tensor<2>) -> Tensor<1> {
-        match self {
-            Loss::LogL1 => log_l1(prediction, reference),
-            Loss::RelL2 => {
-                let weight = prediction
-                    .clone()
-                    .detach()
-                    .square()
-                    .add_scalar(RELATIVE_L2_EPS);
-                ((prediction - reference).square() / weight).mean()
-            }
-        }
+    /// The mean loss of `prediction` against `reference` (as many values each).
+    pub fn mean(self, prediction: &[f32], reference: &[f32]) -> f64 {
+        let sum: f64 = (prediction.iter().zip(reference))
+            .map(|(&p, &r)| self.element(p, r).0 as f64)
+            .sum();
+        sum / prediction.len().max(1) as f64
     }
 
-    /// One element's loss and its derivative in the prediction `p` (for the CPU engine).
+    /// One element's loss and its derivative in the prediction `p`.
     pub fn element(self, p: f32, r: f32) -> (f32, f32) {
         match self {
             Loss::LogL1 => {
@@ -62,16 +54,6 @@ impl Loss {
             }
         }
     }
-}
-
-/// Per-element |log(1 + p) − log(1 + r)|, any tensor rank.
-pub fn log_l1_map<const D: usize>(prediction: Tensor<D>, reference: Tensor<D>) -> Tensor<D> {
-    (prediction.log1p() - reference.log1p()).abs()
-}
-
-/// The mean of [`log_l1_map`]: the paper's training loss, and every run's validation loss.
-pub fn log_l1<const D: usize>(prediction: Tensor<D>, reference: Tensor<D>) -> Tensor<1> {
-    log_l1_map(prediction, reference).mean()
 }
 
 /// One value's log-L1 error, for metrics on images. Negative radiance (a denoiser's overshoot)

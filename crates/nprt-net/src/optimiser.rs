@@ -1,22 +1,34 @@
-//! What updates a network's weights during training: burn's Adam over the network's own
-//! tensors, or an engine of the objective's own that keeps the parameters and Adam's moments
-//! on its device and takes whole steps there (nprt-net's GPU kernels). The loop and the
-//! checkpoint see only this; a checkpoint's optimiser file says which of the two wrote it.
+//! What trains a network's weights: an engine's steps ([`EngineSteps`]: the batch's loss,
+//! gradients and an Adam update together, wherever the parameters live), and Adam on the host
+//! ([`Adam`]), the update the CPU engine's steps take. The GPU kernels run the same update
+//! (shaders/adam.wgsl), and both keep Adam's state in one file format, so a checkpoint resumes
+//! on either engine.
 
+use std::collections::HashMap;
 use std::path::Path;
 
-use anyhow::{anyhow, bail, Result};
-use burn::module::Module;
-use burn::optim::{AdamConfig, ModuleOptimizer};
+use anyhow::{anyhow, bail, Context, Result};
+use safetensors::{tensor::TensorView, Dtype, SafeTensors};
+
+use crate::network::parameters::Parameters;
 
 /// Adam's ε, on every engine.
 pub const ADAM_EPSILON: f32 = 1e-8;
+/// Adam's decay rates (Kingma and Ba's, and PyTorch's defaults).
+pub const ADAM_BETA1: f32 = 0.9;
+pub const ADAM_BETA2: f32 = 0.999;
 
-/// Steps taken on a device of their own: the parameters and Adam's moments live there, and a
-/// step is the batch's loss, gradients and Adam update together.
-pub trait DeviceSteps<N, B> {
-    /// Queues one step on `batch` at learning rate `lr`. Returns the step queued before it
-    /// (None for the first): its batch's mean loss and its samples, read while this one runs.
+/// Checkpoint files of Adam's state start with this.
+pub const STATE_PREFIX: &str = "adam-";
+/// burn's optimiser state, written by nprt before its own Adam: refused by name.
+const BURN_PREFIX: &str = "optimizer-";
+
+/// Steps on an engine: the parameters and Adam's moments live there, and a step is the
+/// batch's loss, gradients and Adam update together.
+pub trait EngineSteps<N, B> {
+    /// Takes (or queues) one step on `batch` at learning rate `lr`. Returns a finished step's
+    /// mean loss and samples: this one's on an engine that steps at once, the one queued
+    /// before it on a device that runs while the host goes on (None for its first).
     fn step(&mut self, batch: &B, lr: f64) -> Result<Option<(f64, u64)>>;
     /// The last queued step's loss and samples once it is done (None when none is pending).
     fn finish(&mut self) -> Result<Option<(f64, u64)>>;
@@ -26,94 +38,133 @@ pub trait DeviceSteps<N, B> {
     fn store(&self, net: &mut N);
     /// Writes Adam's state (moments and step count) to `path`.
     fn save(&self, path: &Path) -> Result<()>;
-    /// Reads Adam's state back from `path`, written by [`Self::save`] for the same network.
+    /// Reads Adam's state back from `path`, written by [`Self::save`] on any engine for a
+    /// network of the same shapes.
     fn load(&mut self, path: &Path) -> Result<()>;
-    /// Where the steps run, for reports ("GPU kernels on …").
+    /// Where the steps run, for reports ("cpu", "GPU kernels on …").
     fn describe(&self) -> String;
 }
 
-/// Burn's Adam, or a device's own steps.
-pub enum Optimiser<N, B> {
-    Burn(ModuleOptimizer),
-    Device(Box<dyn DeviceSteps<N, B>>),
+/// Whether a checkpoint file is optimiser state (this nprt's or burn's, to clean up).
+pub fn is_state_file(name: &str) -> bool {
+    name.starts_with(STATE_PREFIX) || name.starts_with(BURN_PREFIX)
 }
 
-/// File names of the two kinds of optimiser state.
-const BURN_PREFIX: &str = "optimizer-";
-const DEVICE_PREFIX: &str = "adam-";
+/// The name of Adam's state file at `step`.
+pub fn state_file(step: u64) -> String {
+    format!("{STATE_PREFIX}{step:09}.safetensors")
+}
 
-impl<N: Module, B> Optimiser<N, B> {
-    /// Burn's Adam as the paper configures it (ε = 1e-8).
-    pub fn burn() -> Self {
-        Optimiser::Burn(AdamConfig::new().with_epsilon(ADAM_EPSILON).init())
-    }
+/// Adam's state over a network's parameters, flat in their visiting order.
+pub struct Adam {
+    moment1: Vec<f32>,
+    moment2: Vec<f32>,
+    steps: u64,
+}
 
-    /// Whether a checkpoint file is optimiser state.
-    pub fn is_state_file(name: &str) -> bool {
-        name.starts_with(BURN_PREFIX) || name.starts_with(DEVICE_PREFIX)
-    }
-
-    /// The name of this optimiser's state file at `step`.
-    pub fn state_file(&self, step: u64) -> String {
-        match self {
-            Optimiser::Burn(_) => format!("{BURN_PREFIX}{step:09}.bpk"),
-            Optimiser::Device(_) => format!("{DEVICE_PREFIX}{step:09}.safetensors"),
+impl Adam {
+    /// Zero moments for `params` values.
+    pub fn new(params: usize) -> Self {
+        Adam {
+            moment1: vec![0.0; params],
+            moment2: vec![0.0; params],
+            steps: 0,
         }
     }
 
-    /// The device's own steps, if they are what this optimiser is.
-    pub fn device_steps(&mut self) -> Option<&mut dyn DeviceSteps<N, B>> {
-        match self {
-            Optimiser::Device(d) => Some(d.as_mut()),
-            Optimiser::Burn(_) => None,
-        }
-    }
-
-    /// Brings `net` up to date with the parameters the optimiser holds, if it holds them.
-    pub fn store(&self, net: &mut N) {
-        if let Optimiser::Device(d) = self {
-            d.store(net);
-        }
+    /// One update of `net` by its gradient `grads` (same shapes) at learning rate `lr`:
+    /// m ← β1 m + (1 − β1) g, v ← β2 v + (1 − β2) g², θ ← θ − lr · (m · c) / (√v + ε · √(1 − β2^t))
+    /// with c = √(1 − β2^t) / (1 − β1^t), in this order in f32 (burn's formulation, which
+    /// trained nprt's models before, and the GPU kernels').
+    pub fn step<N: Parameters>(&mut self, net: &mut N, grads: &N, lr: f64) {
+        self.steps += 1;
+        let t = self.steps.min(i32::MAX as u64) as i32;
+        let c2 = (1.0 - ADAM_BETA2.powi(t)).sqrt();
+        let factor = c2 / (1.0 - ADAM_BETA1.powi(t));
+        let epsilon = ADAM_EPSILON * c2;
+        let lr = lr as f32;
+        let g = grads.flat();
+        let (m, v) = (&mut self.moment1, &mut self.moment2);
+        let mut at = 0;
+        net.visit_mut("", &mut |_, _, w| {
+            let range = at..at + w.len();
+            at = range.end;
+            let moments = m[range.clone()].iter_mut().zip(&mut v[range.clone()]);
+            for ((w, g), (m, v)) in w.iter_mut().zip(&g[range]).zip(moments) {
+                *m = *m * ADAM_BETA1 + *g * (1.0 - ADAM_BETA1);
+                *v = *v * ADAM_BETA2 + (*g * *g) * (1.0 - ADAM_BETA2);
+                *w -= (*m * factor) / (v.sqrt() + epsilon) * lr;
+            }
+        });
+        assert_eq!(at, m.len(), "gradients of the network Adam was made for");
     }
 
     pub fn save(&self, path: &Path) -> Result<()> {
-        match self {
-            Optimiser::Burn(optim) => optim
-                .save(path)
-                .map_err(|e| anyhow!("cannot write optimiser state '{}': {e:?}", path.display())),
-            Optimiser::Device(d) => d.save(path),
-        }
+        save_state(path, [&self.moment1, &self.moment2], self.steps)
     }
 
-    /// Reads the state in `path`; refuses state written by the other kind, naming it.
-    pub fn load(self, path: &Path) -> Result<Self> {
-        let name = path
-            .file_name()
-            .map_or(String::new(), |n| n.to_string_lossy().into_owned());
-        let mine = match &self {
-            Optimiser::Burn(_) => name.starts_with(BURN_PREFIX),
-            Optimiser::Device(_) => name.starts_with(DEVICE_PREFIX),
-        };
-        if !mine {
-            bail!(
-                "checkpoint '{}' holds Adam's state of {}; resume it with the --device that wrote it, or start over in another --out",
-                path.display(),
-                if name.starts_with(DEVICE_PREFIX) {
-                    "nprt's own GPU kernels (--device gpu or wgpu)"
-                } else {
-                    "the CPU engine (--device cpu)"
-                }
-            );
-        }
-        match self {
-            Optimiser::Burn(optim) => optim
-                .load(path)
-                .map(Optimiser::Burn)
-                .map_err(|e| anyhow!("cannot read optimiser state '{}': {e:?}", path.display())),
-            Optimiser::Device(mut d) => {
-                d.load(path)?;
-                Ok(Optimiser::Device(d))
-            }
-        }
+    pub fn load(&mut self, path: &Path) -> Result<()> {
+        let ([m1, m2], steps) = load_state(path, self.moment1.len())?;
+        (self.moment1, self.moment2, self.steps) = (m1, m2, steps);
+        Ok(())
     }
+}
+
+/// Writes Adam's two moments (flat, in visiting order) and its step count to `path`.
+pub fn save_state(path: &Path, moments: [&[f32]; 2], steps: u64) -> Result<()> {
+    let views = ["moment1", "moment2"]
+        .into_iter()
+        .zip(moments)
+        .map(|(name, m)| {
+            let bytes: &[u8] = bytemuck::cast_slice(m);
+            Ok((name, TensorView::new(Dtype::F32, vec![m.len()], bytes)?))
+        })
+        .collect::<Result<Vec<_>, safetensors::SafeTensorError>>()?;
+    let metadata = HashMap::from([("steps".to_string(), steps.to_string())]);
+    let file = safetensors::serialize(views, Some(metadata))?;
+    nprt_io::write_file(path, &file)
+}
+
+/// Reads what [`save_state`] wrote for a network of `params` values; refuses burn's optimiser
+/// state by name.
+pub fn load_state(path: &Path, params: usize) -> Result<([Vec<f32>; 2], u64)> {
+    let name = path
+        .file_name()
+        .map_or(String::new(), |n| n.to_string_lossy().into_owned());
+    if name.starts_with(BURN_PREFIX) {
+        bail!(
+            "checkpoint '{}' holds burn's Adam state, written by an nprt before its own Adam, which this nprt cannot read; finish the run with the nprt that started it, or delete '{}' to start over",
+            path.display(),
+            path.parent().map_or(path, |p| p).display()
+        );
+    }
+    let bytes = std::fs::read(path)
+        .with_context(|| format!("cannot read Adam's state '{}'", path.display()))?;
+    let bad = |why: String| anyhow!("Adam's state '{}' {why}", path.display());
+    let file = SafeTensors::deserialize(&bytes).map_err(|e| bad(format!("is unreadable: {e}")))?;
+    let (_, metadata) = SafeTensors::read_metadata(&bytes).map_err(|e| bad(e.to_string()))?;
+    let steps = metadata
+        .metadata()
+        .as_ref()
+        .and_then(|m| m.get("steps"))
+        .and_then(|s| s.parse().ok())
+        .ok_or_else(|| bad("has no step count".into()))?;
+    let moment = |name: &str| -> Result<Vec<f32>> {
+        let view = file
+            .tensor(name)
+            .map_err(|e| bad(format!("lacks {name}: {e}")))?;
+        if view.dtype() != Dtype::F32 || view.shape() != [params] {
+            return Err(bad(format!(
+                "holds {name} of {:?} {:?}, not this network's {params} f32",
+                view.dtype(),
+                view.shape(),
+            )));
+        }
+        Ok(view
+            .data()
+            .chunks_exact(4)
+            .map(|b| f32::from_le_bytes([b[0], b[1], b[2], b[3]]))
+            .collect())
+    };
+    Ok(([moment("moment1")?, moment("moment2")?], steps))
 }

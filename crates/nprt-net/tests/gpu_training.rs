@@ -1,7 +1,7 @@
 //! The GPU training step (nprt-net's own kernels, `gpu::GpuTrainer`) against the CPU engine
 //! it must agree with: loss and every parameter's gradient (light encoder, transport networks,
 //! hash grids) for every design, activation and encoding, both losses; two Adam steps against
-//! burn's. Overfitting and exact resume through `nprt train --device wgpu` are in nprt's
+//! the host's Adam. Overfitting and exact resume through `nprt train --device wgpu` are in nprt's
 //! tests/train.rs. Runs on
 //! whatever adapter wgpu finds; CI's is Mesa's software Vulkan (scripts/vulkan.sh). Without
 //! one the tests skip, unless NPRT_REQUIRE_VULKAN is set (scripts/test sets it once lavapipe
@@ -11,13 +11,11 @@
 #[allow(dead_code)] // the helpers other test binaries use
 mod common;
 
-use burn::optim::AdamConfig;
 use common::{loud_grids, random_batch, variants};
-use nprt_net::cpu::{HostEncoder, HostTransport, Samples};
-use nprt_net::gpu::{GpuDevice, GpuTrainer, ParameterLayout};
-use nprt_net::optimiser::ADAM_EPSILON;
+use nprt_net::gpu::{GpuDevice, GpuTrainer};
+use nprt_net::optimiser::Adam;
 use nprt_net::{
-    Design, Device, GradientPath, Init, Loss, ModelConfig, NprtNet, PositionEncoding, Precision,
+    cpu, Design, Init, Loss, ModelConfig, NprtNet, Parameters, PositionEncoding, Precision,
 };
 
 /// Euclidean distance of `a` from `b` over b's norm.
@@ -29,14 +27,14 @@ fn relative_error(a: &[f32], b: &[f32]) -> f64 {
 }
 
 /// Each tensor's relative error between two sets of values of one network's shapes.
-fn tensor_errors(a: &(HostEncoder, HostTransport), b: &(HostEncoder, HostTransport)) -> Vec<f64> {
-    let (layout, fa) = ParameterLayout::pack(&a.0, &a.1, 1);
-    let (_, fb) = ParameterLayout::pack(&b.0, &b.1, 1);
-    layout
-        .spans
-        .iter()
-        .map(|s| relative_error(&fa[s.offset..][..s.len], &fb[s.offset..][..s.len]))
-        .collect()
+fn tensor_errors(a: &NprtNet, b: &NprtNet) -> Vec<f64> {
+    let mut tensors = Vec::new();
+    b.visit("", &mut |_, _, v| tensors.push(v.to_vec()));
+    let mut errors = Vec::new();
+    a.visit("", &mut |_, _, v| {
+        errors.push(relative_error(v, &tensors[errors.len()]))
+    });
+    errors
 }
 
 /// `config` with an encoder for the test batches' 64-wide maps, built from seed 4 with loud
@@ -46,21 +44,7 @@ fn network(config: &ModelConfig) -> NprtNet {
         encoder_width: 64,
         ..config.clone()
     };
-    loud_grids(config.build(&mut Init::new(4, &Device::flex())))
-}
-
-/// The CPU engine's loss and gradients of `net` on `samples`.
-fn cpu_gradients(
-    net: &NprtNet,
-    samples: &Samples,
-    loss: Loss,
-) -> (f64, HostEncoder, HostTransport) {
-    let encoder = HostEncoder::from_burn(&net.encoder);
-    let light = encoder.forward(samples.lights, samples.light_width);
-    let transport = HostTransport::from_net(net).gradients(samples, &light.codes, loss);
-    let encoder_grads = encoder.backward(&light, &transport.codes);
-    let tracks = transport.tracks;
-    (transport.loss, encoder_grads, HostTransport { tracks })
+    loud_grids(config.build(&mut Init::new(4)))
 }
 
 #[test]
@@ -73,10 +57,10 @@ fn gpu_gradients_match_the_cpu_engine_for_every_design() {
     for config in variants() {
         let net = network(&config);
         for loss in [Loss::LogL1, Loss::RelL2] {
-            let (want_loss, enc, tr) = cpu_gradients(&net, &samples, loss);
+            let (want_loss, want) = cpu::gradients(&net, &samples, loss);
             let mut gpu = GpuTrainer::new(&net, Precision::F32).unwrap();
             let value = gpu.backward(&samples, loss);
-            let errors = tensor_errors(&gpu.gradients(), &(enc, tr));
+            let errors = tensor_errors(&gpu.gradients(), &want);
             let encoder_tensors = 2 * net.encoder.convs.len() + 2;
             let worst = |e: &[f64]| e.iter().fold(0.0f64, |m, &v| m.max(v));
             let (encoder, transport) = errors.split_at(encoder_tensors);
@@ -101,10 +85,10 @@ fn gpu_gradients_match_the_cpu_engine_for_every_design() {
     }
 }
 
-/// Two steps of the GPU's Adam against burn's Adam stepping on the CPU engine's gradients (the
-/// CPU training path): what each moved every tensor by.
+/// Two steps of the GPU's Adam against the host's Adam stepping on the CPU engine's gradients
+/// (the CPU training path): what each moved every tensor by.
 #[test]
-fn gpu_adam_steps_match_burns_adam_on_the_cpu_engine() {
+fn gpu_adam_steps_match_the_hosts_adam_on_the_cpu_engine() {
     if !GpuDevice::probe() {
         return;
     }
@@ -115,30 +99,17 @@ fn gpu_adam_steps_match_burns_adam_on_the_cpu_engine() {
         encoder_width: 64,
         ..ModelConfig::new(Design::Dsep, None)
     };
-    let device = Device::flex().autodiff();
-    let mut net = loud_grids(config.build(&mut Init::new(4, &device)));
-    let start = host(&net);
+    let mut net = loud_grids(config.build(&mut Init::new(4)));
+    let start = net.clone();
     let mut gpu = GpuTrainer::new(&net, Precision::F32).unwrap();
-    let mut optim = AdamConfig::new().with_epsilon(ADAM_EPSILON).init();
+    let mut adam = Adam::new(net.num_params());
     let lr = 1e-3;
     for _ in 0..2 {
-        let (_, grads) = batch.gradients(&net, &device, GradientPath::Auto, Loss::LogL1);
-        net = optim.step(lr, net, grads);
+        let (_, grads) = cpu::gradients(&net, &samples, Loss::LogL1);
+        adam.step(&mut net, &grads, lr);
         gpu.step(&samples, Loss::LogL1, lr);
     }
-    let moved = |end: &(HostEncoder, HostTransport)| {
-        let (layout, a) = ParameterLayout::pack(&end.0, &end.1, 1);
-        let (_, b) = ParameterLayout::pack(&start.0, &start.1, 1);
-        let d: Vec<f32> = a.iter().zip(&b).map(|(x, y)| x - y).collect();
-        (layout, d)
-    };
-    let (layout, want) = moved(&host(&net));
-    let (_, got) = moved(&gpu.parameters());
-    let errors: Vec<f64> = layout
-        .spans
-        .iter()
-        .map(|s| relative_error(&got[s.offset..][..s.len], &want[s.offset..][..s.len]))
-        .collect();
+    let errors = tensor_errors(&update(&gpu.parameters(), &start), &update(&net, &start));
     let worst = errors.iter().fold(0.0f64, |m, &e| m.max(e));
     eprintln!("largest relative difference of a tensor's update: {worst:.1e}");
     // Lavapipe: 2.5e-5. Adam's update m/√v magnifies the gradients' rounding where they are
@@ -146,12 +117,18 @@ fn gpu_adam_steps_match_burns_adam_on_the_cpu_engine() {
     assert!(worst < 1e-3, "updates differ: {errors:?}");
 }
 
-/// A network's parameters on the host.
-fn host(net: &NprtNet) -> (HostEncoder, HostTransport) {
-    (
-        HostEncoder::from_burn(&net.encoder),
-        HostTransport::from_net(net),
-    )
+/// What `end` moved every parameter by from `start`, as a network of the same shapes.
+fn update(end: &NprtNet, start: &NprtNet) -> NprtNet {
+    let origin = start.flat();
+    let mut d = end.clone();
+    d.set_flat(
+        &end.flat()
+            .iter()
+            .zip(&origin)
+            .map(|(a, b)| a - b)
+            .collect::<Vec<_>>(),
+    );
+    d
 }
 
 /// A profiled step (`nprt bench train --profile`) is the step: the same loss and parameters to
@@ -179,10 +156,7 @@ fn a_profiled_step_is_a_step_with_its_kernels_timed() {
             return;
         }
     };
-    let flat = |t: &GpuTrainer| {
-        let (encoder, transport) = t.parameters();
-        ParameterLayout::pack(&encoder, &transport, 1).1
-    };
+    let flat = |t: &GpuTrainer| t.parameters().flat();
     assert_eq!(
         flat(&plain),
         flat(&timed),
@@ -238,10 +212,10 @@ fn mixed_precision_gradients_follow_the_cpu_engine_for_every_design() {
     for config in variants() {
         let net = network(&config);
         for loss in [Loss::LogL1, Loss::RelL2] {
-            let (want_loss, enc, tr) = cpu_gradients(&net, &samples, loss);
+            let (want_loss, want) = cpu::gradients(&net, &samples, loss);
             let mut gpu = GpuTrainer::new(&net, Precision::F16).unwrap();
             let value = gpu.backward(&samples, loss);
-            let errors = tensor_errors(&gpu.gradients(), &(enc, tr));
+            let errors = tensor_errors(&gpu.gradients(), &want);
             let worst = errors.iter().fold(0.0f64, |m, &v| m.max(v));
             let loss_error = (value - want_loss).abs() / want_loss;
             let name = format!("{} {} {loss}", config.label(), config.activation);
@@ -276,7 +250,6 @@ fn mixed_precision_steps_follow_f32_steps() {
         ..ModelConfig::new(Design::Dsep, None)
     };
     let net = network(&config);
-    let start = host(&net);
     let [mut full, mut mixed] =
         [Precision::F32, Precision::F16].map(|p| GpuTrainer::new(&net, p).unwrap());
     let before = full.loss(&samples, Loss::LogL1);
@@ -287,16 +260,8 @@ fn mixed_precision_steps_follow_f32_steps() {
     let [after_full, after_mixed] = [&mut full, &mut mixed].map(|t| t.loss(&samples, Loss::LogL1));
     let moved = (after_full - before).abs();
     let apart = (after_mixed - after_full).abs();
-    let flat = |p: &(HostEncoder, HostTransport)| ParameterLayout::pack(&p.0, &p.1, 1).1;
-    let origin = flat(&start);
-    let update = |t: &GpuTrainer| -> Vec<f32> {
-        flat(&t.parameters())
-            .iter()
-            .zip(&origin)
-            .map(|(a, b)| a - b)
-            .collect()
-    };
-    let updates = relative_error(&update(&mixed), &update(&full));
+    let updated = |t: &GpuTrainer| update(&t.parameters(), &net).flat();
+    let updates = relative_error(&updated(&mixed), &updated(&full));
     eprintln!(
         "loss {before:.5} → {after_full:.5} (f32), {after_mixed:.5} (mixed); updates apart by \
          {updates:.1e}"

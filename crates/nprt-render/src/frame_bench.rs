@@ -4,7 +4,7 @@
 
 use anyhow::{Context, Result};
 use nprt_net::model::folder::ModelFile;
-use nprt_net::{Design, Device, DirectLight, Engine, Init, ModelConfig};
+use nprt_net::{Design, DirectLight, Engine, Init, ModelConfig};
 use nprt_scene::{load_scene, SceneOptions};
 use nprt_trace::TraceScene;
 
@@ -165,7 +165,7 @@ fn untrained(
         direct,
         ..ModelConfig::new(design, None)
     };
-    let net = config.build(&mut Init::new(1, &Device::flex()));
+    let net = config.build(&mut Init::new(1));
     let file = ModelFile::untrained(config.clone(), &net, bounds);
     let mut model = Relighter::new(file, net, engine)?;
     model.set_precision(precision)?;

@@ -7,10 +7,9 @@ use std::time::Instant;
 
 use anyhow::Result;
 use glam::{Vec2, Vec3};
-use nprt_net::burn::tensor::{Tensor, TensorData};
-use nprt_net::cpu::{self, HostTransport, TransferCodes};
+use nprt_net::cpu::TransferCodes;
 use nprt_net::gbuffer_features;
-use nprt_net::{load_model, Device, DirectLight, Engine, LightInput, ModelFile, NprtNet, FEATURES};
+use nprt_net::{load_model, DirectLight, Engine, LightInput, ModelFile, NprtNet, FEATURES};
 use nprt_scene::{Camera, EnvMap};
 use nprt_trace::{render, render_direct, render_gbuffer, GBuffer, RenderSettings, TraceScene};
 
@@ -28,9 +27,8 @@ pub const DEFAULT_DIRECT_SPP: u32 = 16;
 /// A trained model ready to shade G-buffers.
 pub struct Relighter {
     pub file: ModelFile,
+    /// The weights; the CPU engine runs them where frames are made on the CPU.
     net: NprtNet,
-    /// The transport networks on the CPU engine, where frames are made on the CPU.
-    host: Option<HostTransport>,
     /// The encoder and transport networks as our own kernels, where frames are made there.
     #[cfg(feature = "wgpu")]
     gpu: Option<crate::gpu::GpuNetwork>,
@@ -136,7 +134,7 @@ impl Relighter {
     /// Loads the model in `dir` to run on `engine`: the CPU engine, or the frame path's own
     /// kernels (crate::gpu), which upload the weights read on the host.
     pub fn load(dir: &Path, engine: Engine) -> Result<Self> {
-        let (file, net) = load_model(dir, &Device::flex())?;
+        let (file, net) = load_model(dir)?;
         Self::new(file, net, engine)
     }
 
@@ -149,7 +147,6 @@ impl Relighter {
             return Ok(Relighter {
                 file,
                 net,
-                host: None,
                 gpu,
                 raster: Default::default(),
             });
@@ -158,12 +155,9 @@ impl Relighter {
             !engine.is_gpu(),
             "this nprt-render was built without its GPU kernels (feature `wgpu`)"
         );
-        anyhow::ensure!(cpu::applies(&net), "the CPU engine runs f32 networks only");
-        let host = Some(HostTransport::from_net(&net));
         Ok(Relighter {
             file,
             net,
-            host,
             #[cfg(feature = "wgpu")]
             gpu: None,
             #[cfg(feature = "wgpu")]
@@ -536,13 +530,8 @@ impl Relighter {
             return LightCode(Code::Device(gpu.encode_map(map, rotation_deg, width, norm)));
         }
         let input = LightInput::new(map, rotation_deg, config.encoder_width, config.map_norm);
-        let w = input.width;
-        let pixels = Tensor::from_data(
-            TensorData::new(input.pixels, [1, 3, w / 2, w]),
-            &Device::flex(),
-        );
         LightCode(Code::Host {
-            code: nprt_net::host_values(self.net.encoder.forward(pixels).into_data()),
+            code: self.net.encoder.forward(&input.pixels, input.width).codes,
             divisor: input.scale,
         })
     }
@@ -611,7 +600,7 @@ impl Relighter {
             .par_chunks_mut(FEATURES)
             .zip(&foreground)
             .for_each(|(f, &i)| f.copy_from_slice(&gbuffer_features(&self.file.bounds, g, i)));
-        let transfer = self.host.as_ref().map(|h| h.transfer_codes(&features));
+        let transfer = self.host().map(|h| h.transfer_codes(&features));
         Pixels {
             count: g.mask.len(),
             foreground,
@@ -628,14 +617,21 @@ impl Relighter {
     /// new viewpoint or (`transfer_known`) a lighting change under a still camera; None off the
     /// CPU engine.
     pub fn flops_per_pixel(&self, transfer_known: bool) -> Option<f64> {
-        self.host
-            .as_ref()
-            .map(|h| h.flops_per_pixel(transfer_known))
+        self.host().map(|h| h.flops_per_pixel(transfer_known))
+    }
+
+    /// The network, where the CPU engine makes the frames.
+    fn host(&self) -> Option<&NprtNet> {
+        #[cfg(feature = "wgpu")]
+        if self.gpu.is_some() {
+            return None;
+        }
+        Some(&self.net)
     }
 
     /// Radiance of every pixel under `light`; background pixels are zero.
     pub fn relight(&self, px: &Pixels, light: &LightCode) -> Vec<Vec3> {
-        let rgb = match &self.host {
+        let rgb = match self.host() {
             Some(host) => {
                 let (code, scale) = self.host_light(light);
                 host.radiance(&px.features, &code, scale, px.transfer.as_ref())
@@ -722,8 +718,7 @@ mod tests {
             direct,
             ..ModelConfig::new(Design::Dsep, None)
         };
-        let device = Device::flex();
-        let net = config.build(&mut Init::new(3, &device));
+        let net = config.build(&mut Init::new(3));
         let file = ModelFile {
             level_gain,
             ..ModelFile::untrained(config, &net, [[-3.0; 3], [3.0; 3]])

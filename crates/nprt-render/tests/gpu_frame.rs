@@ -6,9 +6,8 @@
 #![cfg(feature = "wgpu")]
 
 use glam::Vec3;
-use nprt_net::cpu::{HostEncoder, HostTransport};
 use nprt_net::{
-    gbuffer_features, Activation, Design, Device, Init, LightInput, MapNorm, ModelConfig, NprtNet,
+    gbuffer_features, Activation, Design, Init, LightInput, MapNorm, ModelConfig, NprtNet,
     PositionEncoding,
 };
 use nprt_render::gpu::{GpuDevice, GpuLightCode, GpuLightInput, GpuNetwork};
@@ -49,9 +48,9 @@ fn model(design: Design, activation: Activation, encoding: PositionEncoding, see
         encoding,
         ..ModelConfig::new(design, Some(activation))
     };
-    let mut net = config.build(&mut Init::new(seed, &Device::flex()));
+    let mut net = config.build(&mut Init::new(seed));
     for grid in net.tracks.iter_mut().filter_map(|t| t.grid.as_mut()) {
-        grid.table = grid.table.clone().map(|t| t.mul_scalar(1e4));
+        grid.table.iter_mut().for_each(|v| *v *= 1e4);
     }
     net
 }
@@ -78,14 +77,11 @@ fn gpu_light_codes_and_radiance_match_the_cpu_engine_for_every_design() {
                 let gpu = GpuNetwork::new(&net, gain).unwrap();
                 let there = gpu.light_code(&GpuLightInput::upload(&device, &input));
                 let (code, _) = there.read(&device);
-                let want_code = HostEncoder::from_burn(&net.encoder)
-                    .forward(&input.pixels, 64)
-                    .codes;
+                let want_code = net.encoder.forward(&input.pixels, 64).codes;
                 let code_error = relative_difference(&code, &want_code);
                 let light = GpuLightCode::upload(&device, &want_code, divisor);
                 let (rgb, _) = gpu.radiance(&gpu.pixels(&features), &light, None);
-                let host = HostTransport::from_net(&net);
-                let want = host.radiance(&features, &want_code, scale, None);
+                let want = net.radiance(&features, &want_code, scale, None);
                 let error = relative_difference(&rgb, &want);
                 eprintln!(
                     "{design} {activation} {encoding}: code {code_error:.2e}, radiance {error:.2e}"
@@ -115,16 +111,14 @@ fn the_widest_encoder_input_gets_the_cpu_engines_light_code() {
         encoder_width: width,
         ..ModelConfig::new(Design::Prt, None)
     };
-    let net = config.build(&mut Init::new(7, &Device::flex()));
+    let net = config.build(&mut Init::new(7));
     let map = nprt_scene::open_envmap("builtin:indoor:4").unwrap();
     let input = LightInput::new(&map, 0.0, width, MapNorm::Channel);
     let device = GpuDevice::get().unwrap();
     let input_there = GpuLightInput::upload(&device, &input);
     let gpu = GpuNetwork::new(&net, [1.0; 3]).unwrap();
     let (code, _) = gpu.light_code(&input_there).read(&device);
-    let want = HostEncoder::from_burn(&net.encoder)
-        .forward(&input.pixels, width)
-        .codes;
+    let want = net.encoder.forward(&input.pixels, width).codes;
     let error = relative_difference(&code, &want);
     assert!(error < 3e-6, "light code off by {error}");
 }
@@ -143,7 +137,7 @@ fn the_encoder_input_made_on_the_device_is_the_hosts() {
     let device = GpuDevice::get().unwrap();
     let net = model(Design::Dsep, Activation::Siren, PositionEncoding::None, 3);
     let gpu = GpuNetwork::new(&net, [1.0; 3]).unwrap();
-    let encoder = HostEncoder::from_burn(&net.encoder);
+    let encoder = &net.encoder;
     let maps = [
         ("builtin:sky:25:40", false, 64, 30.0, MapNorm::Channel),
         ("builtin:sky:60:200:3", false, 64, -145.0, MapNorm::Mean),
@@ -201,12 +195,10 @@ fn half_precision_radiance_follows_the_cpu_engines_for_every_design() {
                 let net = model(design, activation, encoding, seed);
                 let mut gpu = GpuNetwork::new(&net, [1.0; 3]).unwrap();
                 gpu.set_half(true).unwrap();
-                let code = HostEncoder::from_burn(&net.encoder)
-                    .forward(&input.pixels, 64)
-                    .codes;
+                let code = net.encoder.forward(&input.pixels, 64).codes;
                 let light = GpuLightCode::upload(&device, &code, scale);
                 let (rgb, _) = gpu.radiance(&gpu.pixels(&features), &light, None);
-                let want = HostTransport::from_net(&net).radiance(&features, &code, scale, None);
+                let want = net.radiance(&features, &code, scale, None);
                 let error = mean_relative_difference(&rgb, &want);
                 eprintln!(
                     "{design} {activation} {encoding} ({}): mean error {error:.2e}",

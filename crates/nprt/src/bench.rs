@@ -6,17 +6,15 @@ use std::path::PathBuf;
 use anyhow::Result;
 use nprt_net::bench::pytorch_peer::{PeerRun, PeerScript, PeerVariant};
 use nprt_net::{
-    measure_throughput, median, Activation, Design, DirectLight, Engine, GradientPath, ModelConfig,
-    Precision,
+    measure_throughput, median, Activation, Design, DirectLight, Engine, ModelConfig, Precision,
 };
 
 use crate::flags::{DeviceArg, Resolution};
 
 #[derive(clap::Subcommand)]
 pub enum BenchCommand {
-    /// Training samples/s of each design (forward, backward and Adam on one batch) with the CPU
-    /// engine and with burn's autodiff graph (or, with --device gpu or wgpu, nprt's own GPU
-    /// kernels), beside the PyTorch peer (bench/train_pytorch.py,
+    /// Training samples/s of each design (forward, backward and Adam on one batch) on the CPU
+    /// engine (or, with --device gpu or wgpu, nprt's own GPU kernels), beside the PyTorch peer (bench/train_pytorch.py,
     /// embedded in nprt) running the same networks, batch and loss when --python is given; the
     /// ratio is the engine's to the fastest of the PyTorch variants asked for.
     Train(BenchTrainArgs),
@@ -289,7 +287,6 @@ fn train(a: BenchTrainArgs) -> Result<()> {
     check_profile(a.profile, &a.device)?;
     let threads = rayon::current_num_threads();
     let engine = a.device.engine()?;
-    let cpu = !engine.is_gpu();
     let rounds = a.rounds.max(1);
     println!(
         "training throughput on {}, batch {}, {} maps per batch, {} timed steps, {threads} threads, \
@@ -301,22 +298,14 @@ fn train(a: BenchTrainArgs) -> Result<()> {
     );
     let peer = peer(a.python.as_ref(), engine)?;
     println!(
-        "{:<10} {:<6} {:<4} {:>14} {:>18} {:>17} {:>8} {:>15}  peer",
-        "design",
-        "act",
-        "prec",
-        "nprt samples/s",
-        "autodiff samples/s",
-        "PyTorch samples/s",
-        "ratio",
-        "rounds' ratios"
+        "{:<10} {:<6} {:<4} {:>14} {:>17} {:>8} {:>15}  peer",
+        "design", "act", "prec", "nprt samples/s", "PyTorch samples/s", "ratio", "rounds' ratios"
     );
     for &arch in &a.designs.arch {
         let config = ModelConfig::new(arch, a.activation);
-        let measure = |path, precision| {
+        let measure = |precision| {
             measure_throughput(
                 &config,
-                path,
                 a.batch_size,
                 a.views,
                 a.steps,
@@ -349,28 +338,22 @@ fn train(a: BenchTrainArgs) -> Result<()> {
                 }
             }
             for (&precision, rates) in a.precision.iter().zip(&mut ours) {
-                rates.push(measure(GradientPath::Auto, precision)?);
+                rates.push(measure(precision)?);
             }
         }
         let best = fastest(&variants);
         let theirs = best.map_or(Vec::new(), |v| variants[v].clone());
-        // Off the CPU burn's autodiff is the only path, so the column would repeat the first.
-        let autodiff = match cpu {
-            true => Some(measure(GradientPath::Autodiff, Precision::F32)?),
-            false => None,
-        };
         for (&precision, ours) in a.precision.iter().zip(ours) {
             let ratios: Vec<f64> = ours.iter().zip(&theirs).map(|(o, t)| o / t).collect();
             let ours = median(ours);
             let theirs = (!theirs.is_empty()).then(|| median(theirs.clone()));
             let spread = ratio_range(&ratios);
             println!(
-                "{:<10} {:<6} {:<4} {:>14.0} {:>18} {:>17} {:>8} {:>15}  {}",
+                "{:<10} {:<6} {:<4} {:>14.0} {:>17} {:>8} {:>15}  {}",
                 arch.name(),
                 config.activation.name(),
                 precision.name(),
                 ours,
-                autodiff.map_or("-".into(), |t| format!("{t:.0}")),
                 theirs.map_or("-".into(), |t| format!("{t:.0}")),
                 theirs.map_or("-".into(), |t| format!("{:.2}×", ours / t)),
                 spread,

@@ -5,7 +5,7 @@ use std::path::PathBuf;
 use anyhow::{bail, Result};
 use nprt_net::network::encoder::check_input_width;
 use nprt_net::{
-    layer_table, Activation, Design, Device, Init, ModelConfig, NprtNet, PositionEncoding,
+    layer_table, Activation, Design, Init, ModelConfig, NprtNet, PositionEncoding,
     DEFAULT_ENCODER_WIDTH,
 };
 
@@ -47,7 +47,7 @@ pub fn run(c: ModelCommand) -> Result<()> {
 fn info(a: ModelInfoArgs) -> Result<()> {
     let (config, net) = match (&a.model, a.arch) {
         (Some(dir), _) => {
-            let (file, net) = nprt_net::load_model(dir, &Device::flex())?;
+            let (file, net) = nprt_net::load_model(dir)?;
             println!(
                 "model '{}': trained on dataset {} (scene {})",
                 dir.display(),
@@ -68,7 +68,7 @@ fn info(a: ModelInfoArgs) -> Result<()> {
                 encoding: a.encoding,
                 ..ModelConfig::new(arch, a.activation)
             };
-            let net = config.build(&mut Init::new(0, &Device::flex()));
+            let net = config.build(&mut Init::new(0));
             (config, net)
         }
         (None, None) => bail!("give --arch or --model"),

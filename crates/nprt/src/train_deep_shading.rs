@@ -1,5 +1,5 @@
 //! `nprt train-deep-shading`: flags for training the Deep Shading baseline; the work is
-//! `nprt_net::deep_shading::train`. It has no `--device`: the U-Net trains on the CPU (burn),
+//! `nprt_net::deep_shading::train`. It has no `--device`: the U-Net trains on the CPU engine,
 //! since the GPU kernels do not have its up-sampling and skip connections yet.
 
 use std::path::PathBuf;

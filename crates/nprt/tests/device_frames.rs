@@ -14,7 +14,7 @@ mod common;
 use common::block_rms;
 use glam::Vec3;
 use nprt_net::model::folder::ModelFile;
-use nprt_net::{Compute, Design, Device, DirectLight, Engine, Init, ModelConfig};
+use nprt_net::{Compute, Design, DirectLight, Engine, Init, ModelConfig};
 use nprt_render::{DirectSampling, FrameCache, Relighter};
 use nprt_scene::{Camera, Material, Mesh, Scene};
 use nprt_trace::TraceScene;
@@ -51,7 +51,7 @@ fn camera() -> Camera {
 fn relighters(config: ModelConfig, scene: &Scene) -> (Relighter, Relighter) {
     let wgpu = Compute::Wgpu.engine().unwrap();
     let (lo, hi) = scene.bounds();
-    let net = config.build(&mut Init::new(5, &Device::flex()));
+    let net = config.build(&mut Init::new(5));
     let file = ModelFile::untrained(config, &net, [lo.to_array(), hi.to_array()]);
     let cpu = Relighter::new(file.clone(), net.clone(), Engine::Cpu).unwrap();
     let gpu = Relighter::new(file, net, wgpu).unwrap();

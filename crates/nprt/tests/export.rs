@@ -67,9 +67,8 @@ fn export_writes_kernels_weights_and_a_worked_example_that_webgpu_runs() {
             .product::<usize>();
     }
     assert_eq!(next, weights.len());
-    let (_, net) = nprt_net::load_model(&model, &nprt_net::Device::flex()).unwrap();
+    let (_, net) = nprt_net::load_model(&model).unwrap();
     assert_eq!(weights.len(), net.total_params());
-    let host = nprt_net::cpu::HostTransport::from_net(&net);
     let tensor = |name: &str| {
         let t = manifest["weights"]["tensors"]
             .as_array()
@@ -88,11 +87,11 @@ fn export_writes_kernels_weights_and_a_worked_example_that_webgpu_runs() {
     };
     assert_eq!(
         tensor("track1.shading.0.weight"),
-        host.tracks[1].shading.layers[0].weight
+        net.tracks[1].shading.layers[0].weight
     );
     assert_eq!(
         tensor("track0.grid"),
-        *host.tracks[0].grid.as_ref().unwrap()
+        net.tracks[0].grid.as_ref().unwrap().table
     );
     half_precision_kernels_and_weights(&out, &manifest, &tensor);
     assert_eq!(manifest["tracks"][1]["kind"], "specular");

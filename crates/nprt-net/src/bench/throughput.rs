@@ -2,8 +2,6 @@
 
 use std::time::Instant;
 
-use burn::optim::AdamConfig;
-use burn::tensor::Device;
 use rand::{RngExt, SeedableRng};
 use rand_pcg::Pcg64Mcg;
 
@@ -13,19 +11,19 @@ use crate::init::Init;
 use crate::loss::Loss;
 use crate::model::config::ModelConfig;
 use crate::network::encoder::CODE_SIZE;
-use crate::optimiser::ADAM_EPSILON;
-use crate::training::batch::{Batch, GradientPath};
+use crate::network::parameters::Parameters;
+use crate::optimiser::Adam;
+use crate::training::batch::Batch;
 use crate::Precision;
 
 /// Samples/s of `steps` full steps (forward, backward, Adam) on one synthetic batch of
-/// `batch_size` samples over `views` maps, after `warmup` untimed steps: on the CPU with the
-/// gradients computed by `path`, on the GPU kernels in `precision` (elsewhere f32 only).
+/// `batch_size` samples over `views` maps, after `warmup` untimed steps: on the CPU engine, or
+/// on the GPU kernels in `precision` (elsewhere f32 only).
 #[allow(clippy::too_many_arguments)]
 // Without the kernels `engine` is always the CPU.
 #[cfg_attr(not(feature = "kernels"), allow(unused_variables))]
 pub fn measure_throughput(
     config: &ModelConfig,
-    path: GradientPath,
     batch_size: usize,
     views: usize,
     steps: usize,
@@ -42,17 +40,15 @@ pub fn measure_throughput(
         precision == Precision::F32,
         "--precision {precision} runs on nprt's own GPU kernels only: use --device gpu"
     );
-    // The CPU's steps: burn's network and Adam, which the kernels above do not use.
-    let device = Device::flex().autodiff();
-    let mut net = config.build(&mut Init::new(0, &device));
-    let mut optim = AdamConfig::new().with_epsilon(ADAM_EPSILON).init();
+    let mut net = config.build(&mut Init::new(0));
+    let mut adam = Adam::new(net.num_params());
     let mut timed = Instant::now();
     for step in 0..warmup + steps {
         if step == warmup {
             timed = Instant::now();
         }
-        let (_, grads) = batch.gradients(&net, &device, path, Loss::LogL1);
-        net = optim.step(1e-4, net, grads);
+        let (_, grads) = crate::cpu::gradients(&net, &batch.samples(), Loss::LogL1);
+        adam.step(&mut net, &grads, 1e-4);
     }
     Ok((batch_size * steps) as f64 / timed.elapsed().as_secs_f64())
 }
@@ -89,7 +85,7 @@ pub fn profile_kernels(
     warmup: usize,
     precision: Precision,
 ) -> anyhow::Result<Vec<crate::gpu::KernelTime>> {
-    let net = config.build(&mut Init::new(0, &Device::flex()));
+    let net = config.build(&mut Init::new(0));
     let mut gpu = crate::gpu::GpuTrainer::new(&net, precision)?;
     let batch = synthetic_batch(config, batch_size, views);
     let samples = batch.samples();
@@ -109,7 +105,7 @@ fn kernel_throughput(
     warmup: usize,
     precision: Precision,
 ) -> anyhow::Result<f64> {
-    let net = config.build(&mut Init::new(0, &Device::flex()));
+    let net = config.build(&mut Init::new(0));
     let mut gpu = crate::gpu::GpuTrainer::new(&net, precision)?;
     let samples = batch.samples();
     let mut timed = Instant::now();
@@ -147,8 +143,8 @@ pub struct InferenceSpeed {
 /// foreground pixels in host memory (the encoder, once per lighting, is not counted). The GPU
 /// kernels' frames are timed by nprt-render's `bench frame`, which keeps them on the device.
 pub fn measure_inference(config: &ModelConfig, pixels: usize, repeats: usize) -> InferenceSpeed {
-    let net = config.build(&mut Init::new(0, &Device::flex()));
-    let host = crate::cpu::HostTransport::from_net(&net);
+    let net = config.build(&mut Init::new(0));
+    let host = &net;
     let mut rng = Pcg64Mcg::seed_from_u64(1);
     let features: Vec<f32> = (0..pixels * FEATURES)
         .map(|_| rng.random::<f32>())

@@ -1,34 +1,14 @@
-//! A host copy of an [`Mlp`]: forward over a block of rows keeping what backward needs, and
+//! An [`Mlp`] on the CPU engine: forward over a block of rows keeping what backward needs, and
 //! backward into parameter gradients. Bias and activation are one pass after each matrix
 //! product, and a SIREN layer computes its derivative (ω0·cos) in the same pass as its value.
 
 use std::ops::Range;
 
-use burn::module::Param;
-use burn::nn::Linear;
-use burn::tensor::Tensor;
-
-use super::accumulate;
 use super::matmul::{matmul, MatRef, Op};
 use super::sincos::{sin_scaled, sincos_scaled};
 use crate::network::activation::{Activation, OMEGA_0};
+use crate::network::dense::Dense;
 use crate::network::mlp::Mlp;
-
-/// One dense layer `y = x·W + b`, W row-major `d_in × d_out` as burn's `Linear` keeps it.
-#[derive(Clone, Debug, PartialEq)]
-pub struct Dense {
-    pub weight: Vec<f32>,
-    pub bias: Vec<f32>,
-    pub d_in: usize,
-    pub d_out: usize,
-}
-
-/// The layers of an MLP on the host, or (same shapes) their gradients.
-#[derive(Clone, Debug, PartialEq)]
-pub struct DenseStack {
-    pub layers: Vec<Dense>,
-    pub activation: Activation,
-}
 
 /// An input of layer 0 that rows share in groups (the light code: one per view), multiplied by
 /// its weight rows once per group instead of once per row.
@@ -76,58 +56,7 @@ impl Tape {
     }
 }
 
-pub(super) fn host<const D: usize>(p: &Param<Tensor<D>>) -> Vec<f32> {
-    crate::host_values::host_values(p.val().into_data())
-}
-
-/// Replaces `p`'s values with `values` (same shape), keeping its id (which keys Adam's state),
-/// its device and whether it takes gradients.
-pub(super) fn store<const D: usize>(p: &mut Param<Tensor<D>>, values: &[f32]) {
-    *p = p.clone().map(|t| {
-        let data = burn::tensor::TensorData::new(values.to_vec(), t.dims());
-        let stored = Tensor::from_data(data, (&t.device(), t.dtype()));
-        if t.is_require_grad() {
-            stored.require_grad()
-        } else {
-            stored
-        }
-    });
-}
-
 impl Dense {
-    pub fn from_linear(l: &Linear) -> Self {
-        let [d_in, d_out] = l.weight.val().dims();
-        Dense {
-            weight: host(&l.weight),
-            bias: l.bias.as_ref().map_or(vec![0.0; d_out], host),
-            d_in,
-            d_out,
-        }
-    }
-
-    /// Writes these values into `l` (same shapes): the inverse of [`Self::from_linear`].
-    pub fn store_into(&self, l: &mut Linear) {
-        store(&mut l.weight, &self.weight);
-        if let Some(b) = &mut l.bias {
-            store(b, &self.bias);
-        }
-    }
-
-    /// All zeros in this layer's shapes: a gradient accumulator.
-    pub fn zeros_like(&self) -> Self {
-        Dense {
-            weight: vec![0.0; self.weight.len()],
-            bias: vec![0.0; self.bias.len()],
-            ..*self
-        }
-    }
-
-    /// Adds `other` (same shapes) to this one.
-    pub fn add(&mut self, other: &Self) {
-        accumulate(&mut self.weight, &other.weight);
-        accumulate(&mut self.bias, &other.bias);
-    }
-
     /// The weight rows `rows` as a matrix.
     fn rows(&self, rows: Range<usize>) -> MatRef<'_> {
         MatRef::new(
@@ -147,40 +76,7 @@ impl Dense {
     }
 }
 
-impl DenseStack {
-    pub fn from_mlp(mlp: &Mlp) -> Self {
-        DenseStack {
-            layers: mlp.layers.iter().map(Dense::from_linear).collect(),
-            activation: mlp.activation,
-        }
-    }
-
-    /// Writes these values into `mlp` (same shapes): the inverse of [`Self::from_mlp`].
-    pub fn store_into(&self, mlp: &mut Mlp) {
-        for (d, l) in self.layers.iter().zip(&mut mlp.layers) {
-            d.store_into(l);
-        }
-    }
-
-    /// All zeros in this stack's shapes: a gradient accumulator.
-    pub fn zeros_like(&self) -> Self {
-        DenseStack {
-            layers: self.layers.iter().map(Dense::zeros_like).collect(),
-            activation: self.activation,
-        }
-    }
-
-    /// Adds `other` (same shapes) to this one.
-    pub fn add(&mut self, other: &Self) {
-        for (a, b) in self.layers.iter_mut().zip(&other.layers) {
-            a.add(b);
-        }
-    }
-
-    pub fn d_out(&self) -> usize {
-        self.layers.last().map_or(0, |l| l.d_out)
-    }
-
+impl Mlp {
     /// Runs the rows of `x` (with `shared`, the rest of layer 0's input) through every layer,
     /// keeping what [`Self::backward`] needs when `pass` is [`Pass::Train`].
     pub fn forward(&self, x: MatRef, shared: Option<&SharedInput>, tape: &mut Tape, pass: Pass) {
@@ -257,7 +153,7 @@ impl DenseStack {
         shared: Option<&SharedInput>,
         tape: &mut Tape,
         d_output: &mut Vec<f32>,
-        grads: &mut DenseStack,
+        grads: &mut Mlp,
         mut d_input: Option<&mut [f32]>,
         mut d_shared: Option<&mut [f32]>,
     ) {

@@ -1,5 +1,5 @@
-//! Row-major f32 matrix products through the `gemm` crate (the kernels burn's CPU backend uses),
-//! with either operand read transposed through its strides instead of copied.
+//! Row-major f32 matrix products through the `gemm` crate, with either operand read transposed
+//! through its strides instead of copied.
 
 /// A row-major matrix view: `rows × cols` values, row `r` starting at `r · stride`.
 #[derive(Clone, Copy)]

@@ -1,14 +1,11 @@
-//! The transport tracks of a design on the host: forward, the training loss and backward for a
-//! whole batch, block by block on all cores, given the light codes the encoder made.
-//!
-//! Computes exactly what [`crate::network::nprt_net::NprtNet::shade`] and [`crate::loss::Loss::mean`] compute
-//! (same operations in f32), so that burn's autodiff and this path agree to rounding; a test
-//! holds them to that.
+//! The transport tracks of a design on the CPU engine: forward, the training loss and backward
+//! for a whole batch, block by block on all cores, given the light codes the encoder made; and
+//! the radiance of a frame's pixels for one light code.
 
 use rayon::prelude::*;
 
 use super::accumulate;
-use super::dense::{DenseStack, Pass, SharedInput, Tape};
+use super::dense::{Pass, SharedInput, Tape};
 use super::matmul::MatRef;
 use super::samples::Samples;
 use crate::encoding::features::FEATURES;
@@ -16,8 +13,10 @@ use crate::encoding::hash_grid;
 use crate::loss::Loss;
 use crate::network::design::TRANSPORT_CODE;
 use crate::network::encoder::CODE_SIZE;
+use crate::network::mlp::Mlp;
 use crate::network::nprt_net::NprtNet;
-use crate::network::track_kind::TrackKind;
+use crate::network::parameters::Parameters;
+use crate::network::track::Track;
 
 /// Rows per block: small enough that a block's activations stay in the caches, large enough
 /// for efficient matrix products.
@@ -28,29 +27,12 @@ const RUNS: usize = 8;
 /// The group of every row when one light code lights them all.
 const ONE_GROUP: [u32; BLOCK] = [0; BLOCK];
 
-/// One track's networks on the host.
-#[derive(Clone)]
-pub struct HostTrack {
-    pub kind: TrackKind,
-    inputs: Vec<usize>,
-    /// The hash grid's tables, `LEVELS · TABLE_SIZE × LEVEL_FEATURES`, when the track has one.
-    pub grid: Option<Vec<f32>>,
-    pub transfer: Option<DenseStack>,
-    pub shading: DenseStack,
-}
-
-/// The transport part of a network (every track) on the host.
-#[derive(Clone)]
-pub struct HostTransport {
-    pub tracks: Vec<HostTrack>,
-}
-
 /// Loss and gradients of one batch.
 pub struct TransportGradients {
     /// Mean log-L1 over the batch's values.
     pub loss: f64,
-    /// Per track, gradients of the transfer and shading networks.
-    pub tracks: Vec<HostTrack>,
+    /// Per track, gradients of its grid, transfer and shading networks.
+    pub tracks: Vec<Track>,
     /// Gradient at each view's light code, `views × CODE_SIZE`.
     pub codes: Vec<f32>,
 }
@@ -104,15 +86,15 @@ struct Lighting<'a> {
     view: &'a [u32],
 }
 
-impl HostTrack {
+impl Track {
     /// Whether the first layer reads the features as they are.
     fn reads_features(&self) -> bool {
-        self.inputs.len() == FEATURES && self.grid.is_none()
+        self.kind.reads_all() && self.grid.is_none()
     }
 
     /// Width of the first layer's per-row input: the features read plus the grid's encoding.
     fn width(&self) -> usize {
-        self.inputs.len() + self.grid.as_ref().map_or(0, |_| hash_grid::OUTPUTS)
+        self.kind.inputs().len() + self.grid.as_ref().map_or(0, |_| hash_grid::OUTPUTS)
     }
 
     /// The shading network's first-layer weight rows that multiply ê: after ŝ, or first for
@@ -132,43 +114,26 @@ impl HostTrack {
         }
     }
 
-    fn zeros_like(&self) -> Self {
-        HostTrack {
-            grid: self.grid.as_ref().map(|t| vec![0.0; t.len()]),
-            transfer: self.transfer.as_ref().map(DenseStack::zeros_like),
-            shading: self.shading.zeros_like(),
-            ..self.clone()
-        }
-    }
-
-    fn add(&mut self, other: &Self) {
-        if let (Some(a), Some(b)) = (&mut self.transfer, &other.transfer) {
-            a.add(b);
-        }
-        self.shading.add(&other.shading);
-        if let (Some(a), Some(b)) = (&mut self.grid, &other.grid) {
-            accumulate(a, b);
-        }
-    }
-
     /// This track's inputs of each row (with the grid's encoding after them), gathered into
     /// `x` unless it reads the features as they are; the rows as a matrix.
     fn inputs<'a>(&self, features: &'a [f32], x: &'a mut Vec<f32>, n: usize) -> MatRef<'a> {
         if self.reads_features() {
             return MatRef::new(features, n, FEATURES);
         }
-        let width = self.width();
+        let (width, inputs) = (self.width(), self.kind.inputs());
         x.resize(n * width, 0.0);
         for (row, f) in x
             .chunks_exact_mut(width)
             .zip(features.chunks_exact(FEATURES))
         {
-            let (own, encoded) = row.split_at_mut(self.inputs.len());
-            own.iter_mut()
-                .zip(&self.inputs)
-                .for_each(|(v, &i)| *v = f[i]);
-            if let Some(table) = &self.grid {
-                hash_grid::encode(table, &hash_grid::corners(hash_grid::position(f)), encoded);
+            let (own, encoded) = row.split_at_mut(inputs.len());
+            own.iter_mut().zip(&inputs).for_each(|(v, &i)| *v = f[i]);
+            if let Some(grid) = &self.grid {
+                hash_grid::encode(
+                    &grid.table,
+                    &hash_grid::corners(hash_grid::position(f)),
+                    encoded,
+                );
             }
         }
         self.gathered(features, x, n)
@@ -186,14 +151,18 @@ impl HostTrack {
 
     /// Adds to the grid's gradient what the gradient at the first layer's inputs (`d_x`,
     /// `rows × width`) sends back through the encoding.
-    fn grid_backward(&self, features: &[f32], d_x: &[f32], grads: &mut HostTrack) {
+    fn grid_backward(&self, features: &[f32], d_x: &[f32], grads: &mut Track) {
         let Some(grad) = &mut grads.grid else { return };
-        let own = self.inputs.len();
+        let own = self.kind.inputs().len();
         for (d, f) in d_x
             .chunks_exact(self.width())
             .zip(features.chunks_exact(FEATURES))
         {
-            hash_grid::scatter(grad, &hash_grid::corners(hash_grid::position(f)), &d[own..]);
+            hash_grid::scatter(
+                &mut grad.table,
+                &hash_grid::corners(hash_grid::position(f)),
+                &d[own..],
+            );
         }
     }
 
@@ -234,7 +203,7 @@ impl HostTrack {
 
     /// ŝ of the rows of `features` into `out` (`rows × TRANSPORT_CODE`), for a track with a
     /// transfer network.
-    fn transfer_code(&self, ft: &DenseStack, features: &[f32], out: &mut [f32]) {
+    fn transfer_code(&self, ft: &Mlp, features: &[f32], out: &mut [f32]) {
         with_passes(1, |passes| {
             let pass = &mut passes[0];
             let x = self.inputs(features, &mut pass.x, features.len() / FEATURES);
@@ -274,7 +243,7 @@ impl HostTrack {
         features: &[f32],
         light: Lighting,
         dr: &[f32],
-        grads: &mut HostTrack,
+        grads: &mut Track,
         d_codes: &mut [f32],
     ) {
         let n = dr.len() / 3;
@@ -330,42 +299,15 @@ impl HostTrack {
     }
 }
 
-impl HostTransport {
-    pub fn from_net(net: &NprtNet) -> Self {
-        let tracks = net
-            .tracks
-            .iter()
-            .map(|t| HostTrack {
-                kind: t.kind,
-                inputs: t.kind.inputs(),
-                grid: t
-                    .grid
-                    .as_ref()
-                    .map(|g| crate::host_values::host_values(g.table.val().into_data())),
-                transfer: t.transfer.as_ref().map(DenseStack::from_mlp),
-                shading: DenseStack::from_mlp(&t.shading),
-            })
-            .collect();
-        HostTransport { tracks }
-    }
-
-    /// Writes these values into `net`'s tracks (same shapes): the inverse of
-    /// [`Self::from_net`].
-    pub fn store_into(&self, net: &mut NprtNet) {
-        for (h, t) in self.tracks.iter().zip(&mut net.tracks) {
-            if let (Some(values), Some(grid)) = (&h.grid, &mut t.grid) {
-                super::dense::store(&mut grid.table, values);
-            }
-            if let (Some(values), Some(mlp)) = (&h.transfer, &mut t.transfer) {
-                values.store_into(mlp);
-            }
-            h.shading.store_into(&mut t.shading);
-        }
-    }
-
-    /// The batch's mean `loss` and its gradients, for the light codes `codes`
+impl NprtNet {
+    /// The batch's mean `loss` and its transport gradients, for the light codes `codes`
     /// (`views × CODE_SIZE`, the encoder's output for the batch's maps).
-    pub fn gradients(&self, batch: &Samples, codes: &[f32], loss: Loss) -> TransportGradients {
+    pub fn transport_gradients(
+        &self,
+        batch: &Samples,
+        codes: &[f32],
+        loss: Loss,
+    ) -> TransportGradients {
         let n = batch.len();
         let views = codes.len() / CODE_SIZE;
         let view: Vec<u32> = batch.view.iter().map(|&v| v as u32).collect();
@@ -408,7 +350,7 @@ impl HostTransport {
     /// those a lighting change runs again. The light code's share of each shading network's
     /// first layer, made once per lighting, is not counted.
     pub fn flops_per_pixel(&self, transfer_known: bool) -> f64 {
-        let dense = |s: &DenseStack| -> f64 {
+        let dense = |s: &Mlp| -> f64 {
             s.layers
                 .iter()
                 .map(|l| 2.0 * (l.d_in * l.d_out) as f64)
@@ -459,6 +401,27 @@ impl HostTransport {
         known: Option<&TransferCodes>,
     ) -> Vec<f32> {
         assert_eq!(code.len(), CODE_SIZE);
+        self.shade(features, code, None, &|_| scale, known)
+    }
+
+    /// Radiance (`n × 3`) of a batch mixing views: each row lit by its view's code among
+    /// `codes` (`views × CODE_SIZE`) and scaled by its map's scale.
+    pub fn predict(&self, batch: &Samples, codes: &[f32]) -> Vec<f32> {
+        let view: Vec<u32> = batch.view.iter().map(|&v| v as u32).collect();
+        let scale = |r: usize| std::array::from_fn(|i| batch.scale[3 * r + i]);
+        self.shade(batch.features, codes, Some(&view), &scale, None)
+    }
+
+    /// The rows of `features` under `codes`, row r lit by code `view[r]` (the first code
+    /// without `view`) and scaled by `scale(r)`.
+    fn shade(
+        &self,
+        features: &[f32],
+        codes: &[f32],
+        view: Option<&[u32]>,
+        scale: &(dyn Fn(usize) -> [f32; 3] + Sync),
+        known: Option<&TransferCodes>,
+    ) -> Vec<f32> {
         let n = features.len() / FEATURES;
         let mut out = vec![0.0; n * 3];
         out.par_chunks_mut(BLOCK * 3)
@@ -468,8 +431,8 @@ impl HostTransport {
                 with_passes(self.tracks.len(), |passes| {
                     let rows = f.len() / FEATURES;
                     let light = Lighting {
-                        codes: code,
-                        view: &ONE_GROUP[..rows],
+                        codes,
+                        view: view.map_or(&ONE_GROUP[..rows], |v| &v[b * BLOCK..][..rows]),
                     };
                     for (k, (t, pass)) in self.tracks.iter().zip(passes.iter_mut()).enumerate() {
                         let s = known.filter(|_| t.transfer.is_some()).map(|c| {
@@ -481,8 +444,10 @@ impl HostTransport {
                             (0..3).for_each(|i| out[r * 3 + i] += c[i]);
                         }
                     }
-                    out.chunks_exact_mut(3)
-                        .for_each(|c| (0..3).for_each(|i| c[i] *= scale[i]));
+                    for (r, c) in out.chunks_exact_mut(3).enumerate() {
+                        let s = scale(b * BLOCK + r);
+                        (0..3).for_each(|i| c[i] *= s[i]);
+                    }
                 })
             });
         out
@@ -491,7 +456,7 @@ impl HostTransport {
     fn zero_gradients(&self, views: usize) -> TransportGradients {
         TransportGradients {
             loss: 0.0,
-            tracks: self.tracks.iter().map(HostTrack::zeros_like).collect(),
+            tracks: self.tracks.iter().map(Track::zeros_like).collect(),
             codes: vec![0.0; views * CODE_SIZE],
         }
     }

@@ -3,18 +3,17 @@
 use std::path::Path;
 
 use anyhow::{Context, Result};
-use burn::tensor::{Device, Tensor, TensorData};
 use glam::Vec3;
 use nprt_scene::EnvMap;
 use nprt_trace::GBuffer;
 use serde::{Deserialize, Serialize};
 
 use super::options::DeepShadingOptions;
-use super::unet::{feature_image, DeepShading};
-use crate::encoding::features::FEATURES;
+use super::unet::feature_image;
 use crate::init::Init;
 use crate::model::folder::{load_weights, read_config, WEIGHTS_FILE};
 use crate::network::encoder::{check_input_width, LightInput};
+use crate::network::unet::DeepShading;
 
 pub const TAG: &str = "deep-shading";
 pub const CONFIG_FILE: &str = "deep-shading.json";
@@ -51,10 +50,10 @@ pub fn read_file(dir: &Path) -> Result<DeepShadingFile> {
 }
 
 impl DeepShadingModel {
-    /// Loads the network in `dir`; it runs on the CPU (burn), whatever the engine.
+    /// Loads the network in `dir`; it runs on the CPU engine, whatever the engine.
     pub fn load(dir: &Path) -> Result<Self> {
         let file = read_file(dir)?;
-        let mut net = DeepShading::new(&mut Init::new(0, &Device::flex()), file.encoder_width);
+        let mut net = DeepShading::new(&mut Init::new(0), file.encoder_width);
         load_weights(&dir.join(WEIGHTS_FILE), &mut net, TAG)?;
         Ok(DeepShadingModel { file, net })
     }
@@ -76,20 +75,9 @@ impl DeepShadingModel {
             self.file.encoder_width,
             self.file.options.map_norm,
         );
-        let lw = light.width;
-        let out = self.net.forward(
-            Tensor::from_data(TensorData::new(img, [1, FEATURES, ph, pw]), &Device::flex()),
-            Tensor::from_data(
-                TensorData::new(light.pixels, [1, 3, lw / 2, lw]),
-                &Device::flex(),
-            ),
-            Tensor::from_data(
-                TensorData::new(light.scale.to_vec(), [1, 3]),
-                &Device::flex(),
-            ),
-        );
-        let data = out.into_data();
-        let v = data.as_slice::<f32>().expect("f32 output");
+        let v = self
+            .net
+            .shade(&img, &light.pixels, light.width, light.scale, (ph, pw));
         (0..width * height)
             .map(|i| {
                 let (x, y) = (i % width, i / width);

@@ -4,9 +4,6 @@
 use std::path::Path;
 
 use anyhow::{bail, Result};
-use burn::module::Module;
-use burn::optim::GradientsParams;
-use burn::tensor::{Device, Tensor, TensorData};
 use nprt_data::dataset::load_manifest_hashed;
 use nprt_data::views::{load_views, ImageView};
 use nprt_scene::EnvMap;
@@ -14,17 +11,20 @@ use rand::seq::SliceRandom;
 
 use super::model::{read_file, DeepShadingFile, CONFIG_FILE, TAG};
 use super::options::DeepShadingOptions;
-use super::unet::{feature_image, DeepShading};
-use crate::encoding::features::FEATURES;
+use super::unet::feature_image;
+use crate::cpu::UnetBatch;
 use crate::encoding::map_norm::MapNorm;
 use crate::init::Init;
-use crate::loss::log_l1_map;
+use crate::loss::Loss;
 use crate::model::folder::{save_weights, WEIGHTS_FILE};
 use crate::network::encoder::{check_input_width, LightInput};
-use crate::optimiser::DeviceSteps;
+use crate::network::parameters::Parameters;
+use crate::network::unet::DeepShading;
+use crate::optimiser::EngineSteps;
 use crate::training::checkpoint::{self, RunState};
+use crate::training::host_steps::HostSteps;
 use crate::training::schedule::Schedule;
-use crate::training::training_loop::{self, epoch_rng, Objective, TrainSummary};
+use crate::training::training_loop::{self, epoch_rng, Objective, Steps, TrainSummary};
 use crate::training::training_set::{log_mean_level, open_recorded_maps};
 
 /// What training needs of each view, padded to multiples of 8.
@@ -112,35 +112,35 @@ impl Split {
         })
     }
 
-    /// The masked log-L1 loss of the views `batch`, and their foreground pixels.
-    fn loss(&self, net: &DeepShading, batch: &[usize], device: &Device) -> (Tensor<1>, u64) {
-        let (b, pw, ph) = (batch.len(), self.width, self.height);
+    /// The views `batch` as the CPU engine takes them, and their foreground pixels.
+    fn batch(&self, batch: &[usize]) -> (UnetBatch, u64) {
         let views: Vec<&Sample> = batch.iter().map(|&i| &self.samples[i]).collect();
-        let cat = |f: fn(&Sample) -> &Vec<f32>| {
-            views
-                .iter()
-                .flat_map(|s| f(s).iter().copied())
-                .collect::<Vec<f32>>()
+        let cat = |f: fn(&Sample) -> &[f32]| -> Vec<f32> {
+            views.iter().flat_map(|s| f(s).iter().copied()).collect()
         };
-        let tensor = |data: Vec<f32>, shape: [usize; 4]| {
-            Tensor::<4>::from_data(TensorData::new(data, shape), device)
+        let unet = UnetBatch {
+            features: cat(|s| &s.features),
+            radiance: cat(|s| &s.radiance),
+            mask: cat(|s| &s.mask),
+            lights: cat(|s| &s.light.pixels),
+            light_width: views[0].light.width,
+            scale: cat(|s| &s.light.scale),
+            height: self.height,
+            width: self.width,
         };
-        let lw = views[0].light.width;
-        let features = tensor(cat(|s| &s.features), [b, FEATURES, ph, pw]);
-        let reference = tensor(cat(|s| &s.radiance), [b, 3, ph, pw]);
-        let mask = tensor(cat(|s| &s.mask), [b, 1, ph, pw]);
-        let light = tensor(cat(|s| &s.light.pixels), [b, 3, lw / 2, lw]);
-        let scale = Tensor::from_data(
-            TensorData::new(
-                views.iter().flat_map(|s| s.light.scale).collect::<Vec<_>>(),
-                [b, 3],
-            ),
-            device,
-        );
-        let pred = net.forward(features, light, scale);
-        let err = log_l1_map(pred, reference) * mask.clone().expand([b, 3, ph, pw]);
-        let loss = err.sum() / (mask.sum() * 3.0).clamp_min(1.0);
-        (loss, views.iter().map(|s| s.foreground).sum())
+        (unet, views.iter().map(|s| s.foreground).sum())
+    }
+
+    /// The masked log-L1 loss of the views `batch` and, when `train`, its gradients.
+    fn loss(
+        &self,
+        net: &DeepShading,
+        batch: &[usize],
+        train: bool,
+    ) -> (f64, Option<DeepShading>, u64) {
+        let (unet, foreground) = self.batch(batch);
+        let (loss, grads) = net.loss_and_gradients(&unet, Loss::LogL1, train);
+        (loss, grads, foreground)
     }
 }
 
@@ -197,34 +197,25 @@ impl Objective for UnetObjective {
             .into_iter()
     }
 
-    fn gradients(
-        &self,
-        net: &DeepShading,
-        batch: &Vec<usize>,
-        device: &Device,
-    ) -> (f64, GradientsParams, u64) {
-        let (loss, samples) = self.train.loss(net, batch, device);
-        let value = loss.clone().into_scalar::<f64>();
-        (
-            value,
-            GradientsParams::from_grads(loss.backward(), net),
-            samples,
-        )
+    fn engine_steps(&self, net: &DeepShading) -> Result<Steps<'_, Self>> {
+        Ok(Box::new(HostSteps::new(
+            net,
+            |net: &DeepShading, batch: &Vec<usize>| {
+                let (loss, grads, samples) = self.train.loss(net, batch, true);
+                (loss, grads.expect("asked for"), samples)
+            },
+            |net: &DeepShading, batch: &Vec<usize>| self.test.loss(net, batch, false).0,
+        )))
     }
 
-    fn validation_loss(
-        &self,
-        net: &DeepShading,
-        device: &Device,
-        _steps: Option<&mut dyn DeviceSteps<DeepShading, Self::Batch>>,
-    ) -> Result<f64> {
+    fn validation_loss(&self, steps: &mut dyn EngineSteps<DeepShading, Vec<usize>>) -> Result<f64> {
         let n = self.test.samples.len();
         let views: Vec<usize> = (0..n).collect();
-        Ok(views
-            .chunks(self.file.options.batch_views)
-            .map(|c| self.test.loss(net, c, device).0.into_scalar::<f32>() as f64 * c.len() as f64)
-            .sum::<f64>()
-            / n as f64)
+        let mut sum = 0.0;
+        for chunk in views.chunks(self.file.options.batch_views) {
+            sum += steps.loss(&chunk.to_vec())? * chunk.len() as f64;
+        }
+        Ok(sum / n as f64)
     }
 
     fn save_model(
@@ -233,7 +224,6 @@ impl Objective for UnetObjective {
         net: &DeepShading,
         schedule: &Schedule,
         state: &RunState,
-        _device: &Device,
     ) -> Result<()> {
         save_weights(&out.join(WEIGHTS_FILE), net, TAG)?;
         let mut file = self.file.clone();
@@ -248,8 +238,8 @@ impl Objective for UnetObjective {
 
 /// Trains (or resumes exactly, Adam's moments included) a Deep Shading network on the dataset
 /// in `data`, with the validation loss on its test views after every epoch. Returns the run's
-/// summary and the model's config as saved. The U-Net trains on the CPU (burn) whatever the
-/// engine: the GPU kernels do not have its up-sampling and skip connections yet.
+/// summary and the model's config as saved. The U-Net trains on the CPU engine whatever the
+/// device: the GPU kernels do not have its up-sampling and skip connections yet.
 pub fn train(
     data: &Path,
     opts: &DeepShadingOptions,

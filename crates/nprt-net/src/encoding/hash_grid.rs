@@ -5,16 +5,14 @@
 //! interpolation, level after level. Gradients reach only the eight rows per level a position
 //! touches.
 //!
-//! The vertex lookup ([`corners`]) is shared by burn's path ([`HashGrid::forward`]) and the
-//! CPU engine ([`encode`], [`scatter`]), so the two read the same rows with the same weights.
+//! The vertex lookup ([`corners`]) and the interpolation ([`encode`]) and its adjoint
+//! ([`scatter`]) are the CPU engine's; the GPU kernels restate them and are tested against them.
 
 use std::sync::LazyLock;
 
-use burn::module::{Module, Param};
-use burn::tensor::{Int, Tensor, TensorData};
-
 use crate::encoding::features::feature;
 use crate::init::Init;
+use crate::network::parameters::{child, Parameters, Visit, VisitMut};
 
 /// Grid resolutions, from [`MIN_RES`] to [`MAX_RES`] cells along each side of the scene's box
 /// in a geometric progression.
@@ -120,46 +118,30 @@ pub fn scatter(grad: &mut [f32], c: &Corners, d_out: &[f32]) {
     }
 }
 
-/// The learned tables of every level, `LEVELS · TABLE_SIZE × LEVEL_FEATURES`.
-#[derive(Module, Debug)]
+/// The learned tables of every level, `LEVELS · TABLE_SIZE × LEVEL_FEATURES`, or (same shape)
+/// their gradient.
+#[derive(Clone, Debug, PartialEq)]
 pub struct HashGrid {
-    pub table: Param<Tensor<2>>,
+    pub table: Vec<f32>,
 }
 
 impl HashGrid {
     pub fn new(init: &mut Init) -> Self {
         HashGrid {
-            table: init.uniform([LEVELS * TABLE_SIZE, LEVEL_FEATURES], INIT_BOUND),
+            table: init.uniform(LEVELS * TABLE_SIZE * LEVEL_FEATURES, INIT_BOUND),
         }
     }
+}
 
-    /// The encoding [B, OUTPUTS] of the positions in `features` [B, 19]. The lookup is made on
-    /// the host (the positions are inputs, not parameters); the gather and the weighting are
-    /// tensor operations, so autodiff scatters the gradient into the table.
-    pub fn forward(&self, features: &Tensor<2>) -> Tensor<2> {
-        let n = features.dims()[0];
-        let device = features.device();
-        let positions =
-            crate::host_values::host_values(features.clone().narrow(1, 0, 3).into_data());
-        let mut rows = Vec::with_capacity(n * LEVELS * CORNERS);
-        let mut weights = Vec::with_capacity(n * LEVELS * CORNERS);
-        for p in positions.chunks_exact(3) {
-            let c = corners([p[0], p[1], p[2]]);
-            rows.extend(c.row.iter().map(|&r| r as i64));
-            weights.extend_from_slice(&c.weight);
-        }
-        let rows =
-            Tensor::<1, Int>::from_data(TensorData::new(rows, [n * LEVELS * CORNERS]), &device);
-        let weights = Tensor::<4>::from_data(
-            TensorData::new(weights, [n, LEVELS, CORNERS, 1]),
-            (&device, features.dtype()),
-        );
-        let values = self
-            .table
-            .val()
-            .select(0, rows)
-            .reshape([n, LEVELS, CORNERS, LEVEL_FEATURES]);
-        (values * weights).sum_dim(2).reshape([n, OUTPUTS])
+impl Parameters for HashGrid {
+    fn visit(&self, prefix: &str, f: &mut Visit) {
+        let shape = [LEVELS * TABLE_SIZE, LEVEL_FEATURES];
+        f(&child(prefix, "table"), &shape, &self.table);
+    }
+
+    fn visit_mut(&mut self, prefix: &str, f: &mut VisitMut) {
+        let shape = [LEVELS * TABLE_SIZE, LEVEL_FEATURES];
+        f(&child(prefix, "table"), &shape, &mut self.table);
     }
 }
 

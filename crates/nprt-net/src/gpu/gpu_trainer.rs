@@ -4,17 +4,14 @@
 //! submission of our own kernels (a handful of dispatches per layer) with no host round trip
 //! inside it.
 //!
-//! It computes what the CPU engine computes ([`HostEncoder`] and [`HostTransport`]), in f32,
-//! and the tests hold the two together; Adam is burn's formulation, which the CPU path steps
-//! with. In [`Precision::F16`] the transport networks' dense layers run in mixed precision
+//! It computes what the CPU engine computes, in f32, and the tests hold the two together; Adam
+//! is the host's ([`crate::optimiser::Adam`]), with the same state file. In [`Precision::F16`] the transport networks' dense layers run in mixed precision
 //! (`half_products`), the master weights and Adam staying f32.
 
-use std::collections::HashMap;
 use std::path::Path;
 use std::sync::Arc;
 
-use anyhow::{anyhow, Context, Result};
-use safetensors::{tensor::TensorView, Dtype, SafeTensors};
+use anyhow::Result;
 
 use super::device_dataset::DeviceDataset;
 use super::kernel_timer::{KernelTime, KernelTimer};
@@ -22,17 +19,14 @@ use super::kernels::{ADAM, GATHER_SAMPLES};
 use super::network_layout::NetworkLayout;
 use super::parameters::ParameterLayout;
 use super::{groups_for, Dispatch, GpuDevice};
-use crate::cpu::{HostEncoder, HostTransport, Samples};
+use crate::cpu::Samples;
 use crate::encoding::features::FEATURES;
 use crate::encoding::hash_grid;
 use crate::loss::Loss;
 use crate::network::encoder::CODE_SIZE;
 use crate::network::nprt_net::NprtNet;
-use crate::optimiser::ADAM_EPSILON;
+use crate::optimiser::{load_state, save_state, ADAM_BETA1, ADAM_BETA2, ADAM_EPSILON};
 use crate::Precision;
-
-const BETA_1: f32 = 0.9;
-const BETA_2: f32 = 0.999;
 
 /// A network's parameters, gradients and Adam moments on the device, and the step that trains
 /// them.
@@ -42,8 +36,7 @@ pub struct GpuTrainer {
     /// Where each tensor lies, in the network's structure.
     pub(super) net: NetworkLayout,
     /// The network's shapes on the host (their values are the initial ones, not kept current).
-    encoder: HostEncoder,
-    transport: HostTransport,
+    shapes: NprtNet,
     pub(super) params: wgpu::Buffer,
     pub(super) grads: wgpu::Buffer,
     moment1: wgpu::Buffer,
@@ -163,14 +156,14 @@ pub(super) struct BatchBuffers {
 /// `count` values whose gradients are scaled by `grad_scale`.
 fn adam_params(count: usize, lr: f64, t: u64, grad_scale: f32) -> Vec<u32> {
     let t = t as i32;
-    let correction2 = (1.0 - BETA_2.powi(t)).sqrt();
-    let factor = correction2 / (1.0 - BETA_1.powi(t));
+    let correction2 = (1.0 - ADAM_BETA2.powi(t)).sqrt();
+    let factor = correction2 / (1.0 - ADAM_BETA1.powi(t));
     let mut params = vec![count as u32, 0, 0, 0];
     params.extend(
         [
             lr as f32,
-            BETA_1,
-            BETA_2,
+            ADAM_BETA1,
+            ADAM_BETA2,
             factor,
             ADAM_EPSILON * correction2,
             1.0 / grad_scale,
@@ -191,11 +184,10 @@ impl GpuTrainer {
         if half {
             gpu.check_half()?;
         }
-        let encoder = HostEncoder::from_burn(&net.encoder);
-        let transport = HostTransport::from_net(net);
+        let shapes = net.clone();
         let align = gpu.device.limits().min_storage_buffer_offset_alignment as usize / 4;
-        let (layout, flat) = ParameterLayout::pack(&encoder, &transport, align.max(1));
-        let net = NetworkLayout::new(&gpu, &layout, &encoder, &transport, half);
+        let (layout, flat) = ParameterLayout::pack(net, align.max(1));
+        let net = NetworkLayout::new(&gpu, &layout, net, half);
         let zeros = vec![0.0f32; layout.total];
         let [params, grads, moment1, moment2] =
             [&flat, &zeros, &zeros, &zeros].map(|v| gpu.upload(v));
@@ -243,8 +235,7 @@ impl GpuTrainer {
             resolutions: gpu.upload(&hash_grid::resolutions()),
             net,
             layout,
-            encoder,
-            transport,
+            shapes,
             gpu,
         })
     }
@@ -255,9 +246,9 @@ impl GpuTrainer {
     }
 
     /// The parameters' current values, in the network's shapes.
-    pub fn parameters(&self) -> (HostEncoder, HostTransport) {
+    pub fn parameters(&self) -> NprtNet {
         let flat = self.gpu.read(&self.params, self.layout.total);
-        self.layout.unpack(&flat, &self.encoder, &self.transport)
+        self.layout.unpack(&flat, &self.shapes)
     }
 
     /// Whether the transport networks' products run in f16 ([`Precision::F16`]).
@@ -266,7 +257,7 @@ impl GpuTrainer {
     }
 
     /// The gradients of the last step, in the network's shapes (its loss scale divided out).
-    pub fn gradients(&self) -> (HostEncoder, HostTransport) {
+    pub fn gradients(&self) -> NprtNet {
         let scale = self.plans.last().map_or(1.0, |p| p.batch.grad_scale);
         let flat: Vec<f32> = self
             .gpu
@@ -274,7 +265,7 @@ impl GpuTrainer {
             .into_iter()
             .map(|g| g / scale)
             .collect();
-        self.layout.unpack(&flat, &self.encoder, &self.transport)
+        self.layout.unpack(&flat, &self.shapes)
     }
 
     /// The loss of `batch` and every parameter's gradient, kept on the device
@@ -513,56 +504,26 @@ impl GpuTrainer {
             .collect()
     }
 
-    /// Writes Adam's state (both moments, flat, and the step count) to `path` as safetensors.
+    /// Writes Adam's state to `path` as the host's Adam does (the moments without the
+    /// layout's gaps), so that either engine resumes it.
     pub fn save_state(&self, path: &Path) -> Result<()> {
         let total = self.layout.total;
-        let moments = [&self.moment1, &self.moment2].map(|m| self.gpu.read(m, total));
-        let bytes = moments
-            .each_ref()
-            .map(|m| bytemuck::cast_slice::<f32, u8>(m));
-        let views = ["moment1", "moment2"]
-            .into_iter()
-            .zip(bytes)
-            .map(|(name, b)| Ok((name, TensorView::new(Dtype::F32, vec![total], b)?)))
-            .collect::<Result<Vec<_>, safetensors::SafeTensorError>>()?;
-        let metadata = HashMap::from([("steps".to_string(), self.steps.to_string())]);
-        let file = safetensors::serialize(views, Some(metadata))?;
-        nprt_io::write_file(path, &file)
+        let [m1, m2] =
+            [&self.moment1, &self.moment2].map(|m| self.layout.compact(&self.gpu.read(m, total)));
+        save_state(path, [&m1, &m2], self.steps)
     }
 
-    /// Reads Adam's state back from `path` (written by [`Self::save_state`] for a network of
-    /// the same shapes).
+    /// Reads Adam's state back from `path`, written by either engine for a network of the same
+    /// shapes.
     pub fn load_state(&mut self, path: &Path) -> Result<()> {
-        let bytes = std::fs::read(path)
-            .with_context(|| format!("cannot read Adam's state '{}'", path.display()))?;
-        let bad = |why: String| anyhow!("Adam's state '{}' {why}", path.display());
-        let file =
-            SafeTensors::deserialize(&bytes).map_err(|e| bad(format!("is unreadable: {e}")))?;
-        let (_, metadata) = SafeTensors::read_metadata(&bytes).map_err(|e| bad(e.to_string()))?;
-        let steps = metadata
-            .metadata()
-            .as_ref()
-            .and_then(|m| m.get("steps"))
-            .and_then(|s| s.parse().ok())
-            .ok_or_else(|| bad("has no step count".into()))?;
-        for (name, buffer) in [("moment1", &self.moment1), ("moment2", &self.moment2)] {
-            let view = file
-                .tensor(name)
-                .map_err(|e| bad(format!("lacks {name}: {e}")))?;
-            if view.dtype() != Dtype::F32 || view.shape() != [self.layout.total] {
-                return Err(bad(format!(
-                    "holds {name} of {:?} {:?}, not this network's {} f32",
-                    view.dtype(),
-                    view.shape(),
-                    self.layout.total
-                )));
-            }
-            let values: Vec<f32> = view
-                .data()
-                .chunks_exact(4)
-                .map(|b| f32::from_le_bytes([b[0], b[1], b[2], b[3]]))
-                .collect();
-            self.gpu.write(buffer, &values);
+        // Checkpoints of the kernels from before the shared format hold the moments with the
+        // layout's gaps.
+        let (moments, steps) = match load_state(path, self.layout.params()) {
+            Ok((m, steps)) => (m.map(|m| self.layout.expand(&m)), steps),
+            Err(e) => load_state(path, self.layout.total).map_err(|_| e)?,
+        };
+        for (values, buffer) in moments.iter().zip([&self.moment1, &self.moment2]) {
+            self.gpu.write(buffer, values);
         }
         self.steps = steps;
         Ok(())

@@ -4,11 +4,12 @@
 use super::half_layers::HalfWeight;
 use super::parameters::{ParameterLayout, Span};
 use super::{Dispatch, GpuDevice};
-use crate::cpu::{DenseStack, HostEncoder, HostTransport};
 use crate::encoding::hash_grid;
 use crate::network::activation::Activation;
 use crate::network::design::TRANSPORT_CODE;
 use crate::network::encoder::CODE_SIZE;
+use crate::network::mlp::Mlp;
+use crate::network::nprt_net::NprtNet;
 use crate::network::track_kind::TrackKind;
 
 /// One dense layer's place in the flat buffers.
@@ -107,18 +108,13 @@ pub(super) struct NetworkLayout {
 }
 
 impl NetworkLayout {
-    /// The places of `encoder`'s and `transport`'s tensors in `layout`; each track's input
+    /// The places of `net`'s tensors in `layout`; each track's input
     /// indices are uploaded to `gpu`, and with `half` the transport networks' f16 weights are
     /// made there (zero until refreshed).
-    pub fn new(
-        gpu: &GpuDevice,
-        layout: &ParameterLayout,
-        encoder: &HostEncoder,
-        transport: &HostTransport,
-        half: bool,
-    ) -> Self {
-        // Spans in the order ParameterLayout walks the tensors: the encoder's, then the tracks'.
+    pub fn new(gpu: &GpuDevice, layout: &ParameterLayout, net: &NprtNet, half: bool) -> Self {
+        // Spans in the order the network visits its tensors: the encoder's, then the tracks'.
         let mut spans = layout.spans.iter().copied();
+        let encoder = &net.encoder;
         let convs = encoder
             .convs
             .iter()
@@ -134,7 +130,7 @@ impl NetworkLayout {
             d_in: encoder.to_code.d_in,
             d_out: encoder.to_code.d_out,
         };
-        let mut tracks: Vec<TrackAt> = transport
+        let mut tracks: Vec<TrackAt> = net
             .tracks
             .iter()
             .map(|t| {
@@ -171,7 +167,7 @@ impl NetworkLayout {
 }
 
 /// The layers of `stack`, their spans taken in order from `spans`.
-fn mlp_at(stack: &DenseStack, spans: &mut impl Iterator<Item = Span>) -> MlpAt {
+fn mlp_at(stack: &Mlp, spans: &mut impl Iterator<Item = Span>) -> MlpAt {
     let mut take = || spans.next().expect("a span per tensor");
     MlpAt {
         layers: stack

@@ -3,7 +3,8 @@
 //! a multiple of the device's storage-binding alignment, so a kernel can also bind one tensor
 //! on its own; the gaps stay zero and Adam leaves them so.
 
-use crate::cpu::{HostEncoder, HostTransport};
+use crate::network::nprt_net::NprtNet;
+use crate::network::parameters::Parameters;
 
 /// Where one tensor lies in the flat buffers, in f32 elements.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -19,33 +20,6 @@ impl Span {
     }
 }
 
-/// Every tensor of a network in its one order: the encoder's convolutions (weight, bias), its
-/// last layer, then per track the grid's tables, the transfer network's layers and the shading
-/// network's layers. Packing and unpacking both walk it.
-fn tensors<'a>(
-    encoder: &'a mut HostEncoder,
-    transport: &'a mut HostTransport,
-) -> Vec<&'a mut Vec<f32>> {
-    let mut all = Vec::new();
-    for conv in &mut encoder.convs {
-        all.push(&mut conv.weight);
-        all.push(&mut conv.bias);
-    }
-    all.push(&mut encoder.to_code.weight);
-    all.push(&mut encoder.to_code.bias);
-    for track in &mut transport.tracks {
-        if let Some(grid) = &mut track.grid {
-            all.push(grid);
-        }
-        let layers = track.transfer.iter_mut().flat_map(|t| t.layers.iter_mut());
-        for layer in layers.chain(track.shading.layers.iter_mut()) {
-            all.push(&mut layer.weight);
-            all.push(&mut layer.bias);
-        }
-    }
-    all
-}
-
 /// The flat layout of a network's tensors.
 pub struct ParameterLayout {
     pub spans: Vec<Span>,
@@ -54,42 +28,51 @@ pub struct ParameterLayout {
 }
 
 impl ParameterLayout {
-    /// The layout of `encoder` and `transport` with tensors starting at multiples of `align`
-    /// elements, and their values packed in it.
-    pub fn pack(
-        encoder: &HostEncoder,
-        transport: &HostTransport,
-        align: usize,
-    ) -> (ParameterLayout, Vec<f32>) {
-        let (mut encoder, mut transport) = (encoder.clone(), transport.clone());
+    /// The layout of `net`'s tensors (in their visiting order) with tensors starting at
+    /// multiples of `align` elements, and their values packed in it.
+    pub fn pack(net: &NprtNet, align: usize) -> (ParameterLayout, Vec<f32>) {
         let mut flat = Vec::new();
         let mut spans = Vec::new();
-        for t in tensors(&mut encoder, &mut transport) {
+        net.visit("", &mut |_, _, t| {
             flat.resize(flat.len().next_multiple_of(align), 0.0);
             spans.push(Span {
                 offset: flat.len(),
                 len: t.len(),
             });
             flat.extend_from_slice(t);
-        }
+        });
         let total = flat.len();
         (ParameterLayout { spans, total }, flat)
     }
 
-    /// `flat`'s values poured into copies of `encoder` and `transport` (same shapes as packed).
-    pub fn unpack(
-        &self,
-        flat: &[f32],
-        encoder: &HostEncoder,
-        transport: &HostTransport,
-    ) -> (HostEncoder, HostTransport) {
-        let (mut encoder, mut transport) = (encoder.clone(), transport.clone());
-        for (t, span) in tensors(&mut encoder, &mut transport)
-            .into_iter()
-            .zip(&self.spans)
-        {
-            t.copy_from_slice(&flat[span.offset..][..span.len]);
+    /// `flat`'s values poured into a copy of `net` (same shapes as packed).
+    pub fn unpack(&self, flat: &[f32], net: &NprtNet) -> NprtNet {
+        let mut net = net.clone();
+        net.set_flat(&self.compact(flat));
+        net
+    }
+
+    /// The tensors of `flat` one after the other, without the gaps: the host's layout
+    /// ([`Parameters::flat`]).
+    pub fn compact(&self, flat: &[f32]) -> Vec<f32> {
+        (self.spans.iter())
+            .flat_map(|s| flat[s.offset..][..s.len].iter().copied())
+            .collect()
+    }
+
+    /// The inverse of [`Self::compact`]: the gaps zero.
+    pub fn expand(&self, compact: &[f32]) -> Vec<f32> {
+        let mut flat = vec![0.0; self.total];
+        let mut at = 0;
+        for s in &self.spans {
+            flat[s.offset..][..s.len].copy_from_slice(&compact[at..at + s.len]);
+            at += s.len;
         }
-        (encoder, transport)
+        flat
+    }
+
+    /// Values in the tensors, gaps not counted.
+    pub fn params(&self) -> usize {
+        self.spans.iter().map(|s| s.len).sum()
     }
 }

@@ -4,10 +4,10 @@
 
 use std::path::Path;
 
+use std::collections::HashMap;
+
 use anyhow::{bail, Context, Result};
-use burn::module::Module;
-use burn::store::{ModuleSnapshot, SafetensorsStore};
-use burn::tensor::Device;
+use safetensors::{tensor::TensorView, Dtype, SafeTensors};
 use serde::de::DeserializeOwned;
 use serde::{Deserialize, Serialize};
 
@@ -15,6 +15,7 @@ use crate::init::Init;
 use crate::model::config::ModelConfig;
 use crate::network::encoder::check_input_width;
 use crate::network::nprt_net::NprtNet;
+use crate::network::parameters::Parameters;
 
 /// Identifies a model folder's config file.
 pub const MODEL_FORMAT: &str = "nprt-model";
@@ -84,22 +85,38 @@ pub fn save_model(dir: &Path, file: &ModelFile, net: &NprtNet) -> Result<()> {
 
 /// Weights as safetensors, tagged with the network that produced them (`design:activation`,
 /// [`ModelConfig::weights_tag`], or another network kind's name).
-pub fn save_weights<M: Module>(path: &Path, net: &M, tag: &str) -> Result<()> {
-    // One metadata key only: the header is then byte-for-byte reproducible.
-    let mut store = SafetensorsStore::from_bytes(None)
-        .clear_metadata()
-        .metadata("nprt_design", tag);
-    net.save_into(&mut store)
-        .map_err(|e| anyhow::anyhow!("cannot serialise weights: {e}"))?;
-    let bytes = store
-        .get_bytes()
-        .map_err(|e| anyhow::anyhow!("cannot serialise weights: {e}"))?;
-    if let Some(name) = non_finite_tensor(&bytes)? {
+pub fn save_weights<M: Parameters>(path: &Path, net: &M, tag: &str) -> Result<()> {
+    let mut tensors = Vec::new();
+    let mut non_finite = None;
+    net.visit("", &mut |name, shape, values| {
+        if non_finite.is_none() && !values.iter().all(|v| v.is_finite()) {
+            non_finite = Some(name.to_string());
+        }
+        tensors.push((
+            name.to_string(),
+            shape.to_vec(),
+            bytemuck::cast_slice::<f32, u8>(values).to_vec(),
+        ));
+    });
+    if let Some(name) = non_finite {
         bail!(
             "refusing to write '{}': weight tensor '{name}' holds NaN or infinity (training diverged)",
             path.display()
         );
     }
+    let views = tensors
+        .iter()
+        .map(|(name, shape, bytes)| {
+            Ok((
+                name.as_str(),
+                TensorView::new(Dtype::F32, shape.clone(), bytes)?,
+            ))
+        })
+        .collect::<Result<Vec<_>, safetensors::SafeTensorError>>()?;
+    // One metadata key only: the header is then byte-for-byte reproducible.
+    let metadata = HashMap::from([("nprt_design".to_string(), tag.to_string())]);
+    let bytes = safetensors::serialize(views, Some(metadata))
+        .map_err(|e| anyhow::anyhow!("cannot serialise weights: {e}"))?;
     nprt_io::write_file(path, &bytes)
 }
 
@@ -123,7 +140,7 @@ fn non_finite_tensor(bytes: &[u8]) -> Result<Option<String>> {
 }
 
 /// Loads weights saved by [`save_weights`] into `net`, which must be of the same design.
-pub fn load_weights<M: Module>(path: &Path, net: &mut M, tag: &str) -> Result<()> {
+pub fn load_weights<M: Parameters>(path: &Path, net: &mut M, tag: &str) -> Result<()> {
     let bytes =
         std::fs::read(path).with_context(|| format!("cannot read weights '{}'", path.display()))?;
     let saved_design = read_design_tag(&bytes)
@@ -144,23 +161,42 @@ pub fn load_weights<M: Module>(path: &Path, net: &mut M, tag: &str) -> Result<()
             path.display()
         );
     }
-    let mut store = SafetensorsStore::from_bytes(Some(bytes)).validate(true);
-    let result = net
-        .load_from(&mut store)
-        .map_err(|e| anyhow::anyhow!("cannot load weights '{}': {e}", path.display()))?;
-    if !result.errors.is_empty() || !result.missing.is_empty() || !result.unused.is_empty() {
+    let file = SafeTensors::deserialize(&bytes)
+        .with_context(|| format!("'{}' is not an nprt weights file", path.display()))?;
+    let (mut missing, mut bad) = (Vec::new(), Vec::new());
+    net.visit_mut("", &mut |name, shape, values| match file.tensor(name) {
+        Err(_) => missing.push(name.to_string()),
+        Ok(view) if view.dtype() != Dtype::F32 || view.shape() != shape => bad.push(format!(
+            "{name} is {:?} {:?}, not F32 {shape:?}",
+            view.dtype(),
+            view.shape()
+        )),
+        Ok(view) => {
+            for (v, b) in values.iter_mut().zip(view.data().chunks_exact(4)) {
+                *v = f32::from_le_bytes([b[0], b[1], b[2], b[3]]);
+            }
+        }
+    });
+    let mut known = std::collections::HashSet::new();
+    net.visit("", &mut |name, _, _| {
+        known.insert(name.to_string());
+    });
+    let unused: Vec<String> = (file.names().into_iter())
+        .filter(|n| !known.contains(*n))
+        .map(str::to_string)
+        .collect();
+    if !missing.is_empty() || !unused.is_empty() || !bad.is_empty() {
         bail!(
             "weights '{}' do not fit the '{tag}' network: {} missing, {} unexpected, {} bad tensors (first: {})",
             path.display(),
-            result.missing.len(),
-            result.unused.len(),
-            result.errors.len(),
-            result
-                .missing
+            missing.len(),
+            unused.len(),
+            bad.len(),
+            missing
                 .first()
-                .map(|m| m.0.clone())
-                .or(result.unused.first().cloned())
-                .or(result.errors.first().map(|e| format!("{e:?}")))
+                .or(unused.first())
+                .or(bad.first())
+                .cloned()
                 .unwrap_or_default()
         );
     }
@@ -220,10 +256,10 @@ pub fn read_config<T: DeserializeOwned>(
     serde_json::from_value(value).with_context(|| format!("'{}' is malformed", path.display()))
 }
 
-/// Loads a trained model folder onto `device`.
-pub fn load_model(dir: &Path, device: &Device) -> Result<(ModelFile, NprtNet)> {
+/// Loads a trained model folder.
+pub fn load_model(dir: &Path) -> Result<(ModelFile, NprtNet)> {
     let file = read_model_file(dir)?;
-    let mut net = file.config.build(&mut Init::new(0, device));
+    let mut net = file.config.build(&mut Init::new(0));
     load_weights(
         &dir.join(WEIGHTS_FILE),
         &mut net,

@@ -1,8 +1,7 @@
 //! The layer table of `nprt model info`: every parameterised layer with its shape and count.
 
-use burn::module::Module;
-
 use crate::network::nprt_net::NprtNet;
+use crate::network::parameters::Parameters;
 
 /// One row of `nprt model info`.
 pub struct LayerRow {
@@ -15,14 +14,14 @@ pub struct LayerRow {
 pub fn layer_table(net: &NprtNet) -> Vec<LayerRow> {
     let mut rows = Vec::new();
     for (i, conv) in net.encoder.convs.iter().enumerate() {
-        let [o, c, kh, kw] = conv.weight.val().dims();
+        let (o, c, k) = (conv.c_out, conv.c_in, conv.k);
         rows.push(LayerRow {
             name: format!("encoder.conv{i}"),
-            shape: format!("{c}→{o}, {kh}×{kw}"),
+            shape: format!("{c}→{o}, {k}×{k}"),
             params: conv.num_params(),
         });
     }
-    let [i, o] = net.encoder.to_code.weight.val().dims();
+    let (i, o) = (net.encoder.to_code.d_in, net.encoder.to_code.d_out);
     rows.push(LayerRow {
         name: "encoder.to_code".into(),
         shape: format!("{i}→{o}"),

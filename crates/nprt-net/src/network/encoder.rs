@@ -1,19 +1,16 @@
 //! The light encoder F_L: a small CNN that turns a lat-long environment map into the light code ê.
 
-use burn::module::Module;
-use burn::nn::conv::Conv2d;
-use burn::nn::pool::{MaxPool2d, MaxPool2dConfig};
-use burn::nn::Linear;
-use burn::tensor::activation::relu;
-use burn::tensor::Tensor;
 use glam::Vec2;
 use nprt_scene::envmap::{uv_to_direction, EnvMap};
 use rayon::prelude::*;
 
 use crate::encoding::map_norm::MapNorm;
-use crate::init::{conv2d, Init};
+use crate::init::Init;
 use crate::network::activation::Activation;
+use crate::network::conv::Conv;
+use crate::network::dense::Dense;
 use crate::network::mlp::Mlp;
+use crate::network::parameters::{child, Parameters, Visit, VisitMut};
 
 /// Convolution blocks of the paper's encoder.
 pub const BLOCKS: usize = 5;
@@ -42,40 +39,36 @@ pub fn check_input_width(width: usize) -> anyhow::Result<()> {
 /// 5 × (3×3 conv with 32 channels, ReLU, skip connection, 2×2 max-pool), then one dense layer
 /// to the 64-d code. The skip adds the block's input to the ReLU output; the first block's
 /// 3-channel input is zero-padded to 32 channels for that sum, so the skips add no parameters.
-#[derive(Module, Debug)]
+/// Also (same shapes) its gradient. The CPU engine runs it (`cpu::light_encoder`).
+#[derive(Clone, Debug, PartialEq)]
 pub struct LightEncoder {
-    pub convs: Vec<Conv2d>,
-    pub pool: MaxPool2d,
-    pub to_code: Linear,
+    pub convs: Vec<Conv>,
+    pub to_code: Dense,
 }
 
 impl LightEncoder {
     pub fn new(init: &mut Init, width: usize) -> Self {
         let convs = (0..BLOCKS)
-            .map(|i| conv2d(init, if i == 0 { 3 } else { CHANNELS }, CHANNELS, 3))
+            .map(|i| Conv::new(init, if i == 0 { 3 } else { CHANNELS }, CHANNELS, 3))
             .collect();
         let flat = CHANNELS * (width >> BLOCKS) * (width >> (BLOCKS + 1));
         let mut to_code = Mlp::new(init, &[flat, CODE_SIZE], Activation::Relu);
         LightEncoder {
             convs,
-            pool: MaxPool2dConfig::new([2, 2]).with_strides([2, 2]).init(),
             to_code: to_code.layers.remove(0),
         }
     }
+}
 
-    /// Maps [V, 3, W/2, W] pre-processed maps to [V, 64] codes.
-    pub fn forward(&self, mut x: Tensor<4>) -> Tensor<2> {
-        for conv in &self.convs {
-            let [v, c, h, w] = x.dims();
-            let skip = if c == CHANNELS {
-                x.clone()
-            } else {
-                let pad = Tensor::zeros([v, CHANNELS - c, h, w], (&x.device(), x.dtype()));
-                Tensor::cat(vec![x.clone(), pad], 1)
-            };
-            x = self.pool.forward(relu(conv.forward(x)) + skip);
-        }
-        self.to_code.forward(x.flatten(1, 3))
+impl Parameters for LightEncoder {
+    fn visit(&self, prefix: &str, f: &mut Visit) {
+        self.convs.visit(&child(prefix, "convs"), f);
+        self.to_code.visit(&child(prefix, "to_code"), f);
+    }
+
+    fn visit_mut(&mut self, prefix: &str, f: &mut VisitMut) {
+        self.convs.visit_mut(&child(prefix, "convs"), f);
+        self.to_code.visit_mut(&child(prefix, "to_code"), f);
     }
 }
 

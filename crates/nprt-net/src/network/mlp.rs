@@ -1,19 +1,15 @@
 //! A multilayer perceptron with SIREN or ReLU hidden layers and their initialisations.
 
-use burn::module::Module;
-use burn::nn::Linear;
-use burn::tensor::activation::relu;
-use burn::tensor::Tensor;
-
-use crate::init::{dense, Init};
+use crate::init::Init;
 use crate::network::activation::{Activation, OMEGA_0};
+use crate::network::dense::Dense;
+use crate::network::parameters::{child, Parameters, Visit, VisitMut};
 
 /// A multilayer perceptron: every layer but the last is followed by the activation; the last
-/// one is linear.
-#[derive(Module, Debug)]
+/// one is linear. Also (same shapes) its gradient.
+#[derive(Clone, Debug, PartialEq)]
 pub struct Mlp {
-    pub layers: Vec<Linear>,
-    #[module(skip)]
+    pub layers: Vec<Dense>,
     pub activation: Activation,
 }
 
@@ -36,34 +32,28 @@ impl Mlp {
                     Activation::Siren if i == 0 => 1.0 / fan_in,
                     Activation::Siren => (6.0 / fan_in).sqrt() / OMEGA_0,
                 };
-                dense(init, w[0], w[1], bound)
+                Dense::new(init, w[0], w[1], bound)
             })
             .collect();
         Mlp { layers, activation }
     }
 
-    pub fn forward(&self, mut x: Tensor<2>) -> Tensor<2> {
-        let last = self.layers.len() - 1;
-        for (i, layer) in self.layers.iter().enumerate() {
-            x = layer.forward(x);
-            if i < last {
-                x = match self.activation {
-                    Activation::Siren => x.mul_scalar(OMEGA_0).sin(),
-                    Activation::Relu => relu(x),
-                };
-            }
-        }
-        x
-    }
-
     /// (input, output) widths of each layer.
     pub fn shapes(&self) -> Vec<[usize; 2]> {
-        self.layers
-            .iter()
-            .map(|l| {
-                let [i, o] = l.weight.val().dims();
-                [i, o]
-            })
-            .collect()
+        self.layers.iter().map(|l| [l.d_in, l.d_out]).collect()
+    }
+
+    pub fn d_out(&self) -> usize {
+        self.layers.last().map_or(0, |l| l.d_out)
+    }
+}
+
+impl Parameters for Mlp {
+    fn visit(&self, prefix: &str, f: &mut Visit) {
+        self.layers.visit(&child(prefix, "layers"), f);
+    }
+
+    fn visit_mut(&mut self, prefix: &str, f: &mut VisitMut) {
+        self.layers.visit_mut(&child(prefix, "layers"), f);
     }
 }

@@ -1,10 +1,15 @@
 //! The networks: the light encoder, dense layers and their activations, the transport tracks and
-//! their kinds, the four designs, the whole network, and how their weights start.
+//! their kinds, the four designs, the whole network, the Deep Shading U-Net, and the one
+//! weight type they all are to the model file and the optimiser (`parameters`).
 
 pub mod activation;
+pub mod conv;
+pub mod dense;
 pub mod design;
 pub mod encoder;
 pub mod mlp;
 pub mod nprt_net;
+pub mod parameters;
 pub mod track;
 pub mod track_kind;
+pub mod unet;

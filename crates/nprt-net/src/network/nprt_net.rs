@@ -1,17 +1,16 @@
 //! The whole network: light encoder plus a design's transport tracks.
 
-use burn::module::Module;
-use burn::tensor::{Int, Tensor};
-
 use crate::encoding::position_encoding::PositionEncoding;
-use crate::init::{shifted_bias, Init};
+use crate::init::Init;
 use crate::network::activation::Activation;
 use crate::network::design::Design;
 use crate::network::encoder::LightEncoder;
+use crate::network::parameters::{child, Parameters, Visit, VisitMut};
 use crate::network::track::Track;
 
-/// Encoder plus transport: G-buffer features and a light code in, radiance out.
-#[derive(Module, Debug)]
+/// Encoder plus transport: G-buffer features and a light code in, radiance out. Also (same
+/// shapes) its gradient. The CPU engine runs it (`cpu`), the GPU kernels from its values.
+#[derive(Clone, Debug, PartialEq)]
 pub struct NprtNet {
     pub encoder: LightEncoder,
     pub tracks: Vec<Track>,
@@ -32,39 +31,12 @@ impl NprtNet {
         NprtNet { encoder, tracks }
     }
 
-    /// Radiance [B, 3] for features [B, 19] lit by codes [B, 64] of maps normalised by
-    /// `scale` [B, 3].
-    pub fn shade(&self, features: Tensor<2>, code: Tensor<2>, scale: Tensor<2>) -> Tensor<2> {
-        let radiance = self
-            .tracks
-            .iter()
-            .map(|t| t.forward(&features, &code))
-            .reduce(|a, b| a + b)
-            .expect("a design has at least one track");
-        radiance * scale
-    }
-
-    /// Radiance for a batch mixing views: `light` holds the V pre-processed maps [V, 3, H, W],
-    /// `view` [B] says which map lights each sample and `scale` [B, 3] is what that map was
-    /// divided by.
-    pub fn forward(
-        &self,
-        features: Tensor<2>,
-        light: Tensor<4>,
-        view: Tensor<1, Int>,
-        scale: Tensor<2>,
-    ) -> Tensor<2> {
-        let code = self.encoder.forward(light).select(0, view);
-        self.shade(features, code, scale)
-    }
-
     /// Adds `log_level` to every track's output bias, so that an untrained network predicts
     /// radiance of about exp(`log_level`) × the map's mean. Starting at the data's level
     /// matters where it is far from the map's mean (a room lit through a window gets a small
     /// fraction of its map): started orders of magnitude too bright, the exp output's first
     /// steps overshoot to near zero, where log-L1's gradient (∝ the prediction) vanishes and
-    /// Adam, still scaled by the first steps' huge gradients, never brings it back. The
-    /// shifted bias is a fresh leaf, so autodiff trains it as any parameter.
+    /// Adam, still scaled by the first steps' huge gradients, never brings it back.
     pub fn shift_output_level(mut self, log_level: f32) -> Self {
         for track in &mut self.tracks {
             let last = track
@@ -72,7 +44,7 @@ impl NprtNet {
                 .layers
                 .last_mut()
                 .expect("a network has layers");
-            last.bias = shifted_bias(last.bias.take(), log_level);
+            last.bias.iter_mut().for_each(|b| *b += log_level);
         }
         self
     }
@@ -94,5 +66,17 @@ impl NprtNet {
             .filter_map(|t| t.grid.as_ref())
             .map(|g| g.num_params())
             .sum()
+    }
+}
+
+impl Parameters for NprtNet {
+    fn visit(&self, prefix: &str, f: &mut Visit) {
+        self.encoder.visit(&child(prefix, "encoder"), f);
+        self.tracks.visit(&child(prefix, "tracks"), f);
+    }
+
+    fn visit_mut(&mut self, prefix: &str, f: &mut VisitMut) {
+        self.encoder.visit_mut(&child(prefix, "encoder"), f);
+        self.tracks.visit_mut(&child(prefix, "tracks"), f);
     }
 }

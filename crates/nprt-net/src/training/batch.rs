@@ -1,23 +1,9 @@
-//! A batch of pixel samples in host memory and its forward pass.
-
-use burn::optim::GradientsParams;
-use burn::tensor::{Device, Int, Tensor, TensorData};
+//! A batch of pixel samples in host memory, or picked for a device that holds the dataset.
 
 use crate::cpu::Samples;
 
 use crate::encoding::features::FEATURES;
-use crate::loss::Loss;
-use crate::network::nprt_net::NprtNet;
 use crate::training::training_set::ViewSamples;
-
-/// Which code computes a batch's gradients.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum GradientPath {
-    /// The CPU engine where it applies (burn's CPU backend, f32), else burn's autodiff.
-    Auto,
-    /// burn's autodiff graph: the reference the CPU engine is held to.
-    Autodiff,
-}
 
 /// Samples drawn from several views, and those views' maps: gathered on the host, or only
 /// picked, for a device that holds the dataset to gather.
@@ -139,43 +125,5 @@ impl Batch {
 
     pub fn is_empty(&self) -> bool {
         self.view.is_empty()
-    }
-
-    /// The views' maps [V, 3, W/2, W] on `device`.
-    pub fn light_tensor(&self, device: &Device) -> Tensor<4> {
-        let w = self.light_width;
-        let shape = [self.lights.len() / (3 * w * w / 2), 3, w / 2, w];
-        Tensor::from_data(TensorData::new(self.lights.clone(), shape), device)
-    }
-
-    /// Predicted radiance [B, 3] and the reference [B, 3] on `device`.
-    pub fn forward(&self, net: &NprtNet, device: &Device) -> (Tensor<2>, Tensor<2>) {
-        let n = self.len();
-        let f = Tensor::from_data(
-            TensorData::new(self.features.clone(), [n, FEATURES]),
-            device,
-        );
-        let r = Tensor::from_data(TensorData::new(self.radiance.clone(), [n, 3]), device);
-        let v = Tensor::<1, Int>::from_data(TensorData::new(self.view.clone(), [n]), device);
-        let s = Tensor::from_data(TensorData::new(self.scale.clone(), [n, 3]), device);
-        (net.forward(f, self.light_tensor(device), v, s), r)
-    }
-
-    /// `loss` on this batch and every parameter's gradient (`device` is an autodiff device),
-    /// computed by `path`.
-    pub fn gradients(
-        &self,
-        net: &NprtNet,
-        device: &Device,
-        path: GradientPath,
-        loss: Loss,
-    ) -> (f64, GradientsParams) {
-        if path == GradientPath::Auto && crate::cpu::applies(net) {
-            return crate::cpu::gradients(net, &self.samples(), device, loss);
-        }
-        let (pred, reference) = self.forward(net, device);
-        let loss = loss.mean(pred, reference);
-        let value = loss.clone().into_scalar::<f64>();
-        (value, GradientsParams::from_grads(loss.backward(), net))
     }
 }

@@ -9,10 +9,7 @@
 //! factor per channel: the training targets' sum over the network's. The mean of noisy
 //! targets is unbiased, so no converged reference is needed, and no held-out view is seen.
 
-use burn::tensor::Device;
-
 use crate::choice::named_choice;
-use crate::host_values::host_values;
 use crate::network::nprt_net::NprtNet;
 use crate::training::batch::Batch;
 use crate::training::training_set::ViewSamples;
@@ -45,13 +42,11 @@ pub fn level_gain(
     views: &[ViewSamples],
     max_samples: usize,
     batch_size: usize,
-    device: &Device,
 ) -> [f32; 3] {
     let views: Vec<&ViewSamples> = views.iter().filter(|v| !v.is_empty()).collect();
     let (mut predicted, mut target) = ([0.0f64; 3], [0.0f64; 3]);
     for batch in Batch::strided(&views, max_samples, batch_size) {
-        let (pred, _) = batch.forward(net, device);
-        let pred = host_values(pred.into_data());
+        let pred = crate::cpu::predict(net, &batch.samples());
         for (i, s) in batch.scale.chunks_exact(3).enumerate() {
             for k in 0..3 {
                 predicted[k] += (pred[3 * i + k] / s[k]) as f64;
@@ -87,12 +82,11 @@ mod tests {
 
     #[test]
     fn the_gain_is_the_factor_between_targets_and_predictions() {
-        let device = Device::flex();
         let config = ModelConfig {
             encoder_width: 64,
             ..ModelConfig::new(Design::Albedo, None)
         };
-        let net = config.build(&mut Init::new(1, &device));
+        let net = config.build(&mut Init::new(1));
         let sky = nprt_scene::open_envmap("builtin:sky").unwrap();
         let warm = EnvMap::constant(Vec3::new(3.0, 1.0, 0.2)).unwrap();
         let bounds = [[-1.0; 3], [1.0; 3]];
@@ -142,8 +136,7 @@ mod tests {
             .iter()
             .map(|view| {
                 let all: Vec<(u32, u32)> = (0..view.len() as u32).map(|p| (0, p)).collect();
-                let (pred, _) = Batch::gather(&[view], &all).forward(&net, &device);
-                host_values(pred.into_data())
+                crate::cpu::predict(&net, &Batch::gather(&[view], &all).samples())
             })
             .collect();
         let scaled = views(records(&|v, p| {
@@ -153,7 +146,7 @@ mod tests {
         }));
         // Over every pixel, and over a strided subset in small batches.
         for (max_samples, batch_size) in [(1000, 1000), (50, 16)] {
-            let gain = level_gain(&net, &scaled, max_samples, batch_size, &device);
+            let gain = level_gain(&net, &scaled, max_samples, batch_size);
             for k in 0..3 {
                 assert!(
                     (gain[k] / factor[k] - 1.0).abs() < 1e-4,
@@ -162,6 +155,6 @@ mod tests {
             }
         }
         // Targets without light: the network's output is kept, not zeroed.
-        assert_eq!(level_gain(&net, &dark, 1000, 1000, &device), [1.0; 3]);
+        assert_eq!(level_gain(&net, &dark, 1000, 1000), [1.0; 3]);
     }
 }

@@ -5,11 +5,11 @@
 use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result};
-use burn::module::Module;
 use serde::{Deserialize, Serialize};
 
 use crate::model::folder::{load_weights, save_weights};
-use crate::optimiser::Optimiser;
+use crate::network::parameters::Parameters;
+use crate::optimiser::{is_state_file, state_file, EngineSteps};
 use crate::training::loss_curves::LossRow;
 
 const DIR: &str = "checkpoint";
@@ -64,7 +64,7 @@ pub(crate) fn read(out: &Path) -> Result<Option<Checkpoint>> {
 }
 
 /// Loads the checkpoint's weights into `net`.
-pub(crate) fn restore_weights<M: Module>(
+pub(crate) fn restore_weights<M: Parameters>(
     out: &Path,
     ck: &Checkpoint,
     net: &mut M,
@@ -73,35 +73,35 @@ pub(crate) fn restore_weights<M: Module>(
     load_weights(&dir(out).join(&ck.weights), net, tag)
 }
 
-/// `optim` with the checkpoint's optimiser state.
-pub(crate) fn restore_optimiser<M: Module, B>(
+/// Loads the checkpoint's optimiser state into `steps`.
+pub(crate) fn restore_optimiser<M, B>(
     out: &Path,
     ck: &Checkpoint,
-    optim: Optimiser<M, B>,
-) -> Result<Optimiser<M, B>> {
-    optim.load(&dir(out).join(&ck.optimizer))
+    steps: &mut dyn EngineSteps<M, B>,
+) -> Result<()> {
+    steps.load(&dir(out).join(&ck.optimizer))
 }
 
 /// Weights, optimiser state, then the state file that names them; older files are removed last.
-pub(crate) fn write<M: Module, B>(
+pub(crate) fn write<M: Parameters, B>(
     out: &Path,
     ck: &mut Checkpoint,
     net: &M,
-    optim: &Optimiser<M, B>,
+    steps: &dyn EngineSteps<M, B>,
     tag: &str,
 ) -> Result<()> {
     let dir = dir(out);
     let weights = format!("weights-{:09}.safetensors", ck.state.step);
-    let optimizer = optim.state_file(ck.state.step);
+    let optimizer = state_file(ck.state.step);
     save_weights(&dir.join(&weights), net, tag)?;
-    optim.save(&dir.join(&optimizer))?;
+    steps.save(&dir.join(&optimizer))?;
     ck.weights = weights;
     ck.optimizer = optimizer;
     let json = serde_json::to_vec_pretty(ck)?;
     nprt_io::write_file(&dir.join(STATE_FILE), &json)?;
     for entry in std::fs::read_dir(&dir)?.flatten() {
         let name = entry.file_name().to_string_lossy().to_string();
-        if (name.starts_with("weights-") || Optimiser::<M, B>::is_state_file(&name))
+        if (name.starts_with("weights-") || is_state_file(&name))
             && name != ck.weights
             && name != ck.optimizer
         {

@@ -1,5 +1,5 @@
 //! Training steps of a Neural PRT design on our own GPU kernels, as the training loop takes
-//! them ([`DeviceSteps`]): the parameters and Adam's moments stay on the device between steps
+//! them ([`EngineSteps`]): the parameters and Adam's moments stay on the device between steps
 //! and come back to the host network only for checkpoints (validation runs on the device too),
 //! and the dataset may be held there as well.
 
@@ -10,7 +10,7 @@ use anyhow::Result;
 use crate::gpu::{DeviceDataset, GpuTrainer};
 use crate::loss::Loss;
 use crate::network::nprt_net::NprtNet;
-use crate::optimiser::DeviceSteps;
+use crate::optimiser::EngineSteps;
 use crate::training::batch::Batch;
 use crate::training::training_set::TrainingSet;
 use crate::Precision;
@@ -50,7 +50,7 @@ impl KernelSteps {
     }
 }
 
-impl DeviceSteps<NprtNet, Batch> for KernelSteps {
+impl EngineSteps<NprtNet, Batch> for KernelSteps {
     fn step(&mut self, batch: &Batch, lr: f64) -> Result<Option<(f64, u64)>> {
         self.samples.push_back(batch.len() as u64);
         let before = match &batch.picks {
@@ -76,9 +76,7 @@ impl DeviceSteps<NprtNet, Batch> for KernelSteps {
     }
 
     fn store(&self, net: &mut NprtNet) {
-        let (encoder, transport) = self.trainer.parameters();
-        encoder.store_into(&mut net.encoder);
-        transport.store_into(net);
+        *net = self.trainer.parameters();
     }
 
     fn save(&self, path: &Path) -> Result<()> {

@@ -1,11 +1,12 @@
 //! Training: the training set in memory, batches, the learning-rate schedule, the one training
-//! loop with checkpoints and exact resume, the GPU kernels' steps as the loop takes them, the
+//! loop with checkpoints and exact resume, each engine's steps as the loop takes them, the
 //! Neural PRT objective run through it, validation, calibration and loss curves.
 
 pub mod batch;
 pub mod calibration;
 pub mod checkpoint;
 pub mod epoch_plan;
+pub mod host_steps;
 #[cfg(feature = "kernels")]
 pub mod kernel_steps;
 pub mod loss_curves;

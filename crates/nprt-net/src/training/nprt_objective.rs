@@ -10,25 +10,25 @@ use std::path::Path;
 use std::sync::Mutex;
 
 use anyhow::{bail, Context, Result};
-use burn::module::Module;
-use burn::optim::GradientsParams;
-use burn::tensor::Device;
 
 use crate::engine::Engine;
 use crate::init::Init;
+use crate::loss::Loss;
 use crate::model::config::ModelConfig;
 use crate::model::folder::{save_model, ModelFile, MODEL_FORMAT, MODEL_VERSION};
 use crate::network::nprt_net::NprtNet;
-use crate::optimiser::{DeviceSteps, ADAM_EPSILON};
-use crate::training::batch::{Batch, GradientPath};
+use crate::network::parameters::Parameters;
+use crate::optimiser::{EngineSteps, ADAM_EPSILON};
+use crate::training::batch::Batch;
 use crate::training::calibration::{level_gain, Calibration, LEVEL_SAMPLES};
 use crate::training::checkpoint::RunState;
 use crate::training::epoch_plan::{group_batches, EpochPlan};
+use crate::training::host_steps::HostSteps;
 use crate::training::schedule::Schedule;
 use crate::training::train_options::{Gather, TrainOptions};
-use crate::training::training_loop::{self, Objective, TrainSummary};
+use crate::training::training_loop::{self, Objective, Steps, TrainSummary};
 use crate::training::training_set::{TrainingSet, ViewSamples};
-use crate::training::validation::{forward_log_l1, validation_loss};
+use crate::training::validation::validation_loss;
 use crate::Precision;
 
 /// A Neural PRT design learning a dataset's pixels.
@@ -121,44 +121,35 @@ impl Objective for PixelObjective<'_> {
             })
     }
 
-    fn gradients(
-        &self,
-        net: &NprtNet,
-        batch: &Batch,
-        device: &Device,
-    ) -> (f64, GradientsParams, u64) {
-        let (loss, grads) = batch.gradients(net, device, GradientPath::Auto, self.opts.loss);
-        (loss, grads, batch.len() as u64)
-    }
-
-    #[cfg(feature = "kernels")]
-    fn device_steps(&self, net: &NprtNet) -> Result<Option<Box<dyn DeviceSteps<NprtNet, Batch>>>> {
-        if !self.kernels {
-            return Ok(None);
+    fn engine_steps(&self, net: &NprtNet) -> Result<Steps<'_, Self>> {
+        #[cfg(feature = "kernels")]
+        if self.kernels {
+            let dataset = self.resident().then_some(self.set);
+            let steps = crate::training::kernel_steps::KernelSteps::new(
+                net,
+                self.opts.loss,
+                self.opts.precision,
+                dataset,
+            )?;
+            return Ok(Box::new(steps));
         }
-        let dataset = self.resident().then_some(self.set);
-        let steps = crate::training::kernel_steps::KernelSteps::new(
+        let loss = self.opts.loss;
+        Ok(Box::new(HostSteps::new(
             net,
-            self.opts.loss,
-            self.opts.precision,
-            dataset,
-        )?;
-        Ok(Some(Box::new(steps)))
+            move |net: &NprtNet, batch: &Batch| {
+                let (value, grads) = crate::cpu::gradients(net, &batch.samples(), loss);
+                (value, grads, batch.len() as u64)
+            },
+            |net: &NprtNet, batch: &Batch| {
+                let prediction = crate::cpu::predict(net, &batch.samples());
+                Loss::LogL1.mean(&prediction, &batch.radiance)
+            },
+        )))
     }
 
-    fn validation_loss(
-        &self,
-        net: &NprtNet,
-        device: &Device,
-        steps: Option<&mut dyn DeviceSteps<NprtNet, Batch>>,
-    ) -> Result<f64> {
+    fn validation_loss(&self, steps: &mut dyn EngineSteps<NprtNet, Batch>) -> Result<f64> {
         let (samples, batch_size) = (self.opts.val_samples, self.opts.batch_size);
-        match steps {
-            Some(steps) => validation_loss(self.set, samples, batch_size, |b| steps.loss(b)),
-            None => validation_loss(self.set, samples, batch_size, |b| {
-                Ok(forward_log_l1(net, b, device))
-            }),
-        }
+        validation_loss(self.set, samples, batch_size, |b| steps.loss(b))
     }
 
     fn save_model(
@@ -167,7 +158,6 @@ impl Objective for PixelObjective<'_> {
         net: &NprtNet,
         schedule: &Schedule,
         state: &RunState,
-        device: &Device,
     ) -> Result<()> {
         let transport_params = net.transport_params();
         let options = TrainOptions {
@@ -193,15 +183,8 @@ impl Objective for PixelObjective<'_> {
                 "adam_epsilon": ADAM_EPSILON,
                 "loss": self.opts.loss.name(),
             }),
-            level_gain: (self.opts.calibration == Calibration::Level).then(|| {
-                level_gain(
-                    &net.valid(),
-                    &self.set.train,
-                    LEVEL_SAMPLES,
-                    self.opts.batch_size,
-                    device,
-                )
-            }),
+            level_gain: (self.opts.calibration == Calibration::Level)
+                .then(|| level_gain(net, &self.set.train, LEVEL_SAMPLES, self.opts.batch_size)),
         };
         save_model(out, &file, net)?;
         *self.saved.lock().unwrap_or_else(|e| e.into_inner()) = Some(file);

@@ -5,7 +5,7 @@
 //! Shading U-Net are two.
 //!
 //! Resume is exact because a batch is a function of the seed, the epoch and its index only,
-//! and parameter ids (which key Adam's state) are stable.
+//! and a network's tensors (which Adam's state follows) come in one fixed order.
 //!
 //! Batches are built on a thread of their own, a few ahead of the step that takes them, so
 //! that a fast device does not wait for the host to gather its samples; the run reports how
@@ -15,14 +15,12 @@ use std::path::Path;
 use std::time::Instant;
 
 use anyhow::{bail, Context, Result};
-use burn::module::Module;
-use burn::optim::GradientsParams;
-use burn::tensor::Device;
 use rand::SeedableRng;
 use rand_pcg::Pcg64Mcg;
 
 use crate::init::Init;
-use crate::optimiser::{DeviceSteps, Optimiser};
+use crate::network::parameters::Parameters;
+use crate::optimiser::EngineSteps;
 use crate::training::checkpoint::{self, Checkpoint, RunState};
 use crate::training::loss_curves::{self as curves, LossRow};
 use crate::training::schedule::Schedule;
@@ -38,9 +36,13 @@ const EPOCH_CHECKPOINT_SECS: f64 = 10.0;
 /// Batches built ahead of the step that takes them.
 const BATCHES_AHEAD: usize = 2;
 
-/// What one network's training is: its construction, its batches and its loss.
+/// The steps of an objective's engine, borrowing the objective.
+pub type Steps<'a, O> = Box<dyn EngineSteps<<O as Objective>::Net, <O as Objective>::Batch> + 'a>;
+
+/// What one network's training is: its construction, its batches, its loss and the engine that
+/// takes its steps.
 pub trait Objective: Sync {
-    type Net: Module;
+    type Net: Parameters + Clone;
     /// Built on the batch thread, taken by the training thread.
     type Batch: Send;
     /// Names the network in its weights' metadata and in messages.
@@ -60,41 +62,18 @@ pub trait Objective: Sync {
         epoch: usize,
         from: usize,
     ) -> impl Iterator<Item = Self::Batch> + '_;
-    /// The batch's mean loss, every parameter's gradient, and how many samples (pixels) the
-    /// batch holds; `device` is an autodiff device.
-    fn gradients(
-        &self,
-        net: &Self::Net,
-        batch: &Self::Batch,
-        device: &Device,
-    ) -> (f64, GradientsParams, u64);
-    /// Steps on a device of the objective's own for `net` (its weights as they stand), in place
-    /// of burn's optimiser; none by default.
-    #[allow(clippy::type_complexity)]
-    fn device_steps(
-        &self,
-        _net: &Self::Net,
-    ) -> Result<Option<Box<dyn DeviceSteps<Self::Net, Self::Batch>>>> {
-        Ok(None)
-    }
-    /// Loss on held-out data with a network off the autodiff device, or on `steps` (a
-    /// device's own, holding the same parameters) where the run has them; NaN where there is
-    /// no held-out data.
-    fn validation_loss(
-        &self,
-        net: &Self::Net,
-        device: &Device,
-        steps: Option<&mut dyn DeviceSteps<Self::Net, Self::Batch>>,
-    ) -> Result<f64>;
-    /// Writes the model folder's own files (config and weights) for the network as it stands;
-    /// `device` is the one [`Self::validation_loss`] runs on.
+    /// The engine's steps from `net` (its weights as they stand) with fresh moments.
+    fn engine_steps(&self, net: &Self::Net) -> Result<Steps<'_, Self>>;
+    /// Loss on held-out data under the parameters `steps` hold; NaN where there is no
+    /// held-out data.
+    fn validation_loss(&self, steps: &mut dyn EngineSteps<Self::Net, Self::Batch>) -> Result<f64>;
+    /// Writes the model folder's own files (config and weights) for the network as it stands.
     fn save_model(
         &self,
         out: &Path,
         net: &Self::Net,
         schedule: &Schedule,
         state: &RunState,
-        device: &Device,
     ) -> Result<()>;
 }
 
@@ -108,7 +87,7 @@ pub struct TrainSummary {
     pub final_train: f64,
     pub final_val: f64,
     pub resumed_from_epoch: Option<f64>,
-    /// Where the steps ran: "GPU kernels on …" for a device's own steps, else "cpu".
+    /// Where the steps ran: "cpu", or "GPU kernels on …".
     pub steps_on: String,
     /// Where this invocation's time went.
     pub split: TimeSplit,
@@ -157,31 +136,25 @@ pub fn epoch_rng(seed: u64, epoch: u64, stream: u64) -> Pcg64Mcg {
 /// Trains (or resumes training of) `objective`'s network in the model folder `out`.
 pub fn train<O: Objective>(objective: &O, schedule: &Schedule, out: &Path) -> Result<TrainSummary> {
     schedule.check()?;
-    // burn keeps the parameters on the host; a device's own steps read them from there.
-    let device = Device::flex().autodiff();
-    let inner = device.clone().inner();
-    let mut net = objective.build(&mut Init::new(schedule.seed, &device));
+    let mut net = objective.build(&mut Init::new(schedule.seed));
     std::fs::create_dir_all(checkpoint::dir(out))
         .with_context(|| format!("cannot create model folder '{}'", out.display()))?;
     let _lock = lock_folder(out)?;
     let (ck, resumed_from_epoch) = start(objective, schedule, out, &mut net)?;
-    let mut optim = match objective.device_steps(&net)? {
-        Some(steps) => Optimiser::Device(steps),
-        None => Optimiser::burn(),
-    };
+    let mut steps = objective.engine_steps(&net)?;
     if resumed_from_epoch.is_some() {
-        optim = checkpoint::restore_optimiser(out, &ck, optim)?;
+        checkpoint::restore_optimiser(out, &ck, steps.as_mut())?;
     }
     let mut run = Run::new(objective, schedule, out, ck);
     let mut trained = false;
     while run.ck.state.epoch < schedule.epochs && !run.out_of_time() {
         trained = true;
         let total = run.steps_in(run.ck.state.epoch);
-        net = run.epoch(total, &device, net, &mut optim)?;
-        optim.store(&mut net);
+        run.epoch(total, &mut net, steps.as_mut())?;
+        steps.store(&mut net);
         // The epoch ended, or the budget ran out within it: validate and save either way.
         let validating = Instant::now();
-        let val = objective.validation_loss(&net.valid(), &inner, optim.device_steps())?;
+        let val = objective.validation_loss(steps.as_mut())?;
         run.split.validation += since(validating);
         if !val.is_finite() {
             // The last step's update broke the weights after a finite loss: nothing is saved.
@@ -191,18 +164,15 @@ pub fn train<O: Objective>(objective: &O, schedule: &Schedule, out: &Path) -> Re
         let finished = run.ck.state.epoch >= schedule.epochs || run.out_of_time();
         let since_saved = run.last_checkpoint.elapsed().as_secs_f64();
         if finished || since_saved >= schedule.checkpoint_secs.min(EPOCH_CHECKPOINT_SECS) {
-            run.save(&net, &optim, &inner)?;
+            run.save(&net, steps.as_ref())?;
         }
     }
     run.bar.finish_and_clear();
-    run.steps_on = match &optim {
-        Optimiser::Device(steps) => steps.describe(),
-        Optimiser::Burn(_) => "cpu".into(),
-    };
+    run.steps_on = steps.describe();
     if !trained {
         // A finished run asked again: its model files follow this invocation's options (the
         // output calibration, say), since nothing else will write them.
-        objective.save_model(out, &net, schedule, &run.ck.state, &inner)?;
+        objective.save_model(out, &net, schedule, &run.ck.state)?;
     }
     Ok(run.summary(resumed_from_epoch))
 }
@@ -357,22 +327,19 @@ impl<'s, O: Objective> Run<'s, O> {
     }
 
     /// One epoch of `total` batches from the checkpoint's batch on, until its end or the time
-    /// budget's, with checkpoints as due. Batches are built on a thread of their own.
+    /// budget's, with checkpoints (of `net`, brought up to date) as due. Batches are built on a
+    /// thread of their own.
     fn epoch(
         &mut self,
         total: usize,
-        device: &Device,
-        net: O::Net,
-        optim: &mut Optimiser<O::Net, O::Batch>,
-    ) -> Result<O::Net> {
+        net: &mut O::Net,
+        steps: &mut dyn EngineSteps<O::Net, O::Batch>,
+    ) -> Result<()> {
         let (objective, epoch) = (self.objective, self.ck.state.epoch);
         let row_every = (total as u64).div_ceil(TRAIN_ROWS_PER_EPOCH).max(1);
         let from = self.ck.state.batch;
-        let (seed, inner) = (self.schedule.seed, device.clone().inner());
-        // The network moves into the scope and back out, so that the optimiser updates the
-        // only handle to its tensors.
-        std::thread::scope(|scope| -> Result<O::Net> {
-            let mut net = net;
+        let seed = self.schedule.seed;
+        std::thread::scope(|scope| -> Result<()> {
             let (sender, batches) = std::sync::mpsc::sync_channel(BATCHES_AHEAD);
             scope.spawn(move || {
                 for batch in objective.batches(seed, epoch, from) {
@@ -388,16 +355,9 @@ impl<'s, O: Objective> Run<'s, O> {
                 let stepping = Instant::now();
                 let lr = self.learning_rate();
                 self.queued += 1;
-                let done = match optim {
-                    // A device's step returns the one before it, so that the device does not
-                    // wait for the host.
-                    Optimiser::Device(steps) => steps.step(&batch, lr)?,
-                    Optimiser::Burn(adam) => {
-                        let (value, grads, samples) = objective.gradients(&net, &batch, device);
-                        net = adam.step(lr, net, grads);
-                        Some((value, samples))
-                    }
-                };
+                // A device's step returns the one before it, so that the device does not wait
+                // for the host.
+                let done = steps.step(&batch, lr)?;
                 self.split.steps += since(stepping);
                 if let Some((value, samples)) = done {
                     self.record_step(value, samples, epoch, total, row_every)?;
@@ -406,13 +366,12 @@ impl<'s, O: Objective> Run<'s, O> {
                     break;
                 }
                 if self.last_checkpoint.elapsed().as_secs_f64() > self.schedule.checkpoint_secs {
-                    self.settle(optim, epoch, total, row_every)?;
-                    optim.store(&mut net);
-                    self.save(&net, optim, &inner)?;
+                    self.settle(steps, epoch, total, row_every)?;
+                    steps.store(net);
+                    self.save(net, steps)?;
                 }
             }
-            self.settle(optim, epoch, total, row_every)?;
-            Ok(net)
+            self.settle(steps, epoch, total, row_every)
         })
     }
 
@@ -446,19 +405,17 @@ impl<'s, O: Objective> Run<'s, O> {
     /// end of an epoch.
     fn settle(
         &mut self,
-        optim: &mut Optimiser<O::Net, O::Batch>,
+        steps: &mut dyn EngineSteps<O::Net, O::Batch>,
         epoch: usize,
         total: usize,
         row_every: u64,
     ) -> Result<()> {
-        if let Optimiser::Device(steps) = optim {
-            // Waiting for the step is the step's time.
-            let waiting = Instant::now();
-            let last = steps.finish()?;
-            self.split.steps += since(waiting);
-            if let Some((value, samples)) = last {
-                self.record_step(value, samples, epoch, total, row_every)?;
-            }
+        // Waiting for the step is the step's time.
+        let waiting = Instant::now();
+        let last = steps.finish()?;
+        self.split.steps += since(waiting);
+        if let Some((value, samples)) = last {
+            self.record_step(value, samples, epoch, total, row_every)?;
         }
         Ok(())
     }
@@ -541,16 +498,11 @@ impl<'s, O: Objective> Run<'s, O> {
     }
 
     /// Writes the checkpoint, the model files and the loss curves.
-    fn save(
-        &mut self,
-        net: &O::Net,
-        optim: &Optimiser<O::Net, O::Batch>,
-        device: &Device,
-    ) -> Result<()> {
+    fn save(&mut self, net: &O::Net, steps: &dyn EngineSteps<O::Net, O::Batch>) -> Result<()> {
         let saving = Instant::now();
         let (objective, out, ck) = (self.objective, self.out, &mut self.ck);
-        checkpoint::write(out, ck, net, optim, &objective.tag())?;
-        objective.save_model(out, net, self.schedule, &ck.state, device)?;
+        checkpoint::write(out, ck, net, steps, &objective.tag())?;
+        objective.save_model(out, net, self.schedule, &ck.state)?;
         curves::write_csv(&out.join("loss.csv"), &ck.history)?;
         curves::plot(&out.join("loss.png"), &ck.history, &objective.title())?;
         self.split.saving += since(saving);

@@ -1,10 +1,7 @@
 //! The per-epoch validation loss of a Neural PRT network on held-out lighting.
 
 use anyhow::Result;
-use burn::tensor::Device;
 
-use crate::loss::log_l1;
-use crate::network::nprt_net::NprtNet;
 use crate::training::batch::Batch;
 use crate::training::training_set::{TrainingSet, ViewSamples};
 
@@ -28,10 +25,4 @@ pub fn validation_loss(
         return Ok(f64::NAN);
     }
     Ok(sum / count as f64)
-}
-
-/// `batch`'s mean log-L1 loss through burn's forward pass of `net` on `device`.
-pub fn forward_log_l1(net: &NprtNet, batch: &Batch, device: &Device) -> f64 {
-    let (pred, reference) = batch.forward(net, device);
-    log_l1(pred, reference).into_scalar::<f32>() as f64
 }

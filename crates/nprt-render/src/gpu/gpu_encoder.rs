@@ -4,10 +4,10 @@
 
 use std::sync::Arc;
 
-use nprt_net::cpu::HostEncoder;
 use nprt_net::gpu::kernels::ENCODER_BLOCK;
 use nprt_net::gpu::{groups_for, Dispatch, GpuDevice};
 use nprt_net::network::encoder::{BLOCKS, CHANNELS, CODE_SIZE};
+use nprt_net::LightEncoder;
 
 use super::gpu_mlp::{dense_layer, GpuDense, Rows};
 use super::kept_last::KeptLast;
@@ -40,7 +40,7 @@ impl EncoderRun {
 
 impl GpuEncoder {
     /// `encoder`'s weights uploaded.
-    pub fn upload(gpu: &GpuDevice, encoder: &HostEncoder) -> Self {
+    pub fn upload(gpu: &GpuDevice, encoder: &LightEncoder) -> Self {
         GpuEncoder {
             convs: encoder
                 .convs

@@ -2,12 +2,13 @@
 //! networks run in half precision) and the dispatches of its forward pass over rows of inputs,
 //! through ping-pong activations.
 
-use nprt_net::cpu::{Dense, DenseStack};
 use nprt_net::gpu::Dispatch;
 use nprt_net::gpu::{activation_code, pad16, Bias, GpuDevice, HalfWeight, Held, Operand, Output};
+use nprt_net::network::dense::Dense;
+use nprt_net::network::mlp::Mlp;
 use nprt_net::Activation;
 
-/// One dense layer's weights (`d_in × d_out`, burn's layout) and bias on the device, and the
+/// One dense layer's weights (`d_in × d_out`, as the model file stores them) and bias on the device, and the
 /// weights in f16 where the networks run in half precision.
 pub(super) struct GpuDense {
     pub weight: wgpu::Buffer,
@@ -54,7 +55,7 @@ pub(super) struct FirstLayer<'a> {
 
 impl GpuMlp {
     /// `s`'s layers uploaded (f32 only).
-    pub fn upload(gpu: &GpuDevice, s: &DenseStack) -> Self {
+    pub fn upload(gpu: &GpuDevice, s: &Mlp) -> Self {
         GpuMlp {
             layers: s.layers.iter().map(|d| GpuDense::upload(gpu, d)).collect(),
             activation: s.activation,

@@ -9,9 +9,9 @@ use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::{Arc, Mutex, OnceLock};
 
 use anyhow::Result;
-use nprt_net::cpu::{DenseStack, HostEncoder, HostTransport};
 use nprt_net::encoding::hash_grid;
 use nprt_net::network::encoder::CODE_SIZE;
+use nprt_net::network::mlp::Mlp;
 use nprt_net::{MapNorm, NprtNet, TrackKind, FEATURES, TRANSPORT_CODE};
 use nprt_scene::EnvMap;
 
@@ -144,11 +144,9 @@ impl GpuNetwork {
     pub fn new(net: &NprtNet, gain: [f32; 3]) -> Result<Self> {
         static NETWORKS: AtomicU64 = AtomicU64::new(0);
         let gpu = GpuDevice::get()?;
-        let host = HostTransport::from_net(net);
-        let encoder = HostEncoder::from_burn(&net.encoder);
         let storage = |data: &[f32]| gpu.upload(data);
-        let mlp = |s: &DenseStack| GpuMlp::upload(&gpu, s);
-        let tracks: Vec<GpuTrack> = host
+        let mlp = |s: &Mlp| GpuMlp::upload(&gpu, s);
+        let tracks: Vec<GpuTrack> = net
             .tracks
             .iter()
             .map(|t| {
@@ -158,7 +156,7 @@ impl GpuNetwork {
                     index: gpu.upload(&index),
                     count: index.len(),
                     width: index.len() + t.grid.as_ref().map_or(0, |_| hash_grid::OUTPUTS),
-                    grid: t.grid.as_deref().map(storage),
+                    grid: t.grid.as_ref().map(|g| storage(&g.table)),
                     transfer: t.transfer.as_ref().map(mlp),
                     shading: mlp(&t.shading),
                 }
@@ -175,7 +173,7 @@ impl GpuNetwork {
             inputs: KeptLast::default(),
             encoding: Mutex::new(()),
             id: NETWORKS.fetch_add(1, Ordering::Relaxed),
-            encoder: GpuEncoder::upload(&gpu, &encoder),
+            encoder: GpuEncoder::upload(&gpu, &net.encoder),
             tracks,
             resolutions: gpu.upload(&hash_grid::resolutions()),
             map: GpuMap::default(),

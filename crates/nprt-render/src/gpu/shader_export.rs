@@ -9,10 +9,13 @@
 use std::path::{Path, PathBuf};
 
 use anyhow::{bail, Context, Result};
-use nprt_net::cpu::{Dense, DenseStack, HostEncoder, HostTransport};
 use nprt_net::encoding::hash_grid;
+use nprt_net::network::dense::Dense;
 use nprt_net::network::encoder::CODE_SIZE;
-use nprt_net::{gbuffer_features, load_model, Device, LightInput, FEATURES, TRANSPORT_CODE};
+use nprt_net::network::mlp::Mlp;
+use nprt_net::{
+    gbuffer_features, load_model, LightEncoder, LightInput, NprtNet, FEATURES, TRANSPORT_CODE,
+};
 use nprt_trace::{render_gbuffer, TraceScene};
 use serde_json::{json, Value};
 
@@ -92,7 +95,7 @@ impl WeightFile {
         self.halves.extend(bits);
     }
 
-    fn mlp(&mut self, name: &str, m: &DenseStack) -> Value {
+    fn mlp(&mut self, name: &str, m: &Mlp) -> Value {
         let layers: Vec<Value> = (m.layers.iter().enumerate())
             .map(|(i, l)| {
                 let name = format!("{name}.{i}");
@@ -104,7 +107,7 @@ impl WeightFile {
     }
 
     /// The encoder's blocks and its dense layer into the code, their tensors added.
-    fn encoder(&mut self, encoder: &HostEncoder) -> (Vec<Value>, Value) {
+    fn encoder(&mut self, encoder: &LightEncoder) -> (Vec<Value>, Value) {
         let convs: Vec<Value> = (encoder.convs.iter().enumerate())
             .map(|(i, c)| {
                 json!({
@@ -119,10 +122,11 @@ impl WeightFile {
     }
 
     /// Each transport track: its kind, inputs, grid and networks, their tensors added.
-    fn tracks(&mut self, transport: &HostTransport) -> Vec<Value> {
-        transport.tracks.iter().enumerate()
+    fn tracks(&mut self, net: &NprtNet) -> Vec<Value> {
+        net.tracks.iter().enumerate()
             .map(|(i, t)| {
                 let grid = t.grid.as_ref().map(|g| {
+                    let g = &g.table;
                     let rows = g.len() / hash_grid::LEVEL_FEATURES;
                     json!({
                         "table": self.add(&format!("track{i}.grid"), &[rows, hash_grid::LEVEL_FEATURES], g),
@@ -150,7 +154,7 @@ impl WeightFile {
 /// Exports the model in `model_dir` into `out` (created if need be; files in it are replaced,
 /// each atomically), with a worked example relighting `view` of its scene.
 pub fn export_model(model_dir: &Path, out: &Path, view: &ExampleView) -> Result<ExportSummary> {
-    let (file, net) = load_model(model_dir, &Device::flex())?;
+    let (file, net) = load_model(model_dir)?;
     if out.exists() && !out.is_dir() {
         bail!("--out '{}' is not a folder", out.display());
     }
@@ -170,8 +174,8 @@ pub fn export_model(model_dir: &Path, out: &Path, view: &ExampleView) -> Result<
     }
 
     let mut weights = WeightFile::default();
-    let (convs, to_code) = weights.encoder(&HostEncoder::from_burn(&net.encoder));
-    let tracks = weights.tracks(&HostTransport::from_net(&net));
+    let (convs, to_code) = weights.encoder(&net.encoder);
+    let tracks = weights.tracks(&net);
     write("weights.bin", &le_bytes(&weights.values, f32::to_le_bytes))?;
     write(
         "weights_f16.bin",

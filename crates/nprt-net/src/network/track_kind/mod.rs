@@ -1,7 +1,7 @@
 //! What a transport track reads and how its outputs make radiance: one file per kind states its
 //! inputs and its combine rule once ([`KindSpec`]), and everything else derives from that
-//! table: the burn forward pass (`Track::forward`), the CPU engine's forward and
-//! backward ([`TrackKind::radiance`], [`TrackKind::output_gradients`]) and the WGSL table
+//! table: the CPU engine's forward and backward ([`TrackKind::radiance`],
+//! [`TrackKind::output_gradients`]), the tests' f64 reference, and the WGSL table
 //! that the training and frame kernels and the export read ([`kind_table_wgsl`]).
 //!
 //! A rule is a sum of terms, each the exp of three of the shading network's outputs (its
