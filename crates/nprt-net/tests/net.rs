@@ -318,3 +318,36 @@ fn output_level_shift_scales_the_untrained_prediction() {
         }
     }
 }
+
+/// The weights file is the model folder's contract: every design's header (tensor names,
+/// shapes, order and offsets) and the Deep Shading U-Net's is byte for byte the one burn wrote
+/// before nprt had its own weight type (tests/data/weights_headers.json, from `nprt demo
+/// --quick` at stop 46), so model folders written before still load.
+#[test]
+fn weights_files_have_the_headers_models_were_written_with() {
+    use nprt_net::deep_shading::DeepShading;
+    let golden: serde_json::Map<String, serde_json::Value> =
+        serde_json::from_str(include_str!("data/weights_headers.json")).unwrap();
+    let dir = std::env::temp_dir().join(format!("nprt-net-headers-{}", std::process::id()));
+    for (tag, header) in &golden {
+        let path = dir.join(format!("{}.safetensors", tag.replace(':', "-")));
+        match tag.split_once(':') {
+            None => save_weights(&path, &DeepShading::new(&mut Init::new(0), 128), tag),
+            Some((design, activation)) => {
+                let design = *Design::ALL.iter().find(|d| d.name() == design).unwrap();
+                let activation = [Activation::Siren, Activation::Relu]
+                    .into_iter()
+                    .find(|a| a.name() == activation);
+                let net = ModelConfig::new(design, activation).build(&mut Init::new(0));
+                save_weights(&path, &net, tag)
+            }
+        }
+        .unwrap();
+        let bytes = std::fs::read(&path).unwrap();
+        let n = u64::from_le_bytes(bytes[..8].try_into().unwrap()) as usize;
+        let written = std::str::from_utf8(&bytes[8..8 + n]).unwrap();
+        assert_eq!(written, header.as_str().unwrap(), "{tag}");
+    }
+    assert_eq!(golden.len(), Design::ALL.len() + 1);
+    std::fs::remove_dir_all(&dir).ok();
+}

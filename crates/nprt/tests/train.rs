@@ -82,6 +82,7 @@ fn the_gpu_path_overfits_and_resumes_exactly() {
     // engine, and by then the loss has fallen to a tenth.
     overfits(&[("dsep", "hash-grid")], "wgpu", 100);
     resumes_exactly("wgpu");
+    resumes_across_engines();
     batches_gathered_on_the_gpu_equal_the_hosts();
     mixed_precision_trains_as_f32_does();
 }
@@ -619,4 +620,30 @@ fn a_dataset_is_packed_once_and_again_only_when_it_changes() {
     assert!(dir.join("packed-indirect.bin").exists());
     std::fs::remove_dir_all(&dir).unwrap();
     std::fs::remove_dir_all(&model).unwrap();
+}
+
+/// A checkpoint is one format on both engines (the weights, and Adam's moments in the
+/// network's tensor order): a run started on the CPU engine continues on the GPU kernels and
+/// back, each leg resuming where the last stopped.
+fn resumes_across_engines() {
+    let out = fresh_dir("resume-across-engines");
+    let run = |epochs: &str, device: &str| {
+        let args = [
+            "--epochs",
+            epochs,
+            "--schedule",
+            "paper",
+            "--device",
+            device,
+        ];
+        train(&out, "albedo", &args)
+    };
+    run("1", "cpu");
+    for (epochs, device, from) in [("2", "wgpu", "1.00"), ("3", "cpu", "2.00")] {
+        let log = run(epochs, device);
+        assert!(log.contains(&format!("resumed from epoch {from}")), "{log}");
+    }
+    let val: Vec<f64> = losses(&out).iter().filter_map(|r| r.1).collect();
+    assert_eq!(val.len(), 3, "one validation row per epoch: {val:?}");
+    assert!(val.iter().all(|v| v.is_finite()), "{val:?}");
 }
