@@ -15,7 +15,8 @@ use common::{loud_grids, random_batch, variants};
 use nprt_net::gpu::{GpuDevice, GpuTrainer};
 use nprt_net::optimiser::Adam;
 use nprt_net::{
-    cpu, Design, Init, Loss, ModelConfig, NprtNet, Parameters, PositionEncoding, Precision,
+    cpu, Activation, Design, Init, Loss, ModelConfig, NprtNet, Parameters, PositionEncoding,
+    Precision,
 };
 
 /// Euclidean distance of `a` from `b` over b's norm.
@@ -82,6 +83,35 @@ fn gpu_gradients_match_the_cpu_engine_for_every_design() {
             // the same dispatches.
             assert_eq!(gpu.loss(&samples, loss), value, "{name}: forward-only loss");
         }
+    }
+}
+
+/// A network of three tracks, beyond every design (D/S's two and a full one): the kernels sum
+/// and differentiate any number of tracks, one dispatch per track, as the CPU engine does.
+#[test]
+fn three_tracks_train_as_on_the_cpu_engine() {
+    if !GpuDevice::probe() {
+        return;
+    }
+    let batch = random_batch(300, 3, 25);
+    let samples = batch.samples();
+    let mut net = network(&ModelConfig::new(Design::Dsep, None));
+    let mut init = Init::new(5);
+    let kind = nprt_net::TrackKind::Full;
+    let encoding = PositionEncoding::None;
+    let third = nprt_net::Track::new(&mut init, Design::Dsep, kind, Activation::Siren, encoding);
+    net.tracks.push(third);
+    for loss in [Loss::LogL1, Loss::RelL2] {
+        let (want_loss, want) = cpu::gradients(&net, &samples, loss);
+        let mut gpu = GpuTrainer::new(&net, Precision::F32).unwrap();
+        let value = gpu.backward(&samples, loss);
+        let worst = tensor_errors(&gpu.gradients(), &want)
+            .into_iter()
+            .fold(0.0f64, f64::max);
+        let loss_error = (value - want_loss).abs() / want_loss;
+        eprintln!("three tracks, {loss}: loss {loss_error:.1e}, gradients {worst:.1e}");
+        assert!(loss_error < 1e-5, "{loss}: loss off by {loss_error}");
+        assert!(worst < 1e-4, "{loss}: a gradient off by {worst}");
     }
 }
 

@@ -100,6 +100,43 @@ fn gpu_light_codes_and_radiance_match_the_cpu_engine_for_every_design() {
     }
 }
 
+/// A network of three tracks, beyond every design (D/S's two and a full one): the frame path
+/// sums any number of tracks, one `combine` per track, as the CPU engine does.
+#[test]
+fn three_tracks_shade_as_on_the_cpu_engine() {
+    if !GpuDevice::probe() {
+        return;
+    }
+    let device = GpuDevice::get().unwrap();
+    let features = room_features();
+    let mut net = model(
+        Design::Dsep,
+        Activation::Siren,
+        PositionEncoding::HashGrid,
+        40,
+    );
+    let kind = nprt_net::TrackKind::Full;
+    let third = nprt_net::Track::new(
+        &mut Init::new(41),
+        Design::Dsep,
+        kind,
+        Activation::Siren,
+        PositionEncoding::None,
+    );
+    net.tracks.push(third);
+    let (divisor, gain) = ([0.5, 3.0, 1.0], [4.0, 1.0, 0.5]);
+    let gpu = GpuNetwork::new(&net, gain).unwrap();
+    let map = nprt_scene::open_envmap("builtin:sky:25:40").unwrap();
+    let input = LightInput::new(&map, 30.0, 64, MapNorm::Channel);
+    let code = net.encoder.forward(&input.pixels, 64).codes;
+    let light = GpuLightCode::upload(&device, &code, divisor);
+    let (rgb, _) = gpu.radiance(&gpu.pixels(&features), &light, None);
+    let want = net.radiance(&features, &code, [2.0, 3.0, 0.5], None);
+    let error = relative_difference(&rgb, &want);
+    eprintln!("three tracks: radiance {error:.2e}");
+    assert!(error < 1e-5, "three tracks: radiance off by {error}");
+}
+
 #[test]
 fn the_widest_encoder_input_gets_the_cpu_engines_light_code() {
     if !GpuDevice::probe() {

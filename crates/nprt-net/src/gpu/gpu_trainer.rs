@@ -145,6 +145,9 @@ pub(super) struct BatchBuffers {
     pub view: wgpu::Buffer,
     pub codes: wgpu::Buffer,
     pub d_codes: wgpu::Buffer,
+    /// The tracks' radiance summed (before the map's scale), and the loss's gradient there.
+    pub radiance_sum: wgpu::Buffer,
+    pub d_radiance: wgpu::Buffer,
     pub row_loss: wgpu::Buffer,
     pub loss: wgpu::Buffer,
     /// A picked batch's records and views (u32; see [`GpuTrainer::queue_picked_step`]).
@@ -548,6 +551,8 @@ impl GpuTrainer {
             view: gpu.buffer(rows),
             codes: gpu.buffer(views * CODE_SIZE),
             d_codes: gpu.buffer(views * CODE_SIZE),
+            radiance_sum: gpu.buffer(rows * 3),
+            d_radiance: gpu.buffer(rows * 3),
             row_loss: gpu.buffer(rows),
             loss: gpu.buffer(1),
             picks: gpu.buffer(2 * rows),

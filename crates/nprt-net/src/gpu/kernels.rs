@@ -39,8 +39,9 @@ pub const GEMM: KernelSource = kernel!("gemm");
 pub const COLUMN_SUM: KernelSource = kernel!("column_sum");
 pub static COMBINE: LazyLock<KernelSource> =
     LazyLock::new(|| with_kinds(kernel!("combine", "track_radiance")));
-pub static RADIANCE_LOSS: LazyLock<KernelSource> =
-    LazyLock::new(|| with_kinds(kernel!("radiance_loss", "track_radiance")));
+pub const RADIANCE_LOSS: KernelSource = kernel!("radiance_loss");
+pub static TRACK_GRADIENT: LazyLock<KernelSource> =
+    LazyLock::new(|| with_kinds(kernel!("track_gradient", "track_radiance")));
 pub const ADAM: KernelSource = kernel!("adam");
 pub const GATHER_SAMPLES: KernelSource = kernel!("gather_samples", "pixel_features");
 /// The network inputs of a G-buffer left on the device (nprt-render's frame path).

@@ -5,7 +5,7 @@
 
 use super::codes::loss_code;
 use super::gpu_trainer::{BatchBuffers, GpuTrainer};
-use super::kernels::{GRID_BACKWARD, RADIANCE_LOSS, TRACK_INPUTS};
+use super::kernels::{COMBINE, GRID_BACKWARD, RADIANCE_LOSS, TRACK_GRADIENT, TRACK_INPUTS};
 use super::network_layout::TrackAt;
 use super::products::{Bias, FirstLayer, MlpTape, Operand, Output};
 use super::{groups_for, Bind, Dispatch};
@@ -48,31 +48,42 @@ impl GpuTrainer {
             .iter()
             .map(|t| self.track_forward(plan, t, b))
             .collect();
-        let kinds: Vec<u32> = self.net.tracks.iter().map(|t| t.kind.code()).collect();
-        let last = tapes.last().expect("a track");
-        let mut params = vec![
-            b.rows as u32,
-            kinds.len() as u32,
-            kinds[0],
-            *kinds.last().expect("a track"),
-            loss_code(loss),
-            0,
-            0,
-            0,
-        ];
+        // The tracks' radiance summed into `radiance`, one track per dispatch (any number of
+        // tracks), then the loss and its gradient at that sum.
+        for (k, (t, tape)) in self.net.tracks.iter().zip(&tapes).enumerate() {
+            let params = [
+                b.rows,
+                t.kind.code() as usize,
+                usize::from(k > 0),
+                0,
+                0,
+                0,
+                0,
+                0,
+            ];
+            plan.push(self.gpu.prepare(
+                &COMBINE,
+                &params.map(|v| v as u32),
+                &[
+                    &b.features,
+                    tape.shading.outputs.last().expect("a layer"),
+                    &self.gpu.empty,
+                    &b.radiance_sum,
+                ],
+                groups_for(b.rows),
+            ));
+        }
+        let mut params = vec![b.rows as u32, loss_code(loss), 0, 0];
         let norm = b.grad_scale / (3 * b.rows.max(1)) as f32;
         params.extend([norm, 0.0, 0.0, 0.0].map(f32::to_bits));
         plan.push(self.gpu.prepare(
             &RADIANCE_LOSS,
             &params,
             &[
-                &b.features,
+                &b.radiance_sum,
                 &b.radiance,
                 &b.scale,
-                tapes[0].shading.outputs.last().expect("a layer"),
-                last.shading.outputs.last().expect("a layer"),
-                &tapes[0].d_out,
-                &last.d_out,
+                &b.d_radiance,
                 &b.row_loss,
             ],
             groups_for(b.rows),
@@ -87,6 +98,17 @@ impl GpuTrainer {
         );
         let forward = plan.len();
         for (t, tape) in self.net.tracks.iter().zip(&tapes) {
+            plan.push(self.gpu.prepare(
+                &TRACK_GRADIENT,
+                &[b.rows as u32, t.kind.code(), 0, 0],
+                &[
+                    &b.features,
+                    tape.shading.outputs.last().expect("a layer"),
+                    &b.d_radiance,
+                    &tape.d_out,
+                ],
+                groups_for(b.rows),
+            ));
             self.track_backward(plan, t, tape, b);
         }
         forward

@@ -488,30 +488,27 @@ impl GpuNetwork {
                 t.shading
                     .record(gpu, &mut list, x, chunk.rows, first, &px.work.scratch, out);
             }
-            let kinds: Vec<u32> = self.tracks.iter().map(|t| t.kind.code()).collect();
-            let params = [
-                chunk.rows as u32,
-                kinds.len() as u32,
-                kinds[0],
-                *kinds.last().expect("a track"),
-                chunk.first as u32,
-                CODE_SIZE as u32,
-                0,
-                0,
-            ];
-            let out1 = px.work.outputs.last().expect("a track");
-            list.push(gpu.prepare(
-                &COMBINE,
-                &params,
-                &[
-                    &chunk.features,
-                    &px.work.outputs[0],
-                    out1,
-                    &self.light,
-                    &px.rgb,
-                ],
-                groups_for(chunk.rows),
-            ));
+            // The tracks' radiance summed into rgb one track per dispatch (any number of
+            // tracks), the last multiplied by the map's divisor and the model's gain.
+            let n = self.tracks.len();
+            for (k, (t, out)) in self.tracks.iter().zip(&px.work.outputs).enumerate() {
+                let params = [
+                    chunk.rows,
+                    t.kind.code() as usize,
+                    usize::from(k > 0),
+                    usize::from(k + 1 == n),
+                    chunk.first,
+                    CODE_SIZE,
+                    0,
+                    0,
+                ];
+                list.push(gpu.prepare(
+                    &COMBINE,
+                    &params.map(|v| v as u32),
+                    &[&chunk.features, out, &self.light, &px.rgb],
+                    groups_for(chunk.rows),
+                ));
+            }
         }
         list
     }

@@ -1,8 +1,8 @@
 // A row's radiance from its tracks' shading outputs (log-radiance): each track's terms, exp of
 // three outputs times a weight, 1 or an albedo among the pixel inputs, as the kind table before
 // this file says (generated from nprt-net's TrackKind). Shared by the kernels that combine the
-// tracks (frames) and that train on them (each kernel's source is the table, this file, then
-// its own, which binds `features`, `out0` and `out1`).
+// tracks and that take the gradient to a track's outputs (each kernel's source is the table,
+// this file, then its own, which binds `features` and the track's outputs `out`).
 
 const FEATURES: u32 = 19u;
 
@@ -21,17 +21,13 @@ fn term_weight(kind: u32, t: u32, r: u32) -> vec3<f32> {
     return vec3<f32>(features[f], features[f + 1u], features[f + 2u]);
 }
 
-// exp of each term's three outputs of a track (in out0 or out1).
-fn exps(kind: u32, out: u32, r: u32) -> array<vec3<f32>, MAX_TERMS> {
+// exp of each term's three outputs of the track.
+fn exps(kind: u32, r: u32) -> array<vec3<f32>, MAX_TERMS> {
     let n = outputs(kind) * r;
     var e: array<vec3<f32>, MAX_TERMS>;
     for (var t = 0u; t < KIND_TERMS[kind]; t++) {
         let i = n + 3u * t;
-        if (out == 0u) {
-            e[t] = exp(vec3<f32>(out0[i], out0[i + 1u], out0[i + 2u]));
-        } else {
-            e[t] = exp(vec3<f32>(out1[i], out1[i + 1u], out1[i + 2u]));
-        }
+        e[t] = exp(vec3<f32>(out[i], out[i + 1u], out[i + 2u]));
     }
     return e;
 }

@@ -165,8 +165,11 @@ async function main() {
       const dIn = first.dIn - 64;
       runMlp(pass, t.shading, kept[i], rows, { dIn, wRow: codeFirst ? 64 : 0, bias }, scratch, outputs[i]);
     });
-    const params = new Uint32Array([rows, tracks.length, tracks[0].kind, tracks.at(-1).kind, 0, 64, 0, 0]);
-    dispatch(pass, 'combine', params, [features, outputs[0], outputs.at(-1), code, rgb], groups(rows));
+    // The tracks' radiance summed into rgb one track per dispatch, the last scaled.
+    tracks.forEach((t, i) => {
+      const params = new Uint32Array([rows, t.kind, i > 0 ? 1 : 0, i === tracks.length - 1 ? 1 : 0, 0, 64, 0, 0]);
+      dispatch(pass, 'combine', params, [features, outputs[i], code, rgb], groups(rows));
+    });
     pass.end();
     const readback = device.createBuffer({ size: rows * 12, usage: GPUBufferUsage.MAP_READ | GPUBufferUsage.COPY_DST });
     encoder.copyBufferToBuffer(rgb, 0, readback, 0, rows * 12);
