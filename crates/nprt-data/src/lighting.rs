@@ -148,7 +148,7 @@ pub fn map_hash(spec: &str) -> Result<String> {
         blake3::hash(spec.as_bytes())
     } else {
         blake3::hash(
-            &std::fs::read(spec)
+            &nprt_io::read_input(std::path::Path::new(spec))
                 .with_context(|| format!("cannot read environment map '{spec}'"))?,
         )
     };

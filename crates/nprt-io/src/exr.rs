@@ -55,6 +55,7 @@ pub fn write_channels(
 /// refuses a size the memory here cannot decode (a corrupt header claimed gigabytes, which the
 /// decoder allocated before finding the data malformed).
 pub fn checked_size(path: &Path) -> Result<(usize, usize)> {
+    crate::check_input(path)?;
     let meta = ::exr::meta::MetaData::read_from_file(path, false)
         .with_context(|| format!("cannot read '{}'", path.display()))?;
     let header = meta

@@ -19,6 +19,7 @@ pub struct LinearImage {
 /// Reads `path` by its content (the extension only picks OpenEXR). Integer formats are
 /// sRGB-decoded unless `raw`; floating-point ones are linear already.
 pub fn read_linear_rgb(path: &Path, raw: bool) -> Result<LinearImage> {
+    crate::check_input(path)?;
     let is_exr = path
         .extension()
         .and_then(|e| e.to_str())

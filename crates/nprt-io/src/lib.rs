@@ -1,7 +1,8 @@
 //! nprt-io: how every nprt stage touches the file system and the terminal. It owns writing
 //! files so that no run ever leaves a half-written one (a temporary file renamed into place),
 //! checking early that an output folder is writable (and never replacing a device, FIFO or
-//! link target it was not asked to), checking sizes against the machine's memory and cores
+//! link target it was not asked to), inputs checked to be regular files (a FIFO
+//! would block for ever), lock files opened without following links, checking sizes against the machine's memory and cores
 //! before allocating, the one style of progress bar with an ETA, and the file formats of pixels: multi-channel OpenEXR, the one image reader (EXR, PNG,
 //! JPEG, Radiance HDR as linear RGB), tone-mapped PNG, the sRGB curve, and line plots. It sits
 //! at the bottom of the stack and must know nothing of scenes or networks: callers hand it
@@ -19,7 +20,9 @@
 mod atomic;
 pub mod exr;
 mod image_read;
+mod input_file;
 mod limits;
+mod lock_file;
 mod plot;
 mod png;
 mod progress;
@@ -31,7 +34,9 @@ pub use atomic::{
 };
 pub use image_read::{linear_rgb, read_linear_rgb, LinearImage};
 pub use indicatif::ProgressBar;
+pub use input_file::{check_input, read_input, read_input_string};
 pub use limits::{available_memory, check_threads, ensure_memory, thread_limit};
+pub use lock_file::open_lock_file;
 pub use plot::plot_lines;
 pub use png::{srgb8, to_image, write_png};
 pub use progress::progress_bar;

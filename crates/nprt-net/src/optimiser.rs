@@ -138,7 +138,7 @@ pub fn load_state(path: &Path, params: usize) -> Result<([Vec<f32>; 2], u64)> {
             path.parent().map_or(path, |p| p).display()
         );
     }
-    let bytes = std::fs::read(path)
+    let bytes = nprt_io::read_input(path)
         .with_context(|| format!("cannot read Adam's state '{}'", path.display()))?;
     let bad = |why: String| anyhow!("Adam's state '{}' {why}", path.display());
     let file = SafeTensors::deserialize(&bytes).map_err(|e| bad(format!("is unreadable: {e}")))?;

@@ -39,7 +39,7 @@ fn catmull_rom(p: [Vec3; 4], t: f32) -> Vec3 {
 impl CameraPath {
     /// Reads `{"keyframes": [{"position": [x,y,z], "target": [x,y,z], "fov_x_deg": 60}, …]}`.
     pub fn load(path: &Path) -> Result<Self> {
-        let text = std::fs::read_to_string(path)
+        let text = nprt_io::read_input_string(path)
             .with_context(|| format!("cannot read camera path '{}'", path.display()))?;
         Self::from_json(&text).with_context(|| format!("camera path '{}'", path.display()))
     }

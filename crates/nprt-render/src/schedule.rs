@@ -91,7 +91,7 @@ impl LightingSchedule {
     /// turning by `spin_deg` over its segment.
     pub fn parse(spec: &str, spin_deg: f32) -> Result<Self> {
         let segments = if spec.ends_with(".json") {
-            let text = std::fs::read_to_string(Path::new(spec))
+            let text = nprt_io::read_input_string(Path::new(spec))
                 .with_context(|| format!("cannot read lighting schedule '{spec}'"))?;
             parse_segments(&text).with_context(|| format!("lighting schedule '{spec}'"))?
         } else {

@@ -52,7 +52,7 @@ impl CameraVolume {
 
     /// Reads and checks a camera-volume file; errors name the file and the reason.
     pub fn load(path: &Path) -> Result<Self> {
-        let text = std::fs::read_to_string(path)
+        let text = nprt_io::read_input_string(path)
             .with_context(|| format!("cannot read camera volume '{}'", path.display()))?;
         let f: VolumeFile = serde_json::from_str(&text)
             .with_context(|| format!("camera volume '{}'", path.display()))?;

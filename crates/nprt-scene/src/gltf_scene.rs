@@ -17,7 +17,8 @@ use nprt_io::linear_rgb;
 
 pub fn load(path: &Path) -> Result<Scene> {
     let name = path.display().to_string();
-    let bytes = std::fs::read(path).with_context(|| format!("cannot read glTF file '{name}'"))?;
+    let bytes =
+        nprt_io::read_input(path).with_context(|| format!("cannot read glTF file '{name}'"))?;
     // Required extensions are checked before validation, which would bury them in a list of
     // consequences (e.g. Draco-compressed accessors without buffer views).
     let unvalidated = gltf::Gltf::from_slice_without_validation(&bytes)

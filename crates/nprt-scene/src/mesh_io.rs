@@ -63,6 +63,7 @@ fn fan(poly: &[u32], out: &mut Vec<[u32; 3]>) {
 }
 
 fn load_ply(path: &Path) -> Result<Mesh> {
+    nprt_io::check_input(path)?;
     let mut file = std::io::BufReader::new(std::fs::File::open(path)?);
     let ply = Parser::<DefaultElement>::new()
         .read_ply(&mut file)

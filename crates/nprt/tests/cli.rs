@@ -456,8 +456,10 @@ fn bench_frame_times_every_stage_on_each_device() {
                 pixels > 0.0 && gbuffer > 0.0 && encoder > 0.0 && networks > 0.0 && relight > 0.0,
                 "{row}"
             );
+            // Each column is printed rounded to 0.1 ms: the four parts and the total may
+            // disagree by up to 5 × 0.05 (seen: 389.9 against 389.7).
             assert!(
-                (total - (gbuffer + encoder + networks + direct)).abs() < 0.2,
+                (total - (gbuffer + encoder + networks + direct)).abs() < 0.26,
                 "{row}"
             );
         }

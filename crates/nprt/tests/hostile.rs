@@ -133,22 +133,26 @@ fn non_finite_results_are_refused_and_black_lighting_is_warned_of() {
     tiny_dataset(&data);
     let d = data.to_str().unwrap();
     // A learning rate that breaks the weights: the run stops with exit 1 (it saved a model
-    // with a non-finite validation loss and exit 0), and what it kept renders finite frames or
-    // none. The broken weights make infinite radiance on the CPU engine (exp overflows).
+    // with a non-finite validation loss and exit 0) and removes the model files it saved at
+    // every step's checkpoint (weights of 1e30, finite, rendered black frames with exit 0), so
+    // render refuses the folder. The broken weights make infinite radiance on the CPU engine
+    // (exp overflows).
     let blown = dir.join("blown");
     let b = blown.to_str().unwrap();
+    let every_step = ["--lr", "1e30", "--epochs", "2", "--checkpoint-minutes", "0"];
     fails(
-        &train_args(d, b, &["--lr", "1e30", "--epochs", "2"]),
-        &["training diverged", "validation loss inf", "lower --lr"],
+        &train_args(d, b, &every_step),
+        &[
+            "training diverged",
+            "validation loss inf",
+            "its model files are removed",
+            "lower --lr",
+        ],
     );
-    let blown_frames = dir.join("blown-frames");
-    let rendered = render_exr(b, &blown_frames, "1", &[]);
-    if rendered.status.success() {
-        let (_, _, ch) = read_channels(&blown_frames.join("frames/0000.exr")).unwrap();
-        assert!(ch.values().flatten().all(|v| v.is_finite()));
-    } else {
-        assert_eq!(rendered.status.code(), Some(1));
-    }
+    assert!(!blown.join("model.json").exists() && !blown.join("weights.safetensors").exists());
+    let rendered = render_exr(b, &dir.join("blown-frames"), "1", &[]);
+    assert_eq!(rendered.status.code(), Some(1));
+    assert!(String::from_utf8_lossy(&rendered.stderr).contains("is not a model folder"));
 
     // A camera path keyframe straight above its target renders finite frames.
     let model = dir.join("model");
@@ -432,6 +436,172 @@ fn a_second_training_run_on_one_folder_is_refused_by_name() {
     }
     next.kill().unwrap();
     next.wait().unwrap();
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+/// Lock files made links to other files are refused by kind and their targets left intact
+/// (the model folder's `.lock` had its target overwritten with a pid, the dataset's
+/// `.packing.lock` had its target truncated to 0 bytes).
+#[cfg(unix)]
+#[test]
+fn lock_files_are_never_followed() {
+    let dir = fresh_dir("lock-links");
+    let data = dir.join("ds");
+    tiny_dataset(&data);
+    let d = data.to_str().unwrap();
+    let precious = dir.join("precious.txt");
+    std::fs::write(&precious, b"keep me").unwrap();
+    let out = dir.join("model");
+    std::fs::create_dir_all(&out).unwrap();
+    std::os::unix::fs::symlink(&precious, out.join(".lock")).unwrap();
+    let o = out.to_str().unwrap();
+    fails(
+        &train_args(d, o, &["--epochs", "1"]),
+        &["lock file", ".lock", "is a symbolic link"],
+    );
+    std::fs::remove_file(out.join(".lock")).unwrap();
+    // The first run packed the dataset before it took the model folder's lock: unpacked
+    // again, the next run must take the packing lock.
+    for entry in std::fs::read_dir(&data).unwrap().flatten() {
+        if entry.file_name().to_string_lossy().starts_with("packed-") {
+            std::fs::remove_file(entry.path()).unwrap();
+        }
+    }
+    std::fs::remove_file(data.join(".packing.lock")).ok();
+    std::os::unix::fs::symlink(&precious, data.join(".packing.lock")).unwrap();
+    fails(
+        &train_args(d, o, &["--epochs", "1"]),
+        &[".packing.lock", "is a symbolic link"],
+    );
+    assert_eq!(std::fs::read(&precious).unwrap(), b"keep me");
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+/// Runs nprt expecting exit 1 within a minute, with every `needle` in its output (a report on
+/// stdout, or stderr): a command that blocks is killed and the test fails, instead of hanging
+/// the suite.
+fn fails_in_time(args: &[&str], needles: &[&str]) {
+    let mut child = Command::new(env!("CARGO_BIN_EXE_nprt"))
+        .args(args)
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    let started = std::time::Instant::now();
+    while child.try_wait().unwrap().is_none() {
+        if started.elapsed().as_secs() > 60 {
+            child.kill().ok();
+            panic!("{args:?} blocked for a minute");
+        }
+        std::thread::sleep(std::time::Duration::from_millis(50));
+    }
+    let out = child.wait_with_output().unwrap();
+    let err = String::from_utf8_lossy(&out.stderr) + String::from_utf8_lossy(&out.stdout);
+    assert_eq!(out.status.code(), Some(1), "{args:?}: {err}");
+    for n in needles {
+        assert!(err.contains(n), "stderr for {args:?} lacks '{n}':\n{err}");
+    }
+}
+
+/// Makes `path` a FIFO (nothing ever writes to it: opening it to read would block for ever).
+#[cfg(unix)]
+fn make_fifo(path: &Path) {
+    std::fs::remove_file(path).ok();
+    let status = Command::new("mkfifo").arg(path).status().unwrap();
+    assert!(status.success());
+}
+
+/// Inputs that are FIFOs (a view file, a model's weights, an environment map, the packing
+/// lock), which blocked `dataset verify`, `model info`, `reference` and `train` for ever, are
+/// refused by kind at once.
+#[cfg(unix)]
+#[test]
+fn fifos_given_as_inputs_are_refused_without_blocking() {
+    let dir = fresh_dir("fifos");
+    let data = dir.join("ds");
+    tiny_dataset(&data);
+    let d = data.to_str().unwrap();
+    let model = dir.join("model");
+    let m = model.to_str().unwrap();
+    ok(&train_args(d, m, &["--epochs", "1"]));
+    make_fifo(&model.join("weights.safetensors"));
+    fails_in_time(
+        &["model", "info", "--model", m],
+        &["weights.safetensors", "is a FIFO"],
+    );
+    let map = dir.join("map.exr");
+    make_fifo(&map);
+    let out = dir.join("ref");
+    let mut args = reference_args(&out);
+    args[3] = map.to_str().unwrap();
+    fails_in_time(&args, &["map.exr", "is a FIFO"]);
+    make_fifo(&data.join(".packing.lock"));
+    std::fs::remove_file(data.join("packed-radiance.bin")).ok();
+    let again = dir.join("again");
+    fails_in_time(
+        &train_args(d, again.to_str().unwrap(), &["--epochs", "1"]),
+        &[".packing.lock", "is a FIFO"],
+    );
+    make_fifo(&view_file(&data, "train"));
+    fails_in_time(&["dataset", "verify", d], &["is a FIFO"]);
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+/// A checkpoint whose state says more epochs than steps (edited to 10⁹, which replayed a
+/// billion epochs' shuffles before the first step) is refused at once as damaged.
+#[test]
+fn a_damaged_resume_state_is_refused_at_once() {
+    let dir = fresh_dir("state");
+    let data = dir.join("ds");
+    tiny_dataset(&data);
+    let d = data.to_str().unwrap();
+    let model = dir.join("model");
+    let m = model.to_str().unwrap();
+    let paper = |epochs| ["--epochs", epochs, "--schedule", "paper"];
+    ok(&train_args(d, m, &paper("1")));
+    let state = model.join("checkpoint/state.json");
+    let mut json: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(&state).unwrap()).unwrap();
+    json["epoch"] = serde_json::json!(1_000_000_000u64);
+    std::fs::write(&state, json.to_string()).unwrap();
+    fails_in_time(
+        &train_args(d, m, &paper("2")),
+        &["state.json", "is damaged", "1000000000 epochs"],
+    );
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+/// A manifest naming one view file twice under two spellings (`views/./NAME`), which trained
+/// on that view twice, and a model whose bounds are inverted (which changed the rendered image
+/// silently), are refused by name.
+#[test]
+fn two_spellings_of_a_file_and_inverted_bounds_are_refused() {
+    let dir = fresh_dir("spellings");
+    let data = dir.join("ds");
+    tiny_dataset(&data);
+    let d = data.to_str().unwrap();
+    let model = dir.join("model");
+    let m = model.to_str().unwrap();
+    ok(&train_args(d, m, &["--epochs", "1"]));
+    let json = std::fs::read_to_string(model.join("model.json")).unwrap();
+    let mut file: serde_json::Value = serde_json::from_str(&json).unwrap();
+    let bounds = file["bounds"].clone();
+    file["bounds"] = serde_json::json!([bounds[1], bounds[0]]);
+    std::fs::write(model.join("model.json"), file.to_string()).unwrap();
+    fails(
+        &["model", "info", "--model", m],
+        &["model '", "bounds", "not a finite box"],
+    );
+    let manifest = data.join("manifest.json");
+    let text = std::fs::read_to_string(&manifest).unwrap();
+    let mut m: serde_json::Value = serde_json::from_str(&text).unwrap();
+    let first = m["views"][0]["file"]
+        .as_str()
+        .unwrap()
+        .replacen('/', "/./", 1);
+    m["views"][1]["file"] = serde_json::json!(first);
+    std::fs::write(&manifest, m.to_string()).unwrap();
+    fails(&["dataset", "verify", d], &["views/./", "named by more than one view"]);
     std::fs::remove_dir_all(&dir).unwrap();
 }
 

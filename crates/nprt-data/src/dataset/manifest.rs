@@ -156,16 +156,7 @@ impl Manifest {
         if let Some(i) = s.train_maps.iter().find(|i| s.test_maps.contains(i)) {
             bail!("map {i} is both a training and a test map: test lightings must be unseen in training");
         }
-        let [lo, hi] = self.bounds;
-        if !self.bounds.iter().flatten().all(|v| v.is_finite())
-            || (0..3).any(|k| lo[k] > hi[k])
-            || (0..3).filter(|&k| lo[k] < hi[k]).count() < 2
-        {
-            bail!(
-                "bounds {:?} are not a finite box (min ≤ max) spanning at least two axes",
-                self.bounds
-            );
-        }
+        check_bounds(&self.bounds)?;
         for v in &self.views {
             self.check_view(v)?;
         }
@@ -228,13 +219,16 @@ impl Manifest {
                 v.gain
             );
         }
+        // Plain names only: '.', '..' or a root would let two spellings name one file (a view
+        // trained on twice), or name one outside the folder.
         let file = Path::new(&v.file);
-        if file.is_absolute()
-            || file
-                .components()
-                .any(|c| matches!(c, std::path::Component::ParentDir))
+        if !file
+            .components()
+            .all(|c| matches!(c, std::path::Component::Normal(_)))
         {
-            bail!("{what}: file must be a path inside the dataset folder");
+            bail!(
+                "{what}: file must be a plain path inside the dataset folder (no '.', '..' or leading '/')"
+            );
         }
         Ok(())
     }
@@ -256,7 +250,12 @@ impl Manifest {
                     v.index
                 );
             }
-            if !files.insert(v.file.as_str()) {
+            // Compared as paths: "views//a.exr" names "views/a.exr".
+            if !files.insert(
+                Path::new(&v.file)
+                    .components()
+                    .collect::<std::path::PathBuf>(),
+            ) {
                 bail!("file '{}' is named by more than one view", v.file);
             }
         }
@@ -366,9 +365,22 @@ pub fn load_manifest(dir: &Path) -> Result<Manifest> {
 /// fix every view's camera, map, rotation and seed); models record it to refuse other data.
 pub fn load_manifest_hashed(dir: &Path) -> Result<(Manifest, String)> {
     let path = dir.join(MANIFEST);
-    let bytes =
-        std::fs::read(&path).with_context(|| format!("cannot read '{}'", path.display()))?;
+    let bytes = nprt_io::read_input(&path)?;
     let manifest = Manifest::from_json(&bytes)
         .with_context(|| format!("'{}' is not a usable nprt dataset manifest", path.display()))?;
     Ok((manifest, blake3::hash(&bytes).to_hex().to_string()))
+}
+
+/// Scene bounds positions can be normalised with: finite, min ≤ max on every axis, spanning at
+/// least two (a flat scene spans two; inverted or empty bounds would map every position
+/// elsewhere, silently). What a dataset's manifest and a model's config must hold.
+pub fn check_bounds(bounds: &[[f32; 3]; 2]) -> Result<()> {
+    let [lo, hi] = bounds;
+    if !bounds.iter().flatten().all(|v| v.is_finite())
+        || (0..3).any(|k| lo[k] > hi[k])
+        || (0..3).filter(|&k| lo[k] < hi[k]).count() < 2
+    {
+        bail!("bounds {bounds:?} are not a finite box (min ≤ max) spanning at least two axes");
+    }
+    Ok(())
 }

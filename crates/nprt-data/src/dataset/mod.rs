@@ -14,8 +14,8 @@ mod view_file;
 
 pub use generation::{prepare, render_view, run, Summary};
 pub use manifest::{
-    load_manifest, load_manifest_hashed, Jitter, Manifest, MapRecord, Settings, ViewRecord,
-    VolumeRecord, FORMAT_VERSION, MANIFEST,
+    check_bounds, load_manifest, load_manifest_hashed, Jitter, Manifest, MapRecord, Settings,
+    ViewRecord, VolumeRecord, FORMAT_VERSION, MANIFEST,
 };
 pub use packed::{views_stamp, PackHeader, PackedDataset, PackedTarget, PACK_FORMAT, PACK_VERSION};
 pub use packed_pixel::{PackedPixel, PACKED_PIXEL_BYTES};

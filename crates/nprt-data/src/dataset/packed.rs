@@ -165,6 +165,7 @@ impl PackedDataset {
         dataset_hash: &str,
         target: PackedTarget,
     ) -> Result<Self> {
+        nprt_io::check_input(path)?;
         let file = File::open(path).with_context(|| format!("cannot open '{}'", path.display()))?;
         // SAFETY: packs are only ever replaced by rename, never changed in place, so the mapped
         // file stays as it was while mapped.
@@ -284,7 +285,7 @@ impl PackedDataset {
 /// Takes the dataset's packing lock, waiting while another process holds it.
 fn lock_packing(dir: &Path) -> Result<File> {
     let path = dir.join(".packing.lock");
-    let file = File::create(&path).with_context(|| {
+    let file = nprt_io::open_lock_file(&path).with_context(|| {
         format!(
             "cannot pack the dataset in '{}' (training packs it beside manifest.json; make the folder writable, or copy the dataset where it is)",
             dir.display()

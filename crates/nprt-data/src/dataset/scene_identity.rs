@@ -9,7 +9,8 @@ pub fn scene_source(spec: &str) -> Result<Vec<u8>> {
     if spec.starts_with("builtin:") {
         Ok(spec.as_bytes().to_vec())
     } else {
-        std::fs::read(spec).with_context(|| format!("cannot read scene '{spec}'"))
+        nprt_io::read_input(std::path::Path::new(spec))
+            .with_context(|| format!("cannot read scene '{spec}'"))
     }
 }
 

@@ -11,7 +11,7 @@ use serde::{Deserialize, Serialize};
 use super::options::DeepShadingOptions;
 use super::unet::feature_image;
 use crate::init::Init;
-use crate::model::folder::{load_weights, read_config, WEIGHTS_FILE};
+use crate::model::folder::{check_bounds, load_weights, read_config, WEIGHTS_FILE};
 use crate::network::encoder::{check_input_width, LightInput};
 use crate::network::unet::DeepShading;
 
@@ -45,6 +45,7 @@ pub struct DeepShadingModel {
 pub fn read_file(dir: &Path) -> Result<DeepShadingFile> {
     let file: DeepShadingFile = read_config(dir, CONFIG_FILE, TAG, 1, "Deep Shading model")?;
     check_input_width(file.encoder_width)
+        .and_then(|()| check_bounds(&file.bounds))
         .with_context(|| format!("Deep Shading model '{}'", dir.display()))?;
     Ok(file)
 }

@@ -218,6 +218,10 @@ impl Objective for UnetObjective {
         Ok(sum / n as f64)
     }
 
+    fn model_files(&self) -> [&'static str; 2] {
+        [CONFIG_FILE, WEIGHTS_FILE]
+    }
+
     fn save_model(
         &self,
         out: &Path,

@@ -11,6 +11,8 @@ use safetensors::{tensor::TensorView, Dtype, SafeTensors};
 use serde::de::DeserializeOwned;
 use serde::{Deserialize, Serialize};
 
+pub use nprt_data::dataset::check_bounds;
+
 use crate::init::Init;
 use crate::model::config::ModelConfig;
 use crate::network::encoder::check_input_width;
@@ -141,8 +143,8 @@ fn non_finite_tensor(bytes: &[u8]) -> Result<Option<String>> {
 
 /// Loads weights saved by [`save_weights`] into `net`, which must be of the same design.
 pub fn load_weights<M: Parameters>(path: &Path, net: &mut M, tag: &str) -> Result<()> {
-    let bytes =
-        std::fs::read(path).with_context(|| format!("cannot read weights '{}'", path.display()))?;
+    let bytes = nprt_io::read_input(path)
+        .with_context(|| format!("cannot read weights '{}'", path.display()))?;
     let saved_design = read_design_tag(&bytes)
         .with_context(|| format!("'{}' is not an nprt weights file", path.display()))?;
     // Weights saved before the tag named the activation carry the design alone.
@@ -220,6 +222,7 @@ fn read_design_tag(bytes: &[u8]) -> Result<String> {
 pub fn read_model_file(dir: &Path) -> Result<ModelFile> {
     let file: ModelFile = read_config(dir, CONFIG_FILE, MODEL_FORMAT, MODEL_VERSION, "model")?;
     check_input_width(file.config.encoder_width)
+        .and_then(|()| check_bounds(&file.bounds))
         .with_context(|| format!("model '{}'", dir.display()))?;
     Ok(file)
 }
@@ -235,7 +238,7 @@ pub fn read_config<T: DeserializeOwned>(
     kind: &str,
 ) -> Result<T> {
     let path = dir.join(file_name);
-    let text = std::fs::read_to_string(&path).with_context(|| {
+    let text = nprt_io::read_input_string(&path).with_context(|| {
         format!(
             "'{}' is not a {kind} folder (no readable {file_name})",
             dir.display()

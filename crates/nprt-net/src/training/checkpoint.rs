@@ -52,7 +52,7 @@ pub(crate) fn read(out: &Path) -> Result<Option<Checkpoint>> {
     if !path.exists() {
         return Ok(None);
     }
-    let text = std::fs::read_to_string(&path)
+    let text = nprt_io::read_input_string(&path)
         .with_context(|| format!("cannot read checkpoint '{}'", path.display()))?;
     let ck = serde_json::from_str(&text).with_context(|| {
         format!(

@@ -15,7 +15,9 @@ use crate::engine::Engine;
 use crate::init::Init;
 use crate::loss::Loss;
 use crate::model::config::ModelConfig;
-use crate::model::folder::{save_model, ModelFile, MODEL_FORMAT, MODEL_VERSION};
+use crate::model::folder::{
+    save_model, ModelFile, CONFIG_FILE, MODEL_FORMAT, MODEL_VERSION, WEIGHTS_FILE,
+};
 use crate::network::nprt_net::NprtNet;
 use crate::network::parameters::Parameters;
 use crate::optimiser::{EngineSteps, ADAM_EPSILON};
@@ -150,6 +152,10 @@ impl Objective for PixelObjective<'_> {
     fn validation_loss(&self, steps: &mut dyn EngineSteps<NprtNet, Batch>) -> Result<f64> {
         let (samples, batch_size) = (self.opts.val_samples, self.opts.batch_size);
         validation_loss(self.set, samples, batch_size, |b| steps.loss(b))
+    }
+
+    fn model_files(&self) -> [&'static str; 2] {
+        [CONFIG_FILE, WEIGHTS_FILE]
     }
 
     fn save_model(

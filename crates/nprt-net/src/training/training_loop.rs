@@ -67,6 +67,8 @@ pub trait Objective: Sync {
     /// Loss on held-out data under the parameters `steps` hold; NaN where there is no
     /// held-out data.
     fn validation_loss(&self, steps: &mut dyn EngineSteps<Self::Net, Self::Batch>) -> Result<f64>;
+    /// The model folder's own files (config and weights), which a diverged run removes.
+    fn model_files(&self) -> [&'static str; 2];
     /// Writes the model folder's own files (config and weights) for the network as it stands.
     fn save_model(
         &self,
@@ -182,13 +184,7 @@ pub fn train<O: Objective>(objective: &O, schedule: &Schedule, out: &Path) -> Re
 fn lock_folder(out: &Path) -> Result<std::fs::File> {
     use std::io::Write;
     let path = out.join(".lock");
-    let mut file = std::fs::OpenOptions::new()
-        .read(true)
-        .write(true)
-        .create(true)
-        .truncate(false)
-        .open(&path)
-        .with_context(|| format!("cannot open '{}'", path.display()))?;
+    let mut file = nprt_io::open_lock_file(&path)?;
     if let Err(e) = file.try_lock() {
         let holder = std::fs::read_to_string(&path).unwrap_or_default();
         return Err(match e {
@@ -383,19 +379,28 @@ impl<'s, O: Objective> Run<'s, O> {
         }
     }
 
-    /// The error that ends a diverged run (`why`: the loss that says so) in epoch `epoch`.
+    /// The error that ends a diverged run (`why`: the loss that says so) in epoch `epoch`. The
+    /// model files go: saved as the weights grew, they may hold weights no later command should
+    /// load (`render` made black frames of |w| ≈ 1e30 with exit 0).
     fn diverged(&mut self, why: &str, epoch: usize) -> anyhow::Error {
         self.bar.abandon();
+        let removed = (self.objective.model_files().iter())
+            .filter(|f| std::fs::remove_file(self.out.join(f)).is_ok())
+            .count();
+        let model = match removed {
+            0 => String::new(),
+            _ => "its model files are removed; ".into(),
+        };
         let kept = if checkpoint::exists(self.out) {
             format!(
-                "the last good checkpoint in '{}' is kept",
+                "the last checkpoint in '{}' is kept for inspection",
                 checkpoint::dir(self.out).display()
             )
         } else {
             "no checkpoint had been written yet".to_string()
         };
         anyhow::anyhow!(
-            "training diverged at epoch {} step {} ({why}); {kept}; lower --lr and use another --out",
+            "training diverged at epoch {} step {} ({why}); {model}{kept}; lower --lr and use another --out",
             epoch + 1,
             self.ck.state.step
         )
@@ -559,6 +564,20 @@ fn resume<O: Objective>(
         bail!(
             "model folder '{}' holds a run with other settings (network, dataset or hyper-parameters; a run with a decaying --schedule also keeps its --epochs and --minutes); choose another --out or delete it",
             out.display()
+        );
+    }
+    // Every epoch and every batch is a step, and every step at least one sample: a state that
+    // says otherwise was edited or damaged (an epoch of 10⁹ after a few steps replayed a
+    // billion epochs' shuffles before the first step).
+    let s = &saved.state;
+    if s.epoch as u64 > s.step || s.batch as u64 > s.step || s.samples < s.step {
+        bail!(
+            "checkpoint '{}' is damaged: it says {} epochs, batch {}, {} steps and {} samples; delete the model folder to start over",
+            checkpoint::dir(out).join("state.json").display(),
+            s.epoch,
+            s.batch,
+            s.step,
+            s.samples
         );
     }
     checkpoint::restore_weights(out, saved, net, &objective.tag())

@@ -33,7 +33,7 @@ mod upgrade;
 use upgrade::snake_case;
 
 pub fn load(path: &Path, opts: &SceneOptions) -> Result<Scene> {
-    let text = std::fs::read_to_string(path)
+    let text = nprt_io::read_input_string(path)
         .with_context(|| format!("cannot read scene file '{}'", path.display()))?;
     parse(&text, path, opts)
 }
