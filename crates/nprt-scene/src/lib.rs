@@ -48,6 +48,6 @@ pub use fresnel::{fresnel_conductor, fresnel_dielectric, DielectricFresnel};
 pub use load_scene::load_scene;
 pub use material::{BsdfParams, Material, Scattering, Surface, MIN_ALPHA};
 pub use mesh::Mesh;
-pub use scene::Scene;
+pub use scene::{Scene, MAX_COORDINATE};
 pub use scene_options::SceneOptions;
 pub use texture::{Bitmap, Texture};

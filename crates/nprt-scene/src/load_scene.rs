@@ -42,6 +42,7 @@ pub fn load_scene(spec: &str, opts: &SceneOptions) -> Result<Scene> {
     if scene.meshes.is_empty() {
         bail!("scene file '{spec}' contains no geometry");
     }
+    scene.check_extent(&format!("scene file '{spec}'"))?;
     let sidecar = CameraVolume::sidecar_of(path);
     if sidecar.exists() {
         scene.camera_volume = Some(CameraVolume::load(&sidecar)?);

@@ -10,6 +10,11 @@ use crate::mesh::Mesh;
 /// Mitsuba's default Russian-roulette start depth.
 pub const DEFAULT_RR_DEPTH: u32 = 5;
 
+/// The farthest a vertex may lie from the origin, in scene units on any axis: beyond it f32
+/// positions keep no detail below about 100 units, and the BVH builder failed (an index out
+/// of bounds at 10¹⁹, an endless loop at 10³⁰).
+pub const MAX_COORDINATE: f32 = 1e9;
+
 #[derive(Clone, Debug)]
 pub struct Scene {
     pub name: String,
@@ -51,6 +56,25 @@ impl Scene {
         self.materials.push(material);
         self.meshes.push(mesh);
         self.meshes.len() - 1
+    }
+
+    /// Refuses geometry the tracer cannot hold: a vertex (after its shape's transform) not
+    /// finite or beyond ±[`MAX_COORDINATE`] of the origin, naming the mesh. `what` names the
+    /// scene in the error.
+    pub fn check_extent(&self, what: &str) -> anyhow::Result<()> {
+        for mesh in &self.meshes {
+            let far = mesh
+                .positions
+                .iter()
+                .find(|p| !p.is_finite() || p.abs().max_element() > MAX_COORDINATE);
+            if let Some(p) = far {
+                anyhow::bail!(
+                    "{what}: mesh '{}' has a vertex at {p} (after its transform), beyond ±{MAX_COORDINATE:e} scene units of the origin: f32 positions there keep no detail below about 100 units, and the BVH cannot be built over them",
+                    mesh.name
+                );
+            }
+        }
+        Ok(())
     }
 
     /// Axis-aligned bounds of all geometry (min, max).

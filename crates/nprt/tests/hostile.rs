@@ -547,6 +547,36 @@ fn fifos_given_as_inputs_are_refused_without_blocking() {
     std::fs::remove_dir_all(&dir).unwrap();
 }
 
+/// Geometry the tracer cannot hold is refused when the scene loads, before the BVH is built:
+/// a rectangle scaled by 3e38 panicked inside the builder, a sphere of radius 1e30 looped in it.
+#[test]
+fn geometry_beyond_the_stated_range_is_refused_before_the_bvh() {
+    let dir = fresh_dir("far");
+    std::fs::create_dir_all(&dir).unwrap();
+    for (name, shape) in [
+        (
+            "scaled",
+            r#"<shape type="rectangle"><transform name="to_world"><scale value="3e38"/></transform></shape>"#,
+        ),
+        (
+            "sphere",
+            r#"<shape type="sphere"><float name="radius" value="1e30"/></shape>"#,
+        ),
+        (
+            "negative",
+            r#"<shape type="sphere"><float name="radius" value="-1e38"/></shape>"#,
+        ),
+    ] {
+        let scene = dir.join(format!("{name}.xml"));
+        std::fs::write(&scene, format!(r#"<scene version="3.0.0">{shape}</scene>"#)).unwrap();
+        let out = dir.join(name);
+        let mut args = reference_args(&out);
+        args[1] = scene.to_str().unwrap();
+        fails_in_time(&args, &[&format!("{name}.xml"), "beyond ±1e9 scene units"]);
+    }
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
 /// A checkpoint whose state says more epochs than steps (edited to 10⁹, which replayed a
 /// billion epochs' shuffles before the first step) is refused at once as damaged.
 #[test]
@@ -601,7 +631,10 @@ fn two_spellings_of_a_file_and_inverted_bounds_are_refused() {
         .replacen('/', "/./", 1);
     m["views"][1]["file"] = serde_json::json!(first);
     std::fs::write(&manifest, m.to_string()).unwrap();
-    fails(&["dataset", "verify", d], &["views/./", "named by more than one view"]);
+    fails(
+        &["dataset", "verify", d],
+        &["views/./", "named by more than one view"],
+    );
     std::fs::remove_dir_all(&dir).unwrap();
 }
 
