@@ -16,6 +16,22 @@ fn tiny_dataset(dir: &Path) {
     common::room_dataset(dir, [4, 2], 8, 1);
 }
 
+/// A fresh folder `name` holding a tiny dataset (`ds`) and a model trained on it for one epoch
+/// with `extra` flags (`model`): (folder, dataset, model).
+fn trained_model(name: &str, extra: &[&str]) -> (PathBuf, PathBuf, PathBuf) {
+    let dir = fresh_dir(name);
+    let (data, model) = (dir.join("ds"), dir.join("model"));
+    tiny_dataset(&data);
+    let mut flags = vec!["--epochs", "1"];
+    flags.extend_from_slice(extra);
+    ok(&train_args(
+        data.to_str().unwrap(),
+        model.to_str().unwrap(),
+        &flags,
+    ));
+    (dir, data, model)
+}
+
 fn train_args<'a>(data: &'a str, out: &'a str, extra: &[&'a str]) -> Vec<&'a str> {
     let mut args = vec![
         "train",
@@ -517,13 +533,8 @@ fn make_fifo(path: &Path) {
 #[cfg(unix)]
 #[test]
 fn fifos_given_as_inputs_are_refused_without_blocking() {
-    let dir = fresh_dir("fifos");
-    let data = dir.join("ds");
-    tiny_dataset(&data);
-    let d = data.to_str().unwrap();
-    let model = dir.join("model");
-    let m = model.to_str().unwrap();
-    ok(&train_args(d, m, &["--epochs", "1"]));
+    let (dir, data, model) = trained_model("fifos", &[]);
+    let (d, m) = (data.to_str().unwrap(), model.to_str().unwrap());
     make_fifo(&model.join("weights.safetensors"));
     fails_in_time(
         &["model", "info", "--model", m],
@@ -581,21 +592,15 @@ fn geometry_beyond_the_stated_range_is_refused_before_the_bvh() {
 /// billion epochs' shuffles before the first step) is refused at once as damaged.
 #[test]
 fn a_damaged_resume_state_is_refused_at_once() {
-    let dir = fresh_dir("state");
-    let data = dir.join("ds");
-    tiny_dataset(&data);
-    let d = data.to_str().unwrap();
-    let model = dir.join("model");
-    let m = model.to_str().unwrap();
-    let paper = |epochs| ["--epochs", epochs, "--schedule", "paper"];
-    ok(&train_args(d, m, &paper("1")));
+    let (dir, data, model) = trained_model("state", &["--schedule", "paper"]);
+    let (d, m) = (data.to_str().unwrap(), model.to_str().unwrap());
     let state = model.join("checkpoint/state.json");
     let mut json: serde_json::Value =
         serde_json::from_slice(&std::fs::read(&state).unwrap()).unwrap();
     json["epoch"] = serde_json::json!(1_000_000_000u64);
     std::fs::write(&state, json.to_string()).unwrap();
     fails_in_time(
-        &train_args(d, m, &paper("2")),
+        &train_args(d, m, &["--epochs", "2", "--schedule", "paper"]),
         &["state.json", "is damaged", "1000000000 epochs"],
     );
     std::fs::remove_dir_all(&dir).unwrap();
@@ -606,13 +611,8 @@ fn a_damaged_resume_state_is_refused_at_once() {
 /// silently), are refused by name.
 #[test]
 fn two_spellings_of_a_file_and_inverted_bounds_are_refused() {
-    let dir = fresh_dir("spellings");
-    let data = dir.join("ds");
-    tiny_dataset(&data);
-    let d = data.to_str().unwrap();
-    let model = dir.join("model");
-    let m = model.to_str().unwrap();
-    ok(&train_args(d, m, &["--epochs", "1"]));
+    let (dir, data, model) = trained_model("spellings", &[]);
+    let (d, m) = (data.to_str().unwrap(), model.to_str().unwrap());
     let json = std::fs::read_to_string(model.join("model.json")).unwrap();
     let mut file: serde_json::Value = serde_json::from_str(&json).unwrap();
     let bounds = file["bounds"].clone();
