@@ -91,7 +91,7 @@ impl Accumulator {
 /// The light an image shows on the foreground, per channel: negative values (SH PRT's ringing)
 /// count as none, as on a display. Summed as they were, an SH frame whose light summed to about
 /// zero gave a tint error of order 1e10; with the levels non-negative it is at most 2.
-fn light(rgb: &[Vec3], mask: &[f32]) -> DVec3 {
+pub(crate) fn light(rgb: &[Vec3], mask: &[f32]) -> DVec3 {
     rgb.iter()
         .zip(mask)
         .filter(|(_, &m)| m > 0.5)

@@ -173,9 +173,29 @@ fn describe_denoiser(oidn: &Result<&'static Oidn>) -> String {
 }
 
 /// Stops at a metric that is not a finite number (it would be `null` in results.json and
-/// silently drop out of every mean), naming the method and test view.
+/// silently drop out of every mean), naming the method and test view; the light level and tint,
+/// undefined where a test view's reference holds no light in a channel, likewise.
 fn check_finite(results: &[MethodResult], views: &[ImageView]) -> Result<()> {
     for r in results {
+        if !(r.level.iter().all(|x| x.is_finite()) && r.tint_error.is_finite()) {
+            let dark = views.iter().find(|v| {
+                let l = crate::error_analysis::light(&v.radiance, &v.gbuffer.mask);
+                l.min_element() <= 0.0
+            });
+            let why = match dark {
+                Some(v) => format!(
+                    "test view {} ('{}') holds no light in a channel of its reference (its map lights nothing there)",
+                    v.record.index, v.record.file
+                ),
+                None => "the test views' light sums to nothing".into(),
+            };
+            bail!(
+                "{}: its light level {:?} and tint error {} against the references are not numbers, so no report is written: {why}",
+                r.name,
+                r.level,
+                r.tint_error
+            );
+        }
         for (m, v) in r.per_view.iter().zip(views) {
             let values = m.values();
             if let Some(k) = values.iter().position(|x| !x.is_finite()) {

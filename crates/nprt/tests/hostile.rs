@@ -588,6 +588,43 @@ fn geometry_beyond_the_stated_range_is_refused_before_the_bvh() {
     std::fs::remove_dir_all(&dir).unwrap();
 }
 
+/// A test view whose reference holds no light (lit by a black map) leaves the light level and
+/// tint undefined: eval stops naming the view instead of writing `null` into results.json.
+#[test]
+fn a_black_test_view_stops_eval_naming_it() {
+    let (dir, data, model) = trained_model("black-test", &[]);
+    let view = view_file(&data, "test");
+    let (w, h, mut channels) = read_channels(&view).unwrap();
+    for (name, values) in &mut channels {
+        if ["R", "G", "B"].contains(&name.as_str()) || name.starts_with("half.") {
+            values.fill(0.0);
+        }
+    }
+    let mut channels: Vec<(String, Vec<f32>)> = channels.into_iter().collect();
+    channels.sort_by(|a, b| a.0.cmp(&b.0));
+    write_channels(&view, w, h, &channels).unwrap();
+    let report = dir.join("report");
+    let args = [
+        "eval",
+        "--data",
+        data.to_str().unwrap(),
+        "--model",
+        model.to_str().unwrap(),
+        "--out",
+        report.to_str().unwrap(),
+        "--sh-spp",
+        "4",
+        "--timing-res",
+        "16",
+    ];
+    fails(
+        &args,
+        &["tint error", "holds no light", "no report is written"],
+    );
+    assert!(!report.join("results.json").exists());
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
 /// A checkpoint whose state says more epochs than steps (edited to 10⁹, which replayed a
 /// billion epochs' shuffles before the first step) is refused at once as damaged.
 #[test]
