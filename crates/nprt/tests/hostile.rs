@@ -625,6 +625,32 @@ fn a_black_test_view_stops_eval_naming_it() {
     std::fs::remove_dir_all(&dir).unwrap();
 }
 
+/// A lighting schedule of 10⁴ segments of one map opens that map once (opened per segment, it
+/// grew to 7 GB in a minute): the frame is rendered in seconds.
+#[test]
+fn a_long_lighting_schedule_of_one_map_opens_it_once() {
+    let (dir, _, model) = trained_model("schedule", &[]);
+    let segment = r#"{"map": "builtin:sky", "weight": 1, "rotation_deg": [0, 10]}"#;
+    let segments = vec![segment; 10_000].join(",");
+    let schedule = dir.join("schedule.json");
+    std::fs::write(&schedule, format!(r#"{{"segments": [{segments}]}}"#)).unwrap();
+    let started = std::time::Instant::now();
+    let out = render_exr(
+        model.to_str().unwrap(),
+        &dir.join("frames"),
+        "2",
+        &["--lighting", schedule.to_str().unwrap()],
+    );
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let seconds = started.elapsed().as_secs_f64();
+    assert!(seconds < 30.0, "two frames took {seconds:.0} s");
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
 /// A checkpoint whose state says more epochs than steps (edited to 10⁹, which replayed a
 /// billion epochs' shuffles before the first step) is refused at once as damaged.
 #[test]
