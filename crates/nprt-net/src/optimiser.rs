@@ -78,10 +78,7 @@ impl Adam {
     /// trained nprt's models before, and the GPU kernels').
     pub fn step<N: Parameters>(&mut self, net: &mut N, grads: &N, lr: f64) {
         self.steps += 1;
-        let t = self.steps.min(i32::MAX as u64) as i32;
-        let c2 = (1.0 - ADAM_BETA2.powi(t)).sqrt();
-        let factor = c2 / (1.0 - ADAM_BETA1.powi(t));
-        let epsilon = ADAM_EPSILON * c2;
+        let (factor, epsilon) = bias_corrections(self.steps);
         let lr = lr as f32;
         let g = grads.flat();
         let (m, v) = (&mut self.moment1, &mut self.moment2);
@@ -108,6 +105,14 @@ impl Adam {
         (self.moment1, self.moment2, self.steps) = (m1, m2, steps);
         Ok(())
     }
+}
+
+/// Step `t`'s (from 1) bias corrections, as every engine's update takes them: the factor
+/// c = √(1 − β2^t) / (1 − β1^t) on the first moment, and ε · √(1 − β2^t).
+pub fn bias_corrections(t: u64) -> (f32, f32) {
+    let t = t.min(i32::MAX as u64) as i32;
+    let c2 = (1.0 - ADAM_BETA2.powi(t)).sqrt();
+    (c2 / (1.0 - ADAM_BETA1.powi(t)), ADAM_EPSILON * c2)
 }
 
 /// Writes Adam's two moments (flat, in visiting order) and its step count to `path`.

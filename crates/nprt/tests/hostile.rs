@@ -16,12 +16,19 @@ fn tiny_dataset(dir: &Path) {
     common::room_dataset(dir, [4, 2], 8, 1);
 }
 
+/// A fresh folder `name` holding a tiny dataset in `ds`: (folder, dataset).
+fn with_dataset(name: &str) -> (PathBuf, PathBuf) {
+    let dir = fresh_dir(name);
+    let data = dir.join("ds");
+    tiny_dataset(&data);
+    (dir, data)
+}
+
 /// A fresh folder `name` holding a tiny dataset (`ds`) and a model trained on it for one epoch
 /// with `extra` flags (`model`): (folder, dataset, model).
 fn trained_model(name: &str, extra: &[&str]) -> (PathBuf, PathBuf, PathBuf) {
-    let dir = fresh_dir(name);
-    let (data, model) = (dir.join("ds"), dir.join("model"));
-    tiny_dataset(&data);
+    let (dir, data) = with_dataset(name);
+    let model = dir.join("model");
     let mut flags = vec!["--epochs", "1"];
     flags.extend_from_slice(extra);
     ok(&train_args(
@@ -144,9 +151,7 @@ fn flat_map(path: &Path, value: f32) {
 
 #[test]
 fn non_finite_results_are_refused_and_black_lighting_is_warned_of() {
-    let dir = fresh_dir("nan");
-    let data = dir.join("ds");
-    tiny_dataset(&data);
+    let (dir, data) = with_dataset("nan");
     let d = data.to_str().unwrap();
     // A learning rate that breaks the weights: the run stops with exit 1 (it saved a model
     // with a non-finite validation loss and exit 0) and removes the model files it saved at
@@ -269,9 +274,7 @@ fn non_finite_results_are_refused_and_black_lighting_is_warned_of() {
 
 #[test]
 fn sizes_beyond_the_machine_are_refused_before_allocating() {
-    let dir = fresh_dir("sizes");
-    let data = dir.join("ds");
-    tiny_dataset(&data);
+    let (dir, data) = with_dataset("sizes");
     let d = data.to_str().unwrap();
     let out = dir.join("o");
     let o = out.to_str().unwrap();
@@ -373,9 +376,7 @@ fn view_file(data: &Path, split: &str) -> PathBuf {
 
 #[test]
 fn verify_reports_bad_texels_and_leftovers_and_train_names_the_pixel() {
-    let dir = fresh_dir("verify");
-    let data = dir.join("ds");
-    tiny_dataset(&data);
+    let (dir, data) = with_dataset("verify");
     let d = data.to_str().unwrap();
     // A negative radiance texel: verify calls the view corrupt and train names file and pixel
     // (instead of diverging and blaming --lr).
@@ -415,9 +416,7 @@ fn verify_reports_bad_texels_and_leftovers_and_train_names_the_pixel() {
 
 #[test]
 fn a_second_training_run_on_one_folder_is_refused_by_name() {
-    let dir = fresh_dir("lock");
-    let data = dir.join("ds");
-    tiny_dataset(&data);
+    let (dir, data) = with_dataset("lock");
     let d = data.to_str().unwrap();
     let out = dir.join("model");
     let o = out.to_str().unwrap();
@@ -461,9 +460,7 @@ fn a_second_training_run_on_one_folder_is_refused_by_name() {
 #[cfg(unix)]
 #[test]
 fn lock_files_are_never_followed() {
-    let dir = fresh_dir("lock-links");
-    let data = dir.join("ds");
-    tiny_dataset(&data);
+    let (dir, data) = with_dataset("lock-links");
     let d = data.to_str().unwrap();
     let precious = dir.join("precious.txt");
     std::fs::write(&precious, b"keep me").unwrap();

@@ -8,6 +8,7 @@ use rayon::prelude::*;
 
 use super::matmul::{matmul, MatRef, Op};
 use super::pool::{max_pool, unpool};
+use super::relu::{relu, relu_back};
 use crate::network::encoder::{LightEncoder, CHANNELS, CODE_SIZE};
 use crate::network::parameters::Parameters;
 
@@ -66,7 +67,7 @@ impl LightEncoder {
             let hw = h * w;
             // z becomes the ReLU output.
             let mut z = conv.forward(&x, h, w, &mut cols);
-            z.iter_mut().for_each(|v| *v = v.max(0.0));
+            relu(&mut z);
             // The pool takes the ReLU output plus the skip (the input, zero-padded to CHANNELS
             // channels).
             let (pooled, argmax) = max_pool(CHANNELS, (h, w), |at| {
@@ -141,9 +142,7 @@ impl LightEncoder {
                 Vec::new()
             };
             // Through the ReLU, then the convolution.
-            for (d, r) in d_sum.iter_mut().zip(&tape.relu[b]) {
-                *d = if *r > 0.0 { *d } else { 0.0 };
-            }
+            relu_back(&mut d_sum, &tape.relu[b]);
             let d_input = (b > 0).then_some(d_x.as_mut_slice());
             conv.backward(x, (h, w), &d_sum, &mut g.convs[b], d_input);
             d_out = d_x;

@@ -12,6 +12,7 @@ mod light_encoder;
 mod matmul;
 mod peak;
 mod pool;
+mod relu;
 mod samples;
 pub mod sincos;
 mod transport;
@@ -19,9 +20,7 @@ mod unet;
 
 use crate::loss::Loss;
 use crate::network::nprt_net::NprtNet;
-pub use dense::{Pass, SharedInput, Tape};
 pub use light_encoder::EncoderPass;
-pub use matmul::MatRef;
 pub use peak::{measured_peak, Peak};
 pub use samples::Samples;
 pub use transport::{TransferCodes, TransportGradients};

@@ -7,6 +7,7 @@ use rayon::prelude::*;
 use super::accumulate;
 use super::matmul::{matmul, MatRef, Op};
 use super::pool::{max_pool, unpool};
+use super::relu::{relu, relu_back};
 use crate::encoding::features::FEATURES;
 use crate::loss::Loss;
 use crate::network::conv::Conv;
@@ -67,18 +68,6 @@ fn downsample_sum(d: &[f32], c: usize, (h, w): (usize, usize)) -> Vec<f32> {
         out[(ch * h + y / 2) * w + xo / 2] += g;
     }
     out
-}
-
-/// ReLU in place.
-fn relu(x: &mut [f32]) {
-    x.iter_mut().for_each(|v| *v = v.max(0.0));
-}
-
-/// The gradient through a ReLU whose output was `y`, in place.
-fn relu_back(d: &mut [f32], y: &[f32]) {
-    d.iter_mut()
-        .zip(y)
-        .for_each(|(d, &y)| *d = if y > 0.0 { *d } else { 0.0 });
 }
 
 impl DeepShading {

@@ -25,7 +25,7 @@ use crate::encoding::hash_grid;
 use crate::loss::Loss;
 use crate::network::encoder::CODE_SIZE;
 use crate::network::nprt_net::NprtNet;
-use crate::optimiser::{load_state, save_state, ADAM_BETA1, ADAM_BETA2, ADAM_EPSILON};
+use crate::optimiser::{bias_corrections, load_state, save_state, ADAM_BETA1, ADAM_BETA2};
 use crate::Precision;
 
 /// A network's parameters, gradients and Adam moments on the device, and the step that trains
@@ -158,9 +158,7 @@ pub(super) struct BatchBuffers {
 /// The parameter block of `adam.wgsl` for step `t` (from 1) at learning rate `lr`, over
 /// `count` values whose gradients are scaled by `grad_scale`.
 fn adam_params(count: usize, lr: f64, t: u64, grad_scale: f32) -> Vec<u32> {
-    let t = t as i32;
-    let correction2 = (1.0 - ADAM_BETA2.powi(t)).sqrt();
-    let factor = correction2 / (1.0 - ADAM_BETA1.powi(t));
+    let (factor, epsilon) = bias_corrections(t);
     let mut params = vec![count as u32, 0, 0, 0];
     params.extend(
         [
@@ -168,7 +166,7 @@ fn adam_params(count: usize, lr: f64, t: u64, grad_scale: f32) -> Vec<u32> {
             ADAM_BETA1,
             ADAM_BETA2,
             factor,
-            ADAM_EPSILON * correction2,
+            epsilon,
             1.0 / grad_scale,
             0.0,
             0.0,

@@ -123,9 +123,7 @@ pub fn save_weights<M: Parameters>(path: &Path, net: &M, tag: &str) -> Result<()
 }
 
 /// The first tensor of a safetensors file that holds a non-finite value, if one does.
-fn non_finite_tensor(bytes: &[u8]) -> Result<Option<String>> {
-    let tensors = safetensors::SafeTensors::deserialize(bytes)
-        .map_err(|e| anyhow::anyhow!("not a safetensors file: {e}"))?;
+fn non_finite_tensor(tensors: &SafeTensors) -> Option<String> {
     for (name, view) in tensors.tensors() {
         let finite = match view.dtype() {
             safetensors::Dtype::F32 => view
@@ -135,10 +133,10 @@ fn non_finite_tensor(bytes: &[u8]) -> Result<Option<String>> {
             _ => true,
         };
         if !finite {
-            return Ok(Some(name));
+            return Some(name);
         }
     }
-    Ok(None)
+    None
 }
 
 /// Loads weights saved by [`save_weights`] into `net`, which must be of the same design.
@@ -155,16 +153,14 @@ pub fn load_weights<M: Parameters>(path: &Path, net: &mut M, tag: &str) -> Resul
             path.display()
         );
     }
-    if let Some(name) = non_finite_tensor(&bytes)
-        .with_context(|| format!("'{}' is not an nprt weights file", path.display()))?
-    {
+    let file = SafeTensors::deserialize(&bytes)
+        .with_context(|| format!("'{}' is not an nprt weights file", path.display()))?;
+    if let Some(name) = non_finite_tensor(&file) {
         bail!(
             "weights '{}' are unusable: tensor '{name}' holds NaN or infinity",
             path.display()
         );
     }
-    let file = SafeTensors::deserialize(&bytes)
-        .with_context(|| format!("'{}' is not an nprt weights file", path.display()))?;
     let (mut missing, mut bad) = (Vec::new(), Vec::new());
     net.visit_mut("", &mut |name, shape, values| match file.tensor(name) {
         Err(_) => missing.push(name.to_string()),
