@@ -542,12 +542,17 @@ fn the_gpu_benchmark_script_explains_itself_and_names_what_it_lacks() {
         text.contains("--kitchen") && text.contains("one summary file"),
         "{text}"
     );
-    for (args, why) in [
-        (&["--frobnicate"][..], "unknown argument '--frobnicate'"),
-        (&["--kitchen", "data"][..], "--kitchen needs --cpu-model"),
+    for (args, code, why) in [
+        (&["--frobnicate"][..], 2, "unknown argument '--frobnicate'"),
+        (&["--kitchen", "data"][..], 2, "--kitchen needs --cpu-model"),
+        (
+            &["--quick", "--prepared", "/nonexistent"][..],
+            1,
+            "--quick needs bench/gpu-prepare.sh's folder '/nonexistent'",
+        ),
     ] {
         let out = run(args);
-        assert_eq!(out.status.code(), Some(2), "{args:?}");
+        assert_eq!(out.status.code(), Some(code), "{args:?}");
         assert!(
             String::from_utf8_lossy(&out.stderr).contains(why),
             "{args:?}"
