@@ -10,8 +10,11 @@ use super::network_layout::MlpAt;
 use super::parameters::Span;
 use super::{groups_for, Dispatch, GpuDevice, Part};
 
-/// Rows a `column_sum` thread adds before the chunks' sums are added in a second pass.
-const COLUMN_CHUNK: usize = 256;
+/// Rows a `column_sum` thread adds before the chunks' sums are added in a further pass (and
+/// theirs in another, as a tree). Short: a thread's adds are a chain of dependent loads, and on
+/// an H100 256 of them made each sum over a 16,384-row batch about 35 µs where the data takes a
+/// few (`nprt bench train --profile`, 2026-11-27).
+const COLUMN_CHUNK: usize = 64;
 /// A weight gradient's product is split into chunks of at least ROW_CHUNK rows, at most
 /// ROW_CHUNKS of them (a 256 × 256 layer at batch 16,384: 32 chunks of 512 rows, 512
 /// workgroups instead of 16).
