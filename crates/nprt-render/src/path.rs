@@ -5,7 +5,7 @@ use std::path::Path;
 
 use anyhow::{bail, Context, Result};
 use glam::Vec3;
-use nprt_scene::{Camera, CameraVolume};
+use nprt_scene::{Camera, CameraVolume, MAX_COORDINATE};
 use serde::{Deserialize, Serialize};
 
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -61,6 +61,20 @@ impl CameraPath {
             let finite = k.position.iter().chain(&k.target).all(|v| v.is_finite());
             if !finite || Vec3::from(k.position) == Vec3::from(k.target) {
                 bail!("keyframe {i} has a non-finite value or looks at its own position");
+            }
+            // Checked before any frame is written: at 3e38 the rays' arithmetic overflows and
+            // the first frame was written before the NaN radiance stopped the run.
+            if k.position
+                .iter()
+                .chain(&k.target)
+                .any(|v| v.abs() > MAX_COORDINATE)
+            {
+                bail!(
+                    "keyframe {i} lies beyond ±{MAX_COORDINATE:e} scene units, the farthest a \
+                     scene or camera may reach (position {:?}, target {:?})",
+                    k.position,
+                    k.target
+                );
             }
             if !(1.0..179.0).contains(&k.fov_x_deg) {
                 bail!(
@@ -132,6 +146,26 @@ impl CameraPath {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A keyframe beyond the scene's reach is refused when the path is read, before any
+    /// frame; one at the limit is kept.
+    #[test]
+    fn keyframes_beyond_the_scenes_reach_are_refused_when_read() {
+        let path = |x: f32| {
+            format!(
+                r#"{{"keyframes": [{{"position": [0, 0, 0], "target": [0, 0, -1]}},
+                    {{"position": [{x:e}, 1, 0], "target": [0, 0, -1]}}]}}"#
+            )
+        };
+        assert!(CameraPath::from_json(&path(MAX_COORDINATE)).is_ok());
+        for x in [3e38, -3e38, 2.0 * MAX_COORDINATE] {
+            let err = CameraPath::from_json(&path(x)).unwrap_err().to_string();
+            assert!(
+                err.starts_with("keyframe 1 lies beyond ±1e9 scene units"),
+                "{x}: {err}"
+            );
+        }
+    }
 
     #[test]
     fn passes_through_keyframes() {

@@ -28,9 +28,10 @@ impl DeviceArg {
 /// How long a training run lasts and how its learning rate moves, shared by both trainings.
 #[derive(clap::Args, Clone, Copy)]
 pub struct RunArgs {
-    /// Passes over the training data [default: 20, or as many as fit with --minutes].
-    #[arg(long)]
-    pub epochs: Option<usize>,
+    /// Passes over the training data, 1 to 100,000 (the paper: 500) [default: 20, or as many
+    /// as fit with --minutes].
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=100_000))]
+    pub epochs: Option<u32>,
     /// Wall-clock budget: stop when the run's training time reaches this many minutes (or
     /// after --epochs if given, whichever comes first). The same command continues a stopped
     /// run up to the budget.
@@ -47,7 +48,7 @@ pub struct RunArgs {
 impl From<RunArgs> for RunLength {
     fn from(a: RunArgs) -> Self {
         RunLength {
-            epochs: a.epochs,
+            epochs: a.epochs.map(|e| e as usize),
             minutes: a.minutes,
             lr_schedule: a.schedule,
         }

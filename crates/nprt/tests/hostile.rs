@@ -663,6 +663,24 @@ fn a_damaged_resume_state_is_refused_at_once() {
         &train_args(d, m, &["--epochs", "2", "--schedule", "paper"]),
         &["state.json", "is damaged", "1000000000 epochs"],
     );
+    // Forged consistently (as many steps and samples as epochs), the state is a finished run:
+    // its batches are read, not replayed, and the run ends at once.
+    for key in ["step", "samples"] {
+        json[key] = serde_json::json!(1_000_000_000u64);
+    }
+    std::fs::write(&state, json.to_string()).unwrap();
+    let started = std::time::Instant::now();
+    ok(&train_args(d, m, &["--epochs", "2", "--schedule", "paper"]));
+    let seconds = started.elapsed().as_secs_f64();
+    assert!(seconds < 30.0, "the forged state took {seconds:.0} s");
+    // The run's own length is bounded where a plan of every epoch is made.
+    let out = nprt(&train_args(d, m, &["--epochs", "1000000000"]));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{err}");
+    assert!(
+        err.contains("'1000000000' for '--epochs") && err.contains("1..=100000"),
+        "{err}"
+    );
     std::fs::remove_dir_all(&dir).unwrap();
 }
 

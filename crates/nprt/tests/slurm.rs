@@ -117,6 +117,27 @@ fn unsharded(name: &str, spp: &str) -> PathBuf {
     dir
 }
 
+/// SHARDS is refused before anything is submitted where it is no number, zero, or beyond
+/// Slurm's largest array, 20 digits included (bash's arithmetic wraps past 64 bits); no
+/// cluster needed.
+#[test]
+fn shard_counts_slurm_cannot_run_are_refused_by_name() {
+    let script = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scripts/slurm-generate");
+    for shards in ["0", "-3", "4x", "4000002", "99999999999999999999"] {
+        let out = Command::new("bash")
+            .arg(&script)
+            .args([shards, "--", "--out", "/nonexistent"])
+            .output()
+            .unwrap();
+        assert_eq!(out.status.code(), Some(2), "{shards}");
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert!(
+            err.contains(&format!("SHARDS must be a whole number from 1 to 4000001 (Slurm's largest job array), got '{shards}'")),
+            "{shards}: {err}"
+        );
+    }
+}
+
 #[test]
 fn a_four_task_array_makes_the_unsharded_dataset() {
     if !slurm_runs() {

@@ -2,6 +2,7 @@
 //! the same one.
 
 use anyhow::{bail, Context, Result};
+use nprt_scene::envmap::MAX_RADIANCE;
 use nprt_scene::{CameraVolume, EnvMap, Scene};
 use nprt_trace::TraceScene;
 use rand::{RngExt, SeedableRng};
@@ -162,6 +163,11 @@ fn plan_views(
 ) -> Result<Vec<ViewRecord>> {
     let mut views = Vec::with_capacity((req.train_views + req.test_views) as usize);
     let mut next_own = req.maps.len() - mixed;
+    let brightest: Vec<glam::Vec3> = req
+        .maps
+        .iter()
+        .map(|m| m.texels().iter().fold(glam::Vec3::ZERO, |a, t| a.max(*t)))
+        .collect();
     for index in 0..req.train_views + req.test_views {
         let train = index < req.train_views;
         let (split, local, maps, [w, h]) = if train {
@@ -195,6 +201,7 @@ fn plan_views(
         } else {
             [1.0; 3]
         };
+        check_gain(brightest[map], &req.map_specs[map], gain, index)?;
         let camera = place_camera(ts, &req.volume, req.seed, index, w, h)?;
         views.push(ViewRecord {
             index,
@@ -211,6 +218,20 @@ fn plan_views(
         });
     }
     Ok(views)
+}
+
+/// Refuses a view whose jitter would lift its map past [`MAX_RADIANCE`] when it is rendered,
+/// before any view is: a dataset that stopped there could never be completed.
+fn check_gain(brightest: glam::Vec3, spec: &str, gain: [f32; 3], index: u64) -> Result<()> {
+    let lifted = brightest * glam::Vec3::from(gain);
+    if lifted.max_element() > MAX_RADIANCE {
+        bail!(
+            "view {index}: map '{spec}' (brightest texel {brightest}) times its exposure/tint \
+             jitter gain {gain:?} is {lifted}, past the largest radiance a map may hold \
+             ({MAX_RADIANCE:e}); scale the map down or lower --jitter-exposure/--jitter-tint"
+        );
+    }
+    Ok(())
 }
 
 /// Refuses jitter that could not be recorded (gains are kept within [1/64, 64]).
@@ -266,6 +287,40 @@ mod tests {
     use super::*;
     use crate::lighting::{builtin_per_view, load_all, mixed_views, takes_builtin};
     use nprt_scene::{load_scene, SceneOptions};
+
+    /// A map bright enough that the exposure jitter lifts it past the largest radiance a map
+    /// may hold is refused when the dataset is planned, naming the view, map and gain, not
+    /// when that view is rendered (a dataset that stops there can never be completed); the
+    /// same map without jitter plans.
+    #[test]
+    fn jitter_that_would_lift_a_map_past_the_limit_is_refused_before_rendering() {
+        let scene = load_scene("builtin:room", &SceneOptions::default()).unwrap();
+        let ts = TraceScene::new(&scene);
+        let bright = || EnvMap::constant(glam::Vec3::splat(0.9 * MAX_RADIANCE)).unwrap();
+        let req = |jitter| Request {
+            maps: vec![bright(), bright()],
+            train_views: 8,
+            jitter,
+            ..room_request(&scene, ["builtin:indoor:1", "builtin:indoor:2"])
+        };
+        assert!(plan(&req(Jitter::default()), &ts).is_ok());
+        let err = plan(
+            &req(Jitter {
+                exposure: 1.0,
+                tint: 0.0,
+            }),
+            &ts,
+        )
+        .unwrap_err()
+        .to_string();
+        assert!(
+            err.starts_with("view ")
+                && err.contains("map 'builtin:indoor:")
+                && err.contains("jitter gain")
+                && err.contains("past the largest radiance a map may hold (1e12)"),
+            "{err}"
+        );
+    }
 
     /// Mixing built-in lightings into a pool of maps gives the picked training views their own
     /// maps and leaves every other view, the test views among them, as without mixing.

@@ -269,7 +269,9 @@ impl<'s, O: Objective> Run<'s, O> {
             Some(_) => 0,
             None => (0..schedule.epochs).map(steps_in).sum(),
         };
-        let done_batches = (0..ck.state.epoch).map(steps_in).sum::<usize>() + ck.state.batch;
+        // Every batch done was a step: read, not replayed epoch by epoch (a state edited to
+        // 10⁹ epochs and steps replayed a billion epochs' plans).
+        let done_batches = ck.state.step as usize;
         let what = format!("training {}", objective.tag());
         let bar = match budget {
             Some(b) => nprt_io::progress_bar(schedule.progress, b.ceil() as u64, &what, "s"),
