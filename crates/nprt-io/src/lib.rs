@@ -2,7 +2,7 @@
 //! files so that no run ever leaves a half-written one (a temporary file renamed into place),
 //! checking early that an output folder is writable (and never replacing a device, FIFO or
 //! link target it was not asked to), inputs checked to be regular files (a FIFO
-//! would block for ever), lock files opened without following links, checking sizes against the machine's memory and cores
+//! would block for ever), a mapped file cut short named instead of a bare SIGBUS, lock files opened without following links, checking sizes against the machine's memory and cores
 //! before allocating, the one style of progress bar with an ETA, and the file formats of pixels: multi-channel OpenEXR, the one image reader (EXR, PNG,
 //! JPEG, Radiance HDR as linear RGB), tone-mapped PNG, the sRGB curve, and line plots. It sits
 //! at the bottom of the stack and must know nothing of scenes or networks: callers hand it
@@ -18,6 +18,7 @@
 //! ```
 
 mod atomic;
+mod bus_error;
 pub mod exr;
 mod image_read;
 mod input_file;
@@ -32,6 +33,7 @@ pub use atomic::{
     check_writable, create_parent_dir, leftover_temporaries, output_target, remove_temporaries,
     write_atomically, write_file,
 };
+pub use bus_error::name_on_bus_error;
 pub use image_read::{linear_rgb, read_linear_rgb, LinearImage};
 pub use indicatif::ProgressBar;
 pub use input_file::{check_input, read_input, read_input_string};

@@ -85,11 +85,14 @@ impl BsdfParams {
     /// What the G-buffer stores, (kd, ks, α) of DESIGN.md's model: ks at normal incidence, and
     /// a masked surface's parameters scaled by its opacity (what it reflects on average). Glass
     /// has kd = 0 and α at its floor: the G-buffer sees its reflecting surface only.
+    /// Each is held to [0, 1], the range a dataset's reader accepts: a scene may state
+    /// reflectances above 1 or α of many (Mitsuba traces them as given, as does nprt), but the
+    /// network's inputs stay where a damaged file can be told apart (docs/limits.md).
     pub fn gbuffer(&self) -> (Vec3, Vec3, f32) {
         (
-            self.kd * self.opacity,
-            self.normal_incidence_ks() * self.opacity,
-            self.alpha,
+            (self.kd * self.opacity).clamp(Vec3::ZERO, Vec3::ONE),
+            (self.normal_incidence_ks() * self.opacity).clamp(Vec3::ZERO, Vec3::ONE),
+            self.alpha.min(1.0),
         )
     }
 }

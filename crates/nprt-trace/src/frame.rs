@@ -135,14 +135,17 @@ impl Frame {
     }
 
     /// The frame held by named channels (as [`nprt_io::exr::read_channels`] returns them),
-    /// refusing a missing or wrongly sized channel, non-finite values, and negative ones where
-    /// they have no meaning (radiance, reflectances, alpha, mask), naming the pixel.
+    /// refusing a missing or wrongly sized channel, non-finite values, negative radiance, and
+    /// reflectances, α or mask outside [0, 1] (the G-buffer's range), naming the pixel.
     pub fn from_channels(
         width: usize,
         height: usize,
         ch: &HashMap<String, Vec<f32>>,
     ) -> Result<Frame> {
-        let get = |name: &str, non_negative: bool| -> Result<&Vec<f32>> {
+        // Each channel's range: any finite value, non-negative (radiance), or within [0, 1]
+        // (reflectances, α and the mask, as the G-buffer records them): a value past it is a
+        // damaged or edited file, named here rather than blamed on --lr by a training.
+        let get = |name: &str, range: Option<(f32, f32)>| -> Result<&Vec<f32>> {
             let data = ch
                 .get(name)
                 .with_context(|| format!("lacks channel '{name}'"))?;
@@ -152,31 +155,36 @@ impl Frame {
                     data.len()
                 );
             }
+            let (lo, hi) = range.unwrap_or((f32::MIN, f32::MAX));
             if let Some(i) = data
                 .iter()
-                .position(|v| !v.is_finite() || (non_negative && *v < 0.0))
+                .position(|v| !v.is_finite() || *v < lo || *v > hi)
             {
+                let why = match (data[i].is_finite(), hi) {
+                    (false, _) => String::new(),
+                    (true, f32::MAX) => ", but cannot be negative".into(),
+                    (true, _) => format!(", outside [{lo}, {hi}]"),
+                };
                 bail!(
-                    "channel '{name}' is {} at pixel ({}, {}){}",
+                    "channel '{name}' is {} at pixel ({}, {}){why}",
                     data[i],
                     i % width,
                     i / width,
-                    if data[i].is_finite() {
-                        ", but cannot be negative"
-                    } else {
-                        ""
-                    }
                 );
             }
             Ok(data)
         };
         let mut layers = Vec::with_capacity(VECTOR_LAYERS.len());
         for (prefix, names) in VECTOR_LAYERS {
-            let colour = names == RGB;
+            let range = match prefix {
+                "kd" | "ks" => Some((0.0, 1.0)),
+                _ if names == RGB => Some((0.0, f32::MAX)),
+                _ => None,
+            };
             let c = [
-                get(&channel_name(prefix, names[0]), colour)?,
-                get(&channel_name(prefix, names[1]), colour)?,
-                get(&channel_name(prefix, names[2]), colour)?,
+                get(&channel_name(prefix, names[0]), range)?,
+                get(&channel_name(prefix, names[1]), range)?,
+                get(&channel_name(prefix, names[2]), range)?,
             ];
             layers.push(
                 (0..width * height)
@@ -197,8 +205,8 @@ impl Frame {
                 view,
                 kd,
                 ks,
-                alpha: get("alpha", true)?.clone(),
-                mask: get("mask", true)?.clone(),
+                alpha: get("alpha", Some((0.0, 1.0)))?.clone(),
+                mask: get("mask", Some((0.0, 1.0)))?.clone(),
             },
         })
     }

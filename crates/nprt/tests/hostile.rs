@@ -94,7 +94,7 @@ fn render_exr(model: &str, out: &Path, frames: &str, extra: &[&str]) -> std::pro
 /// Starts a training run on `out` that lasts until killed.
 fn endless_training(data: &str, out: &str) -> std::process::Child {
     Command::new(env!("CARGO_BIN_EXE_nprt"))
-        .args(train_args(data, out, &["--epochs", "1000000"]))
+        .args(train_args(data, out, &["--epochs", "100000"]))
         .stdout(Stdio::null())
         .stderr(Stdio::null())
         .spawn()
@@ -400,7 +400,25 @@ fn verify_reports_bad_texels_and_leftovers_and_train_names_the_pixel() {
         &train_args(d, model.to_str().unwrap(), &["--epochs", "1"]),
         &[name, "channel 'G' is -0.5 at pixel (5, 2)"],
     );
-    std::fs::write(&view, original).unwrap();
+    // A reflectance or α of 1e30 (finite, past the G-buffer's [0, 1]) likewise, where train
+    // blamed --lr.
+    for channel in ["kd.G", "alpha"] {
+        let (w, h, mut ch) = read_channels(&view).unwrap();
+        ch.get_mut("G").unwrap()[2 * w + 5] = 0.5;
+        ch.get_mut(channel).unwrap()[w + 3] = 1e30;
+        let channels: Vec<(String, Vec<f32>)> = ch.into_iter().collect();
+        write_channels(&view, w, h, &channels).unwrap();
+        let why = format!("channel '{channel}' is 1000000000000000000000000000000 at pixel (3, 1), outside [0, 1]");
+        let o = nprt(&["dataset", "verify", d]);
+        let stdout = String::from_utf8_lossy(&o.stdout);
+        assert_eq!(o.status.code(), Some(1));
+        assert!(stdout.contains(&why), "{stdout}");
+        fails(
+            &train_args(d, model.to_str().unwrap(), &["--epochs", "1"]),
+            &[name, &why],
+        );
+        std::fs::write(&view, &original).unwrap();
+    }
     // A temporary file a killed run left: verify reports it, a re-run of generate removes it.
     let leftover = view.with_file_name(format!(".{name}.4242.tmp"));
     std::fs::write(&leftover, b"half a view").unwrap();
@@ -786,5 +804,85 @@ fn small_cases_are_answered_precisely() {
     let err = String::from_utf8_lossy(&o.stderr);
     assert_eq!(o.status.code(), Some(1));
     assert_eq!(err.matches("(os error 2)").count(), 1, "{err}");
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+/// Starts a long CPU training on a tiny dataset, waits for its first checkpoint (the pack is
+/// open and read by then), lets `damage` change the pack under it, and returns the run's exit
+/// status and output.
+fn train_while(name: &str, damage: impl FnOnce(&Path)) -> (Option<i32>, String, PathBuf) {
+    let (dir, data) = with_dataset(name);
+    let model = dir.join("model");
+    let (d, m) = (data.to_str().unwrap(), model.to_str().unwrap());
+    let args = train_args(
+        d,
+        m,
+        &[
+            "--epochs",
+            "20000",
+            "--checkpoint-minutes",
+            "0",
+            "--device",
+            "cpu",
+        ],
+    );
+    let mut child = Command::new(env!("CARGO_BIN_EXE_nprt"))
+        .args(&args)
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    let started = std::time::Instant::now();
+    while !model.join("checkpoint/state.json").exists() {
+        assert!(
+            started.elapsed().as_secs() < 60,
+            "no checkpoint after a minute"
+        );
+        std::thread::sleep(std::time::Duration::from_millis(20));
+    }
+    damage(&data.join("packed-radiance.bin"));
+    let out = child.wait_with_output().unwrap();
+    let text = String::from_utf8_lossy(&out.stderr) + String::from_utf8_lossy(&out.stdout);
+    (out.status.code(), text.into_owned(), dir)
+}
+
+/// A pack cut short while a training maps it ends the run with a message naming the pack
+/// (it died of a bare SIGBUS, status 135); random bytes written over its records end it at
+/// the latest before the last save, named as a changed dataset (not blamed on --lr), and no
+/// model is left behind either way.
+#[test]
+fn a_pack_changed_during_training_is_named() {
+    let (code, text, dir) = train_while("bus", |pack| {
+        std::fs::OpenOptions::new()
+            .write(true)
+            .open(pack)
+            .unwrap()
+            .set_len(0)
+            .unwrap();
+    });
+    assert_eq!(code, Some(1), "{text}");
+    assert!(
+        text.contains("packed-radiance.bin' changed while this process had it mapped"),
+        "{text}"
+    );
+    std::fs::remove_dir_all(&dir).unwrap();
+    let (code, text, dir) = train_while("scribbled", |pack| {
+        use std::io::{Seek, SeekFrom, Write};
+        let mut f = std::fs::OpenOptions::new().write(true).open(pack).unwrap();
+        let len = f.metadata().unwrap().len();
+        f.seek(SeekFrom::Start(len - 4096)).unwrap();
+        let noise: Vec<u8> = (0..4096u32)
+            .map(|i| (i.wrapping_mul(2_654_435_761) >> 13) as u8)
+            .collect();
+        f.write_all(&noise).unwrap();
+    });
+    assert_eq!(code, Some(1), "{text}");
+    assert!(
+        text.contains("the dataset changed while the run read it")
+            && text.contains("packed-radiance.bin' are damaged")
+            && !text.contains("lower --lr"),
+        "{text}"
+    );
+    assert!(!dir.join("model/weights.safetensors").exists());
     std::fs::remove_dir_all(&dir).unwrap();
 }

@@ -97,8 +97,12 @@ pub struct PackedDataset {
 }
 
 enum Records {
-    /// The file, `len` bytes of records after the prelude.
-    Mapped { map: Mmap, len: usize },
+    /// The file at `path`, `len` bytes of records after the prelude.
+    Mapped {
+        map: Mmap,
+        len: usize,
+        path: PathBuf,
+    },
     /// Built in memory (tests, small sets).
     Memory(Vec<PackedPixel>),
 }
@@ -187,23 +191,39 @@ impl PackedDataset {
             .with_context(|| format!("'{}' does not match its manifest", path.display()))?;
         let pack = PackedDataset {
             header,
-            records: Records::Mapped { map, len },
+            records: Records::Mapped {
+                map,
+                len,
+                path: path.to_path_buf(),
+            },
+        };
+        pack.check_records()?;
+        nprt_io::name_on_bus_error(path);
+        Ok(pack)
+    }
+
+    /// Hashes the records again against the hash written with them: a pack changed since it
+    /// was opened (random bytes written over it during a training) is told apart from a
+    /// training that diverged by itself. A pack built in memory has nothing to check.
+    pub fn check_records(&self) -> Result<()> {
+        let Records::Mapped { path, .. } = &self.records else {
+            return Ok(());
         };
         // In pieces, each let go once hashed, so that checking a pack larger than memory
         // never holds more than one piece.
         let mut hasher = blake3::Hasher::new();
-        let bytes: &[u8] = bytemuck::cast_slice(pack.records());
+        let bytes: &[u8] = bytemuck::cast_slice(self.records());
         for (i, piece) in bytes.chunks(HASH_PIECE).enumerate() {
             hasher.update_rayon(piece);
-            pack.release_bytes(i * HASH_PIECE, piece.len());
+            self.release_bytes(i * HASH_PIECE, piece.len());
         }
         let hash = hasher.finalize();
         ensure!(
-            hash.to_hex().as_str() == pack.header.records_hash,
+            hash.to_hex().as_str() == self.header.records_hash,
             "the records of '{}' are damaged (their hash differs from the one written)",
             path.display()
         );
-        Ok(pack)
+        Ok(())
     }
 
     /// A pack held in memory: `views[i]` are the records of view i. It names no dataset and
@@ -243,7 +263,7 @@ impl PackedDataset {
     /// Every record, views one after another in manifest order (as a GPU engine uploads them).
     pub fn records(&self) -> &[PackedPixel] {
         match &self.records {
-            Records::Mapped { map, len } => {
+            Records::Mapped { map, len, .. } => {
                 bytemuck::cast_slice(&map[PRELUDE_BYTES..PRELUDE_BYTES + len])
             }
             Records::Memory(r) => r,

@@ -158,6 +158,10 @@ impl Objective for PixelObjective<'_> {
         [CONFIG_FILE, WEIGHTS_FILE]
     }
 
+    fn check_data(&self) -> Result<()> {
+        self.set.pack.check_records()
+    }
+
     fn save_model(
         &self,
         out: &Path,

@@ -69,6 +69,11 @@ pub trait Objective: Sync {
     fn validation_loss(&self, steps: &mut dyn EngineSteps<Self::Net, Self::Batch>) -> Result<f64>;
     /// The model folder's own files (config and weights), which a diverged run removes.
     fn model_files(&self) -> [&'static str; 2];
+    /// Checks that the data the run reads is still what it was when the run began (a pack
+    /// written over during the run): asked when a run diverges and before its last save.
+    fn check_data(&self) -> Result<()> {
+        Ok(())
+    }
     /// Writes the model folder's own files (config and weights) for the network as it stands.
     fn save_model(
         &self,
@@ -165,6 +170,11 @@ pub fn train<O: Objective>(objective: &O, schedule: &Schedule, out: &Path) -> Re
         run.end_epoch(val, total);
         let finished = run.ck.state.epoch >= schedule.epochs || run.out_of_time();
         let since_saved = run.last_checkpoint.elapsed().as_secs_f64();
+        if finished {
+            if let Err(e) = objective.check_data() {
+                return Err(run.abandon(e, run.ck.state.epoch));
+            }
+        }
         if finished || since_saved >= schedule.checkpoint_secs.min(EPOCH_CHECKPOINT_SECS) {
             run.save(&net, steps.as_ref())?;
         }
@@ -385,6 +395,34 @@ impl<'s, O: Objective> Run<'s, O> {
     /// model files go: saved as the weights grew, they may hold weights no later command should
     /// load (`render` made black frames of |w| ≈ 1e30 with exit 0).
     fn diverged(&mut self, why: &str, epoch: usize) -> anyhow::Error {
+        // Data changed under the run (random bytes over its pack) makes a run diverge too:
+        // said as such, not blamed on --lr.
+        if let Err(e) = self.objective.check_data() {
+            return self.abandon(e, epoch);
+        }
+        let step = self.ck.state.step;
+        let files = self.remove_model_files();
+        anyhow::anyhow!(
+            "training diverged at epoch {} step {step} ({why}); {files}; lower --lr and use another --out",
+            epoch + 1,
+        )
+    }
+
+    /// Stops a run whose data changed while it read it (`e` says how), its model files removed.
+    fn abandon(&mut self, e: anyhow::Error, epoch: usize) -> anyhow::Error {
+        let step = self.ck.state.step;
+        let files = self.remove_model_files();
+        e.context(format!(
+            "training stopped at epoch {} step {step}: the dataset changed while the run read it \
+             (it was checked when the run began); {files}; leave the dataset alone during a run \
+             and run it again",
+            epoch + 1
+        ))
+    }
+
+    /// Removes the model folder's own files, so that no later command loads a model from a
+    /// failed run; says what was removed and what is kept.
+    fn remove_model_files(&mut self) -> String {
         self.bar.abandon();
         let removed = (self.objective.model_files().iter())
             .filter(|f| std::fs::remove_file(self.out.join(f)).is_ok())
@@ -401,11 +439,7 @@ impl<'s, O: Objective> Run<'s, O> {
         } else {
             "no checkpoint had been written yet".to_string()
         };
-        anyhow::anyhow!(
-            "training diverged at epoch {} step {} ({why}); {model}{kept}; lower --lr and use another --out",
-            epoch + 1,
-            self.ck.state.step
-        )
+        format!("{model}{kept}")
     }
 
     /// Waits for the last queued step on a device and counts it: before saving, and at the

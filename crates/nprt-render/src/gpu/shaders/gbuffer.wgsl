@@ -70,8 +70,9 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
     write(i, 0u, sp.p);
     write(i, 3u, sp.ns);
     write(i, 6u, -dir);
-    write(i, 9u, mp.kd * mp.opacity);
-    write(i, 12u, mp.ks * fresnel * mp.opacity);
-    gbuffer[17u * i + 15u] = mp.alpha;
+    // Held to [0, 1] as BsdfParams::gbuffer holds them.
+    write(i, 9u, clamp(mp.kd * mp.opacity, vec3(0.0), vec3(1.0)));
+    write(i, 12u, clamp(mp.ks * fresnel * mp.opacity, vec3(0.0), vec3(1.0)));
+    gbuffer[17u * i + 15u] = min(mp.alpha, 1.0);
     gbuffer[17u * i + 16u] = 1.0;
 }
