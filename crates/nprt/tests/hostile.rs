@@ -886,3 +886,34 @@ fn a_pack_changed_during_training_is_named() {
     assert!(!dir.join("model/weights.safetensors").exists());
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+/// Another design's optimiser state put in a checkpoint (a baseline run's moments in a D/S
+/// folder, which panicked in burn) is refused by name when the run resumes.
+#[test]
+fn another_designs_optimiser_state_is_refused_on_resume() {
+    let (dir, data, baseline) = trained_model("adam-swap", &["--schedule", "paper"]);
+    let d = data.to_str().unwrap();
+    let dsep = dir.join("dsep");
+    let m = dsep.to_str().unwrap();
+    let args = |epochs| {
+        let mut a = train_args(d, m, &["--epochs", epochs, "--schedule", "paper"]);
+        a[4] = "dsep";
+        a
+    };
+    ok(&args("1"));
+    let state = |model: &Path| -> String {
+        let json: serde_json::Value = serde_json::from_slice(
+            &std::fs::read(model.join("checkpoint/state.json")).unwrap(),
+        )
+        .unwrap();
+        json["optimizer"].as_str().unwrap().to_string()
+    };
+    let theirs = baseline.join("checkpoint").join(state(&baseline));
+    let ours = dsep.join("checkpoint").join(state(&dsep));
+    std::fs::copy(&theirs, &ours).unwrap();
+    fails_in_time(
+        &args("2"),
+        &["Adam's state", &state(&dsep), "not this network's"],
+    );
+    std::fs::remove_dir_all(&dir).unwrap();
+}
