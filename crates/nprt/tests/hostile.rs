@@ -902,10 +902,9 @@ fn another_designs_optimiser_state_is_refused_on_resume() {
     };
     ok(&args("1"));
     let state = |model: &Path| -> String {
-        let json: serde_json::Value = serde_json::from_slice(
-            &std::fs::read(model.join("checkpoint/state.json")).unwrap(),
-        )
-        .unwrap();
+        let json: serde_json::Value =
+            serde_json::from_slice(&std::fs::read(model.join("checkpoint/state.json")).unwrap())
+                .unwrap();
         json["optimizer"].as_str().unwrap().to_string()
     };
     let theirs = baseline.join("checkpoint").join(state(&baseline));

@@ -4,7 +4,8 @@
 
 use super::gpu_trainer::{BatchBuffers, GpuTrainer};
 use super::kernels::{
-    ENCODER_BLOCK, ENCODER_INPUT_BACKWARD, ENCODER_POOL_BACKWARD, ENCODER_WEIGHT_BACKWARD,
+    ENCODER_BLOCK, ENCODER_BLOCK_THREADS, ENCODER_INPUT_BACKWARD, ENCODER_POOL_BACKWARD,
+    ENCODER_WEIGHT_BACKWARD,
 };
 use super::network_layout::ConvAt;
 use super::products::{Bias, Operand, Output};
@@ -55,7 +56,7 @@ impl GpuTrainer {
                     &out,
                     &taken,
                 ],
-                groups_for(count),
+                groups_for(ENCODER_BLOCK_THREADS * count),
             ));
             tape.inputs.push(std::mem::replace(&mut x, out));
             tape.sizes.push((h, w));

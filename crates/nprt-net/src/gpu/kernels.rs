@@ -30,6 +30,8 @@ macro_rules! kernel {
 }
 
 pub const ENCODER_BLOCK: KernelSource = kernel!("encoder_block");
+/// Threads `encoder_block` takes per output value: one per slot of its pooling window.
+pub const ENCODER_BLOCK_THREADS: usize = 4;
 pub const ENCODER_POOL_BACKWARD: KernelSource = kernel!("encoder_pool_backward");
 pub const ENCODER_WEIGHT_BACKWARD: KernelSource = kernel!("encoder_weight_backward");
 pub const ENCODER_INPUT_BACKWARD: KernelSource = kernel!("encoder_input_backward");

@@ -4,7 +4,7 @@
 
 use std::sync::Arc;
 
-use nprt_net::gpu::kernels::ENCODER_BLOCK;
+use nprt_net::gpu::kernels::{ENCODER_BLOCK, ENCODER_BLOCK_THREADS};
 use nprt_net::gpu::{groups_for, Dispatch, GpuDevice};
 use nprt_net::network::encoder::{BLOCKS, CHANNELS, CODE_SIZE};
 use nprt_net::LightEncoder;
@@ -95,7 +95,7 @@ impl GpuEncoder {
                 &ENCODER_BLOCK,
                 &[*c_in as u32, h as u32, w as u32, 1, 0, 0, 0, 0],
                 &[&x, weight, bias, &out, &gpu.empty],
-                groups_for(CHANNELS * (h / 2) * (w / 2)),
+                groups_for(ENCODER_BLOCK_THREADS * CHANNELS * (h / 2) * (w / 2)),
             ));
             (x, h, w) = (out, h / 2, w / 2);
         }

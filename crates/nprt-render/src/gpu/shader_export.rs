@@ -25,7 +25,7 @@ use super::kernels::{sources, HALF_SOURCES};
 use crate::{CameraPath, Relighter};
 
 /// Version of the export's layout, bumped whenever a reader would read it differently.
-pub const EXPORT_VERSION: u32 = 5;
+pub const EXPORT_VERSION: u32 = 6;
 
 /// The worked example's view: the model's scene from the start of `nprt render`'s default
 /// camera path, at this size, under this lighting.

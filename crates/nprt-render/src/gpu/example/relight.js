@@ -131,7 +131,7 @@ async function main() {
   let x = upload(light);
   for (const b of blocks) {
     const out = room(32 * (h / 2) * (w / 2));
-    dispatch(pass, 'encoder_block', [b.cIn, h, w, 1, 0, 0, 0, 0], [x, b.weight, b.bias, out, empty], groups(32 * (h / 2) * (w / 2)));
+    dispatch(pass, 'encoder_block', [b.cIn, h, w, 1, 0, 0, 0, 0], [x, b.weight, b.bias, out, empty], groups(4 * 32 * (h / 2) * (w / 2)));
     [x, h, w] = [out, h / 2, w / 2];
   }
   denseLayer(pass, toCode, x, 1, toCode.dIn, 0, toCode.bias, 0, code);
