@@ -4,8 +4,8 @@
 
 use super::gpu_trainer::{BatchBuffers, GpuTrainer};
 use super::kernels::{
-    ENCODER_BLOCK, ENCODER_BLOCK_THREADS, ENCODER_INPUT_BACKWARD, ENCODER_POOL_BACKWARD,
-    ENCODER_WEIGHT_BACKWARD,
+    ENCODER_BLOCK, ENCODER_BLOCK_THREADS, ENCODER_INPUT_BACKWARD, ENCODER_INPUT_BACKWARD_THREADS,
+    ENCODER_POOL_BACKWARD, ENCODER_WEIGHT_BACKWARD,
 };
 use super::network_layout::ConvAt;
 use super::products::{Bias, Operand, Output};
@@ -136,7 +136,7 @@ impl GpuTrainer {
                     &ENCODER_INPUT_BACKWARD,
                     &params.map(|v| v as u32),
                     &[&self.params, &dz, &d_input],
-                    groups_for(b.views * conv.c_in * h * w),
+                    groups_for(ENCODER_INPUT_BACKWARD_THREADS * b.views * conv.c_in * h * w),
                 ));
             }
             d = d_input;

@@ -35,6 +35,8 @@ pub const ENCODER_BLOCK_THREADS: usize = 4;
 pub const ENCODER_POOL_BACKWARD: KernelSource = kernel!("encoder_pool_backward");
 pub const ENCODER_WEIGHT_BACKWARD: KernelSource = kernel!("encoder_weight_backward");
 pub const ENCODER_INPUT_BACKWARD: KernelSource = kernel!("encoder_input_backward");
+/// Threads `encoder_input_backward` takes per input value: one per quarter of the channels.
+pub const ENCODER_INPUT_BACKWARD_THREADS: usize = 4;
 pub const TRACK_INPUTS: KernelSource = kernel!("track_inputs", "hash_grid");
 pub const GRID_BACKWARD: KernelSource = kernel!("grid_backward", "hash_grid");
 pub const GEMM: KernelSource = kernel!("gemm");
