@@ -2,10 +2,11 @@
 //! their pooling tapes, the code layer, and backward from the gradient at the codes into every
 //! encoder weight.
 
+use super::encoder_blocks::{record_blocks, BlockWeights};
 use super::gpu_trainer::{BatchBuffers, GpuTrainer};
 use super::kernels::{
-    ENCODER_BLOCK, ENCODER_BLOCK_THREADS, ENCODER_INPUT_BACKWARD, ENCODER_INPUT_BACKWARD_THREADS,
-    ENCODER_POOL_BACKWARD, ENCODER_WEIGHT_BACKWARD,
+    ENCODER_INPUT_BACKWARD, ENCODER_INPUT_BACKWARD_THREADS, ENCODER_POOL_BACKWARD,
+    ENCODER_WEIGHT_BACKWARD,
 };
 use super::network_layout::ConvAt;
 use super::products::{Bias, Operand, Output};
@@ -33,47 +34,40 @@ impl GpuTrainer {
         plan: &mut Vec<Dispatch>,
         b: &BatchBuffers,
     ) -> EncoderTape {
-        let gpu = &self.gpu;
-        let (mut h, mut w) = (b.light_width / 2, b.light_width);
-        let mut x = b.lights.clone();
-        let mut tape = EncoderTape {
-            inputs: Vec::new(),
-            sizes: Vec::new(),
-            tapes: Vec::new(),
-            flat: x.clone(),
+        let (weights, biases): (Vec<_>, Vec<_>) = (self.net.convs.iter())
+            .map(|conv| (self.part(conv.weight), self.part(conv.bias)))
+            .unzip();
+        let blocks: Vec<BlockWeights> = (self.net.convs.iter().zip(&weights).zip(&biases))
+            .map(|((conv, weight), bias)| BlockWeights {
+                weight,
+                bias,
+                c_in: conv.c_in,
+            })
+            .collect();
+        let pass = record_blocks(
+            &self.gpu,
+            plan,
+            &b.lights,
+            [b.views, b.light_width],
+            &blocks,
+            true,
+        );
+        let tape = EncoderTape {
+            inputs: pass.inputs,
+            sizes: pass.sizes,
+            tapes: pass.tapes,
+            flat: pass.last,
         };
-        for conv in &self.net.convs {
-            let count = b.views * CHANNELS * (h / 2) * (w / 2);
-            let (out, taken) = (gpu.buffer(count), gpu.buffer(count));
-            let params = [conv.c_in, h, w, b.views, 1, 0, 0, 0].map(|v| v as u32);
-            plan.push(gpu.prepare(
-                &ENCODER_BLOCK,
-                &params,
-                &[
-                    &x,
-                    &self.part(conv.weight),
-                    &self.part(conv.bias),
-                    &out,
-                    &taken,
-                ],
-                groups_for(ENCODER_BLOCK_THREADS * count),
-            ));
-            tape.inputs.push(std::mem::replace(&mut x, out));
-            tape.sizes.push((h, w));
-            tape.tapes.push(taken);
-            (h, w) = (h / 2, w / 2);
-        }
         let flat = self.net.to_code.d_in;
         plan.push(self.gpu.product(
             [b.views, CODE_SIZE, flat],
-            Operand::plain(&x, 0, flat),
+            Operand::plain(&tape.flat, 0, flat),
             Operand::plain(&self.params, self.net.to_code.weight.offset, CODE_SIZE),
             Bias::Column(&self.params, self.net.to_code.bias.offset),
             0,
             Output::to(&b.codes, 0, CODE_SIZE),
             None,
         ));
-        tape.flat = x;
         tape
     }
 

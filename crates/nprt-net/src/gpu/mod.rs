@@ -11,6 +11,7 @@
 mod buffer_pool;
 mod codes;
 mod device_dataset;
+mod encoder_blocks;
 mod encoder_step;
 mod gpu_buffer;
 mod gpu_device;
@@ -28,6 +29,7 @@ mod transport_step;
 pub use buffer_pool::{BufferPool, PooledBuffer};
 pub use codes::{activation_code, loss_code};
 pub use device_dataset::DeviceDataset;
+pub use encoder_blocks::{record_blocks, BlockPass, BlockWeights};
 pub use gpu_device::GpuDevice;
 pub use gpu_trainer::GpuTrainer;
 pub use half_layers::{half_weight_bits, held_halves, pad16, HalfWeight, Held, HALF_ROW_BLOCK};

@@ -4,9 +4,8 @@
 
 use std::sync::Arc;
 
-use nprt_net::gpu::kernels::{ENCODER_BLOCK, ENCODER_BLOCK_THREADS};
-use nprt_net::gpu::{groups_for, Dispatch, GpuDevice};
-use nprt_net::network::encoder::{BLOCKS, CHANNELS, CODE_SIZE};
+use nprt_net::gpu::{record_blocks, BlockWeights, Dispatch, GpuDevice};
+use nprt_net::network::encoder::{BLOCKS, CODE_SIZE};
 use nprt_net::LightEncoder;
 
 use super::gpu_mlp::{dense_layer, GpuDense, Rows};
@@ -86,20 +85,16 @@ impl GpuEncoder {
     fn run(&self, gpu: &GpuDevice, width: usize) -> EncoderRun {
         let input = gpu.buffer(3 * width * (width / 2));
         let code = gpu.buffer(CODE_SIZE);
-        let (mut h, mut w) = (width / 2, width);
-        let mut x = input.clone();
+        let blocks: Vec<BlockWeights> = (self.convs.iter())
+            .map(|(weight, bias, c_in)| BlockWeights {
+                weight,
+                bias,
+                c_in: *c_in,
+            })
+            .collect();
+        debug_assert_eq!(blocks.len(), BLOCKS);
         let mut dispatches = Vec::new();
-        for (weight, bias, c_in) in &self.convs {
-            let out = gpu.buffer(CHANNELS * (h / 2) * (w / 2));
-            dispatches.push(gpu.prepare(
-                &ENCODER_BLOCK,
-                &[*c_in as u32, h as u32, w as u32, 1, 0, 0, 0, 0],
-                &[&x, weight, bias, &out, &gpu.empty],
-                groups_for(ENCODER_BLOCK_THREADS * CHANNELS * (h / 2) * (w / 2)),
-            ));
-            (x, h, w) = (out, h / 2, w / 2);
-        }
-        debug_assert_eq!(self.convs.len(), BLOCKS);
+        let x = record_blocks(gpu, &mut dispatches, &input, [1, width], &blocks, false).last;
         let flat = Rows {
             x: &x,
             rows: 1,
