@@ -11,6 +11,8 @@ use obvhs::ray::{Ray, RayHit};
 use obvhs::triangle::Triangle;
 use obvhs::BvhBuildParams;
 
+use crate::hittable::hittable;
+
 /// A triangle laid out for Möller-Trumbore: v0, e1 = v0 − v1, e2 = v2 − v0, n = e1 × e2.
 #[derive(Clone, Copy)]
 pub(crate) struct Tri {
@@ -95,13 +97,16 @@ fn bvh_ray(origin: Vec3, dir: Vec3, tmax: f32) -> Ray {
 
 impl Accel {
     pub fn new(scene: &Scene) -> Self {
-        let tris = scene_triangles(scene);
-        let refs: Vec<(u32, u32)> = scene
+        let all = scene_triangles(scene);
+        let all_refs: Vec<(u32, u32)> = scene
             .meshes
             .iter()
             .enumerate()
             .flat_map(|(mi, mesh)| (0..mesh.indices.len() as u32).map(move |ti| (mi as u32, ti)))
             .collect();
+        let kept = hittable(&all);
+        let tris: Vec<Triangle> = kept.iter().map(|&i| all[i as usize]).collect();
+        let refs: Vec<(u32, u32)> = kept.iter().map(|&i| all_refs[i as usize]).collect();
         let bvh = build_cwbvh_from_tris(
             &tris,
             BvhBuildParams::medium_build(),

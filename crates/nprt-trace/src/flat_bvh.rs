@@ -13,6 +13,7 @@ use obvhs::triangle::Triangle;
 use obvhs::BvhBuildParams;
 
 use crate::accel::Tri;
+use crate::hittable::hittable;
 
 /// Words per node: `[min (3 f32), triangle count, max (3 f32), first]` with `first` the first
 /// child's node (inner nodes: count 0; the second child follows it) or a leaf's first entry of
@@ -34,13 +35,16 @@ impl FlatBvh {
     /// Over triangles given by their corners, in the scene's order (mesh after mesh), which
     /// the records' indices count.
     pub fn from_corners(corners: impl Iterator<Item = [Vec3; 3]>) -> Self {
-        let tris: Vec<Triangle> = corners
+        let all: Vec<Triangle> = corners
             .map(|[v0, v1, v2]| Triangle {
                 v0: v0.into(),
                 v1: v1.into(),
                 v2: v2.into(),
             })
             .collect();
+        // Each record keeps its index among the scene's triangles (`kept[i]`).
+        let kept = hittable(&all);
+        let tris: Vec<Triangle> = kept.iter().map(|&i| all[i as usize]).collect();
         if tris.is_empty() {
             // A placeholder root: a walk must not start on a scene without triangles.
             return FlatBvh {
@@ -67,7 +71,7 @@ impl FlatBvh {
                 let [x, y, z] = v.to_array().map(f32::to_bits);
                 [x, y, z, w]
             };
-            triangles.extend(words(t.v0, i));
+            triangles.extend(words(t.v0, kept[i as usize]));
             triangles.extend(words(t.e1, 0));
             triangles.extend(words(t.e2, 0));
         }

@@ -32,6 +32,7 @@ mod coating;
 mod flat_bvh;
 mod frame;
 mod gbuffer_pass;
+mod hittable;
 mod integrator;
 mod microfacet;
 mod pixel_rng;

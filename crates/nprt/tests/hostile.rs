@@ -807,6 +807,52 @@ fn small_cases_are_answered_precisely() {
     std::fs::remove_dir_all(&dir).unwrap();
 }
 
+/// Geometry collapsed onto a point (a shape scaled by 0 or 10⁻³⁰: a stack overflow in the BVH
+/// builder, found by the `scene_geometry` fuzz target) and many coincident copies of one shape
+/// (300 spheres ran past two minutes) are traced: what a ray cannot hit, or hits at the same
+/// distance as an earlier copy, is left out of the BVH.
+#[test]
+fn collapsed_and_coincident_geometry_is_traced() {
+    let dir = fresh_dir("collapsed");
+    std::fs::create_dir_all(&dir).unwrap();
+    let collapsed = r#"<shape type="sphere"><transform name="to_world"><scale value="0"/></transform></shape>
+        <shape type="cube"><transform name="to_world"><scale value="1e-30"/></transform></shape>
+        <shape type="rectangle"/>"#;
+    let copies = r#"<shape type="sphere"/>"#.repeat(60);
+    for (name, shapes) in [("collapsed", collapsed), ("copies", copies.as_str())] {
+        let scene = dir.join(format!("{name}.xml"));
+        std::fs::write(
+            &scene,
+            format!(r#"<scene version="3.0.0">{shapes}</scene>"#),
+        )
+        .unwrap();
+        let out = dir.join(name);
+        let mut args = reference_args(&out);
+        args[1] = scene.to_str().unwrap();
+        let mut child = Command::new(env!("CARGO_BIN_EXE_nprt"))
+            .args(&args)
+            .stdout(Stdio::null())
+            .stderr(Stdio::piped())
+            .spawn()
+            .unwrap();
+        let started = std::time::Instant::now();
+        while child.try_wait().unwrap().is_none() {
+            if started.elapsed().as_secs() > 60 {
+                child.kill().ok();
+                panic!("{name}: still building after a minute");
+            }
+            std::thread::sleep(std::time::Duration::from_millis(50));
+        }
+        let out = child.wait_with_output().unwrap();
+        assert!(
+            out.status.success(),
+            "{name}: {}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+    }
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
 /// Starts a long CPU training on a tiny dataset, waits for its first checkpoint (the pack is
 /// open and read by then), lets `damage` change the pack under it, and returns the run's exit
 /// status and output.
