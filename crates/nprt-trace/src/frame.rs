@@ -11,6 +11,7 @@ use std::path::Path;
 
 use anyhow::{bail, Context, Result};
 use glam::Vec3;
+use nprt_scene::envmap::MAX_RADIANCE;
 
 #[derive(Clone, Debug, Default)]
 pub struct GBuffer {
@@ -135,16 +136,18 @@ impl Frame {
     }
 
     /// The frame held by named channels (as [`nprt_io::exr::read_channels`] returns them),
-    /// refusing a missing or wrongly sized channel, non-finite values, negative radiance, and
-    /// reflectances, α or mask outside [0, 1] (the G-buffer's range), naming the pixel.
+    /// refusing a missing or wrongly sized channel, non-finite values, radiance outside [0,
+    /// [`MAX_RADIANCE`]], and reflectances, α or mask outside [0, 1] (the G-buffer's range),
+    /// naming the pixel.
     pub fn from_channels(
         width: usize,
         height: usize,
         ch: &HashMap<String, Vec<f32>>,
     ) -> Result<Frame> {
-        // Each channel's range: any finite value, non-negative (radiance), or within [0, 1]
-        // (reflectances, α and the mask, as the G-buffer records them): a value past it is a
-        // damaged or edited file, named here rather than blamed on --lr by a training.
+        // Each channel's range: any finite value, radiance within [0, the largest a map may
+        // hold] (a dataset's writer holds it there), or within [0, 1] (reflectances, α and the
+        // mask, as the G-buffer records them): a value past it is a damaged or edited file,
+        // named here rather than blamed on --lr by a training.
         let get = |name: &str, range: Option<(f32, f32)>| -> Result<&Vec<f32>> {
             let data = ch
                 .get(name)
@@ -160,10 +163,12 @@ impl Frame {
                 .iter()
                 .position(|v| !v.is_finite() || *v < lo || *v > hi)
             {
-                let why = match (data[i].is_finite(), hi) {
+                let why = match (data[i].is_finite(), data[i] < 0.0 && lo == 0.0) {
                     (false, _) => String::new(),
-                    (true, f32::MAX) => ", but cannot be negative".into(),
-                    (true, _) => format!(", outside [{lo}, {hi}]"),
+                    (true, true) => ", but cannot be negative".into(),
+                    // 1e12 rather than its 13 digits; 1 as 1.
+                    (true, false) if hi >= 1e6 => format!(", outside [{lo}, {hi:e}]"),
+                    (true, false) => format!(", outside [{lo}, {hi}]"),
                 };
                 bail!(
                     "channel '{name}' is {} at pixel ({}, {}){why}",
@@ -178,7 +183,7 @@ impl Frame {
         for (prefix, names) in VECTOR_LAYERS {
             let range = match prefix {
                 "kd" | "ks" => Some((0.0, 1.0)),
-                _ if names == RGB => Some((0.0, f32::MAX)),
+                _ if names == RGB => Some((0.0, MAX_RADIANCE)),
                 _ => None,
             };
             let c = [

@@ -400,15 +400,18 @@ fn verify_reports_bad_texels_and_leftovers_and_train_names_the_pixel() {
         &train_args(d, model.to_str().unwrap(), &["--epochs", "1"]),
         &[name, "channel 'G' is -0.5 at pixel (5, 2)"],
     );
-    // A reflectance or α of 1e30 (finite, past the G-buffer's [0, 1]) likewise, where train
-    // blamed --lr.
-    for channel in ["kd.G", "alpha"] {
+    // A reflectance or α of 1e30 (finite, past the G-buffer's [0, 1]) or a radiance of 1e30
+    // (past the largest a map may hold) likewise, where train blamed --lr.
+    for channel in ["kd.G", "alpha", "B"] {
         let (w, h, mut ch) = read_channels(&view).unwrap();
         ch.get_mut("G").unwrap()[2 * w + 5] = 0.5;
         ch.get_mut(channel).unwrap()[w + 3] = 1e30;
         let channels: Vec<(String, Vec<f32>)> = ch.into_iter().collect();
         write_channels(&view, w, h, &channels).unwrap();
-        let why = format!("channel '{channel}' is 1000000000000000000000000000000 at pixel (3, 1), outside [0, 1]");
+        let range = if channel == "B" { "1e12" } else { "1" };
+        let why = format!(
+            "channel '{channel}' is 1000000000000000000000000000000 at pixel (3, 1), outside [0, {range}]"
+        );
         let o = nprt(&["dataset", "verify", d]);
         let stdout = String::from_utf8_lossy(&o.stdout);
         assert_eq!(o.status.code(), Some(1));

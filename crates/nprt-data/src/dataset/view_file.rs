@@ -7,6 +7,7 @@ use std::path::Path;
 use anyhow::{bail, Context, Result};
 use glam::Vec3;
 use nprt_io::exr::{checked_size, read_channels, write_channels};
+use nprt_scene::envmap::MAX_RADIANCE;
 use nprt_trace::Frame;
 
 use super::manifest::ViewRecord;
@@ -34,11 +35,22 @@ pub fn write_view(path: &Path, image: &ViewImage) -> Result<()> {
             channels.push((name.to_string(), half.iter().map(|v| v[k]).collect()));
         }
     }
+    // Radiance is held to the largest a map may hold, the range a reader accepts: only a
+    // firefly under a map near that limit could pass it.
+    for (name, values) in &mut channels {
+        if ["R", "G", "B"].contains(&name.as_str())
+            || name.starts_with("direct.")
+            || name.starts_with("half.")
+        {
+            values.iter_mut().for_each(|v| *v = v.min(MAX_RADIANCE));
+        }
+    }
     write_channels(path, f.width, f.height, &channels)
 }
 
 /// Reads a view file, refusing one whose size disagrees with its record, that lacks a channel
-/// (the half's too, when `in_halves`) or that holds non-finite or negative radiance.
+/// (the half's too, when `in_halves`) or that holds a value past its channel's range (radiance
+/// outside [0, 1e12], reflectances, α or mask outside [0, 1]).
 pub fn read_view(path: &Path, view: &ViewRecord, in_halves: bool) -> Result<ViewImage> {
     // The size is checked from the header, before a corrupt one makes the decoder allocate.
     let (w, h) = checked_size(path)?;
@@ -59,10 +71,10 @@ pub fn read_view(path: &Path, view: &ViewRecord, in_halves: bool) -> Result<View
         let half: Vec<Vec3> = (0..w * h).map(|i| Vec3::new(r[i], g[i], b[i])).collect();
         if let Some(i) = half
             .iter()
-            .position(|v| !v.is_finite() || v.min_element() < 0.0)
+            .position(|v| !v.is_finite() || v.min_element() < 0.0 || v.max_element() > MAX_RADIANCE)
         {
             bail!(
-                "channel half.* is {} at pixel ({}, {}), not a finite, non-negative radiance",
+                "channel half.* is {} at pixel ({}, {}), not a radiance in [0, {MAX_RADIANCE:e}]",
                 half[i],
                 i % w,
                 i / w
