@@ -515,6 +515,16 @@ fn lock_files_are_never_followed() {
 /// stdout, or stderr): a command that blocks is killed and the test fails, instead of hanging
 /// the suite.
 fn fails_in_time(args: &[&str], needles: &[&str]) {
+    let (code, err) = run_in_time(args);
+    assert_eq!(code, Some(1), "{args:?}: {err}");
+    for n in needles {
+        assert!(err.contains(n), "stderr for {args:?} lacks '{n}':\n{err}");
+    }
+}
+
+/// Runs nprt with `args`, killing it and failing the test if it takes over a minute; returns
+/// its exit status and what it printed (stderr, then stdout).
+fn run_in_time(args: &[&str]) -> (Option<i32>, String) {
     let mut child = Command::new(env!("CARGO_BIN_EXE_nprt"))
         .args(args)
         .stdout(Stdio::piped())
@@ -530,11 +540,8 @@ fn fails_in_time(args: &[&str], needles: &[&str]) {
         std::thread::sleep(std::time::Duration::from_millis(50));
     }
     let out = child.wait_with_output().unwrap();
-    let err = String::from_utf8_lossy(&out.stderr) + String::from_utf8_lossy(&out.stdout);
-    assert_eq!(out.status.code(), Some(1), "{args:?}: {err}");
-    for n in needles {
-        assert!(err.contains(n), "stderr for {args:?} lacks '{n}':\n{err}");
-    }
+    let text = String::from_utf8_lossy(&out.stderr) + String::from_utf8_lossy(&out.stdout);
+    (out.status.code(), text.into_owned())
 }
 
 /// Makes `path` a FIFO (nothing ever writes to it: opening it to read would block for ever).
@@ -832,26 +839,8 @@ fn collapsed_and_coincident_geometry_is_traced() {
         let out = dir.join(name);
         let mut args = reference_args(&out);
         args[1] = scene.to_str().unwrap();
-        let mut child = Command::new(env!("CARGO_BIN_EXE_nprt"))
-            .args(&args)
-            .stdout(Stdio::null())
-            .stderr(Stdio::piped())
-            .spawn()
-            .unwrap();
-        let started = std::time::Instant::now();
-        while child.try_wait().unwrap().is_none() {
-            if started.elapsed().as_secs() > 60 {
-                child.kill().ok();
-                panic!("{name}: still building after a minute");
-            }
-            std::thread::sleep(std::time::Duration::from_millis(50));
-        }
-        let out = child.wait_with_output().unwrap();
-        assert!(
-            out.status.success(),
-            "{name}: {}",
-            String::from_utf8_lossy(&out.stderr)
-        );
+        let (code, text) = run_in_time(&args);
+        assert_eq!(code, Some(0), "{name}: {text}");
     }
     std::fs::remove_dir_all(&dir).unwrap();
 }
