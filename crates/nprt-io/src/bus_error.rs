@@ -17,12 +17,16 @@ pub fn name_on_bus_error(path: &Path) {
 #[cfg(unix)]
 mod unix {
     use std::path::Path;
-    use std::sync::atomic::{AtomicPtr, AtomicUsize, Ordering};
+    use std::sync::atomic::{AtomicU8, AtomicUsize, Ordering};
     use std::sync::Once;
 
-    /// The message the handler writes, made beforehand: a signal handler may only call
-    /// async-signal-safe functions (write, _exit), not format or allocate.
-    static MESSAGE: AtomicPtr<u8> = AtomicPtr::new(std::ptr::null_mut());
+    /// Room for the message: a longer one is cut short.
+    const ROOM: usize = 1024;
+
+    /// The message the handler writes, made beforehand in a fixed buffer: a signal handler may
+    /// only call async-signal-safe functions (write, _exit), not format or allocate, and a
+    /// buffer per named file would never be freed.
+    static MESSAGE: [AtomicU8; ROOM] = [const { AtomicU8::new(0) }; ROOM];
     static LENGTH: AtomicUsize = AtomicUsize::new(0);
     static INSTALL: Once = Once::new();
 
@@ -33,10 +37,11 @@ mod unix {
              Leave dataset files alone while a command reads them, then run the command again\n",
             path.display()
         );
-        // Leaked on purpose: the handler may read it at any moment for the rest of the process.
-        let bytes: &'static mut [u8] = Box::leak(text.into_bytes().into_boxed_slice());
+        let bytes = &text.as_bytes()[..text.len().min(ROOM)];
         LENGTH.store(0, Ordering::SeqCst);
-        MESSAGE.store(bytes.as_mut_ptr(), Ordering::SeqCst);
+        for (slot, &b) in MESSAGE.iter().zip(bytes) {
+            slot.store(b, Ordering::Relaxed);
+        }
         LENGTH.store(bytes.len(), Ordering::SeqCst);
         INSTALL.call_once(|| {
             // SAFETY: a plain handler for SIGBUS, which only calls write(2) and _exit(2).
@@ -50,15 +55,15 @@ mod unix {
     }
 
     extern "C" fn on_bus_error(_: libc::c_int) {
-        let (text, len) = (
-            MESSAGE.load(Ordering::SeqCst),
-            LENGTH.load(Ordering::SeqCst),
-        );
-        // SAFETY: write(2) and _exit(2) are async-signal-safe; `text` holds `len` bytes that
-        // are never freed.
+        let len = LENGTH.load(Ordering::SeqCst).min(ROOM);
+        let mut text = [0u8; ROOM];
+        for (b, slot) in text.iter_mut().zip(&MESSAGE).take(len) {
+            *b = slot.load(Ordering::Relaxed);
+        }
+        // SAFETY: write(2) and _exit(2) are async-signal-safe; `text` holds `len` bytes.
         unsafe {
-            if !text.is_null() && len > 0 {
-                libc::write(2, text.cast(), len);
+            if len > 0 {
+                libc::write(2, text.as_ptr().cast(), len);
             }
             libc::_exit(1);
         }
