@@ -864,7 +864,7 @@ fn train_while(name: &str, damage: impl FnOnce(&Path)) -> (Option<i32>, String, 
             "cpu",
         ],
     );
-    let mut child = Command::new(env!("CARGO_BIN_EXE_nprt"))
+    let child = Command::new(env!("CARGO_BIN_EXE_nprt"))
         .args(&args)
         .stdout(Stdio::piped())
         .stderr(Stdio::piped())
