@@ -15,8 +15,7 @@ fuzz_target!(|data: &[u8]| {
     std::fs::create_dir_all(&dir).unwrap();
     std::fs::write(dir.join(CONFIG_FILE), json).unwrap();
     std::fs::write(dir.join(WEIGHTS_FILE), weights).unwrap();
-    let device = nprt_net::Device::default();
-    if let Ok((file, _)) = nprt_net::load_model(&dir, &device) {
+    if let Ok((file, _)) = nprt_net::load_model(&dir) {
         assert!(file.config.encoder_width <= nprt_net::network::encoder::MAX_INPUT_WIDTH);
     }
 });
