@@ -135,6 +135,21 @@ impl Frame {
         nprt_io::ensure_memory(width as u128 * height as u128 * Self::BYTES_PER_PIXEL, what)
     }
 
+    /// The values a channel may hold, where it has a range (others: any finite value):
+    /// radiance and direct light within [0, [`MAX_RADIANCE`]], the largest a map may hold (a
+    /// dataset's writer holds them there), and reflectances, α and the mask within [0, 1], as
+    /// the G-buffer records them.
+    pub fn channel_range(name: &str) -> Option<(f32, f32)> {
+        match name.split_once('.') {
+            Some(("kd" | "ks", _)) => Some((0.0, 1.0)),
+            Some(("direct", _)) => Some((0.0, MAX_RADIANCE)),
+            Some(_) => None,
+            None if RGB.contains(&name) => Some((0.0, MAX_RADIANCE)),
+            None if ["alpha", "mask"].contains(&name) => Some((0.0, 1.0)),
+            None => None,
+        }
+    }
+
     /// The frame held by named channels (as [`nprt_io::exr::read_channels`] returns them),
     /// refusing a missing or wrongly sized channel, non-finite values, radiance outside [0,
     /// [`MAX_RADIANCE`]], and reflectances, α or mask outside [0, 1] (the G-buffer's range),
@@ -144,11 +159,9 @@ impl Frame {
         height: usize,
         ch: &HashMap<String, Vec<f32>>,
     ) -> Result<Frame> {
-        // Each channel's range: any finite value, radiance within [0, the largest a map may
-        // hold] (a dataset's writer holds it there), or within [0, 1] (reflectances, α and the
-        // mask, as the G-buffer records them): a value past it is a damaged or edited file,
-        // named here rather than blamed on --lr by a training.
-        let get = |name: &str, range: Option<(f32, f32)>| -> Result<&Vec<f32>> {
+        // A value past its channel's range is a damaged or edited file, named here rather than
+        // blamed on --lr by a training.
+        let get = |name: &str| -> Result<&Vec<f32>> {
             let data = ch
                 .get(name)
                 .with_context(|| format!("lacks channel '{name}'"))?;
@@ -158,7 +171,7 @@ impl Frame {
                     data.len()
                 );
             }
-            let (lo, hi) = range.unwrap_or((f32::MIN, f32::MAX));
+            let (lo, hi) = Self::channel_range(name).unwrap_or((f32::MIN, f32::MAX));
             if let Some(i) = data
                 .iter()
                 .position(|v| !v.is_finite() || *v < lo || *v > hi)
@@ -181,15 +194,10 @@ impl Frame {
         };
         let mut layers = Vec::with_capacity(VECTOR_LAYERS.len());
         for (prefix, names) in VECTOR_LAYERS {
-            let range = match prefix {
-                "kd" | "ks" => Some((0.0, 1.0)),
-                _ if names == RGB => Some((0.0, MAX_RADIANCE)),
-                _ => None,
-            };
             let c = [
-                get(&channel_name(prefix, names[0]), range)?,
-                get(&channel_name(prefix, names[1]), range)?,
-                get(&channel_name(prefix, names[2]), range)?,
+                get(&channel_name(prefix, names[0]))?,
+                get(&channel_name(prefix, names[1]))?,
+                get(&channel_name(prefix, names[2]))?,
             ];
             layers.push(
                 (0..width * height)
@@ -210,8 +218,8 @@ impl Frame {
                 view,
                 kd,
                 ks,
-                alpha: get("alpha", Some((0.0, 1.0)))?.clone(),
-                mask: get("mask", Some((0.0, 1.0)))?.clone(),
+                alpha: get("alpha")?.clone(),
+                mask: get("mask")?.clone(),
             },
         })
     }

@@ -12,11 +12,14 @@ use obvhs::triangle::Triangle;
 /// Indices into `tris` of the triangles to build over, in order.
 pub fn hittable(tris: &[Triangle]) -> Vec<u32> {
     // The three corners' bits, sorted: equal for any copy of a triangle, whatever its order.
-    let key = |t: &Triangle| {
-        let mut corners = [t.v0, t.v1, t.v2].map(|v| v.to_array().map(f32::to_bits));
-        corners.sort_unstable();
-        corners
-    };
+    let keys: Vec<[[u32; 3]; 3]> = tris
+        .iter()
+        .map(|t| {
+            let mut corners = [t.v0, t.v1, t.v2].map(|v| v.to_array().map(f32::to_bits));
+            corners.sort_unstable();
+            corners
+        })
+        .collect();
     let mut order: Vec<u32> = (0..tris.len() as u32)
         .filter(|&i| {
             let t = &tris[i as usize];
@@ -24,8 +27,8 @@ pub fn hittable(tris: &[Triangle]) -> Vec<u32> {
         })
         .collect();
     // Sorted by corners, then index: each run of copies starts with the earliest.
-    order.sort_unstable_by_key(|&i| (key(&tris[i as usize]), i));
-    order.dedup_by_key(|i| key(&tris[*i as usize]));
+    order.sort_unstable_by_key(|&i| (keys[i as usize], i));
+    order.dedup_by_key(|i| keys[*i as usize]);
     order.sort_unstable();
     order
 }

@@ -35,14 +35,11 @@ pub fn write_view(path: &Path, image: &ViewImage) -> Result<()> {
             channels.push((name.to_string(), half.iter().map(|v| v[k]).collect()));
         }
     }
-    // Radiance is held to the largest a map may hold, the range a reader accepts: only a
-    // firefly under a map near that limit could pass it.
+    // Each channel is held below the top of the range a reader accepts (a half's as radiance):
+    // only a firefly under a map near the radiance limit could pass it.
     for (name, values) in &mut channels {
-        if ["R", "G", "B"].contains(&name.as_str())
-            || name.starts_with("direct.")
-            || name.starts_with("half.")
-        {
-            values.iter_mut().for_each(|v| *v = v.min(MAX_RADIANCE));
+        if let Some((_, top)) = Frame::channel_range(name.strip_prefix("half.").unwrap_or(name)) {
+            values.iter_mut().for_each(|v| *v = v.min(top));
         }
     }
     write_channels(path, f.width, f.height, &channels)

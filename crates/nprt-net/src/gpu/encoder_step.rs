@@ -34,14 +34,15 @@ impl GpuTrainer {
         plan: &mut Vec<Dispatch>,
         b: &BatchBuffers,
     ) -> EncoderTape {
-        let (weights, biases): (Vec<_>, Vec<_>) = (self.net.convs.iter())
-            .map(|conv| (self.part(conv.weight), self.part(conv.bias)))
-            .unzip();
-        let blocks: Vec<BlockWeights> = (self.net.convs.iter().zip(&weights).zip(&biases))
-            .map(|((conv, weight), bias)| BlockWeights {
+        // The parts are bound by reference: made first, then borrowed.
+        let parts: Vec<_> = (self.net.convs.iter())
+            .map(|conv| (self.part(conv.weight), self.part(conv.bias), conv.c_in))
+            .collect();
+        let blocks: Vec<BlockWeights> = (parts.iter())
+            .map(|(weight, bias, c_in)| BlockWeights {
                 weight,
                 bias,
-                c_in: conv.c_in,
+                c_in: *c_in,
             })
             .collect();
         let pass = record_blocks(
