@@ -64,7 +64,7 @@ impl Compute {
 /// Why the GPU kernels cannot run on a hardware adapter here, or None when they can.
 #[cfg(feature = "kernels")]
 fn no_hardware_gpu() -> Option<String> {
-    match crate::gpu::GpuDevice::get() {
+    match nprt_gpu::GpuDevice::get() {
         Err(e) => Some(format!("{e:#}")),
         Ok(gpu) if gpu.software => Some(format!(
             "the only GPU adapter is a software one ({}); --device wgpu runs the GPU kernels \
@@ -83,7 +83,7 @@ fn no_hardware_gpu() -> Option<String> {
 /// The GPU kernels on whatever adapter wgpu finds, software ones included.
 #[cfg(feature = "kernels")]
 fn any_adapter() -> Result<Engine> {
-    crate::gpu::GpuDevice::get().map(|_| Engine::Gpu)
+    nprt_gpu::GpuDevice::get().map(|_| Engine::Gpu)
 }
 
 #[cfg(not(feature = "kernels"))]
@@ -106,7 +106,7 @@ impl Engine {
         match self {
             Engine::Cpu => "cpu".into(),
             #[cfg(feature = "kernels")]
-            Engine::Gpu => match crate::gpu::GpuDevice::get() {
+            Engine::Gpu => match nprt_gpu::GpuDevice::get() {
                 Ok(gpu) => format!("gpu: {}", gpu.adapter),
                 Err(_) => "gpu".into(),
             },
@@ -120,7 +120,7 @@ impl Engine {
 /// done: work still running at exit would run after the driver had shut down.
 pub fn finish() {
     #[cfg(feature = "kernels")]
-    if let Some(gpu) = crate::gpu::GpuDevice::opened() {
+    if let Some(gpu) = nprt_gpu::GpuDevice::opened() {
         gpu.wait();
     }
 }

@@ -12,7 +12,8 @@
 mod common;
 
 use common::{loud_grids, random_batch, variants};
-use nprt_net::gpu::{GpuDevice, GpuTrainer};
+use nprt_gpu::GpuDevice;
+use nprt_net::gpu::GpuTrainer;
 use nprt_net::optimiser::Adam;
 use nprt_net::{
     cpu, Activation, Design, Init, Loss, ModelConfig, NprtNet, Parameters, PositionEncoding,

@@ -56,7 +56,7 @@ pub struct FrameBenchRow {
     pub paths_on: &'static str,
     /// With `profile`: each kernel's GPU time in a lighting change, longest first.
     #[cfg(feature = "wgpu")]
-    pub profile: Option<Vec<nprt_net::gpu::KernelTime>>,
+    pub profile: Option<Vec<nprt_gpu::KernelTime>>,
 }
 
 /// Times every model at every resolution, calling `on_row` as each is done.

@@ -12,6 +12,8 @@ use nprt_net::gbuffer_features;
 use nprt_net::{load_model, DirectLight, Engine, LightInput, ModelFile, NprtNet, FEATURES};
 use nprt_scene::{Camera, EnvMap};
 use nprt_trace::{render, render_direct, render_gbuffer, GBuffer, RenderSettings, TraceScene};
+#[cfg(feature = "wgpu")]
+use {nprt_gpu::KeptLast, nprt_trace::gpu::RasterGBuffer, std::sync::Arc};
 
 use crate::frame_timings::FrameTimings;
 use crate::Precision;
@@ -35,7 +37,7 @@ pub struct Relighter {
     /// With the kernels, the scene of the last frame on the device (by its address: a model
     /// renders the one scene it was trained on) for its rasterised G-buffers.
     #[cfg(feature = "wgpu")]
-    raster: crate::gpu::KeptLast<usize, std::sync::Arc<crate::gpu::RasterGBuffer>>,
+    raster: KeptLast<usize, Arc<RasterGBuffer>>,
 }
 
 /// What the encoder made of one lighting: the 64-d code ê and what the map's channels were
@@ -72,7 +74,7 @@ impl FrameRadiance {
             FrameRadiance::Host(rgb) => rgb,
             #[cfg(feature = "wgpu")]
             FrameRadiance::Device { rgb, pixels } => {
-                let gpu = crate::gpu::GpuDevice::get().expect("a frame on the device has one");
+                let gpu = nprt_gpu::GpuDevice::get().expect("a frame on the device has one");
                 let rgb = gpu.read(&rgb, 3 * pixels);
                 rgb.chunks_exact(3).map(Vec3::from_slice).collect()
             }
@@ -91,7 +93,7 @@ pub struct Pixels {
     gpu: Option<crate::gpu::GpuPixels>,
     /// A G-buffer that stayed on the device (every pixel then has a row) and its camera.
     #[cfg(feature = "wgpu")]
-    gbuffer: Option<(nprt_net::gpu::PooledBuffer, Camera)>,
+    gbuffer: Option<(nprt_gpu::PooledBuffer, Camera)>,
 }
 
 /// How a frame's direct light is traced, for a model that leaves it to the tracer.
@@ -270,7 +272,7 @@ impl Relighter {
     ) -> Result<Vec<Vec3>> {
         #[cfg(feature = "wgpu")]
         if self.gpu.is_some() {
-            let paths = crate::gpu::GpuPaths::direct(sampling.spp, sampling.seed);
+            let paths = nprt_trace::gpu::GpuPaths::direct(sampling.spp, sampling.seed);
             return self.raster(ts)?.trace(camera, map, &paths);
         }
         Ok(render_direct(ts, camera, map, sampling.spp, sampling.seed))
@@ -390,7 +392,7 @@ impl Relighter {
     ) -> Result<Vec<Vec3>> {
         #[cfg(feature = "wgpu")]
         if self.gpu.is_some() {
-            let paths = crate::gpu::GpuPaths {
+            let paths = nprt_trace::gpu::GpuPaths {
                 spp: settings.spp,
                 seed: settings.seed,
                 max_depth: settings.max_depth.unwrap_or(u32::MAX),
@@ -405,11 +407,10 @@ impl Relighter {
 
     /// The scene on the device, uploaded unless it was the last frame's.
     #[cfg(feature = "wgpu")]
-    fn raster(&self, ts: &TraceScene) -> Result<std::sync::Arc<crate::gpu::RasterGBuffer>> {
+    fn raster(&self, ts: &TraceScene) -> Result<Arc<RasterGBuffer>> {
         let key = std::ptr::from_ref(ts.scene) as usize;
-        self.raster.try_get(key, || {
-            crate::gpu::RasterGBuffer::new(ts).map(std::sync::Arc::new)
-        })
+        self.raster
+            .try_get(key, || RasterGBuffer::new(ts).map(Arc::new))
     }
 
     /// Whether frames stay on the device from the G-buffer to the finished frame: on the
@@ -429,7 +430,7 @@ impl Relighter {
             .gpu
             .as_ref()
             .expect("frames on the device have the kernels");
-        let device = crate::gpu::GpuDevice::get()?;
+        let device = nprt_gpu::GpuDevice::get()?;
         let ms = |t: Instant| t.elapsed().as_secs_f64() * 1e3;
         let raster = self.raster(ts)?;
         let clock = Instant::now();
@@ -507,7 +508,7 @@ impl Relighter {
     pub fn profile_relight<K>(
         &self,
         cache: &FrameCache<K>,
-    ) -> Result<Option<Vec<nprt_net::gpu::KernelTime>>> {
+    ) -> Result<Option<Vec<nprt_gpu::KernelTime>>> {
         let (Some(gpu), Some((_, _, px)), Some((_, light))) =
             (&self.gpu, &cache.still, &cache.light)
         else {
@@ -543,7 +544,7 @@ impl Relighter {
             Code::Host { code, divisor } => (code.clone(), *divisor),
             #[cfg(feature = "wgpu")]
             Code::Device(code) => code.read(
-                &crate::gpu::GpuDevice::get().expect("a light code on the device has a device"),
+                &nprt_gpu::GpuDevice::get().expect("a light code on the device has a device"),
             ),
         };
         let gain = self.file.output_gain();
@@ -556,7 +557,7 @@ impl Relighter {
         match &light.0 {
             Code::Device(code) => code.clone(),
             Code::Host { code, divisor } => crate::gpu::GpuLightCode::upload(
-                &crate::gpu::GpuDevice::get().expect("frames on the device have a device"),
+                &nprt_gpu::GpuDevice::get().expect("frames on the device have a device"),
                 code,
                 *divisor,
             ),
@@ -568,7 +569,7 @@ impl Relighter {
     pub fn host_waits(&self) -> Option<u64> {
         #[cfg(feature = "wgpu")]
         if self.gpu.is_some() {
-            return crate::gpu::GpuDevice::get().ok().map(|d| d.host_waits());
+            return nprt_gpu::GpuDevice::get().ok().map(|d| d.host_waits());
         }
         None
     }
@@ -579,7 +580,7 @@ impl Relighter {
     pub fn settle(&self) -> Result<()> {
         #[cfg(feature = "wgpu")]
         if self.gpu.is_some() {
-            crate::gpu::GpuDevice::get()?.wait();
+            nprt_gpu::GpuDevice::get()?.wait();
         }
         Ok(())
     }

@@ -6,11 +6,12 @@
 #![cfg(feature = "wgpu")]
 
 use glam::Vec3;
+use nprt_gpu::GpuDevice;
 use nprt_net::{
     gbuffer_features, Activation, Design, Init, LightInput, MapNorm, ModelConfig, NprtNet,
     PositionEncoding,
 };
-use nprt_render::gpu::{GpuDevice, GpuLightCode, GpuLightInput, GpuNetwork};
+use nprt_render::gpu::{GpuLightCode, GpuLightInput, GpuNetwork};
 use nprt_scene::{load_scene, Camera, SceneOptions};
 use nprt_trace::{render_gbuffer, TraceScene};
 

@@ -1,7 +1,9 @@
 //! The path tracer: ray-scene intersection, the BSDF of DESIGN.md's material model, a path
 //! integrator that follows Mitsuba 3's `path` (same `max_depth` meaning, next-event estimation
 //! on the environment with power-heuristic MIS, Russian roulette), and per-pixel outputs:
-//! radiance, direct-lighting radiance and the G-buffer.
+//! radiance, direct-lighting radiance and the G-buffer; and, with feature `gpu`, the same on the
+//! GPU ([`gpu`]: the G-buffer rasterised and the path tracer as a WGSL kernel, on nprt-gpu's
+//! device), held to the CPU's by tests.
 //!
 //! It owns everything about light transport and pixels, and reads scenes only through
 //! `nprt-scene`; it must not parse files, place dataset cameras or know about networks.
@@ -32,6 +34,8 @@ mod coating;
 mod flat_bvh;
 mod frame;
 mod gbuffer_pass;
+#[cfg(feature = "gpu")]
+pub mod gpu;
 mod hittable;
 mod integrator;
 mod microfacet;

@@ -400,7 +400,7 @@ fn print_profile(
 
 /// `what`'s kernels' GPU times, longest first, beside the `wall_ms` it took at full speed.
 #[cfg(feature = "gpu")]
-fn print_kernel_times(what: &str, times: &[nprt_net::gpu::KernelTime], wall_ms: f64) {
+fn print_kernel_times(what: &str, times: &[nprt_gpu::KernelTime], wall_ms: f64) {
     let sum: f64 = times.iter().map(|k| k.ms).sum();
     println!("  {what}: {sum:.2} ms of GPU time; wall time {wall_ms:.2} ms");
     for k in times {

@@ -84,7 +84,7 @@ pub fn profile_kernels(
     views: usize,
     warmup: usize,
     precision: Precision,
-) -> anyhow::Result<Vec<crate::gpu::KernelTime>> {
+) -> anyhow::Result<Vec<nprt_gpu::KernelTime>> {
     let net = config.build(&mut Init::new(0));
     let mut gpu = crate::gpu::GpuTrainer::new(&net, precision)?;
     let batch = synthetic_batch(config, batch_size, views);

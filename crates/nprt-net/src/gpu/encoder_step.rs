@@ -9,7 +9,7 @@ use super::kernels::{
     ENCODER_WEIGHT_BACKWARD,
 };
 use super::network_layout::ConvAt;
-use super::products::{Bias, Operand, Output};
+use super::products::{Bias, DenseProducts, Operand, Output};
 use super::{groups_for, Dispatch};
 use crate::network::encoder::{CHANNELS, CODE_SIZE};
 

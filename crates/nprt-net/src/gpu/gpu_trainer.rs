@@ -14,7 +14,6 @@ use std::sync::Arc;
 use anyhow::Result;
 
 use super::device_dataset::DeviceDataset;
-use super::kernel_timer::{KernelTime, KernelTimer};
 use super::kernels::{ADAM, GATHER_SAMPLES};
 use super::network_layout::NetworkLayout;
 use super::parameters::ParameterLayout;
@@ -27,6 +26,7 @@ use crate::network::encoder::CODE_SIZE;
 use crate::network::nprt_net::NprtNet;
 use crate::optimiser::{bias_corrections, load_state, save_state, ADAM_BETA1, ADAM_BETA2};
 use crate::Precision;
+use nprt_gpu::{KernelTime, KernelTimer};
 
 /// A network's parameters, gradients and Adam moments on the device, and the step that trains
 /// them.

@@ -61,9 +61,53 @@ pub fn half_weight_bits(weight: &[f32], d_in: usize, d_out: usize) -> Vec<u16> {
     padded
 }
 
-impl GpuDevice {
+/// The half-precision dense layers on the device: f16 weights and rows, and their products.
+pub trait HalfLayers {
     /// `weight` (`d_in × d_out`) in the layout [`HalfWeight`] describes.
-    pub fn upload_half_weight(&self, weight: &[f32], d_in: usize, d_out: usize) -> HalfWeight {
+    fn upload_half_weight(&self, weight: &[f32], d_in: usize, d_out: usize) -> HalfWeight;
+
+    /// A `d_in × d_out` weight in the layout [`HalfWeight`] describes, zero (a mixed-precision
+    /// training step copies its weights in on the device).
+    fn half_weight(&self, d_in: usize, d_out: usize) -> HalfWeight;
+
+    /// The dispatch that writes `rows` rows of `cols` f32 values of `src` (row stride
+    /// `stride`) to `dst` as f16 rows of `pad16(cols)` values, zeros in the padding and in the
+    /// rows up to the next multiple of [`HALF_ROW_BLOCK`].
+    fn half_rows(&self, shape: [usize; 3], src: &wgpu::Buffer, dst: &wgpu::Buffer) -> Dispatch;
+
+    /// The dispatch that writes the `rows` × `cols` matrix whose element (i, j) is
+    /// `src[offset + i · strides[0] + j · strides[1]]` to `dst` as f16 rows of `pad16(cols)`
+    /// values, zeros in the padding and in the rows up to `padded`: [`Self::half_rows`], and a
+    /// weight's f16 copies in a mixed-precision training step (transposed with other strides).
+    fn half_matrix(
+        &self,
+        shape: [usize; 2],
+        strides: [usize; 2],
+        offset: usize,
+        padded: usize,
+        src: &wgpu::Buffer,
+        dst: &wgpu::Buffer,
+    ) -> Dispatch;
+
+    /// The dispatch of one half-precision dense layer, `act(x·W[w_row..] + bias)` over `rows`
+    /// rows of `x` (f16 rows of `k_pad` values, a multiple of 16, held up to the next multiple
+    /// of [`HALF_ROW_BLOCK`] rows), `activation` 0 linear, 1 ReLU, 2 SIREN.
+    #[allow(clippy::too_many_arguments)]
+    fn half_layer(
+        &self,
+        rows: usize,
+        x: &wgpu::Buffer,
+        k_pad: usize,
+        w: &HalfWeight,
+        w_row: usize,
+        bias: &wgpu::Buffer,
+        activation: u32,
+        y: Held,
+    ) -> Dispatch;
+}
+
+impl HalfLayers for GpuDevice {
+    fn upload_half_weight(&self, weight: &[f32], d_in: usize, d_out: usize) -> HalfWeight {
         HalfWeight {
             buffer: self.upload(&half_weight_bits(weight, d_in, d_out)),
             d_out,
@@ -71,9 +115,7 @@ impl GpuDevice {
         }
     }
 
-    /// A `d_in × d_out` weight in the layout [`HalfWeight`] describes, zero (a mixed-precision
-    /// training step copies its weights in on the device).
-    pub fn half_weight(&self, d_in: usize, d_out: usize) -> HalfWeight {
+    fn half_weight(&self, d_in: usize, d_out: usize) -> HalfWeight {
         HalfWeight {
             buffer: self.half_buffer(half_weight_halves(d_in, d_out)),
             d_out,
@@ -81,15 +123,7 @@ impl GpuDevice {
         }
     }
 
-    /// A storage buffer of `halves` f16 values, zero.
-    pub fn half_buffer(&self, halves: usize) -> wgpu::Buffer {
-        self.buffer(halves.div_ceil(2))
-    }
-
-    /// The dispatch that writes `rows` rows of `cols` f32 values of `src` (row stride
-    /// `stride`) to `dst` as f16 rows of `pad16(cols)` values, zeros in the padding and in the
-    /// rows up to the next multiple of [`HALF_ROW_BLOCK`].
-    pub fn half_rows(
+    fn half_rows(
         &self,
         [rows, cols, stride]: [usize; 3],
         src: &wgpu::Buffer,
@@ -99,11 +133,7 @@ impl GpuDevice {
         self.half_matrix([rows, cols], [stride, 1], 0, padded, src, dst)
     }
 
-    /// The dispatch that writes the `rows` × `cols` matrix whose element (i, j) is
-    /// `src[offset + i · strides[0] + j · strides[1]]` to `dst` as f16 rows of `pad16(cols)`
-    /// values, zeros in the padding and in the rows up to `padded`: [`Self::half_rows`], and a
-    /// weight's f16 copies in a mixed-precision training step (transposed with other strides).
-    pub fn half_matrix(
+    fn half_matrix(
         &self,
         [rows, cols]: [usize; 2],
         [stride, col_stride]: [usize; 2],
@@ -118,11 +148,7 @@ impl GpuDevice {
         self.prepare(&HALF_ROWS, &params, &[src, dst], groups)
     }
 
-    /// The dispatch of one half-precision dense layer, `act(x·W[w_row..] + bias)` over `rows`
-    /// rows of `x` (f16 rows of `k_pad` values, a multiple of 16, held up to the next multiple
-    /// of [`HALF_ROW_BLOCK`] rows), `activation` 0 linear, 1 ReLU, 2 SIREN.
-    #[allow(clippy::too_many_arguments)]
-    pub fn half_layer(
+    fn half_layer(
         &self,
         rows: usize,
         x: &wgpu::Buffer,
@@ -148,29 +174,30 @@ impl GpuDevice {
             0,
         ]
         .map(|v| v as u32);
-        self.half_dense(
+        half_dense(
+            self,
             [&HALF_DENSE, &HALF_DENSE_COOP],
             &params,
             &[x, &w.buffer, bias, y16, y32],
             [rows, w.n_pad],
         )
     }
+}
 
-    /// The dispatch of a half-precision dense product (`half_dense`'s main, or on tensor cores
-    /// `half_dense_coop`'s: the first or second of `kernels`, each under its epilogue) over
-    /// `rows` rows and `n_pad` output columns, with the epilogue's `params` and `buffers`.
-    pub(super) fn half_dense(
-        &self,
-        [plain, coop]: [&KernelSource; 2],
-        params: &[u32],
-        buffers: &[&dyn Bind],
-        [rows, n_pad]: [usize; 2],
-    ) -> Dispatch {
-        let kernel = if self.tensor_cores { coop } else { plain };
-        let groups = [
-            n_pad.div_ceil(HALF_COLS) as u32,
-            rows.div_ceil(HALF_ROW_BLOCK) as u32,
-        ];
-        self.prepare(kernel, params, buffers, groups)
-    }
+/// The dispatch of a half-precision dense product (`half_dense`'s main, or on tensor cores
+/// `half_dense_coop`'s: the first or second of `kernels`, each under its epilogue) over
+/// `rows` rows and `n_pad` output columns, with the epilogue's `params` and `buffers`.
+pub(super) fn half_dense(
+    gpu: &GpuDevice,
+    [plain, coop]: [&KernelSource; 2],
+    params: &[u32],
+    buffers: &[&dyn Bind],
+    [rows, n_pad]: [usize; 2],
+) -> Dispatch {
+    let kernel = if gpu.tensor_cores { coop } else { plain };
+    let groups = [
+        n_pad.div_ceil(HALF_COLS) as u32,
+        rows.div_ceil(HALF_ROW_BLOCK) as u32,
+    ];
+    gpu.prepare(kernel, params, buffers, groups)
 }

@@ -14,11 +14,11 @@
 
 use super::codes::activation_code;
 use super::gpu_trainer::GpuTrainer;
-use super::half_layers::{held_halves, pad16, HalfWeight};
+use super::half_layers::{half_dense, held_halves, pad16, HalfLayers, HalfWeight};
 use super::kernels::{HALF_TRAIN, HALF_TRAIN_COOP, HALF_WEIGHT_GRAD, HALF_WEIGHT_GRAD_COOP};
 use super::network_layout::MlpAt;
 use super::products::{row_chunks, Bias, FirstLayer, FirstLayerBias, MlpTape, Output, BACKWARD};
-use super::{groups_for, Dispatch, GpuDevice};
+use super::{groups_for, Bind, Dispatch, GpuDevice};
 
 /// Where a mixed-precision product's results go.
 pub(super) struct HalfOut<'a> {
@@ -31,75 +31,74 @@ pub(super) struct HalfOut<'a> {
     pub y32: Option<&'a wgpu::Buffer>,
 }
 
-impl GpuDevice {
-    /// The dispatch of `act(x·W + bias)` over `rows` rows of `x` (f16 rows of `k_pad` values)
-    /// with `w` from its first row; `activation` 3 or 4 multiplies by ReLU's or SIREN's
-    /// derivative at `out.z` instead (`half_train_layer.wgsl`).
-    fn half_train_layer(
-        &self,
-        rows: usize,
-        (x, k_pad): (&wgpu::Buffer, usize),
-        w: &HalfWeight,
-        bias: Bias,
-        activation: u32,
-        out: HalfOut,
-    ) -> Dispatch {
-        let (bias_mode, bias_buffer, bias_off, group_of) = bias.binding(self);
-        let keep_z = out.z.is_some() && activation < 1 + BACKWARD;
-        let params = [
-            rows,
-            w.d_out,
-            w.n_pad,
-            k_pad,
-            0,
-            activation as usize,
-            bias_mode,
-            bias_off,
-            usize::from(keep_z),
-            usize::from(out.y16.is_some()),
-            usize::from(out.y32.is_some()),
-            0,
-        ]
-        .map(|v| v as u32);
-        self.half_dense(
-            [&HALF_TRAIN, &HALF_TRAIN_COOP],
-            &params,
-            &[
-                x,
-                &w.buffer,
-                bias_buffer,
-                group_of,
-                out.z.unwrap_or(&self.spare),
-                out.y16.unwrap_or(&self.spare),
-                out.y32.unwrap_or(&self.spare),
-            ],
-            [rows, w.n_pad],
-        )
-    }
+/// The dispatch of `act(x·W + bias)` over `rows` rows of `x` (f16 rows of `k_pad` values)
+/// with `w` from its first row; `activation` 3 or 4 multiplies by ReLU's or SIREN's
+/// derivative at `out.z` instead (`half_train_layer.wgsl`).
+fn half_train_layer(
+    gpu: &GpuDevice,
+    rows: usize,
+    (x, k_pad): (&wgpu::Buffer, usize),
+    w: &HalfWeight,
+    bias: Bias,
+    activation: u32,
+    out: HalfOut,
+) -> Dispatch {
+    let (bias_mode, bias_buffer, bias_off, group_of) = bias.binding(gpu);
+    let keep_z = out.z.is_some() && activation < 1 + BACKWARD;
+    let params = [
+        rows,
+        w.d_out,
+        w.n_pad,
+        k_pad,
+        0,
+        activation as usize,
+        bias_mode,
+        bias_off,
+        usize::from(keep_z),
+        usize::from(out.y16.is_some()),
+        usize::from(out.y32.is_some()),
+        0,
+    ]
+    .map(|v| v as u32);
+    half_dense(
+        gpu,
+        [&HALF_TRAIN, &HALF_TRAIN_COOP],
+        &params,
+        &[
+            x,
+            &w.buffer,
+            bias_buffer,
+            group_of,
+            out.z.unwrap_or(&gpu.spare),
+            out.y16.unwrap_or(&gpu.spare),
+            out.y32.unwrap_or(&gpu.spare),
+        ],
+        [rows, w.n_pad],
+    )
+}
 
-    /// The dispatch of xᵀ·dz, `[m, n]`, over `rows` rows cut into chunks of `chunk` rows, chunk
-    /// c's sums into `partial` from c · m · n (`half_weight_sums.wgsl`).
-    fn half_weight_grad(
-        &self,
-        [m, n, rows]: [usize; 3],
-        (x, k_pad): (&wgpu::Buffer, usize),
-        (dz, n_pad): (&wgpu::Buffer, usize),
-        [chunk, chunks]: [usize; 2],
-        partial: &wgpu::Buffer,
-    ) -> Dispatch {
-        let params = [rows.next_multiple_of(16), chunk, m, n, k_pad, n_pad, 0, 0].map(|v| v as u32);
-        let buffers: [&dyn super::Bind; 3] = [x, dz, partial];
-        if self.tensor_cores {
-            let groups = [
-                n_pad.div_ceil(64) as u32,
-                k_pad.div_ceil(256) as u32,
-                chunks as u32,
-            ];
-            self.prepare_grid(&HALF_WEIGHT_GRAD_COOP, &params, &buffers, groups)
-        } else {
-            let groups = groups_for(chunks * m * n);
-            self.prepare(&HALF_WEIGHT_GRAD, &params, &buffers, groups)
-        }
+/// The dispatch of xᵀ·dz, `[m, n]`, over `rows` rows cut into chunks of `chunk` rows, chunk
+/// c's sums into `partial` from c · m · n (`half_weight_sums.wgsl`).
+fn half_weight_grad(
+    gpu: &GpuDevice,
+    [m, n, rows]: [usize; 3],
+    (x, k_pad): (&wgpu::Buffer, usize),
+    (dz, n_pad): (&wgpu::Buffer, usize),
+    [chunk, chunks]: [usize; 2],
+    partial: &wgpu::Buffer,
+) -> Dispatch {
+    let params = [rows.next_multiple_of(16), chunk, m, n, k_pad, n_pad, 0, 0].map(|v| v as u32);
+    let buffers: [&dyn Bind; 3] = [x, dz, partial];
+    if gpu.tensor_cores {
+        let groups = [
+            n_pad.div_ceil(64) as u32,
+            k_pad.div_ceil(256) as u32,
+            chunks as u32,
+        ];
+        gpu.prepare_grid(&HALF_WEIGHT_GRAD_COOP, &params, &buffers, groups)
+    } else {
+        let groups = groups_for(chunks * m * n);
+        gpu.prepare(&HALF_WEIGHT_GRAD, &params, &buffers, groups)
     }
 }
 
@@ -141,7 +140,8 @@ impl GpuTrainer {
             } else {
                 0
             };
-            plan.push(self.gpu.half_train_layer(
+            plan.push(half_train_layer(
+                &self.gpu,
                 rows,
                 (x16, pad16(copies.count)),
                 &copies.stored,
@@ -221,7 +221,8 @@ impl GpuTrainer {
                     },
                 ),
             };
-            plan.push(gpu.half_train_layer(
+            plan.push(half_train_layer(
+                gpu,
                 rows,
                 (g16, n_pad),
                 &copies.transposed,
@@ -244,7 +245,8 @@ impl GpuTrainer {
     ) {
         let [chunk, chunks] = row_chunks(rows.next_multiple_of(16), 16);
         let partial = self.gpu.buffer(chunks * m * n);
-        plan.push(self.gpu.half_weight_grad(
+        plan.push(half_weight_grad(
+            &self.gpu,
             [m, n, rows],
             (x, pad16(m)),
             (dz, pad16(n)),

@@ -79,11 +79,7 @@ pub const HALF_WEIGHT_GRAD_COOP: KernelSource = kernel!(
 /// `kernel` after the track kinds' table, made once per process (a kernel's source lives as
 /// long as the process).
 fn with_kinds(kernel: KernelSource) -> KernelSource {
-    let wgsl = format!("{}{}", kind_table_wgsl(), kernel.wgsl);
-    KernelSource {
-        name: kernel.name,
-        wgsl: Box::leak(wgsl.into_boxed_str()),
-    }
+    KernelSource::joined(kernel.name, &[&kind_table_wgsl(), kernel.wgsl])
 }
 
 /// Rows and columns of the tile a `gemm` workgroup computes.

@@ -1,8 +1,9 @@
 //! Where each tensor of a network lies in the flat parameter buffers, in the network's own
 //! structure (encoder blocks, tracks, layers), as the training step's dispatches address them.
 
-use super::half_layers::HalfWeight;
-use super::parameters::{ParameterLayout, Span};
+use super::half_layers::{HalfLayers, HalfWeight};
+use super::parameters::ParameterLayout;
+use super::Span;
 use super::{Dispatch, GpuDevice};
 use crate::encoding::hash_grid;
 use crate::network::activation::Activation;

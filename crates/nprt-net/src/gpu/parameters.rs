@@ -3,22 +3,10 @@
 //! a multiple of the device's storage-binding alignment, so a kernel can also bind one tensor
 //! on its own; the gaps stay zero and Adam leaves them so.
 
+use nprt_gpu::Span;
+
 use crate::network::nprt_net::NprtNet;
 use crate::network::parameters::Parameters;
-
-/// Where one tensor lies in the flat buffers, in f32 elements.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub struct Span {
-    pub offset: usize,
-    pub len: usize,
-}
-
-impl Span {
-    /// The byte range, for binding this tensor alone.
-    pub fn bytes(self) -> (u64, u64) {
-        ((self.offset * 4) as u64, (self.len * 4) as u64)
-    }
-}
 
 /// The flat layout of a network's tensors.
 pub struct ParameterLayout {

@@ -7,7 +7,7 @@ use super::gpu_trainer::GpuTrainer;
 use super::half_layers::held_halves;
 use super::kernels::{COLUMN_SUM, GEMM, GEMM_TILE};
 use super::network_layout::MlpAt;
-use super::parameters::Span;
+use super::Span;
 use super::{groups_for, Dispatch, GpuDevice, Part};
 
 /// Rows a `column_sum` thread adds before the chunks' sums are added in a further pass (and
@@ -136,14 +136,41 @@ pub(super) struct MlpTape {
     pub pre: Vec<wgpu::Buffer>,
 }
 
-impl GpuDevice {
+/// The matrix products of dense layers on the device (training's and the frame path's).
+pub trait DenseProducts {
     /// The dispatch of C = A·B for `[m, n, k]` (C m × n), with `bias` and `activation` (0
     /// linear, 1 ReLU, 2 SIREN) after, the pre-activation kept in `z` where given: a dense
     /// layer's forward pass, and every product of its backward pass; `activation` 3 or 4
     /// multiplies by ReLU's or SIREN's derivative at the values `z` holds instead (the
     /// gradient at a hidden layer's pre-activation).
     #[allow(clippy::too_many_arguments)]
-    pub fn product(
+    fn product(
+        &self,
+        shape: [usize; 3],
+        a: Operand,
+        b: Operand,
+        bias: Bias,
+        activation: u32,
+        c: Output,
+        z: Option<&wgpu::Buffer>,
+    ) -> Dispatch;
+
+    /// The dispatch of `chunks` products, each over `k_chunk` consecutive values of k (the last
+    /// over what is left), into consecutive m × n blocks of `c` (row stride n), which
+    /// [`GpuTrainer::column_sum`] then adds: a product over many k (a weight's gradient over a
+    /// batch) on chunks × tiles workgroups instead of tiles alone.
+    fn split_product(
+        &self,
+        shape: [usize; 3],
+        a: Operand,
+        b: Operand,
+        split: [usize; 2],
+        c: &wgpu::Buffer,
+    ) -> Dispatch;
+}
+
+impl DenseProducts for GpuDevice {
+    fn product(
         &self,
         shape: [usize; 3],
         a: Operand,
@@ -153,14 +180,10 @@ impl GpuDevice {
         c: Output,
         z: Option<&wgpu::Buffer>,
     ) -> Dispatch {
-        self.gemm(shape, a, b, bias, activation, c, z, None)
+        gemm(self, shape, a, b, bias, activation, c, z, None)
     }
 
-    /// The dispatch of `chunks` products, each over `k_chunk` consecutive values of k (the last
-    /// over what is left), into consecutive m × n blocks of `c` (row stride n), which
-    /// [`GpuTrainer::column_sum`] then adds: a product over many k (a weight's gradient over a
-    /// batch) on chunks × tiles workgroups instead of tiles alone.
-    pub fn split_product(
+    fn split_product(
         &self,
         [m, n, k]: [usize; 3],
         a: Operand,
@@ -169,7 +192,8 @@ impl GpuDevice {
         c: &wgpu::Buffer,
     ) -> Dispatch {
         let out = Output::to(c, 0, n);
-        self.gemm(
+        gemm(
+            self,
             [m, n, k],
             a,
             b,
@@ -180,59 +204,59 @@ impl GpuDevice {
             Some([k_chunk, chunks]),
         )
     }
+}
 
-    #[allow(clippy::too_many_arguments)]
-    fn gemm(
-        &self,
-        [m, n, k]: [usize; 3],
-        a: Operand,
-        b: Operand,
-        bias: Bias,
-        activation: u32,
-        c: Output,
-        z: Option<&wgpu::Buffer>,
-        split: Option<[usize; 2]>,
-    ) -> Dispatch {
-        let (bias_mode, bias_buffer, bias_off, groups) = bias.binding(self);
-        let [k_chunk, chunks] = split.unwrap_or([0, 1]);
-        let params = [
-            m,
-            n,
-            k,
-            a.offset,
-            a.rows,
-            a.cols,
-            b.offset,
-            b.rows,
-            b.cols,
-            c.stride,
-            bias_mode,
-            activation as usize,
-            usize::from(c.accumulate),
-            // Backward z is read, not kept.
-            usize::from(z.is_some() && activation < 1 + BACKWARD),
-            bias_off,
-            c.offset,
-            k_chunk,
-            m * n,
-            a.ones_row.map_or(0, |r| r + 1),
-            0,
-        ];
-        let tiles = |v: usize| (v as u32).div_ceil(GEMM_TILE);
-        self.prepare_grid(
-            &GEMM,
-            &params.map(|v| v as u32),
-            &[
-                a.buffer,
-                b.buffer,
-                bias_buffer,
-                groups,
-                c.buffer,
-                z.unwrap_or(&self.spare),
-            ],
-            [tiles(n), tiles(m), chunks as u32],
-        )
-    }
+#[allow(clippy::too_many_arguments)]
+fn gemm(
+    gpu: &GpuDevice,
+    [m, n, k]: [usize; 3],
+    a: Operand,
+    b: Operand,
+    bias: Bias,
+    activation: u32,
+    c: Output,
+    z: Option<&wgpu::Buffer>,
+    split: Option<[usize; 2]>,
+) -> Dispatch {
+    let (bias_mode, bias_buffer, bias_off, groups) = bias.binding(gpu);
+    let [k_chunk, chunks] = split.unwrap_or([0, 1]);
+    let params = [
+        m,
+        n,
+        k,
+        a.offset,
+        a.rows,
+        a.cols,
+        b.offset,
+        b.rows,
+        b.cols,
+        c.stride,
+        bias_mode,
+        activation as usize,
+        usize::from(c.accumulate),
+        // Backward z is read, not kept.
+        usize::from(z.is_some() && activation < 1 + BACKWARD),
+        bias_off,
+        c.offset,
+        k_chunk,
+        m * n,
+        a.ones_row.map_or(0, |r| r + 1),
+        0,
+    ];
+    let tiles = |v: usize| (v as u32).div_ceil(GEMM_TILE);
+    gpu.prepare_grid(
+        &GEMM,
+        &params.map(|v| v as u32),
+        &[
+            a.buffer,
+            b.buffer,
+            bias_buffer,
+            groups,
+            c.buffer,
+            z.unwrap_or(&gpu.spare),
+        ],
+        [tiles(n), tiles(m), chunks as u32],
+    )
 }
 
 impl GpuTrainer {

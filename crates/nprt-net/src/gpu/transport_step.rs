@@ -7,7 +7,7 @@ use super::codes::loss_code;
 use super::gpu_trainer::{BatchBuffers, GpuTrainer};
 use super::kernels::{COMBINE, GRID_BACKWARD, RADIANCE_LOSS, TRACK_GRADIENT, TRACK_INPUTS};
 use super::network_layout::TrackAt;
-use super::products::{Bias, FirstLayer, MlpTape, Operand, Output};
+use super::products::{Bias, DenseProducts, FirstLayer, MlpTape, Operand, Output};
 use super::{groups_for, Bind, Dispatch};
 use crate::encoding::hash_grid;
 use crate::loss::Loss;

@@ -3,21 +3,24 @@
 //! direct light to the tracer, zero there and that light traced on the device over every
 //! pixel. The map's texels go up once per map ([`GpuMap`]), the rotation with each frame.
 
-use nprt_net::gpu::{GpuDevice, KernelSource};
+use std::sync::LazyLock;
+
+use nprt_gpu::{GpuDevice, KernelSource};
 use nprt_scene::{Camera, EnvMap};
+use nprt_trace::gpu::wgsl::{CAMERA_RAY, LERP, MAP_LOOKUP};
+use nprt_trace::gpu::{camera_words, matrix_words, GpuMap, RasterGBuffer};
 
-use super::gpu_map::{matrix_words, GpuMap};
-use super::raster_gbuffer::{camera_words, RasterGBuffer};
-
-pub const FRAME_BACKGROUND: KernelSource = KernelSource {
-    name: "frame_background",
-    wgsl: concat!(
-        include_str!("shaders/camera_ray.wgsl"),
-        include_str!("shaders/lerp.wgsl"),
-        include_str!("shaders/map_lookup.wgsl"),
-        include_str!("shaders/frame_background.wgsl")
-    ),
-};
+pub static FRAME_BACKGROUND: LazyLock<KernelSource> = LazyLock::new(|| {
+    KernelSource::joined(
+        "frame_background",
+        &[
+            CAMERA_RAY,
+            LERP,
+            MAP_LOOKUP,
+            include_str!("shaders/frame_background.wgsl"),
+        ],
+    )
+});
 
 /// What a frame's background needs: the G-buffer it fills the empty pixels of, its camera and
 /// what goes there.
@@ -44,39 +47,37 @@ pub enum Fill<'a> {
     },
 }
 
-impl GpuMap {
-    /// Records `background` into `rgb` (3 f32 per pixel, the networks' radiance on the
-    /// G-buffer's pixels).
-    pub fn record_background(
-        &self,
-        gpu: &GpuDevice,
-        pass: &mut wgpu::ComputePass,
-        background: &Background,
-        rgb: &wgpu::Buffer,
-    ) {
-        let camera = background.camera;
-        let (map, fill) = match background.fill {
-            Fill::Zero => (None, 0),
-            Fill::Map(map) => (Some(map), 1),
-            Fill::TracedDirect { map, .. } => (Some(map), 0),
-        };
-        let (texels, size, to_local) = match map {
-            Some(map) => (
-                self.texels(gpu, map),
-                [map.width() as u32, map.height() as u32],
-                map.to_world().inverse(),
-            ),
-            None => (gpu.empty.clone(), [1, 2], glam::Mat3::IDENTITY),
-        };
-        let mut params = vec![camera.width, camera.height, size[0], size[1], fill, 0, 0, 0];
-        params.extend(camera_words(camera));
-        params.extend(matrix_words(to_local));
-        gpu.dispatch(
-            pass,
-            &FRAME_BACKGROUND,
-            &params,
-            &[background.samples, &texels, rgb],
-            [camera.width.div_ceil(8), camera.height.div_ceil(8)],
-        );
-    }
+/// Records `background` into `rgb` (3 f32 per pixel, the networks' radiance on the G-buffer's
+/// pixels), the map's texels kept in `maps`.
+pub fn record_background(
+    maps: &GpuMap,
+    gpu: &GpuDevice,
+    pass: &mut wgpu::ComputePass,
+    background: &Background,
+    rgb: &wgpu::Buffer,
+) {
+    let camera = background.camera;
+    let (map, fill) = match background.fill {
+        Fill::Zero => (None, 0),
+        Fill::Map(map) => (Some(map), 1),
+        Fill::TracedDirect { map, .. } => (Some(map), 0),
+    };
+    let (texels, size, to_local) = match map {
+        Some(map) => (
+            maps.texels(gpu, map),
+            [map.width() as u32, map.height() as u32],
+            map.to_world().inverse(),
+        ),
+        None => (gpu.empty.clone(), [1, 2], glam::Mat3::IDENTITY),
+    };
+    let mut params = vec![camera.width, camera.height, size[0], size[1], fill, 0, 0, 0];
+    params.extend(camera_words(camera));
+    params.extend(matrix_words(to_local));
+    gpu.dispatch(
+        pass,
+        &FRAME_BACKGROUND,
+        &params,
+        &[background.samples, &texels, rgb],
+        [camera.width.div_ceil(8), camera.height.div_ceil(8)],
+    );
 }

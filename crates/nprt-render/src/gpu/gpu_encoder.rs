@@ -4,14 +4,15 @@
 
 use std::sync::Arc;
 
-use nprt_net::gpu::{record_blocks, BlockWeights, Dispatch, GpuDevice};
+use nprt_gpu::{Dispatch, GpuDevice};
+use nprt_net::gpu::{record_blocks, BlockWeights};
 use nprt_net::network::encoder::{BLOCKS, CODE_SIZE};
 use nprt_net::LightEncoder;
 
 use super::gpu_mlp::{dense_layer, GpuDense, Rows};
-use super::kept_last::KeptLast;
 use super::light_code::GpuLightCode;
 use super::light_input::GpuLightInput;
+use nprt_gpu::KeptLast;
 
 /// The encoder's weights on the device and its dispatches for inputs of the last width.
 pub(super) struct GpuEncoder {

@@ -2,8 +2,11 @@
 //! networks run in half precision) and the dispatches of its forward pass over rows of inputs,
 //! through ping-pong activations.
 
-use nprt_net::gpu::Dispatch;
-use nprt_net::gpu::{activation_code, pad16, Bias, GpuDevice, HalfWeight, Held, Operand, Output};
+use nprt_gpu::Dispatch;
+use nprt_gpu::GpuDevice;
+use nprt_net::gpu::{
+    activation_code, pad16, Bias, DenseProducts, HalfLayers, HalfWeight, Held, Operand, Output,
+};
 use nprt_net::network::dense::Dense;
 use nprt_net::network::mlp::Mlp;
 use nprt_net::Activation;

@@ -15,20 +15,21 @@ use nprt_net::network::mlp::Mlp;
 use nprt_net::{MapNorm, NprtNet, TrackKind, FEATURES, TRANSPORT_CODE};
 use nprt_scene::EnvMap;
 
-use nprt_net::gpu::{groups_for, BufferPool, Dispatch, GpuDevice, KernelTime, PooledBuffer};
+use nprt_gpu::{groups_for, BufferPool, Dispatch, GpuDevice, KernelTime, PooledBuffer};
 
-use nprt_net::gpu::{held_halves, Bias, Held, Operand, Output, HALF_ROW_BLOCK};
+use nprt_net::gpu::{
+    held_halves, Bias, DenseProducts, HalfLayers, Held, Operand, Output, HALF_ROW_BLOCK,
+};
 
 use nprt_net::gpu::kernels::{COMBINE, GBUFFER_FEATURES, TRACK_INPUTS};
 
-use super::frame_background::{Background, Fill};
+use super::frame_background::{record_background, Background, Fill};
 use super::gpu_encoder::GpuEncoder;
-use super::gpu_map::{GpuMap, SameTexels};
 use super::gpu_mlp::{FirstLayer, GpuMlp, Scratch};
-use super::kept_last::KeptLast;
 use super::light_code::{GpuLightCode, LIGHT_CODE_VALUES};
 use super::light_input::GpuLightInput;
-use super::path_tracer::{record_paths, GpuPaths};
+use nprt_gpu::KeptLast;
+use nprt_trace::gpu::{record_paths, GpuMap, GpuPaths, SameTexels};
 
 /// Most rows per block of dispatches. Fewer blocks mean fewer dispatches to prepare and record
 /// (at 65,536 rows a 1920 × 1080 D/S frame was 32 blocks of a dozen dispatches each). A
@@ -603,7 +604,7 @@ impl GpuNetwork {
                 d.record(&mut pass);
             }
             if let Some(b) = background {
-                self.map.record_background(gpu, &mut pass, b, &px.rgb);
+                record_background(&self.map, gpu, &mut pass, b, &px.rgb);
             }
         }
         gpu.queue.submit([encoder.finish()]);

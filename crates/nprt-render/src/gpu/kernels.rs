@@ -2,10 +2,10 @@
 //! writes). They are nprt-net's network kernels, which training shares, dispatched on its GPU
 //! device.
 
+use nprt_gpu::KernelSource;
 use nprt_net::gpu::kernels::{
     COMBINE, ENCODER_BLOCK, GEMM, HALF_DENSE, HALF_DENSE_COOP, HALF_ROWS, TRACK_INPUTS,
 };
-use nprt_net::gpu::KernelSource;
 
 /// Every network kernel of the frame path, in the order a frame first uses them: what
 /// `nprt export` writes (an engine brings its own G-buffer and background).

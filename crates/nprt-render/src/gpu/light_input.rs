@@ -4,20 +4,20 @@
 //! the map's rotation, into dispatches prepared once per map; on the host the lookups took a
 //! frame milliseconds (64 per texel of a 128-wide input from a 1024-wide map).
 
-use nprt_net::gpu::{groups_for, Dispatch, GpuDevice, KernelSource};
+use std::sync::LazyLock;
+
+use nprt_gpu::{groups_for, Dispatch, GpuDevice, KernelSource};
 use nprt_net::{LightInput, MapNorm};
 use nprt_scene::EnvMap;
+use nprt_trace::gpu::wgsl::{LERP, MAP_LOOKUP};
+use nprt_trace::gpu::{matrix_words, GpuMap};
 
-use super::gpu_map::{matrix_words, GpuMap};
-
-pub const LIGHT_TEXELS: KernelSource = KernelSource {
-    name: "light_texels",
-    wgsl: concat!(
-        include_str!("shaders/lerp.wgsl"),
-        include_str!("shaders/map_lookup.wgsl"),
-        include_str!("shaders/light_texels.wgsl")
-    ),
-};
+pub static LIGHT_TEXELS: LazyLock<KernelSource> = LazyLock::new(|| {
+    KernelSource::joined(
+        "light_texels",
+        &[LERP, MAP_LOOKUP, include_str!("shaders/light_texels.wgsl")],
+    )
+});
 
 pub const LIGHT_NORMALISE: KernelSource = KernelSource {
     name: "light_normalise",

@@ -19,7 +19,8 @@ use nprt_net::{
 use nprt_trace::{render_gbuffer, TraceScene};
 use serde_json::{json, Value};
 
-use nprt_net::gpu::{half_weight_bits, pad16, KernelSource};
+use nprt_gpu::KernelSource;
+use nprt_net::gpu::{half_weight_bits, pad16};
 
 use super::kernels::{sources, HALF_SOURCES};
 use crate::{CameraPath, Relighter};

@@ -8,7 +8,7 @@
 use std::sync::Arc;
 
 use anyhow::{anyhow, Result};
-use nprt_net::gpu::GpuDevice;
+use nprt_gpu::GpuDevice;
 use wgpu::util::DeviceExt;
 use winit::window::Window;
 

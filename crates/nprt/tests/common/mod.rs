@@ -1,7 +1,13 @@
 //! Helpers shared by the integration tests that drive the `nprt` binary.
-#![allow(dead_code)] // each test file uses its own subset
+#![allow(dead_code, unused_imports)] // each test file uses its own subset
 
-pub mod features_scene;
+// Shared with nprt-trace's tests of the tracer on the device.
+#[path = "../../../nprt-trace/tests/common/frame_noise.rs"]
+mod frame_noise;
+#[path = "../../../nprt-trace/tests/common/shared_data.rs"]
+mod shared_data;
+pub use frame_noise::block_rms;
+pub use shared_data::{repo, shared};
 
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
@@ -131,61 +137,4 @@ pub fn wgpu_runs() -> bool {
     assert!(err.contains(why), "{err}");
     eprintln!("skipped: {err}");
     false
-}
-
-/// The repository's root.
-pub fn repo() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("../..")
-        .canonicalize()
-        .unwrap()
-}
-
-/// The folder of large optional data beside the repository (`NPRT_SHARED`, else `../shared`)
-/// when it holds `sub`. Absent, the test is skipped, unless `NPRT_REQUIRE_SHARED=1` (CI) makes
-/// that a failure.
-pub fn shared(sub: &str) -> Option<PathBuf> {
-    let root = std::env::var_os("NPRT_SHARED")
-        .map(PathBuf::from)
-        .unwrap_or_else(|| repo().join("../shared"));
-    let path = root.join(sub);
-    if path.exists() {
-        return Some(path);
-    }
-    assert!(
-        std::env::var("NPRT_REQUIRE_SHARED").as_deref() != Ok("1"),
-        "NPRT_REQUIRE_SHARED=1 but {} is missing",
-        path.display()
-    );
-    eprintln!(
-        "SKIPPED: {} is absent (set NPRT_SHARED to the shared data folder)",
-        path.display()
-    );
-    None
-}
-
-/// Pixels per side of [`block_rms`]'s blocks.
-const BLOCK: usize = 4;
-
-/// Means of `BLOCK`² pixels of a frame `width` wide (its channels summed), for comparing
-/// frames that agree within noise: blocks average the noise down, and many of them show where
-/// one frame is biased.
-fn blocks(frame: &[glam::Vec3], width: usize) -> Vec<f64> {
-    let (bw, bh) = (width / BLOCK, frame.len() / width / BLOCK);
-    let mut out = vec![0.0; bw * bh];
-    for y in 0..bh * BLOCK {
-        for x in 0..bw * BLOCK {
-            let c = frame[y * width + x];
-            out[(y / BLOCK) * bw + x / BLOCK] += (c.x + c.y + c.z) as f64;
-        }
-    }
-    out
-}
-
-/// The root mean square difference of two frames' blocks, relative to the first's mean block.
-pub fn block_rms(a: &[glam::Vec3], b: &[glam::Vec3], width: usize) -> f64 {
-    let (a, b) = (blocks(a, width), blocks(b, width));
-    let mean = a.iter().sum::<f64>() / a.len() as f64;
-    let ms = a.iter().zip(&b).map(|(x, y)| (x - y).powi(2)).sum::<f64>() / a.len() as f64;
-    ms.sqrt() / mean
 }

@@ -6,7 +6,7 @@
 
 use std::sync::{Arc, Mutex};
 
-use super::{Bind, GpuDevice};
+use crate::{Bind, GpuDevice};
 
 /// Buffers handed back, by size, the oldest dropped past a bound; clones share them.
 #[derive(Clone)]

@@ -2,7 +2,7 @@
 
 use wgpu::util::DeviceExt;
 
-use super::GpuDevice;
+use crate::GpuDevice;
 
 const STORAGE: wgpu::BufferUsages = wgpu::BufferUsages::STORAGE
     .union(wgpu::BufferUsages::COPY_SRC)
@@ -61,6 +61,11 @@ impl GpuDevice {
         })
     }
 
+    /// A storage buffer of `halves` f16 values, zero.
+    pub fn half_buffer(&self, halves: usize) -> wgpu::Buffer {
+        self.buffer(halves.div_ceil(2))
+    }
+
     /// Overwrites the start of `buffer` with `values`.
     pub fn write<T: bytemuck::Pod>(&self, buffer: &wgpu::Buffer, values: &[T]) {
         self.queue
@@ -91,7 +96,7 @@ impl GpuDevice {
 
     /// The values of `staging` (a host-readable buffer) once `submission`, which fills it, is
     /// done; `staging` is unmapped again after, to be filled anew.
-    pub(super) fn read_mapped<T: bytemuck::Pod>(
+    pub fn read_mapped<T: bytemuck::Pod>(
         &self,
         staging: &wgpu::Buffer,
         submission: wgpu::SubmissionIndex,

@@ -1,4 +1,4 @@
-//! The rasterised G-buffer (nprt-render's gpu::RasterGBuffer) against the tracer's pixel-centre
+//! The rasterised G-buffer (`gpu::RasterGBuffer`) against the tracer's pixel-centre
 //! G-buffer (`nprt_trace::render_gbuffer`), which it must reproduce: every material feature
 //! the G-buffer records (bitmaps through uv transforms, checkerboards, metallic-roughness,
 //! Fresnel at normal incidence, opacity masks, bump maps seen from either side, one- and
@@ -10,8 +10,9 @@ mod common;
 
 use common::features_scene::{features_scene, views};
 use glam::Vec3;
-use nprt_render::gpu::{GpuDevice, RasterGBuffer};
+use nprt_gpu::GpuDevice;
 use nprt_scene::{load_scene, Scene, SceneOptions};
+use nprt_trace::gpu::RasterGBuffer;
 use nprt_trace::{render_gbuffer, GBuffer, TraceScene};
 
 /// Per pixel, the largest difference of any value of two G-buffers' samples, relative to one

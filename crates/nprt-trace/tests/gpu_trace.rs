@@ -1,4 +1,4 @@
-//! The path tracer on the device (nprt-render's `RasterGBuffer::trace`, `path_trace.wgsl`)
+//! The path tracer on the device (`gpu::RasterGBuffer::trace`, `path_trace.wgsl`)
 //! against nprt-trace's on the CPU, which it must estimate without bias: traced direct light
 //! (paths of two vertices through the pixel centres, as `render_direct`) and full paths with
 //! Russian roulette (as `render`), on a scene with every scattering and material feature and
@@ -10,11 +10,12 @@
 
 mod common;
 
-use common::block_rms;
 use common::features_scene::{features_scene, views};
+use common::frame_noise::block_rms;
 use glam::Vec3;
-use nprt_render::gpu::{GpuDevice, GpuPaths, RasterGBuffer};
+use nprt_gpu::GpuDevice;
 use nprt_scene::{load_scene, open_envmap, Camera, EnvMap, Scene, SceneOptions};
+use nprt_trace::gpu::{GpuPaths, RasterGBuffer};
 use nprt_trace::{render, render_direct, PixelFilter, RenderSettings, TraceScene};
 
 /// Every view of `scene` traced with `paths` on the device and by `cpu` with two seeds: the

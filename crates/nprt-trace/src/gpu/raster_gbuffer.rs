@@ -1,6 +1,6 @@
 //! The G-buffer rasterised on the GPU: a visibility pass (each pixel centre's nearest triangle,
 //! by the hardware rasteriser) and a compute pass that shades the kept triangle as the tracer
-//! would, so that the frame path's G-buffer matches `nprt_trace::render_gbuffer`'s (its
+//! would, so that the frame path's G-buffer matches `crate::render_gbuffer`'s (its
 //! pixel-centre rays) without tracing a ray. The scene it uploads also serves the path tracer
 //! on the device (`path_tracer.rs`).
 
@@ -8,13 +8,13 @@ use std::sync::{Arc, Mutex};
 
 use anyhow::Result;
 use glam::{DMat4, DVec4};
-use nprt_net::gpu::{Bind, BufferPool, GpuDevice, KernelSource, PooledBuffer};
+use nprt_gpu::{Bind, BufferPool, GpuDevice, KernelSource, PooledBuffer};
 use nprt_scene::Camera;
-use nprt_trace::{GBuffer, GSample, TraceScene};
 use wgpu::util::DeviceExt;
 
 use super::gpu_map::GpuMap;
 use super::gpu_scene::GpuScene;
+use crate::{GBuffer, GSample, TraceScene};
 
 /// The compute pass that turns kept triangles into G-buffer samples.
 pub const GBUFFER: KernelSource = KernelSource {
@@ -113,11 +113,11 @@ impl RasterGBuffer {
         })
     }
 
-    pub(crate) fn device(&self) -> &GpuDevice {
+    pub fn device(&self) -> &GpuDevice {
         &self.gpu
     }
 
-    pub(crate) fn scene(&self) -> &GpuScene {
+    pub fn scene(&self) -> &GpuScene {
         &self.scene
     }
 
@@ -128,11 +128,11 @@ impl RasterGBuffer {
 
     /// A buffer of `floats` f32 a dropped G-buffer or traced frame of that size handed back,
     /// or a new one.
-    pub(crate) fn pooled(&self, floats: usize) -> PooledBuffer {
+    pub fn pooled(&self, floats: usize) -> PooledBuffer {
         self.pool.take_pooled(&self.gpu, floats)
     }
 
-    pub(crate) fn maps(&self) -> &GpuMap {
+    pub fn maps(&self) -> &GpuMap {
         &self.maps
     }
 

@@ -9,10 +9,10 @@ use std::sync::{Arc, Mutex, OnceLock};
 
 use anyhow::{Context, Result};
 use glam::Vec3;
+use nprt_gpu::GpuDevice;
 use nprt_scene::{BsdfParams, Material, Scattering, Surface, Texture};
-use nprt_trace::{Coating, FlatBvh, TraceScene};
 
-use nprt_net::gpu::GpuDevice;
+use crate::{Coating, FlatBvh, TraceScene};
 
 /// Words per material record (see [`material_record`]).
 pub const MATERIAL_WORDS: usize = 32;
@@ -115,9 +115,9 @@ impl GpuScene {
             (attributes.len(), "the scene's vertex normals and uvs"),
             (triangles.len(), "the scene's triangles"),
             (bitmaps.texels.len(), "the scene's textures"),
-            (2 * count.max(1) * nprt_trace::NODE_WORDS, "the scene's BVH"),
+            (2 * count.max(1) * crate::NODE_WORDS, "the scene's BVH"),
             (
-                count * nprt_trace::TRIANGLE_WORDS,
+                count * crate::TRIANGLE_WORDS,
                 "the scene's triangles in BVH order",
             ),
         ] {
@@ -157,7 +157,7 @@ impl GpuScene {
                 nodes: gpu.upload(&bvh.nodes),
                 // A buffer may not be empty.
                 triangles: gpu.upload(if bvh.triangles.is_empty() {
-                    &[0; nprt_trace::TRIANGLE_WORDS]
+                    &[0; crate::TRIANGLE_WORDS]
                 } else {
                     &bvh.triangles
                 }),

@@ -6,8 +6,8 @@ use std::sync::{Arc, OnceLock};
 
 use anyhow::{anyhow, Result};
 
-use super::kernel::Pipelines;
-use super::BufferPool;
+use crate::kernel::Pipelines;
+use crate::BufferPool;
 
 /// A wgpu adapter's device and queue, and the kernels compiled for it.
 pub struct GpuDevice {
@@ -28,14 +28,14 @@ pub struct GpuDevice {
     /// Whether `half_layer`'s products run on cooperative matrices (tensor cores): 16 × 16 × 16
     /// f16 products into f32, in subgroups of 32.
     pub tensor_cores: bool,
-    pub(super) pipelines: Pipelines,
+    pub(crate) pipelines: Pipelines,
     /// Bound where a kernel's read-only input is unused, and where a written one is (two
     /// buffers: one dispatch may not bind a buffer both ways).
     pub empty: wgpu::Buffer,
     pub spare: wgpu::Buffer,
     /// Host-readable buffers that reads copied into, kept for the next read of the same size
     /// (a frame read back every lighting change otherwise allocated one of its size each time).
-    pub(super) staging: BufferPool,
+    pub(crate) staging: BufferPool,
     /// Times the host has waited for the queue ([`Self::host_waits`]).
     waits: AtomicU64,
 }
@@ -177,7 +177,7 @@ impl GpuDevice {
         self.waits.load(Ordering::Relaxed)
     }
 
-    pub(super) fn counted_wait(&self) {
+    pub(crate) fn counted_wait(&self) {
         self.waits.fetch_add(1, Ordering::Relaxed);
     }
 }

@@ -7,7 +7,7 @@ use std::sync::Mutex;
 
 use wgpu::util::DeviceExt;
 
-use super::parameters::Span;
+use crate::Span;
 
 /// A kernel's name and WGSL source: what the device compiles and `nprt export` writes.
 pub struct KernelSource {
@@ -15,12 +15,24 @@ pub struct KernelSource {
     pub wgsl: &'static str,
 }
 
+impl KernelSource {
+    /// A kernel whose source is `parts` one after another (WGSL has no includes), for parts
+    /// that another crate owns; made once (in a `LazyLock`): its source lives as long as the
+    /// process.
+    pub fn joined(name: &'static str, parts: &[&str]) -> KernelSource {
+        KernelSource {
+            name,
+            wgsl: Box::leak(parts.concat().into_boxed_str()),
+        }
+    }
+}
+
 /// Threads per workgroup of the one-dimensional kernels.
 pub const GROUP: u32 = 64;
 
 /// A device's compiled pipelines, by kernel name.
 #[derive(Default)]
-pub(super) struct Pipelines {
+pub(crate) struct Pipelines {
     compiled: Mutex<HashMap<&'static str, wgpu::ComputePipeline>>,
 }
 
@@ -51,7 +63,7 @@ impl Pipelines {
 /// One dispatch ready to record: its pipeline, its bind group (which keeps its buffers alive)
 /// and its workgroups. A training step keeps its dispatches and records them again each step.
 pub struct Dispatch {
-    /// The kernel's name, for [`super::KernelTime`].
+    /// The kernel's name, for [`crate::KernelTime`].
     pub kernel: &'static str,
     pipeline: wgpu::ComputePipeline,
     group: wgpu::BindGroup,
@@ -68,7 +80,7 @@ impl Dispatch {
     }
 }
 
-impl super::GpuDevice {
+impl crate::GpuDevice {
     /// A dispatch of `kernel` with `params` (the shader's uniform struct, as u32 words or f32
     /// bit patterns) and `buffers` (whole buffers or parts) at bindings 1, 2, ….
     pub fn prepare(

@@ -6,7 +6,7 @@
 
 use anyhow::{bail, Result};
 
-use super::{Dispatch, GpuDevice};
+use crate::{Dispatch, GpuDevice};
 
 /// One kernel's share of a step: how often it ran and its GPU time in all.
 #[derive(Clone, Debug, PartialEq)]
@@ -17,7 +17,7 @@ pub struct KernelTime {
 }
 
 /// Timestamp queries for `dispatches` dispatches, and the buffers they are read back through.
-pub(super) struct KernelTimer {
+pub struct KernelTimer {
     queries: wgpu::QuerySet,
     resolved: wgpu::Buffer,
     readback: wgpu::Buffer,

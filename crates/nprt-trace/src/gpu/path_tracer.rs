@@ -4,7 +4,7 @@
 
 use anyhow::Result;
 use glam::Vec3;
-use nprt_net::gpu::{GpuDevice, KernelSource};
+use nprt_gpu::{GpuDevice, KernelSource};
 use nprt_scene::{Camera, EnvMap};
 
 use super::gpu_map::{matrix_words, GpuMap};
@@ -65,7 +65,7 @@ impl GpuPaths {
 /// Records a pass of `paths` through `camera` under `map` (as placed in the world) into `rgb`
 /// (3 f32 per pixel): their mean, written, or with `add` added to what `rgb` holds.
 #[allow(clippy::too_many_arguments)]
-pub(crate) fn record_paths(
+pub fn record_paths(
     gpu: &GpuDevice,
     pass: &mut wgpu::ComputePass,
     scene: &GpuScene,

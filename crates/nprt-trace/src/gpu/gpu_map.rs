@@ -1,10 +1,10 @@
 //! An environment map on the device: its texels (a frame's background, the encoder's input and
 //! the path tracer read them) and its sampling table (the path tracer's), uploaded once per map.
 
-use nprt_net::gpu::GpuDevice;
+use nprt_gpu::GpuDevice;
 use nprt_scene::EnvMap;
 
-use super::kept_last::KeptLast;
+use nprt_gpu::KeptLast;
 
 /// The last map's texels on the device (a frame's background, the encoder's input and the path
 /// tracer read them) and its sampling table (the path tracer's), kept with the map they came
@@ -18,7 +18,7 @@ pub struct GpuMap {
 /// A map as a key: equal to another sharing its texels. It holds the map, so its texels cannot
 /// be freed and another map's take their address while they are kept (an address alone as the
 /// key gave a map loaded after another was dropped the dropped one's texels).
-pub(super) struct SameTexels(pub(super) EnvMap);
+pub struct SameTexels(pub EnvMap);
 
 impl PartialEq for SameTexels {
     fn eq(&self, other: &Self) -> bool {
@@ -28,7 +28,7 @@ impl PartialEq for SameTexels {
 
 /// A 3 × 3 matrix as map_lookup.wgsl's callers take it: its columns, each padded to a vec4,
 /// as u32 words of the parameter block (a map's world-to-local rotation).
-pub(super) fn matrix_words(m: glam::Mat3) -> impl Iterator<Item = u32> {
+pub fn matrix_words(m: glam::Mat3) -> impl Iterator<Item = u32> {
     [m.x_axis, m.y_axis, m.z_axis]
         .into_iter()
         .flat_map(|c| c.extend(0.0).to_array().map(f32::to_bits))
@@ -37,7 +37,7 @@ pub(super) fn matrix_words(m: glam::Mat3) -> impl Iterator<Item = u32> {
 impl GpuMap {
     /// `map`'s sampling table on the device ([`nprt_scene::Distribution2D::cells`], three
     /// words a cell), uploaded unless it was the last map's.
-    pub(super) fn table(&self, gpu: &GpuDevice, map: &EnvMap) -> wgpu::Buffer {
+    pub fn table(&self, gpu: &GpuDevice, map: &EnvMap) -> wgpu::Buffer {
         self.table.get(SameTexels(map.clone()), || {
             let words: Vec<u32> = map
                 .distribution()
@@ -49,7 +49,7 @@ impl GpuMap {
     }
 
     /// `map`'s texels on the device, uploaded unless they were the last map's.
-    pub(super) fn texels(&self, gpu: &GpuDevice, map: &EnvMap) -> wgpu::Buffer {
+    pub fn texels(&self, gpu: &GpuDevice, map: &EnvMap) -> wgpu::Buffer {
         self.kept.get(SameTexels(map.clone()), || {
             let flat: Vec<f32> = map.texels().iter().flat_map(|t| t.to_array()).collect();
             gpu.upload(&flat)

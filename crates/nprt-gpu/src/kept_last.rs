@@ -4,6 +4,7 @@
 use std::convert::Infallible;
 use std::sync::Mutex;
 
+/// One cached value and its key, shared between threads.
 pub struct KeptLast<K, V>(Mutex<Option<(K, V)>>);
 
 impl<K, V> Default for KeptLast<K, V> {
