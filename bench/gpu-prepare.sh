@@ -4,7 +4,8 @@
 # ignores it; about 50 MiB, inside a 64 MiB transfer):
 #   nprt        the release binary with the GPU kernels (`--features gpu`), stripped;
 #   tests/      the GPU kernels' correctness tests (nprt-net's gpu_training, nprt-render's
-#               gpu_frame: f32 and the f16/tensor-core paths against the CPU engine), stripped;
+#               gpu_frame: f32 and the f16/tensor-core paths against the CPU engine; nprt-trace's
+#               gpu_trace: the path tracer against the CPU's), stripped;
 #   cooperative_matrix  nprt-render's bench of the tensor-core products (frame and training
 #               shapes), stripped;
 #   lib/        the Vulkan loader (libvulkan.so.1) and glvnd's libraries (Debian's), for a GPU
@@ -46,7 +47,7 @@ for line in sys.stdin:
         print(m["executable"])' "$test"
 }
 log "building the GPU kernels' tests"
-for spec in nprt-net:kernels:gpu_training nprt-render:wgpu:gpu_frame; do
+for spec in nprt-net:kernels:gpu_training nprt-render:wgpu:gpu_frame nprt-trace:gpu:gpu_trace; do
   IFS=: read -r package features test <<<"$spec"
   exe=$(test_binary test "$package" "$features" "$test")
   [ -x "$exe" ] || { log "no test executable for $spec"; exit 1; }

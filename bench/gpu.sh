@@ -8,7 +8,9 @@
 #      time in a step) per design, in f32 and in mixed precision (f16 products on tensor cores),
 #      beside PyTorch on CUDA, eager and torch.compile, each in f32 and bf16 autocast (the
 #      fastest is the peer), at batch 16,384 and 262,144;
-#   2. the paper's schedule (3000 views of 256², 500 epochs) projected from those rates;
+#   2. the paper's schedule (3000 views of 256², 500 epochs) projected from those rates, and its
+#      data (3000 views at 3200 spp) from `nprt generate --device` on the GPU and on the CPU
+#      (a small builtin:room dataset each, measured after the frames);
 #   3. `nprt bench frame --profile` (G-buffer, encoder, networks, direct light traced on the GPU,
 #      total; each kernel of a lighting change)
 #      per design, and D/S with 16 spp of traced direct light, at 512² and 1920×1080
@@ -186,11 +188,26 @@ frames() {
   end_section
 }
 
-# The smallest batch first, then the frames, then the larger batches: a short loan measures
-# the most-asked figures first.
+# Data generation: the same small builtin:room dataset path traced on the GPU and on every CPU
+# core (`nprt generate --device`), each run's samples/s line.
+generation() {
+  log "data generation on $device and on the CPU"
+  section "Data generation (nprt generate, builtin:room, 20 views of 128² at 64 spp): GPU, then CPU ($(nproc) threads)"
+  for d in "$device" cpu; do
+    rm -rf "$work/generate-$d"
+    "$nprt" generate --scene builtin:room --envmaps builtin --out "$work/generate-$d" \
+      --train-views 16 --test-views 4 --spp 64 --test-spp 64 --device "$d" 2>&1 \
+      | tail -n 1 | sed "s/^/$d: /" | tee -a "$work/generate.txt" >>"$summary" || failed=1
+  done
+  end_section
+}
+
+# The smallest batch first, then the frames and data generation, then the larger batches: a
+# short loan measures the most-asked figures first.
 first=${batches%% *}
 train_rates "$first"
 frames
+generation
 for batch in $batches; do
   [ "$batch" = "$first" ] || train_rates "$batch"
 done
@@ -205,6 +222,11 @@ for batch in $batches; do
         samples / $4 / 60, ($5 == "-" ? "-" : sprintf("%.1f", samples / $5 / 60))
     }' "$work/train-$batch.txt" >>"$summary"
 done
+# Its data: 3000 views of 256² at 3200 spp (the paper's references), at the rates measured.
+if [ -f "$work/generate.txt" ]; then
+  sed -nE 's/^([a-z]+): .* ([0-9.]+) Msamples\/s.*/\1 \2/p' "$work/generate.txt" \
+    | awk '$2 > 0 { printf "data on %-4s 3000 views of 256² at 3200 spp: %8.1f h\n", $1, 3000 * 65536 * 3200 / ($2 * 1e6) / 3600 }' >>"$summary"
+fi
 end_section
 
 # With --quick: the tensor-core products at the frame's and training's shapes, per variant.

@@ -5,7 +5,7 @@ use std::path::PathBuf;
 
 use anyhow::Result;
 use nprt_scene::load_scene;
-use nprt_trace::TraceScene;
+use nprt_trace::{TraceDevice, TraceScene, Tracer};
 
 use crate::camera_choice::CameraChoice;
 use crate::dataset::{self, Jitter, Manifest, Request, Summary};
@@ -40,6 +40,9 @@ pub struct GenerateOptions {
     pub camera: CameraChoice,
     /// Render only views with index ≡ K (mod N).
     pub shard: (u64, u64),
+    /// Where the views are path traced: the CPU, or the same tracer on the GPU (recorded in
+    /// the manifest; a dataset is resumed on the tracer that began it).
+    pub device: TraceDevice,
     pub progress: bool,
 }
 
@@ -64,6 +67,7 @@ impl Default for GenerateOptions {
             mix_builtin: None,
             camera: CameraChoice::default(),
             shard: (0, 1),
+            device: TraceDevice::Cpu,
             progress: true,
         }
     }
@@ -146,14 +150,17 @@ pub fn generate(opts: &GenerateOptions, planned: impl FnOnce(Planned)) -> Result
         jitter: opts.jitter,
     };
     let ts = TraceScene::new(&scene);
-    let manifest = dataset::plan(&request, &ts)?;
+    let mut manifest = dataset::plan(&request, &ts)?;
+    manifest.settings.tracer = opts.device;
+    // Opened before the folder is made: a GPU that does not open leaves nothing behind.
+    let tracer = Tracer::new(opts.device, &ts)?;
     dataset::prepare(&opts.out, &manifest)?;
     planned(Planned {
         manifest: &manifest,
         warnings,
     });
     dataset::run(
-        &ts,
+        &tracer,
         &request.maps,
         &manifest,
         &opts.out,

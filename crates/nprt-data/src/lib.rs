@@ -6,7 +6,7 @@
 //! ```
 //! use nprt_data::dataset::{self, Request};
 //! use nprt_scene::{load_scene, open_envmap, SceneOptions};
-//! use nprt_trace::TraceScene;
+//! use nprt_trace::{TraceScene, Tracer};
 //!
 //! let scene = load_scene("builtin:room", &SceneOptions::default())?;
 //! let map_specs = vec!["builtin:sky".to_string(), "builtin:indoor:1".to_string()];
@@ -32,7 +32,7 @@
 //! let manifest = dataset::plan(&request, &ts)?;
 //! let dir = std::env::temp_dir().join(format!("nprt-data-doc-{}", std::process::id()));
 //! dataset::prepare(&dir, &manifest)?;
-//! dataset::run(&ts, &request.maps, &manifest, &dir, (0, 1), false)?;
+//! dataset::run(&Tracer::Cpu(&ts), &request.maps, &manifest, &dir, (0, 1), false)?;
 //! assert_eq!(dataset::verify(&dir)?.complete, 3);
 //! # std::fs::remove_dir_all(&dir)?;
 //! # Ok::<(), anyhow::Error>(())

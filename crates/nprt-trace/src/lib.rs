@@ -44,6 +44,7 @@ mod reference;
 mod render;
 mod shading_frame;
 mod trace_scene;
+mod tracer;
 mod transport_pass;
 
 pub use accel::{Accel, Hit};
@@ -55,4 +56,5 @@ pub use gbuffer_pass::{primary_sample, render_gbuffer};
 pub use reference::{render_reference, Reference, ReferenceOptions, DEFAULT_REFERENCE_SPP};
 pub use render::{render, render_direct, PixelFilter, RenderSettings};
 pub use trace_scene::TraceScene;
+pub use tracer::{TraceDevice, Tracer};
 pub use transport_pass::render_transport;

@@ -5,6 +5,8 @@ use std::path::PathBuf;
 use anyhow::Result;
 use nprt_data::dataset::Jitter;
 use nprt_data::{generate, CameraChoice, GenerateOptions};
+use nprt_net::{Compute, Engine};
+use nprt_trace::TraceDevice;
 
 use crate::flags::{parse_shard, parse_vec3, print_warnings, Resolution};
 
@@ -96,6 +98,13 @@ pub struct GenerateArgs {
     /// corners given by hand).
     #[arg(long)]
     fov: Option<f32>,
+    /// Where the views are path traced: cpu, gpu (the same path tracer as a WGSL kernel on
+    /// the best GPU adapter, a discrete one first; needs the `gpu` feature), wgpu (any
+    /// adapter, Mesa's software lavapipe included) or auto (gpu when a hardware adapter is
+    /// found, else the CPU). The two draw different random numbers: the manifest records which
+    /// began a dataset, and it is resumed on that one.
+    #[arg(long = "device", default_value_t = Compute::Cpu)]
+    device: Compute,
 }
 
 impl TryFrom<GenerateArgs> for GenerateOptions {
@@ -132,8 +141,20 @@ impl TryFrom<GenerateArgs> for GenerateOptions {
                 fov_deg: a.fov,
             },
             shard,
+            device: match a.device.engine()? {
+                Engine::Cpu => TraceDevice::Cpu,
+                Engine::Gpu => TraceDevice::Gpu,
+            },
             progress: true,
         })
+    }
+}
+
+/// The tracer's name for the plan line: "cpu", or "gpu" and the adapter.
+fn tracer_name(device: TraceDevice) -> String {
+    match device {
+        TraceDevice::Cpu => Engine::Cpu.name(),
+        TraceDevice::Gpu => Engine::Gpu.name(),
     }
 }
 
@@ -143,9 +164,10 @@ pub fn run(opts: &GenerateOptions) -> Result<()> {
         print_warnings(&p.warnings);
         let s = &p.manifest.settings;
         println!(
-            "dataset {}: {} train views ({}×{}, {} spp) under {} maps, {} test views ({}×{}, {} spp) under {} held-out maps; shard {}/{}",
+            "dataset {}: {} train views ({}×{}, {} spp) under {} maps, {} test views ({}×{}, {} spp) under {} held-out maps; shard {}/{}; traced on the {}",
             opts.out.display(), s.train_views, s.train_resolution[0], s.train_resolution[1], s.spp, s.train_maps.len(),
-            s.test_views, s.test_resolution[0], s.test_resolution[1], opts.test_spp, s.test_maps.len(), opts.shard.0, opts.shard.1
+            s.test_views, s.test_resolution[0], s.test_resolution[1], opts.test_spp, s.test_maps.len(), opts.shard.0, opts.shard.1,
+            tracer_name(opts.device)
         );
     })?;
     for r in &summary.redone {

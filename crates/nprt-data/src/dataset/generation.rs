@@ -8,7 +8,7 @@ use std::time::Instant;
 use anyhow::{bail, Context, Result};
 use glam::Vec3;
 use nprt_scene::EnvMap;
-use nprt_trace::{render, Frame, PixelFilter, RenderSettings, TraceScene};
+use nprt_trace::{Frame, PixelFilter, RenderSettings, Tracer};
 
 use super::manifest::{load_manifest, Manifest, ViewRecord, MANIFEST};
 use super::view_file::{check_view, write_view, ViewImage};
@@ -44,7 +44,7 @@ const SECOND_HALF: u64 = 0x9e37_79b9_7f4a_7c15;
 /// Renders one view to its file: a test view of a dataset with `test_spp` as two independent
 /// halves, averaged, the first kept apart.
 pub fn render_view(
-    ts: &TraceScene,
+    tracer: &Tracer,
     maps: &[EnvMap],
     manifest: &Manifest,
     view: &ViewRecord,
@@ -62,8 +62,7 @@ pub fn render_view(
     };
     let image = if s.in_halves(view) {
         let half = |seed| {
-            render(
-                ts,
+            tracer.render(
                 &view.camera(),
                 &env,
                 &RenderSettings {
@@ -73,7 +72,7 @@ pub fn render_view(
                 },
             )
         };
-        let (first, second) = (half(view.seed), half(view.seed ^ SECOND_HALF));
+        let (first, second) = (half(view.seed)?, half(view.seed ^ SECOND_HALF)?);
         let mean = |a: &[Vec3], b: &[Vec3]| a.iter().zip(b).map(|(x, y)| (*x + *y) * 0.5).collect();
         let frame = Frame {
             width: first.width,
@@ -88,7 +87,7 @@ pub fn render_view(
         }
     } else {
         ViewImage {
-            frame: render(ts, &view.camera(), &env, &settings),
+            frame: tracer.render(&view.camera(), &env, &settings)?,
             half: None,
         }
     };
@@ -106,15 +105,22 @@ pub struct Summary {
     pub samples: f64,
 }
 
-/// Renders every view of shard `shard.0` of `shard.1` that is not yet complete on disk.
+/// Renders every view of shard `shard.0` of `shard.1` that is not yet complete on disk, with
+/// the tracer the manifest names.
 pub fn run(
-    ts: &TraceScene,
+    tracer: &Tracer,
     maps: &[EnvMap],
     manifest: &Manifest,
     dir: &Path,
     shard: (u64, u64),
     progress: bool,
 ) -> Result<Summary> {
+    anyhow::ensure!(
+        tracer.device() == manifest.settings.tracer,
+        "the dataset is traced on the {:?} tracer, this run on the {:?} one",
+        manifest.settings.tracer,
+        tracer.device()
+    );
     let mine: Vec<&ViewRecord> = manifest
         .views
         .iter()
@@ -142,7 +148,7 @@ pub fn run(
     let bar = nprt_io::progress_bar(progress, todo.len() as u64, "generating", "views");
     let t0 = Instant::now();
     for v in todo {
-        render_view(ts, maps, manifest, v, dir)
+        render_view(tracer, maps, manifest, v, dir)
             .with_context(|| format!("view {} ({})", v.index, v.file))?;
         summary.rendered += 1;
         summary.samples += v.width as f64 * v.height as f64 * manifest.settings.spp_of(v) as f64;
@@ -171,6 +177,7 @@ mod tests {
     use crate::dataset::plan::room_request;
     use crate::dataset::{plan, read_view, Request};
     use nprt_scene::{load_scene, SceneOptions};
+    use nprt_trace::{render, TraceScene};
 
     fn mse(a: &[Vec3], b: &[Vec3]) -> f64 {
         let sum: f64 = a
@@ -195,7 +202,15 @@ mod tests {
         let manifest = plan(&request, &ts).unwrap();
         let dir = std::env::temp_dir().join(format!("nprt-halves-{}", std::process::id()));
         prepare(&dir, &manifest).unwrap();
-        run(&ts, &request.maps, &manifest, &dir, (0, 1), false).unwrap();
+        run(
+            &Tracer::Cpu(&ts),
+            &request.maps,
+            &manifest,
+            &dir,
+            (0, 1),
+            false,
+        )
+        .unwrap();
         let view = |split: &str| manifest.views.iter().find(|v| v.split == split).unwrap();
         let (train, test) = (view("train"), view("test"));
         assert!(!manifest.settings.in_halves(train) && manifest.settings.in_halves(test));

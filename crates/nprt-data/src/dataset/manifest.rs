@@ -6,6 +6,7 @@ use std::path::Path;
 use anyhow::{bail, Context, Result};
 use glam::{Mat4, Vec3};
 use nprt_scene::{Camera, EnvMap, FovAxis};
+use nprt_trace::TraceDevice;
 use serde::{Deserialize, Serialize};
 
 pub const FORMAT_VERSION: u32 = 1;
@@ -39,6 +40,11 @@ pub struct Settings {
     #[serde(default, skip_serializing_if = "Jitter::is_none")]
     pub jitter: Jitter,
     pub camera_volume: VolumeRecord,
+    /// Which tracer rendered the views (they draw different random numbers, so a dataset is
+    /// resumed on the tracer that began it). Absent in datasets made before the GPU tracer:
+    /// the CPU's.
+    #[serde(default)]
+    pub tracer: TraceDevice,
 }
 
 /// How far a training view's map may be brightened, darkened and tinted, in stops: its gain

@@ -501,7 +501,7 @@ mod tests {
     use crate::dataset::plan::room_request;
     use crate::dataset::{plan, prepare, run, Request};
     use nprt_scene::{load_scene, SceneOptions};
-    use nprt_trace::TraceScene;
+    use nprt_trace::{TraceScene, Tracer};
 
     /// A three-view dataset of the built-in room in a fresh folder, its manifest and hash.
     fn room(name: &str) -> (PathBuf, Manifest, String) {
@@ -520,7 +520,15 @@ mod tests {
         let dir = std::env::temp_dir().join(format!("nprt-pack-{name}-{}", std::process::id()));
         let _ = std::fs::remove_dir_all(&dir);
         prepare(&dir, &manifest).unwrap();
-        run(&ts, &request.maps, &manifest, &dir, (0, 1), false).unwrap();
+        run(
+            &Tracer::Cpu(&ts),
+            &request.maps,
+            &manifest,
+            &dir,
+            (0, 1),
+            false,
+        )
+        .unwrap();
         let (manifest, hash) = crate::dataset::load_manifest_hashed(&dir).unwrap();
         (dir, manifest, hash)
     }

@@ -4,7 +4,7 @@
 use anyhow::{bail, Context, Result};
 use nprt_scene::envmap::MAX_RADIANCE;
 use nprt_scene::{CameraVolume, EnvMap, Scene};
-use nprt_trace::TraceScene;
+use nprt_trace::{TraceDevice, TraceScene};
 use rand::{RngExt, SeedableRng};
 use rand_pcg::Pcg64Mcg;
 
@@ -119,6 +119,7 @@ pub fn plan(req: &Request, ts: &TraceScene) -> Result<Manifest> {
             spread_deg: v.spread_deg,
             fov_deg: v.fov_deg,
         },
+        tracer: TraceDevice::Cpu,
     };
     let views = plan_views(req, ts, &train_pool, &test_maps, mixed, own_map)?;
     let (lo, hi) = req.scene.bounds();

@@ -29,7 +29,7 @@ use super::gpu_mlp::{FirstLayer, GpuMlp, Scratch};
 use super::light_code::{GpuLightCode, LIGHT_CODE_VALUES};
 use super::light_input::GpuLightInput;
 use nprt_gpu::KeptLast;
-use nprt_trace::gpu::{record_paths, GpuMap, GpuPaths, SameTexels};
+use nprt_trace::gpu::{record_paths, GpuMap, GpuPaths, PathTargets, SameTexels};
 
 /// Most rows per block of dispatches. Fewer blocks mean fewer dispatches to prepare and record
 /// (at 65,536 rows a 1920 × 1080 D/S frame was 32 blocks of a dozen dispatches each). A
@@ -624,6 +624,11 @@ impl GpuNetwork {
             gpu.wait();
             let clock = std::time::Instant::now();
             let mut encoder = gpu.device.create_command_encoder(&Default::default());
+            let out = PathTargets {
+                rgb: &px.rgb,
+                direct: None,
+                add: true,
+            };
             record_paths(
                 gpu,
                 &mut encoder.begin_compute_pass(&Default::default()),
@@ -632,8 +637,7 @@ impl GpuNetwork {
                 camera,
                 map,
                 &GpuPaths::direct(*spp, *seed),
-                &px.rgb,
-                true,
+                &out,
             );
             gpu.queue.submit([encoder.finish()]);
             gpu.wait();

@@ -16,7 +16,7 @@ mod raster_gbuffer;
 
 pub use gpu_map::{matrix_words, GpuMap, SameTexels};
 pub use gpu_scene::{GpuBvh, GpuScene};
-pub use path_tracer::{record_paths, GpuPaths, PATH_TRACE};
+pub use path_tracer::{record_paths, GpuPaths, PathTargets, PATH_TRACE};
 pub use raster_gbuffer::{camera_words, RasterGBuffer, GBUFFER};
 
 /// The WGSL parts other stages' kernels put before their own (WGSL has no includes): a camera

@@ -7,6 +7,8 @@ use glam::Vec3;
 use nprt_gpu::{GpuDevice, KernelSource};
 use nprt_scene::{Camera, EnvMap};
 
+use crate::{Frame, PixelFilter, RenderSettings};
+
 use super::gpu_map::{matrix_words, GpuMap};
 use super::gpu_scene::GpuScene;
 use super::raster_gbuffer::{camera_words, RasterGBuffer};
@@ -62,8 +64,17 @@ impl GpuPaths {
     }
 }
 
-/// Records a pass of `paths` through `camera` under `map` (as placed in the world) into `rgb`
-/// (3 f32 per pixel): their mean, written, or with `add` added to what `rgb` holds.
+/// Where a pass's mean goes: the radiance into `rgb` (3 f32 per pixel) and, where given, its
+/// direct part into `direct` (as the CPU tracer's `PathRadiance::direct`), written, or with `add`
+/// added to what they hold.
+pub struct PathTargets<'a> {
+    pub rgb: &'a wgpu::Buffer,
+    pub direct: Option<&'a wgpu::Buffer>,
+    pub add: bool,
+}
+
+/// Records a pass of `paths` through `camera` under `map` (as placed in the world) into
+/// `out`.
 #[allow(clippy::too_many_arguments)]
 pub fn record_paths(
     gpu: &GpuDevice,
@@ -73,8 +84,7 @@ pub fn record_paths(
     camera: &Camera,
     map: &EnvMap,
     paths: &GpuPaths,
-    rgb: &wgpu::Buffer,
-    add: bool,
+    out: &PathTargets,
 ) {
     let texels = maps.texels(gpu, map);
     let table = maps.table(gpu, map);
@@ -95,10 +105,10 @@ pub fn record_paths(
             paths.max_depth,
             paths.rr_depth,
             paths.first_path + first,
-            u32::from(add || first > 0),
+            u32::from(out.add || first > 0),
             u32::from(paths.jitter),
             triangles,
-            0,
+            u32::from(out.direct.is_some()),
             0,
             0,
         ];
@@ -120,7 +130,8 @@ pub fn record_paths(
                 &bvh.triangles,
                 &texels,
                 &table,
-                rgb,
+                out.rgb,
+                out.direct.unwrap_or(&gpu.spare),
             ],
             [camera.width.div_ceil(8), camera.height.div_ceil(8)],
         );
@@ -131,6 +142,55 @@ impl RasterGBuffer {
     /// The mean radiance of `paths` per pixel of `camera` under `map` (as placed in the world),
     /// traced on the device and read back.
     pub fn trace(&self, camera: &Camera, map: &EnvMap, paths: &GpuPaths) -> Result<Vec<Vec3>> {
+        Ok(self.traced(camera, map, paths, false)?.0)
+    }
+
+    /// [`Self::trace`], and the direct part of the same paths (the map seen directly, and light
+    /// that reached the first surface straight from it).
+    pub fn trace_with_direct(
+        &self,
+        camera: &Camera,
+        map: &EnvMap,
+        paths: &GpuPaths,
+    ) -> Result<(Vec<Vec3>, Vec<Vec3>)> {
+        let (radiance, direct) = self.traced(camera, map, paths, true)?;
+        Ok((radiance, direct.expect("the direct part was asked for")))
+    }
+
+    /// A frame as [`crate::render`] makes it with `settings`, on the device: the G-buffer
+    /// (rasterised), radiance and its direct part (traced).
+    pub fn render_frame(
+        &self,
+        camera: &Camera,
+        map: &EnvMap,
+        settings: &RenderSettings,
+    ) -> Result<Frame> {
+        let paths = GpuPaths {
+            spp: settings.spp,
+            seed: settings.seed,
+            max_depth: settings.max_depth.unwrap_or(u32::MAX),
+            rr_depth: settings.rr_depth,
+            first_path: 0,
+            jitter: settings.filter == PixelFilter::Box,
+        };
+        let gbuffer = self.render(camera)?;
+        let (radiance, direct) = self.trace_with_direct(camera, map, &paths)?;
+        Ok(Frame {
+            width: camera.width as usize,
+            height: camera.height as usize,
+            radiance,
+            direct,
+            gbuffer,
+        })
+    }
+
+    fn traced(
+        &self,
+        camera: &Camera,
+        map: &EnvMap,
+        paths: &GpuPaths,
+        with_direct: bool,
+    ) -> Result<(Vec<Vec3>, Option<Vec<Vec3>>)> {
         let gpu = self.device();
         let pixels = (camera.width * camera.height) as usize;
         gpu.check_binding(
@@ -138,26 +198,25 @@ impl RasterGBuffer {
             &format!("a {}×{} traced frame", camera.width, camera.height),
         )?;
         let rgb = self.pooled(3 * pixels);
+        let direct = with_direct.then(|| self.pooled(3 * pixels));
         let mut encoder = gpu.device.create_command_encoder(&Default::default());
         {
             let mut pass = encoder.begin_compute_pass(&Default::default());
-            record_paths(
-                gpu,
-                &mut pass,
-                self.scene(),
-                self.maps(),
-                camera,
-                map,
-                paths,
-                &rgb,
-                false,
-            );
+            let out = PathTargets {
+                rgb: &rgb,
+                direct: direct.as_deref(),
+                add: false,
+            };
+            let (scene, maps) = (self.scene(), self.maps());
+            record_paths(gpu, &mut pass, scene, maps, camera, map, paths, &out);
         }
         gpu.queue.submit([encoder.finish()]);
-        Ok(gpu
-            .read(&rgb, 3 * pixels)
-            .chunks_exact(3)
-            .map(Vec3::from_slice)
-            .collect())
+        let read = |buffer: &wgpu::Buffer| -> Vec<Vec3> {
+            gpu.read(buffer, 3 * pixels)
+                .chunks_exact(3)
+                .map(Vec3::from_slice)
+                .collect()
+        };
+        Ok((read(&rgb), direct.as_deref().map(read)))
     }
 }

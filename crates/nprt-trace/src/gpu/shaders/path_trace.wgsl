@@ -2,7 +2,9 @@
 // towards the map at every vertex, combined by the power heuristic; Russian roulette from
 // `rr_depth`; max_depth counts vertices as Mitsuba does, so 2 is direct light), one thread a
 // pixel, `spp` paths through the pixel centre (or jittered over the pixel), their sum over
-// `total_spp` written to or added onto `rgb` (a long estimate is split over dispatches). Its random numbers are its own (PCG), so frames agree with the CPU's
+// `total_spp` written to or added onto `rgb` (a long estimate is split over dispatches), and
+// with `keep_direct` their direct part (the map seen directly, and light that reached the
+// first surface straight from it, as PathRadiance::direct) onto `direct_rgb` alike. Its random numbers are its own (PCG), so frames agree with the CPU's
 // within noise, not sample for sample. After camera_ray.wgsl, lerp.wgsl, map_lookup.wgsl,
 // map_sampling.wgsl, surface.wgsl, bsdf.wgsl and bvh.wgsl.
 
@@ -24,7 +26,7 @@ struct Params {
     // 1: uniform over the pixel; 0: through its centre.
     jitter: u32,
     triangle_count: u32,
-    _pad0: u32,
+    keep_direct: u32,
     _pad1: u32,
     _pad2: u32,
     x_axis: vec4<f32>,
@@ -52,6 +54,13 @@ struct Params {
 @group(0) @binding(9) var<storage, read> texels: array<f32>;
 @group(0) @binding(10) var<storage, read> table: array<u32>;
 @group(0) @binding(11) var<storage, read_write> rgb: array<f32>;
+@group(0) @binding(12) var<storage, read_write> direct_rgb: array<f32>;
+
+// One path's radiance: all of it, and its direct part.
+struct PathOut {
+    total: vec3<f32>,
+    direct: vec3<f32>,
+}
 
 // PCG's output permutation of a 32-bit LCG step (O'Neill 2014), as a hash and a stream.
 fn pcg_hash(x: u32) -> u32 {
@@ -96,12 +105,13 @@ fn scene_hit(origin: vec3<f32>, dir: vec3<f32>, first_hit: bool) -> Hit {
 }
 
 // The radiance one path carries into the camera along `dir` from `origin`.
-fn trace_path(origin_in: vec3<f32>, dir_in: vec3<f32>, state: ptr<function, u32>) -> vec3<f32> {
+fn trace_path(origin_in: vec3<f32>, dir_in: vec3<f32>, state: ptr<function, u32>) -> PathOut {
     let size = vec2<u32>(params.map_width, params.map_height);
     let table_size = vec2<u32>(params.map_width, params.map_height - 1u);
     let to_local = mat3x3<f32>(params.to_local_x.xyz, params.to_local_y.xyz, params.to_local_z.xyz);
     let to_world = mat3x3<f32>(params.to_world_x.xyz, params.to_world_y.xyz, params.to_world_z.xyz);
     var total = vec3<f32>(0.0);
+    var direct = vec3<f32>(0.0);
     var beta = vec3<f32>(1.0);
     var pdf = 0.0;
     var depth = 0u;
@@ -116,7 +126,11 @@ fn trace_path(origin_in: vec3<f32>, dir_in: vec3<f32>, state: ptr<function, u32>
             if depth > 0u && !delta {
                 w = power_heuristic(pdf, lp.w);
             }
-            total += beta * lp.xyz * w;
+            let c = beta * lp.xyz * w;
+            total += c;
+            if depth <= 1u {
+                direct += c;
+            }
             break;
         }
         if depth + 1u >= params.max_depth {
@@ -137,7 +151,11 @@ fn trace_path(origin_in: vec3<f32>, dir_in: vec3<f32>, state: ptr<function, u32>
                 let wi = ls.dir * local;
                 let f = bsdf_eval(b, wo, wi);
                 if any_nonzero(f) && !scene_hit(offset_origin(sp.p, sp.ng, ls.dir), ls.dir, true).found {
-                    total += beta * f * ls.radiance * (power_heuristic(ls.pdf, bsdf_pdf(b, wo, wi)) / ls.pdf);
+                    let c = beta * f * ls.radiance * (power_heuristic(ls.pdf, bsdf_pdf(b, wo, wi)) / ls.pdf);
+                    total += c;
+                    if depth == 0u {
+                        direct += c;
+                    }
                 }
             }
         }
@@ -163,7 +181,7 @@ fn trace_path(origin_in: vec3<f32>, dir_in: vec3<f32>, state: ptr<function, u32>
         // Where the next vertex would end the path, only whether the ray leaves matters.
         hit = scene_hit(origin, dir, depth + 1u >= params.max_depth);
     }
-    return total;
+    return PathOut(total, direct);
 }
 
 @compute @workgroup_size(8, 8)
@@ -174,6 +192,7 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
     let i = id.y * params.width + id.x;
     let size = vec2<u32>(params.width, params.height);
     var sum = vec3<f32>(0.0);
+    var direct = vec3<f32>(0.0);
     for (var s = 0u; s < params.spp; s++) {
         var state = pcg_hash(params.seed ^ pcg_hash(i ^ pcg_hash(params.first_path + s)));
         var film = vec2<f32>(id.xy) + 0.5;
@@ -181,13 +200,25 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
             film = vec2<f32>(id.xy) + vec2<f32>(next_uniform(&state), next_uniform(&state));
         }
         let dir = camera_ray_at(film, size, params.x_axis.xyz, params.y_axis.xyz, params.z_axis.xyz, params.tangents.xy);
-        sum += trace_path(params.origin.xyz, dir, &state);
+        let path = trace_path(params.origin.xyz, dir, &state);
+        sum += path.total;
+        direct += path.direct;
     }
-    var mean = sum / f32(max(params.total_spp, 1u));
+    let n = f32(max(params.total_spp, 1u));
+    var mean = sum / n;
     if params.add == 1u {
         mean += vec3<f32>(rgb[3u * i], rgb[3u * i + 1u], rgb[3u * i + 2u]);
     }
     rgb[3u * i] = mean.x;
     rgb[3u * i + 1u] = mean.y;
     rgb[3u * i + 2u] = mean.z;
+    if params.keep_direct == 1u {
+        var d = direct / n;
+        if params.add == 1u {
+            d += vec3<f32>(direct_rgb[3u * i], direct_rgb[3u * i + 1u], direct_rgb[3u * i + 2u]);
+        }
+        direct_rgb[3u * i] = d.x;
+        direct_rgb[3u * i + 1u] = d.y;
+        direct_rgb[3u * i + 2u] = d.z;
+    }
 }

@@ -1,0 +1,72 @@
+//! Where frames are path traced: the CPU tracer, or (feature `gpu`) the same tracer on the
+//! GPU ([`crate::gpu`]). Both estimate the same image; they draw different random numbers, so
+//! a dataset records which made it.
+
+use anyhow::Result;
+use nprt_scene::{Camera, EnvMap};
+use serde::{Deserialize, Serialize};
+
+use crate::{render, Frame, RenderSettings, TraceScene};
+
+/// Which tracer renders: what a dataset's manifest records and `nprt generate --device`
+/// chooses.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum TraceDevice {
+    #[default]
+    Cpu,
+    Gpu,
+}
+
+impl TraceDevice {
+    pub fn is_cpu(&self) -> bool {
+        *self == TraceDevice::Cpu
+    }
+}
+
+/// A scene ready to trace on one device: on the GPU, uploaded once for every frame.
+pub enum Tracer<'a> {
+    Cpu(&'a TraceScene<'a>),
+    #[cfg(feature = "gpu")]
+    Gpu(crate::gpu::RasterGBuffer),
+}
+
+impl<'a> Tracer<'a> {
+    /// `ts` ready to trace on `device`: an error where the GPU does not open, or in a build
+    /// without the GPU tracer.
+    pub fn new(device: TraceDevice, ts: &'a TraceScene<'a>) -> Result<Self> {
+        match device {
+            TraceDevice::Cpu => Ok(Tracer::Cpu(ts)),
+            #[cfg(feature = "gpu")]
+            TraceDevice::Gpu => Ok(Tracer::Gpu(crate::gpu::RasterGBuffer::new(ts)?)),
+            #[cfg(not(feature = "gpu"))]
+            TraceDevice::Gpu => anyhow::bail!(
+                "this nprt was built without its GPU tracer; rebuild it with `cargo build \
+                 --release --features gpu` (docs/building.md), or use --device cpu"
+            ),
+        }
+    }
+
+    /// The device this tracer runs on.
+    pub fn device(&self) -> TraceDevice {
+        match self {
+            Tracer::Cpu(_) => TraceDevice::Cpu,
+            #[cfg(feature = "gpu")]
+            Tracer::Gpu(_) => TraceDevice::Gpu,
+        }
+    }
+
+    /// A frame of `camera` under `env` as [`render`] makes it with `settings`.
+    pub fn render(
+        &self,
+        camera: &Camera,
+        env: &EnvMap,
+        settings: &RenderSettings,
+    ) -> Result<Frame> {
+        match self {
+            Tracer::Cpu(ts) => Ok(render(ts, camera, env, settings)),
+            #[cfg(feature = "gpu")]
+            Tracer::Gpu(raster) => raster.render_frame(camera, env, settings),
+        }
+    }
+}
