@@ -28,7 +28,7 @@ impl TraceDevice {
 pub enum Tracer<'a> {
     Cpu(&'a TraceScene<'a>),
     #[cfg(feature = "gpu")]
-    Gpu(crate::gpu::RasterGBuffer),
+    Gpu(Box<crate::gpu::RasterGBuffer>),
 }
 
 impl<'a> Tracer<'a> {
@@ -38,7 +38,7 @@ impl<'a> Tracer<'a> {
         match device {
             TraceDevice::Cpu => Ok(Tracer::Cpu(ts)),
             #[cfg(feature = "gpu")]
-            TraceDevice::Gpu => Ok(Tracer::Gpu(crate::gpu::RasterGBuffer::new(ts)?)),
+            TraceDevice::Gpu => Ok(Tracer::Gpu(Box::new(crate::gpu::RasterGBuffer::new(ts)?))),
             #[cfg(not(feature = "gpu"))]
             TraceDevice::Gpu => anyhow::bail!(
                 "this nprt was built without its GPU tracer; rebuild it with `cargo build \

@@ -19,3 +19,6 @@ pub fn loss_code(loss: Loss) -> u32 {
         Loss::RelL2 => 1,
     }
 }
+
+/// Added to an activation's code, `gemm`'s epilogue multiplies by its derivative at z instead.
+pub const BACKWARD: u32 = 2;

@@ -1,14 +1,61 @@
-//! The light encoder's convolution blocks recorded on the device, once for both callers: a
-//! training step (over a batch's maps, keeping each block's pooling tape for backward) and the
-//! frame path (over one map, keeping nothing). Each block halves the image; the code layer
-//! after them is each caller's, as their weights are held differently.
+//! The light encoder recorded on the device, once for both callers: a training step (over a
+//! batch's maps, keeping each block's pooling tape for backward) and the frame path (over one
+//! map, keeping nothing). Each convolution block halves the image; the code layer follows.
 
 use super::kernels::{ENCODER_BLOCK, ENCODER_BLOCK_THREADS};
-use super::{groups_for, Bind, Dispatch, GpuDevice};
-use crate::network::encoder::CHANNELS;
+use super::network_layout::NetworkLayout;
+use super::operands::{Bias, Operand, Output};
+use super::products::DenseProducts;
+use super::{groups_for, Bind, Dispatch, GpuDevice, Part};
+use crate::network::encoder::{CHANNELS, CODE_SIZE};
+
+impl NetworkLayout {
+    /// Appends to `plan` the light encoder over `views` maps `width` × `width / 2` in `input`
+    /// (view-major, channel-major), its weights in `params`: the blocks (each with `keep` its
+    /// pooling tape), then the code layer into `codes` (`views × CODE_SIZE`).
+    #[allow(clippy::too_many_arguments)]
+    pub fn record_encoder(
+        &self,
+        gpu: &GpuDevice,
+        plan: &mut Vec<Dispatch>,
+        params: &wgpu::Buffer,
+        input: &wgpu::Buffer,
+        [views, width]: [usize; 2],
+        codes: &wgpu::Buffer,
+        keep: bool,
+    ) -> BlockPass {
+        let part = |span| Part {
+            buffer: params,
+            span,
+        };
+        // The parts are bound by reference: made first, then borrowed.
+        let parts: Vec<_> = (self.convs.iter())
+            .map(|conv| (part(conv.weight), part(conv.bias), conv.c_in))
+            .collect();
+        let blocks: Vec<BlockWeights> = (parts.iter())
+            .map(|(weight, bias, c_in)| BlockWeights {
+                weight,
+                bias,
+                c_in: *c_in,
+            })
+            .collect();
+        let pass = record_blocks(gpu, plan, input, [views, width], &blocks, keep);
+        let (to_code, flat) = (&self.to_code, self.to_code.d_in);
+        plan.push(gpu.product(
+            [views, CODE_SIZE, flat],
+            Operand::plain(&pass.last, 0, flat),
+            Operand::plain(params, to_code.weight.offset, CODE_SIZE),
+            Bias::Column(params, to_code.bias.offset),
+            0,
+            Output::to(codes, 0, CODE_SIZE),
+            None,
+        ));
+        pass
+    }
+}
 
 /// One block's weights as its caller binds them, and its input channels.
-pub struct BlockWeights<'a> {
+struct BlockWeights<'a> {
     pub weight: &'a dyn Bind,
     pub bias: &'a dyn Bind,
     pub c_in: usize,
@@ -25,7 +72,7 @@ pub struct BlockPass {
 
 /// Appends to `plan` the blocks over `views` maps `width` × `width / 2` in `input`
 /// (view-major, channel-major), each with `keep` its pooling tape.
-pub fn record_blocks(
+fn record_blocks(
     gpu: &GpuDevice,
     plan: &mut Vec<Dispatch>,
     input: &wgpu::Buffer,

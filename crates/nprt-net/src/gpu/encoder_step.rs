@@ -2,14 +2,14 @@
 //! their pooling tapes, the code layer, and backward from the gradient at the codes into every
 //! encoder weight.
 
-use super::encoder_blocks::{record_blocks, BlockWeights};
 use super::gpu_trainer::{BatchBuffers, GpuTrainer};
 use super::kernels::{
     ENCODER_INPUT_BACKWARD, ENCODER_INPUT_BACKWARD_THREADS, ENCODER_POOL_BACKWARD,
     ENCODER_WEIGHT_BACKWARD,
 };
 use super::network_layout::ConvAt;
-use super::products::{Bias, DenseProducts, Operand, Output};
+use super::operands::{Bias, Operand, Output};
+use super::products::DenseProducts;
 use super::{groups_for, Dispatch};
 use crate::network::encoder::{CHANNELS, CODE_SIZE};
 
@@ -34,42 +34,21 @@ impl GpuTrainer {
         plan: &mut Vec<Dispatch>,
         b: &BatchBuffers,
     ) -> EncoderTape {
-        // The parts are bound by reference: made first, then borrowed.
-        let parts: Vec<_> = (self.net.convs.iter())
-            .map(|conv| (self.part(conv.weight), self.part(conv.bias), conv.c_in))
-            .collect();
-        let blocks: Vec<BlockWeights> = (parts.iter())
-            .map(|(weight, bias, c_in)| BlockWeights {
-                weight,
-                bias,
-                c_in: *c_in,
-            })
-            .collect();
-        let pass = record_blocks(
+        let pass = self.net.record_encoder(
             &self.gpu,
             plan,
+            &self.params,
             &b.lights,
             [b.views, b.light_width],
-            &blocks,
+            &b.codes,
             true,
         );
-        let tape = EncoderTape {
+        EncoderTape {
             inputs: pass.inputs,
             sizes: pass.sizes,
             tapes: pass.tapes,
             flat: pass.last,
-        };
-        let flat = self.net.to_code.d_in;
-        plan.push(self.gpu.product(
-            [b.views, CODE_SIZE, flat],
-            Operand::plain(&tape.flat, 0, flat),
-            Operand::plain(&self.params, self.net.to_code.weight.offset, CODE_SIZE),
-            Bias::Column(&self.params, self.net.to_code.bias.offset),
-            0,
-            Output::to(&b.codes, 0, CODE_SIZE),
-            None,
-        ));
-        tape
+        }
     }
 
     /// Records the light encoder's backward pass from the gradient at the codes, `b.d_codes`.

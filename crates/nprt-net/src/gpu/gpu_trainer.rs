@@ -186,8 +186,7 @@ impl GpuTrainer {
             gpu.check_half()?;
         }
         let shapes = net.clone();
-        let align = gpu.device.limits().min_storage_buffer_offset_alignment as usize / 4;
-        let (layout, flat) = ParameterLayout::pack(net, align.max(1));
+        let (layout, flat) = ParameterLayout::pack_for(&gpu, net);
         let net = NetworkLayout::new(&gpu, &layout, net, half);
         let zeros = vec![0.0f32; layout.total];
         let [params, grads, moment1, moment2] =
@@ -198,13 +197,7 @@ impl GpuTrainer {
             &[&grads, &params, &moment1, &moment2],
             groups_for(layout.total),
         );
-        let half_refresh: Vec<Dispatch> = net
-            .tracks
-            .iter()
-            .flat_map(|t| t.transfer.iter().chain([&t.shading]))
-            .flat_map(|m| m.half_layers())
-            .flat_map(|(layer, copies)| copies.refresh(&gpu, &params, layer))
-            .collect();
+        let half_refresh = net.half_refresh(&gpu, &params);
         if !half_refresh.is_empty() {
             let mut encoder = gpu.device.create_command_encoder(&Default::default());
             let mut pass = encoder.begin_compute_pass(&Default::default());

@@ -3,10 +3,14 @@
 //! kept in f32 (`half_layer`). Where the adapter has cooperative matrices of 16 × 16 × 16 f16
 //! products into f32 (NVIDIA's tensor cores through Vulkan) the product runs on them
 //! (`half_dense_coop`); elsewhere a plain kernel computes the same sums (`half_dense`), which
-//! is what the tests run on Mesa's software Vulkan. Training's mixed-precision products
-//! (`half_products`) hold their operands in the same layout.
+//! is what the tests run on Mesa's software Vulkan. A training step's forward and input-gradient
+//! products are the same product under another epilogue (`half_train_layer`: a grouped bias,
+//! the pre-activation kept or the activation's derivative applied); its weight gradients are
+//! `half_products`'.
 
-use super::kernels::{HALF_DENSE, HALF_DENSE_COOP, HALF_ROWS};
+use super::codes::BACKWARD;
+use super::kernels::{HALF_DENSE, HALF_DENSE_COOP, HALF_ROWS, HALF_TRAIN, HALF_TRAIN_COOP};
+use super::operands::Bias;
 use super::{groups_for, Bind, Dispatch, GpuDevice, KernelSource};
 
 /// Rows a half-precision layer's workgroup covers: its inputs and outputs hold the rows up to
@@ -100,7 +104,7 @@ pub trait HalfLayers {
         k_pad: usize,
         w: &HalfWeight,
         w_row: usize,
-        bias: &wgpu::Buffer,
+        bias: &dyn Bind,
         activation: u32,
         y: Held,
     ) -> Dispatch;
@@ -155,7 +159,7 @@ impl HalfLayers for GpuDevice {
         k_pad: usize,
         w: &HalfWeight,
         w_row: usize,
-        bias: &wgpu::Buffer,
+        bias: &dyn Bind,
         activation: u32,
         y: Held,
     ) -> Dispatch {
@@ -187,7 +191,7 @@ impl HalfLayers for GpuDevice {
 /// The dispatch of a half-precision dense product (`half_dense`'s main, or on tensor cores
 /// `half_dense_coop`'s: the first or second of `kernels`, each under its epilogue) over
 /// `rows` rows and `n_pad` output columns, with the epilogue's `params` and `buffers`.
-pub(super) fn half_dense(
+fn half_dense(
     gpu: &GpuDevice,
     [plain, coop]: [&KernelSource; 2],
     params: &[u32],
@@ -200,4 +204,61 @@ pub(super) fn half_dense(
         rows.div_ceil(HALF_ROW_BLOCK) as u32,
     ];
     gpu.prepare(kernel, params, buffers, groups)
+}
+
+/// Where a mixed-precision product's results go.
+pub(super) struct HalfOut<'a> {
+    /// The pre-activation: kept here by a forward product, read for the activation's
+    /// derivative by a backward one.
+    pub z: Option<&'a wgpu::Buffer>,
+    /// f16 rows padded as `half_layers` holds them (the next product's operand).
+    pub y16: Option<&'a wgpu::Buffer>,
+    /// f32 rows of the layer's width.
+    pub y32: Option<&'a wgpu::Buffer>,
+}
+
+/// The dispatch of `act(x·W + bias)` over `rows` rows of `x` (f16 rows of `k_pad` values)
+/// with `w` from its first row; `activation` 3 or 4 multiplies by ReLU's or SIREN's
+/// derivative at `out.z` instead (`half_train_layer.wgsl`).
+pub(super) fn half_train_layer(
+    gpu: &GpuDevice,
+    rows: usize,
+    (x, k_pad): (&wgpu::Buffer, usize),
+    w: &HalfWeight,
+    bias: Bias,
+    activation: u32,
+    out: HalfOut,
+) -> Dispatch {
+    let (bias_mode, bias_buffer, bias_off, group_of) = bias.binding(gpu);
+    let keep_z = out.z.is_some() && activation < 1 + BACKWARD;
+    let params = [
+        rows,
+        w.d_out,
+        w.n_pad,
+        k_pad,
+        0,
+        activation as usize,
+        bias_mode,
+        bias_off,
+        usize::from(keep_z),
+        usize::from(out.y16.is_some()),
+        usize::from(out.y32.is_some()),
+        0,
+    ]
+    .map(|v| v as u32);
+    half_dense(
+        gpu,
+        [&HALF_TRAIN, &HALF_TRAIN_COOP],
+        &params,
+        &[
+            x,
+            &w.buffer,
+            bias_buffer,
+            group_of,
+            out.z.unwrap_or(&gpu.spare),
+            out.y16.unwrap_or(&gpu.spare),
+            out.y32.unwrap_or(&gpu.spare),
+        ],
+        [rows, w.n_pad],
+    )
 }

@@ -12,70 +12,14 @@
 //! gradients, and Adam divides it back out; f16 values saturate instead of overflowing. The
 //! light encoder, the hash grids and the light code's share stay in f32.
 
-use super::codes::activation_code;
+use super::codes::{activation_code, BACKWARD};
 use super::gpu_trainer::GpuTrainer;
-use super::half_layers::{half_dense, held_halves, pad16, HalfLayers, HalfWeight};
-use super::kernels::{HALF_TRAIN, HALF_TRAIN_COOP, HALF_WEIGHT_GRAD, HALF_WEIGHT_GRAD_COOP};
+use super::half_layers::{half_train_layer, held_halves, pad16, HalfLayers, HalfOut};
+use super::kernels::{HALF_WEIGHT_GRAD, HALF_WEIGHT_GRAD_COOP};
 use super::network_layout::MlpAt;
-use super::products::{row_chunks, Bias, FirstLayer, FirstLayerBias, MlpTape, Output, BACKWARD};
+use super::operands::{Bias, Output};
+use super::products::{row_chunks, FirstLayerBias, MlpTape};
 use super::{groups_for, Bind, Dispatch, GpuDevice};
-
-/// Where a mixed-precision product's results go.
-pub(super) struct HalfOut<'a> {
-    /// The pre-activation: kept here by a forward product, read for the activation's
-    /// derivative by a backward one.
-    pub z: Option<&'a wgpu::Buffer>,
-    /// f16 rows padded as `half_layers` holds them (the next product's operand).
-    pub y16: Option<&'a wgpu::Buffer>,
-    /// f32 rows of the layer's width.
-    pub y32: Option<&'a wgpu::Buffer>,
-}
-
-/// The dispatch of `act(x·W + bias)` over `rows` rows of `x` (f16 rows of `k_pad` values)
-/// with `w` from its first row; `activation` 3 or 4 multiplies by ReLU's or SIREN's
-/// derivative at `out.z` instead (`half_train_layer.wgsl`).
-fn half_train_layer(
-    gpu: &GpuDevice,
-    rows: usize,
-    (x, k_pad): (&wgpu::Buffer, usize),
-    w: &HalfWeight,
-    bias: Bias,
-    activation: u32,
-    out: HalfOut,
-) -> Dispatch {
-    let (bias_mode, bias_buffer, bias_off, group_of) = bias.binding(gpu);
-    let keep_z = out.z.is_some() && activation < 1 + BACKWARD;
-    let params = [
-        rows,
-        w.d_out,
-        w.n_pad,
-        k_pad,
-        0,
-        activation as usize,
-        bias_mode,
-        bias_off,
-        usize::from(keep_z),
-        usize::from(out.y16.is_some()),
-        usize::from(out.y32.is_some()),
-        0,
-    ]
-    .map(|v| v as u32);
-    half_dense(
-        gpu,
-        [&HALF_TRAIN, &HALF_TRAIN_COOP],
-        &params,
-        &[
-            x,
-            &w.buffer,
-            bias_buffer,
-            group_of,
-            out.z.unwrap_or(&gpu.spare),
-            out.y16.unwrap_or(&gpu.spare),
-            out.y32.unwrap_or(&gpu.spare),
-        ],
-        [rows, w.n_pad],
-    )
-}
 
 /// The dispatch of xᵀ·dz, `[m, n]`, over `rows` rows cut into chunks of `chunk` rows, chunk
 /// c's sums into `partial` from c · m · n (`half_weight_sums.wgsl`).
@@ -103,55 +47,6 @@ fn half_weight_grad(
 }
 
 impl GpuTrainer {
-    /// [`Self::mlp_forward`] in a mixed-precision step: `x` (f32, `first.count` values a row)
-    /// made f16 once, then each layer's product from the f16 output of the one before.
-    pub(super) fn half_mlp_forward(
-        &self,
-        plan: &mut Vec<Dispatch>,
-        m: &MlpAt,
-        x: &wgpu::Buffer,
-        first: FirstLayer,
-        tape: &MlpTape,
-    ) {
-        let rows = tape.rows;
-        let input = tape.input16.as_ref().expect("a mixed-precision tape");
-        plan.push(
-            self.gpu
-                .half_rows([rows, first.count, first.count], x, input),
-        );
-        let last = m.layers.len() - 1;
-        let mut first_bias = Some(first.bias);
-        for (i, (layer, copies)) in m.half_layers().enumerate() {
-            let (x16, bias) = match first_bias.take() {
-                Some(bias) => (input, bias),
-                None => (
-                    &tape.outputs[i - 1],
-                    Bias::Column(&self.params, layer.bias.offset),
-                ),
-            };
-            let hidden = i < last;
-            let out = HalfOut {
-                z: tape.pre.get(i),
-                y16: hidden.then_some(&tape.outputs[i]),
-                y32: (!hidden).then_some(&tape.outputs[i]),
-            };
-            let activation = if hidden {
-                activation_code(m.activation)
-            } else {
-                0
-            };
-            plan.push(half_train_layer(
-                &self.gpu,
-                rows,
-                (x16, pad16(copies.count)),
-                &copies.stored,
-                bias,
-                activation,
-                out,
-            ));
-        }
-    }
-
     /// [`Self::mlp_backward`] in a mixed-precision step: the gradient at each layer's output
     /// as f16 rows for the products and as f32 rows for the bias's gradient (and `on_first`),
     /// the gradient at the first layer's input into `d_input` (f32) where given.

@@ -15,20 +15,25 @@ mod gpu_trainer;
 mod half_layers;
 mod half_products;
 pub mod kernels;
+mod network_forward;
 mod network_layout;
+mod operands;
 mod parameters;
 mod products;
 mod transport_step;
 
 pub use codes::{activation_code, loss_code};
 pub use device_dataset::DeviceDataset;
-pub use encoder_blocks::{record_blocks, BlockPass, BlockWeights};
+pub use encoder_blocks::BlockPass;
 pub use gpu_trainer::GpuTrainer;
 pub use half_layers::{
     half_weight_bits, held_halves, pad16, HalfLayers, HalfWeight, Held, HALF_ROW_BLOCK,
 };
+pub use network_forward::{FirstLayer, ForwardTargets};
+pub use network_layout::{ConvAt, DenseAt, HalfCopies, MlpAt, NetworkLayout, TrackAt};
+pub use operands::{Bias, Operand, Output};
 pub use parameters::ParameterLayout;
-pub use products::{Bias, DenseProducts, Operand, Output};
+pub use products::DenseProducts;
 
 // The runtime the kernels run on (nprt-gpu), as this module's files name it.
 use nprt_gpu::{groups_for, Bind, Dispatch, GpuDevice, KernelSource, Part, Span};

@@ -14,14 +14,14 @@ use crate::network::nprt_net::NprtNet;
 use crate::network::track_kind::TrackKind;
 
 /// One dense layer's place in the flat buffers.
-pub(super) struct DenseAt {
+pub struct DenseAt {
     pub weight: Span,
     pub bias: Span,
     pub d_in: usize,
     pub d_out: usize,
 }
 
-pub(super) struct MlpAt {
+pub struct MlpAt {
     pub layers: Vec<DenseAt>,
     pub activation: Activation,
     /// In a mixed-precision step, each layer's f16 weights (empty in f32).
@@ -62,7 +62,7 @@ impl MlpAt {
 }
 
 /// One track's networks on the device.
-pub(super) struct TrackAt {
+pub struct TrackAt {
     pub kind: TrackKind,
     /// The feature indices the track reads, in its input order.
     pub index: wgpu::Buffer,
@@ -95,14 +95,14 @@ impl TrackAt {
 }
 
 /// One encoder block's convolution in the flat buffers.
-pub(super) struct ConvAt {
+pub struct ConvAt {
     pub weight: Span,
     pub bias: Span,
     pub c_in: usize,
 }
 
 /// A network's tensors in the flat buffers.
-pub(super) struct NetworkLayout {
+pub struct NetworkLayout {
     pub convs: Vec<ConvAt>,
     pub to_code: DenseAt,
     pub tracks: Vec<TrackAt>,
@@ -131,7 +131,7 @@ impl NetworkLayout {
             d_in: encoder.to_code.d_in,
             d_out: encoder.to_code.d_out,
         };
-        let mut tracks: Vec<TrackAt> = net
+        let tracks: Vec<TrackAt> = net
             .tracks
             .iter()
             .map(|t| {
@@ -149,21 +149,48 @@ impl NetworkLayout {
                 }
             })
             .collect();
-        if half {
-            for t in &mut tracks {
-                let (_, own_row) = t.code_and_own_rows();
-                let own = [own_row, t.own_width()];
-                if let Some(m) = &mut t.transfer {
-                    m.hold_half(gpu, [0, t.width]);
-                }
-                t.shading.hold_half(gpu, own);
-            }
-        }
-        NetworkLayout {
+        let mut layout = NetworkLayout {
             convs,
             to_code,
             tracks,
+        };
+        if half {
+            layout.hold_half(gpu);
         }
+        layout
+    }
+
+    /// Gives the transport networks' layers f16 copies of their weights (zero until
+    /// refreshed, [`Self::half_refresh`]): each MLP's first layer of the rows its own input
+    /// multiplies, every other layer whole.
+    pub fn hold_half(&mut self, gpu: &GpuDevice) {
+        for t in &mut self.tracks {
+            let (_, own_row) = t.code_and_own_rows();
+            let own = [own_row, t.own_width()];
+            if let Some(m) = &mut t.transfer {
+                m.hold_half(gpu, [0, t.width]);
+            }
+            t.shading.hold_half(gpu, own);
+        }
+    }
+
+    /// Drops the f16 copies: the transport networks run in f32 again.
+    pub fn drop_half(&mut self) {
+        for t in &mut self.tracks {
+            t.transfer.iter_mut().for_each(|m| m.half.clear());
+            t.shading.half.clear();
+        }
+    }
+
+    /// The dispatches that copy the transport layers' current weights from `params` into
+    /// their f16 copies (none in f32).
+    pub fn half_refresh(&self, gpu: &GpuDevice, params: &wgpu::Buffer) -> Vec<Dispatch> {
+        self.tracks
+            .iter()
+            .flat_map(|t| t.transfer.iter().chain([&t.shading]))
+            .flat_map(|m| m.half_layers())
+            .flat_map(|(layer, copies)| copies.refresh(gpu, params, layer))
+            .collect()
     }
 }
 
@@ -188,7 +215,7 @@ fn mlp_at(stack: &Mlp, spans: &mut impl Iterator<Item = Span>) -> MlpAt {
 
 /// A dense layer's f16 copies of its weight rows `[row, row + count)`: as stored (the forward
 /// product's right operand) and transposed (the input gradient's).
-pub(super) struct HalfCopies {
+pub struct HalfCopies {
     pub row: usize,
     pub count: usize,
     pub stored: HalfWeight,

@@ -3,7 +3,7 @@
 //! a multiple of the device's storage-binding alignment, so a kernel can also bind one tensor
 //! on its own; the gaps stay zero and Adam leaves them so.
 
-use nprt_gpu::Span;
+use nprt_gpu::{GpuDevice, Span};
 
 use crate::network::nprt_net::NprtNet;
 use crate::network::parameters::Parameters;
@@ -16,8 +16,15 @@ pub struct ParameterLayout {
 }
 
 impl ParameterLayout {
-    /// The layout of `net`'s tensors (in their visiting order) with tensors starting at
-    /// multiples of `align` elements, and their values packed in it.
+    /// The layout of `net`'s tensors (in their visiting order), each starting at a multiple
+    /// of `gpu`'s storage-binding alignment (so a kernel can bind it on its own), and their
+    /// values packed in it.
+    pub fn pack_for(gpu: &GpuDevice, net: &NprtNet) -> (ParameterLayout, Vec<f32>) {
+        let align = gpu.device.limits().min_storage_buffer_offset_alignment as usize / 4;
+        Self::pack(net, align.max(1))
+    }
+
+    /// [`Self::pack_for`] at an alignment of `align` elements.
     pub fn pack(net: &NprtNet, align: usize) -> (ParameterLayout, Vec<f32>) {
         let mut flat = Vec::new();
         let mut spans = Vec::new();

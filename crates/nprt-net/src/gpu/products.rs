@@ -2,13 +2,13 @@
 //! dense layers use too), and, for the training step, sums of columns and an MLP's forward pass
 //! (keeping what backward needs) and backward pass, each a few dispatches appended to a plan.
 
-use super::codes::activation_code;
+use super::codes::{activation_code, BACKWARD};
 use super::gpu_trainer::GpuTrainer;
 use super::half_layers::held_halves;
 use super::kernels::{COLUMN_SUM, GEMM, GEMM_TILE};
 use super::network_layout::MlpAt;
-use super::Span;
-use super::{groups_for, Dispatch, GpuDevice, Part};
+use super::operands::{Bias, Operand, Output};
+use super::{groups_for, Dispatch, GpuDevice};
 
 /// Rows a `column_sum` thread adds before the chunks' sums are added in a further pass (and
 /// theirs in another, as a tree). Short: a thread's adds are a chain of dependent loads, and on
@@ -29,98 +29,6 @@ pub(super) fn row_chunks(rows: usize, align: usize) -> [usize; 2] {
         .next_multiple_of(align)
         .max(ROW_CHUNK);
     [chunk, rows.div_ceil(chunk)]
-}
-
-/// Added to an activation's code, `gemm`'s epilogue multiplies by its derivative at z instead.
-pub(super) const BACKWARD: u32 = 2;
-
-/// One operand of a product: element (i, k) at `offset + i · rows + k · cols` of `buffer`;
-/// for a left operand, `ones_row`'s elements read as ones instead.
-pub struct Operand<'a> {
-    pub buffer: &'a wgpu::Buffer,
-    pub offset: usize,
-    pub rows: usize,
-    pub cols: usize,
-    pub ones_row: Option<usize>,
-}
-
-impl<'a> Operand<'a> {
-    /// A row-major matrix with `stride` values per row, from `offset`.
-    pub fn plain(buffer: &'a wgpu::Buffer, offset: usize, stride: usize) -> Self {
-        Operand {
-            buffer,
-            offset,
-            rows: stride,
-            cols: 1,
-            ones_row: None,
-        }
-    }
-
-    /// The transpose of a row-major matrix with `stride` values per row.
-    pub fn transposed(buffer: &'a wgpu::Buffer, offset: usize, stride: usize) -> Self {
-        Operand {
-            buffer,
-            offset,
-            rows: 1,
-            cols: stride,
-            ones_row: None,
-        }
-    }
-}
-
-/// What a product adds before its activation.
-pub enum Bias<'a> {
-    None,
-    /// `d_out` values from an offset of a buffer.
-    Column(&'a wgpu::Buffer, usize),
-    /// One row of `d_out` values per group, and each row's group.
-    Group(&'a wgpu::Buffer, &'a wgpu::Buffer),
-}
-
-impl<'a> Bias<'a> {
-    /// What a kernel's epilogue takes: its mode (0 none, 1 column, 2 group), its buffer, its
-    /// offset there and the rows' groups (`gpu`'s empty buffer for what is unused).
-    pub(super) fn binding(
-        self,
-        gpu: &'a GpuDevice,
-    ) -> (usize, &'a wgpu::Buffer, usize, &'a wgpu::Buffer) {
-        match self {
-            Bias::None => (0, &gpu.empty, 0, &gpu.empty),
-            Bias::Column(buffer, offset) => (1, buffer, offset, &gpu.empty),
-            Bias::Group(buffer, group) => (2, buffer, 0, group),
-        }
-    }
-}
-
-/// A product's output: `rows` values apart from `offset` of `buffer`, written or added to.
-/// For a column sum, `tail` (`[at, offset]`, `at` > 0) sends the sums from index `at` on to
-/// `offset` of the same buffer instead.
-pub struct Output<'a> {
-    pub buffer: &'a wgpu::Buffer,
-    pub offset: usize,
-    pub stride: usize,
-    pub accumulate: bool,
-    pub tail: Option<[usize; 2]>,
-}
-
-impl<'a> Output<'a> {
-    pub fn to(buffer: &'a wgpu::Buffer, offset: usize, stride: usize) -> Self {
-        Output {
-            buffer,
-            offset,
-            stride,
-            accumulate: false,
-            tail: None,
-        }
-    }
-}
-
-/// How an MLP's first layer reads its input: from weight row `own_row`, `count` values per
-/// row, with `bias`.
-pub(super) struct FirstLayer<'a> {
-    pub own_row: usize,
-    pub count: usize,
-    pub bias: Bias<'a>,
 }
 
 /// What takes a first layer's bias gradient, given the gradient at its pre-activation.
@@ -260,14 +168,6 @@ fn gemm(
 }
 
 impl GpuTrainer {
-    /// One tensor of the parameters, bound on its own.
-    pub(super) fn part(&self, span: Span) -> Part<'_> {
-        Part {
-            buffer: &self.params,
-            span,
-        }
-    }
-
     /// Buffers for an MLP's forward pass over `rows` rows; in a mixed-precision step its input
     /// and hidden layers' outputs as f16 rows (`half_products`).
     pub(super) fn tape(&self, m: &MlpAt, rows: usize) -> MlpTape {
@@ -289,52 +189,6 @@ impl GpuTrainer {
                 .iter()
                 .map(|l| self.gpu.buffer(rows * l.d_out))
                 .collect(),
-        }
-    }
-
-    /// Records `m` over the tape's rows of `x`, keeping each layer's output and each hidden
-    /// layer's pre-activation in `tape`.
-    pub(super) fn mlp_forward(
-        &self,
-        plan: &mut Vec<Dispatch>,
-        m: &MlpAt,
-        x: &wgpu::Buffer,
-        first: FirstLayer,
-        tape: &MlpTape,
-    ) {
-        if !m.half.is_empty() {
-            return self.half_mlp_forward(plan, m, x, first, tape);
-        }
-        let (rows, last) = (tape.rows, m.layers.len() - 1);
-        let mut first = Some(first);
-        for (i, layer) in m.layers.iter().enumerate() {
-            let (input, own_row, count, bias) = match first.take() {
-                Some(f) => (x, f.own_row, f.count, f.bias),
-                None => (
-                    &tape.outputs[i - 1],
-                    0,
-                    layer.d_in,
-                    Bias::Column(&self.params, layer.bias.offset),
-                ),
-            };
-            let activation = if i == last {
-                0
-            } else {
-                activation_code(m.activation)
-            };
-            plan.push(self.gpu.product(
-                [rows, layer.d_out, count],
-                Operand::plain(input, 0, count),
-                Operand::plain(
-                    &self.params,
-                    layer.weight.offset + own_row * layer.d_out,
-                    layer.d_out,
-                ),
-                bias,
-                activation,
-                Output::to(&tape.outputs[i], 0, layer.d_out),
-                tape.pre.get(i),
-            ));
         }
     }
 

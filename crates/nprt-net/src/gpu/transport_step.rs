@@ -5,10 +5,15 @@
 
 use super::codes::loss_code;
 use super::gpu_trainer::{BatchBuffers, GpuTrainer};
-use super::kernels::{COMBINE, GRID_BACKWARD, RADIANCE_LOSS, TRACK_GRADIENT, TRACK_INPUTS};
+use super::half_layers::Held;
+use super::kernels::{COMBINE, GRID_BACKWARD, RADIANCE_LOSS, TRACK_GRADIENT};
+use super::network_forward::FirstLayer;
+use super::network_forward::ForwardTargets;
+use super::network_layout::MlpAt;
 use super::network_layout::TrackAt;
-use super::products::{Bias, DenseProducts, FirstLayer, MlpTape, Operand, Output};
-use super::{groups_for, Bind, Dispatch};
+use super::operands::{Bias, Operand, Output};
+use super::products::{DenseProducts, MlpTape};
+use super::{groups_for, Dispatch};
 use crate::encoding::hash_grid;
 use crate::loss::Loss;
 use crate::network::design::TRANSPORT_CODE;
@@ -114,59 +119,56 @@ impl GpuTrainer {
         forward
     }
 
+    /// What `m`'s forward pass writes into `tape`: each layer's output (the hidden ones f16 in
+    /// a mixed-precision step) and pre-activation.
+    pub(super) fn targets<'a>(&self, m: &MlpAt, tape: &'a MlpTape) -> ForwardTargets<'a> {
+        let half = !m.half.is_empty();
+        let last = tape.outputs.len() - 1;
+        ForwardTargets {
+            outputs: (tape.outputs.iter().enumerate())
+                .map(|(i, b)| match half && i < last {
+                    true => Held::F16(b),
+                    false => Held::F32(b),
+                })
+                .collect(),
+            pre: Some(&tape.pre),
+            input16: tape.input16.as_ref(),
+        }
+    }
+
     /// A track's forward pass over the batch.
     fn track_forward(&self, plan: &mut Vec<Dispatch>, t: &TrackAt, b: &BatchBuffers) -> TrackTape {
         let gpu = &self.gpu;
         let x = gpu.buffer(b.rows * t.width);
-        let grid = t.grid.map(|span| self.part(span));
-        let table: &dyn Bind = match &grid {
-            Some(part) => part,
-            None => &self.gpu.empty,
-        };
-        let params = [b.rows, t.count, t.width, usize::from(t.grid.is_some())].map(|v| v as u32);
-        plan.push(gpu.prepare(
-            &TRACK_INPUTS,
-            &params,
-            &[&b.features, &t.index, table, &self.resolutions, &x],
-            groups_for(b.rows),
-        ));
+        let (params, rows) = (&self.params, b.rows);
+        plan.push(t.record_inputs(gpu, params, &self.resolutions, [&b.features, &x], rows));
         let transfer = t.transfer.as_ref().map(|m| {
-            let tape = self.tape(m, b.rows);
+            let tape = self.tape(m, rows);
             let first = FirstLayer {
                 own_row: 0,
                 count: t.width,
-                bias: Bias::Column(&self.params, m.layers[0].bias.offset),
+                bias: Bias::Column(params, m.layers[0].bias.offset),
             };
-            self.mlp_forward(plan, m, &x, first, &tape);
+            let to = self.targets(m, &tape);
+            m.record_forward(gpu, plan, params, Held::F32(&x), rows, first, &to);
             tape
         });
         // The light code's share of the first shading layer, once per view.
         let first = &t.shading.layers[0];
-        let (code_row, own_row) = t.code_and_own_rows();
         let group_bias = gpu.buffer(b.views * first.d_out);
-        plan.push(self.gpu.product(
-            [b.views, first.d_out, CODE_SIZE],
-            Operand::plain(&b.codes, 0, CODE_SIZE),
-            Operand::plain(
-                &self.params,
-                first.weight.offset + code_row * first.d_out,
-                first.d_out,
-            ),
-            Bias::Column(&self.params, first.bias.offset),
-            0,
-            Output::to(&group_bias, 0, first.d_out),
-            None,
-        ));
-        let shading = self.tape(&t.shading, b.rows);
+        plan.push(t.record_code_share(gpu, params, &b.codes, b.views, &group_bias));
+        let shading = self.tape(&t.shading, rows);
         let input = transfer
             .as_ref()
             .map_or(&x, |tape| tape.outputs.last().expect("a layer"));
         let first_layer = FirstLayer {
-            own_row,
+            own_row: t.code_and_own_rows().1,
             count: t.own_width(),
             bias: Bias::Group(&group_bias, &b.view),
         };
-        self.mlp_forward(plan, &t.shading, input, first_layer, &shading);
+        let to = self.targets(&t.shading, &shading);
+        let input = Held::F32(input);
+        (t.shading).record_forward(gpu, plan, params, input, rows, first_layer, &to);
         TrackTape {
             dx: t.grid.map(|_| gpu.buffer(b.rows * t.width)),
             x,

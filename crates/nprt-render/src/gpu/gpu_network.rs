@@ -9,27 +9,22 @@ use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::{Arc, Mutex, OnceLock};
 
 use anyhow::Result;
+use nprt_gpu::{groups_for, BufferPool, Dispatch, GpuDevice, KeptLast, KernelTime, PooledBuffer};
 use nprt_net::encoding::hash_grid;
-use nprt_net::network::encoder::CODE_SIZE;
-use nprt_net::network::mlp::Mlp;
-use nprt_net::{MapNorm, NprtNet, TrackKind, FEATURES, TRANSPORT_CODE};
-use nprt_scene::EnvMap;
-
-use nprt_gpu::{groups_for, BufferPool, Dispatch, GpuDevice, KernelTime, PooledBuffer};
-
+use nprt_net::gpu::kernels::{COMBINE, GBUFFER_FEATURES};
 use nprt_net::gpu::{
-    held_halves, Bias, DenseProducts, HalfLayers, Held, Operand, Output, HALF_ROW_BLOCK,
+    held_halves, Bias, FirstLayer, ForwardTargets, HalfLayers, Held, MlpAt, NetworkLayout,
+    ParameterLayout, HALF_ROW_BLOCK,
 };
-
-use nprt_net::gpu::kernels::{COMBINE, GBUFFER_FEATURES, TRACK_INPUTS};
+use nprt_net::network::encoder::CODE_SIZE;
+use nprt_net::{MapNorm, NprtNet, FEATURES};
+use nprt_scene::EnvMap;
+use nprt_trace::gpu::{record_paths, GpuMap, GpuPaths, PathTargets, SameTexels};
 
 use super::frame_background::{record_background, Background, Fill};
 use super::gpu_encoder::GpuEncoder;
-use super::gpu_mlp::{FirstLayer, GpuMlp, Scratch};
 use super::light_code::{GpuLightCode, LIGHT_CODE_VALUES};
 use super::light_input::GpuLightInput;
-use nprt_gpu::KeptLast;
-use nprt_trace::gpu::{record_paths, GpuMap, GpuPaths, PathTargets, SameTexels};
 
 /// Most rows per block of dispatches. Fewer blocks mean fewer dispatches to prepare and record
 /// (at 65,536 rows a 1920 × 1080 D/S frame was 32 blocks of a dozen dispatches each). A
@@ -38,24 +33,14 @@ use nprt_trace::gpu::{record_paths, GpuMap, GpuPaths, PathTargets, SameTexels};
 /// (`gemm`: 4,096 tiles of 128 rows).
 const MAX_CHUNK: usize = 1 << 19;
 
-/// One transport track on the device.
-struct GpuTrack {
-    kind: TrackKind,
-    /// The feature indices the track reads, in its input order.
-    index: wgpu::Buffer,
-    count: usize,
-    /// Inputs per row: `count` plus the hash grid's encoding.
-    width: usize,
-    grid: Option<wgpu::Buffer>,
-    transfer: Option<GpuMlp>,
-    shading: GpuMlp,
-}
-
 /// A model's encoder and transport networks on the GPU, and the last map it was lit by.
 pub struct GpuNetwork {
     gpu: Arc<GpuDevice>,
+    /// The weights, as a training step holds them: one flat buffer, and where each tensor
+    /// lies in it (with the transport layers' f16 copies in half precision).
+    params: wgpu::Buffer,
+    net: NetworkLayout,
     encoder: GpuEncoder,
-    tracks: Vec<GpuTrack>,
     resolutions: wgpu::Buffer,
     /// The last map a frame's background or encoder input came from.
     map: GpuMap,
@@ -86,15 +71,35 @@ pub struct GpuNetwork {
 struct Workspace {
     /// Rows they hold (the largest block).
     rows: usize,
-    /// Ping-pong activations.
-    scratch: Scratch,
+    /// Ping-pong activations: f32 and, where the networks run in half precision, f16 (rows
+    /// padded to a multiple of 256 and columns to 16).
+    f32: [wgpu::Buffer; 2],
+    f16: Option<[wgpu::Buffer; 2]>,
     /// Each track's shading outputs.
     outputs: Vec<wgpu::Buffer>,
 }
 
 impl Workspace {
     fn half(&self) -> bool {
-        self.scratch.f16.is_some()
+        self.f16.is_some()
+    }
+
+    /// Where `m`'s forward pass writes through this workspace: its hidden layers' outputs in
+    /// turn into the ping-pong activations (f16 in half precision, where the input made f16
+    /// takes the first), its last into `out`.
+    fn targets<'a>(&'a self, m: &MlpAt, out: Held<'a>) -> ForwardTargets<'a> {
+        let last = m.layers.len() - 1;
+        ForwardTargets {
+            outputs: (0..=last)
+                .map(|i| match (i == last, &self.f16) {
+                    (true, _) => out,
+                    (false, Some(f16)) => Held::F16(&f16[(i + 1) % 2]),
+                    (false, None) => Held::F32(&self.f32[(i + 1) % 2]),
+                })
+                .collect(),
+            pre: None,
+            input16: self.f16.as_ref().map(|f16| &f16[0]),
+        }
     }
 
     /// `buffer`'s rows as the networks run through this workspace hold them.
@@ -145,37 +150,22 @@ impl GpuNetwork {
     pub fn new(net: &NprtNet, gain: [f32; 3]) -> Result<Self> {
         static NETWORKS: AtomicU64 = AtomicU64::new(0);
         let gpu = GpuDevice::get()?;
-        let storage = |data: &[f32]| gpu.upload(data);
-        let mlp = |s: &Mlp| GpuMlp::upload(&gpu, s);
-        let tracks: Vec<GpuTrack> = net
-            .tracks
-            .iter()
-            .map(|t| {
-                let index: Vec<u32> = t.kind.inputs().iter().map(|&i| i as u32).collect();
-                GpuTrack {
-                    kind: t.kind,
-                    index: gpu.upload(&index),
-                    count: index.len(),
-                    width: index.len() + t.grid.as_ref().map_or(0, |_| hash_grid::OUTPUTS),
-                    grid: t.grid.as_ref().map(|g| storage(&g.table)),
-                    transfer: t.transfer.as_ref().map(mlp),
-                    shading: mlp(&t.shading),
-                }
-            })
-            .collect();
+        let (layout, flat) = ParameterLayout::pack_for(&gpu, net);
+        let params = gpu.upload(&flat);
+        let layout = NetworkLayout::new(&gpu, &layout, net, false);
         let mut light = vec![0.0; LIGHT_CODE_VALUES];
         light.extend(gain);
         Ok(GpuNetwork {
-            light: storage(&light),
-            biases: tracks
-                .iter()
+            light: gpu.upload(&light),
+            biases: (layout.tracks.iter())
                 .map(|t| gpu.buffer(t.shading.layers[0].d_out))
                 .collect(),
             inputs: KeptLast::default(),
             encoding: Mutex::new(()),
             id: NETWORKS.fetch_add(1, Ordering::Relaxed),
-            encoder: GpuEncoder::upload(&gpu, &net.encoder),
-            tracks,
+            encoder: GpuEncoder::default(),
+            params,
+            net: layout,
             resolutions: gpu.upload(&hash_grid::resolutions()),
             map: GpuMap::default(),
             workspace: Mutex::new(None),
@@ -188,28 +178,29 @@ impl GpuNetwork {
     /// tensor cores where the adapter has them) or, `false`, in f32. Pixels made before must be
     /// made again.
     pub fn set_half(&mut self, half: bool) -> Result<()> {
-        if half {
-            self.gpu.check_half()?;
+        if !half {
+            self.net.drop_half();
+            return Ok(());
         }
-        let gpu = &self.gpu;
-        let layers = self.tracks.iter_mut().flat_map(|t| {
-            t.transfer
-                .iter_mut()
-                .flat_map(|m| m.layers.iter_mut())
-                .chain(t.shading.layers.iter_mut())
-        });
-        for layer in layers {
-            layer.half = half.then(|| {
-                let weight = gpu.read(&layer.weight, layer.d_in * layer.d_out);
-                gpu.upload_half_weight(&weight, layer.d_in, layer.d_out)
-            });
+        self.gpu.check_half()?;
+        if !self.half() {
+            let gpu = &*self.gpu;
+            self.net.hold_half(gpu);
+            let mut encoder = gpu.device.create_command_encoder(&Default::default());
+            {
+                let mut pass = encoder.begin_compute_pass(&Default::default());
+                for d in self.net.half_refresh(gpu, &self.params) {
+                    d.record(&mut pass);
+                }
+            }
+            gpu.queue.submit([encoder.finish()]);
         }
         Ok(())
     }
 
     /// Whether the dense layers run in half precision ([`Self::set_half`]).
     pub fn half(&self) -> bool {
-        self.tracks[0].shading.layers[0].half.is_some()
+        !self.net.tracks[0].shading.half.is_empty()
     }
 
     /// Where the dense layers run, for reports: "f32", "f16 on tensor cores" or "f16".
@@ -261,7 +252,7 @@ impl GpuNetwork {
         let _one_at_a_time = self.encoding.lock().unwrap_or_else(|e| e.into_inner());
         let mut encoder = gpu.device.create_command_encoder(&Default::default());
         input.record(gpu, &mut encoder, map, rotation_deg);
-        let code = self.encoder.record_code(&self.gpu, &mut encoder, &input);
+        let code = (self.encoder).record_code(gpu, &self.net, &self.params, &mut encoder, &input);
         gpu.queue.submit([encoder.finish()]);
         code
     }
@@ -271,7 +262,7 @@ impl GpuNetwork {
     pub fn light_code(&self, input: &GpuLightInput) -> GpuLightCode {
         let gpu = &*self.gpu;
         let mut encoder = gpu.device.create_command_encoder(&Default::default());
-        let code = self.encoder.record_code(gpu, &mut encoder, input);
+        let code = (self.encoder).record_code(gpu, &self.net, &self.params, &mut encoder, input);
         gpu.queue.submit([encoder.finish()]);
         code
     }
@@ -324,9 +315,7 @@ impl GpuNetwork {
         mut inputs: impl FnMut(&mut wgpu::ComputePass, usize, usize) -> PooledBuffer,
     ) -> GpuPixels {
         let gpu = &*self.gpu;
-        let widest = self
-            .tracks
-            .iter()
+        let widest = (self.net.tracks.iter())
             .flat_map(|t| {
                 let transfer = t.transfer.iter().flat_map(|m| &m.layers);
                 transfer
@@ -347,33 +336,35 @@ impl GpuNetwork {
                 let n = chunk.min(rows - first);
                 let features = inputs(&mut pass, first, n);
                 let mut list = Vec::new();
-                let kept = self
-                    .tracks
-                    .iter()
+                let (params, resolutions) = (&self.params, &self.resolutions);
+                let kept = (self.net.tracks.iter())
                     .map(|t| {
-                        let width = t.transfer.as_ref().map_or(t.width, |_| TRANSPORT_CODE);
+                        let width = t.own_width();
                         let floats = match half {
                             true => held_halves(n, width).div_ceil(2),
                             false => n * width,
                         };
                         let kept = self.pool.take_pooled(gpu, floats);
-                        let gathered = &work.scratch.f32[0];
+                        let gathered = &work.f32[0];
+                        let x = match (&t.transfer, half) {
+                            (None, false) => &*kept,
+                            _ => gathered,
+                        };
+                        list.push(t.record_inputs(gpu, params, resolutions, [&features, x], n));
                         match (&t.transfer, half) {
-                            (None, false) => self.track_inputs(&mut pass, t, &features, n, &kept),
+                            (None, false) => {}
                             (None, true) => {
-                                self.track_inputs(&mut pass, t, &features, n, gathered);
                                 list.push(gpu.half_rows([n, width, width], gathered, &kept));
                             }
                             (Some(transfer), _) => {
-                                self.track_inputs(&mut pass, t, &features, n, gathered);
                                 let first = FirstLayer {
-                                    x_stride: t.width,
-                                    w_row: 0,
-                                    bias: None,
+                                    own_row: 0,
+                                    count: t.width,
+                                    bias: Bias::Column(params, transfer.layers[0].bias.offset),
                                 };
+                                let to = work.targets(transfer, work.held(&kept));
                                 let x = Held::F32(gathered);
-                                let out = work.held(&kept);
-                                transfer.record(gpu, &mut list, x, n, first, &work.scratch, out);
+                                transfer.record_forward(gpu, &mut list, params, x, n, first, &to);
                             }
                         }
                         for d in list.drain(..) {
@@ -412,13 +403,9 @@ impl GpuNetwork {
         let gpu = &*self.gpu;
         let work = Arc::new(Workspace {
             rows,
-            scratch: Scratch {
-                f32: [0, 1].map(|_| gpu.buffer(rows * widest)),
-                f16: half.then(|| [0, 1].map(|_| gpu.half_buffer(held_halves(rows, widest)))),
-            },
-            outputs: self
-                .tracks
-                .iter()
+            f32: [0, 1].map(|_| gpu.buffer(rows * widest)),
+            f16: half.then(|| [0, 1].map(|_| gpu.half_buffer(held_halves(rows, widest)))),
+            outputs: (self.net.tracks.iter())
                 .map(|t| gpu.buffer(rows * t.shading.layers.last().expect("layers").d_out))
                 .collect(),
         });
@@ -445,54 +432,30 @@ impl GpuNetwork {
     fn prepare_relight(&self, px: &GpuPixels) -> Vec<Dispatch> {
         let gpu = &*self.gpu;
         let mut list = Vec::new();
-        for (t, bias) in self.tracks.iter().zip(&self.biases) {
-            let first = &t.shading.layers[0];
-            let code_row = if t.transfer.is_some() {
-                TRANSPORT_CODE
-            } else {
-                0
-            };
-            // b' = b + ê·W[code rows]: one row through the first layer's code rows.
-            list.push(gpu.product(
-                [1, first.d_out, CODE_SIZE],
-                Operand::plain(&self.light, 0, CODE_SIZE),
-                Operand::plain(&first.weight, code_row * first.d_out, first.d_out),
-                Bias::Column(&first.bias, 0),
-                0,
-                Output::to(bias, 0, first.d_out),
-                None,
-            ));
+        let params = &self.params;
+        // b' = b + ê·W[code rows]: the light slot's code through the first layer's code rows.
+        for (t, bias) in self.net.tracks.iter().zip(&self.biases) {
+            list.push(t.record_code_share(gpu, params, &self.light, 1, bias));
         }
         for chunk in &px.chunks {
-            for ((t, kept), (bias, out)) in self
-                .tracks
-                .iter()
+            for ((t, kept), (bias, out)) in (self.net.tracks.iter())
                 .zip(&chunk.kept)
                 .zip(self.biases.iter().zip(&px.work.outputs))
             {
-                let first = match t.transfer {
-                    // [ŝ, ê]: ŝ's rows come first.
-                    Some(_) => FirstLayer {
-                        x_stride: TRANSPORT_CODE,
-                        w_row: 0,
-                        bias: Some(bias),
-                    },
-                    // The baseline's [ê, inputs]: the inputs' rows follow ê's.
-                    None => FirstLayer {
-                        x_stride: t.width,
-                        w_row: CODE_SIZE,
-                        bias: Some(bias),
-                    },
+                // [ŝ, ê] (ŝ's rows first), or the baseline's [ê, inputs].
+                let first = FirstLayer {
+                    own_row: t.code_and_own_rows().1,
+                    count: t.own_width(),
+                    bias: Bias::Column(bias, 0),
                 };
+                let to = px.work.targets(&t.shading, Held::F32(out));
                 let x = px.work.held(kept);
-                let out = Held::F32(out);
-                t.shading
-                    .record(gpu, &mut list, x, chunk.rows, first, &px.work.scratch, out);
+                (t.shading).record_forward(gpu, &mut list, params, x, chunk.rows, first, &to);
             }
             // The tracks' radiance summed into rgb one track per dispatch (any number of
             // tracks), the last multiplied by the map's divisor and the model's gain.
-            let n = self.tracks.len();
-            for (k, (t, out)) in self.tracks.iter().zip(&px.work.outputs).enumerate() {
+            let n = self.net.tracks.len();
+            for (k, (t, out)) in self.net.tracks.iter().zip(&px.work.outputs).enumerate() {
                 let params = [
                     chunk.rows,
                     t.kind.code() as usize,
@@ -534,25 +497,6 @@ impl GpuNetwork {
     fn use_light(&self, encoder: &mut wgpu::CommandEncoder, code: &GpuLightCode) {
         let bytes = 4 * LIGHT_CODE_VALUES as u64;
         encoder.copy_buffer_to_buffer(&code.buffer, 0, &self.light, 0, bytes);
-    }
-
-    fn track_inputs(
-        &self,
-        pass: &mut wgpu::ComputePass,
-        t: &GpuTrack,
-        features: &wgpu::Buffer,
-        rows: usize,
-        x: &wgpu::Buffer,
-    ) {
-        let table = t.grid.as_ref().unwrap_or(&self.gpu.empty);
-        let params = [rows, t.count, t.width, usize::from(t.grid.is_some())].map(|v| v as u32);
-        self.gpu.dispatch(
-            pass,
-            &TRACK_INPUTS,
-            &params,
-            &[features, &t.index, table, &self.resolutions, x],
-            groups_for(rows),
-        );
     }
 
     /// Radiance (`rows × 3`) of `px` under the light `code`, each channel multiplied by the

@@ -13,7 +13,6 @@
 
 mod frame_background;
 mod gpu_encoder;
-mod gpu_mlp;
 mod gpu_network;
 mod kernels;
 mod light_code;
