@@ -67,9 +67,6 @@ pub fn half_weight_bits(weight: &[f32], d_in: usize, d_out: usize) -> Vec<u16> {
 
 /// The half-precision dense layers on the device: f16 weights and rows, and their products.
 pub trait HalfLayers {
-    /// `weight` (`d_in × d_out`) in the layout [`HalfWeight`] describes.
-    fn upload_half_weight(&self, weight: &[f32], d_in: usize, d_out: usize) -> HalfWeight;
-
     /// A `d_in × d_out` weight in the layout [`HalfWeight`] describes, zero (a mixed-precision
     /// training step copies its weights in on the device).
     fn half_weight(&self, d_in: usize, d_out: usize) -> HalfWeight;
@@ -111,14 +108,6 @@ pub trait HalfLayers {
 }
 
 impl HalfLayers for GpuDevice {
-    fn upload_half_weight(&self, weight: &[f32], d_in: usize, d_out: usize) -> HalfWeight {
-        HalfWeight {
-            buffer: self.upload(&half_weight_bits(weight, d_in, d_out)),
-            d_out,
-            n_pad: pad16(d_out),
-        }
-    }
-
     fn half_weight(&self, d_in: usize, d_out: usize) -> HalfWeight {
         HalfWeight {
             buffer: self.half_buffer(half_weight_halves(d_in, d_out)),

@@ -1,0 +1,115 @@
+//! A dataset folder opened from Python: its manifest as a dict, each view's images (radiance,
+//! its direct part, every G-buffer channel) as numpy arrays and its camera as a 4 × 4 matrix.
+
+use std::path::PathBuf;
+
+use nprt_data::dataset::{load_manifest, read_view, Manifest};
+use pyo3::exceptions::PyIndexError;
+use pyo3::prelude::*;
+use pyo3::types::PyDict;
+
+use crate::arrays::{self, CameraOut};
+use crate::error::OrPy;
+
+/// A dataset `nprt generate` wrote (docs/dataset.md), checked as every command checks it.
+#[pyclass(frozen, module = "nprt")]
+pub struct Dataset {
+    dir: PathBuf,
+    manifest: Manifest,
+}
+
+impl Dataset {
+    fn record(&self, index: usize) -> PyResult<&nprt_data::dataset::ViewRecord> {
+        self.manifest.views.get(index).ok_or_else(|| {
+            PyIndexError::new_err(format!(
+                "view {index} of a dataset of {}",
+                self.manifest.views.len()
+            ))
+        })
+    }
+}
+
+#[pymethods]
+impl Dataset {
+    #[new]
+    fn new(py: Python<'_>, path: PathBuf) -> PyResult<Self> {
+        let manifest = py.detach(|| load_manifest(&path)).or_py()?;
+        Ok(Dataset {
+            dir: path,
+            manifest,
+        })
+    }
+
+    /// Views in all (training views first, then test views).
+    fn __len__(&self) -> usize {
+        self.manifest.views.len()
+    }
+
+    /// The manifest (settings, scene bounds, one record per view) as a dict.
+    #[getter]
+    fn manifest<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        let value = serde_json::to_value(&self.manifest).expect("a manifest serialises");
+        arrays::json(py, &value)
+    }
+
+    /// The indices of the views of `split` ("train" or "test").
+    fn split(&self, split: &str) -> Vec<usize> {
+        (self.manifest.views.iter().enumerate())
+            .filter(|(_, v)| v.split == split)
+            .map(|(i, _)| i)
+            .collect()
+    }
+
+    /// View `index`'s images, each an (H, W, 3) or (H, W) float32 array: `radiance`, `direct`,
+    /// `position`, `normal`, `view`, `kd`, `ks`, `alpha`, `mask`, and for a test view rendered
+    /// in halves `half` (the first half's radiance).
+    fn view<'py>(&self, py: Python<'py>, index: usize) -> PyResult<Bound<'py, PyDict>> {
+        let v = self.record(index)?;
+        let halves = self.manifest.settings.in_halves(v);
+        let path = self.dir.join(&v.file);
+        let image = py.detach(|| read_view(&path, v, halves)).or_py()?;
+        let (w, h) = (v.width as usize, v.height as usize);
+        let (f, g) = (&image.frame, &image.frame.gbuffer);
+        let out = PyDict::new(py);
+        for (name, rgb) in [
+            ("radiance", &f.radiance),
+            ("direct", &f.direct),
+            ("position", &g.position),
+            ("normal", &g.normal),
+            ("view", &g.view),
+            ("kd", &g.kd),
+            ("ks", &g.ks),
+        ] {
+            out.set_item(name, arrays::image(py, rgb, w, h))?;
+        }
+        out.set_item("alpha", arrays::plane(py, &g.alpha, w, h))?;
+        out.set_item("mask", arrays::plane(py, &g.mask, w, h))?;
+        if let Some(half) = &image.half {
+            out.set_item("half", arrays::image(py, half, w, h))?;
+        }
+        Ok(out)
+    }
+
+    /// View `index`'s camera: (4 × 4 camera-to-world matrix, horizontal field of view in
+    /// degrees, (width, height)).
+    fn camera<'py>(&self, py: Python<'py>, index: usize) -> PyResult<CameraOut<'py>> {
+        let v = self.record(index)?;
+        let c = v.camera();
+        Ok((
+            arrays::matrix(py, c.to_world),
+            v.fov_x_deg,
+            (v.width, v.height),
+        ))
+    }
+
+    fn __repr__(&self) -> String {
+        let s = &self.manifest.settings;
+        format!(
+            "nprt.Dataset('{}', {} training and {} test views of '{}')",
+            self.dir.display(),
+            s.train_views,
+            s.test_views,
+            s.scene
+        )
+    }
+}

@@ -1,0 +1,59 @@
+//! `nprt.evaluate`: `nprt eval` from Python, its defaults `EvalOptions::default()`'s.
+
+use std::path::PathBuf;
+
+use nprt_eval::{evaluate as run, write_report, EvalOptions};
+use pyo3::prelude::*;
+
+use crate::choice::engine;
+use crate::error::OrPy;
+
+/// Evaluates `models` (model folders) on the test views of the dataset `data` beside every
+/// baseline, writes the report into `out` (report.md, report.html, results.json, images/) and
+/// returns results.json as a dict. Keywords are `nprt eval`'s flags; `None` takes its default.
+/// The GIL is released while it runs.
+#[pyfunction]
+#[pyo3(signature = (
+    data, models, out, *, deep_shading = None, sh_spp = None, timing_res = None, views = None,
+    shown_views = None, seed = None, direct_spp = None, device = "cpu", progress = true
+))]
+#[allow(clippy::too_many_arguments)]
+pub fn evaluate<'py>(
+    py: Python<'py>,
+    data: PathBuf,
+    models: Vec<PathBuf>,
+    out: PathBuf,
+    deep_shading: Option<PathBuf>,
+    sh_spp: Option<u32>,
+    timing_res: Option<u32>,
+    views: Option<usize>,
+    shown_views: Option<usize>,
+    seed: Option<u64>,
+    direct_spp: Option<u32>,
+    device: &str,
+    progress: bool,
+) -> PyResult<Bound<'py, PyAny>> {
+    let d = EvalOptions::default();
+    let opts = EvalOptions {
+        data,
+        models,
+        deep_shading,
+        sh_spp: sh_spp.unwrap_or(d.sh_spp),
+        timing_res: timing_res.unwrap_or(d.timing_res),
+        max_views: views.or(d.max_views),
+        shown_views: shown_views.unwrap_or(d.shown_views),
+        seed: seed.unwrap_or(d.seed),
+        direct_spp: direct_spp.unwrap_or(d.direct_spp),
+        progress,
+    };
+    let engine = engine(device)?;
+    py.detach(|| {
+        let e = run(&opts, engine)?;
+        write_report(&e, &out)
+    })
+    .or_py()?;
+    let path = out.join("results.json");
+    let text = std::fs::read_to_string(&path)
+        .map_err(|e| crate::error::NprtError::new_err(format!("{}: {e}", path.display())))?;
+    py.import("json")?.call_method1("loads", (text,))
+}

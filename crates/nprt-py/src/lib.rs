@@ -1,0 +1,35 @@
+//! nprt-py: nprt from Python, the compiled part (`nprt._nprt`) of the `nprt` package in
+//! `python/`. It owns the conversions between nprt's types and Python's (numpy arrays in and
+//! out, exceptions carrying the CLI's messages, keyword arguments whose defaults are the
+//! libraries' option types' own) and nothing else: every stage's work is its library's, called
+//! as the command line calls it, with the GIL released while it runs.
+
+mod arrays;
+mod choice;
+mod dataset;
+mod error;
+mod evaluate;
+mod generate;
+mod model;
+mod scene;
+mod train;
+
+use pyo3::prelude::*;
+
+#[pymodule]
+fn _nprt(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add("NprtError", m.py().get_type::<error::NprtError>())?;
+    m.add_class::<scene::Scene>()?;
+    m.add_class::<scene::EnvMap>()?;
+    m.add_class::<dataset::Dataset>()?;
+    m.add_class::<model::Model>()?;
+    m.add_function(wrap_pyfunction!(scene::load_scene, m)?)?;
+    m.add_function(wrap_pyfunction!(scene::open_envmap, m)?)?;
+    m.add_function(wrap_pyfunction!(scene::reference, m)?)?;
+    m.add_function(wrap_pyfunction!(scene::look_at, m)?)?;
+    m.add_function(wrap_pyfunction!(generate::generate, m)?)?;
+    m.add_function(wrap_pyfunction!(train::train, m)?)?;
+    m.add_function(wrap_pyfunction!(evaluate::evaluate, m)?)?;
+    m.add("__version__", env!("CARGO_PKG_VERSION"))?;
+    Ok(())
+}

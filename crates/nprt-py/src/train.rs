@@ -1,0 +1,84 @@
+//! `nprt.train`: `nprt train` from Python, its defaults the library's (`TrainOptions`,
+//! `ModelConfig`).
+
+use std::path::PathBuf;
+
+use nprt_net::training::training_set::TrainingSet;
+use nprt_net::{ModelConfig, RunLength, TrainOptions};
+use pyo3::prelude::*;
+use pyo3::types::PyDict;
+
+use crate::choice::{engine, parse};
+use crate::error::OrPy;
+
+/// Trains `arch` ("baseline", "prt", "albedo" or "dsep") on the dataset `data` into the model
+/// folder `out` (a run already there with the same settings is resumed, and a larger `epochs`
+/// or `minutes` continues a finished one), on `device`, for `minutes` of training time and/or
+/// `epochs` passes (without either: 20 epochs). `None` takes `nprt train`'s default. Returns
+/// the run: `epochs`, `steps`, `samples_per_s`, `train_loss`, `validation_loss`, `seconds`,
+/// `steps_on` and `resumed_from_epoch`; the loss curves are in `out`/loss.csv. The GIL is
+/// released while it trains.
+#[pyfunction]
+#[pyo3(signature = (
+    data, arch, out, *, minutes = None, epochs = None, activation = None, device = "cpu",
+    precision = None, batch_size = None, lr = None, schedule = None, seed = None,
+    progress = true
+))]
+#[allow(clippy::too_many_arguments)]
+pub fn train<'py>(
+    py: Python<'py>,
+    data: PathBuf,
+    arch: &str,
+    out: PathBuf,
+    minutes: Option<f64>,
+    epochs: Option<usize>,
+    activation: Option<&str>,
+    device: &str,
+    precision: Option<&str>,
+    batch_size: Option<usize>,
+    lr: Option<f64>,
+    schedule: Option<&str>,
+    seed: Option<u64>,
+    progress: bool,
+) -> PyResult<Bound<'py, PyDict>> {
+    let design = parse(arch)?;
+    let config = ModelConfig::new(design, activation.map(parse).transpose()?);
+    let d = TrainOptions::default();
+    let run = RunLength {
+        epochs,
+        minutes,
+        lr_schedule: schedule.map(parse).transpose()?,
+    };
+    let opts = TrainOptions {
+        schedule: nprt_net::Schedule {
+            seed: seed.unwrap_or(d.schedule.seed),
+            progress,
+            ..d.schedule
+        },
+        batch_size: batch_size.unwrap_or(d.batch_size),
+        precision: precision.map(parse).transpose()?.unwrap_or(d.precision),
+        ..d
+    }
+    .with_run(design, run, lr);
+    let engine = engine(device)?;
+    let (summary, _) = py
+        .detach(|| {
+            opts.check()?;
+            let set = TrainingSet::load(&data, &config, progress, |why| eprintln!("{why}"))?;
+            nprt_net::train(&set, &config, &opts, &out, engine)
+        })
+        .or_py()?;
+    let s = PyDict::new(py);
+    s.set_item("epochs", summary.epochs)?;
+    s.set_item("steps", summary.steps)?;
+    s.set_item("seconds", summary.seconds)?;
+    s.set_item(
+        "samples_per_s",
+        summary.samples as f64 / summary.seconds.max(1e-9),
+    )?;
+    s.set_item("train_loss", summary.final_train)?;
+    s.set_item("validation_loss", summary.final_val)?;
+    s.set_item("steps_on", summary.steps_on)?;
+    s.set_item("resumed_from_epoch", summary.resumed_from_epoch)?;
+    Ok(s)
+}

@@ -1,0 +1,169 @@
+"""Type stubs of nprt's compiled module (crates/nprt-py)."""
+
+import os
+from typing import Any, Dict, List, Optional, Sequence, Tuple, Union
+
+import numpy as np
+import numpy.typing as npt
+
+PathLike = Union[str, "os.PathLike[str]"]
+Matrix = npt.ArrayLike  # 4 x 4 camera-to-world, rows first
+Image = npt.NDArray[np.float32]  # (H, W, 3) linear radiance
+
+__version__: str
+
+class NprtError(RuntimeError):
+    """Bad input (the file and the reason) or a failed stage, with the command line's message."""
+
+class Scene:
+    """A scene: geometry, materials and, where its file has one, a camera."""
+    @property
+    def spec(self) -> str: ...
+    @property
+    def bounds(self) -> Tuple[Tuple[float, float, float], Tuple[float, float, float]]: ...
+    @property
+    def triangles(self) -> int: ...
+    @property
+    def warnings(self) -> List[str]: ...
+    def camera(self) -> Tuple[npt.NDArray[np.float64], float, Tuple[int, int]]:
+        """The scene's own camera, or one framing its bounds: (4 x 4 camera-to-world, horizontal
+        field of view in degrees, (width, height))."""
+    @property
+    def envmap(self) -> Optional["EnvMap"]:
+        """The environment map the scene's file names, if any."""
+
+class EnvMap:
+    """A lat-long environment map (Mitsuba 3's mapping), 2:1, linear RGB radiance."""
+    def __init__(self, texels: npt.ArrayLike, name: str = "array") -> None:
+        """A map from an (H, 2H, 3) array (negative values are clamped to 0)."""
+    def to_array(self) -> Image: ...
+    def rotated(self, degrees: float) -> "EnvMap":
+        """The same map turned by ``degrees`` about +Y."""
+    @property
+    def name(self) -> str: ...
+    @property
+    def shape(self) -> Tuple[int, int]:
+        """(height, width) in texels."""
+
+class Dataset:
+    """A dataset folder `nprt generate` wrote, its manifest checked."""
+    def __init__(self, path: PathLike) -> None: ...
+    def __len__(self) -> int: ...
+    @property
+    def manifest(self) -> Dict[str, Any]: ...
+    def split(self, split: str) -> List[int]:
+        """The indices of the views of ``split`` ("train" or "test")."""
+    def view(self, index: int) -> Dict[str, npt.NDArray[np.float32]]:
+        """radiance, direct, position, normal, view, kd, ks (H, W, 3); alpha, mask (H, W); and
+        half for a test view rendered in halves."""
+    def camera(self, index: int) -> Tuple[npt.NDArray[np.float64], float, Tuple[int, int]]:
+        """(4 x 4 camera-to-world, horizontal field of view in degrees, (width, height))."""
+
+class Model:
+    """A trained model folder, loaded on ``device`` ("cpu", "gpu", "wgpu" or "auto")."""
+    def __init__(self, path: PathLike, device: str = "cpu") -> None: ...
+    @property
+    def info(self) -> Dict[str, Any]:
+        """Its settings and training record (model.json)."""
+    @property
+    def device(self) -> str: ...
+    def render(
+        self,
+        scene: Scene,
+        envmap: EnvMap,
+        camera: Matrix,
+        width: int,
+        height: int,
+        fov: float = 60.0,
+        rotation: float = 0.0,
+        direct_spp: int = 16,
+        seed: int = 0,
+    ) -> Image:
+        """A relit frame of ``scene`` under ``envmap`` turned by ``rotation`` degrees."""
+
+def load_scene(spec: str) -> Scene:
+    """builtin:room, or a Mitsuba .xml, glTF, .ply or .obj file."""
+
+def open_envmap(spec: str) -> EnvMap:
+    """An .exr/.hdr file, builtin:sky[:ELEV[:AZIM[:TURB]]] or builtin:indoor[:SEED]."""
+
+def look_at(
+    origin: Sequence[float], target: Sequence[float], up: Sequence[float] = (0.0, 1.0, 0.0)
+) -> npt.NDArray[np.float64]:
+    """Mitsuba's lookat as a 4 x 4 camera-to-world matrix."""
+
+def reference(
+    scene: Scene,
+    envmap: EnvMap,
+    camera: Matrix,
+    width: int,
+    height: int,
+    fov: float = 60.0,
+    spp: int = 64,
+    seed: int = 0,
+    max_depth: Optional[int] = None,
+) -> Image:
+    """A path-traced frame, as `nprt reference` renders it."""
+
+def generate(
+    scene: str,
+    envmaps: str,
+    out: PathLike,
+    *,
+    train_views: Optional[int] = None,
+    test_views: Optional[int] = None,
+    train_res: Optional[Tuple[int, int]] = None,
+    test_res: Optional[Tuple[int, int]] = None,
+    spp: Optional[int] = None,
+    test_spp: Optional[int] = None,
+    seed: Optional[int] = None,
+    jitter_exposure: Optional[float] = None,
+    jitter_tint: Optional[float] = None,
+    test_maps: Optional[int] = None,
+    mix_builtin: Optional[float] = None,
+    shard: Optional[Tuple[int, int]] = None,
+    camera_volume: Optional[PathLike] = None,
+    volume_min: Optional[Sequence[float]] = None,
+    volume_max: Optional[Sequence[float]] = None,
+    look: Optional[Sequence[float]] = None,
+    spread: Optional[float] = None,
+    fov: Optional[float] = None,
+    device: str = "cpu",
+    progress: bool = True,
+) -> Dict[str, Any]:
+    """`nprt generate`; None takes its default."""
+
+def train(
+    data: PathLike,
+    arch: str,
+    out: PathLike,
+    *,
+    minutes: Optional[float] = None,
+    epochs: Optional[int] = None,
+    activation: Optional[str] = None,
+    device: str = "cpu",
+    precision: Optional[str] = None,
+    batch_size: Optional[int] = None,
+    lr: Optional[float] = None,
+    schedule: Optional[str] = None,
+    seed: Optional[int] = None,
+    progress: bool = True,
+) -> Dict[str, Any]:
+    """`nprt train`; None takes its default."""
+
+def evaluate(
+    data: PathLike,
+    models: Sequence[PathLike],
+    out: PathLike,
+    *,
+    deep_shading: Optional[PathLike] = None,
+    sh_spp: Optional[int] = None,
+    timing_res: Optional[int] = None,
+    views: Optional[int] = None,
+    shown_views: Optional[int] = None,
+    seed: Optional[int] = None,
+    direct_spp: Optional[int] = None,
+    device: str = "cpu",
+    progress: bool = True,
+) -> Dict[str, Any]:
+    """`nprt eval`; returns results.json."""

@@ -1,0 +1,179 @@
+"""nprt's Python package against the built wheel: every stage from Python on tiny sizes, the
+arrays' shapes and conventions, errors as exceptions with the command line's messages, and
+agreement with Mitsuba 3 in the same interpreter where it is installed."""
+
+import json
+import os
+import pathlib
+
+import numpy as np
+import pytest
+
+import nprt
+
+REPO = pathlib.Path(__file__).resolve().parents[2]
+
+
+@pytest.fixture(scope="module")
+def room():
+    return nprt.load_scene("builtin:room")
+
+
+@pytest.fixture(scope="module")
+def dataset(tmp_path_factory):
+    out = tmp_path_factory.mktemp("data")
+    done = nprt.generate(
+        "builtin:room", "builtin", out, train_views=6, test_views=2, train_res=(24, 24),
+        test_res=(32, 24), spp=4, test_spp=8, seed=3, progress=False,
+    )
+    assert done["rendered"] == 8 and done["skipped"] == 0 and done["msamples_per_s"] > 0
+    return out
+
+
+@pytest.fixture(scope="module")
+def model(dataset, tmp_path_factory):
+    out = tmp_path_factory.mktemp("model")
+    run = nprt.train(dataset, "dsep", out, epochs=2, progress=False)
+    assert run["epochs"] == pytest.approx(2.0) and np.isfinite(run["validation_loss"])
+    return out
+
+
+def test_scene_and_cameras(room):
+    lo, hi = room.bounds
+    assert all(l < h for l, h in zip(lo, hi)) and room.triangles > 0
+    matrix, fov, (w, h) = room.camera()
+    assert matrix.shape == (4, 4) and 0 < fov < 180 and w > 0 and h > 0
+    # Rotation and translation only, as Mitsuba's lookat makes them.
+    r = matrix[:3, :3]
+    np.testing.assert_allclose(r.T @ r, np.eye(3), atol=1e-5)
+    look = nprt.look_at([0, 1, 4], [0, 1, 0])
+    np.testing.assert_allclose(look[:3, 2], [0, 0, -1], atol=1e-6)  # forward
+    np.testing.assert_allclose(look[:3, 3], [0, 1, 4], atol=1e-6)  # origin
+
+
+def test_envmap_round_trip_and_rotation():
+    texels = np.random.default_rng(0).random((8, 16, 3), dtype=np.float32)
+    env = nprt.EnvMap(texels, name="noise")
+    assert env.shape == (8, 16) and env.name == "noise"
+    np.testing.assert_array_equal(env.to_array(), texels)
+    # A turn places the map in the world anew (its texels stay): seen from outside the scene,
+    # a quarter turn shows other texels, a whole turn the same.
+    room = nprt.load_scene("builtin:room")
+    _, hi = room.bounds
+    outside = [v + 10.0 for v in hi]
+    away = nprt.look_at(outside, [outside[0] + 1.0, outside[1], outside[2]])
+    seen = lambda m: nprt.reference(room, m, away, 8, 6, fov=30, spp=1)
+    np.testing.assert_array_equal(env.rotated(90.0).to_array(), texels)
+    assert not np.allclose(seen(env.rotated(90.0)), seen(env))
+    np.testing.assert_allclose(seen(env.rotated(360.0)), seen(env), atol=1e-5)
+    negative = texels.copy()
+    negative[0, 0, 0] = -1.0
+    assert nprt.EnvMap(negative).to_array()[0, 0, 0] == 0.0
+
+
+def test_reference_is_seeded_and_sees_a_constant_sky(room):
+    sky = nprt.EnvMap(np.full((16, 32, 3), 0.5, np.float32))
+    # From outside the scene, looking away from it: every pixel sees the sky alone.
+    _, hi = room.bounds
+    outside = [v + 10.0 for v in hi]
+    away = nprt.look_at(outside, [v + 1.0 for v in outside])
+    frame = nprt.reference(room, sky, away, 8, 6, fov=20, spp=4)
+    assert frame.shape == (6, 8, 3) and frame.dtype == np.float32
+    np.testing.assert_allclose(frame, 0.5, rtol=1e-6)
+    camera, fov, _ = room.camera()
+    a = nprt.reference(room, sky, camera, 16, 12, fov=fov, spp=8, seed=1)
+    b = nprt.reference(room, sky, camera, 16, 12, fov=fov, spp=8, seed=1)
+    c = nprt.reference(room, sky, camera, 16, 12, fov=fov, spp=8, seed=2)
+    np.testing.assert_array_equal(a, b)
+    assert not np.array_equal(a, c) and np.all(np.isfinite(a))
+
+
+def test_dataset_as_numpy(dataset):
+    ds = nprt.Dataset(dataset)
+    assert len(ds) == 8 and ds.split("test") == [6, 7]
+    assert ds.manifest["settings"]["spp"] == 4
+    view = ds.view(6)
+    assert view["radiance"].shape == (24, 32, 3) and view["mask"].shape == (24, 32)
+    assert set(view) >= {"radiance", "direct", "position", "normal", "kd", "ks", "alpha", "half"}
+    matrix, fov, size = ds.camera(6)
+    assert matrix.shape == (4, 4) and size == (32, 24) and fov > 0
+    assert "half" not in ds.view(0)
+    with pytest.raises(IndexError):
+        ds.view(8)
+
+
+def test_train_render_and_evaluate(dataset, model, room, tmp_path):
+    m = nprt.Model(model)
+    assert m.info["design"] == "dsep" and m.device == "CPU engine"
+    matrix, fov, (w, h) = nprt.Dataset(dataset).camera(6)
+    sky = nprt.open_envmap("builtin:sky")
+    frame = m.render(room, sky, matrix, w, h, fov)
+    assert frame.shape == (h, w, 3) and np.all(np.isfinite(frame)) and frame.mean() > 0
+    again = m.render(room, sky, matrix, w, h, fov)
+    np.testing.assert_array_equal(frame, again)
+    curve = nprt.loss_curve(model)
+    assert curve["epoch"][-1] == pytest.approx(2.0)
+    results = nprt.evaluate(dataset, [model], tmp_path / "report", views=1, timing_res=16,
+                            sh_spp=4, progress=False)
+    names = [method["name"] for method in results["methods"]]
+    assert any("dsep" in n for n in names) and "pt-5spp" in names
+    assert (tmp_path / "report" / "report.html").exists()
+
+
+def test_errors_carry_the_cli_messages(tmp_path):
+    with pytest.raises(nprt.NprtError, match="missing.xml"):
+        nprt.load_scene(str(tmp_path / "missing.xml"))
+    with pytest.raises(nprt.NprtError, match="2:1"):
+        nprt.EnvMap(np.zeros((8, 8, 3), np.float32))
+    with pytest.raises(ValueError, match="cpu, gpu, wgpu or auto"):
+        nprt.Model(tmp_path, device="tpu")
+    with pytest.raises(nprt.NprtError):
+        nprt.Model(tmp_path / "no-model")
+    with pytest.raises(ValueError, match="design"):
+        nprt.train(tmp_path, "transformer", tmp_path / "m")
+    room = nprt.load_scene("builtin:room")
+    sky = nprt.open_envmap("builtin:sky")
+    with pytest.raises(nprt.NprtError, match="4 × 4"):
+        nprt.reference(room, sky, np.eye(3), 8, 8)
+    with pytest.raises(nprt.NprtError, match="rotate and translate"):
+        nprt.reference(room, sky, np.eye(4) * 2, 8, 8)
+    with pytest.raises(nprt.NprtError, match="holds a dataset made with"):
+        out = tmp_path / "data"
+        nprt.generate("builtin:room", "builtin", out, train_views=1, test_views=1,
+                      train_res=(8, 8), test_res=(8, 8), spp=1, test_spp=2, progress=False)
+        nprt.generate("builtin:room", "builtin", out, train_views=2, test_views=1,
+                      train_res=(8, 8), test_res=(8, 8), spp=1, test_spp=2, progress=False)
+
+
+try:
+    import mitsuba
+except ImportError:
+    mitsuba = None
+
+
+# scripts/test runs these in the peer environment, which has Mitsuba: there it must run.
+@pytest.mark.skipif(mitsuba is None and not os.environ.get("NPRT_REQUIRE_MITSUBA"),
+                    reason="Mitsuba 3 is not in this interpreter (scripts/test installs it)")
+def test_agrees_with_mitsuba_in_the_same_interpreter(tmp_path):
+    """The scene crates/nprt/tests/mitsuba_agreement.rs holds against Mitsuba 3, rendered
+    through nprt's Python API and through `mitsuba` here: channel means within 1% (diffuse)."""
+    import mitsuba as mi
+
+    mi.set_variant(os.environ.get("NPRT_MITSUBA_VARIANT", "scalar_rgb"))
+    mi.set_log_level(mi.LogLevel.Error)
+    path = REPO / "tests" / "mitsuba" / "diffuse_room.xml"
+    scene = nprt.load_scene(str(path))
+    env = scene.envmap
+    # Both renderers read the map as nprt reads it (negative texels clamped).
+    clean = tmp_path / "map.exr"
+    mi.Bitmap(env.to_array()).write(str(clean))
+    matrix, fov, (w, h) = scene.camera()
+    ours = np.mean([nprt.reference(scene, env, matrix, w, h, fov=fov, spp=64, seed=s)
+                    for s in (1, 2)], axis=0)
+    theirs_scene = mi.load_file(str(path), envmap=str(clean))
+    theirs = np.mean([np.array(mi.render(theirs_scene, spp=64, seed=s)) for s in (0, 1)],
+                     axis=0)[..., :3]
+    assert ours.shape == theirs.shape
+    means = ours.reshape(-1, 3).mean(0), theirs.reshape(-1, 3).mean(0)
+    np.testing.assert_allclose(means[0], means[1], rtol=0.01)
+    print(json.dumps({"nprt": means[0].tolist(), "mitsuba": means[1].tolist()}))
