@@ -1,7 +1,7 @@
 """Type stubs of nprt's compiled module (crates/nprt-py)."""
 
 import os
-from typing import Any, Dict, List, Optional, Sequence, Tuple, Union
+from typing import Any, Callable, Dict, List, Optional, Sequence, Tuple, Union
 
 import numpy as np
 import numpy.typing as npt
@@ -148,8 +148,11 @@ def train(
     schedule: Optional[str] = None,
     seed: Optional[int] = None,
     progress: bool = True,
+    callback: Optional[Callable[[Dict[str, Any]], Optional[bool]]] = None,
 ) -> Dict[str, Any]:
-    """`nprt train`; None takes its default."""
+    """`nprt train`; None takes its default. ``callback`` gets each epoch's row of the loss
+    curves; returning False (or Ctrl-C) ends the run there, saved, and the same call resumes
+    it."""
 
 def evaluate(
     data: PathLike,

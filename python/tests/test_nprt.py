@@ -5,6 +5,7 @@ agreement with Mitsuba 3 in the same interpreter where it is installed."""
 import json
 import os
 import pathlib
+import signal
 
 import numpy as np
 import pytest
@@ -118,6 +119,47 @@ def test_train_render_and_evaluate(dataset, model, room, tmp_path):
     names = [method["name"] for method in results["methods"]]
     assert any("dsep" in n for n in names) and "pt-5spp" in names
     assert (tmp_path / "report" / "report.html").exists()
+
+
+def test_training_reports_each_epoch_stops_when_told_and_resumes(dataset, tmp_path):
+    rows = []
+
+    def watch(row):
+        rows.append(row)
+        return False  # stop after the first epoch
+
+    out = tmp_path / "stopped"
+    first = nprt.train(dataset, "baseline", out, epochs=3, callback=watch, progress=False)
+    assert len(rows) == 1 and rows[0]["epoch"] == pytest.approx(1.0)
+    assert first["epochs"] == pytest.approx(1.0) and np.isfinite(rows[0]["val_loss"])
+    rest = nprt.train(dataset, "baseline", out, epochs=3, callback=rows.append, progress=False)
+    assert rest["resumed_from_epoch"] == pytest.approx(1.0)
+    assert rest["epochs"] == pytest.approx(3.0) and [r["epoch"] for r in rows] == [1, 2, 3]
+
+    def fails(row):
+        raise ZeroDivisionError("the callback's own error")
+
+    with pytest.raises(ZeroDivisionError, match="own error"):
+        nprt.train(dataset, "baseline", tmp_path / "raised", epochs=3, callback=fails,
+                   progress=False)
+    # The run was saved before the error was raised: it resumes after its first epoch.
+    again = nprt.train(dataset, "baseline", tmp_path / "raised", epochs=3, progress=False)
+    assert again["resumed_from_epoch"] == pytest.approx(1.0)
+
+
+def test_ctrl_c_saves_the_run_then_raises(dataset, tmp_path):
+    rows = []
+
+    def interrupt(row):
+        rows.append(row)
+        os.kill(os.getpid(), signal.SIGINT)  # as Ctrl-C in a terminal
+
+    out = tmp_path / "interrupted"
+    with pytest.raises(KeyboardInterrupt):
+        nprt.train(dataset, "baseline", out, epochs=3, callback=interrupt, progress=False)
+    assert len(rows) == 1
+    rest = nprt.train(dataset, "baseline", out, epochs=3, progress=False)
+    assert rest["resumed_from_epoch"] == pytest.approx(1.0)
 
 
 def test_errors_carry_the_cli_messages(tmp_path):

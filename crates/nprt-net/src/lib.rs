@@ -75,5 +75,5 @@ pub use training::nprt_objective::train;
 pub use training::run_length::RunLength;
 pub use training::schedule::Schedule;
 pub use training::train_options::{recipe_rate, Gather, TrainOptions};
-pub use training::training_loop::{Objective, TrainSummary};
+pub use training::training_loop::{Objective, TrainSummary, Watch};
 pub use training::validation::validation_loss;

@@ -3,10 +3,13 @@
 
 use std::path::PathBuf;
 
+use std::sync::Mutex;
+
+use nprt_net::training::loss_curves::LossRow;
 use nprt_net::training::training_set::TrainingSet;
 use nprt_net::{ModelConfig, RunLength, TrainOptions};
 use pyo3::prelude::*;
-use pyo3::types::PyDict;
+use pyo3::types::{PyBool, PyDict};
 
 use crate::choice::{engine, parse};
 use crate::error::OrPy;
@@ -16,13 +19,18 @@ use crate::error::OrPy;
 /// or `minutes` continues a finished one), on `device`, for `minutes` of training time and/or
 /// `epochs` passes (without either: 20 epochs). `None` takes `nprt train`'s default. Returns
 /// the run: `epochs`, `steps`, `samples_per_s`, `train_loss`, `validation_loss`, `seconds`,
-/// `steps_on` and `resumed_from_epoch`; the loss curves are in `out`/loss.csv. The GIL is
+/// `steps_on` and `resumed_from_epoch`; the loss curves are in `out`/loss.csv.
+///
+/// `callback`, where given, is called at each epoch's end with that epoch's row of the loss
+/// curves (`step`, `epoch`, `samples`, `seconds`, `train_loss`, `val_loss`); returning False
+/// ends the run there. Ctrl-C ends it there too, then raises KeyboardInterrupt. Either way the
+/// run is saved as at the end of a time budget, and the same call resumes it. The GIL is
 /// released while it trains.
 #[pyfunction]
 #[pyo3(signature = (
     data, arch, out, *, minutes = None, epochs = None, activation = None, device = "cpu",
     precision = None, batch_size = None, lr = None, schedule = None, seed = None,
-    progress = true
+    progress = true, callback = None
 ))]
 #[allow(clippy::too_many_arguments)]
 pub fn train<'py>(
@@ -40,6 +48,7 @@ pub fn train<'py>(
     schedule: Option<&str>,
     seed: Option<u64>,
     progress: bool,
+    callback: Option<Py<PyAny>>,
 ) -> PyResult<Bound<'py, PyDict>> {
     let design = parse(arch)?;
     let config = ModelConfig::new(design, activation.map(parse).transpose()?);
@@ -61,13 +70,34 @@ pub fn train<'py>(
     }
     .with_run(design, run, lr);
     let engine = engine(device)?;
+    // What ended the run early (Ctrl-C, or the callback's own exception), raised once it is
+    // saved.
+    let stopped: Mutex<Option<PyErr>> = Mutex::new(None);
+    let watch = |row: &LossRow| -> bool {
+        Python::attach(|py| {
+            let go_on = py.check_signals().and_then(|()| match &callback {
+                None => Ok(true),
+                Some(f) => {
+                    let answer = f.call1(py, (row_dict(py, row)?,))?;
+                    Ok(!answer.bind(py).is(&PyBool::new(py, false)))
+                }
+            });
+            go_on.unwrap_or_else(|e| {
+                *stopped.lock().unwrap_or_else(|p| p.into_inner()) = Some(e);
+                false
+            })
+        })
+    };
     let (summary, _) = py
         .detach(|| {
             opts.check()?;
             let set = TrainingSet::load(&data, &config, progress, |why| eprintln!("{why}"))?;
-            nprt_net::train(&set, &config, &opts, &out, engine)
+            nprt_net::train(&set, &config, &opts, &out, engine, &watch)
         })
         .or_py()?;
+    if let Some(e) = stopped.into_inner().unwrap_or_else(|p| p.into_inner()) {
+        return Err(e);
+    }
     let s = PyDict::new(py);
     s.set_item("epochs", summary.epochs)?;
     s.set_item("steps", summary.steps)?;
@@ -81,4 +111,16 @@ pub fn train<'py>(
     s.set_item("steps_on", summary.steps_on)?;
     s.set_item("resumed_from_epoch", summary.resumed_from_epoch)?;
     Ok(s)
+}
+
+/// A row of the loss curves as the callback gets it.
+fn row_dict<'py>(py: Python<'py>, row: &LossRow) -> PyResult<Bound<'py, PyDict>> {
+    let d = PyDict::new(py);
+    d.set_item("step", row.step)?;
+    d.set_item("epoch", row.epoch)?;
+    d.set_item("samples", row.samples)?;
+    d.set_item("seconds", row.seconds)?;
+    d.set_item("train_loss", row.train)?;
+    d.set_item("val_loss", row.val)?;
+    Ok(d)
 }

@@ -170,7 +170,7 @@ pub fn run(job: &TrainJob, engine: Engine) -> Result<()> {
         eprintln!("{why}")
     })?;
     print_dataset(&job.data, &set, t0.elapsed().as_secs_f64());
-    let (s, file) = nprt_net::train(&set, &job.config, &job.opts, &job.out, engine)?;
+    let (s, file) = nprt_net::train(&set, &job.config, &job.opts, &job.out, engine, &|_| true)?;
     if let Some(e) = s.resumed_from_epoch {
         println!("resumed from epoch {e:.2}");
     }

@@ -293,6 +293,6 @@ pub fn train(
         seconds: 0.0,
     };
     let objective = UnetObjective { train, test, file };
-    let summary = training_loop::train(&objective, &opts.schedule, out)?;
+    let summary = training_loop::train(&objective, &opts.schedule, out, &|_| true)?;
     Ok((summary, read_file(out)?))
 }

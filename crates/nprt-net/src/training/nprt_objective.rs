@@ -28,7 +28,7 @@ use crate::training::epoch_plan::{group_batches, EpochPlan};
 use crate::training::host_steps::HostSteps;
 use crate::training::schedule::Schedule;
 use crate::training::train_options::{Gather, TrainOptions};
-use crate::training::training_loop::{self, Objective, Steps, TrainSummary};
+use crate::training::training_loop::{self, Objective, Steps, TrainSummary, Watch};
 use crate::training::training_set::{TrainingSet, ViewSamples};
 use crate::training::validation::validation_loss;
 use crate::Precision;
@@ -220,6 +220,7 @@ pub fn train(
     opts: &TrainOptions,
     out: &Path,
     engine: Engine,
+    watch: Watch,
 ) -> Result<(TrainSummary, ModelFile)> {
     opts.check()?;
     // On the GPU the steps run on our own kernels, with the network's host copy (for saving)
@@ -239,7 +240,7 @@ pub fn train(
         saved: Mutex::new(None),
         kernels,
     };
-    let summary = training_loop::train(&objective, &opts.schedule, out)?;
+    let summary = training_loop::train(&objective, &opts.schedule, out, watch)?;
     // The loop saves the model on every path that returns a summary.
     let file = objective
         .saved

@@ -140,8 +140,20 @@ pub fn epoch_rng(seed: u64, epoch: u64, stream: u64) -> Pcg64Mcg {
     Pcg64Mcg::seed_from_u64(u64::from_le_bytes(first))
 }
 
-/// Trains (or resumes training of) `objective`'s network in the model folder `out`.
-pub fn train<O: Objective>(objective: &O, schedule: &Schedule, out: &Path) -> Result<TrainSummary> {
+/// What a run tells its caller at each epoch's end (the row it adds to its loss curves), and
+/// whether to go on: `false` ends the run there, saved as the end of a time budget saves it,
+/// so that the same call resumes it later. The command line goes on; Python's `nprt.train`
+/// passes its callback's answer and stops on Ctrl-C.
+pub type Watch<'a> = &'a (dyn Fn(&LossRow) -> bool + Sync);
+
+/// Trains (or resumes training of) `objective`'s network in the model folder `out`, telling
+/// `watch` each epoch's end.
+pub fn train<O: Objective>(
+    objective: &O,
+    schedule: &Schedule,
+    out: &Path,
+    watch: Watch,
+) -> Result<TrainSummary> {
     schedule.check()?;
     let mut net = objective.build(&mut Init::new(schedule.seed));
     std::fs::create_dir_all(checkpoint::dir(out))
@@ -153,8 +165,8 @@ pub fn train<O: Objective>(objective: &O, schedule: &Schedule, out: &Path) -> Re
         checkpoint::restore_optimiser(out, &ck, steps.as_mut())?;
     }
     let mut run = Run::new(objective, schedule, out, ck);
-    let mut trained = false;
-    while run.ck.state.epoch < schedule.epochs && !run.out_of_time() {
+    let (mut trained, mut go_on) = (false, true);
+    while go_on && run.ck.state.epoch < schedule.epochs && !run.out_of_time() {
         trained = true;
         let total = run.steps_in(run.ck.state.epoch);
         run.epoch(total, &mut net, steps.as_mut())?;
@@ -168,7 +180,8 @@ pub fn train<O: Objective>(objective: &O, schedule: &Schedule, out: &Path) -> Re
             return Err(run.diverged(&format!("validation loss {val}"), run.ck.state.epoch));
         }
         run.end_epoch(val, total);
-        let finished = run.ck.state.epoch >= schedule.epochs || run.out_of_time();
+        go_on = watch(run.ck.history.last().expect("an epoch's end adds a row"));
+        let finished = !go_on || run.ck.state.epoch >= schedule.epochs || run.out_of_time();
         let since_saved = run.last_checkpoint.elapsed().as_secs_f64();
         if finished {
             if let Err(e) = objective.check_data() {
