@@ -79,7 +79,7 @@ pub fn train<'py>(
                 None => Ok(true),
                 Some(f) => {
                     let answer = f.call1(py, (row_dict(py, row)?,))?;
-                    Ok(!answer.bind(py).is(&PyBool::new(py, false)))
+                    Ok(!answer.bind(py).is(PyBool::new(py, false)))
                 }
             });
             go_on.unwrap_or_else(|e| {
