@@ -24,12 +24,14 @@ from ._nprt import (
     Scene,
     __version__,
     evaluate,
+    export,
     generate,
     load_scene,
     look_at,
     open_envmap,
     reference,
     train,
+    train_deep_shading,
 )
 
 __all__ = [
@@ -40,6 +42,7 @@ __all__ = [
     "Scene",
     "__version__",
     "evaluate",
+    "export",
     "generate",
     "load_scene",
     "look_at",
@@ -47,6 +50,7 @@ __all__ = [
     "open_envmap",
     "reference",
     "train",
+    "train_deep_shading",
 ]
 
 

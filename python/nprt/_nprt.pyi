@@ -58,6 +58,10 @@ class Dataset:
         half for a test view rendered in halves."""
     def camera(self, index: int) -> Tuple[npt.NDArray[np.float64], float, Tuple[int, int]]:
         """(4 x 4 camera-to-world, horizontal field of view in degrees, (width, height))."""
+    def verify(self) -> Dict[str, Any]:
+        """`nprt dataset verify`: views, complete, missing, corrupt, leftovers, packs."""
+    def pack(self, direct: str = "learned", progress: bool = True) -> Dict[str, Any]:
+        """`nprt dataset pack`: path, records, bytes."""
 
 class Model:
     """A trained model folder, loaded on ``device`` ("cpu", "gpu", "wgpu" or "auto")."""
@@ -170,3 +174,27 @@ def evaluate(
     progress: bool = True,
 ) -> Dict[str, Any]:
     """`nprt eval`; returns results.json."""
+
+def train_deep_shading(
+    data: PathLike,
+    out: PathLike,
+    *,
+    minutes: Optional[float] = None,
+    epochs: Optional[int] = None,
+    schedule: Optional[str] = None,
+    lr: Optional[float] = None,
+    seed: Optional[int] = None,
+    batch_views: Optional[int] = None,
+    progress: bool = True,
+    callback: Optional[Callable[[Dict[str, Any]], Optional[bool]]] = None,
+) -> Dict[str, Any]:
+    """`nprt train-deep-shading` (the U-Net baseline, on the CPU engine)."""
+
+def export(
+    model: PathLike,
+    out: PathLike,
+    *,
+    example_res: Optional[Tuple[int, int]] = None,
+    example_map: Optional[str] = None,
+) -> Dict[str, Any]:
+    """`nprt export`: files, weights, no_example."""

@@ -162,6 +162,21 @@ def test_ctrl_c_saves_the_run_then_raises(dataset, tmp_path):
     assert rest["resumed_from_epoch"] == pytest.approx(1.0)
 
 
+def test_verify_pack_export_and_deep_shading(dataset, model, tmp_path):
+    ds = nprt.Dataset(dataset)
+    report = ds.verify()
+    assert report["complete"] == report["views"] == 8 and not report["missing"]
+    packed = ds.pack(progress=False)
+    assert packed["records"] > 0 and packed["bytes"] > 0 and os.path.exists(packed["path"])
+    done = nprt.export(model, tmp_path / "export", example_res=(16, 12))
+    names = {pathlib.Path(f).name for f in done["files"]}
+    assert "weights.bin" in names and "export.json" in names and done["weights"] > 0
+    rows = []
+    run = nprt.train_deep_shading(dataset, tmp_path / "ds", epochs=1, callback=rows.append,
+                                  progress=False)
+    assert run["unet_params"] > 0 and len(rows) == 1 and np.isfinite(run["validation_loss"])
+
+
 def test_errors_carry_the_cli_messages(tmp_path):
     with pytest.raises(nprt.NprtError, match="missing.xml"):
         nprt.load_scene(str(tmp_path / "missing.xml"))

@@ -3,12 +3,13 @@
 
 use std::path::PathBuf;
 
-use nprt_data::dataset::{load_manifest, read_view, Manifest};
+use nprt_data::dataset::{load_manifest, load_manifest_hashed, read_view, Manifest, PackedDataset};
 use pyo3::exceptions::PyIndexError;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
 use crate::arrays::{self, CameraOut};
+use crate::choice::parse;
 use crate::error::OrPy;
 
 /// A dataset `nprt generate` wrote (docs/dataset.md), checked as every command checks it.
@@ -100,6 +101,60 @@ impl Dataset {
             v.fov_x_deg,
             (v.width, v.height),
         ))
+    }
+
+    /// Reads every view back: `views`, `complete`, and the files `missing`, `corrupt` (with the
+    /// bad texel), `leftovers` (temporary files of killed runs) and `packs`, as
+    /// `nprt dataset verify` lists them.
+    fn verify<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        let r = py
+            .detach(|| nprt_data::dataset::verify(&self.dir))
+            .or_py()?;
+        let out = PyDict::new(py);
+        out.set_item("views", r.views)?;
+        out.set_item("complete", r.complete)?;
+        out.set_item("missing", r.missing)?;
+        out.set_item("corrupt", r.corrupt)?;
+        out.set_item("leftovers", r.leftovers)?;
+        out.set_item("packs", r.packs)?;
+        Ok(out)
+    }
+
+    /// Packs the dataset for training (`direct` "learned" or "traced", as `nprt train
+    /// --direct`), or checks the pack already there, as `nprt dataset pack`; returns its path,
+    /// its records and its bytes.
+    #[pyo3(signature = (direct = "learned", progress = true))]
+    fn pack<'py>(
+        &self,
+        py: Python<'py>,
+        direct: &str,
+        progress: bool,
+    ) -> PyResult<Bound<'py, PyDict>> {
+        let direct: nprt_net::DirectLight = parse(direct)?;
+        let target = direct.packed_target();
+        let (path, records, bytes) = py
+            .detach(|| {
+                let (manifest, hash) = load_manifest_hashed(&self.dir)?;
+                let pack = PackedDataset::open_or_pack(
+                    &self.dir,
+                    &manifest,
+                    &hash,
+                    target,
+                    progress,
+                    |why| eprintln!("{why}"),
+                )?;
+                anyhow::Ok((
+                    PackedDataset::path(&self.dir, target),
+                    pack.records().len(),
+                    pack.bytes(),
+                ))
+            })
+            .or_py()?;
+        let out = PyDict::new(py);
+        out.set_item("path", path)?;
+        out.set_item("records", records)?;
+        out.set_item("bytes", bytes)?;
+        Ok(out)
     }
 
     fn __repr__(&self) -> String {

@@ -5,6 +5,7 @@ use std::path::PathBuf;
 
 use std::sync::Mutex;
 
+use nprt_net::deep_shading::{self, DeepShadingOptions};
 use nprt_net::training::loss_curves::LossRow;
 use nprt_net::training::training_set::TrainingSet;
 use nprt_net::{ModelConfig, RunLength, TrainOptions};
@@ -70,34 +71,15 @@ pub fn train<'py>(
     }
     .with_run(design, run, lr);
     let engine = engine(device)?;
-    // What ended the run early (Ctrl-C, or the callback's own exception), raised once it is
-    // saved.
-    let stopped: Mutex<Option<PyErr>> = Mutex::new(None);
-    let watch = |row: &LossRow| -> bool {
-        Python::attach(|py| {
-            let go_on = py.check_signals().and_then(|()| match &callback {
-                None => Ok(true),
-                Some(f) => {
-                    let answer = f.call1(py, (row_dict(py, row)?,))?;
-                    Ok(!answer.bind(py).is(PyBool::new(py, false)))
-                }
-            });
-            go_on.unwrap_or_else(|e| {
-                *stopped.lock().unwrap_or_else(|p| p.into_inner()) = Some(e);
-                false
-            })
-        })
-    };
+    let watch = EpochWatch::new(callback);
     let (summary, _) = py
         .detach(|| {
             opts.check()?;
             let set = TrainingSet::load(&data, &config, progress, |why| eprintln!("{why}"))?;
-            nprt_net::train(&set, &config, &opts, &out, engine, &watch)
+            nprt_net::train(&set, &config, &opts, &out, engine, &|r| watch.hear(r))
         })
         .or_py()?;
-    if let Some(e) = stopped.into_inner().unwrap_or_else(|p| p.into_inner()) {
-        return Err(e);
-    }
+    watch.finish()?;
     let s = PyDict::new(py);
     s.set_item("epochs", summary.epochs)?;
     s.set_item("steps", summary.steps)?;
@@ -111,6 +93,102 @@ pub fn train<'py>(
     s.set_item("steps_on", summary.steps_on)?;
     s.set_item("resumed_from_epoch", summary.resumed_from_epoch)?;
     Ok(s)
+}
+
+/// Trains the Deep Shading baseline (Nalbach et al. 2017, a U-Net on G-buffer images) on
+/// `data` into `out`, on the CPU engine, as `nprt train-deep-shading`; `minutes`, `epochs`,
+/// `schedule` and `callback` as for [`train`]. Returns `epochs`, `seconds`, `train_loss`,
+/// `validation_loss`, `unet_params`, `encoder_params` and `resumed_from_epoch`.
+#[pyfunction]
+#[pyo3(signature = (
+    data, out, *, minutes = None, epochs = None, schedule = None, lr = None, seed = None,
+    batch_views = None, progress = true, callback = None
+))]
+#[allow(clippy::too_many_arguments)]
+pub fn train_deep_shading<'py>(
+    py: Python<'py>,
+    data: PathBuf,
+    out: PathBuf,
+    minutes: Option<f64>,
+    epochs: Option<usize>,
+    schedule: Option<&str>,
+    lr: Option<f64>,
+    seed: Option<u64>,
+    batch_views: Option<usize>,
+    progress: bool,
+    callback: Option<Py<PyAny>>,
+) -> PyResult<Bound<'py, PyDict>> {
+    let d = DeepShadingOptions::default();
+    let run = RunLength {
+        epochs,
+        minutes,
+        lr_schedule: schedule.map(parse).transpose()?,
+    };
+    let opts = DeepShadingOptions {
+        schedule: run.apply(nprt_net::Schedule {
+            learning_rate: lr.unwrap_or(d.schedule.learning_rate),
+            seed: seed.unwrap_or(d.schedule.seed),
+            progress,
+            ..d.schedule
+        }),
+        batch_views: batch_views.unwrap_or(d.batch_views),
+        ..d
+    };
+    let watch = EpochWatch::new(callback);
+    let (summary, file) = py
+        .detach(|| deep_shading::train(&data, &opts, &out, &|r| watch.hear(r)))
+        .or_py()?;
+    watch.finish()?;
+    let s = PyDict::new(py);
+    s.set_item("epochs", summary.epochs)?;
+    s.set_item("seconds", summary.seconds)?;
+    s.set_item("train_loss", summary.final_train)?;
+    s.set_item("validation_loss", summary.final_val)?;
+    s.set_item("unet_params", file.unet_params)?;
+    s.set_item("encoder_params", file.encoder_params)?;
+    s.set_item("resumed_from_epoch", summary.resumed_from_epoch)?;
+    Ok(s)
+}
+
+/// A run's epoch ends heard for Python: the callback's answer (False stops the run), Ctrl-C
+/// (stops it), and what stopped it, raised once the run is saved.
+struct EpochWatch {
+    callback: Option<Py<PyAny>>,
+    stopped: Mutex<Option<PyErr>>,
+}
+
+impl EpochWatch {
+    fn new(callback: Option<Py<PyAny>>) -> Self {
+        EpochWatch {
+            callback,
+            stopped: Mutex::new(None),
+        }
+    }
+
+    /// Whether the run goes on after the epoch that `row` ends.
+    fn hear(&self, row: &LossRow) -> bool {
+        Python::attach(|py| {
+            let go_on = py.check_signals().and_then(|()| match &self.callback {
+                None => Ok(true),
+                Some(f) => {
+                    let answer = f.call1(py, (row_dict(py, row)?,))?;
+                    Ok(!answer.bind(py).is(PyBool::new(py, false)))
+                }
+            });
+            go_on.unwrap_or_else(|e| {
+                *self.stopped.lock().unwrap_or_else(|p| p.into_inner()) = Some(e);
+                false
+            })
+        })
+    }
+
+    /// The exception that stopped the run, if one did.
+    fn finish(self) -> PyResult<()> {
+        match self.stopped.into_inner().unwrap_or_else(|p| p.into_inner()) {
+            Some(e) => Err(e),
+            None => Ok(()),
+        }
+    }
 }
 
 /// A row of the loss curves as the callback gets it.

@@ -24,6 +24,7 @@
 //! ```
 
 mod animation;
+mod example_view;
 mod frame_bench;
 mod frame_timings;
 #[cfg(feature = "wgpu")]
@@ -38,6 +39,7 @@ mod sequence;
 pub mod view;
 
 pub use animation::{write_animation, Animation};
+pub use example_view::ExampleView;
 pub use frame_bench::{bench_frame, FrameBenchOptions, FrameBenchRow};
 pub use frame_timings::FrameTimings;
 pub use nprt_net::Precision;

@@ -5,7 +5,14 @@ use std::path::PathBuf;
 
 use anyhow::Result;
 
+use nprt_render::ExampleView;
+
 use crate::flags::Resolution;
+
+/// The worked example's defaults, from the one place that states them.
+fn example() -> ExampleView {
+    ExampleView::default()
+}
 
 #[derive(clap::Args)]
 pub struct ExportArgs {
@@ -18,17 +25,17 @@ pub struct ExportArgs {
     out: PathBuf,
     /// Size of the worked example's G-buffer (example/: a WebGPU page relighting a view of the
     /// model's scene, from the start of `nprt render`'s default camera path), N or WxH.
-    #[arg(long, default_value = "160x120")]
+    #[arg(long, default_value_t = Resolution([example().width, example().height]))]
     example_res: Resolution,
     /// The worked example's lighting: an .exr/.hdr map or a built-in spec.
-    #[arg(long, default_value = "builtin:sky:30:250:3")]
+    #[arg(long, default_value_t = example().map)]
     example_map: String,
 }
 
 #[cfg(feature = "gpu")]
 pub fn run(a: ExportArgs) -> Result<()> {
     let [width, height] = a.example_res.0;
-    let view = nprt_render::gpu::ExampleView {
+    let view = ExampleView {
         width,
         height,
         map: a.example_map,

@@ -81,7 +81,7 @@ pub fn command(a: DeepShadingArgs) -> Result<()> {
 
 /// Trains and prints what the run did.
 pub fn run(job: &DeepShadingJob) -> Result<()> {
-    let (s, f) = deep_shading::train(&job.data, &job.opts, &job.out)?;
+    let (s, f) = deep_shading::train(&job.data, &job.opts, &job.out, &|_| true)?;
     if let Some(e) = s.resumed_from_epoch {
         println!("resumed from epoch {e:.2}");
     }

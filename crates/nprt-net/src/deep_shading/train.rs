@@ -24,7 +24,7 @@ use crate::optimiser::EngineSteps;
 use crate::training::checkpoint::{self, RunState};
 use crate::training::host_steps::HostSteps;
 use crate::training::schedule::Schedule;
-use crate::training::training_loop::{self, epoch_rng, Objective, Steps, TrainSummary};
+use crate::training::training_loop::{self, epoch_rng, Objective, Steps, TrainSummary, Watch};
 use crate::training::training_set::{log_mean_level, open_recorded_maps};
 
 /// What training needs of each view, padded to multiples of 8.
@@ -242,12 +242,13 @@ impl Objective for UnetObjective {
 
 /// Trains (or resumes exactly, Adam's moments included) a Deep Shading network on the dataset
 /// in `data`, with the validation loss on its test views after every epoch. Returns the run's
-/// summary and the model's config as saved. The U-Net trains on the CPU engine whatever the
+/// summary and the model's config as saved; `watch` hears each epoch's end. The U-Net trains on the CPU engine whatever the
 /// device: the GPU kernels do not have its up-sampling and skip connections yet.
 pub fn train(
     data: &Path,
     opts: &DeepShadingOptions,
     out: &Path,
+    watch: Watch,
 ) -> Result<(TrainSummary, DeepShadingFile)> {
     opts.schedule.check()?;
     check_input_width(opts.encoder_width)?;
@@ -293,6 +294,6 @@ pub fn train(
         seconds: 0.0,
     };
     let objective = UnetObjective { train, test, file };
-    let summary = training_loop::train(&objective, &opts.schedule, out, &|_| true)?;
+    let summary = training_loop::train(&objective, &opts.schedule, out, watch)?;
     Ok((summary, read_file(out)?))
 }

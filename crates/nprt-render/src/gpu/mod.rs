@@ -23,4 +23,4 @@ pub use frame_background::{Background, Fill};
 pub use gpu_network::{GpuNetwork, GpuPixels};
 pub use light_code::GpuLightCode;
 pub use light_input::GpuLightInput;
-pub use shader_export::{export_model, ExampleView, ExportSummary};
+pub use shader_export::{export_model, ExportSummary};

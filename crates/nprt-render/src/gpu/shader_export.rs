@@ -23,18 +23,10 @@ use nprt_gpu::KernelSource;
 use nprt_net::gpu::{half_weight_bits, pad16};
 
 use super::kernels::{sources, HALF_SOURCES};
-use crate::{CameraPath, Relighter};
+use crate::{CameraPath, ExampleView, Relighter};
 
 /// Version of the export's layout, bumped whenever a reader would read it differently.
 pub const EXPORT_VERSION: u32 = 6;
-
-/// The worked example's view: the model's scene from the start of `nprt render`'s default
-/// camera path, at this size, under this lighting.
-pub struct ExampleView {
-    pub width: u32,
-    pub height: u32,
-    pub map: String,
-}
 
 /// What an export wrote.
 pub struct ExportSummary {
