@@ -30,6 +30,7 @@ from ._nprt import (
     look_at,
     open_envmap,
     reference,
+    render,
     train,
     train_deep_shading,
 )
@@ -49,6 +50,7 @@ __all__ = [
     "loss_curve",
     "open_envmap",
     "reference",
+    "render",
     "train",
     "train_deep_shading",
 ]

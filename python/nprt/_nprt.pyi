@@ -198,3 +198,24 @@ def export(
     example_map: Optional[str] = None,
 ) -> Dict[str, Any]:
     """`nprt export`: files, weights, no_example."""
+
+def render(
+    model: PathLike,
+    out: PathLike,
+    *,
+    scene: Optional[str] = None,
+    camera_path: Optional[PathLike] = None,
+    camera_volume: Optional[PathLike] = None,
+    lighting: Optional[str] = None,
+    spin: Optional[float] = None,
+    frames: Optional[int] = None,
+    res: Optional[Tuple[int, int]] = None,
+    fps: Optional[int] = None,
+    exposure: Optional[float] = None,
+    exr: bool = False,
+    direct_spp: Optional[int] = None,
+    denoise_direct: bool = False,
+    precision: Optional[str] = None,
+    device: str = "cpu",
+) -> Dict[str, Any]:
+    """`nprt render`: a camera path relit into frames and an animation."""

@@ -162,7 +162,7 @@ def test_ctrl_c_saves_the_run_then_raises(dataset, tmp_path):
     assert rest["resumed_from_epoch"] == pytest.approx(1.0)
 
 
-def test_verify_pack_export_and_deep_shading(dataset, model, tmp_path):
+def test_verify_pack_export_render_and_deep_shading(dataset, model, tmp_path):
     ds = nprt.Dataset(dataset)
     report = ds.verify()
     assert report["complete"] == report["views"] == 8 and not report["missing"]
@@ -171,6 +171,9 @@ def test_verify_pack_export_and_deep_shading(dataset, model, tmp_path):
     done = nprt.export(model, tmp_path / "export", example_res=(16, 12))
     names = {pathlib.Path(f).name for f in done["files"]}
     assert "weights.bin" in names and "export.json" in names and done["weights"] > 0
+    film = nprt.render(model, tmp_path / "film", frames=3, res=(16, 12))
+    pngs = sorted(pathlib.Path(film["frames_dir"]).glob("*.png"))
+    assert len(pngs) == 3 and os.path.exists(film["animation"]) and film["total_ms"] > 0
     rows = []
     run = nprt.train_deep_shading(dataset, tmp_path / "ds", epochs=1, callback=rows.append,
                                   progress=False)
