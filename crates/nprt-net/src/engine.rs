@@ -6,6 +6,7 @@
 //! whichever trained it.
 
 use anyhow::{bail, Result};
+use nprt_trace::TraceDevice;
 
 use crate::choice::named_choice;
 
@@ -95,9 +96,27 @@ fn any_adapter() -> Result<Engine> {
 const WITHOUT_KERNELS: &str = "this nprt was built without its GPU kernels; rebuild it with \
     `cargo build --release --features gpu` (docs/building.md), or use --device cpu";
 
+impl From<TraceDevice> for Engine {
+    /// The engine on the device `tracer` runs on.
+    fn from(tracer: TraceDevice) -> Self {
+        match tracer {
+            TraceDevice::Cpu => Engine::Cpu,
+            TraceDevice::Gpu => Engine::Gpu,
+        }
+    }
+}
+
 impl Engine {
     pub fn is_gpu(self) -> bool {
         self == Engine::Gpu
+    }
+
+    /// The path tracer on this engine's device (`nprt generate --device`).
+    pub fn tracer(self) -> TraceDevice {
+        match self {
+            Engine::Cpu => TraceDevice::Cpu,
+            Engine::Gpu => TraceDevice::Gpu,
+        }
     }
 
     /// A short name for progress lines and reports: "cpu", or "gpu: " and the adapter's name

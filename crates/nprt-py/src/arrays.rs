@@ -99,3 +99,11 @@ pub fn json<'py>(py: Python<'py>, value: &serde_json::Value) -> PyResult<Bound<'
     let text = serde_json::to_string(value).expect("JSON values serialise");
     py.import("json")?.call_method1("loads", (text,))
 }
+
+/// The JSON file `path` (a model's model.json, a report's results.json) as a Python object;
+/// an NprtError naming the file where it cannot be read.
+pub fn json_file<'py>(py: Python<'py>, path: &std::path::Path) -> PyResult<Bound<'py, PyAny>> {
+    let text = std::fs::read_to_string(path)
+        .map_err(|e| crate::error::NprtError::new_err(format!("{}: {e}", path.display())))?;
+    py.import("json")?.call_method1("loads", (text,))
+}

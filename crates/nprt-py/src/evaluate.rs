@@ -5,6 +5,7 @@ use std::path::PathBuf;
 use nprt_eval::{evaluate as run, write_report, EvalOptions};
 use pyo3::prelude::*;
 
+use crate::arrays;
 use crate::choice::engine;
 use crate::error::OrPy;
 
@@ -52,8 +53,5 @@ pub fn evaluate<'py>(
         write_report(&e, &out)
     })
     .or_py()?;
-    let path = out.join("results.json");
-    let text = std::fs::read_to_string(&path)
-        .map_err(|e| crate::error::NprtError::new_err(format!("{}: {e}", path.display())))?;
-    py.import("json")?.call_method1("loads", (text,))
+    arrays::json_file(py, &out.join("results.json"))
 }

@@ -5,8 +5,6 @@ use std::path::PathBuf;
 
 use nprt_data::dataset::Jitter;
 use nprt_data::{CameraChoice, GenerateOptions};
-use nprt_net::Engine;
-use nprt_trace::TraceDevice;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
@@ -80,10 +78,7 @@ pub fn generate<'py>(
             fov_deg: fov,
         },
         shard: shard.unwrap_or(d.shard),
-        device: match choice::engine(device)? {
-            Engine::Cpu => TraceDevice::Cpu,
-            Engine::Gpu => TraceDevice::Gpu,
-        },
+        device: choice::engine(device)?.tracer(),
         progress,
     };
     let mut warnings = Vec::new();

@@ -36,10 +36,7 @@ impl Model {
     /// The model's settings and training record (its model.json) as a dict.
     #[getter]
     fn info<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
-        let path = self.dir.join("model.json");
-        let text = std::fs::read_to_string(&path)
-            .map_err(|e| crate::error::NprtError::new_err(format!("{}: {e}", path.display())))?;
-        py.import("json")?.call_method1("loads", (text,))
+        arrays::json_file(py, &self.dir.join("model.json"))
     }
 
     /// Where the networks run: "cpu", or the GPU adapter.

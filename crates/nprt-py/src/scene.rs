@@ -100,13 +100,8 @@ impl EnvMap {
                 "{name}: an environment map is an (H, 2H, 3) array, got shape ({h}, {w}, {c})"
             )));
         }
-        let texels = (a.outer_iter())
-            .flat_map(|row| {
-                row.outer_iter()
-                    .map(|t| glam::Vec3::new(t[0], t[1], t[2]))
-                    .collect::<Vec<_>>()
-            })
-            .collect();
+        let texels = a.iter().copied().collect::<Vec<f32>>();
+        let texels = texels.chunks_exact(3).map(glam::Vec3::from_slice).collect();
         let map = nprt_scene::EnvMap::from_texels(name, w, h, texels).or_py()?;
         Ok(EnvMap { map })
     }

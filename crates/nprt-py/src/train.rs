@@ -8,7 +8,7 @@ use std::sync::Mutex;
 use nprt_net::deep_shading::{self, DeepShadingOptions};
 use nprt_net::training::loss_curves::LossRow;
 use nprt_net::training::training_set::TrainingSet;
-use nprt_net::{ModelConfig, RunLength, TrainOptions};
+use nprt_net::{ModelConfig, RunLength, TrainOptions, TrainSummary};
 use pyo3::prelude::*;
 use pyo3::types::{PyBool, PyDict};
 
@@ -80,25 +80,14 @@ pub fn train<'py>(
         })
         .or_py()?;
     watch.finish()?;
-    let s = PyDict::new(py);
-    s.set_item("epochs", summary.epochs)?;
-    s.set_item("steps", summary.steps)?;
-    s.set_item("seconds", summary.seconds)?;
-    s.set_item(
-        "samples_per_s",
-        summary.samples as f64 / summary.seconds.max(1e-9),
-    )?;
-    s.set_item("train_loss", summary.final_train)?;
-    s.set_item("validation_loss", summary.final_val)?;
-    s.set_item("steps_on", summary.steps_on)?;
-    s.set_item("resumed_from_epoch", summary.resumed_from_epoch)?;
+    let s = summary_dict(py, &summary)?;
     Ok(s)
 }
 
 /// Trains the Deep Shading baseline (Nalbach et al. 2017, a U-Net on G-buffer images) on
 /// `data` into `out`, on the CPU engine, as `nprt train-deep-shading`; `minutes`, `epochs`,
-/// `schedule` and `callback` as for [`train`]. Returns `epochs`, `seconds`, `train_loss`,
-/// `validation_loss`, `unet_params`, `encoder_params` and `resumed_from_epoch`.
+/// `schedule` and `callback` as for [`train`]. Returns what [`train`] returns, and
+/// `unet_params` and `encoder_params`.
 #[pyfunction]
 #[pyo3(signature = (
     data, out, *, minutes = None, epochs = None, schedule = None, lr = None, seed = None,
@@ -139,14 +128,9 @@ pub fn train_deep_shading<'py>(
         .detach(|| deep_shading::train(&data, &opts, &out, &|r| watch.hear(r)))
         .or_py()?;
     watch.finish()?;
-    let s = PyDict::new(py);
-    s.set_item("epochs", summary.epochs)?;
-    s.set_item("seconds", summary.seconds)?;
-    s.set_item("train_loss", summary.final_train)?;
-    s.set_item("validation_loss", summary.final_val)?;
+    let s = summary_dict(py, &summary)?;
     s.set_item("unet_params", file.unet_params)?;
     s.set_item("encoder_params", file.encoder_params)?;
-    s.set_item("resumed_from_epoch", summary.resumed_from_epoch)?;
     Ok(s)
 }
 
@@ -189,6 +173,23 @@ impl EpochWatch {
             None => Ok(()),
         }
     }
+}
+
+/// A run's summary as both trainings return it.
+fn summary_dict<'py>(py: Python<'py>, summary: &TrainSummary) -> PyResult<Bound<'py, PyDict>> {
+    let s = PyDict::new(py);
+    s.set_item("epochs", summary.epochs)?;
+    s.set_item("steps", summary.steps)?;
+    s.set_item("seconds", summary.seconds)?;
+    s.set_item(
+        "samples_per_s",
+        summary.samples as f64 / summary.seconds.max(1e-9),
+    )?;
+    s.set_item("train_loss", summary.final_train)?;
+    s.set_item("validation_loss", summary.final_val)?;
+    s.set_item("steps_on", summary.steps_on.as_str())?;
+    s.set_item("resumed_from_epoch", summary.resumed_from_epoch)?;
+    Ok(s)
 }
 
 /// A row of the loss curves as the callback gets it.

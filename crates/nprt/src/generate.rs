@@ -6,7 +6,6 @@ use anyhow::Result;
 use nprt_data::dataset::Jitter;
 use nprt_data::{generate, CameraChoice, GenerateOptions};
 use nprt_net::{Compute, Engine};
-use nprt_trace::TraceDevice;
 
 use crate::flags::{parse_shard, parse_vec3, print_warnings, Resolution};
 
@@ -141,20 +140,9 @@ impl TryFrom<GenerateArgs> for GenerateOptions {
                 fov_deg: a.fov,
             },
             shard,
-            device: match a.device.engine()? {
-                Engine::Cpu => TraceDevice::Cpu,
-                Engine::Gpu => TraceDevice::Gpu,
-            },
+            device: a.device.engine()?.tracer(),
             progress: true,
         })
-    }
-}
-
-/// The tracer's name for the plan line: "cpu", or "gpu" and the adapter.
-fn tracer_name(device: TraceDevice) -> String {
-    match device {
-        TraceDevice::Cpu => Engine::Cpu.name(),
-        TraceDevice::Gpu => Engine::Gpu.name(),
     }
 }
 
@@ -167,7 +155,7 @@ pub fn run(opts: &GenerateOptions) -> Result<()> {
             "dataset {}: {} train views ({}×{}, {} spp) under {} maps, {} test views ({}×{}, {} spp) under {} held-out maps; shard {}/{}; traced on the {}",
             opts.out.display(), s.train_views, s.train_resolution[0], s.train_resolution[1], s.spp, s.train_maps.len(),
             s.test_views, s.test_resolution[0], s.test_resolution[1], opts.test_spp, s.test_maps.len(), opts.shard.0, opts.shard.1,
-            tracer_name(opts.device)
+            Engine::from(opts.device).name()
         );
     })?;
     for r in &summary.redone {
