@@ -185,10 +185,11 @@ def train_deep_shading(
     lr: Optional[float] = None,
     seed: Optional[int] = None,
     batch_views: Optional[int] = None,
+    device: str = "cpu",
     progress: bool = True,
     callback: Optional[Callable[[Dict[str, Any]], Optional[bool]]] = None,
 ) -> Dict[str, Any]:
-    """`nprt train-deep-shading` (the U-Net baseline, on the CPU engine)."""
+    """`nprt train-deep-shading` (the U-Net baseline) on `device` ("cpu", "gpu", "wgpu", "auto")."""
 
 def export(
     model: PathLike,

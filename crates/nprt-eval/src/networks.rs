@@ -148,7 +148,7 @@ pub fn load_networks(
         nets.push(Net::Nprt(Box::new(r), dir.clone()));
     }
     if let Some(dir) = &o.deep_shading {
-        let d = DeepShadingModel::load(dir)?;
+        let d = DeepShadingModel::load(dir, engine)?;
         check_model(
             dir,
             dataset_hash,

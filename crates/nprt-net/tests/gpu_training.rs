@@ -190,7 +190,7 @@ fn a_profiled_step_is_a_step_with_its_kernels_timed() {
         second(&mut timed),
         "losses after the profiled step differ"
     );
-    for kernel in ["gemm", "encoder_weight_backward", "adam", "radiance_loss"] {
+    for kernel in ["gemm", "conv_weight_backward", "adam", "radiance_loss"] {
         assert!(
             times.iter().any(|k| k.kernel == kernel),
             "{kernel} untimed: {times:?}"

@@ -1,6 +1,7 @@
 //! Networks: parameter counts, the CPU engine's gradients against finite differences of an f64
 //! reference, its inference against the reference, weight round-trips.
 
+#[allow(dead_code)] // the helpers other test binaries use
 mod common;
 
 use common::reference::Reference;

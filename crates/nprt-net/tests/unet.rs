@@ -6,37 +6,16 @@
 //! far below the change they make, so the check is at a percent, not at rounding. It catches
 //! a gradient sent to the wrong layer, skip or level, or scaled wrongly.
 
-use nprt_net::cpu::UnetBatch;
-use nprt_net::deep_shading::DeepShading;
-use nprt_net::{Init, Loss, Parameters, FEATURES};
-use rand::{RngExt, SeedableRng};
-use rand_pcg::Pcg64Mcg;
+#[allow(dead_code)] // the helpers other test binaries use
+mod common;
 
-fn batch(views: usize, (h, w): (usize, usize)) -> UnetBatch {
-    let mut rng = Pcg64Mcg::seed_from_u64(3);
-    let mut r = |n: usize, lo: f32, hi: f32| -> Vec<f32> {
-        (0..n)
-            .map(|_| lo + (hi - lo) * rng.random::<f32>())
-            .collect()
-    };
-    let mask: Vec<f32> = (0..views * h * w)
-        .map(|i| (i % 7 != 0) as u8 as f32)
-        .collect();
-    UnetBatch {
-        features: r(views * FEATURES * h * w, 0.0, 1.0),
-        radiance: r(views * 3 * h * w, 0.0, 2.0),
-        mask,
-        lights: r(views * 3 * 64 * 32, 0.0, 2.0),
-        light_width: 64,
-        scale: r(views * 3, 0.5, 1.5),
-        height: h,
-        width: w,
-    }
-}
+use common::unet_batch;
+use nprt_net::deep_shading::DeepShading;
+use nprt_net::{Init, Loss, Parameters};
 
 #[test]
 fn unet_gradients_match_finite_differences() {
-    let b = batch(2, (8, 16));
+    let b = unet_batch(2, (8, 16), 3);
     let net = DeepShading::new(&mut Init::new(2), 64);
     let (loss, grads) = net.loss_and_gradients(&b, Loss::LogL1, true);
     let grads = grads.unwrap();

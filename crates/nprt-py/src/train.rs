@@ -85,13 +85,13 @@ pub fn train<'py>(
 }
 
 /// Trains the Deep Shading baseline (Nalbach et al. 2017, a U-Net on G-buffer images) on
-/// `data` into `out`, on the CPU engine, as `nprt train-deep-shading`; `minutes`, `epochs`,
+/// `data` into `out`, on `device` as for [`train`], as `nprt train-deep-shading`; `minutes`, `epochs`,
 /// `schedule` and `callback` as for [`train`]. Returns what [`train`] returns, and
 /// `unet_params` and `encoder_params`.
 #[pyfunction]
 #[pyo3(signature = (
     data, out, *, minutes = None, epochs = None, schedule = None, lr = None, seed = None,
-    batch_views = None, progress = true, callback = None
+    batch_views = None, device = "cpu", progress = true, callback = None
 ))]
 #[allow(clippy::too_many_arguments)]
 pub fn train_deep_shading<'py>(
@@ -104,9 +104,11 @@ pub fn train_deep_shading<'py>(
     lr: Option<f64>,
     seed: Option<u64>,
     batch_views: Option<usize>,
+    device: &str,
     progress: bool,
     callback: Option<Py<PyAny>>,
 ) -> PyResult<Bound<'py, PyDict>> {
+    let engine = engine(device)?;
     let d = DeepShadingOptions::default();
     let run = RunLength {
         epochs,
@@ -125,7 +127,7 @@ pub fn train_deep_shading<'py>(
     };
     let watch = EpochWatch::new(callback);
     let (summary, file) = py
-        .detach(|| deep_shading::train(&data, &opts, &out, &|r| watch.hear(r)))
+        .detach(|| deep_shading::train(&data, &opts, engine, &out, &|r| watch.hear(r)))
         .or_py()?;
     watch.finish()?;
     let s = summary_dict(py, &summary)?;

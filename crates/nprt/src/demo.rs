@@ -123,6 +123,7 @@ pub fn run(a: DemoArgs) -> Result<()> {
             ..defaults
         },
         out: deep.clone(),
+        engine,
     })?;
     steps.begin("4/5 evaluating against the baselines");
     let report = a.out.join("report");

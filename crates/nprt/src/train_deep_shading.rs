@@ -1,14 +1,13 @@
 //! `nprt train-deep-shading`: flags for training the Deep Shading baseline; the work is
-//! `nprt_net::deep_shading::train`. It has no `--device`: the U-Net trains on the CPU engine,
-//! since the GPU kernels do not have its up-sampling and skip connections yet.
+//! `nprt_net::deep_shading::train`.
 
 use std::path::PathBuf;
 
 use anyhow::Result;
 use nprt_net::deep_shading::{self, DeepShadingOptions};
-use nprt_net::{MapNorm, Schedule};
+use nprt_net::{Engine, MapNorm, Schedule};
 
-use crate::flags::RunArgs;
+use crate::flags::{DeviceArg, RunArgs};
 
 /// The defaults every flag shows, from the one place that states them.
 fn d() -> DeepShadingOptions {
@@ -45,6 +44,8 @@ pub struct DeepShadingArgs {
     /// mean over channels), as `nprt train --map-norm`.
     #[arg(long, default_value_t = d().map_norm)]
     map_norm: MapNorm,
+    #[command(flatten)]
+    device: DeviceArg,
 }
 
 /// One Deep Shading training run as the library takes it.
@@ -52,13 +53,17 @@ pub struct DeepShadingJob {
     pub data: PathBuf,
     pub opts: DeepShadingOptions,
     pub out: PathBuf,
+    pub engine: Engine,
 }
 
-impl From<DeepShadingArgs> for DeepShadingJob {
-    fn from(a: DeepShadingArgs) -> Self {
+impl TryFrom<DeepShadingArgs> for DeepShadingJob {
+    type Error = anyhow::Error;
+
+    fn try_from(a: DeepShadingArgs) -> Result<Self> {
         let defaults = DeepShadingOptions::default();
         let run: nprt_net::RunLength = a.run.into();
-        DeepShadingJob {
+        Ok(DeepShadingJob {
+            engine: a.device.engine()?,
             data: a.data,
             opts: DeepShadingOptions {
                 schedule: run.apply(Schedule {
@@ -71,17 +76,17 @@ impl From<DeepShadingArgs> for DeepShadingJob {
                 map_norm: a.map_norm,
             },
             out: a.out,
-        }
+        })
     }
 }
 
 pub fn command(a: DeepShadingArgs) -> Result<()> {
-    run(&a.into())
+    run(&a.try_into()?)
 }
 
 /// Trains and prints what the run did.
 pub fn run(job: &DeepShadingJob) -> Result<()> {
-    let (s, f) = deep_shading::train(&job.data, &job.opts, &job.out, &|_| true)?;
+    let (s, f) = deep_shading::train(&job.data, &job.opts, job.engine, &job.out, &|_| true)?;
     if let Some(e) = s.resumed_from_epoch {
         println!("resumed from epoch {e:.2}");
     }
@@ -95,6 +100,6 @@ pub fn run(job: &DeepShadingJob) -> Result<()> {
         s.final_val,
         job.out.display()
     );
-    println!("time: {}", s.split.describe());
+    println!("time: {} (steps on {})", s.split.describe(), s.steps_on);
     Ok(())
 }

@@ -85,6 +85,81 @@ fn the_gpu_path_overfits_and_resumes_exactly() {
     resumes_across_engines();
     batches_gathered_on_the_gpu_equal_the_hosts();
     mixed_precision_trains_as_f32_does();
+    deep_shading_on_the_kernels_trains_as_on_the_cpu();
+}
+
+/// `train-deep-shading --device wgpu`: the U-Net on the kernels takes the CPU engine's path
+/// (same initial weights, batches and f32 arithmetic up to the order of sums: every epoch's
+/// validation loss within 1e-3 of the CPU's; lavapipe: 2.4e-7; eval's L1 within 1e-5, lavapipe:
+/// 4.7e-8), resumes exactly on the kernels,
+/// and a run started there continues on the CPU.
+fn deep_shading_on_the_kernels_trains_as_on_the_cpu() {
+    let (cpu, gpu, parts) = (
+        fresh_dir("deep-cpu"),
+        fresh_dir("deep-gpu"),
+        fresh_dir("deep-gpu-parts"),
+    );
+    deep_shading(&cpu, "cpu", &["--epochs", "3"]);
+    let log = deep_shading(&gpu, "wgpu", &["--epochs", "3"]);
+    assert!(log.contains("GPU kernels on"), "{log}");
+    let val = |d: &Path| losses(d).iter().filter_map(|r| r.1).collect::<Vec<_>>();
+    let (a, b) = (val(&gpu), val(&cpu));
+    let apart = a
+        .iter()
+        .zip(&b)
+        .fold(0.0f64, |m, (x, y)| m.max((x - y).abs() / y));
+    eprintln!("Deep Shading validation losses: kernels {a:?}, CPU {b:?}: {apart:.1e} apart");
+    assert_eq!(a.len(), 3);
+    assert!(apart < 1e-3, "kernels {a:?} against the CPU's {b:?}");
+    deep_shading(&parts, "wgpu", &["--epochs", "1"]);
+    let out = deep_shading(&parts, "wgpu", &["--epochs", "3"]);
+    assert!(out.contains("resumed from epoch 1.00"), "{out}");
+    let weights = |d: &Path| std::fs::read(d.join("weights.safetensors")).unwrap();
+    assert!(weights(&gpu) == weights(&parts), "resumed weights differ");
+    let out = deep_shading(&parts, "cpu", &["--epochs", "4"]);
+    assert!(out.contains("resumed from epoch 3.00"), "{out}");
+    assert_eq!(val(&parts).len(), 4);
+    // `eval` shades its frames on the device it is given: the same metrics on both (beside a
+    // design, which eval asks for).
+    let design = fresh_dir("deep-beside");
+    train(&design, "baseline", &["--epochs", "1", "--device", "cpu"]);
+    let l1 = |device: &str| {
+        let report = gpu.join(format!("eval-{device}"));
+        ok(&[
+            "eval",
+            "--data",
+            dataset().to_str().unwrap(),
+            "--model",
+            design.to_str().unwrap(),
+            "--deep-shading",
+            gpu.to_str().unwrap(),
+            "--out",
+            report.to_str().unwrap(),
+            "--timing-res",
+            "32",
+            "--sh-spp",
+            "4",
+            "--device",
+            device,
+        ]);
+        let results: serde_json::Value =
+            serde_json::from_slice(&std::fs::read(report.join("results.json")).unwrap()).unwrap();
+        let methods = results["methods"].as_array().unwrap();
+        let m = methods
+            .iter()
+            .find(|m| m["name"] == "deep-shading")
+            .unwrap();
+        m["mean"]["l1"].as_f64().unwrap()
+    };
+    let (on_gpu, on_cpu) = (l1("wgpu"), l1("cpu"));
+    eprintln!("Deep Shading's L1 in eval: kernels {on_gpu}, CPU {on_cpu}");
+    assert!(
+        (on_gpu - on_cpu).abs() <= 1e-5 * on_cpu,
+        "{on_gpu} against {on_cpu}"
+    );
+    for d in [cpu, gpu, parts, design] {
+        std::fs::remove_dir_all(d).unwrap();
+    }
 }
 
 /// `--precision f16` (mixed precision on the kernels) learns as f32 does: after the same
@@ -325,26 +400,32 @@ fn a_model_is_calibrated_to_its_training_level_on_request() {
     assert_eq!(gain(&out), None);
 }
 
+/// `nprt train-deep-shading` on the test dataset into `out` on `device`, with `extra` flags.
+fn deep_shading(out: &Path, device: &str, extra: &[&str]) -> String {
+    let data = dataset().to_str().unwrap();
+    let mut args = vec![
+        "train-deep-shading",
+        "--data",
+        data,
+        "--out",
+        out.to_str().unwrap(),
+        "--encoder-width",
+        "64",
+        "--batch-views",
+        "2",
+        "--device",
+        device,
+    ];
+    args.extend_from_slice(extra);
+    ok(&args)
+}
+
 /// Deep Shading trains through the same loop: exact resume (Adam's moments included), the
 /// same loss files, and a refusal to resume other settings.
 #[test]
 fn deep_shading_resumes_exactly_through_the_shared_loop() {
     let data = dataset().to_str().unwrap();
-    let run = |out: &Path, extra: &[&str]| {
-        let mut args = vec![
-            "train-deep-shading",
-            "--data",
-            data,
-            "--out",
-            out.to_str().unwrap(),
-            "--encoder-width",
-            "64",
-            "--batch-views",
-            "2",
-        ];
-        args.extend_from_slice(extra);
-        ok(&args)
-    };
+    let run = |out: &Path, extra: &[&str]| deep_shading(out, "cpu", extra);
     let straight = fresh_dir("deep-straight");
     let resumed = fresh_dir("deep-parts");
     run(&straight, &["--epochs", "3"]);

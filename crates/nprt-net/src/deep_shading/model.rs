@@ -10,6 +10,7 @@ use serde::{Deserialize, Serialize};
 
 use super::options::DeepShadingOptions;
 use super::unet::feature_image;
+use crate::engine::Engine;
 use crate::init::Init;
 use crate::model::folder::{check_bounds, load_weights, read_config, WEIGHTS_FILE};
 use crate::network::encoder::{check_input_width, LightInput};
@@ -39,6 +40,9 @@ pub struct DeepShadingFile {
 pub struct DeepShadingModel {
     pub file: DeepShadingFile,
     net: DeepShading,
+    /// The network on the GPU kernels, where it was loaded for the GPU (one frame at a time).
+    #[cfg(feature = "kernels")]
+    gpu: Option<std::sync::Mutex<crate::gpu::GpuUnet>>,
 }
 
 /// Reads a Deep Shading folder's config, refusing an encoder width no network can have.
@@ -51,12 +55,44 @@ pub fn read_file(dir: &Path) -> Result<DeepShadingFile> {
 }
 
 impl DeepShadingModel {
-    /// Loads the network in `dir`; it runs on the CPU engine, whatever the engine.
-    pub fn load(dir: &Path) -> Result<Self> {
+    /// Loads the network in `dir` to shade on `engine`.
+    pub fn load(dir: &Path, engine: Engine) -> Result<Self> {
         let file = read_file(dir)?;
         let mut net = DeepShading::new(&mut Init::new(0), file.encoder_width);
         load_weights(&dir.join(WEIGHTS_FILE), &mut net, TAG)?;
-        Ok(DeepShadingModel { file, net })
+        #[cfg(feature = "kernels")]
+        let gpu = match engine.is_gpu() {
+            true => Some(std::sync::Mutex::new(crate::gpu::GpuUnet::new(&net)?)),
+            false => None,
+        };
+        #[cfg(not(feature = "kernels"))]
+        let _ = engine;
+        Ok(DeepShadingModel {
+            file,
+            net,
+            #[cfg(feature = "kernels")]
+            gpu,
+        })
+    }
+
+    /// The U-Net's radiance (3 × h × w) for a view's `features` (FEATURES × h × w) under the
+    /// map `light`, on the engine the model was loaded for.
+    fn radiance(&self, features: Vec<f32>, light: LightInput, (h, w): (usize, usize)) -> Vec<f32> {
+        #[cfg(feature = "kernels")]
+        if let Some(gpu) = &self.gpu {
+            let batch = crate::cpu::UnetBatch {
+                features,
+                radiance: vec![0.0; 3 * h * w],
+                mask: vec![0.0; h * w],
+                lights: light.pixels,
+                light_width: light.width,
+                scale: light.scale.to_vec(),
+                height: h,
+                width: w,
+            };
+            return gpu.lock().unwrap_or_else(|e| e.into_inner()).shade(&batch);
+        }
+        (self.net).shade(&features, &light.pixels, light.width, light.scale, (h, w))
     }
 
     /// Radiance of every pixel of a `width`×`height` G-buffer under `map` rotated by
@@ -76,9 +112,7 @@ impl DeepShadingModel {
             self.file.encoder_width,
             self.file.options.map_norm,
         );
-        let v = self
-            .net
-            .shade(&img, &light.pixels, light.width, light.scale, (ph, pw));
+        let v = self.radiance(img, light, (ph, pw));
         (0..width * height)
             .map(|i| {
                 let (x, y) = (i % width, i / width);

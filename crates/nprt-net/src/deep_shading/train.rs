@@ -5,19 +5,16 @@ use std::path::Path;
 
 use anyhow::{bail, Result};
 use nprt_data::dataset::load_manifest_hashed;
-use nprt_data::views::{load_views, ImageView};
-use nprt_scene::EnvMap;
+use nprt_data::views::load_views;
 use rand::seq::SliceRandom;
 
 use super::model::{read_file, DeepShadingFile, CONFIG_FILE, TAG};
 use super::options::DeepShadingOptions;
-use super::unet::feature_image;
-use crate::cpu::UnetBatch;
-use crate::encoding::map_norm::MapNorm;
+use super::split::Split;
+use crate::engine::Engine;
 use crate::init::Init;
-use crate::loss::Loss;
 use crate::model::folder::{save_weights, WEIGHTS_FILE};
-use crate::network::encoder::{check_input_width, LightInput};
+use crate::network::encoder::check_input_width;
 use crate::network::parameters::Parameters;
 use crate::network::unet::DeepShading;
 use crate::optimiser::EngineSteps;
@@ -25,124 +22,7 @@ use crate::training::checkpoint::{self, RunState};
 use crate::training::host_steps::HostSteps;
 use crate::training::schedule::Schedule;
 use crate::training::training_loop::{self, epoch_rng, Objective, Steps, TrainSummary, Watch};
-use crate::training::training_set::{log_mean_level, open_recorded_maps};
-
-/// What training needs of each view, padded to multiples of 8.
-struct Sample {
-    features: Vec<f32>,
-    radiance: Vec<f32>,
-    mask: Vec<f32>,
-    light: LightInput,
-    foreground: u64,
-}
-
-/// Views of one split, all of one padded size.
-struct Split {
-    samples: Vec<Sample>,
-    width: usize,
-    height: usize,
-}
-
-impl Split {
-    /// ln of the mean foreground radiance relative to its map's mean (as
-    /// `TrainingSet::log_relative_level`).
-    fn log_relative_level(&self) -> f32 {
-        let (mut sum, mut n) = (0.0f64, 0usize);
-        for s in &self.samples {
-            // Background pixels hold zero radiance here; channels are planes of `plane` values.
-            let plane = s.radiance.len() / 3;
-            sum += (0..3)
-                .map(|k| {
-                    let fg: f64 = s.radiance[k * plane..(k + 1) * plane]
-                        .iter()
-                        .map(|&r| r.max(0.0) as f64)
-                        .sum();
-                    fg / s.light.scale[k] as f64
-                })
-                .sum::<f64>();
-            n += 3 * s.foreground as usize;
-        }
-        log_mean_level(sum, n)
-    }
-
-    fn new(
-        views: &[ImageView],
-        maps: &[EnvMap],
-        bounds: &[[f32; 3]; 2],
-        encoder_width: usize,
-        norm: MapNorm,
-    ) -> Result<Self> {
-        let Some(first) = views.first() else {
-            return Ok(Split {
-                samples: Vec::new(),
-                width: 0,
-                height: 0,
-            });
-        };
-        let (w, h) = (first.width, first.height);
-        if views.iter().any(|v| (v.width, v.height) != (w, h)) {
-            bail!("Deep Shading trains on views of one resolution per split");
-        }
-        let samples = views
-            .iter()
-            .map(|v| {
-                let (features, pw, ph) = feature_image(bounds, &v.gbuffer, w, h);
-                let mut radiance = vec![0.0; 3 * pw * ph];
-                let mut mask = vec![0.0; pw * ph];
-                for i in 0..w * h {
-                    let j = (i / w) * pw + i % w;
-                    mask[j] = v.gbuffer.mask[i];
-                    for c in 0..3 {
-                        radiance[c * pw * ph + j] = v.radiance[i][c] * mask[j];
-                    }
-                }
-                Ok(Sample {
-                    foreground: mask.iter().filter(|&&m| m > 0.5).count() as u64,
-                    features,
-                    radiance,
-                    mask,
-                    light: LightInput::new(&v.record.lighting(maps)?, 0.0, encoder_width, norm),
-                })
-            })
-            .collect::<Result<_>>()?;
-        Ok(Split {
-            samples,
-            width: w.div_ceil(8) * 8,
-            height: h.div_ceil(8) * 8,
-        })
-    }
-
-    /// The views `batch` as the CPU engine takes them, and their foreground pixels.
-    fn batch(&self, batch: &[usize]) -> (UnetBatch, u64) {
-        let views: Vec<&Sample> = batch.iter().map(|&i| &self.samples[i]).collect();
-        let cat = |f: fn(&Sample) -> &[f32]| -> Vec<f32> {
-            views.iter().flat_map(|s| f(s).iter().copied()).collect()
-        };
-        let unet = UnetBatch {
-            features: cat(|s| &s.features),
-            radiance: cat(|s| &s.radiance),
-            mask: cat(|s| &s.mask),
-            lights: cat(|s| &s.light.pixels),
-            light_width: views[0].light.width,
-            scale: cat(|s| &s.light.scale),
-            height: self.height,
-            width: self.width,
-        };
-        (unet, views.iter().map(|s| s.foreground).sum())
-    }
-
-    /// The masked log-L1 loss of the views `batch` and, when `train`, its gradients.
-    fn loss(
-        &self,
-        net: &DeepShading,
-        batch: &[usize],
-        train: bool,
-    ) -> (f64, Option<DeepShading>, u64) {
-        let (unet, foreground) = self.batch(batch);
-        let (loss, grads) = net.loss_and_gradients(&unet, Loss::LogL1, train);
-        (loss, grads, foreground)
-    }
-}
+use crate::training::training_set::open_recorded_maps;
 
 struct UnetObjective {
     train: Split,
@@ -150,6 +30,9 @@ struct UnetObjective {
     /// The model file as it will be saved, less what `save_model` fills in from the network
     /// and the run (parameter counts, progress).
     file: DeepShadingFile,
+    /// Whether the steps run on our own GPU kernels.
+    #[cfg_attr(not(feature = "kernels"), allow(dead_code))]
+    kernels: bool,
 }
 
 impl Objective for UnetObjective {
@@ -198,6 +81,11 @@ impl Objective for UnetObjective {
     }
 
     fn engine_steps(&self, net: &DeepShading) -> Result<Steps<'_, Self>> {
+        #[cfg(feature = "kernels")]
+        if self.kernels {
+            let steps = super::kernel_steps::UnetKernelSteps::new(net, &self.train, &self.test)?;
+            return Ok(Box::new(steps));
+        }
         Ok(Box::new(HostSteps::new(
             net,
             |net: &DeepShading, batch: &Vec<usize>| {
@@ -242,11 +130,12 @@ impl Objective for UnetObjective {
 
 /// Trains (or resumes exactly, Adam's moments included) a Deep Shading network on the dataset
 /// in `data`, with the validation loss on its test views after every epoch. Returns the run's
-/// summary and the model's config as saved; `watch` hears each epoch's end. The U-Net trains on the CPU engine whatever the
-/// device: the GPU kernels do not have its up-sampling and skip connections yet.
+/// summary and the model's config as saved; `watch` hears each epoch's end. The steps run on
+/// `engine`; a checkpoint resumes on either.
 pub fn train(
     data: &Path,
     opts: &DeepShadingOptions,
+    engine: Engine,
     out: &Path,
     watch: Watch,
 ) -> Result<(TrainSummary, DeepShadingFile)> {
@@ -293,7 +182,12 @@ pub fn train(
         epochs_done: 0,
         seconds: 0.0,
     };
-    let objective = UnetObjective { train, test, file };
+    let objective = UnetObjective {
+        train,
+        test,
+        file,
+        kernels: cfg!(feature = "kernels") && engine.is_gpu(),
+    };
     let summary = training_loop::train(&objective, &opts.schedule, out, watch)?;
     Ok((summary, read_file(out)?))
 }

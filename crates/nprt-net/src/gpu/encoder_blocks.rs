@@ -2,19 +2,40 @@
 //! batch's maps, keeping each block's pooling tape for backward) and the frame path (over one
 //! map, keeping nothing). Each convolution block halves the image; the code layer follows.
 
+use super::dense_products::DenseProducts;
 use super::kernels::{ENCODER_BLOCK, ENCODER_BLOCK_THREADS};
-use super::network_layout::NetworkLayout;
+use super::layer_at::{ConvAt, DenseAt};
 use super::operands::{Bias, Operand, Output};
-use super::products::DenseProducts;
-use super::{groups_for, Bind, Dispatch, GpuDevice, Part};
-use crate::network::encoder::{CHANNELS, CODE_SIZE};
+use super::{groups_for, Bind, Dispatch, GpuDevice, Part, Span};
+use crate::network::encoder::{LightEncoder, CHANNELS, CODE_SIZE};
 
-impl NetworkLayout {
+/// The light encoder's tensors in the flat buffers: its blocks' convolutions and the code
+/// layer.
+pub struct EncoderAt {
+    pub convs: Vec<ConvAt>,
+    pub to_code: DenseAt,
+}
+
+impl EncoderAt {
+    /// `encoder`'s places, its tensors' spans taken in its visiting order from `spans`.
+    pub fn new(encoder: &LightEncoder, spans: &mut impl Iterator<Item = Span>) -> Self {
+        let convs = (encoder.convs.iter())
+            .map(|c| ConvAt::new(c, spans))
+            .collect();
+        let to_code = DenseAt {
+            weight: spans.next().expect("a span per tensor"),
+            bias: spans.next().expect("a span per tensor"),
+            d_in: encoder.to_code.d_in,
+            d_out: encoder.to_code.d_out,
+        };
+        EncoderAt { convs, to_code }
+    }
+
     /// Appends to `plan` the light encoder over `views` maps `width` × `width / 2` in `input`
     /// (view-major, channel-major), its weights in `params`: the blocks (each with `keep` its
     /// pooling tape), then the code layer into `codes` (`views × CODE_SIZE`).
     #[allow(clippy::too_many_arguments)]
-    pub fn record_encoder(
+    pub fn record(
         &self,
         gpu: &GpuDevice,
         plan: &mut Vec<Dispatch>,

@@ -13,8 +13,9 @@ use std::sync::Arc;
 
 use anyhow::Result;
 
+use super::device_adam::DeviceAdam;
 use super::device_dataset::DeviceDataset;
-use super::kernels::{ADAM, GATHER_SAMPLES};
+use super::kernels::GATHER_SAMPLES;
 use super::network_layout::NetworkLayout;
 use super::parameters::ParameterLayout;
 use super::{groups_for, Dispatch, GpuDevice};
@@ -24,7 +25,6 @@ use crate::encoding::hash_grid;
 use crate::loss::Loss;
 use crate::network::encoder::CODE_SIZE;
 use crate::network::nprt_net::NprtNet;
-use crate::optimiser::{bias_corrections, load_state, save_state, ADAM_BETA1, ADAM_BETA2};
 use crate::Precision;
 use nprt_gpu::{KernelTime, KernelTimer};
 
@@ -39,17 +39,12 @@ pub struct GpuTrainer {
     shapes: NprtNet,
     pub(super) params: wgpu::Buffer,
     pub(super) grads: wgpu::Buffer,
-    moment1: wgpu::Buffer,
-    moment2: wgpu::Buffer,
-    /// Adam steps taken.
-    steps: u64,
     pub(super) resolutions: wgpu::Buffer,
     /// The step's dispatches for the last batch shapes used (training's and validation's, and
     /// their epochs' last, shorter batches), recorded again for every batch of the shape;
     /// the most recently used last.
     plans: Vec<StepPlan>,
-    /// Adam over every parameter; its rate and bias corrections are rewritten each step.
-    adam: Dispatch,
+    adam: DeviceAdam,
     precision: Precision,
     /// In mixed precision, the dispatches that copy the transport layers' weights into their
     /// f16 copies, run after Adam (none in f32).
@@ -155,27 +150,6 @@ pub(super) struct BatchBuffers {
     pub batch_views: wgpu::Buffer,
 }
 
-/// The parameter block of `adam.wgsl` for step `t` (from 1) at learning rate `lr`, over
-/// `count` values whose gradients are scaled by `grad_scale`.
-fn adam_params(count: usize, lr: f64, t: u64, grad_scale: f32) -> Vec<u32> {
-    let (factor, epsilon) = bias_corrections(t);
-    let mut params = vec![count as u32, 0, 0, 0];
-    params.extend(
-        [
-            lr as f32,
-            ADAM_BETA1,
-            ADAM_BETA2,
-            factor,
-            epsilon,
-            1.0 / grad_scale,
-            0.0,
-            0.0,
-        ]
-        .map(f32::to_bits),
-    );
-    params
-}
-
 impl GpuTrainer {
     /// Uploads `net`'s parameters to the process's GPU device, with zero Adam moments, to
     /// train in `precision` (f16 needs f16 in the adapter's shaders).
@@ -188,15 +162,9 @@ impl GpuTrainer {
         let shapes = net.clone();
         let (layout, flat) = ParameterLayout::pack_for(&gpu, net);
         let net = NetworkLayout::new(&gpu, &layout, net, half);
-        let zeros = vec![0.0f32; layout.total];
-        let [params, grads, moment1, moment2] =
-            [&flat, &zeros, &zeros, &zeros].map(|v| gpu.upload(v));
-        let adam = gpu.prepare(
-            &ADAM,
-            &adam_params(layout.total, 0.0, 1, 1.0),
-            &[&grads, &params, &moment1, &moment2],
-            groups_for(layout.total),
-        );
+        let params = gpu.upload(&flat);
+        let grads = gpu.buffer(layout.total);
+        let adam = DeviceAdam::new(&gpu, layout.total, &grads, &params);
         let half_refresh = net.half_refresh(&gpu, &params);
         if !half_refresh.is_empty() {
             let mut encoder = gpu.device.create_command_encoder(&Default::default());
@@ -219,13 +187,10 @@ impl GpuTrainer {
             dataset: None,
             params,
             grads,
-            moment1,
-            moment2,
             adam,
             precision,
             half_refresh,
             plans: Vec::new(),
-            steps: 0,
             resolutions: gpu.upload(&hash_grid::resolutions()),
             net,
             layout,
@@ -375,7 +340,7 @@ impl GpuTrainer {
             _ => &plan.dispatches[..],
         });
         if let Pass::Step(_) = pass {
-            list.push(&self.adam);
+            list.push(&self.adam.dispatch);
             list.extend(&self.half_refresh);
         }
         list
@@ -391,10 +356,8 @@ impl GpuTrainer {
         timer: Option<&mut KernelTimer>,
     ) -> (wgpu::SubmissionIndex, usize, usize) {
         if let Pass::Step(lr) = pass {
-            self.steps += 1;
             let scale = self.plans.last().expect("prepared").batch.grad_scale;
-            let params = adam_params(self.layout.total, lr, self.steps, scale);
-            self.gpu.write(&self.adam.uniform, &params);
+            self.adam.next_step(&self.gpu, self.layout.total, lr, scale);
         }
         let plan = self.plans.last().expect("prepared");
         let copy = self.pending.as_ref().map_or(0, |p| 1 - p.copy);
@@ -437,9 +400,20 @@ impl GpuTrainer {
                 }
                 let b = self.batch_buffers(rows, views, light_width);
                 let mut dispatches = Vec::new();
-                let tape = self.encoder_forward(&mut dispatches, &b);
+                let (gpu, encoder) = (&self.gpu, &self.net.encoder);
+                let maps = [b.views, b.light_width];
+                let tape = encoder.record(
+                    gpu,
+                    &mut dispatches,
+                    &self.params,
+                    &b.lights,
+                    maps,
+                    &b.codes,
+                    true,
+                );
                 let forward = self.record_transport(&mut dispatches, &b, loss);
-                self.encoder_backward(&mut dispatches, &b, &tape);
+                let buffers = [&self.params, &self.grads];
+                encoder.record_backward(gpu, &mut dispatches, buffers, b.views, &b.d_codes, &tape);
                 StepPlan {
                     loss,
                     gathers: self.gathers(&b),
@@ -498,29 +472,15 @@ impl GpuTrainer {
             .collect()
     }
 
-    /// Writes Adam's state to `path` as the host's Adam does (the moments without the
-    /// layout's gaps), so that either engine resumes it.
+    /// Writes Adam's state to `path` as the host's Adam does, so that either engine resumes it.
     pub fn save_state(&self, path: &Path) -> Result<()> {
-        let total = self.layout.total;
-        let [m1, m2] =
-            [&self.moment1, &self.moment2].map(|m| self.layout.compact(&self.gpu.read(m, total)));
-        save_state(path, [&m1, &m2], self.steps)
+        self.adam.save(&self.gpu, &self.layout, path)
     }
 
     /// Reads Adam's state back from `path`, written by either engine for a network of the same
     /// shapes.
     pub fn load_state(&mut self, path: &Path) -> Result<()> {
-        // Checkpoints of the kernels from before the shared format hold the moments with the
-        // layout's gaps.
-        let (moments, steps) = match load_state(path, self.layout.params()) {
-            Ok((m, steps)) => (m.map(|m| self.layout.expand(&m)), steps),
-            Err(e) => load_state(path, self.layout.total).map_err(|_| e)?,
-        };
-        for (values, buffer) in moments.iter().zip([&self.moment1, &self.moment2]) {
-            self.gpu.write(buffer, values);
-        }
-        self.steps = steps;
-        Ok(())
+        self.adam.load(&self.gpu, &self.layout, path)
     }
 
     /// Buffers for batches of `rows` samples over `views` maps `light_width` wide.

@@ -13,12 +13,13 @@
 //! light encoder, the hash grids and the light code's share stay in f32.
 
 use super::codes::{activation_code, BACKWARD};
+use super::dense_products::DenseProducts;
 use super::gpu_trainer::GpuTrainer;
 use super::half_layers::{half_train_layer, held_halves, pad16, HalfLayers, HalfOut};
 use super::kernels::{HALF_WEIGHT_GRAD, HALF_WEIGHT_GRAD_COOP};
+use super::mlp_step::{row_chunks, FirstLayerBias, MlpTape};
 use super::network_layout::MlpAt;
 use super::operands::{Bias, Output};
-use super::products::{row_chunks, FirstLayerBias, MlpTape};
 use super::{groups_for, Bind, Dispatch, GpuDevice};
 
 /// The dispatch of xᵀ·dz, `[m, n]`, over `rows` rows cut into chunks of `chunk` rows, chunk
@@ -86,7 +87,7 @@ impl GpuTrainer {
             );
             match on_first.filter(|_| i == 0) {
                 Some(f) => f(plan, g32),
-                None => self.column_sum(
+                None => self.gpu.column_sum(
                     plan,
                     g32,
                     rows,
@@ -148,7 +149,7 @@ impl GpuTrainer {
             [chunk, chunks],
             &partial,
         ));
-        self.column_sum(
+        self.gpu.column_sum(
             plan,
             &partial,
             chunks,

@@ -33,17 +33,19 @@ pub const ENCODER_BLOCK: KernelSource = kernel!("encoder_block");
 /// Threads `encoder_block` takes per output value: one per slot of its pooling window.
 pub const ENCODER_BLOCK_THREADS: usize = 4;
 pub const ENCODER_POOL_BACKWARD: KernelSource = kernel!("encoder_pool_backward");
-pub const ENCODER_WEIGHT_BACKWARD: KernelSource = kernel!("encoder_weight_backward");
-pub const ENCODER_INPUT_BACKWARD: KernelSource = kernel!("encoder_input_backward");
-/// Threads `encoder_input_backward` takes per input value: one per quarter of the channels.
-pub const ENCODER_INPUT_BACKWARD_THREADS: usize = 4;
+/// A convolution's gradients: at its input (the light encoder's and the U-Net's), and of its
+/// weights and biases, per chunk of image rows.
+pub const CONV_INPUT_BACKWARD: KernelSource = kernel!("conv_input_backward");
+/// Threads `conv_input_backward` takes per input value: one per quarter of the channels.
+pub const CONV_INPUT_BACKWARD_THREADS: usize = 4;
+pub const CONV_WEIGHT_BACKWARD: KernelSource = kernel!("conv_weight_backward");
 pub const TRACK_INPUTS: KernelSource = kernel!("track_inputs", "hash_grid");
 pub const GRID_BACKWARD: KernelSource = kernel!("grid_backward", "hash_grid");
 pub const GEMM: KernelSource = kernel!("gemm");
 pub const COLUMN_SUM: KernelSource = kernel!("column_sum");
 pub static COMBINE: LazyLock<KernelSource> =
     LazyLock::new(|| with_kinds(kernel!("combine", "track_radiance")));
-pub const RADIANCE_LOSS: KernelSource = kernel!("radiance_loss");
+pub const RADIANCE_LOSS: KernelSource = kernel!("radiance_loss", "loss_element");
 pub static TRACK_GRADIENT: LazyLock<KernelSource> =
     LazyLock::new(|| with_kinds(kernel!("track_gradient", "track_radiance")));
 pub const ADAM: KernelSource = kernel!("adam");
@@ -75,6 +77,17 @@ pub const HALF_WEIGHT_GRAD_COOP: KernelSource = kernel!(
     "half_weight_sums",
     "coop_drain"
 );
+
+/// The Deep Shading U-Net's layers (`unet_pass`): its convolutions, pools, decoder inputs,
+/// bottleneck offsets and loss, and their adjoints.
+pub const CONV_FORWARD: KernelSource = kernel!("conv_forward");
+pub const MAX_POOL: KernelSource = kernel!("max_pool");
+pub const POOL_BACKWARD: KernelSource = kernel!("pool_backward");
+pub const UPSAMPLE_CONCAT: KernelSource = kernel!("upsample_concat");
+pub const UPSAMPLE_BACKWARD: KernelSource = kernel!("upsample_backward");
+pub const PLANE_OFFSET: KernelSource = kernel!("plane_offset");
+pub const OFFSET_BACKWARD: KernelSource = kernel!("offset_backward");
+pub const UNET_LOSS: KernelSource = kernel!("unet_loss", "loss_element");
 
 /// `kernel` after the track kinds' table, made once per process (a kernel's source lives as
 /// long as the process).

@@ -8,6 +8,9 @@
 //! layouts, designs and the hash grid stay defined where the CPU engine reads them.
 
 mod codes;
+mod conv_layers;
+mod dense_products;
+mod device_adam;
 mod device_dataset;
 mod encoder_blocks;
 mod encoder_step;
@@ -15,25 +18,30 @@ mod gpu_trainer;
 mod half_layers;
 mod half_products;
 pub mod kernels;
+mod layer_at;
+mod mlp_step;
 mod network_forward;
 mod network_layout;
 mod operands;
 mod parameters;
-mod products;
 mod transport_step;
+mod unet_pass;
+mod unet_trainer;
 
 pub use codes::{activation_code, loss_code};
+pub use dense_products::DenseProducts;
 pub use device_dataset::DeviceDataset;
-pub use encoder_blocks::BlockPass;
+pub use encoder_blocks::{BlockPass, EncoderAt};
 pub use gpu_trainer::GpuTrainer;
 pub use half_layers::{
     half_weight_bits, held_halves, pad16, HalfLayers, HalfWeight, Held, HALF_ROW_BLOCK,
 };
+pub use layer_at::{ConvAt, DenseAt};
 pub use network_forward::{FirstLayer, ForwardTargets};
-pub use network_layout::{ConvAt, DenseAt, HalfCopies, MlpAt, NetworkLayout, TrackAt};
+pub use network_layout::{HalfCopies, MlpAt, NetworkLayout, TrackAt};
 pub use operands::{Bias, Operand, Output};
 pub use parameters::ParameterLayout;
-pub use products::DenseProducts;
+pub use unet_trainer::GpuUnet;
 
 // The runtime the kernels run on (nprt-gpu), as this module's files name it.
 use nprt_gpu::{groups_for, Bind, Dispatch, GpuDevice, KernelSource, Part, Span};

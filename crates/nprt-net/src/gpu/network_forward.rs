@@ -4,11 +4,11 @@
 //! parameter buffer where [`NetworkLayout`](super::network_layout::NetworkLayout) places them.
 
 use super::codes::activation_code;
+use super::dense_products::DenseProducts;
 use super::half_layers::{half_train_layer, pad16, HalfLayers, HalfOut, Held};
 use super::kernels::TRACK_INPUTS;
 use super::network_layout::{MlpAt, TrackAt};
 use super::operands::{Bias, Operand, Output};
-use super::products::DenseProducts;
 use super::{groups_for, Bind, Dispatch, GpuDevice, Part};
 use crate::network::encoder::CODE_SIZE;
 

@@ -1,7 +1,9 @@
 //! Where each tensor of a network lies in the flat parameter buffers, in the network's own
 //! structure (encoder blocks, tracks, layers), as the training step's dispatches address them.
 
+use super::encoder_blocks::EncoderAt;
 use super::half_layers::{HalfLayers, HalfWeight};
+use super::layer_at::DenseAt;
 use super::parameters::ParameterLayout;
 use super::Span;
 use super::{Dispatch, GpuDevice};
@@ -12,14 +14,6 @@ use crate::network::encoder::CODE_SIZE;
 use crate::network::mlp::Mlp;
 use crate::network::nprt_net::NprtNet;
 use crate::network::track_kind::TrackKind;
-
-/// One dense layer's place in the flat buffers.
-pub struct DenseAt {
-    pub weight: Span,
-    pub bias: Span,
-    pub d_in: usize,
-    pub d_out: usize,
-}
 
 pub struct MlpAt {
     pub layers: Vec<DenseAt>,
@@ -94,17 +88,9 @@ impl TrackAt {
     }
 }
 
-/// One encoder block's convolution in the flat buffers.
-pub struct ConvAt {
-    pub weight: Span,
-    pub bias: Span,
-    pub c_in: usize,
-}
-
 /// A network's tensors in the flat buffers.
 pub struct NetworkLayout {
-    pub convs: Vec<ConvAt>,
-    pub to_code: DenseAt,
+    pub encoder: EncoderAt,
     pub tracks: Vec<TrackAt>,
 }
 
@@ -115,22 +101,7 @@ impl NetworkLayout {
     pub fn new(gpu: &GpuDevice, layout: &ParameterLayout, net: &NprtNet, half: bool) -> Self {
         // Spans in the order the network visits its tensors: the encoder's, then the tracks'.
         let mut spans = layout.spans.iter().copied();
-        let encoder = &net.encoder;
-        let convs = encoder
-            .convs
-            .iter()
-            .map(|c| ConvAt {
-                weight: spans.next().expect("a span per tensor"),
-                bias: spans.next().expect("a span per tensor"),
-                c_in: c.c_in,
-            })
-            .collect();
-        let to_code = DenseAt {
-            weight: spans.next().expect("a span per tensor"),
-            bias: spans.next().expect("a span per tensor"),
-            d_in: encoder.to_code.d_in,
-            d_out: encoder.to_code.d_out,
-        };
+        let encoder = EncoderAt::new(&net.encoder, &mut spans);
         let tracks: Vec<TrackAt> = net
             .tracks
             .iter()
@@ -149,11 +120,7 @@ impl NetworkLayout {
                 }
             })
             .collect();
-        let mut layout = NetworkLayout {
-            convs,
-            to_code,
-            tracks,
-        };
+        let mut layout = NetworkLayout { encoder, tracks };
         if half {
             layout.hold_half(gpu);
         }

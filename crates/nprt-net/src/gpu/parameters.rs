@@ -5,7 +5,6 @@
 
 use nprt_gpu::{GpuDevice, Span};
 
-use crate::network::nprt_net::NprtNet;
 use crate::network::parameters::Parameters;
 
 /// The flat layout of a network's tensors.
@@ -19,13 +18,13 @@ impl ParameterLayout {
     /// The layout of `net`'s tensors (in their visiting order), each starting at a multiple
     /// of `gpu`'s storage-binding alignment (so a kernel can bind it on its own), and their
     /// values packed in it.
-    pub fn pack_for(gpu: &GpuDevice, net: &NprtNet) -> (ParameterLayout, Vec<f32>) {
+    pub fn pack_for<N: Parameters>(gpu: &GpuDevice, net: &N) -> (ParameterLayout, Vec<f32>) {
         let align = gpu.device.limits().min_storage_buffer_offset_alignment as usize / 4;
         Self::pack(net, align.max(1))
     }
 
     /// [`Self::pack_for`] at an alignment of `align` elements.
-    pub fn pack(net: &NprtNet, align: usize) -> (ParameterLayout, Vec<f32>) {
+    pub fn pack<N: Parameters>(net: &N, align: usize) -> (ParameterLayout, Vec<f32>) {
         let mut flat = Vec::new();
         let mut spans = Vec::new();
         net.visit("", &mut |_, _, t| {
@@ -41,7 +40,7 @@ impl ParameterLayout {
     }
 
     /// `flat`'s values poured into a copy of `net` (same shapes as packed).
-    pub fn unpack(&self, flat: &[f32], net: &NprtNet) -> NprtNet {
+    pub fn unpack<N: Parameters + Clone>(&self, flat: &[f32], net: &N) -> N {
         let mut net = net.clone();
         net.set_flat(&self.compact(flat));
         net

@@ -4,15 +4,16 @@
 //! into every parameter, the grids' tables and the light codes.
 
 use super::codes::loss_code;
+use super::dense_products::DenseProducts;
 use super::gpu_trainer::{BatchBuffers, GpuTrainer};
 use super::half_layers::Held;
 use super::kernels::{COMBINE, GRID_BACKWARD, RADIANCE_LOSS, TRACK_GRADIENT};
+use super::mlp_step::MlpTape;
 use super::network_forward::FirstLayer;
 use super::network_forward::ForwardTargets;
 use super::network_layout::MlpAt;
 use super::network_layout::TrackAt;
 use super::operands::{Bias, Operand, Output};
-use super::products::{DenseProducts, MlpTape};
 use super::{groups_for, Dispatch};
 use crate::encoding::hash_grid;
 use crate::loss::Loss;
@@ -93,7 +94,7 @@ impl GpuTrainer {
             ],
             groups_for(b.rows),
         ));
-        self.column_sum(
+        self.gpu.column_sum(
             plan,
             &b.row_loss,
             b.rows,
@@ -205,7 +206,7 @@ impl GpuTrainer {
         // rows' and the code's gradients all follow from it.
         let d_views = gpu.buffer(b.views * first.d_out);
         let on_first = |plan: &mut Vec<Dispatch>, dz: &wgpu::Buffer| {
-            self.column_sum(
+            self.gpu.column_sum(
                 plan,
                 dz,
                 b.rows,
@@ -213,7 +214,7 @@ impl GpuTrainer {
                 Some((&b.view, b.views)),
                 Output::to(&d_views, 0, first.d_out),
             );
-            self.column_sum(
+            self.gpu.column_sum(
                 plan,
                 &d_views,
                 b.views,
@@ -276,7 +277,7 @@ impl GpuTrainer {
                 groups_for(chunks * GRID_BACKWARD_THREADS),
             ));
             let d_table = Output::to(&self.grads, span.offset, span.len);
-            self.column_sum(plan, &partial, chunks, span.len, None, d_table);
+            gpu.column_sum(plan, &partial, chunks, span.len, None, d_table);
         }
     }
 }

@@ -3,6 +3,7 @@
 
 pub mod reference;
 
+use nprt_net::cpu::UnetBatch;
 use nprt_net::{Activation, Batch, Design, Loss, ModelConfig, NprtNet};
 use nprt_net::{PositionEncoding, FEATURES};
 use rand::{RngExt, SeedableRng};
@@ -123,4 +124,28 @@ pub fn check_gradients(
         "{name}: {checked} entries checked, {kinks} skipped at a kink"
     );
     checked
+}
+
+/// `views` random U-Net views of h × w (features in [0, 1), radiance in [0, 2), every seventh
+/// pixel background) under random 64-wide maps.
+pub fn unet_batch(views: usize, (h, w): (usize, usize), seed: u64) -> UnetBatch {
+    let mut rng = Pcg64Mcg::seed_from_u64(seed);
+    let mut r = |n: usize, lo: f32, hi: f32| -> Vec<f32> {
+        (0..n)
+            .map(|_| lo + (hi - lo) * rng.random::<f32>())
+            .collect()
+    };
+    let mask: Vec<f32> = (0..views * h * w)
+        .map(|i| (i % 7 != 0) as u8 as f32)
+        .collect();
+    UnetBatch {
+        features: r(views * FEATURES * h * w, 0.0, 1.0),
+        radiance: r(views * 3 * h * w, 0.0, 2.0),
+        mask,
+        lights: r(views * 3 * 64 * 32, 0.0, 2.0),
+        light_width: 64,
+        scale: r(views * 3, 0.5, 1.5),
+        height: h,
+        width: w,
+    }
 }

@@ -54,7 +54,8 @@ impl GpuEncoder {
             let code = gpu.buffer(CODE_SIZE);
             let mut dispatches = Vec::new();
             let size = [1, input.width];
-            net.record_encoder(gpu, &mut dispatches, params, &pixels, size, &code, false);
+            net.encoder
+                .record(gpu, &mut dispatches, params, &pixels, size, &code, false);
             Arc::new(EncoderRun {
                 input: pixels,
                 code,

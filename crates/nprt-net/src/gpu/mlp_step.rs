@@ -1,20 +1,15 @@
-//! Recording primitives: a strided matrix product with its epilogue (which the frame path's
-//! dense layers use too), and, for the training step, sums of columns and an MLP's forward pass
-//! (keeping what backward needs) and backward pass, each a few dispatches appended to a plan.
+//! An MLP's share of a training step: the buffers its forward pass keeps for backward, and its
+//! backward pass into every layer's gradients (the weights' summed over chunks of rows).
 
 use super::codes::{activation_code, BACKWARD};
+use super::dense_products::DenseProducts;
 use super::gpu_trainer::GpuTrainer;
 use super::half_layers::held_halves;
-use super::kernels::{COLUMN_SUM, GEMM, GEMM_TILE};
+use super::kernels::GEMM_TILE;
 use super::network_layout::MlpAt;
 use super::operands::{Bias, Operand, Output};
-use super::{groups_for, Dispatch, GpuDevice};
+use super::Dispatch;
 
-/// Rows a `column_sum` thread adds before the chunks' sums are added in a further pass (and
-/// theirs in another, as a tree). Short: a thread's adds are a chain of dependent loads, and on
-/// an H100 256 of them made each sum over a 16,384-row batch about 35 µs where the data takes a
-/// few (`nprt bench train --profile`, 2026-11-27).
-const COLUMN_CHUNK: usize = 64;
 /// A weight gradient's product is split into chunks of at least ROW_CHUNK rows, at most
 /// ROW_CHUNKS of them (a 256 × 256 layer at batch 16,384: 32 chunks of 512 rows, 512
 /// workgroups instead of 16).
@@ -42,129 +37,6 @@ pub(super) struct MlpTape {
     pub input16: Option<wgpu::Buffer>,
     pub outputs: Vec<wgpu::Buffer>,
     pub pre: Vec<wgpu::Buffer>,
-}
-
-/// The matrix products of dense layers on the device (training's and the frame path's).
-pub trait DenseProducts {
-    /// The dispatch of C = A·B for `[m, n, k]` (C m × n), with `bias` and `activation` (0
-    /// linear, 1 ReLU, 2 SIREN) after, the pre-activation kept in `z` where given: a dense
-    /// layer's forward pass, and every product of its backward pass; `activation` 3 or 4
-    /// multiplies by ReLU's or SIREN's derivative at the values `z` holds instead (the
-    /// gradient at a hidden layer's pre-activation).
-    #[allow(clippy::too_many_arguments)]
-    fn product(
-        &self,
-        shape: [usize; 3],
-        a: Operand,
-        b: Operand,
-        bias: Bias,
-        activation: u32,
-        c: Output,
-        z: Option<&wgpu::Buffer>,
-    ) -> Dispatch;
-
-    /// The dispatch of `chunks` products, each over `k_chunk` consecutive values of k (the last
-    /// over what is left), into consecutive m × n blocks of `c` (row stride n), which
-    /// [`GpuTrainer::column_sum`] then adds: a product over many k (a weight's gradient over a
-    /// batch) on chunks × tiles workgroups instead of tiles alone.
-    fn split_product(
-        &self,
-        shape: [usize; 3],
-        a: Operand,
-        b: Operand,
-        split: [usize; 2],
-        c: &wgpu::Buffer,
-    ) -> Dispatch;
-}
-
-impl DenseProducts for GpuDevice {
-    fn product(
-        &self,
-        shape: [usize; 3],
-        a: Operand,
-        b: Operand,
-        bias: Bias,
-        activation: u32,
-        c: Output,
-        z: Option<&wgpu::Buffer>,
-    ) -> Dispatch {
-        gemm(self, shape, a, b, bias, activation, c, z, None)
-    }
-
-    fn split_product(
-        &self,
-        [m, n, k]: [usize; 3],
-        a: Operand,
-        b: Operand,
-        [k_chunk, chunks]: [usize; 2],
-        c: &wgpu::Buffer,
-    ) -> Dispatch {
-        let out = Output::to(c, 0, n);
-        gemm(
-            self,
-            [m, n, k],
-            a,
-            b,
-            Bias::None,
-            0,
-            out,
-            None,
-            Some([k_chunk, chunks]),
-        )
-    }
-}
-
-#[allow(clippy::too_many_arguments)]
-fn gemm(
-    gpu: &GpuDevice,
-    [m, n, k]: [usize; 3],
-    a: Operand,
-    b: Operand,
-    bias: Bias,
-    activation: u32,
-    c: Output,
-    z: Option<&wgpu::Buffer>,
-    split: Option<[usize; 2]>,
-) -> Dispatch {
-    let (bias_mode, bias_buffer, bias_off, groups) = bias.binding(gpu);
-    let [k_chunk, chunks] = split.unwrap_or([0, 1]);
-    let params = [
-        m,
-        n,
-        k,
-        a.offset,
-        a.rows,
-        a.cols,
-        b.offset,
-        b.rows,
-        b.cols,
-        c.stride,
-        bias_mode,
-        activation as usize,
-        usize::from(c.accumulate),
-        // Backward z is read, not kept.
-        usize::from(z.is_some() && activation < 1 + BACKWARD),
-        bias_off,
-        c.offset,
-        k_chunk,
-        m * n,
-        a.ones_row.map_or(0, |r| r + 1),
-        0,
-    ];
-    let tiles = |v: usize| (v as u32).div_ceil(GEMM_TILE);
-    gpu.prepare_grid(
-        &GEMM,
-        &params.map(|v| v as u32),
-        &[
-            a.buffer,
-            b.buffer,
-            bias_buffer,
-            groups,
-            c.buffer,
-            z.unwrap_or(&gpu.spare),
-        ],
-        [tiles(n), tiles(m), chunks as u32],
-    )
 }
 
 impl GpuTrainer {
@@ -240,7 +112,7 @@ impl GpuTrainer {
             );
             match first_bias {
                 Some(f) => f(plan, dz),
-                None if !folded => self.column_sum(
+                None if !folded => self.gpu.column_sum(
                     plan,
                     dz,
                     rows,
@@ -309,51 +181,7 @@ impl GpuTrainer {
             self.gpu
                 .split_product([rows_of_c, n, rows], a, b, [chunk, chunks], &partial),
         );
-        self.column_sum(plan, &partial, chunks, rows_of_c * n, None, out);
-    }
-
-    /// Records the sums over `rows` rows of the `n` columns of `x`, per group where `groups`
-    /// gives each row's group and their number, into `out`. Past [`COLUMN_CHUNK`] rows the sums
-    /// are made per chunk of rows, then over the chunks, in a fixed order either way.
-    pub(super) fn column_sum(
-        &self,
-        plan: &mut Vec<Dispatch>,
-        x: &wgpu::Buffer,
-        rows: usize,
-        n: usize,
-        groups: Option<(&wgpu::Buffer, usize)>,
-        out: Output,
-    ) {
-        let (group_of, count) = groups.unwrap_or((&self.gpu.empty, 1));
-        if rows <= COLUMN_CHUNK {
-            let [tail_at, tail_off] = out.tail.unwrap_or([0, 0]);
-            let params = [
-                rows,
-                n,
-                count,
-                usize::from(out.accumulate),
-                out.offset,
-                0,
-                tail_at,
-                tail_off,
-            ];
-            plan.push(self.gpu.prepare(
-                &COLUMN_SUM,
-                &params.map(|v| v as u32),
-                &[x, group_of, out.buffer],
-                groups_for(count * n),
-            ));
-            return;
-        }
-        let chunks = rows.div_ceil(COLUMN_CHUNK);
-        let partial = self.gpu.buffer(chunks * count * n);
-        let params = [rows, n, count, 0, 0, COLUMN_CHUNK, 0, 0];
-        plan.push(self.gpu.prepare(
-            &COLUMN_SUM,
-            &params.map(|v| v as u32),
-            &[x, group_of, &partial],
-            groups_for(chunks * count * n),
-        ));
-        self.column_sum(plan, &partial, chunks, count * n, None, out);
+        self.gpu
+            .column_sum(plan, &partial, chunks, rows_of_c * n, None, out);
     }
 }
