@@ -4,7 +4,6 @@
 use std::path::PathBuf;
 
 use nprt_render::{DirectSampling, FrameCache, Relighter};
-use nprt_trace::TraceScene;
 use numpy::{AllowTypeChange, PyArray3, PyArrayLike2};
 use pyo3::prelude::*;
 
@@ -71,13 +70,13 @@ impl Model {
             seed,
             denoiser: None,
         };
-        let (s, map) = (&scene.scene, &envmap.map);
+        let map = &envmap.map;
         let (rgb, _) = py
             .detach(|| {
-                let ts = TraceScene::new(s);
                 let mut cache = FrameCache::default();
+                let ts = scene.traced();
                 self.relighter
-                    .frame(&mut cache, &ts, &camera, map, rotation, (), sampling)
+                    .frame(&mut cache, ts, &camera, map, rotation, (), sampling)
             })
             .or_py()?;
         Ok(arrays::image(py, &rgb, width as usize, height as usize))

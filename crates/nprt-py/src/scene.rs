@@ -1,7 +1,7 @@
 //! Scenes and environment maps (files, `builtin:` names, numpy arrays) and a path-traced
 //! reference frame of them.
 
-use std::sync::Arc;
+use std::sync::{Arc, OnceLock};
 
 use nprt_scene::SceneOptions;
 use nprt_trace::{render, PixelFilter, RenderSettings, TraceScene};
@@ -16,6 +16,17 @@ use crate::error::OrPy;
 pub struct Scene {
     pub spec: String,
     pub scene: Arc<nprt_scene::Scene>,
+    /// The scene made ready for tracing (its acceleration structure), at the first frame
+    /// rendered and kept for the next.
+    traced: OnceLock<TraceScene<'static>>,
+}
+
+impl Scene {
+    /// The scene ready for tracing, made once.
+    pub fn traced(&self) -> &TraceScene<'static> {
+        self.traced
+            .get_or_init(|| TraceScene::shared(self.scene.clone()))
+    }
 }
 
 #[pymethods]
@@ -78,6 +89,7 @@ pub fn load_scene(py: Python<'_>, spec: &str) -> PyResult<Scene> {
     Ok(Scene {
         spec: spec.to_string(),
         scene: Arc::new(scene),
+        traced: OnceLock::new(),
     })
 }
 
@@ -201,8 +213,8 @@ pub fn reference<'py>(
         filter: PixelFilter::Box,
         progress: false,
     };
-    let (s, map) = (&scene.scene, &envmap.map);
-    let frame = py.detach(|| render(&TraceScene::new(s), &camera, map, &settings));
+    let map = &envmap.map;
+    let frame = py.detach(|| render(scene.traced(), &camera, map, &settings));
     Ok(arrays::image(
         py,
         &frame.radiance,

@@ -408,7 +408,7 @@ impl Relighter {
     /// The scene on the device, uploaded unless it was the last frame's.
     #[cfg(feature = "wgpu")]
     fn raster(&self, ts: &TraceScene) -> Result<Arc<RasterGBuffer>> {
-        let key = std::ptr::from_ref(ts.scene) as usize;
+        let key = std::ptr::from_ref(&*ts.scene) as usize;
         self.raster
             .try_get(key, || RasterGBuffer::new(ts).map(Arc::new))
     }

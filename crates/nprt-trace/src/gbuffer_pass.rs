@@ -16,7 +16,7 @@ pub fn primary_sample(ts: &TraceScene, camera: &Camera, x: usize, y: usize) -> G
 pub(crate) fn gsample(ts: &TraceScene, ray: &CameraRay) -> GSample {
     match ray.hit {
         Some(hit) => {
-            let sp = surface_point(ts.scene, &hit, ray.dir);
+            let sp = surface_point(&ts.scene, &hit, ray.dir);
             let (kd, ks, alpha) = sp.params.gbuffer();
             GSample {
                 position: sp.p,

@@ -209,7 +209,7 @@ fn walk(
         if depth + 1 >= s.max_depth {
             return None;
         }
-        let sp = surface_point(ts.scene, &hit, dir);
+        let sp = surface_point(&ts.scene, &hit, dir);
         let frame = Frame3::new(sp.ns);
         let wo = frame.to_local(-dir);
         let bsdf = Bsdf::new(sp.params, ts.coatings[sp.material].as_ref())

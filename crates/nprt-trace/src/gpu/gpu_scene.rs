@@ -70,7 +70,7 @@ pub struct GpuScene {
 impl GpuScene {
     /// Uploads `ts`'s scene; refuses one whose triangles or textures a GPU buffer cannot hold.
     pub fn new(gpu: &GpuDevice, ts: &TraceScene) -> Result<Self> {
-        let scene = ts.scene;
+        let scene = &*ts.scene;
         let vertices: usize = scene.meshes.iter().map(|m| m.positions.len()).sum();
         let mut positions = Vec::with_capacity(3 * vertices);
         let mut attributes = Vec::with_capacity(5 * vertices);
