@@ -170,6 +170,8 @@ def evaluate(
     shown_views: Optional[int] = None,
     seed: Optional[int] = None,
     direct_spp: Optional[int] = None,
+    temporal_frames: Optional[int] = None,
+    temporal_res: Optional[int] = None,
     device: str = "cpu",
     progress: bool = True,
 ) -> Dict[str, Any]:
@@ -190,6 +192,20 @@ def train_deep_shading(
     callback: Optional[Callable[[Dict[str, Any]], Optional[bool]]] = None,
 ) -> Dict[str, Any]:
     """`nprt train-deep-shading` (the U-Net baseline) on `device` ("cpu", "gpu", "wgpu", "auto")."""
+
+def model_info(
+    model: Optional[PathLike] = None,
+    *,
+    arch: Optional[str] = None,
+    activation: Optional[str] = None,
+    encoder_width: Optional[int] = None,
+    encoding: Optional[str] = None,
+) -> Dict[str, Any]:
+    """`nprt model info`: the layer table and parameter counts of a trained model folder, or of
+    a design (`arch`: baseline, prt, albedo, dsep) untrained. Keys: config, layers (name, shape,
+    params), encoder_params, transport_params (without hash-grid entries, as the paper's Table
+    1), paper_params, grid_entries, total_params; for a model also dataset_hash, scene_hash,
+    level_gain."""
 
 def export(
     model: PathLike,

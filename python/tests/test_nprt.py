@@ -115,9 +115,11 @@ def test_train_render_and_evaluate(dataset, model, room, tmp_path):
     curve = nprt.loss_curve(model)
     assert curve["epoch"][-1] == pytest.approx(2.0)
     results = nprt.evaluate(dataset, [model], tmp_path / "report", views=1, timing_res=16,
-                            sh_spp=4, progress=False)
+                            sh_spp=4, temporal_frames=3, temporal_res=16, progress=False)
     names = [method["name"] for method in results["methods"]]
     assert any("dsep" in n for n in names) and "pt-5spp" in names
+    temporal = results["temporal"]
+    assert temporal["frames"] == 3 and len(temporal["methods"][0]["per_pair"]) == 2
     assert (tmp_path / "report" / "report.html").exists()
 
 
@@ -178,6 +180,29 @@ def test_verify_pack_export_render_and_deep_shading(dataset, model, tmp_path):
     run = nprt.train_deep_shading(dataset, tmp_path / "ds", epochs=1, callback=rows.append,
                                   progress=False)
     assert run["unet_params"] > 0 and len(rows) == 1 and np.isfinite(run["validation_loss"])
+
+
+def test_model_info_gives_the_layer_table_and_the_papers_counts(model):
+    for arch in ["baseline", "prt", "albedo", "dsep"]:
+        info = nprt.model_info(arch=arch)
+        # The transport counts are the paper's Table 1 (D/S within 2%, the others closer).
+        assert abs(info["transport_params"] / info["paper_params"] - 1) < 0.02, info
+        assert sum(r["params"] for r in info["layers"]) == info["total_params"]
+        assert info["total_params"] == info["encoder_params"] + info["transport_params"]
+    grid = nprt.model_info(arch="dsep", encoding="hash-grid", encoder_width=64)
+    assert grid["grid_entries"] > 0 and grid["config"]["encoder_width"] == 64
+    trained, saved = nprt.model_info(model), nprt.Model(model).info
+    # model.json holds the config's fields at its top level.
+    assert all(saved[k] == v for k, v in trained["config"].items()), (trained, saved)
+    assert trained["transport_params"] == saved["transport_params"]
+    assert trained["dataset_hash"] == saved["dataset_hash"] != ""
+    with pytest.raises(ValueError, match="not both"):
+        nprt.model_info(model, arch="dsep")
+
+
+def test_the_compiled_module_is_one_abi3_build():
+    # One wheel for CPython 3.9 and later: the extension is built against the stable ABI.
+    assert nprt._nprt.__file__.endswith(".abi3.so"), nprt._nprt.__file__
 
 
 def test_errors_carry_the_cli_messages(tmp_path):

@@ -8,6 +8,7 @@
 
 use crate::method::MethodResult;
 use crate::metrics::Metrics;
+use crate::temporal::TemporalResult;
 
 /// Standard errors a difference must clear to decide a claim (about 95% two-sided).
 const DECISIVE_SE: f64 = 2.0;
@@ -108,6 +109,20 @@ impl Claim {
                 p.se,
                 p.lower_on,
                 p.views
+            ),
+            verdict: p.lower(),
+        }
+    }
+}
+
+impl Claim {
+    /// "`a` flickers less than `b`": judged on their temporal errors over the same frame pairs.
+    pub fn steadier(a: &TemporalResult, b: &TemporalResult) -> Claim {
+        let p = Paired::new(&a.per_pair, &b.per_pair);
+        Claim {
+            text: format!(
+                "{} flickers less than {} along the camera path (temporal error {:.4} vs {:.4}; per frame pair {:+.4} ± {:.4}, lower on {} of {})",
+                a.name, b.name, a.temporal_error, b.temporal_error, p.diff, p.se, p.lower_on, p.views
             ),
             verdict: p.lower(),
         }

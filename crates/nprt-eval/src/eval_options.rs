@@ -21,6 +21,10 @@ pub struct EvalOptions {
     pub seed: u64,
     /// Samples per pixel of the direct light of models that trace it.
     pub direct_spp: u32,
+    /// Frames of the temporal evaluation along a camera path (0: none).
+    pub temporal_frames: usize,
+    /// Side of its square frames.
+    pub temporal_res: u32,
     pub progress: bool,
 }
 
@@ -36,6 +40,8 @@ impl Default for EvalOptions {
             shown_views: 3,
             seed: 0,
             direct_spp: DEFAULT_DIRECT_SPP,
+            temporal_frames: 12,
+            temporal_res: 64,
             progress: true,
         }
     }

@@ -7,14 +7,15 @@ use std::path::PathBuf;
 
 use anyhow::{bail, Result};
 use nprt_data::dataset::Manifest;
+use nprt_data::dataset::Settings;
 use nprt_data::dataset::{load_checked_scene, load_manifest_hashed};
 use nprt_data::views::{load_views, ImageView};
 use nprt_net::training::training_set::open_recorded_map;
 use nprt_net::Engine;
 use nprt_render::oidn::Oidn;
 use nprt_render::DirectSampling;
-use nprt_scene::EnvMap;
-use nprt_trace::TraceScene;
+use nprt_scene::{EnvMap, Scene};
+use nprt_trace::{PixelFilter, RenderSettings, TraceScene};
 use serde::{Deserialize, Serialize};
 
 use crate::claim::Claim;
@@ -25,6 +26,7 @@ use crate::networks::{load_networks, run_networks, Net};
 use crate::path_tracing::{equal_time_spp, run_denoised, run_path_tracing, Traced};
 use crate::sh_prt::run_sh_prt;
 use crate::shown_view::ShownView;
+use crate::temporal::{run_temporal, Temporal, TemporalSetup};
 use crate::test_bench::TestBench;
 use crate::timing::{time_table, Timing};
 
@@ -56,6 +58,11 @@ pub struct Evaluation {
     /// Images of the shown views, per method (reference first), in the report's images folder.
     #[serde(skip)]
     pub shown: Vec<ShownView>,
+    /// Every method along a camera path (None where it was not run; `temporal_note` says why).
+    #[serde(default)]
+    pub temporal: Option<Temporal>,
+    #[serde(default)]
+    pub temporal_note: String,
 }
 
 /// Runs the whole evaluation: the networks first (the slowest Neural PRT design sets the
@@ -112,6 +119,10 @@ pub fn evaluate(o: &EvalOptions, engine: Engine) -> Result<Evaluation> {
     }
     baselines.extend(run_sh_prt(&mut bench, o.sh_spp));
     bench.bar.finish_and_clear();
+    let oidn_ok = oidn.as_ref().ok().copied();
+    let traced = (&pt5, equal_time.as_slice());
+    let (temporal, temporal_note) =
+        temporal_run(o, (&scene, &ts, s), &maps, &nets, traced, oidn_ok)?;
     results.push(pt5.result);
     results.extend(equal_time.into_iter().map(|(_, t)| t.result));
     results.extend(baselines);
@@ -148,7 +159,69 @@ pub fn evaluate(o: &EvalOptions, engine: Engine) -> Result<Evaluation> {
         denoiser,
         cpu_threads: rayon::current_num_threads(),
         shown: bench.shown,
+        temporal,
+        temporal_note,
     })
+}
+
+/// The temporal evaluation (`temporal::run_temporal`) at the options' frames and size, along
+/// the scene's camera volume, the lighting changing from the first held-out map to the second,
+/// with path tracing at the largest equal-time sample count (5 spp without one); or why it was
+/// not run.
+fn temporal_run(
+    o: &EvalOptions,
+    (scene, ts, settings): (&Scene, &TraceScene, &Settings),
+    maps: &BTreeMap<usize, EnvMap>,
+    nets: &[(Net, String)],
+    (pt5, equal_time): (&Traced, &[(u32, Traced)]),
+    oidn: Option<&'static Oidn>,
+) -> Result<(Option<Temporal>, String)> {
+    let (spp, pt) = equal_time
+        .iter()
+        .max_by_key(|(n, _)| *n)
+        .map_or((5, pt5), |(n, t)| (*n, t));
+    let path_tracing = (pt.result.name.as_str(), spp);
+    if o.temporal_frames == 0 {
+        return Ok((None, "not run (--temporal-frames 0)".into()));
+    }
+    if o.temporal_frames < 2 || o.temporal_res < 8 {
+        bail!("--temporal-frames must be 0 or at least 2, and --temporal-res at least 8");
+    }
+    let Some(volume) = &scene.camera_volume else {
+        let why = format!(
+            "not run: scene '{}' has no camera volume (a NAME.camera.json beside it) to move the camera through",
+            settings.scene
+        );
+        return Ok((None, why));
+    };
+    let mut held_out = maps.values();
+    let first = held_out.next().expect("a map per test view");
+    let tracer = |spp, seed| RenderSettings {
+        spp,
+        max_depth: settings.max_depth,
+        rr_depth: settings.rr_depth,
+        seed,
+        filter: PixelFilter::Centre,
+        progress: false,
+    };
+    let setup = TemporalSetup {
+        ts,
+        volume,
+        maps: [first, held_out.next().unwrap_or(first)],
+        frames: o.temporal_frames,
+        resolution: [o.temporal_res; 2],
+        reference_spp: settings.test_spp.unwrap_or(settings.spp),
+        tracer: &tracer,
+        seed: o.seed,
+        direct_spp: o.direct_spp,
+    };
+    let rows = nets.len()
+        + nets.iter().filter(|(n, _)| n.traces_direct()).count() * usize::from(oidn.is_some());
+    let steps = (o.temporal_frames * (rows + 2)) as u64;
+    let bar = nprt_io::progress_bar(o.progress, steps, "along a camera path", "frames");
+    let t = run_temporal(&setup, nets, path_tracing, oidn, &|| bar.inc(1))?;
+    bar.finish_and_clear();
+    Ok((Some(t), String::new()))
 }
 
 /// The maps of the views evaluated, by index: only those, since a dataset with a fresh map per
@@ -315,7 +388,28 @@ impl Evaluation {
                 out.push(Claim::beats(m, other, l1));
             }
         }
+        out.extend(self.temporal_checks());
         out
+    }
+
+    /// The paper's argument from temporal artefacts: D/S flickers less than Deep Shading and
+    /// than denoised path tracing of its cost, judged over the path's frame pairs.
+    fn temporal_checks(&self) -> Vec<Claim> {
+        let Some(t) = &self.temporal else {
+            return Vec::new();
+        };
+        let Some(ds) = t.method("nprt-dsep") else {
+            return Vec::new();
+        };
+        let denoised = t
+            .methods
+            .iter()
+            .find(|m| m.name.starts_with("pt-") && m.name.ends_with(" + OIDN"));
+        [t.method("deep-shading"), denoised]
+            .into_iter()
+            .flatten()
+            .map(|other| Claim::steadier(ds, other))
+            .collect()
     }
 }
 

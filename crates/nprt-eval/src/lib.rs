@@ -29,6 +29,7 @@ pub mod sh;
 mod sh_prt;
 mod shown_view;
 mod stopwatch;
+pub mod temporal;
 mod test_bench;
 mod timing;
 

@@ -57,7 +57,7 @@ pub use loss::Loss;
 pub use model::config::{ModelConfig, DEFAULT_ENCODER_WIDTH, DEFAULT_MAP_NORM};
 pub use model::direct_light::DirectLight;
 pub use model::folder::{load_model, read_model_file, ModelFile};
-pub use model::layer_table::layer_table;
+pub use model::layer_table::{layer_table, ModelSummary};
 pub use network::activation::{Activation, OMEGA_0};
 pub use network::design::{Design, TRANSPORT_CODE};
 pub use network::encoder::{LightEncoder, LightInput};

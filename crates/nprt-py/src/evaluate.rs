@@ -16,7 +16,8 @@ use crate::error::OrPy;
 #[pyfunction]
 #[pyo3(signature = (
     data, models, out, *, deep_shading = None, sh_spp = None, timing_res = None, views = None,
-    shown_views = None, seed = None, direct_spp = None, device = "cpu", progress = true
+    shown_views = None, seed = None, direct_spp = None, temporal_frames = None,
+    temporal_res = None, device = "cpu", progress = true
 ))]
 #[allow(clippy::too_many_arguments)]
 pub fn evaluate<'py>(
@@ -31,6 +32,8 @@ pub fn evaluate<'py>(
     shown_views: Option<usize>,
     seed: Option<u64>,
     direct_spp: Option<u32>,
+    temporal_frames: Option<usize>,
+    temporal_res: Option<u32>,
     device: &str,
     progress: bool,
 ) -> PyResult<Bound<'py, PyAny>> {
@@ -45,6 +48,8 @@ pub fn evaluate<'py>(
         shown_views: shown_views.unwrap_or(d.shown_views),
         seed: seed.unwrap_or(d.seed),
         direct_spp: direct_spp.unwrap_or(d.direct_spp),
+        temporal_frames: temporal_frames.unwrap_or(d.temporal_frames),
+        temporal_res: temporal_res.unwrap_or(d.temporal_res),
         progress,
     };
     let engine = engine(device)?;

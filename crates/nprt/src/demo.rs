@@ -43,6 +43,8 @@ struct Plan {
     deep_shading: RunLength,
     sh_spp: u32,
     timing_res: u32,
+    /// The temporal evaluation's frames and their side.
+    temporal: (usize, u32),
     frames: usize,
     frame_res: u32,
 }
@@ -62,6 +64,7 @@ const FULL: Plan = Plan {
     deep_shading: RunLength::minutes(2.0),
     sh_spp: 256,
     timing_res: 512,
+    temporal: (12, 64),
     frames: 48,
     frame_res: 128,
 };
@@ -77,6 +80,7 @@ const QUICK: Plan = Plan {
     deep_shading: RunLength::epochs(2),
     sh_spp: 16,
     timing_res: 64,
+    temporal: (6, 32),
     frames: 4,
     frame_res: 48,
 };
@@ -135,6 +139,8 @@ pub fn run(a: DemoArgs) -> Result<()> {
                 deep_shading: Some(deep),
                 sh_spp: p.sh_spp,
                 timing_res: p.timing_res,
+                temporal_frames: p.temporal.0,
+                temporal_res: p.temporal.1,
                 ..EvalOptions::default()
             },
             out: report.clone(),

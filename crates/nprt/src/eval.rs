@@ -47,6 +47,15 @@ pub struct EvalArgs {
     /// traced`, traced per frame and counted in their time.
     #[arg(long, default_value_t = d().direct_spp)]
     direct_spp: u32,
+    /// Frames of the temporal evaluation: every method along a slow camera move through the
+    /// scene's camera volume, the lighting changing from one held-out map to another half-way,
+    /// scored frame to frame against path-traced references at the dataset's test spp (0 skips
+    /// it).
+    #[arg(long, default_value_t = d().temporal_frames)]
+    temporal_frames: usize,
+    /// Side of the temporal evaluation's square frames.
+    #[arg(long, default_value_t = d().temporal_res)]
+    temporal_res: u32,
     #[command(flatten)]
     device: DeviceArg,
 }
@@ -70,6 +79,8 @@ impl From<EvalArgs> for EvalJob {
                 shown_views: a.shown_views,
                 seed: a.seed,
                 direct_spp: a.direct_spp,
+                temporal_frames: a.temporal_frames,
+                temporal_res: a.temporal_res,
                 progress: true,
             },
             out: a.out,

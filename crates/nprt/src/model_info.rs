@@ -3,11 +3,7 @@
 use std::path::PathBuf;
 
 use anyhow::{bail, Result};
-use nprt_net::network::encoder::check_input_width;
-use nprt_net::{
-    layer_table, Activation, Design, Init, ModelConfig, NprtNet, PositionEncoding,
-    DEFAULT_ENCODER_WIDTH,
-};
+use nprt_net::{Activation, Design, ModelSummary, PositionEncoding, DEFAULT_ENCODER_WIDTH};
 
 #[derive(clap::Subcommand)]
 pub enum ModelCommand {
@@ -45,9 +41,9 @@ pub fn run(c: ModelCommand) -> Result<()> {
 }
 
 fn info(a: ModelInfoArgs) -> Result<()> {
-    let (config, net) = match (&a.model, a.arch) {
+    let summary = match (&a.model, a.arch) {
         (Some(dir), _) => {
-            let (file, net) = nprt_net::load_model(dir)?;
+            let (file, summary) = ModelSummary::of_model(dir)?;
             println!(
                 "model '{}': trained on dataset {} (scene {})",
                 dir.display(),
@@ -59,25 +55,19 @@ fn info(a: ModelInfoArgs) -> Result<()> {
                     "output calibrated to its training level: gain R {r:.3} G {g:.3} B {b:.3}"
                 );
             }
-            (file.config, net)
+            summary
         }
         (None, Some(arch)) => {
-            check_input_width(a.encoder_width)?;
-            let config = ModelConfig {
-                encoder_width: a.encoder_width,
-                encoding: a.encoding,
-                ..ModelConfig::new(arch, a.activation)
-            };
-            let net = config.build(&mut Init::new(0));
-            (config, net)
+            ModelSummary::of_design(arch, a.activation, a.encoder_width, a.encoding)?
         }
         (None, None) => bail!("give --arch or --model"),
     };
-    print_description(&config, &net);
+    print_description(&summary);
     Ok(())
 }
 
-fn print_description(config: &ModelConfig, net: &NprtNet) {
+fn print_description(s: &ModelSummary) {
+    let config = &s.config;
     println!(
         "design {} ({} transport layers), light encoder input {}×{}, map normalised by its {}, direct light {}, position encoding {}",
         config.design,
@@ -95,29 +85,26 @@ fn print_description(config: &ModelConfig, net: &NprtNet) {
         config.encoding
     );
     println!("{:<24} {:<22} {:>10}", "layer", "shape", "params");
-    for row in layer_table(net) {
+    for row in &s.layers {
         println!("{:<24} {:<22} {:>10}", row.name, row.shape, row.params);
     }
-    let transport = net.transport_params();
-    let grid = net.grid_params();
-    let encoder = net.total_params() - transport;
-    let paper = config.design.paper_params();
+    let (paper, transport) = (s.paper_params, s.transport_params);
     let mb = |params: usize| params as f64 * 4.0 / 1e6;
-    println!("encoder parameters:   {encoder:>10}");
+    println!("encoder parameters:   {:>10}", s.encoder_params);
     println!(
-        "transport parameters: {:>10} (paper: {paper}, {:+.2}%)",
-        transport - grid,
-        ((transport - grid) as f64 / paper as f64 - 1.0) * 100.0
+        "transport parameters: {transport:>10} (paper: {paper}, {:+.2}%)",
+        (transport as f64 / paper as f64 - 1.0) * 100.0
     );
-    if grid > 0 {
+    if s.grid_entries > 0 {
         println!(
-            "hash grid entries:    {grid:>10} ({:.2} MB as f32)",
-            mb(grid)
+            "hash grid entries:    {:>10} ({:.2} MB as f32)",
+            s.grid_entries,
+            mb(s.grid_entries)
         );
     }
     println!(
         "total parameters:     {:>10} ({:.2} MB as f32)",
-        transport + encoder,
-        mb(transport + encoder)
+        s.total_params,
+        mb(s.total_params)
     );
 }

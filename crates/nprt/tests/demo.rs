@@ -182,6 +182,7 @@ fn quick_demo_then_render_and_eval() {
         "noise floor {floor}, best L1 {best}"
     );
     assert_eq!(results["reference_spp"], 32);
+    temporal_stability_is_reported(&results, &md, &report);
     let html = std::fs::read_to_string(report.join("report.html")).unwrap();
     assert!(
         !html.contains("src=\"images/") && html.matches("data:image/png;base64,").count() > 20,
@@ -358,4 +359,54 @@ fn gpu_frames_match(render: &dyn Fn(&Path, &str) -> String, cpu_frames: &Path) {
             "frame {frame}: {beyond} pixels off, median {median}"
         );
     }
+}
+
+/// The temporal evaluation (`--temporal-frames`, the quick demo's 6 at 32²): every network and
+/// path-traced row along the camera path, each frame pair and frame scored, the references' own
+/// floor below path tracing's, and the report's table, plot, strips and claims. Path tracing's
+/// fresh noise in every frame makes it flicker more than D/S, whose frames change only with the
+/// view and the light.
+fn temporal_stability_is_reported(results: &Value, md: &str, report: &Path) {
+    let t = &results["temporal"];
+    assert_eq!(t["frames"], 6, "{t}");
+    assert_eq!(t["change_at"], 3, "{t}");
+    let methods = t["methods"].as_array().unwrap();
+    let row = |n: &str| {
+        methods
+            .iter()
+            .find(|m| m["name"].as_str().unwrap() == n)
+            .unwrap_or_else(|| panic!("{n} missing from the temporal rows"))
+    };
+    for m in methods {
+        let e = m["temporal_error"].as_f64().unwrap();
+        assert!(e.is_finite() && e >= 0.0, "{m}");
+        assert_eq!(m["per_pair"].as_array().unwrap().len(), 5, "{m}");
+        assert_eq!(m["per_frame_l1"].as_array().unwrap().len(), 6, "{m}");
+    }
+    for n in ["nprt-dsep", "nprt-baseline", "deep-shading"] {
+        row(n);
+    }
+    let pt = methods
+        .iter()
+        .find(|m| m["name"].as_str().unwrap().starts_with("pt-equal-time"))
+        .expect("an equal-time path-tracing row");
+    let err = |m: &Value| m["temporal_error"].as_f64().unwrap();
+    let floor = t["noise_floor"].as_f64().unwrap();
+    assert!(
+        err(pt) > err(row("nprt-dsep")) && err(pt) > floor && floor > 0.0,
+        "path tracing {}, D/S {}, floor {floor}",
+        err(pt),
+        err(row("nprt-dsep"))
+    );
+    for want in [
+        "## Temporal stability along a camera path",
+        "| nprt-dsep | ",
+        "images/temporal-l1.png",
+        "images/temporal-nprt-dsep.png",
+        "images/temporal-nprt-dsep-diff.png",
+        "nprt-dsep flickers less than deep-shading along the camera path (",
+    ] {
+        assert!(md.contains(want), "report.md lacks {want}");
+    }
+    assert!(report.join("images/temporal-reference.png").is_file());
 }

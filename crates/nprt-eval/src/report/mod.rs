@@ -10,6 +10,7 @@ use nprt_io::write_file;
 
 mod html;
 mod pictures;
+mod temporal_section;
 
 use html::to_html;
 use pictures::{auto_exposure, crop, crop_window, heat_map, save, HEAT_MAX, ZOOM};
@@ -19,13 +20,13 @@ use crate::method::BINS;
 use crate::metrics::{Metrics, RELATIVE_EPS};
 
 /// A method name as a file-name part.
-fn slug(name: &str) -> String {
+pub(super) fn slug(name: &str) -> String {
     name.chars()
         .map(|c| if c.is_ascii_alphanumeric() { c } else { '-' })
         .collect()
 }
 
-fn fmt(v: f64) -> String {
+pub(super) fn fmt(v: f64) -> String {
     if !v.is_finite() {
         "–".into()
     } else if v != 0.0 && (v.abs() < 1e-3 || v.abs() >= 1e4) {
@@ -58,6 +59,7 @@ pub fn write_report(e: &Evaluation, dir: &Path) -> Result<(PathBuf, PathBuf)> {
     claims(&mut md, e)?;
     timings(&mut md, e)?;
     error_analysis(&mut md, e, dir)?;
+    temporal_section::temporal(&mut md, e, dir)?;
     images(&mut md, e, dir)?;
     training_curves(&mut md, e, dir)?;
     let md_path = dir.join("report.md");
@@ -255,7 +257,7 @@ fn images(md: &mut String, e: &Evaluation, dir: &Path) -> Result<()> {
     writeln!(md, "\n## Images\n\nPer view: full frames, a {ZOOM}× crop where the first network errs most, and relative-error heat maps \
         (|error| / (reference + {RELATIVE_EPS}), black 0 → pale yellow ≥ {HEAT_MAX}). Exposure set per view from the reference.\n")?;
     for v in &e.shown {
-        let exposure = auto_exposure(v);
+        let exposure = auto_exposure(&v.reference, &v.mask);
         let first = v
             .methods
             .first()

@@ -16,11 +16,12 @@ pub(super) const HEAT_MAX: f32 = 0.5;
 /// Magnification of crops.
 pub(super) const ZOOM: usize = 3;
 
-/// Exposure (stops) putting the 90th percentile of the foreground's luminance at 0.7.
-pub(super) fn auto_exposure(v: &ShownView) -> f32 {
-    let mut l: Vec<f32> = (0..v.mask.len())
-        .filter(|&i| v.mask[i] > 0.5)
-        .map(|i| luminance(v.reference[i]))
+/// Exposure (stops) putting the 90th percentile of the foreground's luminance in `reference`
+/// at 0.7.
+pub(super) fn auto_exposure(reference: &[Vec3], mask: &[f32]) -> f32 {
+    let mut l: Vec<f32> = (0..mask.len())
+        .filter(|&i| mask[i] > 0.5)
+        .map(|i| luminance(reference[i]))
         .collect();
     if l.is_empty() {
         return 0.0;

@@ -1,9 +1,23 @@
-//! The layer table of `nprt model info`: every parameterised layer with its shape and count.
+//! What `nprt model info` (and `nprt.model_info` in Python) says of a network: every
+//! parameterised layer with its shape and count, and the counts the paper's Table 1 compares.
 
+use std::path::Path;
+
+use anyhow::Result;
+use serde::Serialize;
+
+use crate::encoding::position_encoding::PositionEncoding;
+use crate::init::Init;
+use crate::model::config::ModelConfig;
+use crate::model::folder::{load_model, ModelFile};
+use crate::network::activation::Activation;
+use crate::network::design::Design;
+use crate::network::encoder::check_input_width;
 use crate::network::nprt_net::NprtNet;
 use crate::network::parameters::Parameters;
 
 /// One row of `nprt model info`.
+#[derive(Serialize)]
 pub struct LayerRow {
     pub name: String,
     pub shape: String,
@@ -65,4 +79,60 @@ pub fn layer_table(net: &NprtNet) -> Vec<LayerRow> {
         }
     }
     rows
+}
+
+/// A network's layer table and parameter counts.
+#[derive(Serialize)]
+pub struct ModelSummary {
+    pub config: ModelConfig,
+    pub layers: Vec<LayerRow>,
+    /// The light encoder's parameters.
+    pub encoder_params: usize,
+    /// The transport networks' parameters without hash-grid entries (as the paper's Table 1).
+    pub transport_params: usize,
+    /// The design's count in the paper's Table 1.
+    pub paper_params: usize,
+    /// Hash-grid entries (0 without a grid).
+    pub grid_entries: usize,
+    pub total_params: usize,
+}
+
+impl ModelSummary {
+    /// A design's summary, untrained: `activation` None is the paper's for the design.
+    pub fn of_design(
+        design: Design,
+        activation: Option<Activation>,
+        encoder_width: usize,
+        encoding: PositionEncoding,
+    ) -> Result<Self> {
+        check_input_width(encoder_width)?;
+        let config = ModelConfig {
+            encoder_width,
+            encoding,
+            ..ModelConfig::new(design, activation)
+        };
+        Ok(Self::new(&config, &config.build(&mut Init::new(0))))
+    }
+
+    /// A trained model folder's summary (its config and weights checked as loading does), and
+    /// its model file.
+    pub fn of_model(dir: &Path) -> Result<(ModelFile, Self)> {
+        let (file, net) = load_model(dir)?;
+        let summary = Self::new(&file.config, &net);
+        Ok((file, summary))
+    }
+
+    pub fn new(config: &ModelConfig, net: &NprtNet) -> Self {
+        let transport = net.transport_params();
+        let grid = net.grid_params();
+        ModelSummary {
+            config: config.clone(),
+            layers: layer_table(net),
+            encoder_params: net.total_params() - transport,
+            transport_params: transport - grid,
+            paper_params: config.design.paper_params(),
+            grid_entries: grid,
+            total_params: net.total_params(),
+        }
+    }
 }
