@@ -172,6 +172,7 @@ def evaluate(
     direct_spp: Optional[int] = None,
     temporal_frames: Optional[int] = None,
     temporal_res: Optional[int] = None,
+    nrc_warmup: Optional[int] = None,
     device: str = "cpu",
     progress: bool = True,
 ) -> Dict[str, Any]:

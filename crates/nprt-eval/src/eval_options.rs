@@ -25,6 +25,8 @@ pub struct EvalOptions {
     pub temporal_frames: usize,
     /// Side of its square frames.
     pub temporal_res: u32,
+    /// Frames the warmed radiance caches render before the path's first (0: cold ones only).
+    pub nrc_warmup: usize,
     pub progress: bool,
 }
 
@@ -42,6 +44,7 @@ impl Default for EvalOptions {
             direct_spp: DEFAULT_DIRECT_SPP,
             temporal_frames: 12,
             temporal_res: 64,
+            nrc_warmup: 8,
             progress: true,
         }
     }

@@ -7,7 +7,6 @@ use std::path::PathBuf;
 
 use anyhow::{bail, Result};
 use nprt_data::dataset::Manifest;
-use nprt_data::dataset::Settings;
 use nprt_data::dataset::{load_checked_scene, load_manifest_hashed};
 use nprt_data::views::{load_views, ImageView};
 use nprt_net::training::training_set::open_recorded_map;
@@ -122,7 +121,7 @@ pub fn evaluate(o: &EvalOptions, engine: Engine) -> Result<Evaluation> {
     let oidn_ok = oidn.as_ref().ok().copied();
     let traced = (&pt5, equal_time.as_slice());
     let (temporal, temporal_note) =
-        temporal_run(o, (&scene, &ts, s), &maps, &nets, traced, oidn_ok)?;
+        temporal_run(o, (&scene, &ts, &manifest), &maps, &nets, traced, oidn_ok)?;
     results.push(pt5.result);
     results.extend(equal_time.into_iter().map(|(_, t)| t.result));
     results.extend(baselines);
@@ -170,7 +169,7 @@ pub fn evaluate(o: &EvalOptions, engine: Engine) -> Result<Evaluation> {
 /// not run.
 fn temporal_run(
     o: &EvalOptions,
-    (scene, ts, settings): (&Scene, &TraceScene, &Settings),
+    (scene, ts, manifest): (&Scene, &TraceScene, &Manifest),
     maps: &BTreeMap<usize, EnvMap>,
     nets: &[(Net, String)],
     (pt5, equal_time): (&Traced, &[(u32, Traced)]),
@@ -181,6 +180,7 @@ fn temporal_run(
         .max_by_key(|(n, _)| *n)
         .map_or((5, pt5), |(n, t)| (*n, t));
     let path_tracing = (pt.result.name.as_str(), spp);
+    let settings = &manifest.settings;
     if o.temporal_frames == 0 {
         return Ok((None, "not run (--temporal-frames 0)".into()));
     }
@@ -214,6 +214,8 @@ fn temporal_run(
         tracer: &tracer,
         seed: o.seed,
         direct_spp: o.direct_spp,
+        bounds: manifest.bounds,
+        nrc_warmup: o.nrc_warmup,
     };
     let rows = nets.len()
         + nets.iter().filter(|(n, _)| n.traces_direct()).count() * usize::from(oidn.is_some());
@@ -392,8 +394,9 @@ impl Evaluation {
         out
     }
 
-    /// The paper's argument from temporal artefacts: D/S flickers less than Deep Shading and
-    /// than denoised path tracing of its cost, judged over the path's frame pairs.
+    /// The paper's argument from temporal artefacts: D/S flickers less than Deep Shading, than
+    /// denoised path tracing of its cost and than the radiance caches trained online, judged
+    /// over the path's frame pairs.
     fn temporal_checks(&self) -> Vec<Claim> {
         let Some(t) = &self.temporal else {
             return Vec::new();
@@ -405,11 +408,16 @@ impl Evaluation {
             .methods
             .iter()
             .find(|m| m.name.starts_with("pt-") && m.name.ends_with(" + OIDN"));
-        [t.method("deep-shading"), denoised]
-            .into_iter()
-            .flatten()
-            .map(|other| Claim::steadier(ds, other))
-            .collect()
+        [
+            t.method("deep-shading"),
+            denoised,
+            t.method("nrc"),
+            t.method("nrc-cache"),
+        ]
+        .into_iter()
+        .flatten()
+        .map(|other| Claim::steadier(ds, other))
+        .collect()
     }
 }
 

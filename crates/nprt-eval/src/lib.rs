@@ -23,6 +23,7 @@ mod evaluate;
 mod method;
 pub mod metrics;
 mod networks;
+pub mod nrc;
 mod path_tracing;
 mod report;
 pub mod sh;

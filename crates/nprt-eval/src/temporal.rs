@@ -12,13 +12,17 @@ use glam::Vec3;
 use nprt_render::oidn::Oidn;
 use nprt_render::{CameraPath, DirectSampling};
 use nprt_scene::{Camera, CameraVolume, EnvMap};
-use nprt_trace::{render, render_gbuffer, GBuffer, RenderSettings, TraceScene};
+use nprt_trace::{render, render_gbuffer, CacheRead, GBuffer, RenderSettings, TraceScene};
 use serde::{Deserialize, Serialize};
+
+use std::time::Instant;
 
 use anyhow::Result;
 
 use crate::metrics::Metrics;
 use crate::networks::Net;
+use crate::nrc::{Nrc, NrcSettings};
+use crate::stopwatch::ms;
 
 /// Share of the scene's camera sweep (`CameraPath::through_volume`, across the volume and back)
 /// the frames cover: a slow move, as in a video.
@@ -42,6 +46,10 @@ pub struct TemporalSetup<'a> {
     pub tracer: &'a dyn Fn(u32, u64) -> RenderSettings,
     pub seed: u64,
     pub direct_spp: u32,
+    /// The scene's bounds (the radiance cache's positions are normalised by them).
+    pub bounds: [[f32; 3]; 2],
+    /// Frames the warmed caches render (at the first frame) before the first one measured.
+    pub nrc_warmup: usize,
 }
 
 /// One method's frames along the path, scored against the references.
@@ -54,6 +62,10 @@ pub struct TemporalResult {
     pub per_pair: Vec<f64>,
     /// Each frame's L1 error against its reference.
     pub per_frame_l1: Vec<f64>,
+    /// Mean milliseconds a frame cost on this machine (a network's G-buffer included; a
+    /// cache's training included).
+    #[serde(default)]
+    pub ms_per_frame: f64,
 }
 
 /// The temporal evaluation's results.
@@ -66,6 +78,9 @@ pub struct Temporal {
     pub change_at: usize,
     /// The maps' names, in order.
     pub maps: [String; 2],
+    /// Frames the warmed caches rendered before the first.
+    #[serde(default)]
+    pub nrc_warmup: usize,
     /// The references' own temporal error: their first halves of samples scored against the
     /// whole, a floor of noise under every method's figure.
     pub noise_floor: f64,
@@ -102,6 +117,11 @@ struct PathFrame {
 }
 
 impl TemporalSetup<'_> {
+    /// The map lighting frame `f`, placed.
+    fn lit(&self, f: &PathFrame) -> EnvMap {
+        self.maps[f.map].rotated_y(f.rotation)
+    }
+
     fn change_at(&self) -> usize {
         self.frames / 2
     }
@@ -126,11 +146,12 @@ impl TemporalSetup<'_> {
 }
 
 /// Every method's frames along the path (the networks, path tracing at `spp` and, with
-/// `oidn`, denoised), scored against references. `on_frame` hears each frame rendered.
+/// `oidn`, denoised, the radiance caches), scored against references. `on_frame` hears each
+/// frame rendered.
 pub fn run_temporal(
     setup: &TemporalSetup,
     nets: &[(Net, String)],
-    (pt_name, spp): (&str, u32),
+    path_tracing: (&str, u32),
     oidn: Option<&'static Oidn>,
     on_frame: &dyn Fn(),
 ) -> Result<Temporal> {
@@ -141,28 +162,82 @@ pub fn run_temporal(
         reference_spp: setup.reference_spp,
         change_at: setup.change_at(),
         maps: setup.maps.map(|m| m.name().to_string()),
+        nrc_warmup: setup.nrc_warmup,
         ..Temporal::default()
     };
-    let lit = |f: &PathFrame| setup.maps[f.map].rotated_y(f.rotation);
-    // References in two halves of different seeds: the whole, and the first half (the floor).
+    let refs = references(setup, &frames, on_frame);
+    let mut rows = network_rows(setup, &frames, &refs, nets, oidn, on_frame)?;
+    rows.extend(traced_rows(
+        setup,
+        &frames,
+        &refs,
+        path_tracing,
+        oidn,
+        on_frame,
+    )?);
+    rows.extend(cache_rows(setup, &frames, on_frame));
+    let width = setup.resolution[0] as usize;
+    let score =
+        |name: &str, rgb: &[Vec<Vec3>]| score(name, rgb, &refs.whole, &refs.gbuffers, width);
+    t.noise_floor = score("reference (half)", &refs.halves).temporal_error;
+    t.keep_strip("reference", &refs.whole, &refs.gbuffers);
+    for (name, rgb, ms_per_frame) in rows {
+        t.methods.push(TemporalResult {
+            ms_per_frame,
+            ..score(&name, &rgb)
+        });
+        t.keep_strip(&name, &rgb, &refs.gbuffers);
+    }
+    Ok(t)
+}
+
+/// A method's name, its frames along the path and their mean cost in milliseconds.
+type Row = (String, Vec<Vec<Vec3>>, f64);
+
+/// The path's references (in two halves of different seeds: the whole, and the first half,
+/// the floor) and G-buffers, with what a G-buffer cost.
+struct References {
+    whole: Vec<Vec<Vec3>>,
+    halves: Vec<Vec<Vec3>>,
+    gbuffers: Vec<GBuffer>,
+    gbuffer_ms: f64,
+}
+
+fn references(setup: &TemporalSetup, frames: &[PathFrame], on_frame: &dyn Fn()) -> References {
     let half = (setup.reference_spp / 2).max(1);
-    let mut references = Vec::new();
-    let mut halves = Vec::new();
-    let mut gbuffers = Vec::new();
+    let mut r = References {
+        whole: Vec::new(),
+        halves: Vec::new(),
+        gbuffers: Vec::new(),
+        gbuffer_ms: 0.0,
+    };
     for (i, f) in frames.iter().enumerate() {
-        let map = lit(f);
+        let map = setup.lit(f);
         let seed = |h: u64| setup.seed ^ 0x7e3a_0000 ^ (i as u64) << 8 ^ h;
         let a = render(setup.ts, &f.camera, &map, &(setup.tracer)(half, seed(1))).radiance;
         let b = render(setup.ts, &f.camera, &map, &(setup.tracer)(half, seed(2))).radiance;
-        references.push(a.iter().zip(&b).map(|(x, y)| (*x + *y) * 0.5).collect());
-        halves.push(a);
-        gbuffers.push(render_gbuffer(setup.ts, &f.camera));
+        r.whole
+            .push(a.iter().zip(&b).map(|(x, y)| (*x + *y) * 0.5).collect());
+        r.halves.push(a);
+        let t = Instant::now();
+        r.gbuffers.push(render_gbuffer(setup.ts, &f.camera));
+        r.gbuffer_ms += ms(t) / frames.len() as f64;
         on_frame();
     }
-    let width = setup.resolution[0] as usize;
-    let score = |name: &str, rgb: &[Vec<Vec3>]| score(name, rgb, &references, &gbuffers, width);
-    t.noise_floor = score("reference (half)", &halves).temporal_error;
-    t.keep_strip("reference", &references, &gbuffers);
+    r
+}
+
+/// Every network's frames (and, with `oidn`, those of a network that traces its direct light
+/// with that light denoised), each costing its G-buffer too.
+fn network_rows(
+    setup: &TemporalSetup,
+    frames: &[PathFrame],
+    refs: &References,
+    nets: &[(Net, String)],
+    oidn: Option<&'static Oidn>,
+    on_frame: &dyn Fn(),
+) -> Result<Vec<Row>> {
+    let mut rows = Vec::new();
     for (net, name) in nets {
         let denoisers = [None]
             .into_iter()
@@ -173,38 +248,113 @@ pub fn run_temporal(
                 Some(_) => format!("{name} + OIDN"),
             };
             let mut rgb = Vec::new();
-            for (i, (f, g)) in frames.iter().zip(&gbuffers).enumerate() {
+            let mut frame_ms = refs.gbuffer_ms;
+            for (i, (f, g)) in frames.iter().zip(&refs.gbuffers).enumerate() {
                 let sampling = DirectSampling {
                     spp: setup.direct_spp,
                     seed: setup.seed ^ 0x7e3a_d1ec ^ i as u64,
                     denoiser,
                 };
                 let map = (setup.maps[f.map], f.rotation);
-                rgb.push(net.shade(setup.ts, &f.camera, g, map, sampling)?.rgb);
+                let shaded = net.shade(setup.ts, &f.camera, g, map, sampling)?;
+                frame_ms += shaded.total_ms() / frames.len() as f64;
+                rgb.push(shaded.rgb);
                 on_frame();
             }
-            t.methods.push(score(&row, &rgb));
-            t.keep_strip(&row, &rgb, &gbuffers);
+            rows.push((row, rgb, frame_ms));
         }
     }
+    Ok(rows)
+}
+
+/// Path tracing at `spp` as `pt_name`, fresh seeds every frame, and with `oidn` the same
+/// denoised.
+fn traced_rows(
+    setup: &TemporalSetup,
+    frames: &[PathFrame],
+    refs: &References,
+    (pt_name, spp): (&str, u32),
+    oidn: Option<&'static Oidn>,
+    on_frame: &dyn Fn(),
+) -> Result<Vec<Row>> {
     let mut traced = Vec::new();
+    let mut traced_ms = 0.0;
     for (i, f) in frames.iter().enumerate() {
         let seed = setup.seed ^ 0x7e3a_5eed ^ (i as u64) << 8;
-        traced.push(render(setup.ts, &f.camera, &lit(f), &(setup.tracer)(spp, seed)).radiance);
+        let (map, settings) = (setup.lit(f), (setup.tracer)(spp, seed));
+        let start = Instant::now();
+        traced.push(render(setup.ts, &f.camera, &map, &settings).radiance);
+        traced_ms += ms(start) / frames.len() as f64;
         on_frame();
     }
-    t.methods.push(score(pt_name, &traced));
-    t.keep_strip(pt_name, &traced, &gbuffers);
+    let mut rows = Vec::new();
     if let Some(oidn) = oidn {
         let (w, h) = (setup.resolution[0] as usize, setup.resolution[1] as usize);
-        let denoised = (traced.iter().zip(&gbuffers))
+        let start = Instant::now();
+        let denoised = (traced.iter().zip(&refs.gbuffers))
             .map(|(f, g)| oidn.denoise_frame(f, g, w, h))
             .collect::<Result<Vec<_>>>()?;
-        let name = format!("{pt_name} + OIDN");
-        t.methods.push(score(&name, &denoised));
-        t.keep_strip(&name, &denoised, &gbuffers);
+        let denoise_ms = ms(start) / frames.len() as f64;
+        rows.push((
+            format!("{pt_name} + OIDN"),
+            denoised,
+            traced_ms + denoise_ms,
+        ));
     }
-    Ok(t)
+    rows.insert(0, (pt_name.to_string(), traced, traced_ms));
+    Ok(rows)
+}
+
+/// NRC and NRC-CACHE from a cold start, and each again warmed where `setup` asks.
+fn cache_rows(setup: &TemporalSetup, frames: &[PathFrame], on_frame: &dyn Fn()) -> Vec<Row> {
+    let warmups = match setup.nrc_warmup {
+        0 => vec![0],
+        n => vec![0, n],
+    };
+    let reads = [
+        ("nrc", CacheRead::Spread),
+        ("nrc-cache", CacheRead::FirstVertex),
+    ];
+    let mut rows = Vec::new();
+    for (name, read) in reads {
+        for &warmup in &warmups {
+            let row = match warmup {
+                0 => name.to_string(),
+                n => format!("{name} (warmed {n} frames)"),
+            };
+            let (rgb, frame_ms) = run_cache(setup, frames, read, warmup, on_frame);
+            rows.push((row, rgb, frame_ms));
+        }
+    }
+    rows
+}
+
+/// A radiance cache reading as `read` says, trained online frame after frame along `frames`
+/// from a cold start, after `warmup` frames at the first one; its frames and their mean cost.
+fn run_cache(
+    setup: &TemporalSetup,
+    frames: &[PathFrame],
+    read: CacheRead,
+    warmup: usize,
+    on_frame: &dyn Fn(),
+) -> (Vec<Vec<Vec3>>, f64) {
+    let path = (setup.tracer)(1, 0).path();
+    let seed = setup.seed ^ 0x7e3a_ca4e ^ u64::from(read == CacheRead::FirstVertex);
+    let mut nrc = Nrc::new(NrcSettings::new(read), &setup.bounds, seed);
+    let first = setup.lit(&frames[0]);
+    for _ in 0..warmup {
+        nrc.frame(setup.ts, &frames[0].camera, &first, &path);
+    }
+    let mut rgb = Vec::new();
+    let mut total_ms = 0.0;
+    for f in frames {
+        let map = setup.lit(f);
+        let start = Instant::now();
+        rgb.push(nrc.frame(setup.ts, &f.camera, &map, &path).0);
+        total_ms += ms(start);
+        on_frame();
+    }
+    (rgb, total_ms / frames.len() as f64)
 }
 
 /// A method's frames scored against the references: per pair and per frame.
@@ -232,6 +382,7 @@ fn score(
         temporal_error: per_pair.iter().sum::<f64>() / per_pair.len().max(1) as f64,
         per_pair,
         per_frame_l1,
+        ms_per_frame: 0.0,
     }
 }
 

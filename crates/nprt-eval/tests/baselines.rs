@@ -3,7 +3,8 @@
 
 use glam::{Vec2, Vec3};
 use nprt_eval::metrics::Metrics;
-use nprt_eval::sh::{basis, ShTransport};
+use nprt_eval::sh::ShTransport;
+use nprt_net::encoding::spherical_harmonics::basis;
 use nprt_scene::envmap::uv_to_direction;
 use nprt_scene::{Camera, EnvMap, Material, Mesh, Scene};
 use nprt_trace::{render, PixelFilter, RenderSettings, TraceScene};

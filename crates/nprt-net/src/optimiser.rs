@@ -60,15 +60,24 @@ pub struct Adam {
     moment1: Vec<f32>,
     moment2: Vec<f32>,
     steps: u64,
+    /// β1 and β2.
+    betas: [f32; 2],
 }
 
 impl Adam {
     /// Zero moments for `params` values.
     pub fn new(params: usize) -> Self {
+        Self::with_betas(params, [ADAM_BETA1, ADAM_BETA2])
+    }
+
+    /// Zero moments for `params` values, with decay rates of one's own (the radiance cache's
+    /// faster second moment, which follows a target that moves as it trains).
+    pub fn with_betas(params: usize, betas: [f32; 2]) -> Self {
         Adam {
             moment1: vec![0.0; params],
             moment2: vec![0.0; params],
             steps: 0,
+            betas,
         }
     }
 
@@ -78,7 +87,8 @@ impl Adam {
     /// trained nprt's models before, and the GPU kernels').
     pub fn step<N: Parameters>(&mut self, net: &mut N, grads: &N, lr: f64) {
         self.steps += 1;
-        let (factor, epsilon) = bias_corrections(self.steps);
+        let [beta1, beta2] = self.betas;
+        let (factor, epsilon) = bias_corrections_for(self.steps, self.betas);
         let lr = lr as f32;
         let g = grads.flat();
         let (m, v) = (&mut self.moment1, &mut self.moment2);
@@ -88,8 +98,8 @@ impl Adam {
             at = range.end;
             let moments = m[range.clone()].iter_mut().zip(&mut v[range.clone()]);
             for ((w, g), (m, v)) in w.iter_mut().zip(&g[range]).zip(moments) {
-                *m = *m * ADAM_BETA1 + *g * (1.0 - ADAM_BETA1);
-                *v = *v * ADAM_BETA2 + (*g * *g) * (1.0 - ADAM_BETA2);
+                *m = *m * beta1 + *g * (1.0 - beta1);
+                *v = *v * beta2 + (*g * *g) * (1.0 - beta2);
                 *w -= (*m * factor) / (v.sqrt() + epsilon) * lr;
             }
         });
@@ -110,9 +120,14 @@ impl Adam {
 /// Step `t`'s (from 1) bias corrections, as every engine's update takes them: the factor
 /// c = √(1 − β2^t) / (1 − β1^t) on the first moment, and ε · √(1 − β2^t).
 pub fn bias_corrections(t: u64) -> (f32, f32) {
+    bias_corrections_for(t, [ADAM_BETA1, ADAM_BETA2])
+}
+
+/// [`bias_corrections`] under decay rates `[β1, β2]`.
+fn bias_corrections_for(t: u64, [beta1, beta2]: [f32; 2]) -> (f32, f32) {
     let t = t.min(i32::MAX as u64) as i32;
-    let c2 = (1.0 - ADAM_BETA2.powi(t)).sqrt();
-    (c2 / (1.0 - ADAM_BETA1.powi(t)), ADAM_EPSILON * c2)
+    let c2 = (1.0 - beta2.powi(t)).sqrt();
+    (c2 / (1.0 - beta1.powi(t)), ADAM_EPSILON * c2)
 }
 
 /// Writes Adam's two moments (flat, in visiting order) and its step count to `path`.

@@ -17,7 +17,7 @@ use crate::error::OrPy;
 #[pyo3(signature = (
     data, models, out, *, deep_shading = None, sh_spp = None, timing_res = None, views = None,
     shown_views = None, seed = None, direct_spp = None, temporal_frames = None,
-    temporal_res = None, device = "cpu", progress = true
+    temporal_res = None, nrc_warmup = None, device = "cpu", progress = true
 ))]
 #[allow(clippy::too_many_arguments)]
 pub fn evaluate<'py>(
@@ -34,6 +34,7 @@ pub fn evaluate<'py>(
     direct_spp: Option<u32>,
     temporal_frames: Option<usize>,
     temporal_res: Option<u32>,
+    nrc_warmup: Option<usize>,
     device: &str,
     progress: bool,
 ) -> PyResult<Bound<'py, PyAny>> {
@@ -50,6 +51,7 @@ pub fn evaluate<'py>(
         direct_spp: direct_spp.unwrap_or(d.direct_spp),
         temporal_frames: temporal_frames.unwrap_or(d.temporal_frames),
         temporal_res: temporal_res.unwrap_or(d.temporal_res),
+        nrc_warmup: nrc_warmup.unwrap_or(d.nrc_warmup),
         progress,
     };
     let engine = engine(device)?;

@@ -2,6 +2,8 @@
 //! environment. `max_depth` counts path vertices as Mitsuba does (1: the emitter seen
 //! directly; 2: direct illumination; …), Russian roulette starts at `rr_depth`.
 
+use std::ops::ControlFlow;
+
 use glam::{Vec2, Vec3};
 use nprt_scene::{BsdfParams, Camera, EnvMap, Scene};
 use rand::RngExt;
@@ -133,28 +135,33 @@ pub struct PathSettings {
 }
 
 /// A surface vertex of a path, ready to shade.
-struct Vertex<'a> {
-    sp: SurfacePoint,
-    frame: Frame3,
-    wo: Vec3,
-    bsdf: Bsdf<'a>,
+pub(crate) struct Vertex<'a> {
+    pub sp: SurfacePoint,
+    pub frame: Frame3,
+    pub wo: Vec3,
+    pub bsdf: Bsdf<'a>,
     /// Throughput up to this vertex.
-    beta: Vec3,
+    pub beta: Vec3,
     /// Surface bounces before this vertex.
-    depth: u32,
+    pub depth: u32,
+    /// Length of the segment that reached it, and the density of the BSDF sample that chose
+    /// that segment's direction (0 for the camera ray) and whether it was a delta lobe's.
+    pub dist: f32,
+    pub pdf_in: f32,
+    pub delta_in: bool,
 }
 
 /// How a path left the scene.
-struct Escape {
-    dir: Vec3,
-    beta: Vec3,
+pub(crate) struct Escape {
+    pub dir: Vec3,
+    pub beta: Vec3,
     /// Surface bounces before leaving (0: the camera ray missed).
-    depth: u32,
+    pub depth: u32,
     /// Density of the BSDF sample that left (0 when `depth` is 0).
-    pdf: f32,
+    pub pdf: f32,
     /// The last bounce was a delta lobe (glass, a mask's pass-through): no light sample could
     /// have found this direction.
-    delta: bool,
+    pub delta: bool,
 }
 
 /// A ray from the camera and what it hits, traced once and shared by every path that starts
@@ -183,13 +190,14 @@ impl CameraRay {
 
 /// Follows a path by BSDF sampling, calling `at_surface` at each vertex before it scatters,
 /// until it leaves the scene (`Some`) or ends on a surface (absorbed, Russian roulette from
-/// `rr_depth`, or `max_depth` reached: `None`). The one walk behind both integrators.
-fn walk(
+/// `rr_depth`, `max_depth` reached, or `at_surface` breaking: `None`). The one walk behind
+/// every integrator.
+pub(crate) fn walk(
     ts: &TraceScene,
     ray: &CameraRay,
     s: &PathSettings,
     rng: &mut Pcg64Mcg,
-    mut at_surface: impl FnMut(&Vertex, &mut Pcg64Mcg),
+    mut at_surface: impl FnMut(&Vertex, &mut Pcg64Mcg) -> ControlFlow<()>,
 ) -> Option<Escape> {
     let (mut beta, mut pdf, mut depth, mut delta) = (Vec3::ONE, 0.0f32, 0u32, false);
     // Product of the relative indices crossed: Russian roulette judges the throughput as if
@@ -224,8 +232,13 @@ fn walk(
             bsdf,
             beta,
             depth,
+            dist: hit.t,
+            pdf_in: pdf,
+            delta_in: delta,
         };
-        at_surface(&v, rng);
+        if at_surface(&v, rng).is_break() {
+            return None;
+        }
         let bs = v
             .bsdf
             .sample(wo, Vec2::new(rng.random(), rng.random()), rng.random())?;
@@ -261,44 +274,52 @@ pub fn trace_path(
         return out;
     }
     let escape = walk(ts, ray, s, rng, |v, rng| {
-        if !v.bsdf.is_smooth() {
-            return;
+        let c = next_event(ts, env, v, rng);
+        out.total += c;
+        if v.depth == 0 {
+            out.direct += c;
         }
-        let (wi_world, le, light_pdf) =
-            env.sample(Vec3::new(rng.random(), rng.random(), rng.random()));
-        if light_pdf <= 0.0 {
-            return;
-        }
-        let wi = v.frame.to_local(wi_world);
-        let f = v.bsdf.eval(v.wo, wi);
-        if f != Vec3::ZERO
-            && !ts.accel.occluded(
-                offset_origin(v.sp.p, v.sp.ng, wi_world),
-                wi_world,
-                f32::INFINITY,
-            )
-        {
-            let c = v.beta * f * le * (mis(light_pdf, v.bsdf.pdf(v.wo, wi)) / light_pdf);
-            out.total += c;
-            if v.depth == 0 {
-                out.direct += c;
-            }
-        }
+        ControlFlow::Continue(())
     });
     if let Some(e) = escape {
-        let (le, light_pdf) = env.eval_pdf(e.dir);
-        let weight = if e.depth == 0 || e.delta {
-            1.0
-        } else {
-            mis(e.pdf, light_pdf)
-        };
-        let c = e.beta * le * weight;
+        let c = escaped(env, &e);
         out.total += c;
         if e.depth <= 1 {
             out.direct += c;
         }
     }
     out
+}
+
+/// Next-event estimation at `v`: a light sample towards the environment, weighted by MIS
+/// against BSDF sampling (nothing at a vertex with no smooth lobe).
+pub(crate) fn next_event(ts: &TraceScene, env: &EnvMap, v: &Vertex, rng: &mut Pcg64Mcg) -> Vec3 {
+    if !v.bsdf.is_smooth() {
+        return Vec3::ZERO;
+    }
+    let (wi_world, le, light_pdf) = env.sample(Vec3::new(rng.random(), rng.random(), rng.random()));
+    if light_pdf <= 0.0 {
+        return Vec3::ZERO;
+    }
+    let wi = v.frame.to_local(wi_world);
+    let f = v.bsdf.eval(v.wo, wi);
+    let origin = offset_origin(v.sp.p, v.sp.ng, wi_world);
+    if f == Vec3::ZERO || ts.accel.occluded(origin, wi_world, f32::INFINITY) {
+        return Vec3::ZERO;
+    }
+    v.beta * f * le * (mis(light_pdf, v.bsdf.pdf(v.wo, wi)) / light_pdf)
+}
+
+/// The environment's light along a path's escape, weighted by MIS against light sampling
+/// (fully where no light sample could have found it: the camera ray, or after a delta lobe).
+pub(crate) fn escaped(env: &EnvMap, e: &Escape) -> Vec3 {
+    let (le, light_pdf) = env.eval_pdf(e.dir);
+    let weight = if e.depth == 0 || e.delta {
+        1.0
+    } else {
+        mis(e.pdf, light_pdf)
+    };
+    e.beta * le * weight
 }
 
 /// Follows one path by BSDF sampling alone until it leaves the scene; returns the escape
@@ -310,7 +331,7 @@ pub fn trace_escape(
     s: &PathSettings,
     rng: &mut Pcg64Mcg,
 ) -> Option<(Vec3, Vec3)> {
-    walk(ts, ray, s, rng, |_, _| {})
+    walk(ts, ray, s, rng, |_, _| ControlFlow::Continue(()))
         .filter(|e| e.depth > 0)
         .map(|e| (e.dir, e.beta))
 }

@@ -30,6 +30,7 @@
 
 mod accel;
 mod bsdf;
+mod cached_path;
 mod coating;
 mod flat_bvh;
 mod frame;
@@ -49,10 +50,15 @@ mod transport_pass;
 
 pub use accel::{Accel, Hit};
 pub use bsdf::Bsdf;
+pub use cached_path::{
+    trace_cached, CachePath, CacheRead, CacheVertex, CachedPath, TrainingVertex, SPREAD,
+};
 pub use coating::Coating;
 pub use flat_bvh::{FlatBvh, NODE_WORDS, TRIANGLE_WORDS};
 pub use frame::{Frame, GBuffer, GSample};
 pub use gbuffer_pass::{primary_sample, render_gbuffer};
+pub use integrator::{CameraRay, PathSettings};
+pub use pixel_rng::pixel_rng;
 pub use reference::{render_reference, Reference, ReferenceOptions, DEFAULT_REFERENCE_SPP};
 pub use render::{render, render_direct, PixelFilter, RenderSettings};
 pub use trace_scene::TraceScene;

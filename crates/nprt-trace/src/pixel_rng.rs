@@ -13,6 +13,6 @@ fn mix(mut z: u64) -> u64 {
 
 /// The random stream of pixel `index` under `seed`: independent of thread count and order, so
 /// the same seed gives the same image.
-pub(crate) fn pixel_rng(seed: u64, index: u64) -> Pcg64Mcg {
+pub fn pixel_rng(seed: u64, index: u64) -> Pcg64Mcg {
     Pcg64Mcg::seed_from_u64(mix(seed.wrapping_mul(0x9e37_79b9_7f4a_7c15) ^ mix(index)))
 }

@@ -39,13 +39,20 @@ struct PixelOut {
     gb: GSample,
 }
 
+impl RenderSettings {
+    /// What each path of a render follows: its depth limit and Russian roulette.
+    pub fn path(&self) -> PathSettings {
+        PathSettings {
+            max_depth: self.max_depth.unwrap_or(u32::MAX),
+            rr_depth: self.rr_depth,
+        }
+    }
+}
+
 pub fn render(ts: &TraceScene, camera: &Camera, env: &EnvMap, s: &RenderSettings) -> Frame {
     let (w, h) = (camera.width as usize, camera.height as usize);
     let bar = nprt_io::progress_bar(s.progress, h as u64, "rendering", "rows");
-    let path_settings = PathSettings {
-        max_depth: s.max_depth.unwrap_or(u32::MAX),
-        rr_depth: s.rr_depth,
-    };
+    let path_settings = s.path();
     let rows: Vec<Vec<PixelOut>> = (0..h)
         .into_par_iter()
         .map(|y| {

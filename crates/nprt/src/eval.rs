@@ -56,6 +56,11 @@ pub struct EvalArgs {
     /// Side of the temporal evaluation's square frames.
     #[arg(long, default_value_t = d().temporal_res)]
     temporal_res: u32,
+    /// The Neural Radiance Cache baselines (NRC, NRC-CACHE) run along the temporal path from
+    /// a cold start, and again after rendering this many frames at its first frame (0: cold
+    /// only).
+    #[arg(long, default_value_t = d().nrc_warmup)]
+    nrc_warmup: usize,
     #[command(flatten)]
     device: DeviceArg,
 }
@@ -81,6 +86,7 @@ impl From<EvalArgs> for EvalJob {
                 direct_spp: a.direct_spp,
                 temporal_frames: a.temporal_frames,
                 temporal_res: a.temporal_res,
+                nrc_warmup: a.nrc_warmup,
                 progress: true,
             },
             out: a.out,

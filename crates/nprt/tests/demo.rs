@@ -361,11 +361,13 @@ fn gpu_frames_match(render: &dyn Fn(&Path, &str) -> String, cpu_frames: &Path) {
     }
 }
 
-/// The temporal evaluation (`--temporal-frames`, the quick demo's 6 at 32²): every network and
-/// path-traced row along the camera path, each frame pair and frame scored, the references' own
-/// floor below path tracing's, and the report's table, plot, strips and claims. Path tracing's
-/// fresh noise in every frame makes it flicker more than D/S, whose frames change only with the
-/// view and the light.
+/// The temporal evaluation (`--temporal-frames`, the quick demo's 6 at 32²): every network,
+/// path-traced and radiance-cache row along the camera path, each frame pair and frame scored
+/// and timed, the references' own floor below path tracing's (whose fresh noise every frame
+/// adds to the references'), and the report's table, plot, strips and claims. Which method
+/// flickers least is the claims' to judge: at 32 spp the references' noise is most of every
+/// figure (path tracing 0.070 to 0.082 against D/S's 0.074 over three runs, its equal-time
+/// sample count set by measured times).
 fn temporal_stability_is_reported(results: &Value, md: &str, report: &Path) {
     let t = &results["temporal"];
     assert_eq!(t["frames"], 6, "{t}");
@@ -383,8 +385,16 @@ fn temporal_stability_is_reported(results: &Value, md: &str, report: &Path) {
         assert_eq!(m["per_pair"].as_array().unwrap().len(), 5, "{m}");
         assert_eq!(m["per_frame_l1"].as_array().unwrap().len(), 6, "{m}");
     }
-    for n in ["nprt-dsep", "nprt-baseline", "deep-shading"] {
-        row(n);
+    for n in [
+        "nprt-dsep",
+        "nprt-baseline",
+        "deep-shading",
+        "nrc",
+        "nrc-cache",
+        "nrc (warmed 8 frames)",
+        "nrc-cache (warmed 8 frames)",
+    ] {
+        assert!(row(n)["ms_per_frame"].as_f64().unwrap() > 0.0, "{n}");
     }
     let pt = methods
         .iter()
@@ -393,10 +403,9 @@ fn temporal_stability_is_reported(results: &Value, md: &str, report: &Path) {
     let err = |m: &Value| m["temporal_error"].as_f64().unwrap();
     let floor = t["noise_floor"].as_f64().unwrap();
     assert!(
-        err(pt) > err(row("nprt-dsep")) && err(pt) > floor && floor > 0.0,
-        "path tracing {}, D/S {}, floor {floor}",
-        err(pt),
-        err(row("nprt-dsep"))
+        err(pt) > floor && floor > 0.0,
+        "path tracing {}, floor {floor}",
+        err(pt)
     );
     for want in [
         "## Temporal stability along a camera path",
@@ -405,6 +414,7 @@ fn temporal_stability_is_reported(results: &Value, md: &str, report: &Path) {
         "images/temporal-nprt-dsep.png",
         "images/temporal-nprt-dsep-diff.png",
         "nprt-dsep flickers less than deep-shading along the camera path (",
+        "nprt-dsep flickers less than nrc-cache along the camera path (",
     ] {
         assert!(md.contains(want), "report.md lacks {want}");
     }

@@ -33,18 +33,22 @@ pub(super) fn temporal(md: &mut String, e: &Evaluation, dir: &Path) -> Result<()
          (R_t − R_t−1)| on linear radiance: how much a method's frames change beyond what the \
          reference's change explains (0 for the reference itself). The references' own, their \
          first halves of samples against the whole: {}. SH PRT precomputes its transport per \
-         view and is not run along a path.\n",
+         view and is not run along a path. The Neural Radiance Cache (NRC: read where a path's \
+         footprint has spread; NRC-CACHE: read at the first vertex) trains online along the \
+         path from a cold start, and also after {} frames at the first frame (warmed); its \
+         time per frame includes its training.\n",
         t.frames,
         t.maps[0],
         t.change_at,
         t.maps[1],
         t.reference_spp,
-        fmt(t.noise_floor)
+        fmt(t.noise_floor),
+        t.nrc_warmup
     )?;
     let c = t.change_at;
     writeln!(
         md,
-        "| method | temporal error | mean L1 per frame | L1 at frame {} | L1 at frame {c} (new map) |\n|---|---|---|---|---|",
+        "| method | temporal error | mean L1 per frame | L1 at frame {} | L1 at frame {c} (new map) | ms per frame |\n|---|---|---|---|---|---|",
         c.saturating_sub(1)
     )?;
     for m in &t.methods {
@@ -53,12 +57,13 @@ pub(super) fn temporal(md: &mut String, e: &Evaluation, dir: &Path) -> Result<()
         let at = |i: usize| l1.get(i).copied().unwrap_or(f64::NAN);
         writeln!(
             md,
-            "| {} | {} | {} | {} | {} |",
+            "| {} | {} | {} | {} | {} | {:.1} |",
             m.name,
             fmt(m.temporal_error),
             fmt(mean),
             fmt(at(c.saturating_sub(1))),
-            fmt(at(c))
+            fmt(at(c)),
+            m.ms_per_frame
         )?;
     }
     let series: Vec<(String, Vec<(f64, f64)>)> = (t.methods.iter())

@@ -1,5 +1,6 @@
 //! The networks: the light encoder, dense layers and their activations, the transport tracks and
-//! their kinds, the four designs, the whole network, the Deep Shading U-Net, and the one
+//! their kinds, the four designs, the whole network, the Deep Shading U-Net, the Neural
+//! Radiance Cache's network, and the one
 //! weight type they all are to the model file and the optimiser (`parameters`).
 
 pub mod activation;
@@ -10,6 +11,7 @@ pub mod encoder;
 pub mod mlp;
 pub mod nprt_net;
 pub mod parameters;
+pub mod radiance_cache;
 pub mod track;
 pub mod track_kind;
 pub mod unet;
