@@ -60,8 +60,8 @@ pub struct TemporalResult {
     pub temporal_error: f64,
     /// Each consecutive pair's (frame t − 1 → t, t from 1).
     pub per_pair: Vec<f64>,
-    /// Each frame's L1 error against its reference.
-    pub per_frame_l1: Vec<f64>,
+    /// Each frame's errors against its reference.
+    pub per_frame: Vec<Metrics>,
     /// Mean milliseconds a frame cost on this machine (a network's G-buffer included; a
     /// cache's training included).
     #[serde(default)]
@@ -374,15 +374,22 @@ fn score(
             )
         })
         .collect();
-    let per_frame_l1 = (rgb.iter().zip(references).zip(gbuffers))
-        .map(|((m, r), g)| Metrics::compute(m, r, &g.mask, width).l1)
+    let per_frame = (rgb.iter().zip(references).zip(gbuffers))
+        .map(|((m, r), g)| Metrics::compute(m, r, &g.mask, width))
         .collect();
     TemporalResult {
         name: name.into(),
         temporal_error: per_pair.iter().sum::<f64>() / per_pair.len().max(1) as f64,
         per_pair,
-        per_frame_l1,
+        per_frame,
         ms_per_frame: 0.0,
+    }
+}
+
+impl TemporalResult {
+    /// Each frame's L1 error.
+    pub fn per_frame_l1(&self) -> Vec<f64> {
+        self.per_frame.iter().map(|m| m.l1).collect()
     }
 }
 

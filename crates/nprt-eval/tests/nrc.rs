@@ -93,7 +93,7 @@ fn a_change_of_sky_spikes_a_warmed_caches_error() {
     };
     let t = run_temporal(&setup, &[], ("pt", 4), None, &|| {}).unwrap();
     let c = t.change_at;
-    let l1 = |name: &str| t.method(name).unwrap().per_frame_l1.clone();
+    let l1 = |name: &str| t.method(name).unwrap().per_frame_l1();
     // Converged under the first sky, far off at the change (it still holds a · L), settled
     // again within a few frames (seen: 0.04 before, 1.02 at the change, 0.10 three frames on,
     // its noise at the brighter sky).

@@ -52,7 +52,7 @@ pub(super) fn temporal(md: &mut String, e: &Evaluation, dir: &Path) -> Result<()
         c.saturating_sub(1)
     )?;
     for m in &t.methods {
-        let l1 = &m.per_frame_l1;
+        let l1 = &m.per_frame_l1();
         let mean = l1.iter().sum::<f64>() / l1.len().max(1) as f64;
         let at = |i: usize| l1.get(i).copied().unwrap_or(f64::NAN);
         writeln!(
@@ -68,11 +68,8 @@ pub(super) fn temporal(md: &mut String, e: &Evaluation, dir: &Path) -> Result<()
     }
     let series: Vec<(String, Vec<(f64, f64)>)> = (t.methods.iter())
         .map(|m| {
-            let points = m.per_frame_l1.iter().enumerate();
-            (
-                m.name.clone(),
-                points.map(|(i, &v)| (i as f64, v)).collect(),
-            )
+            let points = m.per_frame_l1().into_iter().enumerate();
+            (m.name.clone(), points.map(|(i, v)| (i as f64, v)).collect())
         })
         .collect();
     let rel = "images/temporal-l1.png";
@@ -83,6 +80,18 @@ pub(super) fn temporal(md: &mut String, e: &Evaluation, dir: &Path) -> Result<()
         &series,
     )?;
     writeln!(md, "\n![L1 error per frame]({rel})\n")?;
+    writeln!(
+        md,
+        "Table 6's metrics along the path (× 10³, ± the standard error over the {} frames; \
+         consecutive frames are alike, so this spread understates the uncertainty):\n",
+        t.frames
+    )?;
+    super::table6::table6(
+        md,
+        t.methods
+            .iter()
+            .map(|m| (m.name.as_str(), m.per_frame.as_slice())),
+    )?;
     strips(md, t, dir)
 }
 

@@ -1,0 +1,59 @@
+//! The paper's Table 6 as it prints it: L1, L2, dSSIM, MAPE and MRSE × 10³ per method, here
+//! with each mean's standard error over the views (or frames) it averages.
+
+use std::fmt::Write as _;
+
+use anyhow::Result;
+
+use crate::metrics::Metrics;
+
+/// Table 6's metrics, by index into [`Metrics::values`].
+const TABLE6: [usize; 5] = [0, 1, 3, 4, 5];
+
+/// Writes the table for `rows` (a method's name and its per-view or per-frame metrics).
+pub(super) fn table6<'a>(
+    md: &mut String,
+    rows: impl Iterator<Item = (&'a str, &'a [Metrics])>,
+) -> Result<()> {
+    write!(md, "| method |")?;
+    for k in TABLE6 {
+        write!(md, " {} × 10³ |", Metrics::NAMES[k])?;
+    }
+    writeln!(md, "\n|---|{}", "---|".repeat(TABLE6.len()))?;
+    for (name, values) in rows {
+        write!(md, "| {name} |")?;
+        for k in TABLE6 {
+            let (mean, se) = mean_and_se(values.iter().map(|m| m.values()[k]));
+            write!(md, " {:.2} ± {:.2} |", 1e3 * mean, 1e3 * se)?;
+        }
+        writeln!(md)?;
+    }
+    writeln!(md)?;
+    Ok(())
+}
+
+/// The mean of `values` and its standard error (NaN with fewer than two).
+fn mean_and_se(values: impl Iterator<Item = f64>) -> (f64, f64) {
+    let v: Vec<f64> = values.collect();
+    let n = v.len() as f64;
+    let mean = v.iter().sum::<f64>() / n;
+    if v.len() < 2 {
+        return (mean, f64::NAN);
+    }
+    let var = v.iter().map(|x| (x - mean).powi(2)).sum::<f64>() / (n - 1.0);
+    (mean, (var / n).sqrt())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_standard_error_is_the_spread_over_root_n() {
+        let (mean, se) = mean_and_se([1.0, 2.0, 3.0, 4.0].into_iter());
+        assert_eq!(mean, 2.5);
+        // Sample variance 5/3 over 4 values.
+        assert!((se - (5.0f64 / 3.0 / 4.0).sqrt()).abs() < 1e-12);
+        assert!(mean_and_se([1.0].into_iter()).1.is_nan());
+    }
+}
