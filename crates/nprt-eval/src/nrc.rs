@@ -18,10 +18,12 @@ use nprt_trace::{
 use rand::seq::SliceRandom;
 use rand::RngExt;
 use rayon::prelude::*;
+use serde::{Deserialize, Serialize};
 
 /// How the cache renders and trains.
-#[derive(Clone, Copy, Debug)]
+#[derive(Clone, Copy, Debug, Serialize, Deserialize)]
 pub struct NrcSettings {
+    #[serde(skip, default = "spread")]
     pub read: CacheRead,
     /// Rendering paths per pixel.
     pub spp: u32,
@@ -33,6 +35,10 @@ pub struct NrcSettings {
     pub steps: usize,
     pub batch: usize,
     pub learning_rate: f64,
+}
+
+fn spread() -> CacheRead {
+    CacheRead::Spread
 }
 
 impl NrcSettings {
@@ -48,6 +54,13 @@ impl NrcSettings {
             learning_rate: 5e-3,
         }
     }
+}
+
+/// The Adam steps per frame that fit a cache's frame into `budget_ms`, from one frame's
+/// rendering time (`render_ms`, reads included) and one step's (`step_ms`): at least one, at
+/// most 16 (four times Müller et al.'s).
+pub fn steps_within(budget_ms: f64, render_ms: f64, step_ms: f64) -> usize {
+    (((budget_ms - render_ms) / step_ms.max(1e-6)).floor() as i64).clamp(1, 16) as usize
 }
 
 /// A cache rendering frame after frame, trained as it goes.
@@ -71,6 +84,11 @@ impl Nrc {
             seed,
             frames: 0,
         }
+    }
+
+    /// Trains `steps` Adam steps per frame from now on.
+    pub fn set_steps(&mut self, steps: usize) {
+        self.settings.steps = steps;
     }
 
     fn query(&self, v: &CacheVertex) -> CacheQuery {
@@ -159,5 +177,19 @@ impl Nrc {
         let targets: Vec<Vec3> = order.iter().map(|&k| targets[k]).collect();
         let loss = self.trainer.train(&queries, &targets, o.steps, o.batch);
         (frame, loss)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::steps_within;
+
+    #[test]
+    fn training_fills_what_rendering_leaves_of_the_budget() {
+        // 20 ms a frame, 8 of them rendering, 2.5 a step: four steps fit, five do not.
+        assert_eq!(steps_within(20.0, 8.0, 2.5), 4);
+        // Over budget already: it still trains, once.
+        assert_eq!(steps_within(5.0, 8.0, 2.5), 1);
+        assert_eq!(steps_within(1e6, 1.0, 1.0), 16);
     }
 }

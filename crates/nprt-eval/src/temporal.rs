@@ -21,7 +21,7 @@ use anyhow::Result;
 
 use crate::metrics::Metrics;
 use crate::networks::Net;
-use crate::nrc::{Nrc, NrcSettings};
+use crate::nrc::{steps_within, Nrc, NrcSettings};
 use crate::stopwatch::ms;
 
 /// Share of the scene's camera sweep (`CameraPath::through_volume`, across the volume and back)
@@ -81,6 +81,10 @@ pub struct Temporal {
     /// Frames the warmed caches rendered before the first.
     #[serde(default)]
     pub nrc_warmup: usize,
+    /// How the caches ran: their settings (Adam steps per frame chosen to fit the budget) and
+    /// the budget.
+    #[serde(default)]
+    pub nrc: Option<NrcBudget>,
     /// The references' own temporal error: their first halves of samples scored against the
     /// whole, a floor of noise under every method's figure.
     pub noise_floor: f64,
@@ -167,15 +171,15 @@ pub fn run_temporal(
     };
     let refs = references(setup, &frames, on_frame);
     let mut rows = network_rows(setup, &frames, &refs, nets, oidn, on_frame)?;
-    rows.extend(traced_rows(
-        setup,
-        &frames,
-        &refs,
-        path_tracing,
-        oidn,
-        on_frame,
-    )?);
-    rows.extend(cache_rows(setup, &frames, on_frame));
+    // The caches' budget: the D/S frame's time (else the slowest network's).
+    let budget = (rows.iter().find(|r| r.0 == "nprt-dsep"))
+        .or_else(|| rows.iter().max_by(|a, b| a.2.total_cmp(&b.2)))
+        .map(|r| r.2);
+    let traced = traced_rows(setup, &frames, &refs, path_tracing, oidn, on_frame)?;
+    rows.extend(traced);
+    let (caches, nrc) = cache_rows(setup, &frames, budget, on_frame);
+    rows.extend(caches);
+    t.nrc = Some(nrc);
     let width = setup.resolution[0] as usize;
     let score =
         |name: &str, rgb: &[Vec<Vec3>]| score(name, rgb, &refs.whole, &refs.gbuffers, width);
@@ -305,8 +309,26 @@ fn traced_rows(
     Ok(rows)
 }
 
-/// NRC and NRC-CACHE from a cold start, and each again warmed where `setup` asks.
-fn cache_rows(setup: &TemporalSetup, frames: &[PathFrame], on_frame: &dyn Fn()) -> Vec<Row> {
+/// What the radiance caches were given: the frame budget they were held to (the D/S frame's
+/// time, where there was one), what a frame's rendering and one training step measured, and
+/// the settings that fit (the steps per frame).
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct NrcBudget {
+    pub budget_ms: Option<f64>,
+    pub render_ms: f64,
+    pub step_ms: f64,
+    pub settings: NrcSettings,
+}
+
+/// NRC and NRC-CACHE from a cold start, and each again warmed where `setup` asks, each
+/// training as many steps per frame as fit `budget_ms` beside its rendering.
+fn cache_rows(
+    setup: &TemporalSetup,
+    frames: &[PathFrame],
+    budget_ms: Option<f64>,
+    on_frame: &dyn Fn(),
+) -> (Vec<Row>, NrcBudget) {
+    let fit = fit_budget(setup, &frames[0], budget_ms);
     let warmups = match setup.nrc_warmup {
         0 => vec![0],
         n => vec![0, n],
@@ -322,25 +344,57 @@ fn cache_rows(setup: &TemporalSetup, frames: &[PathFrame], on_frame: &dyn Fn()) 
                 0 => name.to_string(),
                 n => format!("{name} (warmed {n} frames)"),
             };
-            let (rgb, frame_ms) = run_cache(setup, frames, read, warmup, on_frame);
+            let settings = NrcSettings {
+                read,
+                ..fit.settings
+            };
+            let (rgb, frame_ms) = run_cache(setup, frames, settings, warmup, on_frame);
             rows.push((row, rgb, frame_ms));
         }
     }
-    rows
+    (rows, fit)
 }
 
-/// A radiance cache reading as `read` says, trained online frame after frame along `frames`
+/// Times a cache's frame at the path's first frame, without training and with four steps,
+/// and fits the steps per frame to `budget_ms` (four without one). A throwaway cache is timed:
+/// the measured ones start cold.
+fn fit_budget(setup: &TemporalSetup, first: &PathFrame, budget_ms: Option<f64>) -> NrcBudget {
+    let path = (setup.tracer)(1, 0).path();
+    let map = setup.lit(first);
+    let mut settings = NrcSettings::new(CacheRead::Spread);
+    let timed = |steps: usize| {
+        let mut nrc = Nrc::new(NrcSettings { steps, ..settings }, &setup.bounds, setup.seed);
+        // The first frame of a cold cache warms nothing up but the caches of the machine.
+        nrc.frame(setup.ts, &first.camera, &map, &path);
+        let start = Instant::now();
+        nrc.frame(setup.ts, &first.camera, &map, &path);
+        ms(start)
+    };
+    let render_ms = timed(0);
+    let step_ms = ((timed(4) - render_ms) / 4.0).max(1e-3);
+    if let Some(budget) = budget_ms {
+        settings.steps = steps_within(budget, render_ms, step_ms);
+    }
+    NrcBudget {
+        budget_ms,
+        render_ms,
+        step_ms,
+        settings,
+    }
+}
+
+/// A radiance cache with `settings`, trained online frame after frame along `frames`
 /// from a cold start, after `warmup` frames at the first one; its frames and their mean cost.
 fn run_cache(
     setup: &TemporalSetup,
     frames: &[PathFrame],
-    read: CacheRead,
+    settings: NrcSettings,
     warmup: usize,
     on_frame: &dyn Fn(),
 ) -> (Vec<Vec<Vec3>>, f64) {
     let path = (setup.tracer)(1, 0).path();
-    let seed = setup.seed ^ 0x7e3a_ca4e ^ u64::from(read == CacheRead::FirstVertex);
-    let mut nrc = Nrc::new(NrcSettings::new(read), &setup.bounds, seed);
+    let seed = setup.seed ^ 0x7e3a_ca4e ^ u64::from(settings.read == CacheRead::FirstVertex);
+    let mut nrc = Nrc::new(settings, &setup.bounds, seed);
     let first = setup.lit(&frames[0]);
     for _ in 0..warmup {
         nrc.frame(setup.ts, &frames[0].camera, &first, &path);

@@ -402,6 +402,10 @@ fn temporal_stability_is_reported(results: &Value, md: &str, report: &Path) {
         .iter()
         .find(|m| m["name"].as_str().unwrap().starts_with("pt-equal-time"))
         .expect("an equal-time path-tracing row");
+    // The caches were held to the D/S frame's time, their steps per frame fitted to it.
+    let nrc = &t["nrc"];
+    assert!(nrc["budget_ms"].as_f64().unwrap() > 0.0, "{nrc}");
+    assert!((1..=16).contains(&nrc["settings"]["steps"].as_u64().unwrap()), "{nrc}");
     let err = |m: &Value| m["temporal_error"].as_f64().unwrap();
     let floor = t["noise_floor"].as_f64().unwrap();
     assert!(
@@ -418,6 +422,7 @@ fn temporal_stability_is_reported(results: &Value, md: &str, report: &Path) {
         "nprt-dsep flickers less than deep-shading along the camera path (",
         "nprt-dsep flickers less than nrc-cache along the camera path (",
         "Table 6's metrics along the path",
+        "The radiance caches, held to the D/S frame's",
         "| nrc-cache (warmed 8 frames) | ",
     ] {
         assert!(md.contains(want), "report.md lacks {want}");

@@ -45,6 +45,24 @@ pub(super) fn temporal(md: &mut String, e: &Evaluation, dir: &Path) -> Result<()
         fmt(t.noise_floor),
         t.nrc_warmup
     )?;
+    if let Some(n) = &t.nrc {
+        let budget = match n.budget_ms {
+            Some(b) => format!("held to the D/S frame's {b:.1} ms"),
+            None => "given no network to be held to".into(),
+        };
+        writeln!(
+            md,
+            "The radiance caches, {budget}: a frame's rendering ({} path per pixel, its cache \
+             reads included) measured {:.1} ms and a training step ({} pairs) {:.1} ms, so they \
+             train {} step(s) per frame, a {:.0}% share of the pixels tracing a training path.\n",
+            n.settings.spp,
+            n.render_ms,
+            n.settings.batch,
+            n.step_ms,
+            n.settings.steps,
+            100.0 * n.settings.train_share
+        )?;
+    }
     let c = t.change_at;
     writeln!(
         md,
