@@ -214,6 +214,20 @@ fn validation_curve(dir: &Path, name: &str) -> Vec<(f64, f64)> {
     }
 }
 
+/// The rows a network gives: its own, and, with `oidn`, for a model that traces its direct
+/// light, one with that light denoised ("NAME + OIDN"); each with its denoiser.
+pub fn rows_of(
+    net: &Net,
+    name: &str,
+    oidn: Option<&'static Oidn>,
+) -> Vec<(String, Option<&'static Oidn>)> {
+    let mut rows = vec![(name.to_string(), None)];
+    if let Some(o) = oidn.filter(|_| net.traces_direct()) {
+        rows.push((format!("{name} + OIDN"), Some(o)));
+    }
+    rows
+}
+
 /// Every network on every test view; its cost per view is the G-buffer, the encoder, the
 /// network and any traced direct light, as at run time. A model that traces direct light runs
 /// a second time with that light denoised when `oidn` is given (a row of its own, "+ OIDN").
@@ -224,13 +238,10 @@ pub fn run_networks(
 ) -> Result<Vec<MethodResult>> {
     let mut results = Vec::new();
     for (net, name) in nets {
-        let denoisers = [None]
-            .into_iter()
-            .chain(oidn.filter(|_| net.traces_direct()).map(Some));
-        for denoiser in denoisers {
-            let (row, family) = match denoiser {
-                None => (name.clone(), net.family()),
-                Some(_) => (format!("{name} + OIDN"), Family::Denoised),
+        for (row, denoiser) in rows_of(net, name, oidn) {
+            let family = match denoiser {
+                None => net.family(),
+                Some(_) => Family::Denoised,
             };
             let mut acc = Accumulator::new(&row, family, Some(net.params()));
             if denoiser.is_none() {

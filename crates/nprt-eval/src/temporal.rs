@@ -20,7 +20,7 @@ use std::time::Instant;
 use anyhow::Result;
 
 use crate::metrics::Metrics;
-use crate::networks::Net;
+use crate::networks::{rows_of, Net};
 use crate::nrc::{steps_within, Nrc, NrcSettings};
 use crate::stopwatch::ms;
 
@@ -243,14 +243,7 @@ fn network_rows(
 ) -> Result<Vec<Row>> {
     let mut rows = Vec::new();
     for (net, name) in nets {
-        let denoisers = [None]
-            .into_iter()
-            .chain(oidn.filter(|_| net.traces_direct()).map(Some));
-        for denoiser in denoisers {
-            let row = match denoiser {
-                None => name.clone(),
-                Some(_) => format!("{name} + OIDN"),
-            };
+        for (row, denoiser) in rows_of(net, name, oidn) {
             let mut rgb = Vec::new();
             let mut frame_ms = refs.gbuffer_ms;
             for (i, (f, g)) in frames.iter().zip(&refs.gbuffers).enumerate() {

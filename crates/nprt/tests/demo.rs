@@ -405,7 +405,10 @@ fn temporal_stability_is_reported(results: &Value, md: &str, report: &Path) {
     // The caches were held to the D/S frame's time, their steps per frame fitted to it.
     let nrc = &t["nrc"];
     assert!(nrc["budget_ms"].as_f64().unwrap() > 0.0, "{nrc}");
-    assert!((1..=16).contains(&nrc["settings"]["steps"].as_u64().unwrap()), "{nrc}");
+    assert!(
+        (1..=16).contains(&nrc["settings"]["steps"].as_u64().unwrap()),
+        "{nrc}"
+    );
     let err = |m: &Value| m["temporal_error"].as_f64().unwrap();
     let floor = t["noise_floor"].as_f64().unwrap();
     assert!(

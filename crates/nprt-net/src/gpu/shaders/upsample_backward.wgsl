@@ -2,18 +2,7 @@
 // of its 2 × 2 block's gradients in d_cat (views × (c_x + c_skip) × 2h × 2w), in row order as
 // the CPU engine adds them, passed on where `act` (x, a ReLU's output) is positive.
 
-struct UpsampleBackward {
-    c_x: u32,
-    c_skip: u32,
-    h: u32,
-    w: u32,
-    views: u32,
-    _pad0: u32,
-    _pad1: u32,
-    _pad2: u32,
-}
-
-@group(0) @binding(0) var<uniform> p: UpsampleBackward;
+@group(0) @binding(0) var<uniform> p: Upsample;
 @group(0) @binding(1) var<storage, read> d_cat: array<f32>;
 @group(0) @binding(2) var<storage, read> act: array<f32>;
 @group(0) @binding(3) var<storage, read_write> d_x: array<f32>;

@@ -2,18 +2,7 @@
 // then the level's skip (views × c_skip × 2h × 2w), channel-major: views × (c_x + c_skip) ×
 // 2h × 2w, as the CPU engine joins them.
 
-struct Concat {
-    c_x: u32,
-    c_skip: u32,
-    h: u32,
-    w: u32,
-    views: u32,
-    _pad0: u32,
-    _pad1: u32,
-    _pad2: u32,
-}
-
-@group(0) @binding(0) var<uniform> p: Concat;
+@group(0) @binding(0) var<uniform> p: Upsample;
 @group(0) @binding(1) var<storage, read> x: array<f32>;
 @group(0) @binding(2) var<storage, read> skip: array<f32>;
 @group(0) @binding(3) var<storage, read_write> out: array<f32>;
