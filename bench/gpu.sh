@@ -10,7 +10,8 @@
 #      fastest is the peer), at batch 16,384 and 262,144;
 #   2. the paper's schedule (3000 views of 256², 500 epochs) projected from those rates, and its
 #      data (3000 views at 3200 spp) from `nprt generate --device` on the GPU and on the CPU
-#      (a small builtin:room dataset each, measured after the frames);
+#      (a small builtin:room dataset each, measured after the frames), and the Deep Shading
+#      U-Net trained 10 epochs of the GPU's dataset on the kernels and on the CPU;
 #   3. `nprt bench frame --profile` (G-buffer, encoder, networks, direct light traced on the GPU,
 #      total; each kernel of a lighting change)
 #      per design, and D/S with 16 spp of traced direct light, at 512² and 1920×1080
@@ -202,12 +203,26 @@ generation() {
   end_section
 }
 
+# The Deep Shading U-Net on the kernels and on every CPU core, 10 epochs of the dataset the
+# GPU just generated (16 views of 128², 4 a step), each run's summary line.
+deep_shading() {
+  [ -f "$work/generate-$device/manifest.json" ] || return 0
+  log "Deep Shading on $device and on the CPU"
+  section "Deep Shading (nprt train-deep-shading, 10 epochs of 16 views of 128²): GPU, then CPU ($(nproc) threads)"
+  for d in "$device" cpu; do
+    "$nprt" train-deep-shading --data "$work/generate-$device" --out "$work/deep-shading-$d" \
+      --epochs 10 --device "$d" 2>&1 | grep -E '^(trained|time)' | sed "s/^/$d: /" >>"$summary" || failed=1
+  done
+  end_section
+}
+
 # The smallest batch first, then the frames and data generation, then the larger batches: a
 # short loan measures the most-asked figures first.
 first=${batches%% *}
 train_rates "$first"
 frames
 generation
+deep_shading
 for batch in $batches; do
   [ "$batch" = "$first" ] || train_rates "$batch"
 done
