@@ -119,9 +119,9 @@ pub fn evaluate(o: &EvalOptions, engine: Engine) -> Result<Evaluation> {
     baselines.extend(run_sh_prt(&mut bench, o.sh_spp));
     bench.bar.finish_and_clear();
     let oidn_ok = oidn.as_ref().ok().copied();
-    let traced = (&pt5, equal_time.as_slice());
-    let (temporal, temporal_note) =
-        temporal_run(o, (&scene, &ts, &manifest), &maps, &nets, traced, oidn_ok)?;
+    let (traced, with) = ((&pt5, equal_time.as_slice()), (nets.as_slice(), engine));
+    let what = (&scene, &ts, &manifest);
+    let (temporal, temporal_note) = temporal_run(o, what, &maps, with, traced, oidn_ok)?;
     results.push(pt5.result);
     results.extend(equal_time.into_iter().map(|(_, t)| t.result));
     results.extend(baselines);
@@ -136,7 +136,7 @@ pub fn evaluate(o: &EvalOptions, engine: Engine) -> Result<Evaluation> {
         DirectSampling {
             spp: o.direct_spp,
             seed: o.seed,
-            denoiser: oidn.as_ref().ok().copied(),
+            denoiser: oidn_ok,
         },
     )?;
     check_finite(&results, &views)?;
@@ -171,7 +171,7 @@ fn temporal_run(
     o: &EvalOptions,
     (scene, ts, manifest): (&Scene, &TraceScene, &Manifest),
     maps: &BTreeMap<usize, EnvMap>,
-    nets: &[(Net, String)],
+    (nets, engine): (&[(Net, String)], Engine),
     (pt5, equal_time): (&Traced, &[(u32, Traced)]),
     oidn: Option<&'static Oidn>,
 ) -> Result<(Option<Temporal>, String)> {
@@ -216,6 +216,7 @@ fn temporal_run(
         direct_spp: o.direct_spp,
         bounds: manifest.bounds,
         nrc_warmup: o.nrc_warmup,
+        engine,
     };
     let rows = nets.len()
         + nets.iter().filter(|(n, _)| n.traces_direct()).count() * usize::from(oidn.is_some());

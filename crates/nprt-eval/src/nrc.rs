@@ -1,15 +1,17 @@
 //! The Neural Radiance Cache baseline (Müller, Rousselle, Novák, Keller 2021; the paper's Table
 //! 6): frames path-traced with a radiance cache read where paths end (nprt-trace's cached
-//! paths), the cache (nprt-net's `RadianceCache` on the CPU engine) trained online from each
+//! paths), the cache (nprt-net's `RadianceCache`, on the CPU engine or the GPU kernels) trained
+//! online from each
 //! frame's training paths, frame after frame. NRC reads it where the area-spread heuristic ends
 //! a path; NRC-CACHE at the first vertex, where nprt's networks work. It needs no
 //! precomputation, so it starts cold and lags changes of view and light: what the temporal
 //! evaluation measures. docs/evaluation.md lists where it departs from Müller et al.
 
+use anyhow::Result;
 use glam::Vec3;
-use nprt_net::cpu::CacheTrainer;
 use nprt_net::network::radiance_cache::{CacheQuery, RadianceCache};
-use nprt_net::{position_frame, Init};
+use nprt_net::training::cache_trainer::CacheTrainer;
+use nprt_net::{position_frame, Engine, Init};
 use nprt_scene::{Camera, EnvMap};
 use nprt_trace::{
     pixel_rng, trace_cached, CachePath, CacheRead, CacheVertex, CachedPath, CameraRay,
@@ -74,16 +76,22 @@ pub struct Nrc {
 }
 
 impl Nrc {
-    /// A cold cache for a scene of `bounds`; every random choice follows `seed`.
-    pub fn new(settings: NrcSettings, bounds: &[[f32; 3]; 2], seed: u64) -> Self {
+    /// A cold cache for a scene of `bounds`, trained on `engine`; every random choice follows
+    /// `seed`.
+    pub fn new(
+        settings: NrcSettings,
+        bounds: &[[f32; 3]; 2],
+        seed: u64,
+        engine: Engine,
+    ) -> Result<Self> {
         let cache = RadianceCache::new(&mut Init::new(seed));
-        Nrc {
-            trainer: CacheTrainer::new(cache, settings.learning_rate),
+        Ok(Nrc {
+            trainer: CacheTrainer::new(cache, settings.learning_rate, engine)?,
             settings,
             frame_of: position_frame(bounds),
             seed,
             frames: 0,
-        }
+        })
     }
 
     /// Trains `steps` Adam steps per frame from now on.
@@ -148,7 +156,7 @@ impl Nrc {
             .flat_map(|(r, t)| r.iter().chain(t))
             .filter_map(|p| p.read.map(|(v, _)| self.query(&v)))
             .collect();
-        let mut cached = self.trainer.cache.read(&reads).into_iter();
+        let mut cached = self.trainer.read(&reads).into_iter();
         let mut value = |p: &CachedPath| match p.read {
             Some(_) => cached.next().expect("a value per read"),
             None => Vec3::ZERO,

@@ -9,6 +9,7 @@
 //! shows it as a spike in its per-frame error there.
 
 use glam::Vec3;
+use nprt_net::Engine;
 use nprt_render::oidn::Oidn;
 use nprt_render::{CameraPath, DirectSampling};
 use nprt_scene::{Camera, CameraVolume, EnvMap};
@@ -50,6 +51,8 @@ pub struct TemporalSetup<'a> {
     pub bounds: [[f32; 3]; 2],
     /// Frames the warmed caches render (at the first frame) before the first one measured.
     pub nrc_warmup: usize,
+    /// Where the caches train (the networks' engine).
+    pub engine: Engine,
 }
 
 /// One method's frames along the path, scored against the references.
@@ -177,7 +180,7 @@ pub fn run_temporal(
         .map(|r| r.2);
     let traced = traced_rows(setup, &frames, &refs, path_tracing, oidn, on_frame)?;
     rows.extend(traced);
-    let (caches, nrc) = cache_rows(setup, &frames, budget, on_frame);
+    let (caches, nrc) = cache_rows(setup, &frames, budget, on_frame)?;
     rows.extend(caches);
     t.nrc = Some(nrc);
     let width = setup.resolution[0] as usize;
@@ -320,8 +323,8 @@ fn cache_rows(
     frames: &[PathFrame],
     budget_ms: Option<f64>,
     on_frame: &dyn Fn(),
-) -> (Vec<Row>, NrcBudget) {
-    let fit = fit_budget(setup, &frames[0], budget_ms);
+) -> Result<(Vec<Row>, NrcBudget)> {
+    let fit = fit_budget(setup, &frames[0], budget_ms)?;
     let warmups = match setup.nrc_warmup {
         0 => vec![0],
         n => vec![0, n],
@@ -341,39 +344,44 @@ fn cache_rows(
                 read,
                 ..fit.settings
             };
-            let (rgb, frame_ms) = run_cache(setup, frames, settings, warmup, on_frame);
+            let (rgb, frame_ms) = run_cache(setup, frames, settings, warmup, on_frame)?;
             rows.push((row, rgb, frame_ms));
         }
     }
-    (rows, fit)
+    Ok((rows, fit))
 }
 
 /// Times a cache's frame at the path's first frame, without training and with four steps,
 /// and fits the steps per frame to `budget_ms` (four without one). A throwaway cache is timed:
 /// the measured ones start cold.
-fn fit_budget(setup: &TemporalSetup, first: &PathFrame, budget_ms: Option<f64>) -> NrcBudget {
+fn fit_budget(
+    setup: &TemporalSetup,
+    first: &PathFrame,
+    budget_ms: Option<f64>,
+) -> Result<NrcBudget> {
     let path = (setup.tracer)(1, 0).path();
     let map = setup.lit(first);
     let mut settings = NrcSettings::new(CacheRead::Spread);
     let timed = |steps: usize| {
-        let mut nrc = Nrc::new(NrcSettings { steps, ..settings }, &setup.bounds, setup.seed);
+        let settings = NrcSettings { steps, ..settings };
+        let mut nrc = Nrc::new(settings, &setup.bounds, setup.seed, setup.engine)?;
         // The first frame of a cold cache warms nothing up but the caches of the machine.
         nrc.frame(setup.ts, &first.camera, &map, &path);
         let start = Instant::now();
         nrc.frame(setup.ts, &first.camera, &map, &path);
-        ms(start)
+        Ok::<f64, anyhow::Error>(ms(start))
     };
-    let render_ms = timed(0);
-    let step_ms = ((timed(4) - render_ms) / 4.0).max(1e-3);
+    let render_ms = timed(0)?;
+    let step_ms = ((timed(4)? - render_ms) / 4.0).max(1e-3);
     if let Some(budget) = budget_ms {
         settings.steps = steps_within(budget, render_ms, step_ms);
     }
-    NrcBudget {
+    Ok(NrcBudget {
         budget_ms,
         render_ms,
         step_ms,
         settings,
-    }
+    })
 }
 
 /// A radiance cache with `settings`, trained online frame after frame along `frames`
@@ -384,10 +392,10 @@ fn run_cache(
     settings: NrcSettings,
     warmup: usize,
     on_frame: &dyn Fn(),
-) -> (Vec<Vec<Vec3>>, f64) {
+) -> Result<(Vec<Vec<Vec3>>, f64)> {
     let path = (setup.tracer)(1, 0).path();
     let seed = setup.seed ^ 0x7e3a_ca4e ^ u64::from(settings.read == CacheRead::FirstVertex);
-    let mut nrc = Nrc::new(settings, &setup.bounds, seed);
+    let mut nrc = Nrc::new(settings, &setup.bounds, seed, setup.engine)?;
     let first = setup.lit(&frames[0]);
     for _ in 0..warmup {
         nrc.frame(setup.ts, &frames[0].camera, &first, &path);
@@ -401,7 +409,7 @@ fn run_cache(
         total_ms += ms(start);
         on_frame();
     }
-    (rgb, total_ms / frames.len() as f64)
+    Ok((rgb, total_ms / frames.len() as f64))
 }
 
 /// A method's frames scored against the references: per pair and per frame.

@@ -7,6 +7,7 @@
 use glam::Vec3;
 use nprt_eval::nrc::{Nrc, NrcSettings};
 use nprt_eval::temporal::{run_temporal, TemporalSetup};
+use nprt_net::{Compute, Engine};
 use nprt_scene::{Camera, CameraVolume, EnvMap, Material, Mesh, Scene};
 use nprt_trace::{
     render_gbuffer, CacheRead, PathSettings, PixelFilter, RenderSettings, TraceScene,
@@ -47,7 +48,7 @@ fn a_cold_cache_converges_to_the_furnace_answer() {
         rr_depth: 5,
     };
     for read in [CacheRead::FirstVertex, CacheRead::Spread] {
-        let mut nrc = Nrc::new(NrcSettings::new(read), &BOUNDS, 1);
+        let mut nrc = Nrc::new(NrcSettings::new(read), &BOUNDS, 1, Engine::Cpu).unwrap();
         let first = error(&nrc.frame(&ts, &camera, &sky, &path).0, &mask, ALBEDO);
         let mut last = first;
         for _ in 0..40 {
@@ -56,6 +57,38 @@ fn a_cold_cache_converges_to_the_furnace_answer() {
         eprintln!("{read:?}: relative error {first:.3} at the first frame, {last:.4} at the 41st");
         assert!(last < 0.03, "{read:?}: {first} → {last}");
     }
+}
+
+/// The same cache on the GPU kernels (`--device wgpu`; lavapipe in CI), where this build has
+/// them and an adapter.
+#[test]
+fn the_cache_converges_on_the_gpu_kernels_too() {
+    let engine = match Compute::Wgpu.engine() {
+        Ok(e) => e,
+        Err(e) => {
+            let e = format!("{e:#}");
+            let wanted = std::env::var_os("NPRT_REQUIRE_VULKAN").is_some();
+            assert!(!wanted || e.contains("without its GPU kernels"), "{e}");
+            eprintln!("skipped: {e}");
+            return;
+        }
+    };
+    let scene = sphere();
+    let ts = TraceScene::new(&scene);
+    let sky = EnvMap::constant(Vec3::ONE).unwrap();
+    let camera = Camera::look_at(Vec3::new(0.0, 0.5, 3.0), Vec3::ZERO, Vec3::Y, 50.0, 32, 32);
+    let mask = render_gbuffer(&ts, &camera).mask;
+    let path = PathSettings {
+        max_depth: u32::MAX,
+        rr_depth: 5,
+    };
+    let mut nrc = Nrc::new(NrcSettings::new(CacheRead::FirstVertex), &BOUNDS, 1, engine).unwrap();
+    let mut last = f32::NAN;
+    for _ in 0..41 {
+        last = error(&nrc.frame(&ts, &camera, &sky, &path).0, &mask, ALBEDO);
+    }
+    eprintln!("GPU kernels: relative error {last:.4} at the 41st frame");
+    assert!(last < 0.03, "{last}");
 }
 
 #[test]
@@ -90,6 +123,7 @@ fn a_change_of_sky_spikes_a_warmed_caches_error() {
         direct_spp: 4,
         bounds: BOUNDS,
         nrc_warmup: 30,
+        engine: Engine::Cpu,
     };
     let t = run_temporal(&setup, &[], ("pt", 4), None, &|| {}).unwrap();
     let c = t.change_at;

@@ -124,7 +124,7 @@ pub fn bias_corrections(t: u64) -> (f32, f32) {
 }
 
 /// [`bias_corrections`] under decay rates `[β1, β2]`.
-fn bias_corrections_for(t: u64, [beta1, beta2]: [f32; 2]) -> (f32, f32) {
+pub(crate) fn bias_corrections_for(t: u64, [beta1, beta2]: [f32; 2]) -> (f32, f32) {
     let t = t.min(i32::MAX as u64) as i32;
     let c2 = (1.0 - beta2.powi(t)).sqrt();
     (c2 / (1.0 - beta1.powi(t)), ADAM_EPSILON * c2)

@@ -3,33 +3,14 @@
 //! every frame fitting a smooth radiance field.
 
 use glam::Vec3;
-use nprt_net::cpu::CacheTrainer;
 use nprt_net::network::radiance_cache::{CacheQuery, RadianceCache};
-use nprt_net::{Init, Parameters};
-use rand::{RngExt, SeedableRng};
-use rand_pcg::Pcg64Mcg;
+use nprt_net::training::cache_trainer::CacheTrainer;
 
-fn queries(n: usize, seed: u64) -> Vec<CacheQuery> {
-    let mut rng = Pcg64Mcg::seed_from_u64(seed);
-    let mut unit = || {
-        Vec3::new(rng.random(), rng.random(), rng.random())
-            .map(|v: f32| v * 2.0 - 1.0)
-            .normalize()
-    };
-    (0..n)
-        .map(|_| {
-            let p = unit();
-            CacheQuery {
-                position: (p * 0.9).to_array(),
-                dir: unit(),
-                normal: unit(),
-                roughness: 0.3,
-                kd: Vec3::new(0.5, 0.4, 0.3),
-                ks: Vec3::splat(0.04),
-            }
-        })
-        .collect()
-}
+#[allow(dead_code)] // the helpers other test binaries use
+mod common;
+
+use common::cache_queries as queries;
+use nprt_net::{Engine, Init, Parameters};
 
 /// A smooth field of the position and direction.
 fn field(q: &CacheQuery) -> Vec3 {
@@ -89,7 +70,8 @@ fn cache_gradients_match_finite_differences() {
 
 #[test]
 fn online_training_fits_a_smooth_field() {
-    let mut trainer = CacheTrainer::new(RadianceCache::new(&mut Init::new(4)), 5e-3);
+    let cache = RadianceCache::new(&mut Init::new(4));
+    let mut trainer = CacheTrainer::new(cache, 5e-3, Engine::Cpu).unwrap();
     let (mut first, mut last) = (f64::NAN, f64::NAN);
     // Fresh samples every frame, as a cache trained while it renders sees them.
     for frame in 0..200 {
@@ -101,7 +83,7 @@ fn online_training_fits_a_smooth_field() {
         }
     }
     let held_out = queries(512, 5);
-    let read = trainer.cache.read(&held_out);
+    let read = trainer.read(&held_out);
     let err: f32 = (read.iter().zip(&held_out))
         .map(|(r, q)| ((*r - field(q)).abs() / field(q)).max_element())
         .sum::<f32>()

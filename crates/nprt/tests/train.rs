@@ -139,6 +139,8 @@ fn deep_shading_on_the_kernels_trains_as_on_the_cpu() {
             "32",
             "--sh-spp",
             "4",
+            "--temporal-frames",
+            "0",
             "--device",
             device,
         ]);

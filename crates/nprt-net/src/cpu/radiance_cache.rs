@@ -1,6 +1,6 @@
 //! The radiance cache on the CPU engine: its queries encoded, read in parallel blocks of rows,
-//! and trained online: the relative L2 loss of its radiance against path-traced targets and
-//! every weight's gradient (the hash grid's through the encoding's adjoint), then Adam.
+//! and the relative L2 loss of its radiance against path-traced targets with every weight's
+//! gradient (the hash grid's through the encoding's adjoint).
 
 use glam::Vec3;
 use rayon::prelude::*;
@@ -12,27 +12,17 @@ use crate::encoding::spherical_harmonics::basis;
 use crate::loss::Loss;
 use crate::network::parameters::Parameters;
 use crate::network::radiance_cache::{CacheQuery, RadianceCache, INPUTS, SH_BANDS};
-use crate::optimiser::Adam;
-
-/// Adam's β1 and β2 for the cache. β2 is Müller et al.'s 0.99 (not the usual 0.999), and β1
-/// 0.5 (theirs is 0.9): their targets move when the light changes, and with β1 0.9 the
-/// momentum carried a cache past a tripled sky to twice its value, where relative L2's
-/// gradients are weak, and it swung for a dozen frames (tests/nrc.rs in nprt-eval); with 0.5 it
-/// settles within two frames.
-const BETAS: [f32; 2] = [0.5, 0.99];
 
 /// Rows a task reads or trains on at once.
 const BLOCK: usize = 1024;
 
-/// `queries` as the MLP's input rows, and where each reads the grid.
-fn encode(cache: &RadianceCache, queries: &[CacheQuery]) -> (Vec<f32>, Vec<Corners>) {
-    let mut x = vec![0.0; queries.len() * INPUTS];
-    let mut corners = Vec::with_capacity(queries.len());
+/// The queries' input rows but for the grid's columns (the first [`hash_grid::OUTPUTS`] of
+/// each, left as they are): the SH encodings of direction and normal, 1 − e^−α, kd and ks.
+/// The GPU kernels take these too, and fill in the grid themselves.
+pub(crate) fn encode_rest(queries: &[CacheQuery], x: &mut [f32]) {
     let sh = SH_BANDS * SH_BANDS;
     for (q, row) in queries.iter().zip(x.chunks_exact_mut(INPUTS)) {
-        let c = hash_grid::corners(q.position);
-        let (grid, rest) = row.split_at_mut(hash_grid::OUTPUTS);
-        hash_grid::encode(&cache.grid.table, &c, grid);
+        let rest = &mut row[hash_grid::OUTPUTS..];
         let (dir, rest) = rest.split_at_mut(sh);
         basis(SH_BANDS, q.dir, dir);
         let (normal, rest) = rest.split_at_mut(sh);
@@ -40,8 +30,20 @@ fn encode(cache: &RadianceCache, queries: &[CacheQuery]) -> (Vec<f32>, Vec<Corne
         rest[0] = 1.0 - (-q.roughness).exp();
         rest[1..4].copy_from_slice(&q.kd.to_array());
         rest[4..7].copy_from_slice(&q.ks.to_array());
-        corners.push(c);
     }
+}
+
+/// `queries` as the MLP's input rows, and where each reads the grid.
+fn encode(cache: &RadianceCache, queries: &[CacheQuery]) -> (Vec<f32>, Vec<Corners>) {
+    let mut x = vec![0.0; queries.len() * INPUTS];
+    encode_rest(queries, &mut x);
+    let corners = (queries.iter().zip(x.chunks_exact_mut(INPUTS)))
+        .map(|(q, row)| {
+            let c = hash_grid::corners(q.position);
+            hash_grid::encode(&cache.grid.table, &c, &mut row[..hash_grid::OUTPUTS]);
+            c
+        })
+        .collect();
     (x, corners)
 }
 
@@ -122,48 +124,5 @@ impl RadianceCache {
             hash_grid::scatter(&mut grads.grid.table, c, &d[..hash_grid::OUTPUTS]);
         }
         (loss, grads)
-    }
-}
-
-/// A cache trained online: its weights and Adam's state.
-pub struct CacheTrainer {
-    pub cache: RadianceCache,
-    adam: Adam,
-    pub learning_rate: f64,
-}
-
-impl CacheTrainer {
-    pub fn new(cache: RadianceCache, learning_rate: f64) -> Self {
-        CacheTrainer {
-            adam: Adam::with_betas(cache.num_params(), BETAS),
-            cache,
-            learning_rate,
-        }
-    }
-
-    /// `steps` Adam steps on consecutive batches of `batch` of the pairs (wrapping around);
-    /// returns the mean loss over the steps.
-    pub fn train(
-        &mut self,
-        queries: &[CacheQuery],
-        targets: &[Vec3],
-        steps: usize,
-        batch: usize,
-    ) -> f64 {
-        if queries.is_empty() || steps == 0 {
-            return f64::NAN;
-        }
-        let batch = batch.clamp(1, queries.len());
-        let mut total = 0.0;
-        for s in 0..steps {
-            let from = (s * batch) % queries.len();
-            let to = (from + batch).min(queries.len());
-            let (loss, grads) = self
-                .cache
-                .loss_and_gradients(&queries[from..to], &targets[from..to]);
-            self.adam.step(&mut self.cache, &grads, self.learning_rate);
-            total += loss;
-        }
-        total / steps as f64
     }
 }

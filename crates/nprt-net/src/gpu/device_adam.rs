@@ -9,7 +9,7 @@ use anyhow::Result;
 use super::kernels::ADAM;
 use super::parameters::ParameterLayout;
 use super::{groups_for, Dispatch, GpuDevice};
-use crate::optimiser::{bias_corrections, load_state, save_state, ADAM_BETA1, ADAM_BETA2};
+use crate::optimiser::{bias_corrections_for, load_state, save_state, ADAM_BETA1, ADAM_BETA2};
 
 /// Adam's moments and step count for one network's flat buffers, and its dispatch.
 pub struct DeviceAdam {
@@ -17,20 +17,22 @@ pub struct DeviceAdam {
     moment2: wgpu::Buffer,
     /// Steps taken.
     steps: u64,
+    /// β1 and β2.
+    betas: [f32; 2],
     /// Over every parameter; its rate and bias corrections are rewritten each step.
     pub dispatch: Dispatch,
 }
 
 /// The parameter block of `adam.wgsl` for step `t` (from 1) at learning rate `lr`, over
 /// `count` values whose gradients are scaled by `grad_scale`.
-fn adam_params(count: usize, lr: f64, t: u64, grad_scale: f32) -> Vec<u32> {
-    let (factor, epsilon) = bias_corrections(t);
+fn adam_params(count: usize, lr: f64, t: u64, grad_scale: f32, betas: [f32; 2]) -> Vec<u32> {
+    let (factor, epsilon) = bias_corrections_for(t, betas);
     let mut params = vec![count as u32, 0, 0, 0];
     params.extend(
         [
             lr as f32,
-            ADAM_BETA1,
-            ADAM_BETA2,
+            betas[0],
+            betas[1],
             factor,
             epsilon,
             1.0 / grad_scale,
@@ -45,11 +47,22 @@ fn adam_params(count: usize, lr: f64, t: u64, grad_scale: f32) -> Vec<u32> {
 impl DeviceAdam {
     /// Zero moments for the `total` values of `params`, stepped by `grads`.
     pub fn new(gpu: &GpuDevice, total: usize, grads: &wgpu::Buffer, params: &wgpu::Buffer) -> Self {
+        Self::with_betas(gpu, total, grads, params, [ADAM_BETA1, ADAM_BETA2])
+    }
+
+    /// [`Self::new`] with decay rates `[β1, β2]` of one's own (the radiance cache's).
+    pub fn with_betas(
+        gpu: &GpuDevice,
+        total: usize,
+        grads: &wgpu::Buffer,
+        params: &wgpu::Buffer,
+        betas: [f32; 2],
+    ) -> Self {
         let zeros = vec![0.0f32; total];
         let [moment1, moment2] = [&zeros, &zeros].map(|v| gpu.upload(v));
         let dispatch = gpu.prepare(
             &ADAM,
-            &adam_params(total, 0.0, 1, 1.0),
+            &adam_params(total, 0.0, 1, 1.0, betas),
             &[grads, params, &moment1, &moment2],
             groups_for(total),
         );
@@ -57,6 +70,7 @@ impl DeviceAdam {
             moment1,
             moment2,
             steps: 0,
+            betas,
             dispatch,
         }
     }
@@ -65,7 +79,7 @@ impl DeviceAdam {
     /// `grad_scale`, and sets the dispatch for it (recorded after the step's gradients).
     pub fn next_step(&mut self, gpu: &GpuDevice, total: usize, lr: f64, grad_scale: f32) {
         self.steps += 1;
-        let params = adam_params(total, lr, self.steps, grad_scale);
+        let params = adam_params(total, lr, self.steps, grad_scale, self.betas);
         gpu.write(&self.dispatch.uniform, &params);
     }
 

@@ -16,6 +16,7 @@ use anyhow::Result;
 use super::device_adam::DeviceAdam;
 use super::device_dataset::DeviceDataset;
 use super::kernels::GATHER_SAMPLES;
+use super::mlp_step::Trainable;
 use super::network_layout::NetworkLayout;
 use super::parameters::ParameterLayout;
 use super::{groups_for, Dispatch, GpuDevice};
@@ -202,6 +203,15 @@ impl GpuTrainer {
     /// The device's adapter, for reports.
     pub fn adapter(&self) -> &str {
         &self.gpu.adapter
+    }
+
+    /// The trainer's parameters and gradients, for the MLPs' passes.
+    pub(super) fn trainable(&self) -> Trainable<'_> {
+        Trainable {
+            gpu: &self.gpu,
+            params: &self.params,
+            grads: &self.grads,
+        }
     }
 
     /// The parameters' current values, in the network's shapes.

@@ -14,10 +14,9 @@
 
 use super::codes::{activation_code, BACKWARD};
 use super::dense_products::DenseProducts;
-use super::gpu_trainer::GpuTrainer;
 use super::half_layers::{half_train_layer, held_halves, pad16, HalfLayers, HalfOut};
 use super::kernels::{HALF_WEIGHT_GRAD, HALF_WEIGHT_GRAD_COOP};
-use super::mlp_step::{row_chunks, FirstLayerBias, MlpTape};
+use super::mlp_step::{row_chunks, FirstLayerBias, MlpTape, Trainable};
 use super::network_layout::MlpAt;
 use super::operands::{Bias, Output};
 use super::{groups_for, Bind, Dispatch, GpuDevice};
@@ -47,7 +46,7 @@ fn half_weight_grad(
     }
 }
 
-impl GpuTrainer {
+impl Trainable<'_> {
     /// [`Self::mlp_backward`] in a mixed-precision step: the gradient at each layer's output
     /// as f16 rows for the products and as f32 rows for the bias's gradient (and `on_first`),
     /// the gradient at the first layer's input into `d_input` (f32) where given.
@@ -93,7 +92,7 @@ impl GpuTrainer {
                     rows,
                     layer.d_out,
                     None,
-                    Output::to(&self.grads, layer.bias.offset, layer.d_out),
+                    Output::to(self.grads, layer.bias.offset, layer.d_out),
                 ),
             }
             let (derivative, out) = match i {
@@ -142,7 +141,7 @@ impl GpuTrainer {
         let [chunk, chunks] = row_chunks(rows.next_multiple_of(16), 16);
         let partial = self.gpu.buffer(chunks * m * n);
         plan.push(half_weight_grad(
-            &self.gpu,
+            self.gpu,
             [m, n, rows],
             (x, pad16(m)),
             (dz, pad16(n)),
@@ -155,7 +154,7 @@ impl GpuTrainer {
             chunks,
             m * n,
             None,
-            Output::to(&self.grads, offset, n),
+            Output::to(self.grads, offset, n),
         );
     }
 }

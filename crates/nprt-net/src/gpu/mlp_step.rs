@@ -3,12 +3,13 @@
 
 use super::codes::{activation_code, BACKWARD};
 use super::dense_products::DenseProducts;
-use super::gpu_trainer::GpuTrainer;
 use super::half_layers::held_halves;
+use super::half_layers::Held;
 use super::kernels::GEMM_TILE;
+use super::network_forward::ForwardTargets;
 use super::network_layout::MlpAt;
 use super::operands::{Bias, Operand, Output};
-use super::Dispatch;
+use super::{Dispatch, GpuDevice};
 
 /// A weight gradient's product is split into chunks of at least ROW_CHUNK rows, at most
 /// ROW_CHUNKS of them (a 256 × 256 layer at batch 16,384: 32 chunks of 512 rows, 512
@@ -27,22 +28,47 @@ pub(super) fn row_chunks(rows: usize, align: usize) -> [usize; 2] {
 }
 
 /// What takes a first layer's bias gradient, given the gradient at its pre-activation.
-pub(super) type FirstLayerBias<'a> = &'a dyn Fn(&mut Vec<Dispatch>, &wgpu::Buffer);
+pub type FirstLayerBias<'a> = &'a dyn Fn(&mut Vec<Dispatch>, &wgpu::Buffer);
 
 /// What an MLP's forward pass keeps: each layer's output and each hidden layer's
 /// pre-activation; in a mixed-precision step also its input as f16 rows, and the hidden
 /// layers' outputs are f16 rows (`half_products`).
-pub(super) struct MlpTape {
+pub struct MlpTape {
     pub rows: usize,
     pub input16: Option<wgpu::Buffer>,
     pub outputs: Vec<wgpu::Buffer>,
     pub pre: Vec<wgpu::Buffer>,
 }
 
-impl GpuTrainer {
+/// What `m`'s forward pass writes into `tape`: each layer's output (the hidden ones f16 in
+/// a mixed-precision step) and pre-activation.
+pub fn forward_targets<'a>(m: &MlpAt, tape: &'a MlpTape) -> ForwardTargets<'a> {
+    let half = !m.half.is_empty();
+    let last = tape.outputs.len() - 1;
+    ForwardTargets {
+        outputs: (tape.outputs.iter().enumerate())
+            .map(|(i, b)| match half && i < last {
+                true => Held::F16(b),
+                false => Held::F32(b),
+            })
+            .collect(),
+        pre: Some(&tape.pre),
+        input16: tape.input16.as_ref(),
+    }
+}
+
+/// What an MLP's training records against: the device, the flat parameters it reads and the
+/// gradients it writes (a design's trainer's, or the radiance cache's).
+pub struct Trainable<'a> {
+    pub gpu: &'a GpuDevice,
+    pub params: &'a wgpu::Buffer,
+    pub grads: &'a wgpu::Buffer,
+}
+
+impl Trainable<'_> {
     /// Buffers for an MLP's forward pass over `rows` rows; in a mixed-precision step its input
     /// and hidden layers' outputs as f16 rows (`half_products`).
-    pub(super) fn tape(&self, m: &MlpAt, rows: usize) -> MlpTape {
+    pub fn tape(&self, m: &MlpAt, rows: usize) -> MlpTape {
         let half = !m.half.is_empty();
         let last = m.layers.len() - 1;
         MlpTape {
@@ -71,7 +97,7 @@ impl GpuTrainer {
     /// bias gradient (it also receives the light code's share), given the gradient at that
     /// layer's pre-activation.
     #[allow(clippy::too_many_arguments)]
-    pub(super) fn mlp_backward(
+    pub fn mlp_backward(
         &self,
         plan: &mut Vec<Dispatch>,
         m: &MlpAt,
@@ -118,7 +144,7 @@ impl GpuTrainer {
                     rows,
                     layer.d_out,
                     None,
-                    Output::to(&self.grads, layer.bias.offset, layer.d_out),
+                    Output::to(self.grads, layer.bias.offset, layer.d_out),
                 ),
                 None => {}
             }
@@ -138,7 +164,7 @@ impl GpuTrainer {
             plan.push(self.gpu.product(
                 [rows, count, layer.d_out],
                 Operand::plain(dz, 0, layer.d_out),
-                Operand::transposed(&self.params, weights, layer.d_out),
+                Operand::transposed(self.params, weights, layer.d_out),
                 Bias::None,
                 derivative,
                 Output::to(dx, 0, count),
@@ -162,7 +188,7 @@ impl GpuTrainer {
         bias: Option<usize>,
     ) {
         let [chunk, chunks] = row_chunks(rows, 1);
-        let mut out = Output::to(&self.grads, offset, n);
+        let mut out = Output::to(self.grads, offset, n);
         if chunks <= 1 && bias.is_none() {
             plan.push(
                 self.gpu

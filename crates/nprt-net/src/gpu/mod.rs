@@ -24,6 +24,7 @@ mod network_forward;
 mod network_layout;
 mod operands;
 mod parameters;
+mod radiance_cache;
 mod transport_step;
 mod unet_pass;
 mod unet_trainer;
@@ -41,6 +42,7 @@ pub use network_forward::{FirstLayer, ForwardTargets};
 pub use network_layout::{HalfCopies, MlpAt, NetworkLayout, TrackAt};
 pub use operands::{Bias, Operand, Output};
 pub use parameters::ParameterLayout;
+pub use radiance_cache::GpuCache;
 pub use unet_trainer::GpuUnet;
 
 // The runtime the kernels run on (nprt-gpu), as this module's files name it.

@@ -162,7 +162,7 @@ impl NetworkLayout {
 }
 
 /// The layers of `stack`, their spans taken in order from `spans`.
-fn mlp_at(stack: &Mlp, spans: &mut impl Iterator<Item = Span>) -> MlpAt {
+pub fn mlp_at(stack: &Mlp, spans: &mut impl Iterator<Item = Span>) -> MlpAt {
     let mut take = || spans.next().expect("a span per tensor");
     MlpAt {
         layers: stack

@@ -8,10 +8,8 @@ use super::dense_products::DenseProducts;
 use super::gpu_trainer::{BatchBuffers, GpuTrainer};
 use super::half_layers::Held;
 use super::kernels::{COMBINE, GRID_BACKWARD, RADIANCE_LOSS, TRACK_GRADIENT};
-use super::mlp_step::MlpTape;
+use super::mlp_step::{forward_targets, MlpTape};
 use super::network_forward::FirstLayer;
-use super::network_forward::ForwardTargets;
-use super::network_layout::MlpAt;
 use super::network_layout::TrackAt;
 use super::operands::{Bias, Operand, Output};
 use super::{groups_for, Dispatch};
@@ -120,23 +118,6 @@ impl GpuTrainer {
         forward
     }
 
-    /// What `m`'s forward pass writes into `tape`: each layer's output (the hidden ones f16 in
-    /// a mixed-precision step) and pre-activation.
-    pub(super) fn targets<'a>(&self, m: &MlpAt, tape: &'a MlpTape) -> ForwardTargets<'a> {
-        let half = !m.half.is_empty();
-        let last = tape.outputs.len() - 1;
-        ForwardTargets {
-            outputs: (tape.outputs.iter().enumerate())
-                .map(|(i, b)| match half && i < last {
-                    true => Held::F16(b),
-                    false => Held::F32(b),
-                })
-                .collect(),
-            pre: Some(&tape.pre),
-            input16: tape.input16.as_ref(),
-        }
-    }
-
     /// A track's forward pass over the batch.
     fn track_forward(&self, plan: &mut Vec<Dispatch>, t: &TrackAt, b: &BatchBuffers) -> TrackTape {
         let gpu = &self.gpu;
@@ -144,13 +125,13 @@ impl GpuTrainer {
         let (params, rows) = (&self.params, b.rows);
         plan.push(t.record_inputs(gpu, params, &self.resolutions, [&b.features, &x], rows));
         let transfer = t.transfer.as_ref().map(|m| {
-            let tape = self.tape(m, rows);
+            let tape = self.trainable().tape(m, rows);
             let first = FirstLayer {
                 own_row: 0,
                 count: t.width,
                 bias: Bias::Column(params, m.layers[0].bias.offset),
             };
-            let to = self.targets(m, &tape);
+            let to = forward_targets(m, &tape);
             m.record_forward(gpu, plan, params, Held::F32(&x), rows, first, &to);
             tape
         });
@@ -158,7 +139,7 @@ impl GpuTrainer {
         let first = &t.shading.layers[0];
         let group_bias = gpu.buffer(b.views * first.d_out);
         plan.push(t.record_code_share(gpu, params, &b.codes, b.views, &group_bias));
-        let shading = self.tape(&t.shading, rows);
+        let shading = self.trainable().tape(&t.shading, rows);
         let input = transfer
             .as_ref()
             .map_or(&x, |tape| tape.outputs.last().expect("a layer"));
@@ -167,7 +148,7 @@ impl GpuTrainer {
             count: t.own_width(),
             bias: Bias::Group(&group_bias, &b.view),
         };
-        let to = self.targets(&t.shading, &shading);
+        let to = forward_targets(&t.shading, &shading);
         let input = Held::F32(input);
         (t.shading).record_forward(gpu, plan, params, input, rows, first_layer, &to);
         TrackTape {
@@ -244,7 +225,7 @@ impl GpuTrainer {
                 None,
             ));
         };
-        self.mlp_backward(
+        self.trainable().mlp_backward(
             plan,
             &t.shading,
             &tape.shading,
@@ -254,7 +235,7 @@ impl GpuTrainer {
             Some(&on_first),
         );
         if let (Some(m), Some(tr), Some(d_s)) = (&t.transfer, &tape.transfer, &d_s) {
-            self.mlp_backward(
+            self.trainable().mlp_backward(
                 plan,
                 m,
                 tr,

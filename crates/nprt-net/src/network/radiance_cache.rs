@@ -4,7 +4,8 @@
 //! (spherical harmonics to band 3, 16 values each), roughness (1 − e^−α) and albedos, through
 //! a ReLU MLP 64 wide with 5 hidden layers; the radiance is its output times the point's albedo
 //! kd + ks, so the network learns the smoother rest. It trains online while it renders
-//! (nprt-eval's NRC), on the CPU engine (`cpu::radiance_cache`).
+//! (nprt-eval's NRC), on the CPU engine (`cpu::radiance_cache`) or the GPU kernels
+//! (`gpu::radiance_cache`), through `training::cache_trainer`.
 
 use glam::Vec3;
 
@@ -21,6 +22,13 @@ pub const INPUTS: usize = hash_grid::OUTPUTS + 2 * SH_BANDS * SH_BANDS + 1 + 6;
 /// Width and hidden layers of the MLP (Müller et al.'s).
 pub const WIDTH: usize = 64;
 pub const HIDDEN: usize = 5;
+
+/// Adam's β1 and β2 for the cache. β2 is Müller et al.'s 0.99 (not the usual 0.999), and β1
+/// 0.5 (theirs is 0.9): their targets move when the light changes, and with β1 0.9 the
+/// momentum carried a cache past a tripled sky to twice its value, where relative L2's
+/// gradients are weak, and it swung for a dozen frames (tests/nrc.rs in nprt-eval); with 0.5 it
+/// settles within two frames.
+pub const ADAM_BETAS: [f32; 2] = [0.5, 0.99];
 
 /// Where and in which direction the cache is read.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]

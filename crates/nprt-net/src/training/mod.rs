@@ -1,8 +1,10 @@
 //! Training: the training set in memory, batches, the learning-rate schedule, the one training
 //! loop with checkpoints and exact resume, each engine's steps as the loop takes them, the
-//! Neural PRT objective run through it, validation, calibration and loss curves.
+//! Neural PRT objective run through it, validation, calibration and loss curves, and the
+//! radiance cache's online training.
 
 pub mod batch;
+pub mod cache_trainer;
 pub mod calibration;
 pub mod checkpoint;
 pub mod epoch_plan;

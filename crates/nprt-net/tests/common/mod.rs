@@ -3,7 +3,9 @@
 
 pub mod reference;
 
+use glam::Vec3;
 use nprt_net::cpu::UnetBatch;
+use nprt_net::network::radiance_cache::CacheQuery;
 use nprt_net::{Activation, Batch, Design, Loss, ModelConfig, NprtNet};
 use nprt_net::{PositionEncoding, FEATURES};
 use rand::{RngExt, SeedableRng};
@@ -148,4 +150,28 @@ pub fn unet_batch(views: usize, (h, w): (usize, usize), seed: u64) -> UnetBatch 
         height: h,
         width: w,
     }
+}
+
+/// `n` random cache queries: positions inside the unit ball, random directions and normals, a
+/// grey-orange diffuse albedo with a little specular.
+pub fn cache_queries(n: usize, seed: u64) -> Vec<CacheQuery> {
+    let mut rng = Pcg64Mcg::seed_from_u64(seed);
+    let mut unit = || {
+        Vec3::new(rng.random(), rng.random(), rng.random())
+            .map(|v: f32| v * 2.0 - 1.0)
+            .normalize()
+    };
+    (0..n)
+        .map(|_| {
+            let p = unit();
+            CacheQuery {
+                position: (p * 0.9).to_array(),
+                dir: unit(),
+                normal: unit(),
+                roughness: 0.3,
+                kd: Vec3::new(0.5, 0.4, 0.3),
+                ks: Vec3::splat(0.04),
+            }
+        })
+        .collect()
 }
