@@ -3,7 +3,7 @@
 # NVIDIA GPU, so that a short loan is spent measuring, not building: in the folder .gpu/ (git
 # ignores it; about 50 MiB, inside a 64 MiB transfer):
 #   nprt        the release binary with the GPU kernels (`--features gpu`), stripped;
-#   tests/      the GPU kernels' correctness tests (nprt-net's gpu_training and gpu_unet,
+#   tests/      the GPU kernels' correctness tests (nprt-net's gpu_training, gpu_unet, gpu_cache,
 #               nprt-render's gpu_frame: f32 and the f16/tensor-core paths against the CPU
 #               engine; nprt-trace's gpu_trace: the path tracer against the CPU's), stripped;
 #   cooperative_matrix  nprt-render's bench of the tensor-core products (frame and training
@@ -47,7 +47,8 @@ for line in sys.stdin:
         print(m["executable"])' "$test"
 }
 log "building the GPU kernels' tests"
-for spec in nprt-net:kernels:gpu_training nprt-net:kernels:gpu_unet nprt-render:wgpu:gpu_frame \
+for spec in nprt-net:kernels:gpu_training nprt-net:kernels:gpu_unet nprt-net:kernels:gpu_cache \
+  nprt-render:wgpu:gpu_frame \
   nprt-trace:gpu:gpu_trace; do
   IFS=: read -r package features test <<<"$spec"
   exe=$(test_binary test "$package" "$features" "$test")
