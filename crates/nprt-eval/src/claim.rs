@@ -116,6 +116,22 @@ impl Claim {
 }
 
 impl Claim {
+    /// "`a` beats `b` in L1 from frame `from` on" (the frames after a lighting change), judged
+    /// on their per-frame L1 over those frames.
+    pub fn beats_from_frame(a: &TemporalResult, b: &TemporalResult, from: usize) -> Claim {
+        let (la, lb) = (a.per_frame_l1(), b.per_frame_l1());
+        let (la, lb) = (&la[from.min(la.len())..], &lb[from.min(lb.len())..]);
+        let p = Paired::new(la, lb);
+        let mean = |v: &[f64]| v.iter().sum::<f64>() / v.len().max(1) as f64;
+        Claim {
+            text: format!(
+                "{} beats {} in L1 in the frames after the lighting change ({:.4} vs {:.4}; per frame {:+.4} ± {:.4}, lower on {} of {})",
+                a.name, b.name, mean(la), mean(lb), p.diff, p.se, p.lower_on, p.views
+            ),
+            verdict: p.lower(),
+        }
+    }
+
     /// "`a` flickers less than `b`": judged on their temporal errors over the same frame pairs.
     pub fn steadier(a: &TemporalResult, b: &TemporalResult) -> Claim {
         let p = Paired::new(&a.per_pair, &b.per_pair);

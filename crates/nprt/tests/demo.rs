@@ -424,6 +424,7 @@ fn temporal_stability_is_reported(results: &Value, md: &str, report: &Path) {
         "images/temporal-nprt-dsep-diff.png",
         "nprt-dsep flickers less than deep-shading along the camera path (",
         "nprt-dsep flickers less than nrc-cache along the camera path (",
+        "nprt-dsep beats nrc-cache in L1 in the frames after the lighting change (",
         "Table 6's metrics along the path",
         "The radiance caches, held to the D/S frame's",
         "| nrc-cache (warmed 8 frames) | ",
