@@ -13,7 +13,7 @@ use nprt_net::training::training_set::open_recorded_map;
 use nprt_net::Engine;
 use nprt_render::oidn::Oidn;
 use nprt_render::DirectSampling;
-use nprt_scene::{EnvMap, Scene};
+use nprt_scene::{CameraVolume, EnvMap};
 use nprt_trace::{PixelFilter, RenderSettings, TraceScene};
 use serde::{Deserialize, Serialize};
 
@@ -120,7 +120,7 @@ pub fn evaluate(o: &EvalOptions, engine: Engine) -> Result<Evaluation> {
     bench.bar.finish_and_clear();
     let oidn_ok = oidn.as_ref().ok().copied();
     let (traced, with) = ((&pt5, equal_time.as_slice()), (nets.as_slice(), engine));
-    let what = (&scene, &ts, &manifest);
+    let what = (&ts, &manifest);
     let (temporal, temporal_note) = temporal_run(o, what, &maps, with, traced, oidn_ok)?;
     results.push(pt5.result);
     results.extend(equal_time.into_iter().map(|(_, t)| t.result));
@@ -163,13 +163,13 @@ pub fn evaluate(o: &EvalOptions, engine: Engine) -> Result<Evaluation> {
     })
 }
 
-/// The temporal evaluation (`temporal::run_temporal`) at the options' frames and size, along
-/// the scene's camera volume, the lighting changing from the first held-out map to the second,
-/// with path tracing at the largest equal-time sample count (5 spp without one); or why it was
-/// not run.
+/// The temporal evaluation (`temporal::run_temporal`) at the options' frames and size, through
+/// the camera volume the dataset's views were placed in (its manifest records it), the
+/// lighting changing from the first held-out map to the second, with path tracing at the
+/// largest equal-time sample count (5 spp without one); or why it was not run.
 fn temporal_run(
     o: &EvalOptions,
-    (scene, ts, manifest): (&Scene, &TraceScene, &Manifest),
+    (ts, manifest): (&TraceScene, &Manifest),
     maps: &BTreeMap<usize, EnvMap>,
     (nets, engine): (&[(Net, String)], Engine),
     (pt5, equal_time): (&Traced, &[(u32, Traced)]),
@@ -187,13 +187,7 @@ fn temporal_run(
     if o.temporal_frames < 2 || o.temporal_res < 8 {
         bail!("--temporal-frames must be 0 or at least 2, and --temporal-res at least 8");
     }
-    let Some(volume) = &scene.camera_volume else {
-        let why = format!(
-            "not run: scene '{}' has no camera volume (a NAME.camera.json beside it) to move the camera through",
-            settings.scene
-        );
-        return Ok((None, why));
-    };
+    let volume = CameraVolume::from(&settings.camera_volume);
     let mut held_out = maps.values();
     let first = held_out.next().expect("a map per test view");
     let tracer = |spp, seed| RenderSettings {
@@ -206,7 +200,7 @@ fn temporal_run(
     };
     let setup = TemporalSetup {
         ts,
-        volume,
+        volume: &volume,
         maps: [first, held_out.next().unwrap_or(first)],
         frames: o.temporal_frames,
         resolution: [o.temporal_res; 2],

@@ -19,6 +19,27 @@ fn register_font() {
     });
 }
 
+// Sixteen distinct colours: an evaluation's temporal plot has a dozen methods or more, and
+// eight made two of them share one.
+const PALETTE: [RGBColor; 16] = [
+    RGBColor(31, 119, 180),
+    RGBColor(214, 39, 40),
+    RGBColor(44, 160, 44),
+    RGBColor(255, 127, 14),
+    RGBColor(148, 103, 189),
+    RGBColor(140, 86, 75),
+    RGBColor(227, 119, 194),
+    RGBColor(127, 127, 127),
+    RGBColor(188, 189, 34),
+    RGBColor(23, 190, 207),
+    RGBColor(0, 0, 0),
+    RGBColor(255, 187, 120),
+    RGBColor(152, 223, 138),
+    RGBColor(174, 199, 232),
+    RGBColor(255, 152, 150),
+    RGBColor(197, 176, 213),
+];
+
 /// Named series as lines with markers on a log-scaled y axis, as a PNG.
 pub fn plot_lines(
     path: &Path,
@@ -45,26 +66,6 @@ pub fn plot_lines(
     let xs = || series.iter().flat_map(|s| s.1.iter().map(|p| p.0));
     let x_min = xs().fold(0.0, f64::min);
     let x_max = xs().fold(1e-3, f64::max);
-    // Sixteen distinct colours: an evaluation's temporal plot has a dozen methods or more, and
-    // eight made two of them share one.
-    const PALETTE: [RGBColor; 16] = [
-        RGBColor(31, 119, 180),
-        RGBColor(214, 39, 40),
-        RGBColor(44, 160, 44),
-        RGBColor(255, 127, 14),
-        RGBColor(148, 103, 189),
-        RGBColor(140, 86, 75),
-        RGBColor(227, 119, 194),
-        RGBColor(127, 127, 127),
-        RGBColor(188, 189, 34),
-        RGBColor(23, 190, 207),
-        RGBColor(0, 0, 0),
-        RGBColor(255, 187, 120),
-        RGBColor(152, 223, 138),
-        RGBColor(174, 199, 232),
-        RGBColor(255, 152, 150),
-        RGBColor(197, 176, 213),
-    ];
     {
         let root = BitMapBackend::with_buffer(&mut buf, (w, h)).into_drawing_area();
         let err = |e: DrawingAreaErrorKind<_>| anyhow!("cannot draw plot '{title}': {e:?}");

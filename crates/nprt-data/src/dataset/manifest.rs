@@ -5,7 +5,7 @@ use std::path::Path;
 
 use anyhow::{bail, Context, Result};
 use glam::{Mat4, Vec3};
-use nprt_scene::{Camera, EnvMap, FovAxis};
+use nprt_scene::{Camera, CameraVolume, EnvMap, FovAxis};
 use nprt_trace::TraceDevice;
 use serde::{Deserialize, Serialize};
 
@@ -79,6 +79,19 @@ pub struct VolumeRecord {
     pub look: [f32; 3],
     pub spread_deg: f32,
     pub fov_deg: f32,
+}
+
+impl From<&VolumeRecord> for CameraVolume {
+    /// The volume a dataset's cameras were placed in, as recorded.
+    fn from(v: &VolumeRecord) -> Self {
+        CameraVolume {
+            min: v.min.into(),
+            max: v.max.into(),
+            look: Vec3::from(v.look).normalize_or(Vec3::NEG_Z),
+            spread_deg: v.spread_deg,
+            fov_deg: v.fov_deg,
+        }
+    }
 }
 
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]

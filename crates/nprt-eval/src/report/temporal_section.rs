@@ -27,7 +27,7 @@ pub(super) fn temporal(md: &mut String, e: &Evaluation, dir: &Path) -> Result<()
     let [w, h] = t.resolution;
     writeln!(
         md,
-        "{} frames at {w}×{h} along a slow move through the scene's camera volume, lit by `{}` \
+        "{} frames at {w}×{h} along a slow move through the dataset's camera volume, lit by `{}` \
          turning, then from frame {} by `{}`; references at {} spp. The temporal error is the mean, \
          over consecutive frame pairs, foreground pixels and channels, of |(M_t − M_t−1) − \
          (R_t − R_t−1)| on linear radiance: how much a method's frames change beyond what the \
