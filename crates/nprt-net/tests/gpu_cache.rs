@@ -7,33 +7,13 @@
 #[allow(dead_code)] // the helpers other test binaries use
 mod common;
 
-use common::cache_queries;
+use common::{cache_queries, relative_error, tensor_errors, update, worst};
 use glam::Vec3;
 use nprt_gpu::GpuDevice;
 use nprt_net::gpu::GpuCache;
 use nprt_net::network::radiance_cache::{RadianceCache, ADAM_BETAS};
 use nprt_net::training::cache_trainer::CacheTrainer;
 use nprt_net::{Engine, Init, Parameters};
-
-/// Euclidean distance of `a` from `b` over b's norm.
-fn relative_error(a: &[f32], b: &[f32]) -> f64 {
-    assert_eq!(a.len(), b.len());
-    let d: f64 = a.iter().zip(b).map(|(x, y)| ((x - y) as f64).powi(2)).sum();
-    let n: f64 = b.iter().map(|y| (*y as f64).powi(2)).sum();
-    (d / n.max(1e-30)).sqrt()
-}
-
-/// Each tensor's name and relative error between two caches.
-fn tensor_errors(a: &RadianceCache, b: &RadianceCache) -> Vec<(String, f64)> {
-    let mut tensors = Vec::new();
-    b.visit("", &mut |_, _, v| tensors.push(v.to_vec()));
-    let mut errors = Vec::new();
-    a.visit("", &mut |name, _, v| {
-        let e = relative_error(v, &tensors[errors.len()]);
-        errors.push((name.to_string(), e))
-    });
-    errors
-}
 
 fn targets(n: usize) -> Vec<Vec3> {
     (0..n)
@@ -56,7 +36,7 @@ fn gpu_cache_reads_and_gradients_match_the_cpu_engine() {
     let (want_loss, want) = cache.loss_and_gradients(&q[..2048], &t[..2048]);
     let (loss, grads) = gpu.loss_and_gradients(&q[..2048], &t[..2048]);
     let errors = tensor_errors(&grads, &want);
-    let worst = errors.iter().fold(0.0f64, |m, (_, e)| m.max(*e));
+    let worst = worst(&errors);
     let loss_error = (loss - want_loss).abs() / want_loss;
     eprintln!("reads {read_error:.1e}, loss {loss_error:.1e}, gradients {worst:.1e}");
     assert!(read_error < 1e-5, "reads off by {read_error}");
@@ -79,11 +59,7 @@ fn training_on_the_kernels_follows_the_cpu_engine_step_by_step() {
             .map(|_| c.train(&q, &t, 2, 1024))
             .collect::<Vec<f64>>()
     });
-    let moved = |c: &CacheTrainer| -> Vec<f32> {
-        (c.cache().flat().iter().zip(start.flat()))
-            .map(|(a, b)| a - b)
-            .collect()
-    };
+    let moved = |c: &CacheTrainer| update(&c.cache(), &start).flat();
     let error = relative_error(&moved(&trained[1]), &moved(&trained[0]));
     eprintln!(
         "losses CPU {:?}, GPU {:?}; the updates {error:.1e} apart",

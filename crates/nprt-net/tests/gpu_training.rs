@@ -11,7 +11,7 @@
 #[allow(dead_code)] // the helpers other test binaries use
 mod common;
 
-use common::{loud_grids, random_batch, variants};
+use common::{loud_grids, random_batch, relative_error, tensor_errors, update, variants, worst};
 use nprt_gpu::GpuDevice;
 use nprt_net::gpu::GpuTrainer;
 use nprt_net::optimiser::Adam;
@@ -19,25 +19,6 @@ use nprt_net::{
     cpu, Activation, Design, Init, Loss, ModelConfig, NprtNet, Parameters, PositionEncoding,
     Precision,
 };
-
-/// Euclidean distance of `a` from `b` over b's norm.
-fn relative_error(a: &[f32], b: &[f32]) -> f64 {
-    assert_eq!(a.len(), b.len());
-    let d: f64 = a.iter().zip(b).map(|(x, y)| ((x - y) as f64).powi(2)).sum();
-    let n: f64 = b.iter().map(|y| (*y as f64).powi(2)).sum();
-    (d / n.max(1e-30)).sqrt()
-}
-
-/// Each tensor's relative error between two sets of values of one network's shapes.
-fn tensor_errors(a: &NprtNet, b: &NprtNet) -> Vec<f64> {
-    let mut tensors = Vec::new();
-    b.visit("", &mut |_, _, v| tensors.push(v.to_vec()));
-    let mut errors = Vec::new();
-    a.visit("", &mut |_, _, v| {
-        errors.push(relative_error(v, &tensors[errors.len()]))
-    });
-    errors
-}
 
 /// `config` with an encoder for the test batches' 64-wide maps, built from seed 4 with loud
 /// grids.
@@ -68,7 +49,6 @@ fn gpu_gradients_match_the_cpu_engine_for_every_design() {
             let value = gpu.backward(&samples, loss);
             let errors = tensor_errors(&gpu.gradients(), &want);
             let encoder_tensors = 2 * net.encoder.convs.len() + 2;
-            let worst = |e: &[f64]| e.iter().fold(0.0f64, |m, &v| m.max(v));
             let (encoder, transport) = errors.split_at(encoder_tensors);
             let loss_error = (value - want_loss).abs() / want_loss;
             let name = format!("{name} {loss}");
@@ -132,25 +112,11 @@ fn gpu_adam_steps_match_the_hosts_adam_on_the_cpu_engine() {
         gpu.step(&samples, Loss::LogL1, lr);
     }
     let errors = tensor_errors(&update(&gpu.parameters(), &start), &update(&net, &start));
-    let worst = errors.iter().fold(0.0f64, |m, &e| m.max(e));
+    let worst = worst(&errors);
     eprintln!("largest relative difference of a tensor's update: {worst:.1e}");
     // Lavapipe: 2.5e-5. Adam's update m/√v magnifies the gradients' rounding where they are
     // near zero.
     assert!(worst < 1e-3, "updates differ: {errors:?}");
-}
-
-/// What `end` moved every parameter by from `start`, as a network of the same shapes.
-fn update(end: &NprtNet, start: &NprtNet) -> NprtNet {
-    let origin = start.flat();
-    let mut d = end.clone();
-    d.set_flat(
-        &end.flat()
-            .iter()
-            .zip(&origin)
-            .map(|(a, b)| a - b)
-            .collect::<Vec<_>>(),
-    );
-    d
 }
 
 /// A profiled step (`nprt bench train --profile`) is the step: the same loss and parameters to
@@ -238,7 +204,7 @@ fn mixed_precision_gradients_follow_the_cpu_engine_for_every_design() {
             let mut gpu = GpuTrainer::new(&net, Precision::F16).unwrap();
             let value = gpu.backward(&samples, loss);
             let errors = tensor_errors(&gpu.gradients(), &want);
-            let worst = errors.iter().fold(0.0f64, |m, &v| m.max(v));
+            let worst = worst(&errors);
             let loss_error = (value - want_loss).abs() / want_loss;
             let name = format!("{} {} {loss}", config.label(), config.activation);
             eprintln!("{name}: loss {loss_error:.1e}, gradients {worst:.1e}");

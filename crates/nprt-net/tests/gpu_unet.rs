@@ -8,36 +8,12 @@
 #[allow(dead_code)] // the helpers other test binaries use
 mod common;
 
-use common::unet_batch;
+use common::{relative_error, tensor_errors, unet_batch, update, worst};
 use nprt_gpu::GpuDevice;
 use nprt_net::deep_shading::DeepShading;
 use nprt_net::gpu::GpuUnet;
 use nprt_net::optimiser::Adam;
 use nprt_net::{Init, Loss, Parameters};
-
-/// Euclidean distance of `a` from `b` over b's norm.
-fn relative_error(a: &[f32], b: &[f32]) -> f64 {
-    assert_eq!(a.len(), b.len());
-    let d: f64 = a.iter().zip(b).map(|(x, y)| ((x - y) as f64).powi(2)).sum();
-    let n: f64 = b.iter().map(|y| (*y as f64).powi(2)).sum();
-    (d / n.max(1e-30)).sqrt()
-}
-
-/// Each tensor's name and relative error between two networks of one shape.
-fn tensor_errors(a: &DeepShading, b: &DeepShading) -> Vec<(String, f64)> {
-    let mut tensors = Vec::new();
-    b.visit("", &mut |_, _, v| tensors.push(v.to_vec()));
-    let mut errors = Vec::new();
-    a.visit("", &mut |name, _, v| {
-        let e = relative_error(v, &tensors[errors.len()]);
-        errors.push((name.to_string(), e))
-    });
-    errors
-}
-
-fn worst(errors: &[(String, f64)]) -> f64 {
-    errors.iter().fold(0.0f64, |m, (_, e)| m.max(*e))
-}
 
 /// A U-Net for the test batches' 64-wide maps.
 fn network() -> DeepShading {
@@ -91,16 +67,6 @@ fn gpu_unet_shades_as_the_cpu_engine() {
         eprintln!("view {v}: {error:.1e}");
         assert!(error < 1e-5, "view {v} off by {error}");
     }
-}
-
-/// What `end` moved every parameter by from `start`.
-fn update(end: &DeepShading, start: &DeepShading) -> DeepShading {
-    let mut d = end.clone();
-    let moved: Vec<f32> = (end.flat().iter().zip(start.flat()))
-        .map(|(a, b)| a - b)
-        .collect();
-    d.set_flat(&moved);
-    d
 }
 
 #[test]

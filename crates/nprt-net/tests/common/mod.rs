@@ -7,7 +7,7 @@ use glam::Vec3;
 use nprt_net::cpu::UnetBatch;
 use nprt_net::network::radiance_cache::CacheQuery;
 use nprt_net::{Activation, Batch, Design, Loss, ModelConfig, NprtNet};
-use nprt_net::{PositionEncoding, FEATURES};
+use nprt_net::{Parameters, PositionEncoding, FEATURES};
 use rand::{RngExt, SeedableRng};
 use rand_pcg::Pcg64Mcg;
 use reference::Reference;
@@ -174,4 +174,40 @@ pub fn cache_queries(n: usize, seed: u64) -> Vec<CacheQuery> {
             }
         })
         .collect()
+}
+
+/// Euclidean distance of `a` from `b` over b's norm.
+pub fn relative_error(a: &[f32], b: &[f32]) -> f64 {
+    assert_eq!(a.len(), b.len());
+    let d: f64 = a.iter().zip(b).map(|(x, y)| ((x - y) as f64).powi(2)).sum();
+    let n: f64 = b.iter().map(|y| (*y as f64).powi(2)).sum();
+    (d / n.max(1e-30)).sqrt()
+}
+
+/// Each tensor's name and relative error between two networks of one shape, in their visiting
+/// order.
+pub fn tensor_errors<N: Parameters>(a: &N, b: &N) -> Vec<(String, f64)> {
+    let mut tensors = Vec::new();
+    b.visit("", &mut |_, _, v| tensors.push(v.to_vec()));
+    let mut errors = Vec::new();
+    a.visit("", &mut |name, _, v| {
+        let e = relative_error(v, &tensors[errors.len()]);
+        errors.push((name.to_string(), e))
+    });
+    errors
+}
+
+/// The largest of [`tensor_errors`].
+pub fn worst(errors: &[(String, f64)]) -> f64 {
+    errors.iter().fold(0.0f64, |m, (_, e)| m.max(*e))
+}
+
+/// What `end` moved every parameter by from `start`, as a network of the same shapes.
+pub fn update<N: Parameters + Clone>(end: &N, start: &N) -> N {
+    let mut d = end.clone();
+    let moved: Vec<f32> = (end.flat().iter().zip(start.flat()))
+        .map(|(a, b)| a - b)
+        .collect();
+    d.set_flat(&moved);
+    d
 }
