@@ -94,11 +94,6 @@ impl Nrc {
         })
     }
 
-    /// Trains `steps` Adam steps per frame from now on.
-    pub fn set_steps(&mut self, steps: usize) {
-        self.settings.steps = steps;
-    }
-
     fn query(&self, v: &CacheVertex) -> CacheQuery {
         let (lo, extent) = self.frame_of;
         CacheQuery {
@@ -113,14 +108,14 @@ impl Nrc {
 
     /// One frame through `camera` under `env` (as placed in the world): its radiance per
     /// pixel, read from the cache as it stands; then the cache trains on the frame's training
-    /// paths. Returns the frame and the training loss.
+    /// paths.
     pub fn frame(
         &mut self,
         ts: &TraceScene,
         camera: &Camera,
         env: &EnvMap,
         s: &PathSettings,
-    ) -> (Vec<Vec3>, f64) {
+    ) -> Vec<Vec3> {
         let (w, h) = (camera.width as usize, camera.height as usize);
         let seed = self.seed ^ self.frames.wrapping_mul(0x9e37_79b9);
         self.frames += 1;
@@ -183,8 +178,8 @@ impl Nrc {
         order.shuffle(&mut pixel_rng(seed, u64::MAX));
         let queries: Vec<CacheQuery> = order.iter().map(|&k| queries[k]).collect();
         let targets: Vec<Vec3> = order.iter().map(|&k| targets[k]).collect();
-        let loss = self.trainer.train(&queries, &targets, o.steps, o.batch);
-        (frame, loss)
+        self.trainer.train(&queries, &targets, o.steps, o.batch);
+        frame
     }
 }
 

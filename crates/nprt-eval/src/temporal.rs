@@ -405,7 +405,7 @@ fn run_cache(
     for f in frames {
         let map = setup.lit(f);
         let start = Instant::now();
-        rgb.push(nrc.frame(setup.ts, &f.camera, &map, &path).0);
+        rgb.push(nrc.frame(setup.ts, &f.camera, &map, &path));
         total_ms += ms(start);
         on_frame();
     }

@@ -81,6 +81,19 @@ pub struct VolumeRecord {
     pub fov_deg: f32,
 }
 
+impl From<&CameraVolume> for VolumeRecord {
+    /// The volume a dataset's cameras are placed in, for its manifest.
+    fn from(v: &CameraVolume) -> Self {
+        VolumeRecord {
+            min: v.min.into(),
+            max: v.max.into(),
+            look: v.look.into(),
+            spread_deg: v.spread_deg,
+            fov_deg: v.fov_deg,
+        }
+    }
+}
+
 impl From<&VolumeRecord> for CameraVolume {
     /// The volume a dataset's cameras were placed in, as recorded.
     fn from(v: &VolumeRecord) -> Self {

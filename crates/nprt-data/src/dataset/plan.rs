@@ -112,13 +112,7 @@ pub fn plan(req: &Request, ts: &TraceScene) -> Result<Manifest> {
         rr_depth: req.scene.rr_depth,
         seed: req.seed,
         jitter: req.jitter,
-        camera_volume: VolumeRecord {
-            min: v.min.into(),
-            max: v.max.into(),
-            look: v.look.into(),
-            spread_deg: v.spread_deg,
-            fov_deg: v.fov_deg,
-        },
+        camera_volume: VolumeRecord::from(v),
         tracer: TraceDevice::Cpu,
     };
     let views = plan_views(req, ts, &train_pool, &test_maps, mixed, own_map)?;

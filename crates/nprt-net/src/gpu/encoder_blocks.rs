@@ -22,12 +22,7 @@ impl EncoderAt {
         let convs = (encoder.convs.iter())
             .map(|c| ConvAt::new(c, spans))
             .collect();
-        let to_code = DenseAt {
-            weight: spans.next().expect("a span per tensor"),
-            bias: spans.next().expect("a span per tensor"),
-            d_in: encoder.to_code.d_in,
-            d_out: encoder.to_code.d_out,
-        };
+        let to_code = DenseAt::new(&encoder.to_code, spans);
         EncoderAt { convs, to_code }
     }
 

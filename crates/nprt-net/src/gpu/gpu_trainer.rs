@@ -19,6 +19,7 @@ use super::kernels::GATHER_SAMPLES;
 use super::mlp_step::Trainable;
 use super::network_layout::NetworkLayout;
 use super::parameters::ParameterLayout;
+use super::plans::{Pass, Plans};
 use super::{groups_for, Dispatch, GpuDevice};
 use crate::cpu::Samples;
 use crate::encoding::features::FEATURES;
@@ -44,7 +45,7 @@ pub struct GpuTrainer {
     /// The step's dispatches for the last batch shapes used (training's and validation's, and
     /// their epochs' last, shorter batches), recorded again for every batch of the shape;
     /// the most recently used last.
-    plans: Vec<StepPlan>,
+    plans: Plans<StepPlan>,
     adam: DeviceAdam,
     precision: Precision,
     /// In mixed precision, the dispatches that copy the transport layers' weights into their
@@ -108,20 +109,6 @@ struct StepPlan {
     forward: usize,
     /// With a dataset on the device: the batch's gather, one dispatch per shard of records.
     gathers: Vec<Dispatch>,
-}
-
-/// Batch shapes whose plans are kept.
-const PLANS: usize = 4;
-
-/// What a queued submission runs.
-#[derive(Clone, Copy)]
-enum Pass {
-    /// The loss alone.
-    Forward,
-    /// The loss and every gradient.
-    Backward,
-    /// The loss, every gradient and Adam at this learning rate.
-    Step(f64),
 }
 
 /// A batch on the device, and what its step computes besides gradients.
@@ -191,7 +178,7 @@ impl GpuTrainer {
             adam,
             precision,
             half_refresh,
-            plans: Vec::new(),
+            plans: Plans::default(),
             resolutions: gpu.upload(&hash_grid::resolutions()),
             net,
             layout,
@@ -345,10 +332,7 @@ impl GpuTrainer {
         if matches!(inputs, Inputs::Picked { .. }) {
             list.extend(&plan.gathers);
         }
-        list.extend(match pass {
-            Pass::Forward => &plan.dispatches[..plan.forward],
-            _ => &plan.dispatches[..],
-        });
+        list.extend(pass.of(&plan.dispatches, plan.forward));
         if let Pass::Step(_) = pass {
             list.push(&self.adam.dispatch);
             list.extend(&self.half_refresh);
@@ -398,16 +382,13 @@ impl GpuTrainer {
     /// one fits), and writes the batch (or its picks) into its buffers.
     fn prepare(&mut self, inputs: Inputs, loss: Loss) {
         let (rows, views, light_width) = inputs.shape();
-        let fits = self.plans.iter().position(|p| {
+        let fits = self.plans.take(|p| {
             let b = &p.batch;
             p.loss == loss && (b.rows, b.views, b.light_width) == (rows, views, light_width)
         });
         let plan = match fits {
-            Some(i) => self.plans.remove(i),
+            Some(plan) => plan,
             None => {
-                if self.plans.len() == PLANS {
-                    self.plans.remove(0);
-                }
                 let b = self.batch_buffers(rows, views, light_width);
                 let mut dispatches = Vec::new();
                 let (gpu, encoder) = (&self.gpu, &self.net.encoder);
@@ -433,7 +414,7 @@ impl GpuTrainer {
                 }
             }
         };
-        self.plans.push(plan);
+        self.plans.keep(plan);
         let b = &self.plans.last().expect("made above").batch;
         match inputs {
             Inputs::Host(batch) => {

@@ -3,6 +3,7 @@
 
 use super::Span;
 use crate::network::conv::Conv;
+use crate::network::dense::Dense;
 
 /// One dense layer's place in the flat buffers.
 pub struct DenseAt {
@@ -10,6 +11,18 @@ pub struct DenseAt {
     pub bias: Span,
     pub d_in: usize,
     pub d_out: usize,
+}
+
+impl DenseAt {
+    /// `dense`'s place, its weight's and bias's spans taken in order from `spans`.
+    pub fn new(dense: &Dense, spans: &mut impl Iterator<Item = Span>) -> Self {
+        DenseAt {
+            weight: spans.next().expect("a span per tensor"),
+            bias: spans.next().expect("a span per tensor"),
+            d_in: dense.d_in,
+            d_out: dense.d_out,
+        }
+    }
 }
 
 /// One convolution in the flat buffers, and its shape.

@@ -24,6 +24,7 @@ mod network_forward;
 mod network_layout;
 mod operands;
 mod parameters;
+mod plans;
 mod radiance_cache;
 mod transport_step;
 mod unet_pass;

@@ -163,17 +163,9 @@ impl NetworkLayout {
 
 /// The layers of `stack`, their spans taken in order from `spans`.
 pub fn mlp_at(stack: &Mlp, spans: &mut impl Iterator<Item = Span>) -> MlpAt {
-    let mut take = || spans.next().expect("a span per tensor");
     MlpAt {
-        layers: stack
-            .layers
-            .iter()
-            .map(|l| DenseAt {
-                weight: take(),
-                bias: take(),
-                d_in: l.d_in,
-                d_out: l.d_out,
-            })
+        layers: (stack.layers.iter())
+            .map(|l| DenseAt::new(l, spans))
             .collect(),
         activation: stack.activation,
         half: Vec::new(),

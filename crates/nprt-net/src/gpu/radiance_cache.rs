@@ -20,6 +20,7 @@ use super::network_forward::FirstLayer;
 use super::network_layout::{mlp_at, MlpAt};
 use super::operands::{Bias, Output};
 use super::parameters::ParameterLayout;
+use super::plans::{submit, Pass, Plans};
 use super::{groups_for, Dispatch, GpuDevice, Part, Span};
 use crate::cpu::radiance_cache::encode_rest;
 use crate::encoding::features::FEATURES;
@@ -57,12 +58,9 @@ pub struct GpuCache {
     grads: wgpu::Buffer,
     adam: DeviceAdam,
     resolutions: wgpu::Buffer,
-    /// The plans of the last row counts used, the most recent last.
-    plans: Vec<CachePlan>,
+    /// The passes of the last row counts used.
+    plans: Plans<CachePlan>,
 }
-
-/// Row counts whose plans are kept (a full batch, a read chunk, and each's shorter last one).
-const PLANS: usize = 4;
 
 impl GpuCache {
     /// Uploads `cache`'s weights to the process's GPU device, with zero Adam moments under the
@@ -80,7 +78,7 @@ impl GpuCache {
             adam: DeviceAdam::with_betas(&gpu, layout.total, &grads, &params, betas),
             resolutions: gpu.upload(&hash_grid::resolutions()),
             shapes: cache.clone(),
-            plans: Vec::new(),
+            plans: Plans::default(),
             grid,
             mlp,
             params,
@@ -101,7 +99,7 @@ impl GpuCache {
         let mut out = Vec::with_capacity(queries.len());
         for chunk in queries.chunks(READ_ROWS) {
             self.upload(chunk, None);
-            self.submit(false, None);
+            self.submit(Pass::Forward);
             let plan = self.plans.last().expect("uploaded");
             let y = self
                 .gpu
@@ -117,7 +115,7 @@ impl GpuCache {
     /// loss.
     pub fn step(&mut self, queries: &[CacheQuery], targets: &[Vec3], lr: f64) -> f64 {
         self.upload(queries, Some(targets));
-        self.submit(true, Some(lr));
+        self.submit(Pass::Step(lr));
         let plan = self.plans.last().expect("uploaded");
         self.gpu.read(&plan.loss, 1)[0] as f64 / (3 * queries.len()).max(1) as f64
     }
@@ -130,7 +128,7 @@ impl GpuCache {
         targets: &[Vec3],
     ) -> (f64, RadianceCache) {
         self.upload(queries, Some(targets));
-        self.submit(true, None);
+        self.submit(Pass::Backward);
         let plan = self.plans.last().expect("uploaded");
         let loss = self.gpu.read(&plan.loss, 1)[0] as f64 / (3 * queries.len()).max(1) as f64;
         let flat = self.gpu.read(&self.grads, self.layout.total);
@@ -141,14 +139,9 @@ impl GpuCache {
     /// queries, and `targets` where given, into its buffers.
     fn upload(&mut self, queries: &[CacheQuery], targets: Option<&[Vec3]>) {
         let rows = queries.len();
-        let plan = match self.plans.iter().position(|p| p.rows == rows) {
-            Some(i) => self.plans.remove(i),
-            None => {
-                if self.plans.len() == PLANS {
-                    self.plans.remove(0);
-                }
-                self.record(rows)
-            }
+        let plan = match self.plans.take(|p| p.rows == rows) {
+            Some(plan) => plan,
+            None => self.record(rows),
         };
         let mut features = vec![0.0f32; rows * FEATURES];
         for (q, f) in queries.iter().zip(features.chunks_exact_mut(FEATURES)) {
@@ -164,28 +157,19 @@ impl GpuCache {
             let t: Vec<f32> = t.iter().flat_map(|v| v.to_array()).collect();
             self.gpu.write(&plan.targets, &t);
         }
-        self.plans.push(plan);
+        self.plans.keep(plan);
     }
 
-    /// Runs the last plan: its forward part, or all of it (the loss and every gradient) and,
-    /// at a learning rate, Adam.
-    fn submit(&mut self, backward: bool, lr: Option<f64>) {
-        if let Some(lr) = lr {
-            self.adam.next_step(&self.gpu, self.layout.total, lr, 1.0);
-        }
+    /// Runs what `pass` asks of the last plan.
+    fn submit(&mut self, pass: Pass) {
         let plan = self.plans.last().expect("uploaded");
-        let dispatches = match backward {
-            true => &plan.dispatches[..],
-            false => &plan.dispatches[..plan.forward],
-        };
-        let mut encoder = self.gpu.device.create_command_encoder(&Default::default());
-        let mut compute = encoder.begin_compute_pass(&Default::default());
-        dispatches.iter().for_each(|d| d.record(&mut compute));
-        if lr.is_some() {
-            self.adam.dispatch.record(&mut compute);
-        }
-        drop(compute);
-        self.gpu.queue.submit([encoder.finish()]);
+        let recorded = (plan.dispatches.as_slice(), plan.forward);
+        submit(
+            &self.gpu,
+            recorded,
+            pass,
+            (&mut self.adam, self.layout.total),
+        );
     }
 
     /// Records a pass over `rows` queries: the grid's encoding into the input's first columns,

@@ -114,12 +114,7 @@ impl UnetAt {
             .chain(&net.bottleneck)
             .map(&mut conv_at)
             .collect();
-        let code = DenseAt {
-            weight: spans.next().expect("a span per tensor"),
-            bias: spans.next().expect("a span per tensor"),
-            d_in: net.code.d_in,
-            d_out: net.code.d_out,
-        };
+        let code = DenseAt::new(&net.code, &mut spans);
         let mut conv_at = |c| ConvAt::new(c, &mut spans);
         convs.extend(net.up.iter().chain([&net.out]).map(&mut conv_at));
         assert!(spans.next().is_none(), "a tensor without a place");

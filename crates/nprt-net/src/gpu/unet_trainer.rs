@@ -11,6 +11,7 @@ use anyhow::Result;
 use super::conv_layers::Images;
 use super::device_adam::DeviceAdam;
 use super::parameters::ParameterLayout;
+use super::plans::{submit, Pass, Plans};
 use super::unet_pass::{loss_params, UnetAt, UnetBuffers};
 use super::{Dispatch, GpuDevice};
 use crate::cpu::UnetBatch;
@@ -30,7 +31,7 @@ pub struct GpuUnet {
     adam: DeviceAdam,
     /// The passes for the last batch shapes used (training's, validation's, their epochs'
     /// shorter last batches), the most recently used last.
-    plans: Vec<UnetPlan>,
+    plans: Plans<UnetPlan>,
 }
 
 /// A pass's dispatches for one batch shape and loss, with the buffers its batches are written
@@ -45,18 +46,6 @@ struct UnetPlan {
     loss_at: usize,
 }
 
-/// Batch shapes whose plans are kept.
-const PLANS: usize = 4;
-
-/// What a submission runs.
-#[derive(Clone, Copy)]
-enum Pass {
-    Forward,
-    Backward,
-    /// Backward and Adam at this learning rate.
-    Step(f64),
-}
-
 impl GpuUnet {
     /// Uploads `net`'s parameters to the process's GPU device, with zero Adam moments.
     pub fn new(net: &DeepShading) -> Result<Self> {
@@ -68,7 +57,7 @@ impl GpuUnet {
             adam: DeviceAdam::new(&gpu, layout.total, &grads, &params),
             net: UnetAt::new(net, &layout),
             shapes: net.clone(),
-            plans: Vec::new(),
+            plans: Plans::default(),
             params,
             grads,
             layout,
@@ -146,21 +135,8 @@ impl GpuUnet {
         let foreground: f64 = batch.mask.iter().map(|&m| m as f64).sum();
         let uniform = &plan.dispatches[plan.loss_at].uniform;
         gpu.write(uniform, &loss_params(images, loss, foreground));
-        let dispatches = match pass {
-            Pass::Forward => &plan.dispatches[..plan.forward],
-            _ => &plan.dispatches[..],
-        };
-        if let Pass::Step(lr) = pass {
-            self.adam.next_step(gpu, self.layout.total, lr, 1.0);
-        }
-        let mut encoder = gpu.device.create_command_encoder(&Default::default());
-        let mut compute = encoder.begin_compute_pass(&Default::default());
-        dispatches.iter().for_each(|d| d.record(&mut compute));
-        if let Pass::Step(_) = pass {
-            self.adam.dispatch.record(&mut compute);
-        }
-        drop(compute);
-        gpu.queue.submit([encoder.finish()]);
+        let recorded = (plan.dispatches.as_slice(), plan.forward);
+        submit(gpu, recorded, pass, (&mut self.adam, self.layout.total));
         let total = gpu.read(&b.loss, 1)[0] as f64;
         total / (3.0 * foreground).max(1.0)
     }
@@ -168,17 +144,14 @@ impl GpuUnet {
     /// Makes the plan for `images` and `loss` the last of the kept plans (made unless one
     /// fits).
     fn prepare(&mut self, images: Images, light_width: usize, loss: Loss) {
-        let fits = self.plans.iter().position(|p| {
+        let fits = self.plans.take(|p| {
             let b = &p.batch;
             let shape = (b.images.views, b.images.h, b.images.w, b.light_width);
             p.loss == loss && shape == (images.views, images.h, images.w, light_width)
         });
         let plan = match fits {
-            Some(i) => self.plans.remove(i),
+            Some(plan) => plan,
             None => {
-                if self.plans.len() == PLANS {
-                    self.plans.remove(0);
-                }
                 let gpu = &self.gpu;
                 let batch = UnetBuffers::new(gpu, images, light_width, self.net.offset_width());
                 let mut dispatches = Vec::new();
@@ -198,6 +171,6 @@ impl GpuUnet {
                 }
             }
         };
-        self.plans.push(plan);
+        self.plans.keep(plan);
     }
 }
