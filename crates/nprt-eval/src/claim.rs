@@ -91,20 +91,18 @@ pub struct Claim {
 }
 
 impl Claim {
-    /// "`a` beats `b` in `metric`", judged on their per-view values.
-    pub fn beats(a: &MethodResult, b: &MethodResult, metric: usize) -> Claim {
-        let name = Metrics::NAMES[metric];
-        let values = |m: &MethodResult| -> Vec<f64> {
-            m.per_view.iter().map(|v| v.values()[metric]).collect()
-        };
-        let p = Paired::new(&values(a), &values(b));
+    /// "`a` beats `b` in `what`", judged on their paired values (per `per`: view or frame), each
+    /// given with its name.
+    pub fn lower(a: (&str, &[f64]), b: (&str, &[f64]), what: &str, per: &str) -> Claim {
+        let p = Paired::new(a.1, b.1);
+        let mean = |v: &[f64]| v.iter().sum::<f64>() / v.len().max(1) as f64;
         Claim {
             text: format!(
-                "{} beats {} in {name} ({:.4} vs {:.4}; per view {:+.4} ± {:.4}, lower on {} of {})",
-                a.name,
-                b.name,
-                a.mean.values()[metric],
-                b.mean.values()[metric],
+                "{} beats {} in {what} ({:.4} vs {:.4}; per {per} {:+.4} ± {:.4}, lower on {} of {})",
+                a.0,
+                b.0,
+                mean(a.1),
+                mean(b.1),
                 p.diff,
                 p.se,
                 p.lower_on,
@@ -113,23 +111,30 @@ impl Claim {
             verdict: p.lower(),
         }
     }
-}
 
-impl Claim {
+    /// "`a` beats `b` in `metric`", judged on their per-view values.
+    pub fn beats(a: &MethodResult, b: &MethodResult, metric: usize) -> Claim {
+        let values = |m: &MethodResult| -> Vec<f64> {
+            m.per_view.iter().map(|v| v.values()[metric]).collect()
+        };
+        Claim::lower(
+            (&a.name, &values(a)),
+            (&b.name, &values(b)),
+            Metrics::NAMES[metric],
+            "view",
+        )
+    }
+
     /// "`a` beats `b` in L1 from frame `from` on" (the frames after a lighting change), judged
     /// on their per-frame L1 over those frames.
     pub fn beats_from_frame(a: &TemporalResult, b: &TemporalResult, from: usize) -> Claim {
         let (la, lb) = (a.per_frame_l1(), b.per_frame_l1());
-        let (la, lb) = (&la[from.min(la.len())..], &lb[from.min(lb.len())..]);
-        let p = Paired::new(la, lb);
-        let mean = |v: &[f64]| v.iter().sum::<f64>() / v.len().max(1) as f64;
-        Claim {
-            text: format!(
-                "{} beats {} in L1 in the frames after the lighting change ({:.4} vs {:.4}; per frame {:+.4} ± {:.4}, lower on {} of {})",
-                a.name, b.name, mean(la), mean(lb), p.diff, p.se, p.lower_on, p.views
-            ),
-            verdict: p.lower(),
-        }
+        Claim::lower(
+            (&a.name, &la[from.min(la.len())..]),
+            (&b.name, &lb[from.min(lb.len())..]),
+            "L1 in the frames after the lighting change",
+            "frame",
+        )
     }
 
     /// "`a` flickers less than `b`": judged on their temporal errors over the same frame pairs.

@@ -57,6 +57,10 @@ pub struct Evaluation {
     /// Images of the shown views, per method (reference first), in the report's images folder.
     #[serde(skip)]
     pub shown: Vec<ShownView>,
+    /// Indices of the shown views (kept in results.json, so that a report built later from it
+    /// finds their images: [`crate::crop_image`]).
+    #[serde(default)]
+    pub shown_views: Vec<usize>,
     /// Every method along a camera path (None where it was not run; `temporal_note` says why).
     #[serde(default)]
     pub temporal: Option<Temporal>,
@@ -70,16 +74,14 @@ pub fn evaluate(o: &EvalOptions, engine: Engine) -> Result<Evaluation> {
     if o.sh_spp == 0 || o.timing_res < 8 {
         bail!("--sh-spp must be at least 1 and --timing-res at least 8");
     }
-    let (manifest, dataset_hash) = load_manifest_hashed(&o.data)?;
+    let Loaded {
+        manifest,
+        scene,
+        views,
+        maps,
+        nets,
+    } = Loaded::new(o, engine)?;
     let s = &manifest.settings;
-    let scene = load_checked_scene(
-        &s.scene,
-        &s.scene_hash,
-        &format!("dataset '{}' was rendered from", o.data.display()),
-    )?;
-    let views = test_views(o, &manifest)?;
-    let maps = views_maps(&manifest, &views)?;
-    let nets = load_networks(o, engine, &dataset_hash, &s.scene_hash)?;
     let ts = TraceScene::new(&scene);
     let oidn = Oidn::open();
     let denoiser = describe_denoiser(&oidn);
@@ -157,10 +159,75 @@ pub fn evaluate(o: &EvalOptions, engine: Engine) -> Result<Evaluation> {
         peak_gflops: nprt_net::cpu::measured_peak(rayon::current_num_threads()).gflops,
         denoiser,
         cpu_threads: rayon::current_num_threads(),
+        shown_views: bench.shown.iter().map(|v| v.index).collect(),
         shown: bench.shown,
         temporal,
         temporal_note,
     })
+}
+
+/// What an evaluation reads: the dataset's manifest, its scene, the test views evaluated with
+/// their maps, and the networks (refused when trained on another scene).
+struct Loaded {
+    manifest: Manifest,
+    scene: nprt_scene::Scene,
+    views: Vec<ImageView>,
+    maps: BTreeMap<usize, EnvMap>,
+    nets: Vec<(Net, String)>,
+}
+
+impl Loaded {
+    fn new(o: &EvalOptions, engine: Engine) -> Result<Loaded> {
+        let (manifest, dataset_hash) = load_manifest_hashed(&o.data)?;
+        let s = &manifest.settings;
+        let scene = load_checked_scene(
+            &s.scene,
+            &s.scene_hash,
+            &format!("dataset '{}' was rendered from", o.data.display()),
+        )?;
+        let views = test_views(o, &manifest)?;
+        let maps = views_maps(&manifest, &views)?;
+        let nets = load_networks(o, engine, &dataset_hash, &s.scene_hash)?;
+        Ok(Loaded {
+            manifest,
+            scene,
+            views,
+            maps,
+            nets,
+        })
+    }
+}
+
+/// The networks `o` names on the test views alone, without baselines, timings or the camera
+/// path: what the paper's Table 2 (its ablation) compares.
+pub fn score_networks(o: &EvalOptions, engine: Engine) -> Result<Vec<MethodResult>> {
+    let Loaded {
+        manifest,
+        scene,
+        views,
+        maps,
+        nets,
+    } = Loaded::new(o, engine)?;
+    let ts = TraceScene::new(&scene);
+    let mut bench = TestBench {
+        views: &views,
+        maps: &maps,
+        ts: &ts,
+        settings: &manifest.settings,
+        seed: o.seed,
+        direct_spp: o.direct_spp,
+        shown: Vec::new(),
+        bar: nprt_io::progress_bar(
+            o.progress,
+            (views.len() * nets.len()) as u64,
+            "scoring",
+            "views",
+        ),
+    };
+    let results = run_networks(&mut bench, &nets, None)?;
+    bench.bar.finish_and_clear();
+    check_finite(&results, &views)?;
+    Ok(results)
 }
 
 /// The temporal evaluation (`temporal::run_temporal`) at the options' frames and size, through

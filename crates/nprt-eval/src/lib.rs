@@ -35,8 +35,9 @@ mod test_bench;
 mod timing;
 
 pub use eval_options::EvalOptions;
-pub use evaluate::{evaluate, Evaluation};
+pub use evaluate::{evaluate, score_networks, Evaluation};
 pub use method::{Family, MethodResult, BINS};
 pub use metrics::Metrics;
-pub use report::write_report;
+pub use networks::row_name;
+pub use report::{crop_image, fmt, markdown_to_html, mean_and_se, table6, write_report};
 pub use timing::Timing;

@@ -3,7 +3,7 @@
 
 use std::path::PathBuf;
 
-use serde::{Deserialize, Serialize};
+use serde::{Deserialize, Deserializer, Serialize};
 
 use crate::metrics::Metrics;
 
@@ -43,11 +43,15 @@ pub struct MethodResult {
     /// One-off precomputation per view (SH transport), milliseconds.
     pub precompute_ms: Option<f64>,
     /// Pearson correlation over foreground pixels of the per-pixel L1 error with the share of
-    /// direct light, and with specularity.
+    /// direct light, and with specularity (NaN where either is constant).
+    #[serde(deserialize_with = "nan_if_null")]
     pub corr_directness: f64,
+    #[serde(deserialize_with = "nan_if_null")]
     pub corr_specularity: f64,
-    /// Mean per-pixel L1 error in each directness / specularity bin.
+    /// Mean per-pixel L1 error in each directness / specularity bin (NaN for an empty bin).
+    #[serde(deserialize_with = "nans_if_null")]
     pub error_by_directness: Vec<f64>,
+    #[serde(deserialize_with = "nans_if_null")]
     pub error_by_specularity: Vec<f64>,
     pub note: String,
     /// Training curve, for networks.
@@ -69,4 +73,15 @@ pub struct MethodResult {
     /// denoised rows), which the paper's claims compare it with.
     #[serde(default)]
     pub equal_time: Option<String>,
+}
+
+/// JSON writes NaN as null; reading it back gives NaN again (so results.json round-trips).
+fn nan_if_null<'de, D: Deserializer<'de>>(d: D) -> Result<f64, D::Error> {
+    Ok(Option::<f64>::deserialize(d)?.unwrap_or(f64::NAN))
+}
+
+/// [`nan_if_null`] for each value of a list.
+fn nans_if_null<'de, D: Deserializer<'de>>(d: D) -> Result<Vec<f64>, D::Error> {
+    let values = Vec::<Option<f64>>::deserialize(d)?;
+    Ok(values.into_iter().map(|v| v.unwrap_or(f64::NAN)).collect())
 }

@@ -26,6 +26,8 @@ impl Metrics {
     pub const L1: usize = 0;
     pub const RMSE: usize = 2;
     pub const LOG_L1: usize = 6;
+    /// The metrics of the paper's Table 6 (L1, L2, dSSIM, MAPE, MRSE).
+    pub const TABLE6: [usize; 5] = [0, 1, 3, 4, 5];
 
     pub fn values(&self) -> [f64; 7] {
         [

@@ -6,7 +6,7 @@ use std::time::Instant;
 
 use anyhow::{bail, Result};
 use glam::Vec3;
-use nprt_net::Engine;
+use nprt_net::{Engine, ModelConfig};
 use nprt_render::oidn::Oidn;
 use nprt_render::{DirectSampling, Relighter};
 use nprt_scene::{Camera, EnvMap};
@@ -40,7 +40,7 @@ impl Net {
 
     fn kind_name(&self) -> String {
         match self {
-            Net::Nprt(r, _) => format!("nprt-{}", r.file.config.label()),
+            Net::Nprt(r, _) => row_name(&r.file.config),
             Net::DeepShading(..) => "deep-shading".into(),
         }
     }
@@ -108,6 +108,11 @@ impl Net {
             }
         }
     }
+}
+
+/// The row a Neural PRT model of `config` gets in a report (unless two share it).
+pub fn row_name(config: &ModelConfig) -> String {
+    format!("nprt-{}", config.label())
 }
 
 /// A network's frame and what its stages cost, in milliseconds.

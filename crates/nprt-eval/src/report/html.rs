@@ -5,9 +5,10 @@ use std::path::Path;
 use anyhow::{Context, Result};
 use base64::Engine;
 
-/// Renders the report's Markdown as one HTML page (pulldown-cmark, with tables) with every
-/// image embedded as a data URI, so the page can be mailed or moved alone.
-pub(super) fn to_html(md: &str, dir: &Path) -> Result<String> {
+/// Renders a report's Markdown as one HTML page titled `title` (pulldown-cmark, with tables)
+/// with every image (a path relative to `dir`) embedded as a data URI, so the page can be
+/// mailed or moved alone.
+pub fn markdown_to_html(md: &str, dir: &Path, title: &str) -> Result<String> {
     use pulldown_cmark::{Event, Options, Parser, Tag};
     let mut events = Vec::new();
     for event in Parser::new_ext(md, Options::ENABLE_TABLES) {
@@ -32,14 +33,16 @@ pub(super) fn to_html(md: &str, dir: &Path) -> Result<String> {
             other => other,
         });
     }
-    let mut html = String::from(
-        "<!DOCTYPE html><html><head><meta charset=\"utf-8\"><title>nprt evaluation</title><style>\
-         body{font-family:sans-serif;max-width:1400px;margin:2em auto;padding:0 1em}\
-         table{border-collapse:collapse;margin:1em 0}td,th{border:1px solid #ccc;padding:4px 8px;text-align:right}\
-         td:first-child,th:first-child{text-align:left}img{image-rendering:pixelated;max-width:100%}\
-         td img{width:192px}</style></head><body>\n",
+    let mut html = format!(
+        "<!DOCTYPE html><html><head><meta charset=\"utf-8\"><title>{title}</title><style>{STYLE}</style></head><body>\n"
     );
     pulldown_cmark::html::push_html(&mut html, events.into_iter());
     html += "</body></html>\n";
     Ok(html)
 }
+
+/// The reports' page style: readable tables, pixel-exact thumbnails.
+const STYLE: &str = "body{font-family:sans-serif;max-width:1400px;margin:2em auto;padding:0 1em}\
+    table{border-collapse:collapse;margin:1em 0}td,th{border:1px solid #ccc;padding:4px 8px;text-align:right}\
+    td:first-child,th:first-child{text-align:left}img{image-rendering:pixelated;max-width:100%}\
+    td img{width:192px}";

@@ -13,8 +13,9 @@ mod pictures;
 mod table6;
 mod temporal_section;
 
-use html::to_html;
+pub use html::markdown_to_html;
 use pictures::{auto_exposure, crop, crop_window, heat_map, save, HEAT_MAX, ZOOM};
+pub use table6::{mean_and_se, table6};
 
 use crate::evaluate::Evaluation;
 use crate::method::BINS;
@@ -27,7 +28,9 @@ pub(super) fn slug(name: &str) -> String {
         .collect()
 }
 
-pub(super) fn fmt(v: f64) -> String {
+/// A figure as the reports print it: four decimals, or three significant digits in scientific
+/// notation for very small or large values, "–" when not a number.
+pub fn fmt(v: f64) -> String {
     if !v.is_finite() {
         "–".into()
     } else if v != 0.0 && (v.abs() < 1e-3 || v.abs() >= 1e4) {
@@ -66,7 +69,7 @@ pub fn write_report(e: &Evaluation, dir: &Path) -> Result<(PathBuf, PathBuf)> {
     let md_path = dir.join("report.md");
     write_file(&md_path, &md)?;
     let html_path = dir.join("report.html");
-    let html = to_html(&md, dir)?;
+    let html = markdown_to_html(&md, dir, "nprt evaluation")?;
     write_file(&html_path, html)?;
     let json = serde_json::to_vec_pretty(e)?;
     write_file(&dir.join("results.json"), &json)?;
@@ -267,6 +270,17 @@ fn error_analysis(md: &mut String, e: &Evaluation, dir: &Path) -> Result<()> {
     Ok(())
 }
 
+/// The report folder's path (relative to it) of `method`'s crop of shown test view `view`: the
+/// same pixels for every method of that view.
+pub fn crop_image(view: usize, method: &str) -> String {
+    format!("images/{}-crop.png", view_stem(view, method))
+}
+
+/// The file stem of `method`'s images of shown test view `view`.
+fn view_stem(view: usize, method: &str) -> String {
+    format!("view{view}-{}", slug(method))
+}
+
 /// Frames, crops and heat maps of the shown views.
 fn images(md: &mut String, e: &Evaluation, dir: &Path) -> Result<()> {
     writeln!(md, "\n## Images\n\nPer view: full frames, a {ZOOM}× crop where the first network errs most, and relative-error heat maps \
@@ -284,7 +298,7 @@ fn images(md: &mut String, e: &Evaluation, dir: &Path) -> Result<()> {
         writeln!(md, "### Test view {}\n", v.index)?;
         writeln!(md, "| method | frame | crop | error |\n|---|---|---|---|")?;
         for (name, rgb) in all {
-            let stem = format!("view{}-{}", v.index, slug(&name));
+            let stem = view_stem(v.index, &name);
             let full = save(dir, &stem, rgb, v.width, v.height, exposure)?;
             let side = window.2 * ZOOM;
             let cr = save(

@@ -7,22 +7,19 @@ use anyhow::Result;
 
 use crate::metrics::Metrics;
 
-/// Table 6's metrics, by index into [`Metrics::values`].
-const TABLE6: [usize; 5] = [0, 1, 3, 4, 5];
-
-/// Writes the table for `rows` (a method's name and its per-view or per-frame metrics).
-pub(super) fn table6<'a>(
+/// Writes Table 6 into `md` for `rows` (a method's name and its per-view or per-frame metrics).
+pub fn table6<'a>(
     md: &mut String,
     rows: impl Iterator<Item = (&'a str, &'a [Metrics])>,
 ) -> Result<()> {
     write!(md, "| method |")?;
-    for k in TABLE6 {
+    for k in Metrics::TABLE6 {
         write!(md, " {} × 10³ |", Metrics::NAMES[k])?;
     }
-    writeln!(md, "\n|---|{}", "---|".repeat(TABLE6.len()))?;
+    writeln!(md, "\n|---|{}", "---|".repeat(Metrics::TABLE6.len()))?;
     for (name, values) in rows {
         write!(md, "| {name} |")?;
-        for k in TABLE6 {
+        for k in Metrics::TABLE6 {
             let (mean, se) = mean_and_se(values.iter().map(|m| m.values()[k]));
             write!(md, " {:.2} ± {:.2} |", 1e3 * mean, 1e3 * se)?;
         }
@@ -33,7 +30,7 @@ pub(super) fn table6<'a>(
 }
 
 /// The mean of `values` and its standard error (NaN with fewer than two).
-fn mean_and_se(values: impl Iterator<Item = f64>) -> (f64, f64) {
+pub fn mean_and_se(values: impl Iterator<Item = f64>) -> (f64, f64) {
     let v: Vec<f64> = values.collect();
     let n = v.len() as f64;
     let mean = v.iter().sum::<f64>() / n;

@@ -52,9 +52,15 @@ impl ModelConfig {
         }
     }
 
-    /// The design's name, marked `+grid` with a hash grid and `+direct` when direct light is
+    /// The design's name, marked `+siren` or `+relu` with an activation other than the paper's
+    /// for it (Table 2's ablation), `+grid` with a hash grid and `+direct` when direct light is
     /// traced: how reports name it.
     pub fn label(&self) -> String {
+        let activation = if self.activation == self.design.default_activation() {
+            String::new()
+        } else {
+            format!("+{}", self.activation)
+        };
         let grid = match self.encoding {
             PositionEncoding::None => "",
             PositionEncoding::HashGrid => "+grid",
@@ -63,7 +69,7 @@ impl ModelConfig {
             DirectLight::Learned => "",
             DirectLight::Traced => "+direct",
         };
-        format!("{}{grid}{direct}", self.design.name())
+        format!("{}{activation}{grid}{direct}", self.design.name())
     }
 
     /// What the weights file records of the network that wrote it: the design and the

@@ -1,0 +1,18 @@
+//! nprt-paper: the paper's experiments end to end. It owns the pipeline that runs one scene
+//! through every stage (dataset, the four designs and Table 2's ablation, Deep Shading, the
+//! evaluation against every baseline, a relit camera path) at a budget stated once, resuming
+//! whatever a killed run left, and the report that sets the paper's Tables 1-6 beside its own
+//! figures and judges the orderings it states. `nprt demo` and `nprt paper` are two presets of
+//! it. It calls the stages' libraries and must not hold their logic: tracing, training,
+//! metrics and baselines stay in nprt-data, nprt-net and nprt-eval.
+
+pub mod budget;
+mod experiment;
+pub mod orderings;
+mod paper_report;
+pub mod published;
+mod stage_log;
+mod stages;
+
+pub use budget::Budget;
+pub use experiment::{Experiment, Outcome};

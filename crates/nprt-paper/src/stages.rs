@@ -1,0 +1,216 @@
+//! Each stage of an experiment, resumable: the dataset and the trainings resume themselves
+//! (nprt-data and nprt-net keep their settings and progress), and the evaluations are cached
+//! under a key of everything they read, so a killed or repeated run redoes only what changed.
+
+use std::path::{Path, PathBuf};
+
+use anyhow::{Context, Result};
+use nprt_data::{generate, GenerateOptions};
+use nprt_eval::{evaluate, score_networks, write_report, EvalOptions, Evaluation, MethodResult};
+use nprt_net::deep_shading::{self, DeepShadingOptions};
+use nprt_net::model::folder::{CONFIG_FILE, WEIGHTS_FILE};
+use nprt_net::training::training_set::TrainingSet;
+use nprt_net::{ModelConfig, TrainOptions, TrainSummary};
+use nprt_render::oidn::Oidn;
+use nprt_render::{RenderJob, RenderOptions};
+use serde::{Deserialize, Serialize};
+
+use crate::experiment::Experiment;
+
+/// Renders (or resumes) the dataset; whether any view was rendered.
+pub fn dataset(x: &Experiment, data: &Path) -> Result<bool> {
+    let b = &x.budget;
+    let opts = GenerateOptions {
+        scene: x.scene.clone(),
+        envmaps: x.envmaps.clone(),
+        out: data.to_path_buf(),
+        train_views: b.train_views,
+        test_views: b.test_views,
+        train_resolution: [b.train_res; 2],
+        test_resolution: [b.test_res; 2],
+        spp: b.spp,
+        test_spp: b.test_spp,
+        seed: x.seed,
+        test_maps: x.test_maps,
+        camera: x.camera.clone(),
+        device: x.engine.tracer(),
+        progress: true,
+        ..GenerateOptions::default()
+    };
+    let s = generate(&opts, |p| {
+        for w in &p.warnings {
+            eprintln!("warning: {w}");
+        }
+    })?;
+    println!(
+        "dataset '{}': {} views rendered in {:.1} s ({:.3} Msamples/s), {} already complete",
+        data.display(),
+        s.rendered,
+        s.seconds,
+        s.samples / s.seconds.max(1e-9) / 1e6,
+        s.skipped
+    );
+    Ok(s.rendered > 0)
+}
+
+/// Trains (or resumes, or finds finished) one Neural PRT model; whether it trained.
+pub fn train_model(x: &Experiment, data: &Path, config: &ModelConfig, out: &Path) -> Result<bool> {
+    let set = TrainingSet::load(data, config, true, |why| eprintln!("{why}"))?;
+    let opts = TrainOptions::default().with_run(config.design, x.budget.training, None);
+    let (s, _) = nprt_net::train(&set, config, &opts, out, x.engine, &|_| true)?;
+    report_training(&config.label(), &s, out);
+    Ok(s.split.steps > 0.0)
+}
+
+/// Trains (or resumes) the Deep Shading U-Net; whether it trained.
+pub fn train_deep_shading(x: &Experiment, data: &Path, out: &Path) -> Result<bool> {
+    let defaults = DeepShadingOptions::default();
+    let opts = DeepShadingOptions {
+        schedule: x.budget.deep_shading.apply(defaults.schedule.clone()),
+        ..defaults
+    };
+    let (s, _) = deep_shading::train(data, &opts, x.engine, out, &|_| true)?;
+    report_training("deep-shading", &s, out);
+    Ok(s.split.steps > 0.0)
+}
+
+fn report_training(name: &str, s: &TrainSummary, out: &Path) {
+    println!(
+        "{name}: {:.2} epochs, {} steps in {:.1} s of training ({:.0} K samples/s on {}); validation loss {:.5}; model in '{}'",
+        s.epochs,
+        s.steps,
+        s.seconds,
+        s.samples as f64 / s.seconds.max(1e-9) / 1e3,
+        s.steps_on,
+        s.final_val,
+        out.display()
+    );
+}
+
+/// The evaluation options the budget sets.
+pub fn eval_options(x: &Experiment, data: &Path, models: &[PathBuf]) -> EvalOptions {
+    let b = &x.budget;
+    EvalOptions {
+        data: data.to_path_buf(),
+        models: models.to_vec(),
+        sh_spp: b.sh_spp,
+        timing_res: b.timing_res,
+        temporal_frames: b.temporal.0,
+        temporal_res: b.temporal.1,
+        ..EvalOptions::default()
+    }
+}
+
+/// The evaluation against every baseline, written as a report in `report`, or the one a
+/// previous run wrote there from the same inputs; whether it ran.
+pub fn evaluation(x: &Experiment, opts: &EvalOptions, report: &Path) -> Result<(Evaluation, bool)> {
+    let key = inputs_key(x, opts)?;
+    let key_file = report.join("evaluation.key");
+    let results = report.join("results.json");
+    if read_key(&key_file).as_deref() == Some(key.as_str()) {
+        match read_json::<Evaluation>(&results) {
+            Ok(e) => {
+                println!(
+                    "evaluation: as '{}' holds it (its inputs are unchanged)",
+                    results.display()
+                );
+                return Ok((e, false));
+            }
+            Err(e) => eprintln!("evaluating again: {e:#}"),
+        }
+    }
+    let e = evaluate(opts, x.engine)?;
+    let (md, _) = write_report(&e, report)?;
+    nprt_io::write_file(&key_file, &key)?;
+    println!("evaluation report: '{}'", md.display());
+    Ok((e, true))
+}
+
+/// Table 2's runs scored on the test views (`score_networks`), kept in `file` with the key of
+/// their inputs; whether they were scored now.
+pub fn ablation(
+    x: &Experiment,
+    opts: &EvalOptions,
+    file: &Path,
+) -> Result<(Vec<MethodResult>, bool)> {
+    #[derive(Serialize, Deserialize)]
+    struct Scored {
+        key: String,
+        rows: Vec<MethodResult>,
+    }
+    let key = inputs_key(x, opts)?;
+    if let Ok(s) = read_json::<Scored>(file) {
+        if s.key == key {
+            return Ok((s.rows, false));
+        }
+    }
+    let rows = score_networks(opts, x.engine)?;
+    let scored = Scored { key, rows };
+    nprt_io::write_file(file, serde_json::to_vec_pretty(&scored)?)?;
+    Ok((scored.rows, true))
+}
+
+/// A camera path relit by `model` under the dataset's held-out maps, into `frames`.
+pub fn relight(x: &Experiment, data: &Path, model: &Path, frames: &Path) -> Result<()> {
+    let manifest = nprt_data::dataset::load_manifest(data)?;
+    let s = &manifest.settings;
+    let held_out: Vec<&str> = s
+        .test_maps
+        .iter()
+        .map(|&k| s.envmaps[k].spec.as_str())
+        .collect();
+    let (count, side) = x.budget.relight;
+    let job = RenderJob::prepare(
+        &RenderOptions {
+            model: model.to_path_buf(),
+            out: frames.to_path_buf(),
+            camera_volume: x.camera.file.clone(),
+            lighting: held_out.join(","),
+            frames: count,
+            resolution: [side; 2],
+            // The traced light denoised where OIDN is installed: the cleaner frames.
+            denoise_direct: Oidn::open().is_ok(),
+            ..RenderOptions::default()
+        },
+        x.engine,
+    )?;
+    let done = job.run(|_| {})?;
+    println!(
+        "{count} frames at {side}² in '{}' ({:.1} ms per frame), animation '{}'",
+        done.frames_dir.display(),
+        done.mean.total_ms(),
+        done.animation.path().display()
+    );
+    Ok(())
+}
+
+/// A key of everything an evaluation reads: the dataset's manifest, each model's files, the
+/// options, the engine and whether OIDN is there.
+fn inputs_key(x: &Experiment, opts: &EvalOptions) -> Result<String> {
+    let mut h = blake3::Hasher::new();
+    h.update(&read(&opts.data.join("manifest.json"))?);
+    for dir in opts.models.iter().chain(&opts.deep_shading) {
+        for file in [CONFIG_FILE, deep_shading::CONFIG_FILE, WEIGHTS_FILE] {
+            let path = dir.join(file);
+            if path.is_file() {
+                h.update(file.as_bytes());
+                h.update(&read(&path)?);
+            }
+        }
+    }
+    h.update(format!("{opts:?} {} {}", x.engine.name(), Oidn::open().is_ok()).as_bytes());
+    Ok(h.finalize().to_hex().to_string())
+}
+
+fn read(path: &Path) -> Result<Vec<u8>> {
+    std::fs::read(path).with_context(|| format!("cannot read '{}'", path.display()))
+}
+
+fn read_key(path: &Path) -> Option<String> {
+    std::fs::read_to_string(path).ok()
+}
+
+fn read_json<T: for<'de> Deserialize<'de>>(path: &Path) -> Result<T> {
+    serde_json::from_slice(&read(path)?)
+        .with_context(|| format!("'{}' is not what this run wrote", path.display()))
+}

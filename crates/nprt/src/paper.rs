@@ -1,0 +1,94 @@
+//! `nprt paper`: flags for reproducing the paper's tables; the work is `nprt_paper`.
+
+use std::path::PathBuf;
+
+use anyhow::Result;
+use nprt_data::CameraChoice;
+use nprt_eval::claim::Verdict;
+use nprt_paper::{Budget, Experiment};
+
+use crate::flags::DeviceArg;
+
+#[derive(clap::Args)]
+pub struct PaperArgs {
+    /// Scene: builtin:room, or a Mitsuba .xml / glTF / mesh file with a camera volume (a sidecar
+    /// NAME.camera.json, or --camera-volume). The paper's KITCHEN:
+    /// ../shared/scenes/kitchen/scene.xml with --camera-volume docs/kitchen.camera.json.
+    #[arg(long, default_value = "builtin:room")]
+    scene: String,
+    /// Lighting: a folder of .exr/.hdr lat-long maps (some held out for the test views), or
+    /// `builtin` (a fresh procedural lighting per view).
+    #[arg(long, default_value = "builtin")]
+    envmaps: String,
+    /// Output folder: dataset/, models/, report/ (paper.html, report.html) and
+    /// stage-times.json. Re-running resumes what is done; a folder holding another scene,
+    /// lighting or budget is refused.
+    #[arg(long)]
+    out: PathBuf,
+    /// Sizes (docs/paper.md): tiny (test-only, a minute), small (about 45 minutes on 2 cores
+    /// on KITCHEN), medium (hours on a CPU), paper (the paper's: 3000 views of 256², 3200 spp,
+    /// 500 epochs; a cluster and a GPU).
+    #[arg(long, default_value = "small", value_parser = parse_budget)]
+    budget: Budget,
+    /// Camera active volume from a JSON file (docs/dataset.md), instead of the scene's sidecar.
+    #[arg(long)]
+    camera_volume: Option<PathBuf>,
+    /// Maps of the --envmaps folder held out for the test views (default: a fifth).
+    #[arg(long)]
+    test_maps: Option<usize>,
+    /// Seed of every random choice (cameras, lightings, samples, initial weights).
+    #[arg(long, default_value_t = 0)]
+    seed: u64,
+    #[command(flatten)]
+    device: DeviceArg,
+}
+
+fn parse_budget(s: &str) -> Result<Budget> {
+    s.parse()
+}
+
+pub fn command(a: PaperArgs) -> Result<()> {
+    let x = Experiment {
+        camera: CameraChoice {
+            file: a.camera_volume,
+            ..CameraChoice::default()
+        },
+        test_maps: a.test_maps,
+        seed: a.seed,
+        ..Experiment::paper(&a.scene, &a.envmaps, &a.out, a.budget, a.device.engine()?)
+    };
+    let done = x.run()?;
+    println!("\n== nprt paper done in {:.0} s", done.seconds);
+    if let Some((md, html)) = &done.paper {
+        println!(
+            "the paper's tables: {} and {}",
+            md.display(),
+            html.display()
+        );
+    }
+    println!("the evaluation's report: {}", done.report.display());
+    let orderings: Vec<_> = [
+        nprt_paper::orderings::table2(&done.ablation),
+        nprt_paper::orderings::table5(&done.evaluation),
+        nprt_paper::orderings::table6(&done.evaluation),
+    ]
+    .into_iter()
+    .flatten()
+    .collect();
+    for o in &orderings {
+        println!(
+            "{:<13} {}: {}",
+            format!("{}:", o.verdict().word()),
+            o.table,
+            o.statement
+        );
+    }
+    let count = |v: Verdict| orderings.iter().filter(|o| o.verdict() == v).count();
+    println!(
+        "the paper's orderings here: {} hold, {} fail, {} not resolved by the test views",
+        count(Verdict::Holds),
+        count(Verdict::Fails),
+        count(Verdict::Unresolved)
+    );
+    Ok(())
+}

@@ -1,0 +1,114 @@
+//! `nprt paper --budget tiny` end to end on builtin:room: every table of the paper in one
+//! report with finite figures and the paper's columns, a repeated run resumed from its caches,
+//! and a folder of another experiment refused.
+
+mod common;
+
+use common::{fails, fresh_dir, nprt, ok};
+
+#[test]
+fn the_tiny_budget_writes_every_table_and_resumes() {
+    let dir = fresh_dir("paper");
+    let out = dir.to_str().unwrap();
+    let args = ["paper", "--budget", "tiny", "--out", out, "--device", "cpu"];
+    let stdout = ok(&args);
+    assert!(stdout.contains("the paper's orderings here: "), "{stdout}");
+    let report = dir.join("report");
+    let md = std::fs::read_to_string(report.join("paper.md")).unwrap();
+    for want in [
+        "## What this run says",
+        "## Table 1: transport parameters",
+        "| model | nprt | paper |",
+        // The paper's parameter counts beside nprt's.
+        "| nprt-baseline | 219651 | 219651 |",
+        "| nprt-prt | 186947 | 186947 |",
+        "| nprt-albedo | 187718 | 187718 |",
+        "| nprt-baseline+siren | 219651 | – |",
+        "## Table 2: SIREN or ReLU",
+        "| baseline (R) | nprt-baseline |",
+        "| baseline (S) | nprt-baseline+siren |",
+        "| PRT-inspired (R) | nprt-prt+relu |",
+        "| PRT-inspired (S) | nprt-prt |",
+        "**SIREN helps the PRT-inspired design**",
+        "**baseline (S) is highest**",
+        "## Tables 3 and 4",
+        "| nprt-dsep: network |",
+        "| 16.02 |",
+        "| 19–36 (Falcor) |",
+        "## Table 5: the four designs",
+        "| design | loss × 10³ | RMSE × 10³ | RMSE / D/S's | paper RMSE × 10³ | paper RMSE / D/S's |",
+        "for reference only: this scene is not one of the paper's",
+        "**D/S is lowest of the four designs**",
+        "## Table 6: D/S against every competitor",
+        "| method | L1 × 10³ | L2 × 10³ | dSSIM × 10³ | MAPE × 10³ | MRSE × 10³ |",
+        "**D/S is ahead of deep-shading on the test views**",
+        "**D/S is ahead of nrc along the camera path**",
+        "**D/S is ahead of nrc-cache along the camera path**",
+        "## Figures 7 and 9: crops at the same pixels",
+        "-nprt-dsep-crop.png",
+        "images/table2-validation.png",
+        "## Where the paper's figures come from",
+        "| **all** |",
+    ] {
+        assert!(md.contains(want), "paper.md lacks '{want}':\n{md}");
+    }
+    // Every mean ± standard error is a finite number (4 test views give a standard error).
+    let figures: Vec<(f64, f64)> = md
+        .lines()
+        .filter(|l| l.starts_with('|'))
+        .flat_map(|l| l.split('|'))
+        .filter_map(|c| {
+            let (m, s) = c.trim().split_once(" ± ")?;
+            Some((m.parse().expect(m), s.parse().expect(s)))
+        })
+        .collect();
+    // Table 2: 4 rows × 2; Table 5: 4 × 2; Table 6: the test views' rows and the path's × 5.
+    assert!(
+        figures.len() >= 8 + 8 + 5 * 5,
+        "{} figures:\n{md}",
+        figures.len()
+    );
+    for (m, s) in &figures {
+        assert!(
+            m.is_finite() && s.is_finite() && *m >= 0.0 && *s >= 0.0,
+            "{m} ± {s}"
+        );
+    }
+    // Each ordering's verdict is one of the three marks.
+    let judged = md
+        .lines()
+        .filter(|l| l.starts_with("- ") && l.contains("**"))
+        .count();
+    assert!(judged >= 4 + 2 + 5, "{judged} orderings judged:\n{md}");
+    let html = std::fs::read_to_string(report.join("paper.html")).unwrap();
+    assert!(
+        !html.contains("src=\"images/") && html.matches("data:image/png;base64,").count() > 20,
+        "paper.html must embed its images"
+    );
+
+    // Run again: every stage is found done, the evaluation read back rather than repeated.
+    let again = ok(&args);
+    assert!(again.contains("its inputs are unchanged"), "{again}");
+    assert_eq!(
+        std::fs::read_to_string(report.join("paper.md")).unwrap(),
+        md,
+        "a resumed run writes the same tables"
+    );
+    // Another budget in the same folder is refused, naming both.
+    fails(
+        &[
+            "paper", "--budget", "small", "--out", out, "--device", "cpu",
+        ],
+        &[
+            "holds another experiment",
+            "\"budget\":\"tiny\"",
+            "\"budget\":\"small\"",
+        ],
+    );
+    let o = nprt(&["paper", "--budget", "huge", "--out", out]);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(
+        !o.status.success() && err.contains("unknown budget 'huge'"),
+        "{err}"
+    );
+}
