@@ -178,6 +178,21 @@ def evaluate(
 ) -> Dict[str, Any]:
     """`nprt eval`; returns results.json."""
 
+def paper(
+    scene: str,
+    envmaps: str,
+    out: PathLike,
+    *,
+    budget: str = "small",
+    camera_volume: Optional[PathLike] = None,
+    test_maps: Optional[int] = None,
+    seed: int = 0,
+    device: str = "cpu",
+) -> Dict[str, Any]:
+    """`nprt paper`: the paper's Tables 1-6 at ``budget`` ("tiny", "small", "medium", "paper"),
+    resumable; returns ``paper_md``, ``paper_html``, ``report_html``, ``results`` (results.json)
+    and ``orderings`` (table, statement, verdict)."""
+
 def train_deep_shading(
     data: PathLike,
     out: PathLike,

@@ -123,6 +123,22 @@ def test_train_render_and_evaluate(dataset, model, room, tmp_path):
     assert (tmp_path / "report" / "report.html").exists()
 
 
+def test_paper_tables_at_the_tiny_budget(tmp_path):
+    out = tmp_path / "paper"
+    done = nprt.paper("builtin:room", "builtin", out, budget="tiny")
+    md = open(done["paper_md"], encoding="utf-8").read()
+    for table in ["## Table 1", "## Table 2", "## Tables 3 and 4", "## Table 5", "## Table 6"]:
+        assert table in md
+    tables = {o[0] for o in done["orderings"]}
+    assert tables == {"Table 2", "Table 5", "Table 6"}
+    assert all(o[2] in ("holds", "fails", "not resolved") for o in done["orderings"])
+    assert any(m["name"] == "nprt-dsep" for m in done["results"]["methods"])
+    with pytest.raises(ValueError, match="unknown budget 'huge'"):
+        nprt.paper("builtin:room", "builtin", out, budget="huge")
+    with pytest.raises(nprt.NprtError, match="holds another experiment"):
+        nprt.paper("builtin:room", "builtin", out, budget="small")
+
+
 def test_training_reports_each_epoch_stops_when_told_and_resumes(dataset, tmp_path):
     rows = []
 

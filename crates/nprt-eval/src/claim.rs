@@ -83,11 +83,12 @@ impl Paired {
     }
 }
 
-/// One claim, in words with its figures, and its verdict.
+/// One claim, in words with its figures, its verdict and the paired difference it rests on.
 #[derive(Clone, Debug)]
 pub struct Claim {
     pub text: String,
     pub verdict: Verdict,
+    pub paired: Paired,
 }
 
 impl Claim {
@@ -109,6 +110,7 @@ impl Claim {
                 p.views
             ),
             verdict: p.lower(),
+            paired: p,
         }
     }
 
@@ -146,6 +148,7 @@ impl Claim {
                 a.name, b.name, a.temporal_error, b.temporal_error, p.diff, p.se, p.lower_on, p.views
             ),
             verdict: p.lower(),
+            paired: p,
         }
     }
 }

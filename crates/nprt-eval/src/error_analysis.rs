@@ -25,25 +25,7 @@ pub struct Accumulator {
 impl Accumulator {
     pub fn new(name: &str, family: Family, params: Option<usize>) -> Self {
         Accumulator {
-            result: MethodResult {
-                name: name.into(),
-                family,
-                params,
-                mean: Metrics::default(),
-                per_view: vec![],
-                ms_per_view: 0.0,
-                precompute_ms: None,
-                corr_directness: 0.0,
-                corr_specularity: 0.0,
-                error_by_directness: vec![],
-                error_by_specularity: vec![],
-                note: String::new(),
-                loss_png: None,
-                validation: vec![],
-                level: [f64::NAN; 3],
-                tint_error: f64::NAN,
-                equal_time: None,
-            },
+            result: MethodResult::new(name, family, params),
             err: vec![],
             direct: vec![],
             spec: vec![],

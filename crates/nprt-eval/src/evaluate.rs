@@ -201,19 +201,14 @@ impl Loaded {
 /// The networks `o` names on the test views alone, without baselines, timings or the camera
 /// path: what the paper's Table 2 (its ablation) compares.
 pub fn score_networks(o: &EvalOptions, engine: Engine) -> Result<Vec<MethodResult>> {
-    let Loaded {
-        manifest,
-        scene,
-        views,
-        maps,
-        nets,
-    } = Loaded::new(o, engine)?;
-    let ts = TraceScene::new(&scene);
+    let l = Loaded::new(o, engine)?;
+    let (views, nets) = (&l.views, &l.nets);
+    let ts = TraceScene::new(&l.scene);
     let mut bench = TestBench {
-        views: &views,
-        maps: &maps,
+        views,
+        maps: &l.maps,
         ts: &ts,
-        settings: &manifest.settings,
+        settings: &l.manifest.settings,
         seed: o.seed,
         direct_spp: o.direct_spp,
         shown: Vec::new(),
@@ -224,9 +219,9 @@ pub fn score_networks(o: &EvalOptions, engine: Engine) -> Result<Vec<MethodResul
             "views",
         ),
     };
-    let results = run_networks(&mut bench, &nets, None)?;
+    let results = run_networks(&mut bench, nets, None)?;
     bench.bar.finish_and_clear();
-    check_finite(&results, &views)?;
+    check_finite(&results, views)?;
     Ok(results)
 }
 

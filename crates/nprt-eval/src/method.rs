@@ -75,6 +75,31 @@ pub struct MethodResult {
     pub equal_time: Option<String>,
 }
 
+impl MethodResult {
+    /// A row with no views scored yet (its level and tint unknown until they are).
+    pub fn new(name: &str, family: Family, params: Option<usize>) -> Self {
+        MethodResult {
+            name: name.into(),
+            family,
+            params,
+            mean: Metrics::default(),
+            per_view: vec![],
+            ms_per_view: 0.0,
+            precompute_ms: None,
+            corr_directness: 0.0,
+            corr_specularity: 0.0,
+            error_by_directness: vec![],
+            error_by_specularity: vec![],
+            note: String::new(),
+            loss_png: None,
+            validation: vec![],
+            level: [f64::NAN; 3],
+            tint_error: f64::NAN,
+            equal_time: None,
+        }
+    }
+}
+
 /// JSON writes NaN as null; reading it back gives NaN again (so results.json round-trips).
 fn nan_if_null<'de, D: Deserializer<'de>>(d: D) -> Result<f64, D::Error> {
     Ok(Option::<f64>::deserialize(d)?.unwrap_or(f64::NAN))

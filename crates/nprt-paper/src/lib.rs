@@ -10,9 +10,11 @@ pub mod budget;
 mod experiment;
 pub mod orderings;
 mod paper_report;
+mod pipeline;
 pub mod published;
 mod stage_log;
 mod stages;
 
 pub use budget::Budget;
-pub use experiment::{Experiment, Outcome};
+pub use experiment::Experiment;
+pub use pipeline::Outcome;

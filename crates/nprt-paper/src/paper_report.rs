@@ -127,25 +127,17 @@ fn summary(md: &mut String, orderings: &[Ordering]) -> Result<()> {
         count(Verdict::Fails),
         count(Verdict::Unresolved)
     )?;
-    for table in ["Table 2", "Table 5", "Table 6"] {
-        let of: Vec<&Ordering> = orderings.iter().filter(|o| o.table == table).collect();
-        if of.is_empty() {
-            continue;
-        }
-        let words: Vec<String> = of
-            .iter()
-            .map(|o| {
-                let why = o
-                    .claims
-                    .iter()
-                    .find(|c| c.verdict == o.verdict() && o.verdict() != Verdict::Holds)
-                    .map_or(String::new(), |c| format!(" ({})", c.text));
-                format!("{} {}{why}", o.statement, o.verdict().word())
-            })
-            .collect();
-        write!(md, " {table}: {}.", words.join("; "))?;
-    }
     writeln!(md, "\n")?;
+    for table in ["Table 2", "Table 5", "Table 6"] {
+        for o in orderings.iter().filter(|o| o.table == table) {
+            let how = match o.verdict() {
+                Verdict::Holds => "holds".to_string(),
+                v => format!("{}: {}", v.word(), o.breakdown()),
+            };
+            writeln!(md, "- {table}: {} — {how}.", o.statement)?;
+        }
+    }
+    writeln!(md)?;
     Ok(())
 }
 
@@ -159,8 +151,8 @@ fn judged(md: &mut String, orderings: &[Ordering], table: &str) -> Result<()> {
             o.statement,
             o.verdict().word()
         )?;
-        for c in &o.claims {
-            writeln!(md, "  - {} {}", c.verdict.mark(), c.text)?;
+        for c in &o.comparisons {
+            writeln!(md, "  - {} {}", c.claim.verdict.mark(), c.claim.text)?;
         }
     }
     writeln!(md)?;

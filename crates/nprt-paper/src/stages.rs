@@ -5,7 +5,7 @@
 use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result};
-use nprt_data::{generate, GenerateOptions};
+use nprt_data::generate;
 use nprt_eval::{evaluate, score_networks, write_report, EvalOptions, Evaluation, MethodResult};
 use nprt_net::deep_shading::{self, DeepShadingOptions};
 use nprt_net::model::folder::{CONFIG_FILE, WEIGHTS_FILE};
@@ -19,25 +19,7 @@ use crate::experiment::Experiment;
 
 /// Renders (or resumes) the dataset; whether any view was rendered.
 pub fn dataset(x: &Experiment, data: &Path) -> Result<bool> {
-    let b = &x.budget;
-    let opts = GenerateOptions {
-        scene: x.scene.clone(),
-        envmaps: x.envmaps.clone(),
-        out: data.to_path_buf(),
-        train_views: b.train_views,
-        test_views: b.test_views,
-        train_resolution: [b.train_res; 2],
-        test_resolution: [b.test_res; 2],
-        spp: b.spp,
-        test_spp: b.test_spp,
-        seed: x.seed,
-        test_maps: x.test_maps,
-        camera: x.camera.clone(),
-        device: x.engine.tracer(),
-        progress: true,
-        ..GenerateOptions::default()
-    };
-    let s = generate(&opts, |p| {
+    let s = generate(&x.generate_options(data), |p| {
         for w in &p.warnings {
             eprintln!("warning: {w}");
         }

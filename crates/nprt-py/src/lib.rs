@@ -13,6 +13,7 @@ mod export;
 mod generate;
 mod model;
 mod model_info;
+mod paper;
 mod render;
 mod scene;
 mod train;
@@ -35,6 +36,7 @@ fn _nprt(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(train::train_deep_shading, m)?)?;
     m.add_function(wrap_pyfunction!(export::export, m)?)?;
     m.add_function(wrap_pyfunction!(model_info::model_info, m)?)?;
+    m.add_function(wrap_pyfunction!(paper::paper, m)?)?;
     m.add_function(wrap_pyfunction!(render::render, m)?)?;
     m.add_function(wrap_pyfunction!(evaluate::evaluate, m)?)?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;

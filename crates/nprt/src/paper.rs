@@ -39,6 +39,11 @@ pub struct PaperArgs {
     /// Seed of every random choice (cameras, lightings, samples, initial weights).
     #[arg(long, default_value_t = 0)]
     seed: u64,
+    /// Print the `nprt generate` flags of this experiment's dataset and stop: for rendering it
+    /// on a cluster first (`scripts/slurm-generate N -- $(nprt paper ... --generate-flags)`),
+    /// after which `nprt paper` with the same flags finds it complete (docs/paper.md).
+    #[arg(long)]
+    generate_flags: bool,
     #[command(flatten)]
     device: DeviceArg,
 }
@@ -57,6 +62,10 @@ pub fn command(a: PaperArgs) -> Result<()> {
         seed: a.seed,
         ..Experiment::paper(&a.scene, &a.envmaps, &a.out, a.budget, a.device.engine()?)
     };
+    if a.generate_flags {
+        println!("{}", x.generate_flags().join(" "));
+        return Ok(());
+    }
     let done = x.run()?;
     println!("\n== nprt paper done in {:.0} s", done.seconds);
     if let Some((md, html)) = &done.paper {

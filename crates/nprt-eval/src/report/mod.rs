@@ -14,7 +14,7 @@ mod table6;
 mod temporal_section;
 
 pub use html::markdown_to_html;
-use pictures::{auto_exposure, crop, crop_window, heat_map, save, HEAT_MAX, ZOOM};
+use pictures::{auto_exposure, crop, crop_window, heat_map, save, with_background, HEAT_MAX, ZOOM};
 pub use table6::{mean_and_se, table6};
 
 use crate::evaluate::Evaluation;
@@ -284,7 +284,8 @@ fn view_stem(view: usize, method: &str) -> String {
 /// Frames, crops and heat maps of the shown views.
 fn images(md: &mut String, e: &Evaluation, dir: &Path) -> Result<()> {
     writeln!(md, "\n## Images\n\nPer view: full frames, a {ZOOM}× crop where the first network errs most, and relative-error heat maps \
-        (|error| / (reference + {RELATIVE_EPS}), black 0 → pale yellow ≥ {HEAT_MAX}). Exposure set per view from the reference.\n")?;
+        (|error| / (reference + {RELATIVE_EPS}), black 0 → pale yellow ≥ {HEAT_MAX}). Exposure set per view from the reference; \
+        every method's background (where no surface is hit, which no metric scores) is the reference's.\n")?;
     for v in &e.shown {
         let exposure = auto_exposure(&v.reference, &v.mask);
         let first = v
@@ -299,6 +300,7 @@ fn images(md: &mut String, e: &Evaluation, dir: &Path) -> Result<()> {
         writeln!(md, "| method | frame | crop | error |\n|---|---|---|---|")?;
         for (name, rgb) in all {
             let stem = view_stem(v.index, &name);
+            let rgb = &with_background(rgb, v);
             let full = save(dir, &stem, rgb, v.width, v.height, exposure)?;
             let side = window.2 * ZOOM;
             let cr = save(

@@ -58,6 +58,17 @@ pub(super) fn heat_map(pred: &[Vec3], v: &ShownView) -> Vec<Vec3> {
         .collect()
 }
 
+/// `rgb` on its foreground, the reference's pixels elsewhere: the networks leave the background
+/// black (the renderer draws the map there), which no metric scores, so pictures show the
+/// methods' differences where they are measured.
+pub(super) fn with_background(rgb: &[Vec3], v: &ShownView) -> Vec<Vec3> {
+    rgb.iter()
+        .zip(&v.reference)
+        .zip(&v.mask)
+        .map(|((&p, &r), &m)| if m > 0.5 { p } else { r })
+        .collect()
+}
+
 /// The square window (x0, y0, side) around the largest error of `pred`, smoothed over the
 /// window.
 pub(super) fn crop_window(pred: &[Vec3], v: &ShownView) -> (usize, usize, usize) {
@@ -111,4 +122,26 @@ pub(super) fn save(
         Ok(img.save_with_format(tmp, image::ImageFormat::Png)?)
     })?;
     Ok(file)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn pictures_take_the_references_background_and_keep_the_foreground() {
+        let v = ShownView {
+            index: 0,
+            width: 2,
+            height: 1,
+            mask: vec![1.0, 0.0],
+            reference: vec![Vec3::splat(0.5), Vec3::splat(3.0)],
+            methods: vec![],
+        };
+        let network = [Vec3::splat(0.4), Vec3::ZERO];
+        assert_eq!(
+            with_background(&network, &v),
+            [Vec3::splat(0.4), Vec3::splat(3.0)]
+        );
+    }
 }

@@ -1,0 +1,149 @@
+//! An experiment run through every stage (dataset, the designs and Table 2's ablation, Deep
+//! Shading, the evaluation against every baseline, the paper's tables, a relit camera path), in
+//! one output folder that a repeated run resumes.
+
+use std::path::PathBuf;
+
+use anyhow::{bail, Context, Result};
+use nprt_eval::{Evaluation, MethodResult};
+use serde_json::json;
+
+use crate::experiment::Experiment;
+use crate::orderings::ablation_configs;
+use crate::paper_report::write_paper_report;
+use crate::stage_log::StageLog;
+use crate::stages;
+
+/// What a run produced.
+pub struct Outcome {
+    pub evaluation: Evaluation,
+    /// Table 2's four runs on the test views (empty without the paper's tables).
+    pub ablation: Vec<MethodResult>,
+    /// The evaluation's report.html.
+    pub report: PathBuf,
+    /// The paper's tables, paper.md and paper.html.
+    pub paper: Option<(PathBuf, PathBuf)>,
+    pub relit: Option<PathBuf>,
+    pub seconds: f64,
+}
+
+impl Experiment {
+    /// Runs every stage not already done, in order.
+    pub fn run(&self) -> Result<Outcome> {
+        std::fs::create_dir_all(&self.out)
+            .with_context(|| format!("cannot create '{}'", self.out.display()))?;
+        self.claim_folder()?;
+        let mut log = StageLog::open(&self.out)?;
+        let data = self.dataset_dir();
+        log.begin(
+            "dataset",
+            &format!(
+                "generating the dataset: {} under {} maps",
+                self.scene, self.envmaps
+            ),
+        );
+        let worked = stages::dataset(self, &data)?;
+        log.end(worked)?;
+        let models = self.models();
+        for (i, config) in models.iter().enumerate() {
+            let name = format!("train {}", config.label());
+            log.begin(
+                &name,
+                &format!(
+                    "training model {} of {}: {}",
+                    i + 1,
+                    models.len(),
+                    config.label()
+                ),
+            );
+            let worked = stages::train_model(self, &data, config, &self.model_dir(config))?;
+            log.end(worked)?;
+        }
+        let deep = self.out.join("models").join("deep-shading");
+        log.begin("train deep-shading", "training the Deep Shading baseline");
+        let worked = stages::train_deep_shading(self, &data, &deep)?;
+        log.end(worked)?;
+
+        log.begin("evaluation", "evaluating against the baselines");
+        let report = self.out.join("report");
+        let dirs: Vec<PathBuf> = self.designs.iter().map(|c| self.model_dir(c)).collect();
+        let opts = nprt_eval::EvalOptions {
+            deep_shading: Some(deep),
+            ..stages::eval_options(self, &data, &dirs)
+        };
+        let (evaluation, worked) = stages::evaluation(self, &opts, &report)?;
+        log.end(worked)?;
+
+        let (mut ablation, mut paper) = (Vec::new(), None);
+        if self.paper_tables {
+            log.begin("table 2", "scoring Table 2's ablation on the test views");
+            let dirs: Vec<PathBuf> = ablation_configs()
+                .iter()
+                .map(|c| self.model_dir(c))
+                .collect();
+            let opts = stages::eval_options(self, &data, &dirs);
+            let (rows, worked) = stages::ablation(self, &opts, &report.join("table2.json"))?;
+            log.end(worked)?;
+            ablation = rows;
+            paper = Some(write_paper_report(
+                self,
+                &evaluation,
+                &ablation,
+                &log.times,
+                &report,
+            )?);
+        }
+        let mut relit = None;
+        if self.relight {
+            log.begin(
+                "relight",
+                "relighting a camera path under held-out lighting",
+            );
+            let frames = self.out.join("relit");
+            let last = self
+                .designs
+                .last()
+                .context("an experiment trains a design")?;
+            stages::relight(self, &data, &self.model_dir(last), &frames)?;
+            log.end(true)?;
+            relit = Some(frames);
+        }
+        Ok(Outcome {
+            evaluation,
+            ablation,
+            report: report.join("report.html"),
+            paper,
+            relit,
+            seconds: log.elapsed(),
+        })
+    }
+
+    /// What the output folder is for, written on its first run: a later run with another
+    /// scene, lighting, budget or seed is refused rather than mixed into it.
+    fn claim_folder(&self) -> Result<()> {
+        let what = json!({
+            "scene": self.scene,
+            "envmaps": self.envmaps,
+            "budget": self.budget.name,
+            "seed": self.seed,
+            "test_maps": self.test_maps,
+            "camera_volume": self.camera.file,
+            "models": self.models().iter().map(|c| c.label()).collect::<Vec<_>>(),
+        });
+        let file = self.out.join("experiment.json");
+        if let Ok(bytes) = std::fs::read(&file) {
+            let before: serde_json::Value = serde_json::from_slice(&bytes)
+                .with_context(|| format!("'{}' is not an experiment record", file.display()))?;
+            if before != what {
+                bail!(
+                    "'{}' holds another experiment ({}); this one is {}: give another output folder, or remove it to start again",
+                    self.out.display(),
+                    before,
+                    what
+                );
+            }
+            return Ok(());
+        }
+        nprt_io::write_file(&file, serde_json::to_vec_pretty(&what)?)
+    }
+}
