@@ -39,5 +39,8 @@ pub use evaluate::{evaluate, score_networks, Evaluation};
 pub use method::{Family, MethodResult, BINS};
 pub use metrics::Metrics;
 pub use networks::row_name;
-pub use report::{crop_image, fmt, markdown_to_html, mean_and_se, table6, write_report};
+pub use report::{
+    crop_image, fmt, markdown_to_html, mean_and_se, plot_validation, table6, write_report,
+    VALIDATION_PLOT,
+};
 pub use timing::Timing;

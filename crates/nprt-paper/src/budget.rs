@@ -49,11 +49,11 @@ pub const TINY: Budget = Budget {
     timing_res: 64,
     temporal: (6, 32),
     relight: (4, 48),
-    wall_time: "under a minute on 2 cores (builtin:room)",
+    wall_time: "10 s on 2 cores on builtin:room (docs/paper.md)",
 };
 
-/// An hour on 2 cores on KITCHEN: 32 test views, enough to resolve the paper's orderings where
-/// the designs differ by a few percent.
+/// Within an hour on 2 cores on KITCHEN (36 minutes measured): 32 test views, enough to resolve
+/// the paper's orderings where the designs differ by a few percent.
 pub const SMALL: Budget = Budget {
     name: "small",
     train_views: 600,
@@ -68,10 +68,10 @@ pub const SMALL: Budget = Budget {
     timing_res: 512,
     temporal: (12, 64),
     relight: (24, 128),
-    wall_time: "about 45 minutes on 2 cores on KITCHEN (docs/paper.md)",
+    wall_time: "36 minutes on 2 cores on KITCHEN (docs/paper.md)",
 };
 
-/// A night on a workstation's CPU, or minutes of data and training on one GPU.
+/// A night on a workstation's CPU.
 pub const MEDIUM: Budget = Budget {
     name: "medium",
     train_views: 1500,
@@ -86,7 +86,7 @@ pub const MEDIUM: Budget = Budget {
     timing_res: 512,
     temporal: (24, 128),
     relight: (48, 256),
-    wall_time: "about 6 hours on 2 cores, projected from small's rates (docs/paper.md)",
+    wall_time: "about 5 hours on 2 cores on KITCHEN, projected from small's rates (docs/paper.md)",
 };
 
 /// The paper's sizes: 3000 views of 256², 200 test views of 400², 3200-spp references, 500
@@ -113,7 +113,7 @@ pub const PAPER: Budget = Budget {
     timing_res: 512,
     temporal: (48, 256),
     relight: (96, 512),
-    wall_time: "weeks on 2 cores; a cluster for the data and a GPU for training (docs/paper.md)",
+    wall_time: "about 52 days on 2 cores on KITCHEN, projected: a cluster for the data and a GPU for training (docs/paper.md)",
 };
 
 /// The demo's sizes: 800 lightings at 32² rather than 200 at 64² (the same pixels and tracing

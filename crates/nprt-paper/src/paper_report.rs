@@ -9,7 +9,8 @@ use std::path::{Path, PathBuf};
 use anyhow::Result;
 use nprt_eval::claim::Verdict;
 use nprt_eval::{
-    crop_image, markdown_to_html, mean_and_se, row_name, Evaluation, MethodResult, Metrics,
+    crop_image, markdown_to_html, mean_and_se, plot_validation, row_name, Evaluation, MethodResult,
+    Metrics, VALIDATION_PLOT,
 };
 use nprt_net::{Design, ModelConfig};
 
@@ -72,7 +73,7 @@ fn header(md: &mut String, x: &Experiment, e: &Evaluation, times: &[(String, f64
     )?;
     writeln!(
         md,
-        "Lighting `{}`. Dataset: {} training views of {}² at {} spp; {} test views of {}² under \
+        "Lighting `{}`. The budget takes {}. Dataset: {} training views of {}² at {} spp; {} test views of {}² under \
          held-out lighting, references at {} spp. Networks trained {} each on the {} ({} CPU \
          threads). Every figure below is a mean over the test views with its standard error, and \
          every ordering is judged on per-view (or per-frame) differences: ✅ holds (two standard \
@@ -80,6 +81,7 @@ fn header(md: &mut String, x: &Experiment, e: &Evaluation, times: &[(String, f64
          evaluation's full report (every method, error analysis, temporal section) is \
          [report.html](report.html).\n",
         x.envmaps,
+        b.wall_time,
         b.train_views,
         b.train_res,
         b.spp,
@@ -402,23 +404,12 @@ fn crops(md: &mut String, e: &Evaluation, dir: &Path) -> Result<()> {
 /// Table 2's runs.
 fn curves(md: &mut String, ablation: &[MethodResult], dir: &Path) -> Result<()> {
     writeln!(md, "## Training curves\n")?;
-    let designs = "images/validation-vs-seconds.png";
-    if dir.join(designs).is_file() {
-        writeln!(md, "![the designs' validation loss]({designs})\n")?;
+    if dir.join(VALIDATION_PLOT).is_file() {
+        writeln!(md, "![the designs' validation loss]({VALIDATION_PLOT})\n")?;
     }
-    let series: Vec<(String, Vec<(f64, f64)>)> = ablation
-        .iter()
-        .filter(|m| !m.validation.is_empty())
-        .map(|m| (m.name.clone(), m.validation.clone()))
-        .collect();
-    if !series.is_empty() {
-        let rel = "images/table2-validation.png";
-        nprt_io::plot_lines(
-            &dir.join(rel),
-            "Table 2's runs: validation loss against training time",
-            ("seconds of training", "validation log-L1"),
-            &series,
-        )?;
+    let rel = "images/table2-validation.png";
+    let title = "Table 2's runs: validation loss against training time";
+    if plot_validation(ablation, &dir.join(rel), title)? {
         writeln!(md, "![Table 2's validation loss]({rel})\n")?;
     }
     Ok(())

@@ -25,8 +25,8 @@ pub struct PaperArgs {
     /// lighting or budget is refused.
     #[arg(long)]
     out: PathBuf,
-    /// Sizes (docs/paper.md): tiny (test-only, a minute), small (about 45 minutes on 2 cores
-    /// on KITCHEN), medium (hours on a CPU), paper (the paper's: 3000 views of 256², 3200 spp,
+    /// Sizes (docs/paper.md): tiny (test-only, 10 s), small (36 minutes on 2 cores
+    /// on KITCHEN), medium (about 5 hours on 2 cores), paper (the paper's: 3000 views of 256², 3200 spp,
     /// 500 epochs; a cluster and a GPU).
     #[arg(long, default_value = "small", value_parser = parse_budget)]
     budget: Budget,

@@ -112,3 +112,24 @@ fn the_tiny_budget_writes_every_table_and_resumes() {
         "{err}"
     );
 }
+
+#[test]
+fn a_dataset_rendered_from_the_printed_flags_is_the_one_a_run_needs() {
+    // The cluster route: `nprt generate` with the flags `--generate-flags` prints (as
+    // scripts/slurm-generate runs it), then `nprt paper` finds every view done.
+    let dir = fresh_dir("paper-flags");
+    let out = dir.to_str().unwrap();
+    let args = ["paper", "--budget", "tiny", "--out", out, "--device", "cpu"];
+    let flags = ok(&[&args[..], &["--generate-flags"]].concat());
+    let flags: Vec<&str> = flags.split_whitespace().collect();
+    assert!(
+        flags.contains(&"--train-views") && flags.contains(&"24"),
+        "{flags:?}"
+    );
+    ok(&[&["generate"], &flags[..]].concat());
+    let run = ok(&args);
+    assert!(
+        run.contains("0 views rendered") && run.contains("28 already complete"),
+        "{run}"
+    );
+}

@@ -18,7 +18,7 @@ use pictures::{auto_exposure, crop, crop_window, heat_map, save, with_background
 pub use table6::{mean_and_se, table6};
 
 use crate::evaluate::Evaluation;
-use crate::method::BINS;
+use crate::method::{MethodResult, BINS};
 use crate::metrics::{Metrics, RELATIVE_EPS};
 
 /// A method name as a file-name part.
@@ -331,25 +331,39 @@ fn images(md: &mut String, e: &Evaluation, dir: &Path) -> Result<()> {
     Ok(())
 }
 
-/// The networks' validation loss against training time on one plot (recipes and designs
-/// compared at equal wall time), then each network's own loss curves.
-fn training_curves(md: &mut String, e: &Evaluation, dir: &Path) -> Result<()> {
-    writeln!(md, "## Training curves\n")?;
-    let series: Vec<(String, Vec<(f64, f64)>)> = e
-        .methods
+/// Where the report plots its networks' validation curves (relative to its folder).
+pub const VALIDATION_PLOT: &str = "images/validation-vs-seconds.png";
+
+/// Plots the validation loss against training seconds of those `methods` that have a curve
+/// (networks), one line each, into `path`; whether there was any.
+pub fn plot_validation(methods: &[MethodResult], path: &Path, title: &str) -> Result<bool> {
+    let series: Vec<(String, Vec<(f64, f64)>)> = methods
         .iter()
         .filter(|m| !m.validation.is_empty())
         .map(|m| (m.name.clone(), m.validation.clone()))
         .collect();
-    if !series.is_empty() {
-        let rel = "images/validation-vs-seconds.png";
-        plot_lines(
-            &dir.join(rel),
-            "validation loss (held-out lighting) against training time",
-            ("seconds of training", "validation log-L1"),
-            &series,
+    if series.is_empty() {
+        return Ok(false);
+    }
+    plot_lines(
+        path,
+        title,
+        ("seconds of training", "validation log-L1"),
+        &series,
+    )?;
+    Ok(true)
+}
+
+/// The networks' validation loss against training time on one plot (recipes and designs
+/// compared at equal wall time), then each network's own loss curves.
+fn training_curves(md: &mut String, e: &Evaluation, dir: &Path) -> Result<()> {
+    writeln!(md, "## Training curves\n")?;
+    let title = "validation loss (held-out lighting) against training time";
+    if plot_validation(&e.methods, &dir.join(VALIDATION_PLOT), title)? {
+        writeln!(
+            md,
+            "![validation loss against training time]({VALIDATION_PLOT})\n"
         )?;
-        writeln!(md, "![validation loss against training time]({rel})\n")?;
     }
     for m in e.methods.iter().filter(|m| m.loss_png.is_some()) {
         let rel = format!("images/loss-{}.png", slug(&m.name));
