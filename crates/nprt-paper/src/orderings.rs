@@ -167,6 +167,28 @@ pub fn table5(e: &Evaluation) -> Vec<Ordering> {
     ]
 }
 
+/// Every ordering this module judges: Table 2's (from its scored runs), Table 5's and Table 6's
+/// (from the evaluation), in that order.
+pub fn all(e: &Evaluation, ablation: &[MethodResult]) -> Vec<Ordering> {
+    [table2(ablation), table5(e), table6(e)]
+        .into_iter()
+        .flatten()
+        .collect()
+}
+
+/// The rows Table 6 sets D/S (`ds`) against on the test views: path tracing of its cost with
+/// and without OIDN, Deep Shading, SH PRT 9 and 25 (where the evaluation has them).
+pub fn test_view_competitors(ds: &MethodResult) -> [String; 5] {
+    let pt = ds.equal_time.clone().unwrap_or_default();
+    [
+        pt.clone(),
+        format!("{pt} + OIDN"),
+        "deep-shading".into(),
+        "sh-prt-9".into(),
+        "sh-prt-25".into(),
+    ]
+}
+
 /// Table 6's ordering, one per competitor: D/S ahead of it in each of Table 6's metrics, on the
 /// test views (path tracing of D/S's cost with and without OIDN, Deep Shading, SH PRT 9 and 25)
 /// and, for the radiance caches that train online, along the camera path per frame.
@@ -174,16 +196,8 @@ pub fn table6(e: &Evaluation) -> Vec<Ordering> {
     let Some(ds) = e.method(&row_name(&ModelConfig::new(Design::Dsep, None))) else {
         return Vec::new();
     };
-    let pt = ds.equal_time.clone().unwrap_or_default();
-    let names = [
-        pt.clone(),
-        format!("{pt} + OIDN"),
-        "deep-shading".into(),
-        "sh-prt-9".into(),
-        "sh-prt-25".into(),
-    ];
     let table6 = Metrics::TABLE6;
-    let mut out: Vec<Ordering> = names
+    let mut out: Vec<Ordering> = test_view_competitors(ds)
         .iter()
         .filter_map(|n| e.method(n))
         .map(|other| Ordering {

@@ -15,7 +15,7 @@ use nprt_eval::{
 use nprt_net::{Design, ModelConfig};
 
 use crate::experiment::Experiment;
-use crate::orderings::{self, ablation_configs, Ordering};
+use crate::orderings::{self, ablation_configs, test_view_competitors, Ordering};
 use crate::published;
 
 /// Writes paper.md and paper.html into `dir` (the evaluation's report folder, whose images the
@@ -27,14 +27,7 @@ pub fn write_paper_report(
     times: &[(String, f64)],
     dir: &Path,
 ) -> Result<(PathBuf, PathBuf)> {
-    let orderings: Vec<Ordering> = [
-        orderings::table2(ablation),
-        orderings::table5(e),
-        orderings::table6(e),
-    ]
-    .into_iter()
-    .flatten()
-    .collect();
+    let orderings = orderings::all(e, ablation);
     let kitchen = x.scene.to_lowercase().contains("kitchen");
     let mut md = String::new();
     header(&mut md, x, e, times)?;
@@ -321,16 +314,13 @@ fn table5(md: &mut String, e: &Evaluation, kitchen: bool, orderings: &[Ordering]
 fn table6(md: &mut String, e: &Evaluation, orderings: &[Ordering]) -> Result<()> {
     writeln!(md, "## Table 6: D/S against every competitor\n")?;
     writeln!(md, "On the {} test views:\n", e.test_views)?;
-    let ds = design_row(e, Design::Dsep);
-    let pt = ds.and_then(|m| m.equal_time.clone()).unwrap_or_default();
-    let names = [
-        ds.map(|m| m.name.clone()).unwrap_or_default(),
-        pt.clone(),
-        format!("{pt} + OIDN"),
-        "deep-shading".into(),
-        "sh-prt-9".into(),
-        "sh-prt-25".into(),
-    ];
+    let names: Vec<String> = design_row(e, Design::Dsep)
+        .map(|ds| {
+            let mut rows = vec![ds.name.clone()];
+            rows.extend(test_view_competitors(ds));
+            rows
+        })
+        .unwrap_or_default();
     nprt_eval::table6(
         md,
         names

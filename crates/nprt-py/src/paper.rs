@@ -57,15 +57,11 @@ pub fn paper<'py>(
         "results",
         arrays::json_file(py, &out.join("report").join("results.json"))?,
     )?;
-    let orderings: Vec<(&str, String, &str)> = [
-        nprt_paper::orderings::table2(&done.ablation),
-        nprt_paper::orderings::table5(&done.evaluation),
-        nprt_paper::orderings::table6(&done.evaluation),
-    ]
-    .iter()
-    .flatten()
-    .map(|o| (o.table, o.statement.clone(), o.verdict().word()))
-    .collect();
+    let orderings: Vec<(&str, String, &str)> =
+        nprt_paper::orderings::all(&done.evaluation, &done.ablation)
+            .iter()
+            .map(|o| (o.table, o.statement.clone(), o.verdict().word()))
+            .collect();
     d.set_item("orderings", orderings)?;
     Ok(d)
 }

@@ -76,14 +76,7 @@ pub fn command(a: PaperArgs) -> Result<()> {
         );
     }
     println!("the evaluation's report: {}", done.report.display());
-    let orderings: Vec<_> = [
-        nprt_paper::orderings::table2(&done.ablation),
-        nprt_paper::orderings::table5(&done.evaluation),
-        nprt_paper::orderings::table6(&done.evaluation),
-    ]
-    .into_iter()
-    .flatten()
-    .collect();
+    let orderings = nprt_paper::orderings::all(&done.evaluation, &done.ablation);
     for o in &orderings {
         println!(
             "{:<13} {}: {}",

@@ -28,9 +28,7 @@ pub(super) fn slug(name: &str) -> String {
         .collect()
 }
 
-/// A figure as the reports print it: four decimals, or three significant digits in scientific
-/// notation for very small or large values, "–" when not a number.
-pub fn fmt(v: f64) -> String {
+pub(super) fn fmt(v: f64) -> String {
     if !v.is_finite() {
         "–".into()
     } else if v != 0.0 && (v.abs() < 1e-3 || v.abs() >= 1e4) {
