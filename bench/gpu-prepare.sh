@@ -47,8 +47,8 @@ for line in sys.stdin:
         print(m["executable"])' "$test"
 }
 log "building the GPU kernels' tests"
-for spec in nprt-net:kernels:gpu_training nprt-net:kernels:gpu_unet nprt-net:kernels:gpu_cache \
-  nprt-render:wgpu:gpu_frame \
+for spec in nprt-net:gpu:gpu_training nprt-net:gpu:gpu_unet nprt-net:gpu:gpu_cache \
+  nprt-net:gpu:gpu_frame \
   nprt-trace:gpu:gpu_trace; do
   IFS=: read -r package features test <<<"$spec"
   exe=$(test_binary test "$package" "$features" "$test")
@@ -56,7 +56,7 @@ for spec in nprt-net:kernels:gpu_training nprt-net:kernels:gpu_unet nprt-net:ker
   strip -o "$out/tests/$test" "$exe"
 done
 log "building the cooperative-matrix benchmark"
-exe=$(test_binary bench nprt-render wgpu cooperative_matrix)
+exe=$(test_binary bench nprt-render gpu cooperative_matrix)
 [ -x "$exe" ] || { log "no executable for the cooperative_matrix bench"; exit 1; }
 strip -o "$out/cooperative_matrix" "$exe"
 

@@ -17,6 +17,7 @@ import csv
 import os
 
 from ._nprt import (
+    DESIGNS,
     Dataset,
     EnvMap,
     Model,
@@ -38,6 +39,7 @@ from ._nprt import (
 )
 
 __all__ = [
+    "DESIGNS",
     "Dataset",
     "EnvMap",
     "Model",

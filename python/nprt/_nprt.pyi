@@ -11,6 +11,8 @@ Matrix = npt.ArrayLike  # 4 x 4 camera-to-world, rows first
 Image = npt.NDArray[np.float32]  # (H, W, 3) linear radiance
 
 __version__: str
+# The transport designs `train` and `model_info` take (`nprt train --arch`).
+DESIGNS: List[str]
 
 class NprtError(RuntimeError):
     """Bad input (the file and the reason) or a failed stage, with the command line's message."""
@@ -218,7 +220,7 @@ def model_info(
     encoding: Optional[str] = None,
 ) -> Dict[str, Any]:
     """`nprt model info`: the layer table and parameter counts of a trained model folder, or of
-    a design (`arch`: baseline, prt, albedo, dsep) untrained. Keys: config, layers (name, shape,
+    a design (`arch`: one of `DESIGNS`) untrained. Keys: config, layers (name, shape,
     params), encoder_params, transport_params (without hash-grid entries, as the paper's Table
     1), paper_params, grid_entries, total_params; for a model also dataset_hash, scene_hash,
     level_gain."""

@@ -9,6 +9,10 @@ use anyhow::{bail, Result};
 use nprt_trace::TraceDevice;
 
 use crate::choice::named_choice;
+use crate::cpu::CpuShading;
+use crate::model::folder::ModelFile;
+use crate::network::nprt_net::NprtNet;
+use crate::shading::Shading;
 
 /// `--device`: the CPU, a GPU (hardware adapters only), any wgpu adapter (software ones
 /// included), or a GPU when one is present.
@@ -52,7 +56,7 @@ impl Compute {
             Compute::Auto => Ok(match no_hardware_gpu() {
                 None => Engine::Gpu,
                 Some(why) => {
-                    if cfg!(feature = "kernels") {
+                    if cfg!(feature = "gpu") {
                         eprintln!("--device auto: running on the CPU: {why}");
                     }
                     Engine::Cpu
@@ -63,7 +67,7 @@ impl Compute {
 }
 
 /// Why the GPU kernels cannot run on a hardware adapter here, or None when they can.
-#[cfg(feature = "kernels")]
+#[cfg(feature = "gpu")]
 fn no_hardware_gpu() -> Option<String> {
     match nprt_gpu::GpuDevice::get() {
         Err(e) => Some(format!("{e:#}")),
@@ -76,23 +80,23 @@ fn no_hardware_gpu() -> Option<String> {
     }
 }
 
-#[cfg(not(feature = "kernels"))]
+#[cfg(not(feature = "gpu"))]
 fn no_hardware_gpu() -> Option<String> {
     Some(WITHOUT_KERNELS.into())
 }
 
 /// The GPU kernels on whatever adapter wgpu finds, software ones included.
-#[cfg(feature = "kernels")]
+#[cfg(feature = "gpu")]
 fn any_adapter() -> Result<Engine> {
     nprt_gpu::GpuDevice::get().map(|_| Engine::Gpu)
 }
 
-#[cfg(not(feature = "kernels"))]
+#[cfg(not(feature = "gpu"))]
 fn any_adapter() -> Result<Engine> {
     bail!("--device wgpu: {WITHOUT_KERNELS}")
 }
 
-#[cfg(not(feature = "kernels"))]
+#[cfg(not(feature = "gpu"))]
 const WITHOUT_KERNELS: &str = "this nprt was built without its GPU kernels; rebuild it with \
     `cargo build --release --features gpu` (docs/building.md), or use --device cpu";
 
@@ -111,6 +115,20 @@ impl Engine {
         self == Engine::Gpu
     }
 
+    /// The trained network `net` (with `file`'s settings: its encoder's input and its gain) on
+    /// this engine: the one place a frame's networks choose between the CPU engine and the GPU
+    /// kernels.
+    pub fn network(self, file: &ModelFile, net: NprtNet) -> Result<Box<dyn Shading>> {
+        let (width, norm, gain) = (file.config.encoder_width, file.config.map_norm, file.output_gain());
+        match self {
+            Engine::Cpu => Ok(Box::new(CpuShading::new(net, gain, width, norm))),
+            #[cfg(feature = "gpu")]
+            Engine::Gpu => Ok(Box::new(crate::gpu::GpuNetwork::new(&net, gain, width, norm)?)),
+            #[cfg(not(feature = "gpu"))]
+            Engine::Gpu => bail!("--device gpu: {WITHOUT_KERNELS}"),
+        }
+    }
+
     /// The path tracer on this engine's device (`nprt generate --device`).
     pub fn tracer(self) -> TraceDevice {
         match self {
@@ -124,12 +142,12 @@ impl Engine {
     pub fn name(self) -> String {
         match self {
             Engine::Cpu => "cpu".into(),
-            #[cfg(feature = "kernels")]
+            #[cfg(feature = "gpu")]
             Engine::Gpu => match nprt_gpu::GpuDevice::get() {
                 Ok(gpu) => format!("gpu: {}", gpu.adapter),
                 Err(_) => "gpu".into(),
             },
-            #[cfg(not(feature = "kernels"))]
+            #[cfg(not(feature = "gpu"))]
             Engine::Gpu => "gpu".into(),
         }
     }
@@ -138,7 +156,7 @@ impl Engine {
 /// Waits for the work queued on the GPU, if this process opened it. Called once a command is
 /// done: work still running at exit would run after the driver had shut down.
 pub fn finish() {
-    #[cfg(feature = "kernels")]
+    #[cfg(feature = "gpu")]
     if let Some(gpu) = nprt_gpu::GpuDevice::opened() {
         gpu.wait();
     }
@@ -153,7 +171,7 @@ mod tests {
         assert_eq!(Compute::Cpu.engine().unwrap(), Engine::Cpu);
         match Compute::Gpu.engine() {
             Ok(engine) => assert!(engine.is_gpu()),
-            Err(e) if cfg!(feature = "kernels") => {
+            Err(e) if cfg!(feature = "gpu") => {
                 let e = format!("{e:#}");
                 assert!(
                     e.contains("software one") || e.contains("no GPU adapter"),

@@ -8,8 +8,9 @@
 //!    designs, the U-Net, and `parameters`: the one weight type every network is), then
 //!    `optimiser` (Adam, and the steps an engine takes) and `model` (config and folder);
 //! 3. the engines: `cpu` (the CPU engine, on the networks' own weights), `gpu` (our own GPU
-//!    kernels, feature `kernels`, which read the same weights) and `engine` (what `--device`
-//!    resolves to);
+//!    kernels, feature `gpu`, which read the same weights), `shading` (a trained network as
+//!    frames run it, on either) and `engine` (what `--device` resolves to, and the one place
+//!    that picks an engine's network);
 //! 4. `training` (data, batches, schedule, the loop, each engine's steps);
 //! 5. `deep_shading` and `bench`.
 //!
@@ -17,7 +18,7 @@
 //! trace rays or write datasets, and it knows nothing of evaluation or frame rendering.
 //!
 //! No framework: `--device` resolves into an [`Engine`] that runs the steps and frames, the
-//! CPU engine ([`cpu`]) or our own GPU kernels ([`gpu`], feature `kernels`), both on the
+//! CPU engine ([`cpu`]) or our own GPU kernels ([`gpu`], feature `gpu`), both on the
 //! weights [`network`] defines. The gradient checks hold them to f64 finite differences.
 //!
 //! ```
@@ -35,7 +36,7 @@ pub mod cpu;
 pub mod deep_shading;
 pub mod encoding;
 mod engine;
-#[cfg(feature = "kernels")]
+#[cfg(feature = "gpu")]
 pub mod gpu;
 pub mod init;
 pub mod loss;
@@ -43,9 +44,10 @@ pub mod model;
 pub mod network;
 pub mod optimiser;
 mod precision;
+mod shading;
 pub mod training;
 
-#[cfg(feature = "kernels")]
+#[cfg(feature = "gpu")]
 pub use bench::throughput::profile_kernels;
 pub use bench::throughput::{measure_inference, measure_throughput, median, InferenceSpeed};
 pub use encoding::features::{feature, gbuffer_features, pixel_features, position_frame, FEATURES};
@@ -67,6 +69,7 @@ pub use network::parameters::Parameters;
 pub use network::track::Track;
 pub use network::track_kind::TrackKind;
 pub use precision::Precision;
+pub use shading::{LightCode, PixelRows, Shading};
 pub use training::batch::Batch;
 pub use training::calibration::{level_gain, Calibration, LEVEL_SAMPLES};
 pub use training::checkpoint::RunState;

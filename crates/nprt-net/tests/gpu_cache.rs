@@ -2,7 +2,7 @@
 //! its loss and every weight's gradient, and Adam steps trained on either engine. Runs on
 //! whatever adapter wgpu finds (CI's is lavapipe); without one the tests skip, unless
 //! NPRT_REQUIRE_VULKAN is set.
-#![cfg(feature = "kernels")]
+#![cfg(feature = "gpu")]
 
 #[allow(dead_code)] // the helpers other test binaries use
 mod common;

@@ -6,7 +6,7 @@
 //! whatever adapter wgpu finds; CI's is Mesa's software Vulkan (scripts/vulkan.sh). Without
 //! one the tests skip, unless NPRT_REQUIRE_VULKAN is set (scripts/test sets it once lavapipe
 //! is installed).
-#![cfg(feature = "kernels")]
+#![cfg(feature = "gpu")]
 
 #[allow(dead_code)] // the helpers other test binaries use
 mod common;

@@ -3,7 +3,7 @@
 //! two Adam steps against the host's Adam, and a resumed run continuing to the bit. Runs on
 //! whatever adapter wgpu finds (CI's is lavapipe); without one the tests skip, unless
 //! NPRT_REQUIRE_VULKAN is set.
-#![cfg(feature = "kernels")]
+#![cfg(feature = "gpu")]
 
 #[allow(dead_code)] // the helpers other test binaries use
 mod common;

@@ -43,7 +43,7 @@ impl Experiment {
             camera: CameraChoice::default(),
             test_maps: None,
             seed: 0,
-            designs: Design::ALL.map(|d| ModelConfig::new(d, None)).to_vec(),
+            designs: Design::PAPER.map(|d| ModelConfig::new(d, None)).to_vec(),
             paper_tables: true,
             relight: false,
             engine,
@@ -54,7 +54,7 @@ impl Experiment {
     /// direct light traced at run time (the paper's suggested extension, docs/model.md), every
     /// baseline, and a relit camera path; `quick` at the tiny budget.
     pub fn demo(out: &Path, quick: bool, engine: Engine) -> Self {
-        let mut designs = Design::ALL.map(|d| ModelConfig::new(d, None)).to_vec();
+        let mut designs = Design::PAPER.map(|d| ModelConfig::new(d, None)).to_vec();
         designs.push(ModelConfig {
             direct: DirectLight::Traced,
             ..ModelConfig::new(Design::Dsep, None)

@@ -143,11 +143,8 @@ pub fn table2(rows: &[MethodResult]) -> Vec<Ordering> {
 /// Table 5's orderings: D/S lowest of the four designs, and the paper's order of the other
 /// three (albedo ≤ PRT-inspired < baseline).
 pub fn table5(e: &Evaluation) -> Vec<Ordering> {
-    let designs: Vec<Option<&MethodResult>> = Design::ALL
-        .iter()
-        .map(|&d| e.method(&row_name(&ModelConfig::new(d, None))))
-        .collect();
-    let [Some(b), Some(p), Some(a), Some(ds)] = designs[..] else {
+    let [b, p, a, ds] = Design::PAPER.map(|d| e.method(&row_name(&ModelConfig::new(d, None))));
+    let (Some(b), Some(p), Some(a), Some(ds)) = (b, p, a, ds) else {
         return Vec::new();
     };
     vec![
@@ -324,5 +321,36 @@ mod tests {
             "not resolved in log-L1 (+0.0000 ± 0.5774), RMSE (+0.0000 ± 0.5774)"
         );
         assert!(table2(&rows[..3]).is_empty());
+    }
+
+    /// Table 5 compares the paper's four designs by name: a design beyond them (a fifth row,
+    /// listed first) neither hides its orderings nor enters them.
+    #[test]
+    fn table5_judges_the_papers_four_beside_a_fifth_design() {
+        let row = |d: Design, level: f64| {
+            let name = row_name(&ModelConfig::new(d, None));
+            method(&name, &[level, level * 1.5, level * 0.8, level * 1.2])
+        };
+        let fifth = method("dsep-wide", &[0.1; 4]);
+        let methods = vec![
+            fifth,
+            row(Design::Baseline, 4.0),
+            row(Design::Prt, 3.0),
+            row(Design::Albedo, 2.0),
+            row(Design::Dsep, 1.0),
+        ];
+        let mut evaluation: Evaluation = serde_json::from_value(serde_json::json!({
+            "data": "data", "scene": "builtin:room", "test_views": 4, "resolution": [8, 8],
+            "foreground_pixels": 64, "equal_time_spp": 1, "methods": [], "timing_res": 8,
+            "timings": [], "denoiser": "none", "cpu_threads": 1,
+        }))
+        .unwrap();
+        evaluation.methods = methods;
+        let orderings = table5(&evaluation);
+        assert_eq!(orderings.len(), 2);
+        for o in &orderings {
+            assert_eq!(o.verdict(), Verdict::Holds, "{}", o.statement);
+            assert!(o.comparisons.iter().all(|c| !c.claim.text.contains("dsep-wide")));
+        }
     }
 }

@@ -175,7 +175,7 @@ fn table1(md: &mut String, e: &Evaluation, ablation: &[MethodResult]) -> Result<
         "## Table 1: transport parameters (the light encoder excluded)\n"
     )?;
     writeln!(md, "| model | nprt | paper |\n|---|---|---|")?;
-    for d in Design::ALL {
+    for d in Design::PAPER {
         if let Some(m) = design_row(e, d) {
             writeln!(md, "| {} | {} | {} |", m.name, params(m), d.paper_params())?;
         }
@@ -264,7 +264,7 @@ fn paper_ms(what: &str) -> String {
         let (lo, hi) = published::PATH_TRACING_5SPP_MS;
         return format!("{lo:.0}–{hi:.0} (Falcor)");
     }
-    for d in Design::ALL {
+    for d in Design::PAPER {
         let name = row_name(&ModelConfig::new(d, None));
         if what == format!("{name}: encoder") {
             return format!("{:.2}", published::ENCODER_MS);
@@ -294,7 +294,7 @@ fn table5(md: &mut String, e: &Evaluation, kitchen: bool, orderings: &[Ordering]
     )?;
     let rmse = |m: &MethodResult| over_views(m, Metrics::RMSE).0;
     let ds = design_row(e, Design::Dsep).map(rmse);
-    for d in Design::ALL {
+    for d in Design::PAPER {
         let Some(m) = design_row(e, d) else { continue };
         let ratio = ds.map_or("–".into(), |r| format!("{:.3}", rmse(m) / r));
         let paper = published::kitchen_rmse_e3(d);
@@ -352,7 +352,7 @@ fn crops(md: &mut String, e: &Evaluation, dir: &Path) -> Result<()> {
     let pt = ds.and_then(|m| m.equal_time.clone()).unwrap_or_default();
     let mut names: Vec<String> = vec!["reference".into()];
     names.extend(
-        Design::ALL
+        Design::PAPER
             .iter()
             .filter_map(|&d| design_row(e, d))
             .map(|m| m.name.clone()),

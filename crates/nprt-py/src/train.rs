@@ -15,7 +15,7 @@ use pyo3::types::{PyBool, PyDict};
 use crate::choice::{engine, parse};
 use crate::error::OrPy;
 
-/// Trains `arch` ("baseline", "prt", "albedo" or "dsep") on the dataset `data` into the model
+/// Trains `arch` (one of `nprt.DESIGNS`) on the dataset `data` into the model
 /// folder `out` (a run already there with the same settings is resumed, and a larger `epochs`
 /// or `minutes` continues a finished one), on `device`, for `minutes` of training time and/or
 /// `epochs` passes (without either: 20 epochs). `None` takes `nprt train`'s default. Returns

@@ -11,7 +11,7 @@
 //! against the host at a few entries. Prints the adapter's cooperative matrix configurations
 //! first; where it has none, it stops there.
 //!
-//! cargo bench -p nprt-render --features wgpu --bench cooperative_matrix [-- --validate]
+//! cargo bench -p nprt-render --features gpu --bench cooperative_matrix [-- --validate]
 //!
 //! `--validate` only checks each variant's WGSL with naga and translates it to SPIR-V, which
 //! needs no GPU. On one H200 (driver 580.159.04, 2026-11-26), straight from storage, 4 × 4 tiles

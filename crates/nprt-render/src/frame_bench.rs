@@ -55,7 +55,7 @@ pub struct FrameBenchRow {
     /// Where traced direct light ran.
     pub paths_on: &'static str,
     /// With `profile`: each kernel's GPU time in a lighting change, longest first.
-    #[cfg(feature = "wgpu")]
+    #[cfg(feature = "gpu")]
     pub profile: Option<Vec<nprt_gpu::KernelTime>>,
 }
 
@@ -93,7 +93,7 @@ pub fn bench_frame(
             let mut relight_waits = None;
             let mut shown = [Vec::new(), Vec::new()];
             // The last frame's lighting change, timed kernel by kernel.
-            #[cfg(feature = "wgpu")]
+            #[cfg(feature = "gpu")]
             let mut profile = None;
             for i in 0..=opts.repeats {
                 let rotation = 10.0 * i as f32;
@@ -114,7 +114,7 @@ pub fn bench_frame(
                 foreground = cache.foreground();
                 // Both again, left on the device as the viewer leaves them (after the profile,
                 // which reads the kept lighting).
-                #[cfg(feature = "wgpu")]
+                #[cfg(feature = "gpu")]
                 if opts.profile && i == opts.repeats {
                     profile = model.profile_relight(&cache)?;
                 }
@@ -144,7 +144,7 @@ pub fn bench_frame(
                 networks_on: model.networks_on(),
                 gbuffer_on: model.gbuffer_on(),
                 paths_on: model.paths_on(),
-                #[cfg(feature = "wgpu")]
+                #[cfg(feature = "gpu")]
                 profile,
             });
         }

@@ -26,8 +26,9 @@
 mod animation;
 mod example_view;
 mod frame_bench;
+mod frame_stages;
 mod frame_timings;
-#[cfg(feature = "wgpu")]
+#[cfg(feature = "gpu")]
 pub mod gpu;
 pub mod oidn;
 mod path;
@@ -44,9 +45,10 @@ pub use frame_bench::{bench_frame, FrameBenchOptions, FrameBenchRow};
 pub use frame_timings::FrameTimings;
 pub use nprt_net::Precision;
 pub use path::CameraPath;
+pub use frame_stages::FrameRadiance;
+pub use nprt_net::LightCode;
 pub use relight::{
-    background, DirectSampling, FrameCache, FrameRadiance, LightCode, Pixels, Relighter,
-    DEFAULT_DIRECT_SPP,
+    background, DirectSampling, FrameCache, Pixels, Relighter, DEFAULT_DIRECT_SPP,
 };
 pub use render_job::{RenderJob, RenderOptions, DEFAULT_LIGHTING};
 pub use schedule::LightingSchedule;

@@ -9,7 +9,7 @@ use nprt_net::{
     measure_throughput, median, Activation, Design, DirectLight, Engine, ModelConfig, Precision,
 };
 
-use crate::flags::{DeviceArg, Resolution};
+use crate::flags::{design_names, DeviceArg, Resolution};
 
 #[derive(clap::Subcommand)]
 pub enum BenchCommand {
@@ -69,11 +69,7 @@ pub struct BenchFrameArgs {
 #[derive(clap::Args)]
 pub struct BenchDesigns {
     /// Designs to measure, comma-separated.
-    #[arg(
-        long,
-        default_value = "baseline,prt,albedo,dsep",
-        value_delimiter = ','
-    )]
+    #[arg(long, value_delimiter = ',', value_parser = design_names(), default_values_t = Design::ALL)]
     arch: Vec<Design>,
 }
 

@@ -4,7 +4,15 @@ use std::fmt;
 use std::str::FromStr;
 
 use anyhow::{bail, Result};
-use nprt_net::{Compute, Engine, LrSchedule, RunLength};
+use clap::builder::{PossibleValuesParser, TypedValueParser};
+use nprt_net::{Compute, Design, Engine, LrSchedule, RunLength};
+
+/// `--arch`'s parser: the designs' names from `Design::ALL` as clap's possible values, which
+/// `--help` lists, so that no command states the list of designs by hand.
+pub fn design_names() -> impl TypedValueParser<Value = Design> {
+    PossibleValuesParser::new(Design::ALL.map(Design::name))
+        .map(|name| name.parse().expect("a name from Design::ALL"))
+}
 
 /// `--device`, shared by every command that runs the networks.
 #[derive(clap::Args, Clone, Copy)]

@@ -5,6 +5,8 @@ use std::path::PathBuf;
 use anyhow::{bail, Result};
 use nprt_net::{Activation, Design, ModelSummary, PositionEncoding, DEFAULT_ENCODER_WIDTH};
 
+use crate::flags::design_names;
+
 #[derive(clap::Subcommand)]
 pub enum ModelCommand {
     /// Print the layer table and parameter counts of a design (transport counts exclude the
@@ -14,9 +16,8 @@ pub enum ModelCommand {
 
 #[derive(clap::Args)]
 pub struct ModelInfoArgs {
-    /// Transport design: baseline, prt (PRT-inspired), albedo (albedo factorisation) or dsep
-    /// (diffuse/specular separation).
-    #[arg(long, required_unless_present = "model", conflicts_with = "model")]
+    /// Transport design (docs/model.md describes each; the paper's four are its Table 1).
+    #[arg(long, required_unless_present = "model", conflicts_with = "model", value_parser = design_names())]
     arch: Option<Design>,
     /// A trained model folder: load it (checking its config and weights) and describe it.
     #[arg(long)]

@@ -10,7 +10,7 @@ use nprt_net::{
     PositionEncoding, Precision, TrainOptions, DEFAULT_ENCODER_WIDTH, DEFAULT_MAP_NORM,
 };
 
-use crate::flags::{DeviceArg, RunArgs};
+use crate::flags::{design_names, DeviceArg, RunArgs};
 
 /// The defaults every flag shows, from the one place that states them.
 fn d() -> TrainOptions {
@@ -24,8 +24,8 @@ pub struct TrainArgs {
     /// `nprt dataset pack`), so the folder must be writable then.
     #[arg(long)]
     data: PathBuf,
-    /// Transport design: baseline, prt, albedo or dsep.
-    #[arg(long)]
+    /// Transport design (docs/model.md; the paper's four are its Table 1).
+    #[arg(long, value_parser = design_names())]
     arch: Design,
     /// siren or relu for the layers that read the pixel inputs (default: the paper's choice).
     #[arg(long)]

@@ -115,7 +115,7 @@ fn frames_on_the_gpu_match_the_cpus_with_their_background() {
             );
             // The median carries the encoder's input, made on the device from lookups whose
             // trigonometry rounds its own way: within 5e-6 of the host's near a sun's edge,
-            // light codes within 1.0e-6 (nprt-render's tests/gpu_frame.rs); lavapipe: at most 1.0e-6.
+            // light codes within 1.0e-6 (nprt-net's tests/gpu_frame.rs); lavapipe: at most 1.0e-6.
             assert!(beyond <= 0.01 && median < 3e-6, "{design:?}");
         }
     }

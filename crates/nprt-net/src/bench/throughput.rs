@@ -21,7 +21,7 @@ use crate::Precision;
 /// on the GPU kernels in `precision` (elsewhere f32 only).
 #[allow(clippy::too_many_arguments)]
 // Without the kernels `engine` is always the CPU.
-#[cfg_attr(not(feature = "kernels"), allow(unused_variables))]
+#[cfg_attr(not(feature = "gpu"), allow(unused_variables))]
 pub fn measure_throughput(
     config: &ModelConfig,
     batch_size: usize,
@@ -32,7 +32,7 @@ pub fn measure_throughput(
     engine: Engine,
 ) -> anyhow::Result<f64> {
     let batch = synthetic_batch(config, batch_size, views);
-    #[cfg(feature = "kernels")]
+    #[cfg(feature = "gpu")]
     if engine.is_gpu() {
         return kernel_throughput(config, &batch, steps, warmup, precision);
     }
@@ -77,7 +77,7 @@ fn synthetic_batch(config: &ModelConfig, batch_size: usize, views: usize) -> Bat
 /// The GPU time of each of our kernels in one training step in `precision` on the synthetic
 /// batch of [`measure_throughput`], after `warmup` untimed steps (`nprt bench train
 /// --profile`).
-#[cfg(feature = "kernels")]
+#[cfg(feature = "gpu")]
 pub fn profile_kernels(
     config: &ModelConfig,
     batch_size: usize,
@@ -97,7 +97,7 @@ pub fn profile_kernels(
 
 /// [`measure_throughput`] on our own GPU kernels (what `--device gpu` trains with): each step
 /// reads the loss of the one before it back while it runs, as a training run does.
-#[cfg(feature = "kernels")]
+#[cfg(feature = "gpu")]
 fn kernel_throughput(
     config: &ModelConfig,
     batch: &Batch,

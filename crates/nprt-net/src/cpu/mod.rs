@@ -8,6 +8,7 @@
 
 mod conv;
 mod dense;
+mod frame;
 mod light_encoder;
 mod matmul;
 mod peak;
@@ -21,6 +22,7 @@ mod unet;
 
 use crate::loss::Loss;
 use crate::network::nprt_net::NprtNet;
+pub use frame::CpuShading;
 pub use light_encoder::EncoderPass;
 pub use peak::{measured_peak, Peak};
 pub use samples::Samples;

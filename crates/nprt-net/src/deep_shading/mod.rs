@@ -5,7 +5,7 @@
 //! gives it the lighting too: the map goes through the same light encoder (trained jointly)
 //! and its code is added to the U-Net's bottleneck.
 
-#[cfg(feature = "kernels")]
+#[cfg(feature = "gpu")]
 mod kernel_steps;
 mod model;
 mod options;

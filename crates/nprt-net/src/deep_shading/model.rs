@@ -41,7 +41,7 @@ pub struct DeepShadingModel {
     pub file: DeepShadingFile,
     net: DeepShading,
     /// The network on the GPU kernels, where it was loaded for the GPU (one frame at a time).
-    #[cfg(feature = "kernels")]
+    #[cfg(feature = "gpu")]
     gpu: Option<std::sync::Mutex<crate::gpu::GpuUnet>>,
 }
 
@@ -60,17 +60,17 @@ impl DeepShadingModel {
         let file = read_file(dir)?;
         let mut net = DeepShading::new(&mut Init::new(0), file.encoder_width);
         load_weights(&dir.join(WEIGHTS_FILE), &mut net, TAG)?;
-        #[cfg(feature = "kernels")]
+        #[cfg(feature = "gpu")]
         let gpu = match engine.is_gpu() {
             true => Some(std::sync::Mutex::new(crate::gpu::GpuUnet::new(&net)?)),
             false => None,
         };
-        #[cfg(not(feature = "kernels"))]
+        #[cfg(not(feature = "gpu"))]
         let _ = engine;
         Ok(DeepShadingModel {
             file,
             net,
-            #[cfg(feature = "kernels")]
+            #[cfg(feature = "gpu")]
             gpu,
         })
     }
@@ -78,7 +78,7 @@ impl DeepShadingModel {
     /// The U-Net's radiance (3 × h × w) for a view's `features` (FEATURES × h × w) under the
     /// map `light`, on the engine the model was loaded for.
     fn radiance(&self, features: Vec<f32>, light: LightInput, (h, w): (usize, usize)) -> Vec<f32> {
-        #[cfg(feature = "kernels")]
+        #[cfg(feature = "gpu")]
         if let Some(gpu) = &self.gpu {
             let batch = crate::cpu::UnetBatch {
                 features,

@@ -31,7 +31,7 @@ struct UnetObjective {
     /// and the run (parameter counts, progress).
     file: DeepShadingFile,
     /// Whether the steps run on our own GPU kernels.
-    #[cfg_attr(not(feature = "kernels"), allow(dead_code))]
+    #[cfg_attr(not(feature = "gpu"), allow(dead_code))]
     kernels: bool,
 }
 
@@ -81,7 +81,7 @@ impl Objective for UnetObjective {
     }
 
     fn engine_steps(&self, net: &DeepShading) -> Result<Steps<'_, Self>> {
-        #[cfg(feature = "kernels")]
+        #[cfg(feature = "gpu")]
         if self.kernels {
             let steps = super::kernel_steps::UnetKernelSteps::new(net, &self.train, &self.test)?;
             return Ok(Box::new(steps));
@@ -186,7 +186,7 @@ pub fn train(
         train,
         test,
         file,
-        kernels: cfg!(feature = "kernels") && engine.is_gpu(),
+        kernels: cfg!(feature = "gpu") && engine.is_gpu(),
     };
     let summary = training_loop::train(&objective, &opts.schedule, out, watch)?;
     Ok((summary, read_file(out)?))

@@ -2,8 +2,8 @@
 //! Vulkan, Metal, DX12; Mesa's software Vulkan in the tests). This module owns the network
 //! kernels and how their dispatches are recorded: the light encoder's blocks, the dense layers'
 //! products (in f32, and on f16 operands: [`HalfWeight`], `half_products`), the training step of
-//! every design on the device ([`GpuTrainer`]) and the training set held there
-//! ([`DeviceDataset`]). nprt-render's frame path dispatches these kernels too. The kernels
+//! every design on the device ([`GpuTrainer`]), the training set held there
+//! ([`DeviceDataset`]) and a trained network's frames (`frame`: [`GpuNetwork`]). The kernels
 //! compute what the CPU engine ([`crate::cpu`]) computes, and tests hold the two together;
 //! layouts, designs and the hash grid stay defined where the CPU engine reads them.
 
@@ -14,6 +14,7 @@ mod device_adam;
 mod device_dataset;
 mod encoder_blocks;
 mod encoder_step;
+mod frame;
 mod gpu_trainer;
 mod half_layers;
 mod half_products;
@@ -34,6 +35,7 @@ pub use codes::{activation_code, loss_code};
 pub use dense_products::DenseProducts;
 pub use device_dataset::DeviceDataset;
 pub use encoder_blocks::{BlockPass, EncoderAt};
+pub use frame::{GpuLightCode, GpuLightInput, GpuNetwork, GpuPixels};
 pub use gpu_trainer::GpuTrainer;
 pub use half_layers::{
     half_weight_bits, held_halves, pad16, HalfLayers, HalfWeight, Held, HALF_ROW_BLOCK,

@@ -16,7 +16,7 @@ enum CacheOn {
         cache: RadianceCache,
         adam: Adam,
     },
-    #[cfg(feature = "kernels")]
+    #[cfg(feature = "gpu")]
     Gpu(Box<crate::gpu::GpuCache>),
 }
 
@@ -30,7 +30,7 @@ impl CacheTrainer {
     /// `cache` to train on `engine` at `learning_rate` (the GPU engine in a build with the
     /// kernels; the CPU otherwise).
     pub fn new(cache: RadianceCache, learning_rate: f64, engine: Engine) -> Result<Self> {
-        #[cfg(feature = "kernels")]
+        #[cfg(feature = "gpu")]
         if engine.is_gpu() {
             let gpu = crate::gpu::GpuCache::new(&cache, ADAM_BETAS)?;
             return Ok(CacheTrainer {
@@ -38,7 +38,7 @@ impl CacheTrainer {
                 learning_rate,
             });
         }
-        #[cfg(not(feature = "kernels"))]
+        #[cfg(not(feature = "gpu"))]
         let _ = engine;
         Ok(CacheTrainer {
             on: CacheOn::Cpu {
@@ -53,7 +53,7 @@ impl CacheTrainer {
     pub fn cache(&self) -> RadianceCache {
         match &self.on {
             CacheOn::Cpu { cache, .. } => cache.clone(),
-            #[cfg(feature = "kernels")]
+            #[cfg(feature = "gpu")]
             CacheOn::Gpu(gpu) => gpu.parameters(),
         }
     }
@@ -62,7 +62,7 @@ impl CacheTrainer {
     pub fn read(&mut self, queries: &[CacheQuery]) -> Vec<Vec3> {
         match &mut self.on {
             CacheOn::Cpu { cache, .. } => cache.read(queries),
-            #[cfg(feature = "kernels")]
+            #[cfg(feature = "gpu")]
             CacheOn::Gpu(gpu) => gpu.read(queries),
         }
     }
@@ -92,7 +92,7 @@ impl CacheTrainer {
                     adam.step(cache, &grads, lr);
                     loss
                 }
-                #[cfg(feature = "kernels")]
+                #[cfg(feature = "gpu")]
                 CacheOn::Gpu(gpu) => gpu.step(q, t, lr),
             };
         }

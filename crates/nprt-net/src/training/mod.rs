@@ -9,7 +9,7 @@ pub mod calibration;
 pub mod checkpoint;
 pub mod epoch_plan;
 pub mod host_steps;
-#[cfg(feature = "kernels")]
+#[cfg(feature = "gpu")]
 pub mod kernel_steps;
 pub mod loss_curves;
 pub mod lr_schedule;

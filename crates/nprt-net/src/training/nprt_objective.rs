@@ -124,7 +124,7 @@ impl Objective for PixelObjective<'_> {
     }
 
     fn engine_steps(&self, net: &NprtNet) -> Result<Steps<'_, Self>> {
-        #[cfg(feature = "kernels")]
+        #[cfg(feature = "gpu")]
         if self.kernels {
             let dataset = self.resident().then_some(self.set);
             let steps = crate::training::kernel_steps::KernelSteps::new(
@@ -225,7 +225,7 @@ pub fn train(
     opts.check()?;
     // On the GPU the steps run on our own kernels, with the network's host copy (for saving)
     // on the CPU.
-    let kernels = cfg!(feature = "kernels") && engine.is_gpu();
+    let kernels = cfg!(feature = "gpu") && engine.is_gpu();
     if opts.precision != Precision::F32 && !kernels {
         bail!(
             "--precision {} trains on nprt's own GPU kernels only: use --device gpu (a build \

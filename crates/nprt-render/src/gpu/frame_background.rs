@@ -8,7 +8,7 @@ use std::sync::LazyLock;
 use nprt_gpu::{GpuDevice, KernelSource};
 use nprt_scene::{Camera, EnvMap};
 use nprt_trace::gpu::wgsl::{CAMERA_RAY, LERP, MAP_LOOKUP};
-use nprt_trace::gpu::{camera_words, matrix_words, GpuMap, RasterGBuffer};
+use nprt_trace::gpu::{camera_words, matrix_words, GpuMap};
 
 pub static FRAME_BACKGROUND: LazyLock<KernelSource> = LazyLock::new(|| {
     KernelSource::joined(
@@ -32,19 +32,12 @@ pub struct Background<'a> {
 
 /// What a frame adds to the networks' radiance.
 pub enum Fill<'a> {
-    /// Nothing: the empty pixels zero.
-    Zero,
     /// The map (as placed in the world) seen through the empty pixels.
     Map(&'a EnvMap),
-    /// For a model that leaves direct light to the tracer, that light under the map, traced on
-    /// the device: `spp` paths of two vertices through each pixel centre (which brings the
-    /// map to the empty pixels).
-    TracedDirect {
-        map: &'a EnvMap,
-        scene: &'a RasterGBuffer,
-        spp: u32,
-        seed: u64,
-    },
+    /// For a model that leaves direct light to the tracer: the empty pixels zero, as that
+    /// light, traced on the device under the map through each pixel centre, brings the map
+    /// there (`DeviceStages`).
+    TracedDirect(&'a EnvMap),
 }
 
 /// Records `background` into `rgb` (3 f32 per pixel, the networks' radiance on the G-buffer's
@@ -58,18 +51,12 @@ pub fn record_background(
 ) {
     let camera = background.camera;
     let (map, fill) = match background.fill {
-        Fill::Zero => (None, 0),
-        Fill::Map(map) => (Some(map), 1),
-        Fill::TracedDirect { map, .. } => (Some(map), 0),
+        Fill::Map(map) => (map, 1),
+        Fill::TracedDirect(map) => (map, 0),
     };
-    let (texels, size, to_local) = match map {
-        Some(map) => (
-            maps.texels(gpu, map),
-            [map.width() as u32, map.height() as u32],
-            map.to_world().inverse(),
-        ),
-        None => (gpu.empty.clone(), [1, 2], glam::Mat3::IDENTITY),
-    };
+    let texels = maps.texels(gpu, map);
+    let size = [map.width() as u32, map.height() as u32];
+    let to_local = map.to_world().inverse();
     let mut params = vec![camera.width, camera.height, size[0], size[1], fill, 0, 0, 0];
     params.extend(camera_words(camera));
     params.extend(matrix_words(to_local));

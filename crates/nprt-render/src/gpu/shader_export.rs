@@ -20,6 +20,7 @@ use nprt_trace::{render_gbuffer, TraceScene};
 use serde_json::{json, Value};
 
 use nprt_gpu::KernelSource;
+use nprt_net::gpu::kernels::{ENCODER_BLOCK_THREADS, GEMM_TILE};
 use nprt_net::gpu::{half_weight_bits, pad16};
 
 use super::kernels::{sources, HALF_SOURCES};
@@ -105,6 +106,7 @@ impl WeightFile {
             .map(|(i, c)| {
                 json!({
                     "in_channels": c.c_in,
+                    "out_channels": c.bias.len(),
                     "weight": self.add(&format!("encoder.conv{i}.weight"), &[c.bias.len(), c.c_in, 3, 3], &c.weight),
                     "bias": self.add(&format!("encoder.conv{i}.bias"), &[c.bias.len()], &c.bias),
                 })
@@ -186,7 +188,19 @@ pub fn export_model(model_dir: &Path, out: &Path, view: &ExampleView) -> Result<
             "map_norm": config.map_norm.to_string(),
             "scene": file.scene,
         },
-        "encoder": { "input_width": config.encoder_width, "blocks": convs, "to_code": to_code },
+        "encoder": {
+            "input_width": config.encoder_width,
+            "blocks": convs,
+            "to_code": to_code,
+            // `encoder_block` runs this many threads per output value.
+            "block_threads_per_output": ENCODER_BLOCK_THREADS,
+        },
+        // Each pixel's network inputs (the G-buffer's 19 values, nprt-net's `FEATURES`) and
+        // the light code's size.
+        "inputs_per_pixel": FEATURES,
+        "code_size": CODE_SIZE,
+        // `gemm` computes a tile of this many rows and columns of its product per workgroup.
+        "gemm_tile": GEMM_TILE,
         "tracks": tracks,
         "kernels": kernels,
         "weights": { "file": "weights.bin", "dtype": "f32le", "tensors": weights.tensors },
@@ -320,11 +334,15 @@ fn export_kernel(
     };
     let [glsl, hlsl] = translate(k.wgsl, caps)?;
     write(&format!("{}.wgsl", k.name), k.wgsl.as_bytes())?;
+    let (params, param_words, workgroup_size) = interface(k.wgsl)?;
     let mut entry = json!({
         "name": k.name,
         "precision": if half { "f16" } else { "f32" },
         "wgsl": format!("{}.wgsl", k.name),
         "entry_point": "main",
+        "params": params,
+        "param_words": param_words,
+        "workgroup_size": workgroup_size,
     });
     for (language, file, text) in [
         ("glsl", format!("{}.comp.glsl", k.name), glsl),
@@ -344,6 +362,26 @@ fn export_kernel(
         }
     }
     Ok(entry)
+}
+
+/// What a caller of the kernel `wgsl` must know, read from its source: the fields of its
+/// uniform parameters (binding 0: each a u32 word, by name and word index), their size in
+/// words, and the entry point's workgroup size.
+fn interface(wgsl: &str) -> Result<(Vec<Value>, u32, [u32; 3])> {
+    let module = naga::front::wgsl::parse_str(wgsl)
+        .map_err(|e| anyhow::anyhow!("{}", e.emit_to_string(wgsl)))?;
+    let uniform = (module.global_variables.iter())
+        .find(|(_, g)| g.binding.as_ref().is_some_and(|b| b.group == 0 && b.binding == 0))
+        .map(|(_, g)| &module.types[g.ty].inner)
+        .context("no parameters at binding 0")?;
+    let naga::TypeInner::Struct { members, span } = uniform else {
+        bail!("its parameters at binding 0 are not a struct");
+    };
+    let params = (members.iter())
+        .filter_map(|m| m.name.as_ref().map(|name| json!({ "name": name, "word": m.offset / 4 })))
+        .collect();
+    let entry = module.entry_points.first().context("no entry point")?;
+    Ok((params, span / 4, entry.workgroup_size))
 }
 
 /// `wgsl` validated with `caps`, then its GLSL (4.30 compute, bindings as in WGSL) and HLSL

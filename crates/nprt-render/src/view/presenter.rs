@@ -12,7 +12,7 @@ use nprt_gpu::GpuDevice;
 use wgpu::util::DeviceExt;
 use winit::window::Window;
 
-use crate::relight::FrameRadiance;
+use crate::frame_stages::FrameRadiance;
 
 /// Rows of the frame's top the overlay's text may cover.
 pub const OVERLAY_ROWS: u32 = 256;

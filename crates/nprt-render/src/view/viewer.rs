@@ -22,7 +22,8 @@ use super::orbit_camera::OrbitCamera;
 use super::overlay::draw_lines;
 use super::presenter::{Presenter, Shown, OVERLAY_ROWS};
 use crate::frame_timings::FrameTimings;
-use crate::relight::{DirectSampling, FrameCache, FrameRadiance, Relighter};
+use crate::frame_stages::FrameRadiance;
+use crate::relight::{DirectSampling, FrameCache, Relighter};
 use crate::CameraPath;
 use crate::Precision;
 

@@ -60,6 +60,10 @@ named_choice!(Design, "design", {
 });
 
 impl Design {
+    /// The paper's four designs, in its Tables 1 and 5's order: what its tables compare (a
+    /// design beyond the paper is in [`Design::ALL`], not here).
+    pub const PAPER: [Design; 4] = [Design::Baseline, Design::Prt, Design::Albedo, Design::Dsep];
+
     pub fn spec(self) -> &'static DesignSpec {
         match self {
             Design::Baseline => &baseline::SPEC,
@@ -95,5 +99,14 @@ mod tests {
         for d in Design::ALL {
             assert_eq!(d.spec().name, d.name());
         }
+    }
+
+    #[test]
+    fn the_papers_designs_are_those_with_the_papers_counts() {
+        let paper: Vec<Design> = Design::ALL
+            .into_iter()
+            .filter(|d| d.paper_params() > 0)
+            .collect();
+        assert_eq!(paper, Design::PAPER);
     }
 }

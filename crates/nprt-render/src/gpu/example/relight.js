@@ -1,6 +1,7 @@
 // A worked example of running an nprt export: every step nprt's own GPU frame path takes
-// (nprt-render/src/gpu/gpu_network.rs), in WebGPU. One block of rows: the example's G-buffer is
-// small; a renderer cuts larger frames into blocks of at most 65,536 rows.
+// (nprt-net/src/gpu/frame/gpu_network.rs), in WebGPU. One block of rows: the example's G-buffer
+// is small; a renderer cuts larger frames into blocks of at most 65,536 rows. Every size of the
+// network and every kernel's parameters and workgroup size are read from export.json.
 
 const status = document.getElementById('status');
 const report = new URLSearchParams(location.search).has('report');
@@ -51,33 +52,42 @@ async function main() {
   };
   const mlp = (m) => ({ layers: m.layers.map(dense), activation: m.hidden_activation === 'siren' ? 2 : 1 });
 
-  // Kernels: each reads a uniform block of u32 parameters at binding 0 and storage buffers after it.
-  const pipelines = {};
+  // Kernels: each reads a uniform block of u32 parameters at binding 0 (named in export.json,
+  // unnamed ones zero) and storage buffers after it.
+  const kernels = {};
   for (const k of exp.kernels) {
     const code = new TextDecoder().decode(await bytes('../' + k.wgsl));
     const module = device.createShaderModule({ code });
-    pipelines[k.name] = device.createComputePipeline({ layout: 'auto', compute: { module, entryPoint: k.entry_point } });
+    const pipeline = device.createComputePipeline({ layout: 'auto', compute: { module, entryPoint: k.entry_point } });
+    kernels[k.name] = { pipeline, k, word: new Map(k.params.map((p) => [p.name, p.word])) };
   }
   const dispatch = (pass, name, params, buffers, x, y = 1) => {
-    const words = new Uint32Array(Math.ceil(params.length / 4) * 4);
-    words.set(params);
+    const { pipeline, k, word } = kernels[name];
+    const words = new Uint32Array(Math.ceil(k.param_words / 4) * 4);
+    for (const [field, value] of Object.entries(params)) {
+      if (!word.has(field)) throw new Error(`kernel ${name} has no parameter ${field}`);
+      words[word.get(field)] = value;
+    }
     const uniform = device.createBuffer({ size: words.byteLength, usage: GPUBufferUsage.UNIFORM | GPUBufferUsage.COPY_DST });
     device.queue.writeBuffer(uniform, 0, words);
     const entries = [{ binding: 0, resource: { buffer: uniform } }]
       .concat(buffers.map((buffer, i) => ({ binding: i + 1, resource: { buffer } })));
-    const pipeline = pipelines[name];
     pass.setPipeline(pipeline);
     pass.setBindGroup(0, device.createBindGroup({ layout: pipeline.getBindGroupLayout(0), entries }));
     pass.dispatchWorkgroups(x, y);
   };
-  const groups = (n) => Math.ceil(n / 64);
-  // y = act(x·W[wRow..] + bias) over `rows` rows of `dIn` inputs: gemm.wgsl (128 × 128 tiles) with
-  // m = rows, n = d_out, k = dIn, A = x (row stride dIn), B = W from row wRow, a bias per column.
+  // Workgroups for `n` threads of a one-dimensional kernel.
+  const groups = (name, n) => Math.ceil(n / kernels[name].k.workgroup_size[0]);
+  // y = act(x·W[wRow..] + bias) over `rows` rows of `dIn` inputs: gemm.wgsl (tiles of
+  // gemm_tile × gemm_tile) with m = rows, n = d_out, k = dIn, A = x (row stride dIn), B = W from
+  // row wRow, a bias per column.
   const spare = room(4);
+  const tile = exp.gemm_tile;
   const denseLayer = (pass, layer, x, rows, dIn, wRow, bias, activation, y) =>
-    dispatch(pass, 'gemm',
-      [rows, layer.dOut, dIn, 0, dIn, 1, wRow * layer.dOut, layer.dOut, 1, layer.dOut, 1, activation, 0, 0, 0, 0, 0, 0, 0, 0],
-      [x, layer.weight, bias, empty, y, spare], Math.ceil(layer.dOut / 128), Math.ceil(rows / 128));
+    dispatch(pass, 'gemm', {
+      m: rows, n: layer.dOut, k: dIn, a_rs: dIn, a_cs: 1, b_off: wRow * layer.dOut,
+      b_rs: layer.dOut, b_cs: 1, c_rs: layer.dOut, bias: 1, activation,
+    }, [x, layer.weight, bias, empty, y, spare], Math.ceil(layer.dOut / tile), Math.ceil(rows / tile));
   // An MLP: hidden layers take its activation, the last is linear; ping-pongs through `scratch`.
   const runMlp = (pass, m, x, rows, first, scratch, out) => {
     const last = m.layers.length - 1;
@@ -91,7 +101,10 @@ async function main() {
   };
 
   // The networks.
-  const blocks = exp.encoder.blocks.map((b) => ({ cIn: b.in_channels, weight: tensor(b.weight).buffer, bias: tensor(b.bias).buffer }));
+  const blocks = exp.encoder.blocks.map((b) => ({
+    cIn: b.in_channels, cOut: b.out_channels, weight: tensor(b.weight).buffer, bias: tensor(b.bias).buffer,
+  }));
+  const [codeSize, perRow] = [exp.code_size, exp.inputs_per_pixel];
   const toCode = dense(exp.encoder.to_code);
   const resolutions = upload(new Uint32Array(exp.tracks.find((t) => t.grid)?.grid.resolutions ?? [0, 0, 0, 0]));
   const tracks = exp.tracks.map((t) => ({
@@ -106,32 +119,35 @@ async function main() {
   }));
   const empty = room(4);
 
-  // The G-buffer's foreground pixels as rows of 19 inputs.
+  // The G-buffer's foreground pixels as rows of the networks' inputs.
   const per = ex.gbuffer.floats_per_pixel;
   const pixels = ex.width * ex.height;
   const foreground = [];
   for (let i = 0; i < pixels; i++) if (gbuffer[i * per + per - 1] > 0.5) foreground.push(i);
   const rows = foreground.length;
-  const rowInputs = new Float32Array(rows * 19);
-  foreground.forEach((p, r) => rowInputs.set(gbuffer.subarray(p * per, p * per + 19), r * 19));
+  const rowInputs = new Float32Array(rows * perRow);
+  foreground.forEach((p, r) => rowInputs.set(gbuffer.subarray(p * per, p * per + perRow), r * perRow));
   const features = upload(rowInputs);
   const widest = Math.max(...tracks.flatMap((t) => [t.width, ...(t.transfer?.layers ?? []).concat(t.shading.layers).map((l) => l.dOut)]));
   const scratch = [room(rows * widest), room(rows * widest)];
   const outputs = tracks.map((t) => room(rows * t.shading.layers.at(-1).dOut));
   const rgb = room(rows * 3);
 
-  // 1. The light code: 5 convolution blocks, then a dense layer (once per lighting change).
-  // After its 64 values, the factors combine.wgsl multiplies each channel by: the map's
-  // divisor times the model's gain (here already one product), then 1.
-  const code = room(64 + 6);
-  device.queue.writeBuffer(code, 64 * 4, new Float32Array([...ex.light.scale, 1, 1, 1]));
+  // 1. The light code: the convolution blocks, then a dense layer (once per lighting change).
+  // After its values, the factors combine.wgsl multiplies each channel by: the map's divisor
+  // times the model's gain (here already one product), then 1.
+  const code = room(codeSize + 6);
+  device.queue.writeBuffer(code, codeSize * 4, new Float32Array([...ex.light.scale, 1, 1, 1]));
   let encoder = device.createCommandEncoder();
   let pass = encoder.beginComputePass();
   let [h, w] = [ex.light.shape[1], ex.light.shape[2]];
   let x = upload(light);
   for (const b of blocks) {
-    const out = room(32 * (h / 2) * (w / 2));
-    dispatch(pass, 'encoder_block', [b.cIn, h, w, 1, 0, 0, 0, 0], [x, b.weight, b.bias, out, empty], groups(4 * 32 * (h / 2) * (w / 2)));
+    const outputs = b.cOut * (h / 2) * (w / 2);
+    const out = room(outputs);
+    const threads = exp.encoder.block_threads_per_output * outputs;
+    dispatch(pass, 'encoder_block', { c_in: b.cIn, h, w, views: 1 }, [x, b.weight, b.bias, out, empty],
+      groups('encoder_block', threads));
     [x, h, w] = [out, h / 2, w / 2];
   }
   denseLayer(pass, toCode, x, 1, toCode.dIn, 0, toCode.bias, 0, code);
@@ -140,10 +156,10 @@ async function main() {
   // it has one, its transfer network's output ŝ.
   const kept = tracks.map((t) => {
     const inputs = t.transfer ? scratch[0] : room(rows * t.width);
-    dispatch(pass, 'track_inputs', [rows, t.count, t.width, t.grid ? 1 : 0],
-      [features, t.index, t.grid ?? empty, resolutions, inputs], groups(rows));
+    dispatch(pass, 'track_inputs', { rows, count: t.count, width: t.width, grid: t.grid ? 1 : 0 },
+      [features, t.index, t.grid ?? empty, resolutions, inputs], groups('track_inputs', rows));
     if (!t.transfer) return inputs;
-    const s = room(rows * 64);
+    const s = room(rows * t.transfer.layers.at(-1).dOut);
     runMlp(pass, t.transfer, inputs, rows, { dIn: t.width, wRow: 0 }, scratch, s);
     return s;
   });
@@ -159,16 +175,16 @@ async function main() {
       const first = t.shading.layers[0];
       const bias = room(first.dOut);
       // b' = b + ê·W[code rows]: the first layer's code rows over one row.
-      denseLayer(pass, first, code, 1, 64, t.codeRows[0], first.bias, 0, bias);
+      denseLayer(pass, first, code, 1, codeSize, t.codeRows[0], first.bias, 0, bias);
       // The rows that multiply the pixel's own inputs: before ê's (ŝ first), or after them.
       const codeFirst = t.codeRows[0] === 0;
-      const dIn = first.dIn - 64;
-      runMlp(pass, t.shading, kept[i], rows, { dIn, wRow: codeFirst ? 64 : 0, bias }, scratch, outputs[i]);
+      const dIn = first.dIn - codeSize;
+      runMlp(pass, t.shading, kept[i], rows, { dIn, wRow: codeFirst ? codeSize : 0, bias }, scratch, outputs[i]);
     });
     // The tracks' radiance summed into rgb one track per dispatch, the last scaled.
     tracks.forEach((t, i) => {
-      const params = new Uint32Array([rows, t.kind, i > 0 ? 1 : 0, i === tracks.length - 1 ? 1 : 0, 0, 64, 0, 0]);
-      dispatch(pass, 'combine', params, [features, outputs[i], code, rgb], groups(rows));
+      const params = { rows, kind: t.kind, accumulate: i > 0 ? 1 : 0, scaled: i === tracks.length - 1 ? 1 : 0, scale_at: codeSize };
+      dispatch(pass, 'combine', params, [features, outputs[i], code, rgb], groups('combine', rows));
     });
     pass.end();
     const readback = device.createBuffer({ size: rows * 12, usage: GPUBufferUsage.MAP_READ | GPUBufferUsage.COPY_DST });

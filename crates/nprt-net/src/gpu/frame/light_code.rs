@@ -2,7 +2,7 @@
 //! read it, so that a lighting change on the GPU sends nothing back to the host.
 
 use nprt_gpu::GpuDevice;
-use nprt_net::network::encoder::CODE_SIZE;
+use crate::network::encoder::CODE_SIZE;
 
 /// The light code ê (`CODE_SIZE` values) and the map's divisor per channel (3 values after
 /// it) on the device.

@@ -5,26 +5,30 @@
 //! combination, dispatches prepared at the camera's first lighting and recorded again at each
 //! later one: a lighting change waits for the queue once, to read the frame back.
 
+use std::any::Any;
 use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::{Arc, Mutex, OnceLock};
 
 use anyhow::Result;
 use nprt_gpu::{groups_for, BufferPool, Dispatch, GpuDevice, KeptLast, KernelTime, PooledBuffer};
-use nprt_net::encoding::hash_grid;
-use nprt_net::gpu::kernels::{COMBINE, GBUFFER_FEATURES};
-use nprt_net::gpu::{
+use nprt_scene::EnvMap;
+use nprt_trace::gpu::{GpuMap, SameTexels};
+
+use super::encoder_run::GpuEncoder;
+use super::light_code::{GpuLightCode, LIGHT_CODE_VALUES};
+use super::light_input::GpuLightInput;
+use crate::encoding::features::{position_frame, FEATURES};
+use crate::encoding::hash_grid;
+use crate::encoding::map_norm::MapNorm;
+use crate::gpu::kernels::{COMBINE, GBUFFER_FEATURES};
+use crate::gpu::{
     held_halves, Bias, FirstLayer, ForwardTargets, HalfLayers, Held, MlpAt, NetworkLayout,
     ParameterLayout, HALF_ROW_BLOCK,
 };
-use nprt_net::network::encoder::CODE_SIZE;
-use nprt_net::{MapNorm, NprtNet, FEATURES};
-use nprt_scene::EnvMap;
-use nprt_trace::gpu::{record_paths, GpuMap, GpuPaths, PathTargets, SameTexels};
-
-use super::frame_background::{record_background, Background, Fill};
-use super::gpu_encoder::GpuEncoder;
-use super::light_code::{GpuLightCode, LIGHT_CODE_VALUES};
-use super::light_input::GpuLightInput;
+use crate::network::encoder::CODE_SIZE;
+use crate::network::nprt_net::NprtNet;
+use crate::precision::Precision;
+use crate::shading::{foreign, LightCode, PixelRows, Shading};
 
 /// Most rows per block of dispatches. Fewer blocks mean fewer dispatches to prepare and record
 /// (at 65,536 rows a 1920 × 1080 D/S frame was 32 blocks of a dozen dispatches each). A
@@ -62,6 +66,11 @@ pub struct GpuNetwork {
     /// Tells the pixels this network made from another's (their kept dispatches read its
     /// buffers).
     id: u64,
+    /// The encoder's input a map is made into: its width and normalisation.
+    encoder_width: usize,
+    map_norm: MapNorm,
+    /// The model's gain per channel (also in `light`, after the code).
+    gain: [f32; 3],
 }
 
 /// The buffers a camera's pixels run their networks through, which the network keeps for the
@@ -146,8 +155,14 @@ struct PixelChunk {
 
 impl GpuNetwork {
     /// Uploads `net`'s weights to the process's GPU device; its radiance is multiplied by
-    /// `gain` per channel (the model's level gain).
-    pub fn new(net: &NprtNet, gain: [f32; 3]) -> Result<Self> {
+    /// `gain` per channel (the model's level gain), and its light codes made from maps into
+    /// `encoder_width`-wide inputs normalised by `map_norm`.
+    pub fn new(
+        net: &NprtNet,
+        gain: [f32; 3],
+        encoder_width: usize,
+        map_norm: MapNorm,
+    ) -> Result<Self> {
         static NETWORKS: AtomicU64 = AtomicU64::new(0);
         let gpu = GpuDevice::get()?;
         let (layout, flat) = ParameterLayout::pack_for(&gpu, net);
@@ -163,6 +178,9 @@ impl GpuNetwork {
             inputs: KeptLast::default(),
             encoding: Mutex::new(()),
             id: NETWORKS.fetch_add(1, Ordering::Relaxed),
+            encoder_width,
+            map_norm,
+            gain,
             encoder: GpuEncoder::default(),
             params,
             net: layout,
@@ -204,7 +222,7 @@ impl GpuNetwork {
     }
 
     /// Where the dense layers run, for reports: "f32", "f16 on tensor cores" or "f16".
-    pub fn precision(&self) -> &'static str {
+    pub fn precision_name(&self) -> &'static str {
         match (self.half(), self.gpu.tensor_cores) {
             (false, _) => "f32",
             (true, true) => "f16 on tensor cores",
@@ -212,9 +230,10 @@ impl GpuNetwork {
         }
     }
 
-    /// The device's adapter, for reports.
-    pub fn adapter(&self) -> &str {
-        &self.gpu.adapter
+    /// The map texels this network's encoder inputs were last made from, which a renderer's
+    /// background and traced light share.
+    pub fn maps(&self) -> &GpuMap {
+        &self.map
     }
 
     /// `map` under `rotation_deg` made into this model's encoder input on the device (see
@@ -287,7 +306,7 @@ impl GpuNetwork {
         pixels: usize,
         bounds: &[[f32; 3]; 2],
     ) -> GpuPixels {
-        let (lo, extent) = nprt_net::position_frame(bounds);
+        let (lo, extent) = position_frame(bounds);
         self.pixels_with(pixels, |pass, first, n| {
             let features = self.pool.take_pooled(&self.gpu, n * FEATURES);
             let mut params = vec![n as u32, first as u32, 0, 0];
@@ -500,44 +519,24 @@ impl GpuNetwork {
     }
 
     /// Radiance (`rows × 3`) of `px` under the light `code`, each channel multiplied by the
-    /// code's divisor (the map's normalisation) and the model's gain; with `background`
-    /// (pixels of a G-buffer on the device, [`Self::pixels_of_gbuffer`]), the frame's
-    /// background filled in, or traced direct light added. With the milliseconds the traced
-    /// light took (0 without): it is submitted once the networks are done, so that the two can
-    /// be told apart.
-    pub fn radiance(
-        &self,
-        px: &GpuPixels,
-        code: &GpuLightCode,
-        background: Option<&Background>,
-    ) -> (Vec<f32>, f64) {
+    /// code's divisor (the map's normalisation) and the model's gain.
+    pub fn radiance(&self, px: &GpuPixels, code: &GpuLightCode) -> Vec<f32> {
         if px.rows == 0 {
-            return (Vec::new(), 0.0);
+            return Vec::new();
         }
-        let direct_ms = self.queue_radiance(px, code, background);
-        (self.gpu.read(&px.rgb, px.rows * 3), direct_ms)
+        self.queue_radiance(px, code, &mut |_, _| {});
+        self.gpu.read(&px.rgb, px.rows * 3)
     }
 
-    /// [`Self::radiance`] left on the device, in [`GpuPixels::rgb`], and waited for (so that
-    /// a frame's timings hold its GPU work), not read back: what `nprt view` shows.
-    pub fn radiance_on_device(
+    /// Queues [`Self::radiance`]'s work into [`GpuPixels::rgb`], nothing waited for or read
+    /// back, with `after` recorded into the same compute pass once the networks are done (a
+    /// renderer's background, given the pass and the radiance buffer).
+    pub fn queue_radiance(
         &self,
         px: &GpuPixels,
         code: &GpuLightCode,
-        background: Option<&Background>,
-    ) -> f64 {
-        let direct_ms = self.queue_radiance(px, code, background);
-        self.gpu.wait();
-        direct_ms
-    }
-
-    /// Queues [`Self::radiance`]'s work; the milliseconds of the traced light.
-    fn queue_radiance(
-        &self,
-        px: &GpuPixels,
-        code: &GpuLightCode,
-        background: Option<&Background>,
-    ) -> f64 {
+        after: &mut dyn FnMut(&mut wgpu::ComputePass, &wgpu::Buffer),
+    ) {
         let gpu = &*self.gpu;
         let dispatches = self.relight_dispatches(px);
         let mut encoder = gpu.device.create_command_encoder(&Default::default());
@@ -547,47 +546,62 @@ impl GpuNetwork {
             for d in dispatches {
                 d.record(&mut pass);
             }
-            if let Some(b) = background {
-                record_background(&self.map, gpu, &mut pass, b, &px.rgb);
-            }
+            after(&mut pass, &px.rgb);
         }
         gpu.queue.submit([encoder.finish()]);
-        let mut direct_ms = 0.0;
-        if let Some(Background {
-            camera,
-            fill:
-                Fill::TracedDirect {
-                    map,
-                    scene,
-                    spp,
-                    seed,
-                },
-            ..
-        }) = background
-        {
-            gpu.wait();
-            let clock = std::time::Instant::now();
-            let mut encoder = gpu.device.create_command_encoder(&Default::default());
-            let out = PathTargets {
-                rgb: &px.rgb,
-                direct: None,
-                add: true,
-            };
-            record_paths(
-                gpu,
-                &mut encoder.begin_compute_pass(&Default::default()),
-                scene.scene(),
-                &self.map,
-                camera,
-                map,
-                &GpuPaths::direct(*spp, *seed),
-                &out,
-            );
-            gpu.queue.submit([encoder.finish()]);
-            gpu.wait();
-            direct_ms = clock.elapsed().as_secs_f64() * 1e3;
+    }
+}
+
+impl Shading for GpuNetwork {
+    fn light_code(&self, map: &EnvMap, rotation_deg: f32) -> LightCode {
+        LightCode::new(self.encode_map(map, rotation_deg, self.encoder_width, self.map_norm))
+    }
+
+    fn pixels(&self, features: &[f32]) -> PixelRows {
+        PixelRows::new(GpuNetwork::pixels(self, features))
+    }
+
+    fn radiance(&self, px: &PixelRows, light: &LightCode) -> Vec<f32> {
+        let px = px.get::<GpuPixels>().unwrap_or_else(|| foreign("pixels"));
+        let code = light.get::<GpuLightCode>().unwrap_or_else(|| foreign("a light code"));
+        GpuNetwork::radiance(self, px, code)
+    }
+
+    fn light_on_host(&self, light: &LightCode) -> (Vec<f32>, [f32; 3]) {
+        let code = light.get::<GpuLightCode>().unwrap_or_else(|| foreign("a light code"));
+        let (code, divisor) = code.read(&self.gpu);
+        (code, std::array::from_fn(|k| divisor[k] * self.gain[k]))
+    }
+
+    fn precision(&self) -> Precision {
+        match self.half() {
+            true => Precision::F16,
+            false => Precision::F32,
         }
-        direct_ms
+    }
+
+    fn set_precision(&mut self, precision: Precision) -> Result<()> {
+        self.set_half(precision == Precision::F16)
+    }
+
+    fn describe(&self) -> String {
+        match self.half() {
+            false => format!("GPU kernels on {}", self.gpu.adapter),
+            true => format!("GPU kernels on {} ({})", self.gpu.adapter, self.precision_name()),
+        }
+    }
+
+    fn settle(&self) -> Result<()> {
+        self.gpu.wait();
+        Ok(())
+    }
+
+    fn host_waits(&self) -> Option<u64> {
+        Some(self.gpu.host_waits())
+    }
+
+    fn as_any(&self) -> &dyn Any {
+        self
     }
 }
 

@@ -1,13 +1,13 @@
 //! The light encoder on the frame path's device: its dispatches over inputs of one width
-//! (nprt-net's `record_encoder`: convolution blocks, each halving the image, then the dense
+//! (`EncoderAt::record`: convolution blocks, each halving the image, then the dense
 //! layer into the code, on the network's flat weights) kept for the next lighting of that
 //! width.
 
 use std::sync::Arc;
 
 use nprt_gpu::{Dispatch, GpuDevice, KeptLast};
-use nprt_net::gpu::NetworkLayout;
-use nprt_net::network::encoder::CODE_SIZE;
+use crate::gpu::NetworkLayout;
+use crate::network::encoder::CODE_SIZE;
 
 use super::light_code::GpuLightCode;
 use super::light_input::GpuLightInput;

@@ -1,9 +1,9 @@
-//! The GPU frame path's kernels (crate::gpu) against the CPU engine they must agree with:
+//! The GPU frame path's kernels (`gpu::GpuNetwork`) against the CPU engine they must agree with:
 //! light codes and radiance of every design, both activations, with and without the hash
 //! grid, on a real G-buffer. Runs on whatever adapter wgpu finds; CI's is Mesa's software
 //! Vulkan (scripts/vulkan.sh). Without one the tests skip, unless NPRT_REQUIRE_VULKAN is set
 //! (scripts/test sets it once lavapipe is installed).
-#![cfg(feature = "wgpu")]
+#![cfg(feature = "gpu")]
 
 use glam::Vec3;
 use nprt_gpu::GpuDevice;
@@ -11,7 +11,7 @@ use nprt_net::{
     gbuffer_features, Activation, Design, Init, LightInput, MapNorm, ModelConfig, NprtNet,
     PositionEncoding,
 };
-use nprt_render::gpu::{GpuLightCode, GpuLightInput, GpuNetwork};
+use nprt_net::gpu::{GpuLightCode, GpuLightInput, GpuNetwork};
 use nprt_scene::{load_scene, Camera, SceneOptions};
 use nprt_trace::{render_gbuffer, TraceScene};
 
@@ -75,13 +75,13 @@ fn gpu_light_codes_and_radiance_match_the_cpu_engine_for_every_design() {
             for encoding in [PositionEncoding::None, PositionEncoding::HashGrid] {
                 seed += 1;
                 let net = model(design, activation, encoding, seed);
-                let gpu = GpuNetwork::new(&net, gain).unwrap();
+                let gpu = GpuNetwork::new(&net, gain, 64, MapNorm::Channel).unwrap();
                 let there = gpu.light_code(&GpuLightInput::upload(&device, &input));
                 let (code, _) = there.read(&device);
                 let want_code = net.encoder.forward(&input.pixels, 64).codes;
                 let code_error = relative_difference(&code, &want_code);
                 let light = GpuLightCode::upload(&device, &want_code, divisor);
-                let (rgb, _) = gpu.radiance(&gpu.pixels(&features), &light, None);
+                let rgb = gpu.radiance(&gpu.pixels(&features), &light);
                 let want = net.radiance(&features, &want_code, scale, None);
                 let error = relative_difference(&rgb, &want);
                 eprintln!(
@@ -126,12 +126,12 @@ fn three_tracks_shade_as_on_the_cpu_engine() {
     );
     net.tracks.push(third);
     let (divisor, gain) = ([0.5, 3.0, 1.0], [4.0, 1.0, 0.5]);
-    let gpu = GpuNetwork::new(&net, gain).unwrap();
+    let gpu = GpuNetwork::new(&net, gain, 64, MapNorm::Channel).unwrap();
     let map = nprt_scene::open_envmap("builtin:sky:25:40").unwrap();
     let input = LightInput::new(&map, 30.0, 64, MapNorm::Channel);
     let code = net.encoder.forward(&input.pixels, 64).codes;
     let light = GpuLightCode::upload(&device, &code, divisor);
-    let (rgb, _) = gpu.radiance(&gpu.pixels(&features), &light, None);
+    let rgb = gpu.radiance(&gpu.pixels(&features), &light);
     let want = net.radiance(&features, &code, [2.0, 3.0, 0.5], None);
     let error = relative_difference(&rgb, &want);
     eprintln!("three tracks: radiance {error:.2e}");
@@ -154,7 +154,7 @@ fn the_widest_encoder_input_gets_the_cpu_engines_light_code() {
     let input = LightInput::new(&map, 0.0, width, MapNorm::Channel);
     let device = GpuDevice::get().unwrap();
     let input_there = GpuLightInput::upload(&device, &input);
-    let gpu = GpuNetwork::new(&net, [1.0; 3]).unwrap();
+    let gpu = GpuNetwork::new(&net, [1.0; 3], 64, MapNorm::Channel).unwrap();
     let (code, _) = gpu.light_code(&input_there).read(&device);
     let want = net.encoder.forward(&input.pixels, width).codes;
     let error = relative_difference(&code, &want);
@@ -174,7 +174,7 @@ fn the_encoder_input_made_on_the_device_is_the_hosts() {
     }
     let device = GpuDevice::get().unwrap();
     let net = model(Design::Dsep, Activation::Siren, PositionEncoding::None, 3);
-    let gpu = GpuNetwork::new(&net, [1.0; 3]).unwrap();
+    let gpu = GpuNetwork::new(&net, [1.0; 3], 64, MapNorm::Channel).unwrap();
     let encoder = &net.encoder;
     let maps = [
         ("builtin:sky:25:40", false, 64, 30.0, MapNorm::Channel),
@@ -231,16 +231,16 @@ fn half_precision_radiance_follows_the_cpu_engines_for_every_design() {
             for encoding in [PositionEncoding::None, PositionEncoding::HashGrid] {
                 seed += 1;
                 let net = model(design, activation, encoding, seed);
-                let mut gpu = GpuNetwork::new(&net, [1.0; 3]).unwrap();
+                let mut gpu = GpuNetwork::new(&net, [1.0; 3], 64, MapNorm::Channel).unwrap();
                 gpu.set_half(true).unwrap();
                 let code = net.encoder.forward(&input.pixels, 64).codes;
                 let light = GpuLightCode::upload(&device, &code, scale);
-                let (rgb, _) = gpu.radiance(&gpu.pixels(&features), &light, None);
+                let rgb = gpu.radiance(&gpu.pixels(&features), &light);
                 let want = net.radiance(&features, &code, scale, None);
                 let error = mean_relative_difference(&rgb, &want);
                 eprintln!(
                     "{design} {activation} {encoding} ({}): mean error {error:.2e}",
-                    gpu.precision()
+                    gpu.precision_name()
                 );
                 worst = worst.max(error);
             }
@@ -311,13 +311,13 @@ fn a_new_viewpoint_reusing_the_last_ones_buffers_gets_its_own_radiance() {
     let code = vec![0.25f32; nprt_net::network::encoder::CODE_SIZE];
     let light = GpuLightCode::upload(&GpuDevice::get().unwrap(), &code, [1.0, 2.0, 0.5]);
     for half in [false, true] {
-        let mut reused = GpuNetwork::new(&net, [1.0; 3]).unwrap();
-        let mut fresh = GpuNetwork::new(&net, [1.0; 3]).unwrap();
+        let mut reused = GpuNetwork::new(&net, [1.0; 3], 64, MapNorm::Channel).unwrap();
+        let mut fresh = GpuNetwork::new(&net, [1.0; 3], 64, MapNorm::Channel).unwrap();
         reused.set_half(half).unwrap();
         fresh.set_half(half).unwrap();
         drop(reused.pixels(&first));
-        let (got, _) = reused.radiance(&reused.pixels(&second), &light, None);
-        let (want, _) = fresh.radiance(&fresh.pixels(&second), &light, None);
+        let got = reused.radiance(&reused.pixels(&second), &light);
+        let want = fresh.radiance(&fresh.pixels(&second), &light);
         assert_eq!(got, want, "half precision: {half}");
     }
 }

@@ -1,0 +1,99 @@
+//! A trained network's frames on the CPU engine ([`Shading`]): the encoder on the host's
+//! encoder input, each track's ŝ kept per camera, and the shading networks per lighting.
+
+use std::any::Any;
+
+use anyhow::{bail, Result};
+use nprt_scene::EnvMap;
+
+use super::transport::TransferCodes;
+use crate::encoding::map_norm::MapNorm;
+use crate::network::encoder::LightInput;
+use crate::network::nprt_net::NprtNet;
+use crate::precision::Precision;
+use crate::shading::{foreign, LightCode, PixelRows, Shading};
+
+/// A model's networks on the CPU engine.
+pub struct CpuShading {
+    net: NprtNet,
+    /// What each radiance channel is multiplied by besides the map's divisor.
+    gain: [f32; 3],
+    /// The encoder's input: its width and normalisation.
+    encoder_width: usize,
+    map_norm: MapNorm,
+}
+
+/// A lighting on the host: the code ê and what the map's channels were divided by.
+struct HostCode {
+    code: Vec<f32>,
+    divisor: [f32; 3],
+}
+
+/// A camera's pixels on the host: their inputs and each track's ŝ.
+struct HostRows {
+    features: Vec<f32>,
+    transfer: TransferCodes,
+}
+
+impl CpuShading {
+    pub fn new(net: NprtNet, gain: [f32; 3], encoder_width: usize, map_norm: MapNorm) -> Self {
+        CpuShading {
+            net,
+            gain,
+            encoder_width,
+            map_norm,
+        }
+    }
+}
+
+impl Shading for CpuShading {
+    fn light_code(&self, map: &EnvMap, rotation_deg: f32) -> LightCode {
+        let input = LightInput::new(map, rotation_deg, self.encoder_width, self.map_norm);
+        LightCode::new(HostCode {
+            code: self.net.encoder.forward(&input.pixels, input.width).codes,
+            divisor: input.scale,
+        })
+    }
+
+    fn pixels(&self, features: &[f32]) -> PixelRows {
+        PixelRows::new(HostRows {
+            transfer: self.net.transfer_codes(features),
+            features: features.to_vec(),
+        })
+    }
+
+    fn radiance(&self, px: &PixelRows, light: &LightCode) -> Vec<f32> {
+        let rows = px.get::<HostRows>().unwrap_or_else(|| foreign("pixels"));
+        let (code, scale) = self.light_on_host(light);
+        (self.net).radiance(&rows.features, &code, scale, Some(&rows.transfer))
+    }
+
+    fn light_on_host(&self, light: &LightCode) -> (Vec<f32>, [f32; 3]) {
+        let light = light.get::<HostCode>().unwrap_or_else(|| foreign("a light code"));
+        let scale = std::array::from_fn(|k| light.divisor[k] * self.gain[k]);
+        (light.code.clone(), scale)
+    }
+
+    fn precision(&self) -> Precision {
+        Precision::F32
+    }
+
+    fn set_precision(&mut self, precision: Precision) -> Result<()> {
+        if precision == Precision::F16 {
+            bail!("--precision f16 runs on the GPU kernels only (--device gpu or --device wgpu)");
+        }
+        Ok(())
+    }
+
+    fn describe(&self) -> String {
+        "CPU engine".into()
+    }
+
+    fn flops_per_pixel(&self, transfer_known: bool) -> Option<f64> {
+        Some(self.net.flops_per_pixel(transfer_known))
+    }
+
+    fn as_any(&self) -> &dyn Any {
+        self
+    }
+}
