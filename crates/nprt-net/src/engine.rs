@@ -9,10 +9,14 @@ use anyhow::{bail, Result};
 use nprt_trace::TraceDevice;
 
 use crate::choice::named_choice;
-use crate::cpu::CpuShading;
+use crate::cpu::{CpuShading, HostCacheSteps};
 use crate::model::folder::ModelFile;
 use crate::network::nprt_net::NprtNet;
-use crate::shading::Shading;
+use crate::network::parameters::Parameters;
+use crate::network::radiance_cache::{RadianceCache, ADAM_BETAS};
+use crate::network::unet::DeepShading;
+use crate::optimiser::{Adam, CacheSteps};
+use crate::shading::{Shading, UnetShading};
 
 /// `--device`: the CPU, a GPU (hardware adapters only), any wgpu adapter (software ones
 /// included), or a GPU when one is present.
@@ -124,6 +128,32 @@ impl Engine {
             Engine::Cpu => Ok(Box::new(CpuShading::new(net, gain, width, norm))),
             #[cfg(feature = "gpu")]
             Engine::Gpu => Ok(Box::new(crate::gpu::GpuNetwork::new(&net, gain, width, norm)?)),
+            #[cfg(not(feature = "gpu"))]
+            Engine::Gpu => bail!("--device gpu: {WITHOUT_KERNELS}"),
+        }
+    }
+
+    /// The trained Deep Shading U-Net `net` on this engine (one view at a time on the GPU).
+    pub fn unet(self, net: DeepShading) -> Result<Box<dyn UnetShading>> {
+        match self {
+            Engine::Cpu => Ok(Box::new(net)),
+            #[cfg(feature = "gpu")]
+            Engine::Gpu => Ok(Box::new(std::sync::Mutex::new(crate::gpu::GpuUnet::new(&net)?))),
+            #[cfg(not(feature = "gpu"))]
+            Engine::Gpu => bail!("--device gpu: {WITHOUT_KERNELS}"),
+        }
+    }
+
+    /// The radiance cache `cache` to train online on this engine, under the cache's Adam
+    /// betas.
+    pub fn cache_steps(self, cache: RadianceCache) -> Result<Box<dyn CacheSteps>> {
+        match self {
+            Engine::Cpu => Ok(Box::new(HostCacheSteps {
+                adam: Adam::with_betas(cache.num_params(), ADAM_BETAS),
+                cache,
+            })),
+            #[cfg(feature = "gpu")]
+            Engine::Gpu => Ok(Box::new(crate::gpu::GpuCache::new(&cache, ADAM_BETAS)?)),
             #[cfg(not(feature = "gpu"))]
             Engine::Gpu => bail!("--device gpu: {WITHOUT_KERNELS}"),
         }

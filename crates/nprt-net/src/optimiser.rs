@@ -1,5 +1,6 @@
 //! What trains a network's weights: an engine's steps ([`EngineSteps`]: the batch's loss,
-//! gradients and an Adam update together, wherever the parameters live), and Adam on the host
+//! gradients and an Adam update together, wherever the parameters live; [`CacheSteps`] for a
+//! radiance cache trained online), and Adam on the host
 //! ([`Adam`]), the update the CPU engine's steps take. The GPU kernels run the same update
 //! (shaders/adam.wgsl), and both keep Adam's state in one file format, so a checkpoint resumes
 //! on either engine.
@@ -8,9 +9,11 @@ use std::collections::HashMap;
 use std::path::Path;
 
 use anyhow::{anyhow, bail, Context, Result};
+use glam::Vec3;
 use safetensors::{tensor::TensorView, Dtype, SafeTensors};
 
 use crate::network::parameters::Parameters;
+use crate::network::radiance_cache::{CacheQuery, RadianceCache};
 
 /// Adam's ε, on every engine.
 pub const ADAM_EPSILON: f32 = 1e-8;
@@ -43,6 +46,16 @@ pub trait EngineSteps<N, B> {
     fn load(&mut self, path: &Path) -> Result<()>;
     /// Where the steps run, for reports ("cpu", "GPU kernels on …").
     fn describe(&self) -> String;
+}
+
+/// A radiance cache trained online on an engine: its weights and Adam's state there.
+pub trait CacheSteps: Send {
+    /// The weights as they stand.
+    fn cache(&self) -> RadianceCache;
+    /// The radiance the cache holds for each query.
+    fn read(&mut self, queries: &[CacheQuery]) -> Vec<Vec3>;
+    /// One Adam step on the pairs at learning rate `lr`; returns their loss before it.
+    fn step(&mut self, queries: &[CacheQuery], targets: &[Vec3], lr: f64) -> f64;
 }
 
 /// Whether a checkpoint file is optimiser state (this nprt's or burn's, to clean up).

@@ -2,7 +2,8 @@
 //! code once per lighting, a camera's pixels once per viewpoint (their inputs and what of the
 //! network does not depend on the lighting), then radiance for each lighting. The CPU engine
 //! (`cpu::CpuShading`) and the GPU kernels (`gpu::GpuNetwork`) implement it, and
-//! [`crate::Engine::network`] is the one place that picks between them; a frame's other stages
+//! [`crate::Engine::network`] is the one place that picks between them (the Deep Shading
+//! U-Net's [`UnetShading`] likewise, by [`crate::Engine::unet`]); a frame's other stages
 //! (G-buffer, background, traced light) are the renderer's.
 
 use std::any::Any;
@@ -11,6 +12,7 @@ use std::sync::Arc;
 use anyhow::Result;
 use nprt_scene::EnvMap;
 
+use crate::network::encoder::LightInput;
 use crate::precision::Precision;
 
 /// A trained NPRT network on an engine.
@@ -61,6 +63,12 @@ pub trait Shading: Send + Sync {
     /// The engine's own type, for a renderer whose frame stages run beside it (on the GPU, the
     /// device network whose pixels a rasterised G-buffer feeds).
     fn as_any(&self) -> &dyn Any;
+}
+
+/// A trained Deep Shading U-Net on an engine.
+pub trait UnetShading: Send + Sync {
+    /// Radiance (3 × h × w) of a view's `features` (FEATURES × h × w) under the map `light`.
+    fn radiance(&self, features: Vec<f32>, light: LightInput, size: (usize, usize)) -> Vec<f32>;
 }
 
 /// What an engine made of one lighting, held where that engine keeps it.

@@ -25,6 +25,7 @@ use crate::network::nprt_net::NprtNet;
 pub use frame::CpuShading;
 pub use light_encoder::EncoderPass;
 pub use peak::{measured_peak, Peak};
+pub use radiance_cache::HostCacheSteps;
 pub use samples::Samples;
 pub use transport::{TransferCodes, TransportGradients};
 pub use unet::UnetBatch;

@@ -12,6 +12,7 @@ use crate::encoding::spherical_harmonics::basis;
 use crate::loss::Loss;
 use crate::network::parameters::Parameters;
 use crate::network::radiance_cache::{CacheQuery, RadianceCache, INPUTS, SH_BANDS};
+use crate::optimiser::{Adam, CacheSteps};
 
 /// Rows a task reads or trains on at once.
 const BLOCK: usize = 1024;
@@ -124,5 +125,27 @@ impl RadianceCache {
             hash_grid::scatter(&mut grads.grid.table, c, &d[..hash_grid::OUTPUTS]);
         }
         (loss, grads)
+    }
+}
+
+/// The cache on the CPU engine: its weights and the host's Adam.
+pub struct HostCacheSteps {
+    pub cache: RadianceCache,
+    pub adam: Adam,
+}
+
+impl CacheSteps for HostCacheSteps {
+    fn cache(&self) -> RadianceCache {
+        self.cache.clone()
+    }
+
+    fn read(&mut self, queries: &[CacheQuery]) -> Vec<Vec3> {
+        self.cache.read(queries)
+    }
+
+    fn step(&mut self, queries: &[CacheQuery], targets: &[Vec3], lr: f64) -> f64 {
+        let (loss, grads) = self.cache.loss_and_gradients(queries, targets);
+        self.adam.step(&mut self.cache, &grads, lr);
+        loss
     }
 }

@@ -11,9 +11,10 @@ use super::relu::{relu, relu_back};
 use crate::encoding::features::FEATURES;
 use crate::loss::Loss;
 use crate::network::conv::Conv;
-use crate::network::encoder::CODE_SIZE;
+use crate::network::encoder::{LightInput, CODE_SIZE};
 use crate::network::parameters::Parameters;
 use crate::network::unet::{DeepShading, LEVELS};
+use crate::shading::UnetShading;
 
 /// Views of one padded size, channel-major planes each.
 pub struct UnetBatch {
@@ -320,5 +321,11 @@ impl DeepShading {
         let offsets = self.offsets(&codes);
         self.view_forward(features, &offsets, &scale, (h, w))
             .prediction
+    }
+}
+
+impl UnetShading for DeepShading {
+    fn radiance(&self, features: Vec<f32>, light: LightInput, size: (usize, usize)) -> Vec<f32> {
+        self.shade(&features, &light.pixels, light.width, light.scale, size)
     }
 }

@@ -15,6 +15,7 @@ use crate::init::Init;
 use crate::model::folder::{check_bounds, load_weights, read_config, WEIGHTS_FILE};
 use crate::network::encoder::{check_input_width, LightInput};
 use crate::network::unet::DeepShading;
+use crate::shading::UnetShading;
 
 pub const TAG: &str = "deep-shading";
 pub const CONFIG_FILE: &str = "deep-shading.json";
@@ -39,10 +40,8 @@ pub struct DeepShadingFile {
 /// A trained Deep Shading network, ready to shade.
 pub struct DeepShadingModel {
     pub file: DeepShadingFile,
-    net: DeepShading,
-    /// The network on the GPU kernels, where it was loaded for the GPU (one frame at a time).
-    #[cfg(feature = "gpu")]
-    gpu: Option<std::sync::Mutex<crate::gpu::GpuUnet>>,
+    /// The network on the engine it was loaded for.
+    net: Box<dyn UnetShading>,
 }
 
 /// Reads a Deep Shading folder's config, refusing an encoder width no network can have.
@@ -60,39 +59,10 @@ impl DeepShadingModel {
         let file = read_file(dir)?;
         let mut net = DeepShading::new(&mut Init::new(0), file.encoder_width);
         load_weights(&dir.join(WEIGHTS_FILE), &mut net, TAG)?;
-        #[cfg(feature = "gpu")]
-        let gpu = match engine.is_gpu() {
-            true => Some(std::sync::Mutex::new(crate::gpu::GpuUnet::new(&net)?)),
-            false => None,
-        };
-        #[cfg(not(feature = "gpu"))]
-        let _ = engine;
         Ok(DeepShadingModel {
             file,
-            net,
-            #[cfg(feature = "gpu")]
-            gpu,
+            net: engine.unet(net)?,
         })
-    }
-
-    /// The U-Net's radiance (3 × h × w) for a view's `features` (FEATURES × h × w) under the
-    /// map `light`, on the engine the model was loaded for.
-    fn radiance(&self, features: Vec<f32>, light: LightInput, (h, w): (usize, usize)) -> Vec<f32> {
-        #[cfg(feature = "gpu")]
-        if let Some(gpu) = &self.gpu {
-            let batch = crate::cpu::UnetBatch {
-                features,
-                radiance: vec![0.0; 3 * h * w],
-                mask: vec![0.0; h * w],
-                lights: light.pixels,
-                light_width: light.width,
-                scale: light.scale.to_vec(),
-                height: h,
-                width: w,
-            };
-            return gpu.lock().unwrap_or_else(|e| e.into_inner()).shade(&batch);
-        }
-        (self.net).shade(&features, &light.pixels, light.width, light.scale, (h, w))
     }
 
     /// Radiance of every pixel of a `width`×`height` G-buffer under `map` rotated by
@@ -112,7 +82,7 @@ impl DeepShadingModel {
             self.file.encoder_width,
             self.file.options.map_norm,
         );
-        let v = self.radiance(img, light, (ph, pw));
+        let v = self.net.radiance(img, light, (ph, pw));
         (0..width * height)
             .map(|i| {
                 let (x, y) = (i % width, i / width);

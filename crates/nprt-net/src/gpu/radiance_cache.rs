@@ -27,6 +27,7 @@ use crate::encoding::features::FEATURES;
 use crate::encoding::hash_grid;
 use crate::loss::Loss;
 use crate::network::radiance_cache::{CacheQuery, RadianceCache, INPUTS};
+use crate::optimiser::CacheSteps;
 
 /// Threads of `grid_backward` per chunk of rows: one per 64 slots of each level's table.
 const GRID_BACKWARD_THREADS: usize = hash_grid::LEVELS * hash_grid::TABLE_SIZE / 64;
@@ -263,5 +264,19 @@ impl GpuCache {
             dispatches,
             forward,
         }
+    }
+}
+
+impl CacheSteps for GpuCache {
+    fn cache(&self) -> RadianceCache {
+        self.parameters()
+    }
+
+    fn read(&mut self, queries: &[CacheQuery]) -> Vec<Vec3> {
+        GpuCache::read(self, queries)
+    }
+
+    fn step(&mut self, queries: &[CacheQuery], targets: &[Vec3], lr: f64) -> f64 {
+        GpuCache::step(self, queries, targets, lr)
     }
 }

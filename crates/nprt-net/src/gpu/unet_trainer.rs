@@ -16,7 +16,9 @@ use super::unet_pass::{loss_params, UnetAt, UnetBuffers};
 use super::{Dispatch, GpuDevice};
 use crate::cpu::UnetBatch;
 use crate::loss::Loss;
+use crate::network::encoder::LightInput;
 use crate::network::unet::DeepShading;
+use crate::shading::UnetShading;
 
 /// A U-Net's parameters, gradients and Adam moments on the device, and the passes that train
 /// and run it.
@@ -172,5 +174,22 @@ impl GpuUnet {
             }
         };
         self.plans.keep(plan);
+    }
+}
+
+/// One view at a time: the U-Net's buffers are the trainer's.
+impl UnetShading for std::sync::Mutex<GpuUnet> {
+    fn radiance(&self, features: Vec<f32>, light: LightInput, (h, w): (usize, usize)) -> Vec<f32> {
+        let batch = UnetBatch {
+            features,
+            radiance: vec![0.0; 3 * h * w],
+            mask: vec![0.0; h * w],
+            lights: light.pixels,
+            light_width: light.width,
+            scale: light.scale.to_vec(),
+            height: h,
+            width: w,
+        };
+        self.lock().unwrap_or_else(|e| e.into_inner()).shade(&batch)
     }
 }

@@ -1,70 +1,37 @@
-//! The radiance cache trained online, on either engine: the CPU engine (its loss and
-//! gradients, then the host's Adam) or the GPU kernels (`gpu::GpuCache`: weights, gradients
-//! and Adam's moments on the device), read and stepped through one interface.
+//! The radiance cache trained online, on either engine ([`CacheSteps`], made by
+//! [`Engine::cache_steps`]): the CPU engine (its loss and gradients, then the host's Adam) or
+//! the GPU kernels (`gpu::GpuCache`: weights, gradients and Adam's moments on the device).
 
 use anyhow::Result;
 use glam::Vec3;
 
 use crate::engine::Engine;
-use crate::network::parameters::Parameters;
-use crate::network::radiance_cache::{CacheQuery, RadianceCache, ADAM_BETAS};
-use crate::optimiser::Adam;
-
-/// Where the cache's weights live and step.
-enum CacheOn {
-    Cpu {
-        cache: RadianceCache,
-        adam: Adam,
-    },
-    #[cfg(feature = "gpu")]
-    Gpu(Box<crate::gpu::GpuCache>),
-}
+use crate::network::radiance_cache::{CacheQuery, RadianceCache};
+use crate::optimiser::CacheSteps;
 
 /// A cache trained online: its weights and Adam's state on an engine.
 pub struct CacheTrainer {
-    on: CacheOn,
+    on: Box<dyn CacheSteps>,
     pub learning_rate: f64,
 }
 
 impl CacheTrainer {
-    /// `cache` to train on `engine` at `learning_rate` (the GPU engine in a build with the
-    /// kernels; the CPU otherwise).
+    /// `cache` to train on `engine` at `learning_rate`.
     pub fn new(cache: RadianceCache, learning_rate: f64, engine: Engine) -> Result<Self> {
-        #[cfg(feature = "gpu")]
-        if engine.is_gpu() {
-            let gpu = crate::gpu::GpuCache::new(&cache, ADAM_BETAS)?;
-            return Ok(CacheTrainer {
-                on: CacheOn::Gpu(Box::new(gpu)),
-                learning_rate,
-            });
-        }
-        #[cfg(not(feature = "gpu"))]
-        let _ = engine;
         Ok(CacheTrainer {
-            on: CacheOn::Cpu {
-                adam: Adam::with_betas(cache.num_params(), ADAM_BETAS),
-                cache,
-            },
+            on: engine.cache_steps(cache)?,
             learning_rate,
         })
     }
 
     /// The weights as they stand.
     pub fn cache(&self) -> RadianceCache {
-        match &self.on {
-            CacheOn::Cpu { cache, .. } => cache.clone(),
-            #[cfg(feature = "gpu")]
-            CacheOn::Gpu(gpu) => gpu.parameters(),
-        }
+        self.on.cache()
     }
 
     /// The radiance the cache holds for each query.
     pub fn read(&mut self, queries: &[CacheQuery]) -> Vec<Vec3> {
-        match &mut self.on {
-            CacheOn::Cpu { cache, .. } => cache.read(queries),
-            #[cfg(feature = "gpu")]
-            CacheOn::Gpu(gpu) => gpu.read(queries),
-        }
+        self.on.read(queries)
     }
 
     /// `steps` Adam steps on consecutive batches of `batch` of the pairs (wrapping around);
@@ -86,15 +53,7 @@ impl CacheTrainer {
             let from = (s * batch) % queries.len();
             let to = (from + batch).min(queries.len());
             let (q, t) = (&queries[from..to], &targets[from..to]);
-            total += match &mut self.on {
-                CacheOn::Cpu { cache, adam } => {
-                    let (loss, grads) = cache.loss_and_gradients(q, t);
-                    adam.step(cache, &grads, lr);
-                    loss
-                }
-                #[cfg(feature = "gpu")]
-                CacheOn::Gpu(gpu) => gpu.step(q, t, lr),
-            };
+            total += self.on.step(q, t, lr);
         }
         total / steps as f64
     }
