@@ -89,17 +89,21 @@ class Net(nn.Module):
     def __init__(self, design, act, width):
         super().__init__()
         self.encoder = Encoder(width)
-        kinds = {"baseline": ["full"], "prt": ["full"], "albedo": ["albedo"], "dsep": ["diffuse", "specular"]}
-        self.tracks = nn.ModuleList(Track(design, k, act) for k in kinds[design])
+        self.tracks = nn.ModuleList(Track(design, k, act) for k in TRACKS[design])
 
     def forward(self, f, light, view, scale):
         code = self.encoder(light)[view]
         return sum(t(f, code) for t in self.tracks) * scale
 
 
+# The designs this peer has a PyTorch twin of (nprt's names, tested against its Design::ALL),
+# each with its tracks.
+TRACKS = {"baseline": ["full"], "prt": ["full"], "albedo": ["albedo"], "dsep": ["diffuse", "specular"]}
+
+
 def main():
     p = argparse.ArgumentParser()
-    p.add_argument("--designs", default="baseline,prt,albedo,dsep")
+    p.add_argument("--designs", default=",".join(TRACKS))
     p.add_argument("--activation", default="")
     p.add_argument("--batch-size", type=int, default=16384)
     p.add_argument("--views", type=int, default=8)
