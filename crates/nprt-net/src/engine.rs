@@ -12,7 +12,7 @@ use crate::choice::named_choice;
 use crate::cpu::{CpuShading, HostCacheSteps};
 use crate::model::folder::ModelFile;
 use crate::network::nprt_net::NprtNet;
-use crate::network::parameters::Parameters;
+use crate::parameters::Parameters;
 use crate::network::radiance_cache::{RadianceCache, ADAM_BETAS};
 use crate::network::unet::DeepShading;
 use crate::optimiser::{Adam, CacheSteps};

@@ -3,10 +3,11 @@
 //! the model folder format (weights plus config) and the one training loop every network goes
 //! through (checkpoints, exact resume). Its modules keep the pieces apart, as tiny-cuda-nn
 //! does, in layers, each using only those before it:
-//! 1. the shared pieces: `precision`, `init` (how parameters start), `loss`;
+//! 1. the shared pieces: `precision`, `parameters` (the one weight type every network is),
+//!    `init` (how parameters start), `loss`;
 //! 2. `encoding` (what the networks see), then `network` (layers, encoder, track kinds,
-//!    designs, the U-Net, and `parameters`: the one weight type every network is), then
-//!    `optimiser` (Adam, and the steps an engine takes) and `model` (config and folder);
+//!    designs, the U-Net, the radiance cache), then `optimiser` (Adam, and the steps an engine
+//!    takes) and `model` (config and folder);
 //! 3. the engines: `cpu` (the CPU engine, on the networks' own weights), `gpu` (our own GPU
 //!    kernels, feature `gpu`, which read the same weights), `shading` (a trained network as
 //!    frames run it, on either) and `engine` (what `--device` resolves to, and the one place
@@ -43,6 +44,7 @@ pub mod loss;
 pub mod model;
 pub mod network;
 pub mod optimiser;
+pub mod parameters;
 mod precision;
 mod shading;
 pub mod training;
@@ -65,7 +67,7 @@ pub use network::design::{Design, TRANSPORT_CODE};
 pub use network::encoder::{LightEncoder, LightInput};
 pub use network::mlp::Mlp;
 pub use network::nprt_net::NprtNet;
-pub use network::parameters::Parameters;
+pub use parameters::Parameters;
 pub use network::track::Track;
 pub use network::track_kind::TrackKind;
 pub use precision::Precision;

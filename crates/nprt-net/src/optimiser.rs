@@ -12,7 +12,7 @@ use anyhow::{anyhow, bail, Context, Result};
 use glam::Vec3;
 use safetensors::{tensor::TensorView, Dtype, SafeTensors};
 
-use crate::network::parameters::Parameters;
+use crate::parameters::Parameters;
 use crate::network::radiance_cache::{CacheQuery, RadianceCache};
 
 /// Adam's ε, on every engine.

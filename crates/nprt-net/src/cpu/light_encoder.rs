@@ -10,7 +10,7 @@ use super::matmul::{matmul, MatRef, Op};
 use super::pool::{max_pool, unpool};
 use super::relu::{relu, relu_back};
 use crate::network::encoder::{LightEncoder, CHANNELS, CODE_SIZE};
-use crate::network::parameters::Parameters;
+use crate::parameters::Parameters;
 
 /// What one view's forward pass keeps for backward.
 pub struct ViewTape {

@@ -10,7 +10,7 @@ use super::matmul::MatRef;
 use crate::encoding::hash_grid::{self, Corners};
 use crate::encoding::spherical_harmonics::basis;
 use crate::loss::Loss;
-use crate::network::parameters::Parameters;
+use crate::parameters::Parameters;
 use crate::network::radiance_cache::{CacheQuery, RadianceCache, INPUTS, SH_BANDS};
 use crate::optimiser::{Adam, CacheSteps};
 

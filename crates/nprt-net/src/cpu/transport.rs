@@ -15,7 +15,7 @@ use crate::network::design::TRANSPORT_CODE;
 use crate::network::encoder::CODE_SIZE;
 use crate::network::mlp::Mlp;
 use crate::network::nprt_net::NprtNet;
-use crate::network::parameters::Parameters;
+use crate::parameters::Parameters;
 use crate::network::track::Track;
 
 /// Rows per block: small enough that a block's activations stay in the caches, large enough

@@ -12,7 +12,7 @@ use crate::encoding::features::FEATURES;
 use crate::loss::Loss;
 use crate::network::conv::Conv;
 use crate::network::encoder::{LightInput, CODE_SIZE};
-use crate::network::parameters::Parameters;
+use crate::parameters::Parameters;
 use crate::network::unet::{DeepShading, LEVELS};
 use crate::shading::UnetShading;
 

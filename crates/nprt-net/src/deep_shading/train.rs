@@ -15,7 +15,7 @@ use crate::engine::Engine;
 use crate::init::Init;
 use crate::model::folder::{save_weights, WEIGHTS_FILE};
 use crate::network::encoder::check_input_width;
-use crate::network::parameters::Parameters;
+use crate::parameters::Parameters;
 use crate::network::unet::DeepShading;
 use crate::optimiser::EngineSteps;
 use crate::training::checkpoint::{self, RunState};

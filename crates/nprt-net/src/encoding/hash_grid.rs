@@ -12,7 +12,7 @@ use std::sync::LazyLock;
 
 use crate::encoding::features::feature;
 use crate::init::Init;
-use crate::network::parameters::{child, Parameters, Visit, VisitMut};
+use crate::parameters::{child, Parameters, Visit, VisitMut};
 
 /// Grid resolutions, from [`MIN_RES`] to [`MAX_RES`] cells along each side of the scene's box
 /// in a geometric progression.

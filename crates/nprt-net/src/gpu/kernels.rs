@@ -8,7 +8,7 @@
 
 use std::sync::LazyLock;
 
-use super::KernelSource;
+use nprt_gpu::KernelSource;
 use crate::network::track_kind::kind_table_wgsl;
 
 /// The kernel in `shaders/NAME.wgsl`, after the shared `shaders/PART.wgsl` files listed (those

@@ -1,52 +1,27 @@
 //! Our own GPU kernels for the networks: WGSL compute shaders on nprt-gpu's device (wgpu:
-//! Vulkan, Metal, DX12; Mesa's software Vulkan in the tests). This module owns the network
-//! kernels and how their dispatches are recorded: the light encoder's blocks, the dense layers'
-//! products (in f32, and on f16 operands: [`HalfWeight`], `half_products`), the training step of
-//! every design on the device ([`GpuTrainer`]), the training set held there
-//! ([`DeviceDataset`]) and a trained network's frames (`frame`: [`GpuNetwork`]). The kernels
-//! compute what the CPU engine ([`crate::cpu`]) computes, and tests hold the two together;
-//! layouts, designs and the hash grid stay defined where the CPU engine reads them.
+//! Vulkan, Metal, DX12; Mesa's software Vulkan in the tests), computing what the CPU engine
+//! ([`crate::cpu`]) computes, which tests hold them to. In layers, each folder using only those
+//! before it (and nprt-gpu's runtime directly, never through this module):
+//! 0. [`kernels`]: the kernel list, each shader's WGSL (`shaders/`);
+//! 1. `products`: matrix products and their operands, in f32 and on f16 (tensor cores);
+//! 2. `layers`: where each tensor lies in the flat parameter buffer, and each layer's forward
+//!    pass recorded on it;
+//! 3. `passes`: backward passes and Adam on the device;
+//! 4. `trainers` (each network's training step: [`GpuTrainer`], [`GpuUnet`], [`GpuCache`],
+//!    with [`DeviceDataset`]) and, beside them, `frame` (a trained network's frames:
+//!    [`GpuNetwork`], the GPU engine's [`crate::Shading`]).
+//!
+//! Layouts, designs and the hash grid stay defined where the CPU engine reads them
+//! (`network`, `encoding`). The public surface is the trainers, the device network and the
+//! kernel list, with the f16 weight layout the export writes.
 
-mod codes;
-mod conv_layers;
-mod dense_products;
-mod device_adam;
-mod device_dataset;
-mod encoder_blocks;
-mod encoder_step;
 mod frame;
-mod gpu_trainer;
-mod half_layers;
-mod half_products;
 pub mod kernels;
-mod layer_at;
-mod mlp_step;
-mod network_forward;
-mod network_layout;
-mod operands;
-mod parameters;
-mod plans;
-mod radiance_cache;
-mod transport_step;
-mod unet_pass;
-mod unet_trainer;
+mod layers;
+mod passes;
+mod products;
+mod trainers;
 
-pub use codes::{activation_code, loss_code};
-pub use dense_products::DenseProducts;
-pub use device_dataset::DeviceDataset;
-pub use encoder_blocks::{BlockPass, EncoderAt};
 pub use frame::{GpuLightCode, GpuLightInput, GpuNetwork, GpuPixels};
-pub use gpu_trainer::GpuTrainer;
-pub use half_layers::{
-    half_weight_bits, held_halves, pad16, HalfLayers, HalfWeight, Held, HALF_ROW_BLOCK,
-};
-pub use layer_at::{ConvAt, DenseAt};
-pub use network_forward::{FirstLayer, ForwardTargets};
-pub use network_layout::{HalfCopies, MlpAt, NetworkLayout, TrackAt};
-pub use operands::{Bias, Operand, Output};
-pub use parameters::ParameterLayout;
-pub use radiance_cache::GpuCache;
-pub use unet_trainer::GpuUnet;
-
-// The runtime the kernels run on (nprt-gpu), as this module's files name it.
-use nprt_gpu::{groups_for, Bind, Dispatch, GpuDevice, KernelSource, Part, Span};
+pub use products::half_layers::{half_weight_bits, pad16};
+pub use trainers::{DeviceDataset, GpuCache, GpuTrainer, GpuUnet};

@@ -17,7 +17,7 @@ use crate::init::Init;
 use crate::model::config::ModelConfig;
 use crate::network::encoder::check_input_width;
 use crate::network::nprt_net::NprtNet;
-use crate::network::parameters::Parameters;
+use crate::parameters::Parameters;
 
 /// Identifies a model folder's config file.
 pub const MODEL_FORMAT: &str = "nprt-model";

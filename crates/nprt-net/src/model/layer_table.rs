@@ -14,7 +14,7 @@ use crate::network::activation::Activation;
 use crate::network::design::Design;
 use crate::network::encoder::check_input_width;
 use crate::network::nprt_net::NprtNet;
-use crate::network::parameters::Parameters;
+use crate::parameters::Parameters;
 
 /// One row of `nprt model info`.
 #[derive(Serialize)]

@@ -2,7 +2,7 @@
 //! [c_out, c_in, k, k], read as a row-major c_out × (c_in · k²) matrix by the engines.
 
 use crate::init::Init;
-use crate::network::parameters::{child, Parameters, Visit, VisitMut};
+use crate::parameters::{child, Parameters, Visit, VisitMut};
 
 /// One convolution, or (same shapes) its gradient.
 #[derive(Clone, Debug, PartialEq)]

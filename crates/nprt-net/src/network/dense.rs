@@ -2,7 +2,7 @@
 //! stores it).
 
 use crate::init::Init;
-use crate::network::parameters::{child, Parameters, Visit, VisitMut};
+use crate::parameters::{child, Parameters, Visit, VisitMut};
 
 /// One dense layer, or (same shapes) its gradient.
 #[derive(Clone, Debug, PartialEq)]

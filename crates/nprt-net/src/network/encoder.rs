@@ -10,7 +10,7 @@ use crate::network::activation::Activation;
 use crate::network::conv::Conv;
 use crate::network::dense::Dense;
 use crate::network::mlp::Mlp;
-use crate::network::parameters::{child, Parameters, Visit, VisitMut};
+use crate::parameters::{child, Parameters, Visit, VisitMut};
 
 /// Convolution blocks of the paper's encoder.
 pub const BLOCKS: usize = 5;

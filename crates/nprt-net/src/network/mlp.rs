@@ -3,7 +3,7 @@
 use crate::init::Init;
 use crate::network::activation::{Activation, OMEGA_0};
 use crate::network::dense::Dense;
-use crate::network::parameters::{child, Parameters, Visit, VisitMut};
+use crate::parameters::{child, Parameters, Visit, VisitMut};
 
 /// A multilayer perceptron: every layer but the last is followed by the activation; the last
 /// one is linear. Also (same shapes) its gradient.

@@ -1,7 +1,7 @@
 //! The networks: the light encoder, dense layers and their activations, the transport tracks and
-//! their kinds, the four designs, the whole network, the Deep Shading U-Net, the Neural
-//! Radiance Cache's network, and the one
-//! weight type they all are to the model file and the optimiser (`parameters`).
+//! their kinds, the four designs, the whole network, the Deep Shading U-Net and the Neural
+//! Radiance Cache's network, each of them `crate::parameters` to the model file and the
+//! optimiser.
 
 pub mod activation;
 pub mod conv;
@@ -10,7 +10,6 @@ pub mod design;
 pub mod encoder;
 pub mod mlp;
 pub mod nprt_net;
-pub mod parameters;
 pub mod radiance_cache;
 pub mod track;
 pub mod track_kind;

@@ -5,7 +5,7 @@ use crate::init::Init;
 use crate::network::activation::Activation;
 use crate::network::design::Design;
 use crate::network::encoder::LightEncoder;
-use crate::network::parameters::{child, Parameters, Visit, VisitMut};
+use crate::parameters::{child, Parameters, Visit, VisitMut};
 use crate::network::track::Track;
 
 /// Encoder plus transport: G-buffer features and a light code in, radiance out. Also (same

@@ -13,7 +13,7 @@ use crate::encoding::hash_grid::{self, HashGrid};
 use crate::init::Init;
 use crate::network::activation::Activation;
 use crate::network::mlp::Mlp;
-use crate::network::parameters::{child, Parameters, Visit, VisitMut};
+use crate::parameters::{child, Parameters, Visit, VisitMut};
 
 /// Spherical-harmonics bands of the direction's and the normal's encodings (16 values each).
 pub const SH_BANDS: usize = 4;

@@ -8,7 +8,7 @@ use crate::network::activation::Activation;
 use crate::network::design::{Design, Layout, TRANSPORT_CODE};
 use crate::network::encoder::CODE_SIZE;
 use crate::network::mlp::Mlp;
-use crate::network::parameters::{child, Parameters, Visit, VisitMut};
+use crate::parameters::{child, Parameters, Visit, VisitMut};
 use crate::network::track_kind::TrackKind;
 
 /// One transport track: an optional transfer network F_T on the pixel inputs, and the shading

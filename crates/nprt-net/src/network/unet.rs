@@ -10,7 +10,7 @@ use crate::network::conv::Conv;
 use crate::network::dense::Dense;
 use crate::network::encoder::{LightEncoder, CODE_SIZE};
 use crate::network::mlp::Mlp;
-use crate::network::parameters::{child, Parameters, Visit, VisitMut};
+use crate::parameters::{child, Parameters, Visit, VisitMut};
 
 /// Channels of the encoder levels (full, ½, ¼ resolution) and of the ⅛-resolution bottleneck.
 pub const WIDTHS: [usize; 4] = [16, 32, 64, 64];

@@ -74,7 +74,7 @@ mod tests {
     use crate::init::Init;
     use crate::model::config::ModelConfig;
     use crate::network::encoder::LightInput;
-    use crate::Design;
+    use crate::network::design::Design;
     use glam::Vec3;
     use nprt_data::dataset::{PackedDataset, PackedPixel, PackedTarget};
     use nprt_scene::envmap::EnvMap;

@@ -8,7 +8,7 @@ use anyhow::{Context, Result};
 use serde::{Deserialize, Serialize};
 
 use crate::model::folder::{load_weights, save_weights};
-use crate::network::parameters::Parameters;
+use crate::parameters::Parameters;
 use crate::optimiser::{is_state_file, state_file, EngineSteps};
 use crate::training::loss_curves::LossRow;
 

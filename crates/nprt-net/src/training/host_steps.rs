@@ -5,7 +5,7 @@ use std::path::Path;
 
 use anyhow::Result;
 
-use crate::network::parameters::Parameters;
+use crate::parameters::Parameters;
 use crate::optimiser::{Adam, EngineSteps};
 
 /// A batch's mean loss, the network's gradient (same shapes) and its samples.

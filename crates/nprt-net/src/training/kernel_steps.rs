@@ -13,7 +13,7 @@ use crate::network::nprt_net::NprtNet;
 use crate::optimiser::EngineSteps;
 use crate::training::batch::Batch;
 use crate::training::training_set::TrainingSet;
-use crate::Precision;
+use crate::precision::Precision;
 
 pub struct KernelSteps {
     trainer: GpuTrainer,

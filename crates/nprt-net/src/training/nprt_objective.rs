@@ -19,7 +19,7 @@ use crate::model::folder::{
     save_model, ModelFile, CONFIG_FILE, MODEL_FORMAT, MODEL_VERSION, WEIGHTS_FILE,
 };
 use crate::network::nprt_net::NprtNet;
-use crate::network::parameters::Parameters;
+use crate::parameters::Parameters;
 use crate::optimiser::{EngineSteps, ADAM_EPSILON};
 use crate::training::batch::Batch;
 use crate::training::calibration::{level_gain, Calibration, LEVEL_SAMPLES};
@@ -31,7 +31,7 @@ use crate::training::train_options::{Gather, TrainOptions};
 use crate::training::training_loop::{self, Objective, Steps, TrainSummary, Watch};
 use crate::training::training_set::{TrainingSet, ViewSamples};
 use crate::training::validation::validation_loss;
-use crate::Precision;
+use crate::precision::Precision;
 
 /// A Neural PRT design learning a dataset's pixels.
 struct PixelObjective<'a> {

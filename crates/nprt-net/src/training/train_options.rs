@@ -11,7 +11,7 @@ use crate::training::calibration::Calibration;
 use crate::training::lr_schedule::LrSchedule;
 use crate::training::run_length::RunLength;
 use crate::training::schedule::Schedule;
-use crate::Precision;
+use crate::precision::Precision;
 
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct TrainOptions {

@@ -19,7 +19,7 @@ use rand::SeedableRng;
 use rand_pcg::Pcg64Mcg;
 
 use crate::init::Init;
-use crate::network::parameters::Parameters;
+use crate::parameters::Parameters;
 use crate::optimiser::EngineSteps;
 use crate::training::checkpoint::{self, Checkpoint, RunState};
 use crate::training::loss_curves::{self as curves, LossRow};

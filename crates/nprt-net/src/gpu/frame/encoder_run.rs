@@ -6,7 +6,7 @@
 use std::sync::Arc;
 
 use nprt_gpu::{Dispatch, GpuDevice, KeptLast};
-use crate::gpu::NetworkLayout;
+use crate::gpu::layers::network_layout::NetworkLayout;
 use crate::network::encoder::CODE_SIZE;
 
 use super::light_code::GpuLightCode;

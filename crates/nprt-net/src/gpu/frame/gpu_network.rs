@@ -21,10 +21,11 @@ use crate::encoding::features::{position_frame, FEATURES};
 use crate::encoding::hash_grid;
 use crate::encoding::map_norm::MapNorm;
 use crate::gpu::kernels::{COMBINE, GBUFFER_FEATURES};
-use crate::gpu::{
-    held_halves, Bias, FirstLayer, ForwardTargets, HalfLayers, Held, MlpAt, NetworkLayout,
-    ParameterLayout, HALF_ROW_BLOCK,
-};
+use crate::gpu::layers::network_forward::{FirstLayer, ForwardTargets};
+use crate::gpu::layers::network_layout::{MlpAt, NetworkLayout};
+use crate::gpu::layers::parameters::ParameterLayout;
+use crate::gpu::products::half_layers::{held_halves, HalfLayers, Held, HALF_ROW_BLOCK};
+use crate::gpu::products::operands::Bias;
 use crate::network::encoder::CODE_SIZE;
 use crate::network::nprt_net::NprtNet;
 use crate::precision::Precision;

@@ -2,10 +2,10 @@
 //! dense layer's, in training and in frames, and the products of their backward passes) and
 //! sums of columns, each a dispatch or a few appended to a plan.
 
-use super::codes::BACKWARD;
-use super::kernels::{COLUMN_SUM, GEMM, GEMM_TILE};
-use super::operands::{Bias, Operand, Output};
-use super::{groups_for, Dispatch, GpuDevice};
+use crate::gpu::products::codes::BACKWARD;
+use crate::gpu::kernels::{COLUMN_SUM, GEMM, GEMM_TILE};
+use crate::gpu::products::operands::{Bias, Operand, Output};
+use nprt_gpu::{groups_for, Dispatch, GpuDevice};
 
 /// Rows a `column_sum` thread adds before the chunks' sums are added in a further pass (and
 /// theirs in another, as a tree). Short: a thread's adds are a chain of dependent loads, and on

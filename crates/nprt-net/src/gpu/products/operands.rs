@@ -1,7 +1,7 @@
 //! What a product on the device reads and writes: its operands (strided matrices in a buffer),
 //! the bias its epilogue adds, and where its output goes.
 
-use super::GpuDevice;
+use nprt_gpu::GpuDevice;
 
 /// One operand of a product: element (i, k) at `offset + i · rows + k · cols` of `buffer`;
 /// for a left operand, `ones_row`'s elements read as ones instead.
@@ -49,7 +49,7 @@ pub enum Bias<'a> {
 impl<'a> Bias<'a> {
     /// What a kernel's epilogue takes: its mode (0 none, 1 column, 2 group), its buffer, its
     /// offset there and the rows' groups (`gpu`'s empty buffer for what is unused).
-    pub(super) fn binding(
+    pub(crate) fn binding(
         self,
         gpu: &'a GpuDevice,
     ) -> (usize, &'a wgpu::Buffer, usize, &'a wgpu::Buffer) {

@@ -1,8 +1,8 @@
 //! What the device trainers (a design's, the U-Net's, the radiance cache's) keep between calls:
 //! the passes recorded for the batch shapes asked for last, and what a submission of one runs.
 
-use super::device_adam::DeviceAdam;
-use super::{Dispatch, GpuDevice};
+use crate::gpu::passes::device_adam::DeviceAdam;
+use nprt_gpu::{Dispatch, GpuDevice};
 
 /// Batch shapes whose passes are kept: training's and validation's, and each epoch's shorter
 /// last batch (or a read's and a training step's, and their shorter last ones).

@@ -8,7 +8,7 @@ use nprt_data::dataset::PACKED_PIXEL_BYTES;
 
 use glam::Vec3;
 
-use super::GpuDevice;
+use nprt_gpu::GpuDevice;
 use crate::encoding::features::position_frame;
 use crate::network::encoder::LightInput;
 use nprt_data::dataset::PackedDataset;
@@ -23,7 +23,7 @@ const _: () = assert!(
 );
 
 /// The pack's records from `first` on, in one storage buffer.
-pub(super) struct Shard {
+pub(crate) struct Shard {
     pub records: wgpu::Buffer,
     pub first: u32,
     pub count: u32,
@@ -32,14 +32,14 @@ pub(super) struct Shard {
 /// A training set on the device.
 pub struct DeviceDataset {
     /// The records, cut where a buffer would pass the device's binding limit.
-    pub(super) shards: Vec<Shard>,
+    pub(crate) shards: Vec<Shard>,
     /// Per training view: its map (`light_floats` each) and its scale (3 each).
-    pub(super) lights: wgpu::Buffer,
-    pub(super) scales: wgpu::Buffer,
-    pub(super) light_floats: usize,
+    pub(crate) lights: wgpu::Buffer,
+    pub(crate) scales: wgpu::Buffer,
+    pub(crate) light_floats: usize,
     /// The gather kernel's bounds: the pack's minimum, extent, and the extent positions are
     /// normalised by, as vec4s.
-    pub(super) bounds: [f32; 12],
+    pub(crate) bounds: [f32; 12],
     /// Bytes held on the device.
     pub bytes: u64,
 }

@@ -8,12 +8,12 @@ use std::sync::Arc;
 
 use anyhow::Result;
 
-use super::conv_layers::Images;
-use super::device_adam::DeviceAdam;
-use super::parameters::ParameterLayout;
-use super::plans::{submit, Pass, Plans};
-use super::unet_pass::{loss_params, UnetAt, UnetBuffers};
-use super::{Dispatch, GpuDevice};
+use crate::gpu::layers::conv::Images;
+use crate::gpu::passes::device_adam::DeviceAdam;
+use crate::gpu::layers::parameters::ParameterLayout;
+use crate::gpu::trainers::plans::{submit, Pass, Plans};
+use crate::gpu::passes::unet::{loss_params, UnetAt, UnetBuffers};
+use nprt_gpu::{Dispatch, GpuDevice};
 use crate::cpu::UnetBatch;
 use crate::loss::Loss;
 use crate::network::encoder::LightInput;

@@ -1,15 +1,15 @@
 //! The network's forward pass recorded on the device, written once for its two callers: a
 //! training step (over a batch, keeping what backward needs) and the frame path (over a
 //! camera's pixels, through ping-pong activations). Both read the weights from one flat
-//! parameter buffer where [`NetworkLayout`](super::network_layout::NetworkLayout) places them.
+//! parameter buffer where [`NetworkLayout`](crate::gpu::layers::network_layout::NetworkLayout) places them.
 
-use super::codes::activation_code;
-use super::dense_products::DenseProducts;
-use super::half_layers::{half_train_layer, pad16, HalfLayers, HalfOut, Held};
-use super::kernels::TRACK_INPUTS;
-use super::network_layout::{MlpAt, TrackAt};
-use super::operands::{Bias, Operand, Output};
-use super::{groups_for, Bind, Dispatch, GpuDevice, Part};
+use crate::gpu::products::codes::activation_code;
+use crate::gpu::products::dense_products::DenseProducts;
+use crate::gpu::products::half_layers::{half_train_layer, pad16, HalfLayers, HalfOut, Held};
+use crate::gpu::kernels::TRACK_INPUTS;
+use crate::gpu::layers::network_layout::{MlpAt, TrackAt};
+use crate::gpu::products::operands::{Bias, Operand, Output};
+use nprt_gpu::{groups_for, Bind, Dispatch, GpuDevice, Part};
 use crate::network::encoder::CODE_SIZE;
 
 /// How an MLP's first layer reads its input: from weight row `own_row`, `count` values per
@@ -139,7 +139,7 @@ impl MlpAt {
                     };
                     let bias = Part {
                         buffer,
-                        span: super::Span {
+                        span: nprt_gpu::Span {
                             offset,
                             len: layer.d_out,
                         },

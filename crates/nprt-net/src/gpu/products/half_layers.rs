@@ -8,10 +8,10 @@
 //! the pre-activation kept or the activation's derivative applied); its weight gradients are
 //! `half_products`'.
 
-use super::codes::BACKWARD;
-use super::kernels::{HALF_DENSE, HALF_DENSE_COOP, HALF_ROWS, HALF_TRAIN, HALF_TRAIN_COOP};
-use super::operands::Bias;
-use super::{groups_for, Bind, Dispatch, GpuDevice, KernelSource};
+use crate::gpu::products::codes::BACKWARD;
+use crate::gpu::kernels::{HALF_DENSE, HALF_DENSE_COOP, HALF_ROWS, HALF_TRAIN, HALF_TRAIN_COOP};
+use crate::gpu::products::operands::Bias;
+use nprt_gpu::{groups_for, Bind, Dispatch, GpuDevice, KernelSource};
 
 /// Rows a half-precision layer's workgroup covers: its inputs and outputs hold the rows up to
 /// the next multiple of this.
@@ -196,7 +196,7 @@ fn half_dense(
 }
 
 /// Where a mixed-precision product's results go.
-pub(super) struct HalfOut<'a> {
+pub(crate) struct HalfOut<'a> {
     /// The pre-activation: kept here by a forward product, read for the activation's
     /// derivative by a backward one.
     pub z: Option<&'a wgpu::Buffer>,
@@ -209,7 +209,7 @@ pub(super) struct HalfOut<'a> {
 /// The dispatch of `act(x·W + bias)` over `rows` rows of `x` (f16 rows of `k_pad` values)
 /// with `w` from its first row; `activation` 3 or 4 multiplies by ReLU's or SIREN's
 /// derivative at `out.z` instead (`half_train_layer.wgsl`).
-pub(super) fn half_train_layer(
+pub(crate) fn half_train_layer(
     gpu: &GpuDevice,
     rows: usize,
     (x, k_pad): (&wgpu::Buffer, usize),

@@ -3,16 +3,16 @@
 //! first shading layer's bias, the loss and its gradient at the tracks' outputs, and backward
 //! into every parameter, the grids' tables and the light codes.
 
-use super::codes::loss_code;
-use super::dense_products::DenseProducts;
-use super::gpu_trainer::{BatchBuffers, GpuTrainer};
-use super::half_layers::Held;
-use super::kernels::{COMBINE, GRID_BACKWARD, RADIANCE_LOSS, TRACK_GRADIENT};
-use super::mlp_step::{forward_targets, MlpTape};
-use super::network_forward::FirstLayer;
-use super::network_layout::TrackAt;
-use super::operands::{Bias, Operand, Output};
-use super::{groups_for, Dispatch};
+use crate::gpu::products::codes::loss_code;
+use crate::gpu::products::dense_products::DenseProducts;
+use crate::gpu::trainers::gpu_trainer::{BatchBuffers, GpuTrainer};
+use crate::gpu::products::half_layers::Held;
+use crate::gpu::kernels::{COMBINE, GRID_BACKWARD, RADIANCE_LOSS, TRACK_GRADIENT};
+use crate::gpu::passes::mlp_step::{forward_targets, MlpTape};
+use crate::gpu::layers::network_forward::FirstLayer;
+use crate::gpu::layers::network_layout::TrackAt;
+use crate::gpu::products::operands::{Bias, Operand, Output};
+use nprt_gpu::{groups_for, Dispatch};
 use crate::encoding::hash_grid;
 use crate::loss::Loss;
 use crate::network::design::TRANSPORT_CODE;
@@ -40,7 +40,7 @@ impl GpuTrainer {
     /// its `codes`: parameter gradients into `grads`, the codes' gradient added to `d_codes`
     /// (cleared before), the loss summed into `loss`. Returns how many of `plan`'s dispatches
     /// it holds once the loss is made (the forward part).
-    pub(super) fn record_transport(
+    pub(crate) fn record_transport(
         &self,
         plan: &mut Vec<Dispatch>,
         b: &BatchBuffers,

@@ -3,13 +3,13 @@
 //! encoder fuses its own into `encoder_block`), the gradient at its input and its weights'
 //! gradients.
 
-use super::dense_products::DenseProducts;
-use super::kernels::{
+use crate::gpu::products::dense_products::DenseProducts;
+use crate::gpu::kernels::{
     CONV_FORWARD, CONV_INPUT_BACKWARD, CONV_INPUT_BACKWARD_THREADS, CONV_WEIGHT_BACKWARD,
 };
-use super::layer_at::ConvAt;
-use super::operands::Output;
-use super::{groups_for, Dispatch, GpuDevice, Part};
+use crate::gpu::layers::layer_at::ConvAt;
+use crate::gpu::products::operands::Output;
+use nprt_gpu::{groups_for, Dispatch, GpuDevice, Part};
 
 /// Chunks of image rows a convolution's weight gradients are summed over, at most: enough
 /// threads for a GPU (a 128 × 64 map's first encoder block at 8 maps: 256 chunks × 896

@@ -1,15 +1,15 @@
 //! An MLP's share of a training step: the buffers its forward pass keeps for backward, and its
 //! backward pass into every layer's gradients (the weights' summed over chunks of rows).
 
-use super::codes::{activation_code, BACKWARD};
-use super::dense_products::DenseProducts;
-use super::half_layers::held_halves;
-use super::half_layers::Held;
-use super::kernels::GEMM_TILE;
-use super::network_forward::ForwardTargets;
-use super::network_layout::MlpAt;
-use super::operands::{Bias, Operand, Output};
-use super::{Dispatch, GpuDevice};
+use crate::gpu::products::codes::{activation_code, BACKWARD};
+use crate::gpu::products::dense_products::DenseProducts;
+use crate::gpu::products::half_layers::held_halves;
+use crate::gpu::products::half_layers::Held;
+use crate::gpu::kernels::GEMM_TILE;
+use crate::gpu::layers::network_forward::ForwardTargets;
+use crate::gpu::layers::network_layout::MlpAt;
+use crate::gpu::products::operands::{Bias, Operand, Output};
+use nprt_gpu::{Dispatch, GpuDevice};
 
 /// A weight gradient's product is split into chunks of at least ROW_CHUNK rows, at most
 /// ROW_CHUNKS of them (a 256 × 256 layer at batch 16,384: 32 chunks of 512 rows, 512
@@ -19,7 +19,7 @@ const ROW_CHUNKS: usize = 32;
 
 /// How a weight gradient's sum over `rows` rows is split: `[rows a chunk, chunks]`, each chunk
 /// a multiple of `align` rows (a tensor-core product's tile side; 1 for `gemm`).
-pub(super) fn row_chunks(rows: usize, align: usize) -> [usize; 2] {
+pub(crate) fn row_chunks(rows: usize, align: usize) -> [usize; 2] {
     let chunk = rows
         .div_ceil(ROW_CHUNKS)
         .next_multiple_of(align)

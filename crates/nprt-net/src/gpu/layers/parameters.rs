@@ -5,7 +5,7 @@
 
 use nprt_gpu::{GpuDevice, Span};
 
-use crate::network::parameters::Parameters;
+use crate::parameters::Parameters;
 
 /// The flat layout of a network's tensors.
 pub struct ParameterLayout {

@@ -1,12 +1,12 @@
 //! Where each tensor of a network lies in the flat parameter buffers, in the network's own
 //! structure (encoder blocks, tracks, layers), as the training step's dispatches address them.
 
-use super::encoder_blocks::EncoderAt;
-use super::half_layers::{HalfLayers, HalfWeight};
-use super::layer_at::DenseAt;
-use super::parameters::ParameterLayout;
-use super::Span;
-use super::{Dispatch, GpuDevice};
+use crate::gpu::layers::light_encoder::EncoderAt;
+use crate::gpu::products::half_layers::{HalfLayers, HalfWeight};
+use crate::gpu::layers::layer_at::DenseAt;
+use crate::gpu::layers::parameters::ParameterLayout;
+use nprt_gpu::Span;
+use nprt_gpu::{Dispatch, GpuDevice};
 use crate::encoding::hash_grid;
 use crate::network::activation::Activation;
 use crate::network::design::TRANSPORT_CODE;

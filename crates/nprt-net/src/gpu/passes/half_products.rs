@@ -12,14 +12,14 @@
 //! gradients, and Adam divides it back out; f16 values saturate instead of overflowing. The
 //! light encoder, the hash grids and the light code's share stay in f32.
 
-use super::codes::{activation_code, BACKWARD};
-use super::dense_products::DenseProducts;
-use super::half_layers::{half_train_layer, held_halves, pad16, HalfLayers, HalfOut};
-use super::kernels::{HALF_WEIGHT_GRAD, HALF_WEIGHT_GRAD_COOP};
-use super::mlp_step::{row_chunks, FirstLayerBias, MlpTape, Trainable};
-use super::network_layout::MlpAt;
-use super::operands::{Bias, Output};
-use super::{groups_for, Bind, Dispatch, GpuDevice};
+use crate::gpu::products::codes::{activation_code, BACKWARD};
+use crate::gpu::products::dense_products::DenseProducts;
+use crate::gpu::products::half_layers::{half_train_layer, held_halves, pad16, HalfLayers, HalfOut};
+use crate::gpu::kernels::{HALF_WEIGHT_GRAD, HALF_WEIGHT_GRAD_COOP};
+use crate::gpu::passes::mlp_step::{row_chunks, FirstLayerBias, MlpTape, Trainable};
+use crate::gpu::layers::network_layout::MlpAt;
+use crate::gpu::products::operands::{Bias, Output};
+use nprt_gpu::{groups_for, Bind, Dispatch, GpuDevice};
 
 /// The dispatch of xᵀ·dz, `[m, n]`, over `rows` rows cut into chunks of `chunk` rows, chunk
 /// c's sums into `partial` from c · m · n (`half_weight_sums.wgsl`).
@@ -50,7 +50,7 @@ impl Trainable<'_> {
     /// [`Self::mlp_backward`] in a mixed-precision step: the gradient at each layer's output
     /// as f16 rows for the products and as f32 rows for the bias's gradient (and `on_first`),
     /// the gradient at the first layer's input into `d_input` (f32) where given.
-    pub(super) fn half_mlp_backward(
+    pub(crate) fn half_mlp_backward(
         &self,
         plan: &mut Vec<Dispatch>,
         m: &MlpAt,

@@ -1,7 +1,7 @@
 //! Where a layer's tensors lie in a network's flat parameter buffers (`ParameterLayout`), and
 //! its shape: what every recorded dispatch addresses a layer by.
 
-use super::Span;
+use nprt_gpu::Span;
 use crate::network::conv::Conv;
 use crate::network::dense::Dense;
 

@@ -2,12 +2,12 @@
 //! gradient at the codes into every encoder weight, through the code layer and each block's
 //! pool, ReLU and skip.
 
-use super::conv_layers::{record_input_gradient, record_weight_gradients, Images, InputGradient};
-use super::dense_products::DenseProducts;
-use super::encoder_blocks::{BlockPass, EncoderAt};
-use super::kernels::ENCODER_POOL_BACKWARD;
-use super::operands::{Bias, Operand, Output};
-use super::{groups_for, Dispatch, GpuDevice};
+use crate::gpu::layers::conv::{record_input_gradient, record_weight_gradients, Images, InputGradient};
+use crate::gpu::products::dense_products::DenseProducts;
+use crate::gpu::layers::light_encoder::{BlockPass, EncoderAt};
+use crate::gpu::kernels::ENCODER_POOL_BACKWARD;
+use crate::gpu::products::operands::{Bias, Operand, Output};
+use nprt_gpu::{groups_for, Dispatch, GpuDevice};
 use crate::network::encoder::{CHANNELS, CODE_SIZE};
 
 impl EncoderAt {

@@ -6,9 +6,9 @@ use std::path::Path;
 
 use anyhow::Result;
 
-use super::kernels::ADAM;
-use super::parameters::ParameterLayout;
-use super::{groups_for, Dispatch, GpuDevice};
+use crate::gpu::kernels::ADAM;
+use crate::gpu::layers::parameters::ParameterLayout;
+use nprt_gpu::{groups_for, Dispatch, GpuDevice};
 use crate::optimiser::{bias_corrections_for, load_state, save_state, ADAM_BETA1, ADAM_BETA2};
 
 /// Adam's moments and step count for one network's flat buffers, and its dispatch.

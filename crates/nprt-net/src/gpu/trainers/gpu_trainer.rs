@@ -13,35 +13,35 @@ use std::sync::Arc;
 
 use anyhow::Result;
 
-use super::device_adam::DeviceAdam;
-use super::device_dataset::DeviceDataset;
-use super::kernels::GATHER_SAMPLES;
-use super::mlp_step::Trainable;
-use super::network_layout::NetworkLayout;
-use super::parameters::ParameterLayout;
-use super::plans::{Pass, Plans};
-use super::{groups_for, Dispatch, GpuDevice};
+use crate::gpu::passes::device_adam::DeviceAdam;
+use crate::gpu::trainers::device_dataset::DeviceDataset;
+use crate::gpu::kernels::GATHER_SAMPLES;
+use crate::gpu::passes::mlp_step::Trainable;
+use crate::gpu::layers::network_layout::NetworkLayout;
+use crate::gpu::layers::parameters::ParameterLayout;
+use crate::gpu::trainers::plans::{Pass, Plans};
+use nprt_gpu::{groups_for, Dispatch, GpuDevice};
 use crate::cpu::Samples;
 use crate::encoding::features::FEATURES;
 use crate::encoding::hash_grid;
 use crate::loss::Loss;
 use crate::network::encoder::CODE_SIZE;
 use crate::network::nprt_net::NprtNet;
-use crate::Precision;
+use crate::precision::Precision;
 use nprt_gpu::{KernelTime, KernelTimer};
 
 /// A network's parameters, gradients and Adam moments on the device, and the step that trains
 /// them.
 pub struct GpuTrainer {
-    pub(super) gpu: Arc<GpuDevice>,
+    pub(crate) gpu: Arc<GpuDevice>,
     layout: ParameterLayout,
     /// Where each tensor lies, in the network's structure.
-    pub(super) net: NetworkLayout,
+    pub(crate) net: NetworkLayout,
     /// The network's shapes on the host (their values are the initial ones, not kept current).
     shapes: NprtNet,
-    pub(super) params: wgpu::Buffer,
-    pub(super) grads: wgpu::Buffer,
-    pub(super) resolutions: wgpu::Buffer,
+    pub(crate) params: wgpu::Buffer,
+    pub(crate) grads: wgpu::Buffer,
+    pub(crate) resolutions: wgpu::Buffer,
     /// The step's dispatches for the last batch shapes used (training's and validation's, and
     /// their epochs' last, shorter batches), recorded again for every batch of the shape;
     /// the most recently used last.
@@ -112,7 +112,7 @@ struct StepPlan {
 }
 
 /// A batch on the device, and what its step computes besides gradients.
-pub(super) struct BatchBuffers {
+pub(crate) struct BatchBuffers {
     pub rows: usize,
     /// What the loss's gradient is multiplied by, and Adam divides by: 1 in f32; in mixed
     /// precision 3 · rows rounded up to a power of two, which makes the gradient at the outputs
@@ -193,7 +193,7 @@ impl GpuTrainer {
     }
 
     /// The trainer's parameters and gradients, for the MLPs' passes.
-    pub(super) fn trainable(&self) -> Trainable<'_> {
+    pub(crate) fn trainable(&self) -> Trainable<'_> {
         Trainable {
             gpu: &self.gpu,
             params: &self.params,

@@ -5,20 +5,20 @@
 //! the masked loss; then backward into every weight's gradient. It computes what the CPU
 //! engine's `cpu::unet` computes, in f32, and the tests hold the two together.
 
-use super::codes::loss_code;
-use super::conv_layers::{
+use crate::gpu::products::codes::loss_code;
+use crate::gpu::layers::conv::{
     record_conv, record_input_gradient, record_weight_gradients, Images, InputGradient,
 };
-use super::dense_products::DenseProducts;
-use super::encoder_blocks::{BlockPass, EncoderAt};
-use super::kernels::{
+use crate::gpu::products::dense_products::DenseProducts;
+use crate::gpu::layers::light_encoder::{BlockPass, EncoderAt};
+use crate::gpu::kernels::{
     MAX_POOL, OFFSET_BACKWARD, PLANE_OFFSET, POOL_BACKWARD, UNET_LOSS, UPSAMPLE_BACKWARD,
     UPSAMPLE_CONCAT,
 };
-use super::layer_at::{ConvAt, DenseAt};
-use super::operands::{Bias, Operand, Output};
-use super::parameters::ParameterLayout;
-use super::{groups_for, Dispatch, GpuDevice};
+use crate::gpu::layers::layer_at::{ConvAt, DenseAt};
+use crate::gpu::products::operands::{Bias, Operand, Output};
+use crate::gpu::layers::parameters::ParameterLayout;
+use nprt_gpu::{groups_for, Dispatch, GpuDevice};
 use crate::encoding::features::FEATURES;
 use crate::loss::Loss;
 use crate::network::encoder::CODE_SIZE;
