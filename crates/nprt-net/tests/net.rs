@@ -14,7 +14,7 @@ use rand_pcg::Pcg64Mcg;
 
 #[test]
 fn transport_parameter_counts_are_the_papers() {
-    for design in Design::ALL {
+    for design in Design::PAPER {
         for activation in [Activation::Siren, Activation::Relu] {
             let net = ModelConfig::new(design, Some(activation)).build(&mut Init::new(0));
             let (ours, paper) = (net.transport_params(), design.paper_params());
@@ -349,6 +349,7 @@ fn weights_files_have_the_headers_models_were_written_with() {
         let written = std::str::from_utf8(&bytes[8..8 + n]).unwrap();
         assert_eq!(written, header.as_str().unwrap(), "{tag}");
     }
-    assert_eq!(golden.len(), Design::ALL.len() + 1);
+    // The paper's four designs' headers and the U-Net's: a design added since has none.
+    assert_eq!(golden.len(), Design::PAPER.len() + 1);
     std::fs::remove_dir_all(&dir).ok();
 }
