@@ -270,7 +270,7 @@ fn paper_ms(what: &str) -> String {
             return format!("{:.2}", published::ENCODER_MS);
         }
         if what == format!("{name}: network") {
-            return format!("{:.2}", published::network_ms(d));
+            return published::network_ms(d).map_or("–".into(), |ms| format!("{ms:.2}"));
         }
     }
     "–".into()
@@ -298,10 +298,12 @@ fn table5(md: &mut String, e: &Evaluation, kitchen: bool, orderings: &[Ordering]
         let Some(m) = design_row(e, d) else { continue };
         let ratio = ds.map_or("–".into(), |r| format!("{:.3}", rmse(m) / r));
         let paper = published::kitchen_rmse_e3(d);
-        let paper_ratio = paper / published::kitchen_rmse_e3(Design::Dsep);
+        let paper_ratio = paper.zip(published::kitchen_rmse_e3(Design::Dsep));
+        let paper_ratio = paper_ratio.map_or("–".into(), |(p, ds)| format!("{:.3}", p / ds));
+        let paper = paper.map_or("–".into(), |p| format!("{p:.1}"));
         writeln!(
             md,
-            "| {} | {} | {} | {ratio} | {paper:.1} | {paper_ratio:.3} |",
+            "| {} | {} | {} | {ratio} | {paper} | {paper_ratio} |",
             m.name,
             e3(m, Metrics::LOG_L1),
             e3(m, Metrics::RMSE)

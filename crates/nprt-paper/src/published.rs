@@ -17,26 +17,23 @@ pub const MISSING: &str = "Table 2's and Table 6's figures, Table 5's log-loss a
 /// Tables 3 and 4: the light encoder's milliseconds per 512² frame.
 pub const ENCODER_MS: f64 = 0.34;
 
-/// Tables 3 and 4: each design's network, milliseconds per 512² frame.
-pub fn network_ms(design: Design) -> f64 {
-    match design {
-        Design::Baseline => 9.73,
-        Design::Prt => 10.57,
-        Design::Albedo => 10.60,
-        Design::Dsep => 16.02,
-    }
+/// Tables 3 and 4: each of the paper's designs' network, milliseconds per 512² frame (None for
+/// a design beyond the paper).
+pub fn network_ms(design: Design) -> Option<f64> {
+    of_paper_design([9.73, 10.57, 10.60, 16.02], design)
 }
 
 /// Tables 3 and 4: Falcor's path tracing at 5 spp, milliseconds per 512² frame (a range over
 /// the paper's scenes).
 pub const PATH_TRACING_5SPP_MS: (f64, f64) = (19.0, 36.0);
 
-/// Table 5, KITCHEN: RMSE × 10³ per design.
-pub fn kitchen_rmse_e3(design: Design) -> f64 {
-    match design {
-        Design::Baseline => 16.6,
-        Design::Prt => 15.0,
-        Design::Albedo => 15.1,
-        Design::Dsep => 14.8,
-    }
+/// Table 5, KITCHEN: RMSE × 10³ per design (None for a design beyond the paper).
+pub fn kitchen_rmse_e3(design: Design) -> Option<f64> {
+    of_paper_design([16.6, 15.0, 15.1, 14.8], design)
+}
+
+/// `design`'s figure of `figures`, given in [`Design::PAPER`]'s order (the paper's tables').
+fn of_paper_design(figures: [f64; 4], design: Design) -> Option<f64> {
+    let index = Design::PAPER.iter().position(|&d| d == design)?;
+    Some(figures[index])
 }
