@@ -105,12 +105,13 @@ mod tests {
             err,
             "unknown map normalisation 'max' (expected mean or channel)"
         );
+        // A list of three or more: commas, then "or" (the designs' names, whatever they are).
         let err = serde_json::from_str::<Design>("\"mlp\"")
             .unwrap_err()
             .to_string();
-        assert!(
-            err.contains("unknown design 'mlp' (expected baseline, prt, albedo or dsep)"),
-            "{err}"
-        );
+        let names = Design::ALL.map(Design::name);
+        let (last, rest) = names.split_last().unwrap();
+        let want = format!("unknown design 'mlp' (expected {} or {last})", rest.join(", "));
+        assert!(rest.len() >= 2 && err.contains(&want), "{err}");
     }
 }
