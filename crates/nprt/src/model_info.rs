@@ -92,10 +92,14 @@ fn print_description(s: &ModelSummary) {
     let (paper, transport) = (s.paper_params, s.transport_params);
     let mb = |params: usize| params as f64 * 4.0 / 1e6;
     println!("encoder parameters:   {:>10}", s.encoder_params);
-    println!(
-        "transport parameters: {transport:>10} (paper: {paper}, {:+.2}%)",
-        (transport as f64 / paper as f64 - 1.0) * 100.0
-    );
+    let against = match paper {
+        0 => "a design beyond the paper's Table 1".to_string(),
+        _ => format!(
+            "paper: {paper}, {:+.2}%",
+            (transport as f64 / paper as f64 - 1.0) * 100.0
+        ),
+    };
+    println!("transport parameters: {transport:>10} ({against})");
     if s.grid_entries > 0 {
         println!(
             "hash grid entries:    {:>10} ({:.2} MB as f32)",
