@@ -40,8 +40,8 @@ pub struct GenerateOptions {
     pub camera: CameraChoice,
     /// Render only views with index ≡ K (mod N).
     pub shard: (u64, u64),
-    /// Where the views are path traced: the CPU, or the same tracer on the GPU (recorded in
-    /// the manifest; a dataset is resumed on the tracer that began it).
+    /// Where the views are path traced: the CPU, or the same tracer on the GPU (the one that
+    /// began a dataset is recorded in its manifest; either resumes it).
     pub device: TraceDevice,
     pub progress: bool,
 }

@@ -71,6 +71,16 @@ impl Paired {
         }
     }
 
+    /// The mean difference with its standard error, as reports print it: with no ± where
+    /// fewer than two differences give no spread (and "none" where there are none).
+    pub fn spread(&self) -> String {
+        match self.views {
+            0 => "none".into(),
+            1 => format!("{:+.4} (one, no spread)", self.diff),
+            _ => format!("{:+.4} ± {:.4}", self.diff, self.se),
+        }
+    }
+
     /// The verdict on "a is lower than b" (every metric here is an error).
     pub fn lower(&self) -> Verdict {
         if self.diff + DECISIVE_SE * self.se < 0.0 {
@@ -99,13 +109,12 @@ impl Claim {
         let mean = |v: &[f64]| v.iter().sum::<f64>() / v.len().max(1) as f64;
         Claim {
             text: format!(
-                "{} beats {} in {what} ({:.4} vs {:.4}; per {per} {:+.4} ± {:.4}, lower on {} of {})",
+                "{} beats {} in {what} ({:.4} vs {:.4}; per {per} {}, lower on {} of {})",
                 a.0,
                 b.0,
                 mean(a.1),
                 mean(b.1),
-                p.diff,
-                p.se,
+                p.spread(),
                 p.lower_on,
                 p.views
             ),
@@ -144,8 +153,8 @@ impl Claim {
         let p = Paired::new(&a.per_pair, &b.per_pair);
         Claim {
             text: format!(
-                "{} flickers less than {} along the camera path (temporal error {:.4} vs {:.4}; per frame pair {:+.4} ± {:.4}, lower on {} of {})",
-                a.name, b.name, a.temporal_error, b.temporal_error, p.diff, p.se, p.lower_on, p.views
+                "{} flickers less than {} along the camera path (temporal error {:.4} vs {:.4}; per frame pair {}, lower on {} of {})",
+                a.name, b.name, a.temporal_error, b.temporal_error, p.spread(), p.lower_on, p.views
             ),
             verdict: p.lower(),
             paired: p,

@@ -2,7 +2,12 @@
 
 use std::path::PathBuf;
 
+use anyhow::{bail, Result};
 use nprt_render::DEFAULT_DIRECT_SPP;
+use nprt_trace::Frame;
+
+/// The most frames the warmed radiance caches render before the path: a cache settles in tens.
+pub const MAX_NRC_WARMUP: usize = 1_000;
 
 /// What to evaluate; `Default` needs `data` and `models` filled in.
 #[derive(Clone, Debug)]
@@ -28,6 +33,47 @@ pub struct EvalOptions {
     /// Frames the warmed radiance caches render before the path's first (0: cold ones only).
     pub nrc_warmup: usize,
     pub progress: bool,
+}
+
+impl EvalOptions {
+    /// Refuses options no evaluation can run, before any work: counts of zero, sizes whose
+    /// frames the machine cannot hold (the memory check `render` and `generate` make), and a
+    /// warm-up without end. Each message names the flag.
+    pub fn check(&self) -> Result<()> {
+        if self.sh_spp == 0 || self.timing_res < 8 {
+            bail!("--sh-spp must be at least 1 and --timing-res at least 8");
+        }
+        if self.max_views == Some(0) {
+            bail!("--views must be at least 1 (it limits the test views evaluated)");
+        }
+        let side = self.timing_res;
+        Frame::check_size(side, side, &format!("--timing-res {side}: a {side}×{side} frame"))?;
+        if self.temporal_frames == 0 {
+            return Ok(());
+        }
+        if self.temporal_frames < 2 || self.temporal_res < 8 {
+            bail!("--temporal-frames must be 0 or at least 2, and --temporal-res at least 8");
+        }
+        let side = self.temporal_res;
+        Frame::check_size(side, side, &format!("--temporal-res {side}: a {side}×{side} frame"))?;
+        // Every method's frames along the path are kept for the report, with the references'
+        // two halves and the path-traced rows: 3 f32 a pixel each.
+        let rows = 2 * (self.models.len() + 1) + 6;
+        let bytes = self.temporal_frames as u128 * rows as u128 * (side as u128).pow(2) * 12;
+        let what = format!(
+            "--temporal-frames {} at --temporal-res {side}",
+            self.temporal_frames
+        );
+        nprt_io::ensure_memory(bytes, &what)?;
+        if self.nrc_warmup > MAX_NRC_WARMUP {
+            bail!(
+                "--nrc-warmup {} is more than {MAX_NRC_WARMUP} frames (a radiance cache \
+                 settles in tens)",
+                self.nrc_warmup
+            );
+        }
+        Ok(())
+    }
 }
 
 impl Default for EvalOptions {

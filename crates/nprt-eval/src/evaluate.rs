@@ -71,9 +71,7 @@ pub struct Evaluation {
 /// Runs the whole evaluation: the networks first (the slowest Neural PRT design sets the
 /// equal-time sample count), then path tracing, denoised path tracing and SH PRT.
 pub fn evaluate(o: &EvalOptions, engine: Engine) -> Result<Evaluation> {
-    if o.sh_spp == 0 || o.timing_res < 8 {
-        bail!("--sh-spp must be at least 1 and --timing-res at least 8");
-    }
+    o.check()?;
     let Loaded {
         manifest,
         scene,
@@ -245,9 +243,6 @@ fn temporal_run(
     let settings = &manifest.settings;
     if o.temporal_frames == 0 {
         return Ok((None, "not run (--temporal-frames 0)".into()));
-    }
-    if o.temporal_frames < 2 || o.temporal_res < 8 {
-        bail!("--temporal-frames must be 0 or at least 2, and --temporal-res at least 8");
     }
     let volume = CameraVolume::from(&settings.camera_volume);
     let mut held_out = maps.values();

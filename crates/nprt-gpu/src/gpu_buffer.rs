@@ -24,6 +24,20 @@ impl GpuDevice {
         Ok(())
     }
 
+    /// Refuses a `width` × `height` frame (`what`) whose side passes the largest 2D texture
+    /// this device makes (16,384 on most: the rasterised G-buffer is one texture), saying so
+    /// before any of it is made.
+    pub fn check_frame(&self, width: u32, height: u32, what: &str) -> anyhow::Result<()> {
+        let most = self.device.limits().max_texture_dimension_2d;
+        if width.max(height) > most {
+            anyhow::bail!(
+                "{what}: {width}×{height} pixels, but the GPU ({}) rasterises frames of at most                  {most} pixels a side; use a smaller frame or --device cpu",
+                self.adapter
+            );
+        }
+        Ok(())
+    }
+
     /// The most bytes one storage buffer on this device holds and binds whole.
     pub fn max_binding_bytes(&self) -> u64 {
         let limits = self.device.limits();

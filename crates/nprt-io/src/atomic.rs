@@ -89,11 +89,7 @@ pub fn write_atomically(path: &Path, write: impl FnOnce(&Path) -> Result<()>) ->
     let name = target
         .file_name()
         .with_context(|| format!("output path '{}' has no file name", path.display()))?;
-    let tmp = dir.join(format!(
-        ".{}.{}{TMP_SUFFIX}",
-        name.to_string_lossy(),
-        std::process::id()
-    ));
+    let tmp = dir.join(temporary_name(name));
     if let Err(e) = write(&tmp) {
         let _ = std::fs::remove_file(&tmp);
         return Err(e.context(format!("cannot write '{}'", path.display())));
@@ -103,6 +99,29 @@ pub fn write_atomically(path: &Path, write: impl FnOnce(&Path) -> Result<()>) ->
 }
 
 const TMP_SUFFIX: &str = ".tmp";
+/// The most bytes a file name may have (Linux, macOS and Windows alike).
+const NAME_MAX: usize = 255;
+
+/// The temporary file's name beside `name`: `.{name}.{pid}.tmp`, where the name part is cut to
+/// a prefix and a hash of the whole if that would pass [`NAME_MAX`] (a long name the file
+/// system accepts must not fail for its temporary's sake).
+fn temporary_name(name: &std::ffi::OsStr) -> String {
+    use std::hash::{Hash, Hasher};
+    let name = name.to_string_lossy();
+    let pid = std::process::id();
+    let whole = format!(".{name}.{pid}{TMP_SUFFIX}");
+    if whole.len() <= NAME_MAX {
+        return whole;
+    }
+    let mut hasher = std::hash::DefaultHasher::new();
+    name.hash(&mut hasher);
+    // `~` and 16 hex digits replace the cut end.
+    let mut cut = NAME_MAX - (whole.len() - name.len()) - 17;
+    while !name.is_char_boundary(cut) {
+        cut -= 1;
+    }
+    format!(".{}~{:016x}.{pid}{TMP_SUFFIX}", &name[..cut], hasher.finish())
+}
 
 /// The temporary files [`write_atomically`] left in `dir` (runs killed mid-write leave them),
 /// each with the name of the file it was to become; none where `dir` does not exist.
@@ -185,6 +204,22 @@ mod tests {
             0,
             "nothing may be left behind"
         );
+        std::fs::remove_dir_all(&d).unwrap();
+    }
+
+    /// A file name of 250 bytes (the file system takes up to 255) is written: its temporary's
+    /// name is shortened to fit.
+    #[test]
+    fn a_long_file_name_is_written_through_a_shorter_temporary() {
+        let d = dir("long");
+        for name in ["a".repeat(250), format!("{}é", "b".repeat(252))] {
+            let path = d.join(&name);
+            write_file(&path, b"kept").unwrap();
+            assert_eq!(std::fs::read(&path).unwrap(), b"kept");
+            let tmp = temporary_name(std::ffi::OsStr::new(&name));
+            assert!(tmp.len() <= NAME_MAX && tmp.ends_with(".tmp"), "{tmp}");
+        }
+        assert_eq!(temporary_name(std::ffi::OsStr::new("v.exr")), format!(".v.exr.{}.tmp", std::process::id()));
         std::fs::remove_dir_all(&d).unwrap();
     }
 

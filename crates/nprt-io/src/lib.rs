@@ -38,7 +38,7 @@ pub use image_read::{linear_rgb, read_linear_rgb, LinearImage};
 pub use indicatif::ProgressBar;
 pub use input_file::{check_input, read_input, read_input_string};
 pub use limits::{available_memory, check_threads, ensure_memory, thread_limit};
-pub use lock_file::open_lock_file;
+pub use lock_file::{lock_folder, open_lock_file};
 pub use plot::plot_lines;
 pub use png::{srgb8, to_image, write_png};
 pub use progress::progress_bar;

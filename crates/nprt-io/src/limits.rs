@@ -40,12 +40,13 @@ pub fn thread_limit() -> usize {
     8 * cores
 }
 
-/// Refuses a worker-thread count of 0 or above [`thread_limit`].
-pub fn check_threads(n: usize) -> Result<()> {
+/// Refuses a worker-thread count of 0 or above [`thread_limit`], given by `source` (a flag or
+/// an environment variable).
+pub fn check_threads(n: usize, source: &str) -> Result<()> {
     let limit = thread_limit();
     if n == 0 || n > limit {
         bail!(
-            "--threads {n} is not in 1..={limit} (8 per core of the {} cores here)",
+            "{source} {n} is not in 1..={limit} (8 per core of the {} cores here)",
             limit / 8
         );
     }
@@ -68,10 +69,10 @@ mod tests {
             err.contains("a huge frame needs") && err.contains("GiB"),
             "{err}"
         );
-        check_threads(1).unwrap();
-        check_threads(thread_limit()).unwrap();
+        check_threads(1, "--threads").unwrap();
+        check_threads(thread_limit(), "--threads").unwrap();
         for n in [0, thread_limit() + 1, 100_000] {
-            let err = check_threads(n).unwrap_err().to_string();
+            let err = check_threads(n, "--threads").unwrap_err().to_string();
             assert!(err.contains(&format!("--threads {n}")), "{err}");
         }
     }

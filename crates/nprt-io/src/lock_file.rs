@@ -31,6 +31,33 @@ pub fn open_lock_file(path: &Path) -> Result<File> {
         .with_context(|| format!("cannot open lock file '{}'", path.display()))
 }
 
+/// Takes the folder `dir` for this run until the returned file is dropped (the OS releases it
+/// if the process dies): its `.lock` holds an advisory lock and this process's id. A second
+/// run on the same folder is refused by name, `what` saying what the folder is (a "model
+/// folder", an "experiment folder") and `flag` how to give another.
+pub fn lock_folder(dir: &Path, what: &str, flag: &str) -> Result<File> {
+    use std::io::Write;
+    let path = dir.join(".lock");
+    let mut file = open_lock_file(&path)?;
+    if let Err(e) = file.try_lock() {
+        let holder = std::fs::read_to_string(&path).unwrap_or_default();
+        return Err(match e {
+            std::fs::TryLockError::WouldBlock => anyhow::anyhow!(
+                "{what} '{}' is in use by another run ({}); wait for it to end or use another {flag}",
+                dir.display(),
+                holder.trim()
+            ),
+            std::fs::TryLockError::Error(e) => {
+                anyhow::Error::new(e).context(format!("cannot lock '{}'", path.display()))
+            }
+        });
+    }
+    file.set_len(0)
+        .and_then(|()| write!(file, "pid {}", std::process::id()))
+        .with_context(|| format!("cannot write '{}'", path.display()))?;
+    Ok(file)
+}
+
 #[cfg(all(test, unix))]
 mod tests {
     use super::*;

@@ -3,6 +3,7 @@
 
 use std::path::{Path, PathBuf};
 
+use anyhow::{bail, Result};
 use nprt_data::{CameraChoice, GenerateOptions};
 use nprt_net::{Design, DirectLight, Engine, ModelConfig};
 
@@ -108,10 +109,28 @@ impl Experiment {
         }
     }
 
+    /// Refuses paths that are not UTF-8, naming the flag, before any work: the experiment
+    /// writes them into its records, the report and `nprt generate`'s flags, which would hold
+    /// another path.
+    pub fn check_paths(&self) -> Result<()> {
+        let paths = [("--out", Some(&self.out)), ("--camera-volume", self.camera.file.as_ref())];
+        for (flag, path) in paths {
+            if let Some(p) = path.filter(|p| p.to_str().is_none()) {
+                bail!(
+                    "{flag} '{}' is not valid UTF-8: nprt paper writes its paths into its \
+                     records and flags; use a path of UTF-8 characters",
+                    p.display()
+                );
+            }
+        }
+        Ok(())
+    }
+
     /// The `nprt generate` flags that render this experiment's dataset (into `OUT/dataset`),
     /// for a cluster to render it first (`scripts/slurm-generate N -- FLAGS`, docs/paper.md);
     /// a run then finds it complete.
-    pub fn generate_flags(&self) -> Vec<String> {
+    pub fn generate_flags(&self) -> Result<Vec<String>> {
+        self.check_paths()?;
         let o = self.generate_options(&self.dataset_dir());
         let mut flags: Vec<String> = [
             ("--scene", o.scene.clone()),
@@ -134,7 +153,7 @@ impl Experiment {
         if let Some(f) = &o.camera.file {
             flags.extend(["--camera-volume".into(), f.display().to_string()]);
         }
-        flags
+        Ok(flags)
     }
 
     pub(crate) fn dataset_dir(&self) -> PathBuf {

@@ -62,9 +62,7 @@ impl Ordering {
                         };
                         let by = match v {
                             Verdict::Holds => String::new(),
-                            _ => {
-                                format!(" ({:+.4} ± {:.4})", c.claim.paired.diff, c.claim.paired.se)
-                            }
+                            _ => format!(" ({})", c.claim.paired.spread()),
                         };
                         format!("{}{vs}{by}", c.metric)
                     })

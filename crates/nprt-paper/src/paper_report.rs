@@ -9,7 +9,8 @@ use std::path::{Path, PathBuf};
 use anyhow::Result;
 use nprt_eval::claim::Verdict;
 use nprt_eval::{
-    crop_image, markdown_to_html, mean_and_se, plot_validation, row_name, Evaluation, MethodResult,
+    crop_image, markdown_to_html, mean_and_se, mean_and_se_text, plot_validation, row_name,
+    Evaluation, MethodResult,
     Metrics, VALIDATION_PLOT,
 };
 use nprt_net::{Design, ModelConfig};
@@ -161,8 +162,7 @@ fn over_views(m: &MethodResult, k: usize) -> (f64, f64) {
 
 /// [`over_views`] × 10³, as the paper prints it.
 fn e3(m: &MethodResult, k: usize) -> String {
-    let (mean, se) = over_views(m, k);
-    format!("{:.2} ± {:.2}", 1e3 * mean, 1e3 * se)
+    mean_and_se_text(m.per_view.iter().map(|v| v.values()[k]), 1e3)
 }
 
 fn design_row(e: &Evaluation, d: Design) -> Option<&MethodResult> {

@@ -30,9 +30,11 @@ pub struct Outcome {
 impl Experiment {
     /// Runs every stage not already done, in order.
     pub fn run(&self) -> Result<Outcome> {
+        self.check_paths()?;
         std::fs::create_dir_all(&self.out)
             .with_context(|| format!("cannot create '{}'", self.out.display()))?;
-        self.claim_folder()?;
+        let _lock = nprt_io::lock_folder(&self.out, "experiment folder", "--out")?;
+        let claim = self.claim()?;
         let mut log = StageLog::open(&self.out)?;
         let data = self.dataset_dir();
         log.begin(
@@ -44,6 +46,11 @@ impl Experiment {
         );
         let worked = stages::dataset(self, &data)?;
         log.end(worked)?;
+        // Claimed once the dataset stage has taken the settings: a run they are refused in
+        // leaves the folder free for the corrected command.
+        if let Some(claim) = claim {
+            claim.write()?;
+        }
         let models = self.models();
         for (i, config) in models.iter().enumerate() {
             let name = format!("train {}", config.label());
@@ -118,9 +125,10 @@ impl Experiment {
         })
     }
 
-    /// What the output folder is for, written on its first run: a later run with another
-    /// scene, lighting, budget or seed is refused rather than mixed into it.
-    fn claim_folder(&self) -> Result<()> {
+    /// What the output folder is for, recorded by its first run once its settings hold: a
+    /// later run with another scene, lighting, budget or seed is refused rather than mixed into
+    /// it. None where the folder is this experiment's already; the record to write otherwise.
+    fn claim(&self) -> Result<Option<Claim>> {
         let what = json!({
             "scene": self.scene,
             "envmaps": self.envmaps,
@@ -142,8 +150,20 @@ impl Experiment {
                     what
                 );
             }
-            return Ok(());
+            return Ok(None);
         }
-        nprt_io::write_file(&file, serde_json::to_vec_pretty(&what)?)
+        Ok(Some(Claim { file, what }))
+    }
+}
+
+/// An experiment's record, to write into its folder.
+struct Claim {
+    file: PathBuf,
+    what: serde_json::Value,
+}
+
+impl Claim {
+    fn write(&self) -> Result<()> {
+        nprt_io::write_file(&self.file, serde_json::to_vec_pretty(&self.what)?)
     }
 }

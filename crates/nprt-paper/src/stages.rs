@@ -84,13 +84,17 @@ pub fn eval_options(x: &Experiment, data: &Path, models: &[PathBuf]) -> EvalOpti
 }
 
 /// The evaluation against every baseline, written as a report in `report`, or the one a
-/// previous run wrote there from the same inputs; whether it ran.
+/// previous run wrote there from the same inputs; whether it ran. The kept one is taken only
+/// where its key holds the inputs and its outputs as this run wrote them (results.json and
+/// the pictures): a report rewritten by hand (`nprt eval --out` into the same folder) or with
+/// pictures gone is made again.
 pub fn evaluation(x: &Experiment, opts: &EvalOptions, report: &Path) -> Result<(Evaluation, bool)> {
-    let key = inputs_key(x, opts)?;
+    let inputs = inputs_key(x, opts)?;
     let key_file = report.join("evaluation.key");
     let results = report.join("results.json");
-    if read_key(&key_file).as_deref() == Some(key.as_str()) {
-        match read_json::<Evaluation>(&results) {
+    let kept = read_key(&key_file);
+    if kept.as_deref() == Some(format!("{inputs}\n{}", outputs_key(report)).as_str()) {
+        match read_json::<Evaluation>(&results).and_then(|e| held(e, opts)) {
             Ok(e) => {
                 println!(
                     "evaluation: as '{}' holds it (its inputs are unchanged)",
@@ -103,6 +107,7 @@ pub fn evaluation(x: &Experiment, opts: &EvalOptions, report: &Path) -> Result<(
     }
     let e = evaluate(opts, x.engine)?;
     let (md, _) = write_report(&e, report)?;
+    let key = format!("{inputs}\n{}", outputs_key(report));
     nprt_io::write_file(&key_file, &key)?;
     println!("evaluation report: '{}'", md.display());
     Ok((e, true))
@@ -122,7 +127,7 @@ pub fn ablation(
     }
     let key = inputs_key(x, opts)?;
     if let Ok(s) = read_json::<Scored>(file) {
-        if s.key == key {
+        if s.key == key && s.rows.iter().all(|r| complete(r, None)) {
             return Ok((s.rows, false));
         }
     }
@@ -182,6 +187,46 @@ fn inputs_key(x: &Experiment, opts: &EvalOptions) -> Result<String> {
     }
     h.update(format!("{opts:?} {} {}", x.engine.name(), Oidn::open().is_ok()).as_bytes());
     Ok(h.finalize().to_hex().to_string())
+}
+
+/// What a report folder's evaluation wrote, by content: results.json, report.md and every
+/// picture report.md shows (the paper's report adds pictures of its own to the same folder).
+fn outputs_key(report: &Path) -> String {
+    let mut h = blake3::Hasher::new();
+    let md = std::fs::read_to_string(report.join("report.md")).unwrap_or_default();
+    for file in ["results.json", "report.md"] {
+        h.update(&std::fs::read(report.join(file)).unwrap_or_default());
+    }
+    for picture in md.split("](").skip(1).filter_map(|rest| rest.split(')').next()) {
+        h.update(picture.as_bytes());
+        // A picture gone hashes as no bytes: the key then differs.
+        h.update(&std::fs::read(report.join(picture)).unwrap_or_default());
+    }
+    h.finalize().to_hex().to_string()
+}
+
+/// `e` read back, refused unless it is the evaluation `opts` asks for: every model's row and
+/// every method's figures on as many test views, each finite.
+fn held(e: Evaluation, opts: &EvalOptions) -> Result<Evaluation> {
+    let views = opts.max_views.map_or(e.test_views, |n| n.min(e.test_views));
+    anyhow::ensure!(
+        e.test_views == views && e.methods.len() > opts.models.len(),
+        "the kept evaluation is not this run's ({} test views, {} methods)",
+        e.test_views,
+        e.methods.len()
+    );
+    if let Some(m) = e.methods.iter().find(|m| !complete(m, Some(views))) {
+        anyhow::bail!("the kept evaluation's '{}' lacks figures", m.name);
+    }
+    Ok(e)
+}
+
+/// Whether `m` has a finite mean and a finite figure per view (`views` of them, where known).
+fn complete(m: &MethodResult, views: Option<usize>) -> bool {
+    let finite = |v: &nprt_eval::Metrics| v.values().iter().all(|x| x.is_finite());
+    !m.per_view.is_empty()
+        && views.is_none_or(|n| m.per_view.len() == n)
+        && m.per_view.iter().all(finite)
 }
 
 fn read(path: &Path) -> Result<Vec<u8>> {

@@ -3,7 +3,7 @@
 
 use std::path::PathBuf;
 
-use anyhow::Result;
+use anyhow::{Context, Result};
 use nprt_net::bench::pytorch_peer::{PeerRun, PeerScript, PeerVariant};
 use nprt_net::{
     measure_throughput, median, Activation, Design, DirectLight, Engine, ModelConfig, Precision,
@@ -281,6 +281,8 @@ fn infer(a: BenchInferArgs) -> Result<()> {
 
 fn train(a: BenchTrainArgs) -> Result<()> {
     check_profile(a.profile, &a.device)?;
+    nprt_net::Batch::check_size(a.batch_size, a.views, nprt_net::DEFAULT_ENCODER_WIDTH)
+        .context("--batch-size and --views")?;
     let threads = rayon::current_num_threads();
     let engine = a.device.engine()?;
     let rounds = a.rounds.max(1);

@@ -125,9 +125,27 @@ fn describe(e: &anyhow::Error) -> String {
     text
 }
 
+/// Worker threads: `--threads`, else RAYON_NUM_THREADS (which rayon would read unchecked),
+/// each held to the same bound; None for rayon's default (one per core).
+fn worker_threads(flag: Option<usize>) -> Result<Option<usize>> {
+    if let Some(n) = flag {
+        nprt_io::check_threads(n, "--threads")?;
+        return Ok(Some(n));
+    }
+    let Ok(value) = std::env::var("RAYON_NUM_THREADS") else {
+        return Ok(None);
+    };
+    let n: usize = (value.trim().parse())
+        .with_context(|| format!("RAYON_NUM_THREADS='{value}' is not a thread count"))?;
+    if n == 0 {
+        return Ok(None);
+    }
+    nprt_io::check_threads(n, "RAYON_NUM_THREADS")?;
+    Ok(Some(n))
+}
+
 fn run(cli: Cli) -> Result<()> {
-    if let Some(n) = cli.threads {
-        nprt_io::check_threads(n)?;
+    if let Some(n) = worker_threads(cli.threads)? {
         rayon::ThreadPoolBuilder::new()
             .num_threads(n)
             .build_global()

@@ -63,7 +63,7 @@ pub fn command(a: PaperArgs) -> Result<()> {
         ..Experiment::paper(&a.scene, &a.envmaps, &a.out, a.budget, a.device.engine()?)
     };
     if a.generate_flags {
-        println!("{}", x.generate_flags().join(" "));
+        println!("{}", x.generate_flags()?.join(" "));
         return Ok(());
     }
     let done = x.run()?;

@@ -454,7 +454,8 @@ fn a_second_training_run_on_one_folder_is_refused_by_name() {
     fails(
         &train_args(d, o, &["--epochs", "1"]),
         &[
-            "is in use by another training run",
+            "model folder",
+            "is in use by another run",
             &format!("pid {}", first.id()),
         ],
     );

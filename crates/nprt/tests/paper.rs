@@ -94,6 +94,36 @@ fn the_tiny_budget_writes_every_table_and_resumes() {
         md,
         "a resumed run writes the same tables"
     );
+    // A report rewritten by hand (an evaluation of one view into the same folder) is not taken
+    // for the run's own: the run evaluates again.
+    let models = dir.join("models");
+    let model = |name: &str| models.join(name).to_str().unwrap().to_string();
+    let data = dir.join("dataset");
+    ok(&[
+        "eval", "--data", data.to_str().unwrap(), "--model", &model("dsep"), "--views", "1",
+        "--out", report.to_str().unwrap(), "--temporal-frames", "0", "--device", "cpu",
+    ]);
+    let redone = ok(&args);
+    assert!(!redone.contains("its inputs are unchanged"), "{redone}");
+    let md = std::fs::read_to_string(report.join("paper.md")).unwrap();
+    assert!(!md.contains(" 1 test views"), "{md}");
+    // Pictures gone: evaluated again too.
+    std::fs::remove_dir_all(report.join("images")).unwrap();
+    let redone = ok(&args);
+    assert!(!redone.contains("its inputs are unchanged"), "{redone}");
+    assert!(report.join("images").is_dir());
+    // A stage time no run takes, read back, is refused by file.
+    let times = dir.join("stage-times.json");
+    let kept = std::fs::read_to_string(&times).unwrap();
+    let forged: serde_json::Value = serde_json::from_str(&kept).unwrap();
+    for secs in [1e308, -3600.0] {
+        let mut forged = forged.clone();
+        forged[0][1] = serde_json::json!(secs);
+        std::fs::write(&times, forged.to_string()).unwrap();
+        fails(&args, &["stage-times.json", "which no run takes"]);
+    }
+    std::fs::write(&times, kept).unwrap();
+
     // Another budget in the same folder is refused, naming both.
     fails(
         &[
@@ -132,4 +162,36 @@ fn a_dataset_rendered_from_the_printed_flags_is_the_one_a_run_needs() {
         run.contains("0 views rendered") && run.contains("28 already complete"),
         "{run}"
     );
+}
+
+/// A run refused before its dataset exists claims nothing (the corrected command is not
+/// refused for a setting it no longer asks), and an output path that is not UTF-8 is refused
+/// by its flag before any work.
+#[test]
+fn a_refused_run_claims_nothing_and_paths_must_be_utf8() {
+    let dir = fresh_dir("paper-claim");
+    let out = dir.to_str().unwrap();
+    fails(
+        &[
+            "paper", "--budget", "tiny", "--out", out, "--device", "cpu", "--scene",
+            "no-such-scene.xml",
+        ],
+        &["no-such-scene.xml"],
+    );
+    assert!(!dir.join("experiment.json").exists());
+    #[cfg(unix)]
+    {
+        use std::os::unix::ffi::OsStrExt;
+        let odd = dir.join(std::ffi::OsStr::from_bytes(b"out\xff"));
+        let o = std::process::Command::new(env!("CARGO_BIN_EXE_nprt"))
+            .args(["paper", "--budget", "tiny", "--device", "cpu", "--out"])
+            .arg(&odd)
+            .output()
+            .unwrap();
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(o.status.code(), Some(1), "{err}");
+        assert!(err.contains("--out") && err.contains("not valid UTF-8"), "{err}");
+        assert!(!odd.exists(), "nothing is made for a refused path");
+    }
+    std::fs::remove_dir_all(&dir).ok();
 }

@@ -40,9 +40,9 @@ pub struct Settings {
     #[serde(default, skip_serializing_if = "Jitter::is_none")]
     pub jitter: Jitter,
     pub camera_volume: VolumeRecord,
-    /// Which tracer rendered the views (they draw different random numbers, so a dataset is
-    /// resumed on the tracer that began it). Absent in datasets made before the GPU tracer:
-    /// the CPU's.
+    /// Which tracer began the dataset (informative: the two draw different random numbers but
+    /// agree within noise, so a dataset is resumed, or trained on, with either). Absent in
+    /// datasets made before the GPU tracer: the CPU's.
     #[serde(default)]
     pub tracer: TraceDevice,
 }

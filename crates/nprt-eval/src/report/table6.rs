@@ -20,13 +20,26 @@ pub fn table6<'a>(
     for (name, values) in rows {
         write!(md, "| {name} |")?;
         for k in Metrics::TABLE6 {
-            let (mean, se) = mean_and_se(values.iter().map(|m| m.values()[k]));
-            write!(md, " {:.2} ± {:.2} |", 1e3 * mean, 1e3 * se)?;
+            let text = mean_and_se_text(values.iter().map(|m| m.values()[k]), 1e3);
+            write!(md, " {text} |")?;
         }
         writeln!(md)?;
     }
     writeln!(md)?;
     Ok(())
+}
+
+/// The mean of `values` times `scale` and its standard error, as reports print them (two
+/// decimals): "mean ± se"; the mean alone where one value gives no spread; "–" where there is
+/// no value or the mean is not finite. A report never prints NaN.
+pub fn mean_and_se_text(values: impl Iterator<Item = f64>, scale: f64) -> String {
+    let v: Vec<f64> = values.collect();
+    let (mean, se) = mean_and_se(v.iter().copied());
+    match (v.len(), mean.is_finite(), se.is_finite()) {
+        (0, _, _) | (_, false, _) => "–".into(),
+        (_, true, true) => format!("{:.2} ± {:.2}", scale * mean, scale * se),
+        (_, true, false) => format!("{:.2}", scale * mean),
+    }
 }
 
 /// The mean of `values` and its standard error (NaN with fewer than two).
@@ -52,5 +65,10 @@ mod tests {
         // Sample variance 5/3 over 4 values.
         assert!((se - (5.0f64 / 3.0 / 4.0).sqrt()).abs() < 1e-12);
         assert!(mean_and_se([1.0].into_iter()).1.is_nan());
+        // Printed: no ± over one value, no NaN over none.
+        assert_eq!(mean_and_se_text([1.0, 2.0].into_iter(), 1e3), "1500.00 ± 500.00");
+        assert_eq!(mean_and_se_text([0.015].into_iter(), 1e3), "15.00");
+        assert_eq!(mean_and_se_text(std::iter::empty(), 1e3), "–");
+        assert_eq!(mean_and_se_text([f64::NAN, 1.0].into_iter(), 1e3), "–");
     }
 }

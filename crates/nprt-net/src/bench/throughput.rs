@@ -31,7 +31,7 @@ pub fn measure_throughput(
     precision: Precision,
     engine: Engine,
 ) -> anyhow::Result<f64> {
-    let batch = synthetic_batch(config, batch_size, views);
+    let batch = synthetic_batch(config, batch_size, views)?;
     #[cfg(feature = "gpu")]
     if engine.is_gpu() {
         return kernel_throughput(config, &batch, steps, warmup, precision);
@@ -53,14 +53,16 @@ pub fn measure_throughput(
     Ok((batch_size * steps) as f64 / timed.elapsed().as_secs_f64())
 }
 
-/// A batch of uniform random values (seeded): `batch_size` samples over `views` maps.
-fn synthetic_batch(config: &ModelConfig, batch_size: usize, views: usize) -> Batch {
+/// A batch of uniform random values (seeded): `batch_size` samples over `views` maps, refused
+/// where the machine cannot hold it.
+fn synthetic_batch(config: &ModelConfig, batch_size: usize, views: usize) -> anyhow::Result<Batch> {
+    Batch::check_size(batch_size, views, config.encoder_width)?;
     let mut rng = Pcg64Mcg::seed_from_u64(0);
     let w = config.encoder_width;
     let mut random = |n: usize, scale: f32| -> Vec<f32> {
         (0..n).map(|_| rng.random::<f32>() * scale).collect()
     };
-    Batch {
+    Ok(Batch {
         features: random(batch_size * FEATURES, 1.0),
         radiance: random(batch_size * 3, 4.0),
         view: (0..batch_size).map(|i| (i % views) as i64).collect(),
@@ -71,7 +73,7 @@ fn synthetic_batch(config: &ModelConfig, batch_size: usize, views: usize) -> Bat
         lights: random(views * 3 * w * w / 2, 1.0),
         light_width: w,
         picks: None,
-    }
+    })
 }
 
 /// The GPU time of each of our kernels in one training step in `precision` on the synthetic
@@ -87,7 +89,7 @@ pub fn profile_kernels(
 ) -> anyhow::Result<Vec<nprt_gpu::KernelTime>> {
     let net = config.build(&mut Init::new(0));
     let mut gpu = crate::gpu::GpuTrainer::new(&net, precision)?;
-    let batch = synthetic_batch(config, batch_size, views);
+    let batch = synthetic_batch(config, batch_size, views)?;
     let samples = batch.samples();
     for _ in 0..warmup {
         gpu.queue_step(&samples, Loss::LogL1, 1e-4);

@@ -31,6 +31,20 @@ pub struct Picks {
 }
 
 impl Batch {
+    /// Refuses a batch of `samples` samples over `views` maps `light_width` wide (0: maps not
+    /// counted) that the machine's memory cannot hold: its inputs, targets, scales and view
+    /// indices, and the maps, before any is allocated.
+    pub fn check_size(samples: usize, views: usize, light_width: usize) -> anyhow::Result<()> {
+        if samples == 0 || views == 0 {
+            anyhow::bail!("the batch size and the views per batch must be positive");
+        }
+        let per_sample = (FEATURES + 3 + 3) as u128 * 4 + 8;
+        let per_view = 3 * (light_width as u128).pow(2) / 2 * 4;
+        let bytes = samples as u128 * per_sample + views as u128 * per_view;
+        let what = format!("a batch of {samples} samples over {views} maps");
+        nprt_io::ensure_memory(bytes, &what)
+    }
+
     /// Gathers `samples` ((view position in `views`, pixel) pairs) from `views`.
     pub fn gather(views: &[&ViewSamples], samples: &[(u32, u32)]) -> Self {
         let mut b = Batch {

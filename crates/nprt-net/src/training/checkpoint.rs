@@ -4,7 +4,7 @@
 
 use std::path::{Path, PathBuf};
 
-use anyhow::{Context, Result};
+use anyhow::{bail, Context, Result};
 use serde::{Deserialize, Serialize};
 
 use crate::model::folder::{load_weights, save_weights};
@@ -54,12 +54,22 @@ pub(crate) fn read(out: &Path) -> Result<Option<Checkpoint>> {
     }
     let text = nprt_io::read_input_string(&path)
         .with_context(|| format!("cannot read checkpoint '{}'", path.display()))?;
-    let ck = serde_json::from_str(&text).with_context(|| {
+    let ck: Checkpoint = serde_json::from_str(&text).with_context(|| {
         format!(
             "checkpoint '{}' is malformed (or from an older nprt); delete the folder to start over",
             path.display()
         )
     })?;
+    // Read back as input: a training time that is negative or not finite would let a run
+    // train past its budget (or never start).
+    let seconds = ck.state.seconds;
+    if !(seconds.is_finite() && seconds >= 0.0) {
+        bail!(
+            "checkpoint '{}' says the run has trained {seconds} s, which no run has; delete \
+             the folder to start over",
+            path.display()
+        );
+    }
     Ok(Some(ck))
 }
 

@@ -7,6 +7,7 @@ use serde::{Deserialize, Serialize};
 use crate::choice::named_choice;
 use crate::loss::Loss;
 use crate::network::design::Design;
+use crate::training::batch::Batch;
 use crate::training::calibration::Calibration;
 use crate::training::lr_schedule::LrSchedule;
 use crate::training::run_length::RunLength;
@@ -104,9 +105,7 @@ impl TrainOptions {
     /// Refuses settings no run can use.
     pub fn check(&self) -> Result<()> {
         self.schedule.check()?;
-        if self.batch_size == 0 || self.views_per_batch == 0 {
-            bail!("the batch size and the views per batch must be positive");
-        }
+        Batch::check_size(self.batch_size, self.views_per_batch, 0)?;
         if self.val_samples == 0 {
             bail!(
                 "the validation samples must be positive: every epoch ends with a validation loss"

@@ -158,7 +158,7 @@ pub fn train<O: Objective>(
     let mut net = objective.build(&mut Init::new(schedule.seed));
     std::fs::create_dir_all(checkpoint::dir(out))
         .with_context(|| format!("cannot create model folder '{}'", out.display()))?;
-    let _lock = lock_folder(out)?;
+    let _lock = nprt_io::lock_folder(out, "model folder", "--out")?;
     let (ck, resumed_from_epoch) = start(objective, schedule, out, &mut net)?;
     let mut steps = objective.engine_steps(&net)?;
     if resumed_from_epoch.is_some() {
@@ -200,31 +200,6 @@ pub fn train<O: Objective>(
         objective.save_model(out, &net, schedule, &run.ck.state)?;
     }
     Ok(run.summary(resumed_from_epoch))
-}
-
-/// Takes the model folder `out` for this run until the returned file is dropped (the OS
-/// releases it if the process dies); a second run on the same folder is refused by name.
-fn lock_folder(out: &Path) -> Result<std::fs::File> {
-    use std::io::Write;
-    let path = out.join(".lock");
-    let mut file = nprt_io::open_lock_file(&path)?;
-    if let Err(e) = file.try_lock() {
-        let holder = std::fs::read_to_string(&path).unwrap_or_default();
-        return Err(match e {
-            std::fs::TryLockError::WouldBlock => anyhow::anyhow!(
-                "model folder '{}' is in use by another training run ({}); wait for it to end or use another --out",
-                out.display(),
-                holder.trim()
-            ),
-            std::fs::TryLockError::Error(e) => {
-                anyhow::Error::new(e).context(format!("cannot lock '{}'", path.display()))
-            }
-        });
-    }
-    file.set_len(0)
-        .and_then(|()| write!(file, "pid {}", std::process::id()))
-        .with_context(|| format!("cannot write '{}'", path.display()))?;
-    Ok(file)
 }
 
 /// The run's checkpoint: the one in `out` (its weights loaded into `net`) or a fresh one, and

@@ -161,11 +161,10 @@ impl RasterGBuffer {
     /// pixel in row order, in a buffer of its own (queued; later submissions may read it).
     pub fn samples(&self, camera: &Camera) -> Result<PooledBuffer> {
         let gpu = &*self.gpu;
+        let what = format!("the G-buffer of a {}×{} frame", camera.width, camera.height);
+        gpu.check_frame(camera.width, camera.height, &what)?;
         let pixels = (camera.width * camera.height) as usize;
-        gpu.check_binding(
-            4 * SAMPLE_FLOATS * pixels,
-            &format!("the G-buffer of a {}×{} frame", camera.width, camera.height),
-        )?;
+        gpu.check_binding(4 * SAMPLE_FLOATS * pixels, &what)?;
         let size = (camera.width, camera.height);
         let mut kept = self.targets.lock().unwrap_or_else(|e| e.into_inner());
         let targets = match kept.take() {
