@@ -44,6 +44,9 @@ struct VolumeFile {
     fov_deg: f32,
 }
 
+/// The farthest a camera volume's corner may lie from the origin.
+const MAX_COORDINATE: f32 = 1e6;
+
 impl CameraVolume {
     /// The sidecar that states the camera volume of the scene file `scene`.
     pub fn sidecar_of(scene: &Path) -> PathBuf {
@@ -69,10 +72,13 @@ impl CameraVolume {
         Ok(v)
     }
 
-    /// What makes this volume unusable, if anything: the rule each field breaks.
+    /// What makes this volume unusable, if anything: the rule each field breaks. The one check
+    /// of a camera volume, wherever one is read (a sidecar, flags, a dataset's manifest).
     pub fn problem(&self) -> Option<&'static str> {
         if !(self.min.is_finite() && self.max.is_finite() && self.min.cmple(self.max).all()) {
             Some("\"min\" must not exceed \"max\" on any axis")
+        } else if self.min.abs().max(self.max.abs()).max_element() > MAX_COORDINATE {
+            Some("\"min\" and \"max\" must lie within ±10⁶ (f32 rays lose their precision beyond)")
         } else if !self.look.is_finite() || self.look == Vec3::ZERO {
             Some("\"look\" must be a non-zero direction")
         } else if !(self.spread_deg >= 0.0 && self.spread_deg < 90.0) {

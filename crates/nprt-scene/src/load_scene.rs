@@ -42,6 +42,11 @@ pub fn load_scene(spec: &str, opts: &SceneOptions) -> Result<Scene> {
     if scene.meshes.is_empty() {
         bail!("scene file '{spec}' contains no geometry");
     }
+    let clamped: Vec<String> = (scene.materials.iter_mut())
+        .flat_map(|m| m.clamp_reflectances())
+        .map(|w| format!("scene file '{spec}': {w}"))
+        .collect();
+    scene.warnings.extend(clamped);
     scene.check_extent(&format!("scene file '{spec}'"))?;
     let sidecar = CameraVolume::sidecar_of(path);
     if sidecar.exists() {

@@ -132,6 +132,35 @@ pub struct Material {
 }
 
 impl Material {
+    /// Holds the reflectances (kd, ks, or glTF's base colour) and the transmittance to [0, 1],
+    /// as light that is not created or taken away needs; a warning for each it changed.
+    pub fn clamp_reflectances(&mut self) -> Vec<String> {
+        let mut changed = Vec::new();
+        let mut clamp = |what: &str, t: &mut Texture| {
+            if let Some(c) = t.clamped_to_unit() {
+                *t = c;
+                changed.push(what.to_string());
+            }
+        };
+        match &mut self.surface {
+            Surface::Direct { kd, ks, .. } => {
+                clamp("diffuse reflectance", kd);
+                clamp("specular reflectance", ks);
+            }
+            Surface::MetallicRoughness { base, .. } => clamp("base colour", base),
+        }
+        clamp("transmittance", &mut self.transmittance);
+        (changed.into_iter())
+            .map(|what| {
+                format!(
+                    "material '{}': its {what} goes outside [0, 1] (light would be created or \
+                     negative); held to [0, 1]",
+                    self.name
+                )
+            })
+            .collect()
+    }
+
     /// An opaque material of DESIGN.md's model.
     pub fn new(name: &str, surface: Surface, two_sided: bool) -> Self {
         Material {

@@ -96,6 +96,35 @@ impl Texture {
         Texture::Constant(Vec3::splat(v))
     }
 
+    /// This texture with every value it can give held to [0, 1] (what a reflectance or a
+    /// transmittance may be), or None where it gives none outside.
+    pub fn clamped_to_unit(&self) -> Option<Texture> {
+        let unit = |v: Vec3| v.clamp(Vec3::ZERO, Vec3::ONE);
+        let outside = |v: Vec3| unit(v) != v;
+        match self {
+            Texture::Constant(c) => outside(*c).then(|| Texture::Constant(unit(*c))),
+            Texture::Checkerboard { color0, color1, to_uv } => (outside(*color0)
+                || outside(*color1))
+            .then(|| Texture::Checkerboard {
+                color0: unit(*color0),
+                color1: unit(*color1),
+                to_uv: *to_uv,
+            }),
+            Texture::Bitmap { image, to_uv, factor } => {
+                let values = image.texels.iter().map(|t| *t * *factor);
+                values.clone().any(outside).then(|| Texture::Bitmap {
+                    image: Arc::new(Bitmap {
+                        width: image.width,
+                        height: image.height,
+                        texels: values.map(unit).collect(),
+                    }),
+                    to_uv: *to_uv,
+                    factor: Vec3::ONE,
+                })
+            }
+        }
+    }
+
     pub fn eval(&self, uv: Vec2) -> Vec3 {
         match self {
             Texture::Constant(c) => *c,

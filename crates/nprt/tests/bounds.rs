@@ -123,3 +123,98 @@ fn a_frame_beyond_the_gpus_texture_size_is_refused() {
         );
     }
 }
+
+/// A dataset whose manifest records a camera volume `generate` would refuse is refused where
+/// it is read, by the same rule, not evaluated along a path through it.
+#[test]
+fn a_manifest_camera_volume_is_checked_as_generate_checks_it() {
+    let dir = fresh_dir("bounds-volume");
+    tiny_room_model(&dir, "baseline", &[]);
+    let manifest = dir.join("data/manifest.json");
+    let kept = std::fs::read_to_string(&manifest).unwrap();
+    let json: serde_json::Value = serde_json::from_str(&kept).unwrap();
+    let volume = &json["settings"]["camera_volume"];
+    for (field, value, rule) in [
+        ("min", serde_json::json!([9.0, 9.0, 9.0]), "must not exceed"),
+        ("look", serde_json::json!([0.0, 0.0, 0.0]), "non-zero direction"),
+        ("fov_deg", serde_json::json!(0.0), "fov_deg"),
+        ("fov_deg", serde_json::json!(-5.0), "fov_deg"),
+        ("spread_deg", serde_json::json!(90.0), "spread_deg"),
+        ("max", serde_json::json!([1e30, 1e30, 1e30]), "within ±10⁶"),
+    ] {
+        let mut edited = json.clone();
+        edited["settings"]["camera_volume"][field] = value;
+        assert_ne!(&edited["settings"]["camera_volume"], volume);
+        std::fs::write(&manifest, edited.to_string()).unwrap();
+        eval_fails(&dir, &[], &["camera_volume", rule]);
+    }
+    std::fs::write(&manifest, kept).unwrap();
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+/// Weights with a value no trained network holds (finite, 10³⁰) are refused where they load,
+/// not rendered into black frames or exported with an all-zero reference.
+#[test]
+fn weights_of_an_implausible_magnitude_are_refused_on_load() {
+    use nprt_net::model::folder::{load_model, save_model};
+    use nprt_net::Parameters;
+    let dir = fresh_dir("bounds-weights");
+    let model = tiny_room_model(&dir, "baseline", &[]);
+    let (file, mut net) = load_model(&model).unwrap();
+    let mut first = true;
+    net.visit_mut("", &mut |_, _, values| {
+        if std::mem::take(&mut first) {
+            values[0] = 1e30;
+        }
+    });
+    save_model(&model, &file, &net).unwrap();
+    let frames = dir.join("frames");
+    for args in [
+        &["render", "--model", model.to_str().unwrap(), "--out", frames.to_str().unwrap()][..],
+        &["export", model.to_str().unwrap(), "--out", frames.to_str().unwrap()],
+    ] {
+        let o = nprt(args);
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(o.status.code(), Some(1), "{args:?}: {err}");
+        assert!(err.contains("holds 1e30") && err.contains("damaged"), "{err}");
+    }
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+/// Reflectances outside [0, 1] (a negative value, a bitmap's negative texels, a blend weight of
+/// 2) are held to [0, 1] with a warning, as maps are: the dataset they make verifies.
+#[test]
+fn reflectances_outside_the_unit_range_are_clamped_with_a_warning() {
+    let dir = fresh_dir("bounds-reflectance");
+    std::fs::create_dir_all(&dir).unwrap();
+    let scene = dir.join("odd.xml");
+    std::fs::write(
+        &scene,
+        r#"<scene version="3.0.0">
+  <shape type="cube"><bsdf type="diffuse"><rgb name="reflectance" value="-1, 0.5, 2"/></bsdf></shape>
+  <shape type="rectangle"><bsdf type="blendbsdf"><float name="weight" value="2"/>
+    <bsdf type="diffuse"><rgb name="reflectance" value="0.5"/></bsdf>
+    <bsdf type="roughconductor"><float name="alpha" value="0.2"/><string name="material" value="none"/></bsdf>
+  </bsdf></shape>
+</scene>"#,
+    )
+    .unwrap();
+    std::fs::write(
+        dir.join("odd.camera.json"),
+        r#"{"min": [-3, 0, 2], "max": [3, 1, 3], "look": [0, 0, -1], "spread_deg": 10, "fov_deg": 50}"#,
+    )
+    .unwrap();
+    let data = dir.join("data");
+    let o = nprt(&[
+        "generate", "--scene", scene.to_str().unwrap(), "--envmaps", "builtin", "--out",
+        data.to_str().unwrap(), "--train-views", "2", "--test-views", "1", "--train-res", "8",
+        "--test-res", "8", "--spp", "2", "--test-spp", "2",
+    ]);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(o.status.success(), "{err}");
+    assert!(err.contains("diffuse reflectance goes outside [0, 1]"), "{err}");
+    assert!(err.contains("blend weight 2 is outside [0, 1]"), "{err}");
+    let o = nprt(&["dataset", "verify", data.to_str().unwrap()]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stdout));
+    std::fs::remove_dir_all(&dir).ok();
+}

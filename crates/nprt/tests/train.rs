@@ -515,7 +515,11 @@ fn bad_runs_stop_clearly_and_keep_the_last_good_checkpoint() {
     // Bad arguments and inputs.
     let bad = common::nprt(&["train", "--data", data, "--arch", "mlp", "--out", o]);
     assert!(!bad.status.success());
-    assert!(String::from_utf8_lossy(&bad.stderr).contains("unknown design 'mlp'"));
+    let err = String::from_utf8_lossy(&bad.stderr);
+    assert!(
+        err.contains("invalid value 'mlp'") && err.contains("[possible values: baseline, prt"),
+        "{err}"
+    );
     fails(
         &[
             "train",

@@ -100,7 +100,8 @@ impl From<&VolumeRecord> for CameraVolume {
         CameraVolume {
             min: v.min.into(),
             max: v.max.into(),
-            look: Vec3::from(v.look).normalize_or(Vec3::NEG_Z),
+            // A zero direction stays zero, for `CameraVolume::problem` to refuse.
+            look: Vec3::from(v.look).normalize_or_zero(),
             spread_deg: v.spread_deg,
             fov_deg: v.fov_deg,
         }
@@ -172,6 +173,9 @@ impl Manifest {
             if n < 2 || n % 2 != 0 {
                 bail!("test_spp is {n}: it must be even and at least 2 (test views are rendered as two independent halves)");
             }
+        }
+        if let Some(p) = CameraVolume::from(&s.camera_volume).problem() {
+            bail!("camera_volume: {p}");
         }
         let maps = s.envmaps.len();
         if let Some(&i) = s

@@ -25,6 +25,9 @@ pub const MODEL_FORMAT: &str = "nprt-model";
 pub const MODEL_VERSION: u32 = 1;
 pub const CONFIG_FILE: &str = "model.json";
 pub const WEIGHTS_FILE: &str = "weights.safetensors";
+/// The largest weight a trained network holds, by far (trained weights and hash-grid entries
+/// stay within tens): a file with more is damaged, and would render black or infinite frames.
+pub const MAX_WEIGHT: f32 = 1e6;
 
 /// The config file of a model folder: what to build, how to feed it, where it came from.
 #[derive(Clone, Debug, Serialize, Deserialize)]
@@ -122,18 +125,17 @@ pub fn save_weights<M: Parameters>(path: &Path, net: &M, tag: &str) -> Result<()
     nprt_io::write_file(path, &bytes)
 }
 
-/// The first tensor of a safetensors file that holds a non-finite value, if one does.
-fn non_finite_tensor(tensors: &SafeTensors) -> Option<String> {
+/// The first tensor of a safetensors file that holds a value no trained network has (not
+/// finite, or beyond ±[`MAX_WEIGHT`]), and that value, if one does.
+fn implausible_tensor(tensors: &SafeTensors) -> Option<(String, f32)> {
     for (name, view) in tensors.tensors() {
-        let finite = match view.dtype() {
-            safetensors::Dtype::F32 => view
-                .data()
-                .chunks_exact(4)
-                .all(|b| f32::from_le_bytes([b[0], b[1], b[2], b[3]]).is_finite()),
-            _ => true,
-        };
-        if !finite {
-            return Some(name);
+        if view.dtype() != safetensors::Dtype::F32 {
+            continue;
+        }
+        let values = view.data().chunks_exact(4);
+        let mut values = values.map(|b| f32::from_le_bytes([b[0], b[1], b[2], b[3]]));
+        if let Some(v) = values.find(|v| !(v.abs() <= MAX_WEIGHT)) {
+            return Some((name, v));
         }
     }
     None
@@ -155,9 +157,10 @@ pub fn load_weights<M: Parameters>(path: &Path, net: &mut M, tag: &str) -> Resul
     }
     let file = SafeTensors::deserialize(&bytes)
         .with_context(|| format!("'{}' is not an nprt weights file", path.display()))?;
-    if let Some(name) = non_finite_tensor(&file) {
+    if let Some((name, v)) = implausible_tensor(&file) {
         bail!(
-            "weights '{}' are unusable: tensor '{name}' holds NaN or infinity",
+            "weights '{}' are unusable: tensor '{name}' holds {v:e}, beyond any trained network's \
+             (±{MAX_WEIGHT:e}); the file is damaged",
             path.display()
         );
     }

@@ -271,6 +271,13 @@ impl<'a> Ctx<'a> {
             Texture::Constant(c) => c.x,
             _ => return self.fail(node, "a textured blend weight is not supported"),
         };
+        if !(0.0..=1.0).contains(&w) {
+            self.scene.warnings.push(format!(
+                "{}: blend weight {w} is outside [0, 1]; held to it",
+                self.at(node)
+            ));
+        }
+        let w = w.clamp(0.0, 1.0);
         let parts = self.nested_materials(node)?;
         if parts.len() != 2 {
             return self.fail(node, "blendbsdf needs exactly two nested BSDFs");
