@@ -9,6 +9,7 @@
 pub mod budget;
 mod experiment;
 pub mod orderings;
+mod paper_figures;
 mod paper_report;
 mod pipeline;
 pub mod published;
