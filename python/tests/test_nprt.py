@@ -4,6 +4,7 @@ agreement with Mitsuba 3 in the same interpreter where it is installed."""
 
 import json
 import os
+import pickle
 import pathlib
 import signal
 
@@ -225,8 +226,12 @@ def test_the_compiled_module_is_one_abi3_build():
 
 
 def test_errors_carry_the_cli_messages(tmp_path):
-    with pytest.raises(nprt.NprtError, match="missing.xml"):
+    with pytest.raises(nprt.NprtError, match="missing.xml") as raised:
         nprt.load_scene(str(tmp_path / "missing.xml"))
+    # Defined as nprt.NprtError, so a worker process's failure pickles with its message.
+    assert nprt.NprtError.__module__ == "nprt"
+    again = pickle.loads(pickle.dumps(raised.value))
+    assert type(again) is nprt.NprtError and "missing.xml" in str(again)
     with pytest.raises(nprt.NprtError, match="2:1"):
         nprt.EnvMap(np.zeros((8, 8, 3), np.float32))
     with pytest.raises(ValueError, match="cpu, gpu, wgpu or auto"):

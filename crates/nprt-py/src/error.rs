@@ -6,7 +6,7 @@ use pyo3::exceptions::PyRuntimeError;
 use pyo3::PyErr;
 
 create_exception!(
-    _nprt,
+    nprt,
     NprtError,
     PyRuntimeError,
     "An error of nprt's: bad input (the file and the reason) or a failed stage."
