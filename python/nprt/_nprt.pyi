@@ -157,8 +157,8 @@ def train(
     callback: Optional[Callable[[Dict[str, Any]], Optional[bool]]] = None,
 ) -> Dict[str, Any]:
     """`nprt train`; None takes its default. ``callback`` gets each epoch's row of the loss
-    curves; returning False (or Ctrl-C) ends the run there, saved, and the same call resumes
-    it."""
+    curves; returning a false value other than None (False, 0, numpy's False_), or Ctrl-C,
+    ends the run there, saved, and the same call resumes it."""
 
 def evaluate(
     data: PathLike,

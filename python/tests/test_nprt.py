@@ -102,6 +102,8 @@ def test_dataset_as_numpy(dataset):
     assert "half" not in ds.view(0)
     with pytest.raises(IndexError):
         ds.view(8)
+    with pytest.raises(ValueError, match="'train' or 'test', not 'tset'"):
+        ds.split("tset")
 
 
 def test_train_render_and_evaluate(dataset, model, room, tmp_path):
@@ -164,6 +166,12 @@ def test_training_reports_each_epoch_stops_when_told_and_resumes(dataset, tmp_pa
     # The run was saved before the error was raised: it resumes after its first epoch.
     again = nprt.train(dataset, "baseline", tmp_path / "raised", epochs=3, progress=False)
     assert again["resumed_from_epoch"] == pytest.approx(1.0)
+    # Any false answer stops, as Python judges it (numpy's False_ from `val > thr`, 0).
+    for k, answer in enumerate([np.False_, 0]):
+        seen = []
+        nprt.train(dataset, "baseline", tmp_path / f"false{k}", epochs=2, progress=False,
+                   callback=lambda row: seen.append(row) or answer)
+        assert len(seen) == 1, (answer, seen)
 
 
 def test_ctrl_c_saves_the_run_then_raises(dataset, tmp_path):

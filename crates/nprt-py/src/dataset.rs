@@ -4,7 +4,7 @@
 use std::path::PathBuf;
 
 use nprt_data::dataset::{load_manifest, load_manifest_hashed, read_view, Manifest, PackedDataset};
-use pyo3::exceptions::PyIndexError;
+use pyo3::exceptions::{PyIndexError, PyValueError};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
@@ -53,12 +53,17 @@ impl Dataset {
         arrays::json(py, &value)
     }
 
-    /// The indices of the views of `split` ("train" or "test").
-    fn split(&self, split: &str) -> Vec<usize> {
-        (self.manifest.views.iter().enumerate())
+    /// The indices of the views of `split` ("train" or "test"; another name is a ValueError).
+    fn split(&self, split: &str) -> PyResult<Vec<usize>> {
+        if !["train", "test"].contains(&split) {
+            return Err(PyValueError::new_err(format!(
+                "split must be 'train' or 'test', not '{split}'"
+            )));
+        }
+        Ok((self.manifest.views.iter().enumerate())
             .filter(|(_, v)| v.split == split)
             .map(|(i, _)| i)
-            .collect()
+            .collect())
     }
 
     /// View `index`'s images, each an (H, W, 3) or (H, W) float32 array: `radiance`, `direct`,

@@ -10,7 +10,7 @@ use nprt_net::training::loss_curves::LossRow;
 use nprt_net::training::training_set::TrainingSet;
 use nprt_net::{ModelConfig, RunLength, TrainOptions, TrainSummary};
 use pyo3::prelude::*;
-use pyo3::types::{PyBool, PyDict};
+use pyo3::types::PyDict;
 
 use crate::choice::{engine, parse};
 use crate::error::OrPy;
@@ -23,8 +23,9 @@ use crate::error::OrPy;
 /// `steps_on` and `resumed_from_epoch`; the loss curves are in `out`/loss.csv.
 ///
 /// `callback`, where given, is called at each epoch's end with that epoch's row of the loss
-/// curves (`step`, `epoch`, `samples`, `seconds`, `train_loss`, `val_loss`); returning False
-/// ends the run there. Ctrl-C ends it there too, then raises KeyboardInterrupt. Either way the
+/// curves (`step`, `epoch`, `samples`, `seconds`, `train_loss`, `val_loss`); returning a false
+/// value (False, 0, numpy's False_: anything whose `bool` is False, None aside) ends the run
+/// there; returning nothing goes on. Ctrl-C ends it there too, then raises KeyboardInterrupt. Either way the
 /// run is saved as at the end of a time budget, and the same call resumes it. The GIL is
 /// released while it trains.
 #[pyfunction]
@@ -156,9 +157,12 @@ impl EpochWatch {
         Python::attach(|py| {
             let go_on = py.check_signals().and_then(|()| match &self.callback {
                 None => Ok(true),
+                // No answer (None) goes on; any other by its truth (False, 0, numpy's
+                // False_ stop).
                 Some(f) => {
                     let answer = f.call1(py, (row_dict(py, row)?,))?;
-                    Ok(!answer.bind(py).is(PyBool::new(py, false)))
+                    let answer = answer.bind(py);
+                    Ok(answer.is_none() || answer.is_truthy()?)
                 }
             });
             go_on.unwrap_or_else(|e| {
