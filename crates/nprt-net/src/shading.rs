@@ -29,10 +29,6 @@ pub trait Shading: Send + Sync {
     /// the model's gain.
     fn radiance(&self, px: &PixelRows, light: &LightCode) -> Vec<f32>;
 
-    /// The light code and the scale of each radiance channel (the map's divisor times the
-    /// model's gain), on the host.
-    fn light_on_host(&self, light: &LightCode) -> (Vec<f32>, [f32; 3]);
-
     /// The precision the dense layers run in.
     fn precision(&self) -> Precision;
 

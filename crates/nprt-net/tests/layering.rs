@@ -62,7 +62,9 @@ fn no_module_imports_a_later_layer() {
     let mut checked = 0;
     for file in files {
         let relative = file.strip_prefix(&src).unwrap();
-        let mut parts = relative.iter().map(|p| p.to_str().unwrap().trim_end_matches(".rs"));
+        let mut parts = relative
+            .iter()
+            .map(|p| p.to_str().unwrap().trim_end_matches(".rs"));
         let top = parts.next().unwrap();
         if top == "lib" {
             continue;
@@ -83,7 +85,12 @@ fn no_module_imports_a_later_layer() {
         }
         let folder = parts.next().unwrap();
         let Some(own) = layer(GPU_LAYERS, folder) else {
-            assert_eq!(folder, "mod", "{} is in no layer of gpu", relative.display());
+            assert_eq!(
+                folder,
+                "mod",
+                "{} is in no layer of gpu",
+                relative.display()
+            );
             continue;
         };
         assert!(

@@ -7,10 +7,11 @@
 use std::fmt::Write as _;
 
 use anyhow::Result;
-use nprt_eval::{mean_and_se, row_name, Evaluation, MethodResult, Metrics};
-use nprt_net::{Design, ModelConfig};
+use nprt_eval::{row_name, Evaluation, MethodResult, Metrics};
+use nprt_net::Design;
 
 use crate::orderings::{ablation_configs, test_view_competitors};
+use crate::paper_report::{design_row, over_views};
 use crate::published::{self, SCENES, TABLE2, TABLE2_SCENES, TABLE5, TABLE6, TABLE6_METHODS};
 
 /// Table 2's runs, in `ablation_configs`' order, as the paper names them.
@@ -32,7 +33,7 @@ fn ratio(a: Option<f64>, b: Option<f64>) -> String {
 /// The mean of metric `k` over `m`'s views, where it has views.
 fn mean(m: Option<&MethodResult>, k: usize) -> Option<f64> {
     let m = m.filter(|m| !m.per_view.is_empty())?;
-    Some(mean_and_se(m.per_view.iter().map(|v| v.values()[k])).0)
+    Some(over_views(m, k).0)
 }
 
 /// Table 2 relative to PRT-inspired (S): nprt's runs and the paper's in each of its scenes.
@@ -46,14 +47,25 @@ pub fn table2(md: &mut String, ablation: &[MethodResult]) -> Result<()> {
          0.058 for 58 × 10³), and every figure relative to PRT-inspired (S)'s in the same \
          column, nprt's beside the paper's:\n"
     )?;
-    write!(md, "| run | nprt loss / PRT (S)'s | nprt RMSE / PRT (S)'s |")?;
+    write!(
+        md,
+        "| run | nprt loss / PRT (S)'s | nprt RMSE / PRT (S)'s |"
+    )?;
     for s in TABLE2_SCENES {
-        write!(md, " paper {s} loss × 10³ | RMSE × 10³ | loss / PRT (S)'s | RMSE / PRT (S)'s |")?;
+        write!(
+            md,
+            " paper {s} loss × 10³ | RMSE × 10³ | loss / PRT (S)'s | RMSE / PRT (S)'s |"
+        )?;
     }
-    writeln!(md, "\n|---|---|---|{}", "---|".repeat(4 * TABLE2_SCENES.len()))?;
+    writeln!(
+        md,
+        "\n|---|---|---|{}",
+        "---|".repeat(4 * TABLE2_SCENES.len())
+    )?;
     let last = runs.len() - 1;
     for (i, run) in TABLE2_RUNS.iter().enumerate() {
-        let nprt = [Metrics::LOG_L1, Metrics::RMSE].map(|k| ratio(mean(runs[i], k), mean(runs[last], k)));
+        let nprt =
+            [Metrics::LOG_L1, Metrics::RMSE].map(|k| ratio(mean(runs[i], k), mean(runs[last], k)));
         write!(md, "| {run} | {} | {} |", nprt[0], nprt[1])?;
         for (s, _) in TABLE2_SCENES.iter().enumerate() {
             let [loss, rmse] = TABLE2[i][s];
@@ -69,9 +81,13 @@ pub fn table2(md: &mut String, ablation: &[MethodResult]) -> Result<()> {
 
 /// Table 5 relative to D/S: nprt's designs beside the paper's in each of its four scenes.
 pub fn table5(md: &mut String, e: &Evaluation, kitchen: bool) -> Result<()> {
-    let row = |d: Design| e.method(&row_name(&ModelConfig::new(d, None)));
+    let row = |d: Design| design_row(e, d);
     let ds = row(Design::Dsep);
-    let here = if kitchen { "this run's scene is the paper's KITCHEN" } else { "none of them is this run's scene" };
+    let here = if kitchen {
+        "this run's scene is the paper's KITCHEN"
+    } else {
+        "none of them is this run's scene"
+    };
     writeln!(
         md,
         "The paper's Table 5 in its four scenes ({here}), × 10³, and each design's figure \
@@ -104,8 +120,7 @@ pub fn table5(md: &mut String, e: &Evaluation, kitchen: bool) -> Result<()> {
 /// Table 6 relative to D/S: each competitor's figure over D/S's, per metric, on nprt's test
 /// views and in the paper's two scenes, then the paper's own figures.
 pub fn table6(md: &mut String, e: &Evaluation) -> Result<()> {
-    let ds_name = row_name(&ModelConfig::new(Design::Dsep, None));
-    let Some(ds) = e.method(&ds_name) else {
+    let Some(ds) = design_row(e, Design::Dsep) else {
         return Ok(());
     };
     let names = || Metrics::TABLE6.map(|k| Metrics::NAMES[k]).join(" | ");
@@ -130,13 +145,24 @@ pub fn table6(md: &mut String, e: &Evaluation) -> Result<()> {
             "The paper's Table 6 on its {scene} (× 10³ over a camera path; PRT: one frame), and \
              each figure relative to its D/S's:\n"
         )?;
-        writeln!(md, "| paper's method | {} | {} |\n|---|{}", names(), names().replace(" |", " / D/S's |") + " / D/S's", "---|".repeat(10))?;
+        writeln!(
+            md,
+            "| paper's method | {} | {} |\n|---|{}",
+            names(),
+            names().replace(" |", " / D/S's |") + " / D/S's",
+            "---|".repeat(10)
+        )?;
         for (method, figures) in TABLE6_METHODS.iter().zip(rows) {
             let values: Vec<String> = figures.iter().map(|v| format!("{v:.2}")).collect();
             let ratios: Vec<String> = (figures.iter().zip(rows[last]))
                 .map(|(v, d)| ratio(Some(*v), Some(d)))
                 .collect();
-            writeln!(md, "| {method} | {} | {} |", values.join(" | "), ratios.join(" | "))?;
+            writeln!(
+                md,
+                "| {method} | {} | {} |",
+                values.join(" | "),
+                ratios.join(" | ")
+            )?;
         }
         writeln!(md)?;
     }
@@ -189,7 +215,10 @@ pub fn papers_own_orderings(md: &mut String) -> Result<()> {
             for (method, figures) in TABLE6_METHODS.iter().zip(&rows[..last]) {
                 if figures[k] < ds {
                     let name = Metrics::NAMES[metric];
-                    exceptions.push(format!("{name}: {method} {:.2} against {ds:.2}", figures[k]));
+                    exceptions.push(format!(
+                        "{name}: {method} {:.2} against {ds:.2}",
+                        figures[k]
+                    ));
                 }
             }
         }

@@ -156,7 +156,7 @@ fn judged(md: &mut String, orderings: &[Ordering], table: &str) -> Result<()> {
 }
 
 /// The mean of metric `k` over `m`'s views and its standard error.
-fn over_views(m: &MethodResult, k: usize) -> (f64, f64) {
+pub(crate) fn over_views(m: &MethodResult, k: usize) -> (f64, f64) {
     mean_and_se(m.per_view.iter().map(|v| v.values()[k]))
 }
 
@@ -165,7 +165,7 @@ fn e3(m: &MethodResult, k: usize) -> String {
     mean_and_se_text(m.per_view.iter().map(|v| v.values()[k]), 1e3)
 }
 
-fn design_row(e: &Evaluation, d: Design) -> Option<&MethodResult> {
+pub(crate) fn design_row(e: &Evaluation, d: Design) -> Option<&MethodResult> {
     e.method(&row_name(&ModelConfig::new(d, None)))
 }
 

@@ -51,8 +51,7 @@ pub const TABLE5: [[[f64; 2]; 4]; 4] = [
 /// Table 5: `design`'s loss and RMSE × 10³ in scene `scene` of [`SCENES`] (None for a design
 /// beyond the paper).
 pub fn table5(scene: usize, design: Design) -> Option<[f64; 2]> {
-    let index = Design::PAPER.iter().position(|&d| d == design)?;
-    Some(TABLE5[scene][index])
+    Some(TABLE5[scene][paper_index(design)?])
 }
 
 /// Table 6's rows, as the paper names them (its D/S last).
@@ -100,6 +99,10 @@ pub const TABLE6: [(&str, [[f64; 5]; 8]); 2] = [
 
 /// `design`'s figure of `figures`, given in [`Design::PAPER`]'s order (the paper's tables').
 fn of_paper_design(figures: [f64; 4], design: Design) -> Option<f64> {
-    let index = Design::PAPER.iter().position(|&d| d == design)?;
-    Some(figures[index])
+    Some(figures[paper_index(design)?])
+}
+
+/// Where `design` stands in the paper's tables (None for a design beyond the paper).
+fn paper_index(design: Design) -> Option<usize> {
+    Design::PAPER.iter().position(|&d| d == design)
 }

@@ -194,9 +194,8 @@ fn inputs_key(x: &Experiment, opts: &EvalOptions) -> Result<String> {
 fn outputs_key(report: &Path) -> String {
     let mut h = blake3::Hasher::new();
     let md = std::fs::read_to_string(report.join("report.md")).unwrap_or_default();
-    for file in ["results.json", "report.md"] {
-        h.update(&std::fs::read(report.join(file)).unwrap_or_default());
-    }
+    h.update(&std::fs::read(report.join("results.json")).unwrap_or_default());
+    h.update(md.as_bytes());
     for picture in md.split("](").skip(1).filter_map(|rest| rest.split(')').next()) {
         h.update(picture.as_bytes());
         // A picture gone hashes as no bytes: the key then differs.
@@ -206,9 +205,12 @@ fn outputs_key(report: &Path) -> String {
 }
 
 /// `e` read back, refused unless it is the evaluation `opts` asks for: every model's row and
-/// every method's figures on as many test views, each finite.
+/// every method's figures on the dataset's test views (as many as `opts` evaluates), each
+/// finite.
 fn held(e: Evaluation, opts: &EvalOptions) -> Result<Evaluation> {
-    let views = opts.max_views.map_or(e.test_views, |n| n.min(e.test_views));
+    let manifest = nprt_data::dataset::load_manifest(&opts.data)?;
+    let test_views = manifest.settings.test_views as usize;
+    let views = opts.max_views.map_or(test_views, |n| n.min(test_views));
     anyhow::ensure!(
         e.test_views == views && e.methods.len() > opts.models.len(),
         "the kept evaluation is not this run's ({} test views, {} methods)",
@@ -221,7 +223,7 @@ fn held(e: Evaluation, opts: &EvalOptions) -> Result<Evaluation> {
     Ok(e)
 }
 
-/// Whether `m` has a finite mean and a finite figure per view (`views` of them, where known).
+/// Whether `m` has a finite figure per view (`views` of them, where known).
 fn complete(m: &MethodResult, views: Option<usize>) -> bool {
     let finite = |v: &nprt_eval::Metrics| v.values().iter().all(|x| x.is_finite());
     !m.per_view.is_empty()

@@ -16,7 +16,10 @@ use nprt_trace::{render, render_direct, render_gbuffer, GBuffer, RenderSettings,
 pub enum FrameRadiance {
     Host(Vec<Vec3>),
     #[cfg(feature = "gpu")]
-    Device { rgb: wgpu::Buffer, pixels: usize },
+    Device {
+        rgb: wgpu::Buffer,
+        pixels: usize,
+    },
 }
 
 impl FrameRadiance {
@@ -176,7 +179,12 @@ impl FrameStages for HostStages {
     }
 
     #[cfg(feature = "gpu")]
-    fn profile(&self, _: &dyn Shading, _: &PixelRows, _: &LightCode) -> Result<Vec<nprt_gpu::KernelTime>> {
+    fn profile(
+        &self,
+        _: &dyn Shading,
+        _: &PixelRows,
+        _: &LightCode,
+    ) -> Result<Vec<nprt_gpu::KernelTime>> {
         anyhow::bail!("kernel times are measured on the GPU kernels only (--device gpu)")
     }
 

@@ -23,7 +23,10 @@ fn eval_fails(dir: &std::path::Path, extra: &[&str], needles: &[&str]) {
     ];
     args.extend_from_slice(extra);
     fails(&args, needles);
-    assert!(!out.join("results.json").exists(), "{extra:?} wrote results");
+    assert!(
+        !out.join("results.json").exists(),
+        "{extra:?} wrote results"
+    );
 }
 
 #[test]
@@ -34,7 +37,10 @@ fn evaluation_counts_and_sizes_are_bounded_before_any_work() {
     for (flags, needle) in [
         (&["--temporal-frames", &huge][..], "--temporal-frames"),
         (&["--temporal-frames", "1000000000"], "more than the"),
-        (&["--temporal-res", "4294967295"], "--temporal-res 4294967295"),
+        (
+            &["--temporal-res", "4294967295"],
+            "--temporal-res 4294967295",
+        ),
         (&["--temporal-res", "100000"], "--temporal-res 100000"),
         (&["--nrc-warmup", "1000000000"], "--nrc-warmup 1000000000"),
         (&["--views", "0"], "--views must be at least 1"),
@@ -48,7 +54,16 @@ fn evaluation_counts_and_sizes_are_bounded_before_any_work() {
 fn a_batch_beyond_memory_is_refused_by_its_flag() {
     for size in [u64::MAX.to_string(), "1000000000000".to_string()] {
         fails(
-            &["bench", "train", "--arch", "baseline", "--batch-size", &size, "--steps", "1"],
+            &[
+                "bench",
+                "train",
+                "--arch",
+                "baseline",
+                "--batch-size",
+                &size,
+                "--steps",
+                "1",
+            ],
             &["--batch-size", "memory"],
         );
     }
@@ -63,7 +78,10 @@ fn rayon_num_threads_is_held_to_the_threads_bound() {
         .unwrap();
     let err = String::from_utf8_lossy(&o.stderr);
     assert_eq!(o.status.code(), Some(1), "{err}");
-    assert!(err.contains("RAYON_NUM_THREADS 100000 is not in 1..="), "{err}");
+    assert!(
+        err.contains("RAYON_NUM_THREADS 100000 is not in 1..="),
+        "{err}"
+    );
     let o = Command::new(env!("CARGO_BIN_EXE_nprt"))
         .args(["model", "info", "--arch", "baseline"])
         .env("RAYON_NUM_THREADS", "two")
@@ -93,13 +111,23 @@ fn a_checkpoint_with_an_impossible_training_time_is_refused() {
         std::fs::write(&state, forged).unwrap();
         let (data, out) = (dir.join("data"), model.to_str().unwrap().to_string());
         let args = [
-            "train", "--data", data.to_str().unwrap(), "--arch", "baseline", "--out", &out,
-            "--epochs", "2",
+            "train",
+            "--data",
+            data.to_str().unwrap(),
+            "--arch",
+            "baseline",
+            "--out",
+            &out,
+            "--epochs",
+            "2",
         ];
         let o = nprt(&args);
         let err = String::from_utf8_lossy(&o.stderr);
         assert!(!o.status.success(), "{err}");
-        assert!(err.contains("which no run has") || err.contains("malformed"), "{err}");
+        assert!(
+            err.contains("which no run has") || err.contains("malformed"),
+            "{err}"
+        );
         assert!(!err.contains("panicked"), "{err}");
     }
     std::fs::remove_dir_all(&dir).ok();
@@ -116,8 +144,18 @@ fn a_frame_beyond_the_gpus_texture_size_is_refused() {
     for (res, side) in [("16385x1", "16385"), ("1x20000", "20000")] {
         fails(
             &[
-                "bench", "frame", "--arch", "baseline", "--res", res, "--repeats", "1",
-                "--direct-spp", "0", "--device", "wgpu",
+                "bench",
+                "frame",
+                "--arch",
+                "baseline",
+                "--res",
+                res,
+                "--repeats",
+                "1",
+                "--direct-spp",
+                "0",
+                "--device",
+                "wgpu",
             ],
             &[side, "pixels a side"],
         );
@@ -136,7 +174,11 @@ fn a_manifest_camera_volume_is_checked_as_generate_checks_it() {
     let volume = &json["settings"]["camera_volume"];
     for (field, value, rule) in [
         ("min", serde_json::json!([9.0, 9.0, 9.0]), "must not exceed"),
-        ("look", serde_json::json!([0.0, 0.0, 0.0]), "non-zero direction"),
+        (
+            "look",
+            serde_json::json!([0.0, 0.0, 0.0]),
+            "non-zero direction",
+        ),
         ("fov_deg", serde_json::json!(0.0), "fov_deg"),
         ("fov_deg", serde_json::json!(-5.0), "fov_deg"),
         ("spread_deg", serde_json::json!(90.0), "spread_deg"),
@@ -170,13 +212,27 @@ fn weights_of_an_implausible_magnitude_are_refused_on_load() {
     save_model(&model, &file, &net).unwrap();
     let frames = dir.join("frames");
     for args in [
-        &["render", "--model", model.to_str().unwrap(), "--out", frames.to_str().unwrap()][..],
-        &["export", model.to_str().unwrap(), "--out", frames.to_str().unwrap()],
+        &[
+            "render",
+            "--model",
+            model.to_str().unwrap(),
+            "--out",
+            frames.to_str().unwrap(),
+        ][..],
+        &[
+            "export",
+            model.to_str().unwrap(),
+            "--out",
+            frames.to_str().unwrap(),
+        ],
     ] {
         let o = nprt(args);
         let err = String::from_utf8_lossy(&o.stderr);
         assert_eq!(o.status.code(), Some(1), "{args:?}: {err}");
-        assert!(err.contains("holds 1e30") && err.contains("damaged"), "{err}");
+        assert!(
+            err.contains("holds 1e30") && err.contains("damaged"),
+            "{err}"
+        );
     }
     std::fs::remove_dir_all(&dir).ok();
 }
@@ -206,13 +262,32 @@ fn reflectances_outside_the_unit_range_are_clamped_with_a_warning() {
     .unwrap();
     let data = dir.join("data");
     let o = nprt(&[
-        "generate", "--scene", scene.to_str().unwrap(), "--envmaps", "builtin", "--out",
-        data.to_str().unwrap(), "--train-views", "2", "--test-views", "1", "--train-res", "8",
-        "--test-res", "8", "--spp", "2", "--test-spp", "2",
+        "generate",
+        "--scene",
+        scene.to_str().unwrap(),
+        "--envmaps",
+        "builtin",
+        "--out",
+        data.to_str().unwrap(),
+        "--train-views",
+        "2",
+        "--test-views",
+        "1",
+        "--train-res",
+        "8",
+        "--test-res",
+        "8",
+        "--spp",
+        "2",
+        "--test-spp",
+        "2",
     ]);
     let err = String::from_utf8_lossy(&o.stderr);
     assert!(o.status.success(), "{err}");
-    assert!(err.contains("diffuse reflectance goes outside [0, 1]"), "{err}");
+    assert!(
+        err.contains("diffuse reflectance goes outside [0, 1]"),
+        "{err}"
+    );
     assert!(err.contains("blend weight 2 is outside [0, 1]"), "{err}");
     let o = nprt(&["dataset", "verify", data.to_str().unwrap()]);
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stdout));

@@ -26,7 +26,10 @@ fn the_commands_help_lists_every_design() {
             .unwrap();
         let help = String::from_utf8_lossy(&out.stdout).replace(char::is_whitespace, "");
         let want = format!("[possiblevalues:{}]", names(","));
-        assert!(help.contains(&want), "nprt {command:?} --help lacks {want}: {help}");
+        assert!(
+            help.contains(&want),
+            "nprt {command:?} --help lacks {want}: {help}"
+        );
     }
 }
 
@@ -35,7 +38,9 @@ fn the_commands_help_lists_every_design() {
 #[test]
 fn the_pytorch_peers_designs_are_nprts() {
     let peer = repository_file("bench/train_pytorch.py");
-    let start = peer.find("TRACKS = {").expect("train_pytorch.py's TRACKS table");
+    let start = peer
+        .find("TRACKS = {")
+        .expect("train_pytorch.py's TRACKS table");
     let table = &peer[start..start + peer[start..].find('}').unwrap()];
     // Each key is the last quoted word before `": [`.
     let pieces: Vec<&str> = table.split("\": [").collect();
@@ -47,7 +52,10 @@ fn the_pytorch_peers_designs_are_nprts() {
         assert!(twins.contains(&name), "the peer lacks {name}: {twins:?}");
     }
     for twin in twins {
-        assert!(twin.parse::<Design>().is_ok(), "the peer's design {twin} is not nprt's");
+        assert!(
+            twin.parse::<Design>().is_ok(),
+            "the peer's design {twin} is not nprt's"
+        );
     }
     assert!(peer.contains("default=\",\".join(TRACKS)"));
 }

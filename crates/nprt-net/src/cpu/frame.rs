@@ -64,14 +64,12 @@ impl Shading for CpuShading {
 
     fn radiance(&self, px: &PixelRows, light: &LightCode) -> Vec<f32> {
         let rows = px.get::<HostRows>().unwrap_or_else(|| foreign("pixels"));
-        let (code, scale) = self.light_on_host(light);
-        (self.net).radiance(&rows.features, &code, scale, Some(&rows.transfer))
-    }
-
-    fn light_on_host(&self, light: &LightCode) -> (Vec<f32>, [f32; 3]) {
-        let light = light.get::<HostCode>().unwrap_or_else(|| foreign("a light code"));
+        let light = light
+            .get::<HostCode>()
+            .unwrap_or_else(|| foreign("a light code"));
+        // Each channel: the map's divisor times the model's gain.
         let scale = std::array::from_fn(|k| light.divisor[k] * self.gain[k]);
-        (light.code.clone(), scale)
+        (self.net).radiance(&rows.features, &light.code, scale, Some(&rows.transfer))
     }
 
     fn precision(&self) -> Precision {

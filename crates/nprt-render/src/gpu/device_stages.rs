@@ -127,10 +127,13 @@ impl FrameStages for DeviceStages {
         keep: bool,
     ) -> Result<(FrameRadiance, f64)> {
         let net = network(shading);
-        let kept = rows.get::<KeptGBuffer>().context("pixels kept by the GPU's stages")?;
-        let code = light.get::<GpuLightCode>().context("a light code on the GPU")?;
+        let kept = rows
+            .get::<KeptGBuffer>()
+            .context("pixels kept by the GPU's stages")?;
+        let code = light
+            .get::<GpuLightCode>()
+            .context("a light code on the GPU")?;
         let gpu = GpuDevice::get()?;
-        let raster = self.raster(ts)?;
         let background = Background {
             samples: &kept.samples,
             camera: &kept.camera,
@@ -144,6 +147,7 @@ impl FrameStages for DeviceStages {
         });
         let mut direct_ms = 0.0;
         if let Some((spp, seed)) = direct {
+            let raster = self.raster(ts)?;
             gpu.wait();
             let clock = Instant::now();
             let mut encoder = gpu.device.create_command_encoder(&Default::default());
@@ -188,7 +192,9 @@ impl FrameStages for DeviceStages {
             Some(kept) => &kept.px,
             None => rows.get::<GpuPixels>().context("pixels on the GPU")?,
         };
-        let code = light.get::<GpuLightCode>().context("a light code on the GPU")?;
+        let code = light
+            .get::<GpuLightCode>()
+            .context("a light code on the GPU")?;
         net.profile_relight(px, code)
     }
 

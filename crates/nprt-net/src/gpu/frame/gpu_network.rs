@@ -70,8 +70,6 @@ pub struct GpuNetwork {
     /// The encoder's input a map is made into: its width and normalisation.
     encoder_width: usize,
     map_norm: MapNorm,
-    /// The model's gain per channel (also in `light`, after the code).
-    gain: [f32; 3],
 }
 
 /// The buffers a camera's pixels run their networks through, which the network keeps for the
@@ -181,7 +179,6 @@ impl GpuNetwork {
             id: NETWORKS.fetch_add(1, Ordering::Relaxed),
             encoder_width,
             map_norm,
-            gain,
             encoder: GpuEncoder::default(),
             params,
             net: layout,
@@ -566,12 +563,6 @@ impl Shading for GpuNetwork {
         let px = px.get::<GpuPixels>().unwrap_or_else(|| foreign("pixels"));
         let code = light.get::<GpuLightCode>().unwrap_or_else(|| foreign("a light code"));
         GpuNetwork::radiance(self, px, code)
-    }
-
-    fn light_on_host(&self, light: &LightCode) -> (Vec<f32>, [f32; 3]) {
-        let code = light.get::<GpuLightCode>().unwrap_or_else(|| foreign("a light code"));
-        let (code, divisor) = code.read(&self.gpu);
-        (code, std::array::from_fn(|k| divisor[k] * self.gain[k]))
     }
 
     fn precision(&self) -> Precision {
