@@ -7,11 +7,10 @@
 use std::fmt::Write as _;
 
 use anyhow::Result;
-use nprt_eval::{row_name, Evaluation, MethodResult, Metrics};
-use nprt_net::Design;
+use nprt_eval::{mean_and_se, row_name, Evaluation, MethodResult, Metrics};
+use nprt_net::{Design, ModelConfig};
 
 use crate::orderings::{ablation_configs, test_view_competitors};
-use crate::paper_report::{design_row, over_views};
 use crate::published::{self, SCENES, TABLE2, TABLE2_SCENES, TABLE5, TABLE6, TABLE6_METHODS};
 
 /// Table 2's runs, in `ablation_configs`' order, as the paper names them.
@@ -21,6 +20,16 @@ pub const TABLE2_RUNS: [&str; 4] = [
     "PRT-inspired (R)",
     "PRT-inspired (S)",
 ];
+
+/// The mean of metric `k` over `m`'s views and its standard error.
+pub(crate) fn over_views(m: &MethodResult, k: usize) -> (f64, f64) {
+    mean_and_se(m.per_view.iter().map(|v| v.values()[k]))
+}
+
+/// `d`'s row (with its own default activation) of the evaluation.
+pub(crate) fn design_row(e: &Evaluation, d: Design) -> Option<&MethodResult> {
+    e.method(&row_name(&ModelConfig::new(d, None)))
+}
 
 /// `a / b` with three decimals, or "–" where either is missing or `b` is not positive.
 fn ratio(a: Option<f64>, b: Option<f64>) -> String {

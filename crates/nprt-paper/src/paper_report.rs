@@ -9,15 +9,14 @@ use std::path::{Path, PathBuf};
 use anyhow::Result;
 use nprt_eval::claim::Verdict;
 use nprt_eval::{
-    crop_image, markdown_to_html, mean_and_se, mean_and_se_text, plot_validation, row_name,
-    Evaluation, MethodResult,
-    Metrics, VALIDATION_PLOT,
+    crop_image, markdown_to_html, mean_and_se_text, plot_validation, row_name, Evaluation,
+    MethodResult, Metrics, VALIDATION_PLOT,
 };
 use nprt_net::{Design, ModelConfig};
 
 use crate::experiment::Experiment;
 use crate::orderings::{self, ablation_configs, test_view_competitors, Ordering};
-use crate::paper_figures;
+use crate::paper_figures::{self, design_row, over_views};
 use crate::published;
 
 /// Writes paper.md and paper.html into `dir` (the evaluation's report folder, whose images the
@@ -155,19 +154,12 @@ fn judged(md: &mut String, orderings: &[Ordering], table: &str) -> Result<()> {
     Ok(())
 }
 
-/// The mean of metric `k` over `m`'s views and its standard error.
-pub(crate) fn over_views(m: &MethodResult, k: usize) -> (f64, f64) {
-    mean_and_se(m.per_view.iter().map(|v| v.values()[k]))
-}
 
 /// [`over_views`] × 10³, as the paper prints it.
 fn e3(m: &MethodResult, k: usize) -> String {
     mean_and_se_text(m.per_view.iter().map(|v| v.values()[k]), 1e3)
 }
 
-pub(crate) fn design_row(e: &Evaluation, d: Design) -> Option<&MethodResult> {
-    e.method(&row_name(&ModelConfig::new(d, None)))
-}
 
 fn table1(md: &mut String, e: &Evaluation, ablation: &[MethodResult]) -> Result<()> {
     writeln!(
