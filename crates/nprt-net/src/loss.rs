@@ -38,7 +38,8 @@ impl Loss {
     pub fn element(self, p: f32, r: f32) -> (f32, f32) {
         match self {
             Loss::LogL1 => {
-                let d = p.ln_1p() - r.ln_1p();
+                let (log_p, slope) = log_1p_extended(p);
+                let d = log_p - r.ln_1p();
                 let sign = if d > 0.0 {
                     1.0
                 } else if d < 0.0 {
@@ -46,7 +47,7 @@ impl Loss {
                 } else {
                     0.0
                 };
-                (d.abs(), sign / (1.0 + p))
+                (d.abs(), sign * slope)
             }
             Loss::RelL2 => {
                 let (d, w) = (p - r, 1.0 / (p * p + RELATIVE_L2_EPS));
@@ -56,8 +57,36 @@ impl Loss {
     }
 }
 
+/// log(1 + p) and its derivative, continued below 0 by its tangent there (p itself, slope 1):
+/// the linear design's radiance is a dot product that can be negative while it learns, where
+/// log(1 + p) is undefined below −1 and its gradient would grow without bound; the designs
+/// whose radiance is an exp never reach it.
+fn log_1p_extended(p: f32) -> (f32, f32) {
+    if p >= 0.0 {
+        (p.ln_1p(), 1.0 / (1.0 + p))
+    } else {
+        (p, 1.0)
+    }
+}
+
 /// One value's log-L1 error, for metrics on images. Negative radiance (a denoiser's overshoot)
 /// counts as zero, where log(1 + x) is defined.
 pub fn log_l1_error(prediction: f64, reference: f64) -> f64 {
     (prediction.max(0.0).ln_1p() - reference.max(0.0).ln_1p()).abs()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Below zero the loss goes on as its tangent at zero: finite, and pulling the prediction
+    /// up with slope −1.
+    #[test]
+    fn log_l1_is_defined_and_pulls_up_below_zero() {
+        assert_eq!(Loss::LogL1.element(-3.0, 1.0), (3.0 + 2f32.ln(), -1.0));
+        let (at_zero, slope) = Loss::LogL1.element(0.0, 1.0);
+        assert_eq!((at_zero, slope), (2f32.ln(), -1.0));
+        let (above, _) = Loss::LogL1.element(1.0, 1.0);
+        assert_eq!(above, 0.0);
+    }
 }

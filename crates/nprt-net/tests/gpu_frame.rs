@@ -78,7 +78,7 @@ fn gpu_light_codes_and_radiance_match_the_cpu_engine_for_every_design() {
                 let gpu = GpuNetwork::new(&net, gain, 64, MapNorm::Channel).unwrap();
                 let there = gpu.light_code(&GpuLightInput::upload(&device, &input));
                 let (code, _) = there.read(&device);
-                let want_code = net.encoder.forward(&input.pixels, 64).codes;
+                let want_code = net.encoder().unwrap().forward(&input.pixels, 64).codes;
                 let code_error = relative_difference(&code, &want_code);
                 let light = GpuLightCode::upload(&device, &want_code, divisor);
                 let rgb = gpu.radiance(&gpu.pixels(&features), &light);
@@ -123,13 +123,14 @@ fn three_tracks_shade_as_on_the_cpu_engine() {
         kind,
         Activation::Siren,
         PositionEncoding::None,
+        0,
     );
     net.tracks.push(third);
     let (divisor, gain) = ([0.5, 3.0, 1.0], [4.0, 1.0, 0.5]);
     let gpu = GpuNetwork::new(&net, gain, 64, MapNorm::Channel).unwrap();
     let map = nprt_scene::open_envmap("builtin:sky:25:40").unwrap();
     let input = LightInput::new(&map, 30.0, 64, MapNorm::Channel);
-    let code = net.encoder.forward(&input.pixels, 64).codes;
+    let code = net.encoder().unwrap().forward(&input.pixels, 64).codes;
     let light = GpuLightCode::upload(&device, &code, divisor);
     let rgb = gpu.radiance(&gpu.pixels(&features), &light);
     let want = net.radiance(&features, &code, [2.0, 3.0, 0.5], None);
@@ -156,7 +157,7 @@ fn the_widest_encoder_input_gets_the_cpu_engines_light_code() {
     let input_there = GpuLightInput::upload(&device, &input);
     let gpu = GpuNetwork::new(&net, [1.0; 3], 64, MapNorm::Channel).unwrap();
     let (code, _) = gpu.light_code(&input_there).read(&device);
-    let want = net.encoder.forward(&input.pixels, width).codes;
+    let want = net.encoder().unwrap().forward(&input.pixels, width).codes;
     let error = relative_difference(&code, &want);
     assert!(error < 3e-6, "light code off by {error}");
 }
@@ -175,7 +176,7 @@ fn the_encoder_input_made_on_the_device_is_the_hosts() {
     let device = GpuDevice::get().unwrap();
     let net = model(Design::Dsep, Activation::Siren, PositionEncoding::None, 3);
     let gpu = GpuNetwork::new(&net, [1.0; 3], 64, MapNorm::Channel).unwrap();
-    let encoder = &net.encoder;
+    let encoder = net.encoder().unwrap();
     let maps = [
         ("builtin:sky:25:40", false, 64, 30.0, MapNorm::Channel),
         ("builtin:sky:60:200:3", false, 64, -145.0, MapNorm::Mean),
@@ -233,7 +234,7 @@ fn half_precision_radiance_follows_the_cpu_engines_for_every_design() {
                 let net = model(design, activation, encoding, seed);
                 let mut gpu = GpuNetwork::new(&net, [1.0; 3], 64, MapNorm::Channel).unwrap();
                 gpu.set_half(true).unwrap();
-                let code = net.encoder.forward(&input.pixels, 64).codes;
+                let code = net.encoder().unwrap().forward(&input.pixels, 64).codes;
                 let light = GpuLightCode::upload(&device, &code, scale);
                 let rgb = gpu.radiance(&gpu.pixels(&features), &light);
                 let want = net.radiance(&features, &code, scale, None);

@@ -48,7 +48,7 @@ fn gpu_gradients_match_the_cpu_engine_for_every_design() {
             let mut gpu = GpuTrainer::new(&net, Precision::F32).unwrap();
             let value = gpu.backward(&samples, loss);
             let errors = tensor_errors(&gpu.gradients(), &want);
-            let encoder_tensors = 2 * net.encoder.convs.len() + 2;
+            let encoder_tensors = 2 * net.encoder().unwrap().convs.len() + 2;
             let (encoder, transport) = errors.split_at(encoder_tensors);
             let loss_error = (value - want_loss).abs() / want_loss;
             let name = format!("{name} {loss}");
@@ -82,6 +82,7 @@ fn three_tracks() -> NprtNet {
         kind,
         Activation::Siren,
         encoding,
+        0,
     );
     net.tracks.push(third);
     net

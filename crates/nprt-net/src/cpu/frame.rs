@@ -1,5 +1,5 @@
-//! A trained network's frames on the CPU engine ([`Shading`]): the encoder on the host's
-//! encoder input, each track's ŝ kept per camera, and the shading networks per lighting.
+//! A trained network's frames on the CPU engine ([`Shading`]): the light model on the host's
+//! map input, each track's ŝ kept per camera, and the shading networks per lighting.
 
 use std::any::Any;
 
@@ -48,9 +48,10 @@ impl CpuShading {
 
 impl Shading for CpuShading {
     fn light_code(&self, map: &EnvMap, rotation_deg: f32) -> LightCode {
-        let input = LightInput::new(map, rotation_deg, self.encoder_width, self.map_norm);
+        let (width, norm, texels) = (self.encoder_width, self.map_norm, self.net.light.texels());
+        let input = LightInput::with_texels(map, rotation_deg, width, norm, texels);
         LightCode::new(HostCode {
-            code: self.net.encoder.forward(&input.pixels, input.width).codes,
+            code: self.net.light.forward(&input.pixels, input.width).codes().to_vec(),
             divisor: input.scale,
         })
     }

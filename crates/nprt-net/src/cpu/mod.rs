@@ -10,6 +10,7 @@ mod conv;
 mod dense;
 mod frame;
 mod light_encoder;
+mod light_model;
 mod matmul;
 mod peak;
 mod pool;
@@ -24,6 +25,7 @@ use crate::loss::Loss;
 use crate::network::nprt_net::NprtNet;
 pub use frame::CpuShading;
 pub use light_encoder::EncoderPass;
+pub use light_model::LightPass;
 pub use peak::{measured_peak, Peak};
 pub use radiance_cache::HostCacheSteps;
 pub use samples::Samples;
@@ -32,13 +34,13 @@ pub use unet::UnetBatch;
 
 /// The batch's mean `loss` and every parameter's gradient (a network of `net`'s shapes).
 pub fn gradients(net: &NprtNet, batch: &Samples, loss: Loss) -> (f64, NprtNet) {
-    let light = net.encoder.forward(batch.lights, batch.light_width);
-    let g = net.transport_gradients(batch, &light.codes, loss);
-    let encoder = net.encoder.backward(&light, &g.codes);
+    let pass = net.light.forward(batch.lights, batch.light_width);
+    let g = net.transport_gradients(batch, pass.codes(), loss);
+    let light = net.light.backward(&pass, batch.lights, &g.codes);
     (
         g.loss,
         NprtNet {
-            encoder,
+            light,
             tracks: g.tracks,
         },
     )
@@ -46,8 +48,8 @@ pub fn gradients(net: &NprtNet, batch: &Samples, loss: Loss) -> (f64, NprtNet) {
 
 /// The batch's predicted radiance (`n × 3`, its maps' scales applied).
 pub fn predict(net: &NprtNet, batch: &Samples) -> Vec<f32> {
-    let light = net.encoder.forward(batch.lights, batch.light_width);
-    net.predict(batch, &light.codes)
+    let pass = net.light.forward(batch.lights, batch.light_width);
+    net.predict(batch, pass.codes())
 }
 
 /// `acc += x`, element by element: gradients summed over blocks, runs and maps.

@@ -1,6 +1,7 @@
 //! The transport tracks of a design on the CPU engine: forward, the training loss and backward
-//! for a whole batch, block by block on all cores, given the light codes the encoder made; and
-//! the radiance of a frame's pixels for one light code.
+//! for a whole batch, block by block on all cores, given the light codes the light model made;
+//! and the radiance of a frame's pixels for one light code. A linear track's shading outputs
+//! are transfer coefficients, each term's value their dot product with the light code.
 
 use rayon::prelude::*;
 
@@ -33,7 +34,7 @@ pub struct TransportGradients {
     pub loss: f64,
     /// Per track, gradients of its grid, transfer and shading networks.
     pub tracks: Vec<Track>,
-    /// Gradient at each view's light code, `views × CODE_SIZE`.
+    /// Gradient at each view's light code, `views × code size`.
     pub codes: Vec<f32>,
 }
 
@@ -53,8 +54,9 @@ struct TrackPass {
     d_x: Vec<f32>,
     transfer: Tape,
     shading: Tape,
-    /// exp of the shading network's outputs.
-    exps: Vec<f32>,
+    /// Each term's value per row and channel: the exp of the shading network's outputs, or
+    /// for a linear track their dot product with the light code.
+    terms: Vec<f32>,
     /// Gradients at the shading network's outputs and at ŝ.
     d_out: Vec<f32>,
     d_transfer: Vec<f32>,
@@ -86,6 +88,13 @@ struct Lighting<'a> {
     view: &'a [u32],
 }
 
+impl Lighting<'_> {
+    /// The code of row `r`, `size` values.
+    fn code(&self, r: usize, size: usize) -> &[f32] {
+        &self.codes[self.view[r] as usize * size..][..size]
+    }
+}
+
 impl Track {
     /// Whether the first layer reads the features as they are.
     fn reads_features(&self) -> bool {
@@ -106,12 +115,19 @@ impl Track {
         }
     }
 
-    fn shared<'a>(&self, light: Lighting<'a>) -> SharedInput<'a> {
-        SharedInput {
+    /// The light code as the shading network's first layer reads it; None for a linear
+    /// track, whose shading network does not see it.
+    fn shared<'a>(&self, light: Lighting<'a>) -> Option<SharedInput<'a>> {
+        self.coefficients.is_none().then(|| SharedInput {
             weight_rows: self.code_rows(),
             values: light.codes,
             group: light.view,
-        }
+        })
+    }
+
+    /// Values per row of [`TrackPass::terms`]: 3 per term.
+    fn term_values(&self) -> usize {
+        self.kind.outputs()
     }
 
     /// This track's inputs of each row (with the grid's encoding after them), gathered into
@@ -179,26 +195,40 @@ impl Track {
         purpose: Pass,
     ) {
         let shared = self.shared(light);
+        let shared = shared.as_ref();
         let x = self.inputs(features, &mut pass.x, n);
         match (&self.transfer, known) {
             (Some(_), Some(s)) => {
                 let s = MatRef::new(s, n, TRANSPORT_CODE);
-                self.shading
-                    .forward(s, Some(&shared), &mut pass.shading, purpose);
+                self.shading.forward(s, shared, &mut pass.shading, purpose);
             }
             (Some(ft), None) => {
                 ft.forward(x, None, &mut pass.transfer, purpose);
                 let s = MatRef::new(pass.transfer.output(), n, TRANSPORT_CODE);
-                self.shading
-                    .forward(s, Some(&shared), &mut pass.shading, purpose);
+                self.shading.forward(s, shared, &mut pass.shading, purpose);
             }
-            (None, _) => self
-                .shading
-                .forward(x, Some(&shared), &mut pass.shading, purpose),
+            (None, _) => self.shading.forward(x, shared, &mut pass.shading, purpose),
         }
-        pass.exps.clear();
-        pass.exps
-            .extend(pass.shading.output().iter().map(|o| o.exp()));
+        pass.terms.clear();
+        let out = pass.shading.output();
+        let Some(k) = self.coefficients else {
+            pass.terms.extend(out.iter().map(|o| o.exp()));
+            return;
+        };
+        // Term t, channel c: Σ_j T[(t·K + j)·3 + c] · e[j·3 + c].
+        let per_row = self.term_values();
+        pass.terms.resize(n * per_row, 0.0);
+        for (r, (terms, t)) in (pass.terms.chunks_exact_mut(per_row))
+            .zip(out.chunks_exact(per_row * k))
+            .enumerate()
+        {
+            let code = light.code(r, 3 * k);
+            for (term, coeffs) in terms.chunks_exact_mut(3).zip(t.chunks_exact(3 * k)) {
+                for (c, v) in term.iter_mut().enumerate() {
+                    *v = (0..k).map(|j| coeffs[j * 3 + c] * code[j * 3 + c]).sum();
+                }
+            }
+        }
     }
 
     /// ŝ of the rows of `features` into `out` (`rows × TRANSPORT_CODE`), for a track with a
@@ -215,23 +245,47 @@ impl Track {
     /// Radiance of row `r` before the map's scale.
     fn radiance(&self, pass: &TrackPass, features: &[f32], r: usize) -> [f32; 3] {
         let f = &features[r * FEATURES..];
-        let e = &pass.exps[r * self.shading.d_out()..];
+        let e = &pass.terms[r * self.term_values()..];
         self.kind.radiance(f, e)
     }
 
     /// The gradient at the shading network's outputs, into `pass.d_out`, from the gradient
-    /// `dr` at this track's radiance (before the scale).
-    fn d_outputs(&self, pass: &mut TrackPass, features: &[f32], dr: &[f32]) {
-        let outs = self.shading.d_out();
-        pass.d_out.resize(pass.exps.len(), 0.0);
-        for (r, (d, e)) in pass
-            .d_out
-            .chunks_exact_mut(outs)
-            .zip(pass.exps.chunks_exact(outs))
-            .enumerate()
-        {
+    /// `dr` at this track's radiance (before the scale); a linear track adds the gradient at
+    /// each row's light code to `d_codes`.
+    fn d_outputs(
+        &self,
+        pass: &mut TrackPass,
+        features: &[f32],
+        dr: &[f32],
+        light: Lighting,
+        d_codes: &mut [f32],
+    ) {
+        let (outs, per_row) = (self.shading.d_out(), self.term_values());
+        pass.d_out.resize(pass.terms.len() / per_row * outs, 0.0);
+        let rows = pass.d_out.chunks_exact_mut(outs).zip(pass.terms.chunks_exact(per_row));
+        let Some(k) = self.coefficients else {
+            for (r, (d, e)) in rows.enumerate() {
+                let f = &features[r * FEATURES..];
+                self.kind.output_gradients(f, e, &dr[r * 3..r * 3 + 3], d);
+            }
+            return;
+        };
+        let out = pass.shading.output();
+        let mut d_terms = vec![0.0; per_row];
+        for (r, (d, _)) in rows.enumerate() {
             let f = &features[r * FEATURES..];
-            self.kind.output_gradients(f, e, &dr[r * 3..r * 3 + 3], d);
+            self.kind.term_gradients(f, &dr[r * 3..r * 3 + 3], &mut d_terms);
+            let code = light.code(r, 3 * k);
+            let at = light.view[r] as usize * 3 * k;
+            let d_code = &mut d_codes[at..at + 3 * k];
+            let t = &out[r * outs..(r + 1) * outs];
+            for (i, (d, t)) in d.iter_mut().zip(t).enumerate() {
+                // Output i is coefficient j of term `term`, channel c.
+                let (term, j, c) = (i / (3 * k), (i / 3) % k, i % 3);
+                let g = d_terms[term * 3 + c];
+                *d = g * code[j * 3 + c];
+                d_code[j * 3 + c] += g * t;
+            }
         }
     }
 
@@ -248,7 +302,10 @@ impl Track {
     ) {
         let n = dr.len() / 3;
         let shared = self.shared(light);
-        self.d_outputs(pass, features, dr);
+        let shared = shared.as_ref();
+        self.d_outputs(pass, features, dr, light, d_codes);
+        // A linear track's code gradient came from its outputs; its shading network has none.
+        let d_codes = shared.map(|_| d_codes);
         let TrackPass {
             x,
             d_x,
@@ -272,12 +329,12 @@ impl Track {
                 let s = MatRef::new(transfer.output(), n, TRANSPORT_CODE);
                 self.shading.backward(
                     s,
-                    Some(&shared),
+                    shared,
                     shading,
                     d_out,
                     &mut grads.shading,
                     Some(d_transfer),
-                    Some(d_codes),
+                    d_codes,
                 );
                 let x = self.gathered(features, x, n);
                 ft.backward(x, None, transfer, d_transfer, g, d_input, None);
@@ -286,12 +343,12 @@ impl Track {
                 let x = self.gathered(features, x, n);
                 self.shading.backward(
                     x,
-                    Some(&shared),
+                    shared,
                     shading,
                     d_out,
                     &mut grads.shading,
                     d_input,
-                    Some(d_codes),
+                    d_codes,
                 );
             }
         }
@@ -301,7 +358,7 @@ impl Track {
 
 impl NprtNet {
     /// The batch's mean `loss` and its transport gradients, for the light codes `codes`
-    /// (`views × CODE_SIZE`, the encoder's output for the batch's maps).
+    /// (`views × code size`, the light model's output for the batch's maps).
     pub fn transport_gradients(
         &self,
         batch: &Samples,
@@ -309,7 +366,7 @@ impl NprtNet {
         loss: Loss,
     ) -> TransportGradients {
         let n = batch.len();
-        let views = codes.len() / CODE_SIZE;
+        let views = codes.len() / self.light.code_size();
         let view: Vec<u32> = batch.view.iter().map(|&v| v as u32).collect();
         let blocks = n.div_ceil(BLOCK);
         let per_run = blocks.div_ceil(RUNS).max(1);
@@ -360,7 +417,11 @@ impl NprtNet {
             .iter()
             .map(|t| {
                 let transfer = t.transfer.as_ref().map_or(0.0, dense);
-                let code = 2.0 * (CODE_SIZE * t.shading.layers[0].d_out) as f64;
+                let code = match t.coefficients {
+                    None => 2.0 * (CODE_SIZE * t.shading.layers[0].d_out) as f64,
+                    // No code in the first layer; the dot products with it instead.
+                    Some(_) => -2.0 * t.shading.d_out() as f64,
+                };
                 dense(&t.shading) - code + if transfer_known { 0.0 } else { transfer }
             })
             .sum()
@@ -400,7 +461,7 @@ impl NprtNet {
         scale: [f32; 3],
         known: Option<&TransferCodes>,
     ) -> Vec<f32> {
-        assert_eq!(code.len(), CODE_SIZE);
+        assert_eq!(code.len(), self.light.code_size());
         self.shade(features, code, None, &|_| scale, known)
     }
 
@@ -457,7 +518,7 @@ impl NprtNet {
         TransportGradients {
             loss: 0.0,
             tracks: self.tracks.iter().map(Track::zeros_like).collect(),
-            codes: vec![0.0; views * CODE_SIZE],
+            codes: vec![0.0; views * self.light.code_size()],
         }
     }
 

@@ -1,12 +1,22 @@
-//! The real spherical-harmonics basis up to band 4 (25 functions), written out in closed form
-//! (a few lines each) rather than taken from a crate: SH PRT projects light and transport on
-//! it (nprt-eval), and the radiance cache encodes directions with it.
+//! The real spherical-harmonics basis: bands up to 4 (25 functions) written out in closed form
+//! (a few lines each), as the radiance cache evaluates them for every sample, and any band by
+//! the associated Legendre recurrence, which the tests hold to the closed form. SH PRT projects
+//! light and transport on it (nprt-eval), the linear design its lighting (`LightBasis`), and
+//! the radiance cache encodes directions with it.
 
 use glam::Vec3;
 
-/// Real SH basis values of bands 0..`bands` (`bands`² values, at most 5 bands = 25) at the unit
-/// direction `d`, in the usual order (l, m = −l..l) with Cartesian polynomials (Sloan 2008).
+/// The most bands [`basis`] evaluates: band 15, 256 functions.
+pub const MAX_BANDS: usize = 16;
+
+/// Real SH basis values of bands 0..`bands` (`bands`² values) at the unit direction `d`, in the
+/// usual order (l, m = −l..l) with Cartesian polynomials (Sloan 2008): y-terms for m < 0,
+/// x-terms for m > 0, no Condon-Shortley phase.
 pub fn basis(bands: usize, d: Vec3, out: &mut [f32]) {
+    assert!(bands <= MAX_BANDS, "{bands} SH bands: at most {MAX_BANDS}");
+    if bands > 5 {
+        return recurrence(bands, d, &mut out[..bands * bands]);
+    }
     let (x, y, z) = (d.x, d.y, d.z);
     let (x2, y2, z2) = (x * x, y * y, z * z);
     let all = [
@@ -39,43 +49,88 @@ pub fn basis(bands: usize, d: Vec3, out: &mut [f32]) {
     out[..bands * bands].copy_from_slice(&all[..bands * bands]);
 }
 
+/// Any band: Y_l^m = N_l^|m| · Q_l^|m|(z) · (Re or Im of (x + iy)^|m|), with Q the associated
+/// Legendre function without its (1 − z²)^(m/2) factor, which the complex power carries.
+/// Evaluated in f64: the recurrence's terms grow with the band and cancel.
+fn recurrence(bands: usize, d: Vec3, out: &mut [f32]) {
+    let (x, y, z) = (d.x as f64, d.y as f64, d.z as f64);
+    let mut q = [[0.0f64; MAX_BANDS]; MAX_BANDS];
+    let mut power = (1.0f64, 0.0f64);
+    for m in 0..bands {
+        // Q_m^m = (2m − 1)!!, Q_{m+1}^m = (2m + 1) z Q_m^m, then the three-term recurrence.
+        q[m][m] = (1..=m).map(|k| (2 * k - 1) as f64).product();
+        if m + 1 < bands {
+            q[m + 1][m] = (2 * m + 1) as f64 * z * q[m][m];
+        }
+        for l in m + 2..bands {
+            q[l][m] = ((2 * l - 1) as f64 * z * q[l - 1][m] - (l + m - 1) as f64 * q[l - 2][m])
+                / (l - m) as f64;
+        }
+        for l in m..bands {
+            let ratio: f64 = (l - m + 1..=l + m).map(|k| 1.0 / k as f64).product();
+            let mut norm = ((2 * l + 1) as f64 / (4.0 * std::f64::consts::PI) * ratio).sqrt();
+            if m > 0 {
+                norm *= std::f64::consts::SQRT_2;
+            }
+            let at = l * l + l;
+            out[at + m] = (norm * q[l][m] * power.0) as f32;
+            if m > 0 {
+                out[at - m] = (norm * q[l][m] * power.1) as f32;
+            }
+        }
+        power = (power.0 * x - power.1 * y, power.0 * y + power.1 * x);
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
     use nprt_scene::envmap::uv_to_direction;
 
     #[test]
+    fn the_recurrence_is_the_closed_form() {
+        let mut closed = [0.0; 25];
+        let mut general = [0.0; 25];
+        for i in 0..50 {
+            let uv = glam::Vec2::new((i as f32 * 0.618_034) % 1.0, (i as f32 + 0.5) / 50.0);
+            let d = uv_to_direction(uv);
+            basis(5, d, &mut closed);
+            recurrence(5, d, &mut general);
+            for (k, (a, b)) in closed.iter().zip(&general).enumerate() {
+                assert!((a - b).abs() < 1e-5, "Y{k} at {d}: {a} closed, {b} recurrence");
+            }
+        }
+    }
+
+    /// Midpoint quadrature over the sphere on a `w` × `w/2` lat-long grid: the closed form's
+    /// five bands and the recurrence's nine are orthonormal.
+    #[test]
     fn basis_is_orthonormal() {
-        // Midpoint quadrature over the sphere on a fine lat-long grid.
-        let (w, h) = (400, 200);
-        let mut gram = vec![0.0f64; 625];
-        let mut y = [0.0; 25];
-        for row in 0..h {
-            let v = (row as f32 + 0.5) / h as f32;
-            let dw = (2.0 * std::f64::consts::PI / w as f64)
-                * (std::f64::consts::PI / h as f64)
-                * ((v as f64) * std::f64::consts::PI).sin();
-            for col in 0..w {
-                basis(
-                    5,
-                    uv_to_direction(glam::Vec2::new((col as f32 + 0.5) / w as f32, v)),
-                    &mut y,
-                );
-                for i in 0..25 {
-                    for j in 0..25 {
-                        gram[i * 25 + j] += (y[i] * y[j]) as f64 * dw;
+        for (bands, w) in [(5, 400), (9, 240)] {
+            let (h, k) = (w / 2, bands * bands);
+            let mut gram = vec![0.0f64; k * k];
+            let mut y = vec![0.0; k];
+            for row in 0..h {
+                let v = (row as f32 + 0.5) / h as f32;
+                let dw = (2.0 * std::f64::consts::PI / w as f64)
+                    * (std::f64::consts::PI / h as f64)
+                    * ((v as f64) * std::f64::consts::PI).sin();
+                for col in 0..w {
+                    let uv = glam::Vec2::new((col as f32 + 0.5) / w as f32, v);
+                    basis(bands, uv_to_direction(uv), &mut y);
+                    for i in 0..k {
+                        for j in 0..k {
+                            gram[i * k + j] += (y[i] * y[j]) as f64 * dw;
+                        }
                     }
                 }
             }
-        }
-        for i in 0..25 {
-            for j in 0..25 {
-                let want = if i == j { 1.0 } else { 0.0 };
-                assert!(
-                    (gram[i * 25 + j] - want).abs() < 2e-3,
-                    "<Y{i}, Y{j}> = {}",
-                    gram[i * 25 + j]
-                );
+            for i in 0..k {
+                for j in 0..k {
+                    let want = if i == j { 1.0 } else { 0.0 };
+                    let got = gram[i * k + j];
+                    assert!((got - want).abs() < 3e-3, "{bands} bands: <Y{i}, Y{j}> = {got}");
+                }
             }
         }
     }

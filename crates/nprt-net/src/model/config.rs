@@ -5,10 +5,14 @@ use serde::{Deserialize, Serialize};
 
 use crate::encoding::map_norm::MapNorm;
 use crate::encoding::position_encoding::PositionEncoding;
+use nprt_scene::EnvMap;
+
 use crate::init::Init;
 use crate::model::direct_light::DirectLight;
 use crate::network::activation::Activation;
 use crate::network::design::Design;
+use crate::network::encoder::{LightInput, Texels};
+use crate::network::light_basis::BasisChoice;
 use crate::network::nprt_net::NprtNet;
 
 /// Everything needed to rebuild a network, besides its weights.
@@ -30,6 +34,10 @@ pub struct ModelConfig {
     /// does). Written only for a hash grid, for the same reason as `direct`.
     #[serde(default, skip_serializing_if = "PositionEncoding::is_none")]
     pub encoding: PositionEncoding,
+    /// The linear design's light basis (absent: [`BasisChoice::default`]); written only for
+    /// that design, which alone reads it.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub basis: Option<BasisChoice>,
 }
 
 /// Encoder input width when none is asked for: on the demo, 64 measured 10% worse in L1 than
@@ -49,7 +57,33 @@ impl ModelConfig {
             map_norm: DEFAULT_MAP_NORM,
             direct: DirectLight::Learned,
             encoding: PositionEncoding::None,
+            basis: design.is_linear().then(BasisChoice::default),
         }
+    }
+
+    /// Refuses a basis given to a design that has none.
+    pub fn check(&self) -> anyhow::Result<()> {
+        if let (Some(b), false) = (self.basis, self.design.is_linear()) {
+            anyhow::bail!(
+                "light basis {b} given to design {}: only the linear design projects the                  lighting on a basis",
+                self.design
+            );
+        }
+        Ok(())
+    }
+
+    /// The linear design's basis (its default where the file names none).
+    pub fn light_basis(&self) -> BasisChoice {
+        self.basis.unwrap_or_default()
+    }
+
+    /// `map` turned by `rotation_deg` about +Y as this model's light model takes it.
+    pub fn light_input(&self, map: &EnvMap, rotation_deg: f32) -> LightInput {
+        let texels = match self.design.is_linear() {
+            true => Texels::Linear,
+            false => Texels::Log,
+        };
+        LightInput::with_texels(map, rotation_deg, self.encoder_width, self.map_norm, texels)
     }
 
     /// The design's name, marked `+siren` or `+relu` with an activation other than the paper's
@@ -69,14 +103,21 @@ impl ModelConfig {
             DirectLight::Learned => "",
             DirectLight::Traced => "+direct",
         };
-        format!("{}{activation}{grid}{direct}", self.design.name())
+        let basis = match self.design.is_linear() {
+            true => format!("+{}", self.light_basis()),
+            false => String::new(),
+        };
+        format!("{}{basis}{activation}{grid}{direct}", self.design.name())
     }
 
     /// What the weights file records of the network that wrote it: the design and the
     /// activation, which both change what the same weights compute (an edit of model.json's
     /// activation went undetected).
     pub fn weights_tag(&self) -> String {
-        format!("{}:{}", self.design.name(), self.activation)
+        match self.design.is_linear() {
+            true => format!("{}:{}:{}", self.design, self.activation, self.light_basis()),
+            false => format!("{}:{}", self.design.name(), self.activation),
+        }
     }
 
     pub fn build(&self, init: &mut Init) -> NprtNet {
@@ -86,6 +127,7 @@ impl ModelConfig {
             self.activation,
             self.encoder_width,
             self.encoding,
+            self.light_basis(),
         )
     }
 }

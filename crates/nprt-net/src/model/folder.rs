@@ -221,6 +221,7 @@ fn read_design_tag(bytes: &[u8]) -> Result<String> {
 pub fn read_model_file(dir: &Path) -> Result<ModelFile> {
     let file: ModelFile = read_config(dir, CONFIG_FILE, MODEL_FORMAT, MODEL_VERSION, "model")?;
     check_input_width(file.config.encoder_width)
+        .and_then(|()| file.config.check())
         .and_then(|()| check_bounds(&file.bounds))
         .with_context(|| format!("model '{}'", dir.display()))?;
     Ok(file)

@@ -13,6 +13,7 @@ use crate::model::folder::{load_model, ModelFile};
 use crate::network::activation::Activation;
 use crate::network::design::Design;
 use crate::network::encoder::check_input_width;
+use crate::network::light_model::LightModel;
 use crate::network::nprt_net::NprtNet;
 use crate::parameters::Parameters;
 
@@ -27,20 +28,29 @@ pub struct LayerRow {
 /// Every parameterised layer of a network with its shape and parameter count.
 pub fn layer_table(net: &NprtNet) -> Vec<LayerRow> {
     let mut rows = Vec::new();
-    for (i, conv) in net.encoder.convs.iter().enumerate() {
-        let (o, c, k) = (conv.c_out, conv.c_in, conv.k);
-        rows.push(LayerRow {
-            name: format!("encoder.conv{i}"),
-            shape: format!("{c}→{o}, {k}×{k}"),
-            params: conv.num_params(),
-        });
+    match &net.light {
+        LightModel::Encoder(encoder) => {
+            for (i, conv) in encoder.convs.iter().enumerate() {
+                let (o, c, k) = (conv.c_out, conv.c_in, conv.k);
+                rows.push(LayerRow {
+                    name: format!("encoder.conv{i}"),
+                    shape: format!("{c}→{o}, {k}×{k}"),
+                    params: conv.num_params(),
+                });
+            }
+            let (i, o) = (encoder.to_code.d_in, encoder.to_code.d_out);
+            rows.push(LayerRow {
+                name: "encoder.to_code".into(),
+                shape: format!("{i}→{o}"),
+                params: encoder.to_code.num_params(),
+            });
+        }
+        LightModel::Basis(basis) => rows.push(LayerRow {
+            name: format!("basis ({})", basis.choice),
+            shape: format!("{}×{} map → {} per channel", basis.width, basis.width / 2, basis.size()),
+            params: basis.num_params(),
+        }),
     }
-    let (i, o) = (net.encoder.to_code.d_in, net.encoder.to_code.d_out);
-    rows.push(LayerRow {
-        name: "encoder.to_code".into(),
-        shape: format!("{i}→{o}"),
-        params: net.encoder.to_code.num_params(),
-    });
     for track in &net.tracks {
         let track_name = match net.tracks.len() {
             1 => String::new(),

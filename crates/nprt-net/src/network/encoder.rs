@@ -72,9 +72,18 @@ impl Parameters for LightEncoder {
     }
 }
 
-/// An environment map prepared for the encoder: box-filtered to W × W/2, divided by its mean
-/// (over channels or per channel, [`MapNorm`]) and passed through log(1 + x), as the paper
-/// pre-processes it.
+/// How a map's normalised texels are held for the light model.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Texels {
+    /// log(1 + x), as the paper pre-processes them for its encoder.
+    Log,
+    /// As they are, for the linear design's basis, which must stay linear in the map.
+    Linear,
+}
+
+/// An environment map prepared for the light model: box-filtered to W × W/2, divided by its
+/// mean (over channels or per channel, [`MapNorm`]) and, for the paper's encoder, passed
+/// through log(1 + x) ([`Texels`]).
 ///
 /// Radiance is linear in the lighting, so the network predicts radiance for the normalised map
 /// and the model multiplies each channel by `scale` to restore the absolute level.
@@ -89,7 +98,18 @@ pub struct LightInput {
 }
 
 impl LightInput {
+    /// The paper's: log(1 + x) of the normalised texels.
     pub fn new(map: &EnvMap, rotation_deg: f32, width: usize, norm: MapNorm) -> Self {
+        Self::with_texels(map, rotation_deg, width, norm, Texels::Log)
+    }
+
+    pub fn with_texels(
+        map: &EnvMap,
+        rotation_deg: f32,
+        width: usize,
+        norm: MapNorm,
+        texels: Texels,
+    ) -> Self {
         let height = width / 2;
         let map = map.rotated_y(rotation_deg);
         // Enough sub-samples per encoder texel to cover every source texel it spans.
@@ -117,7 +137,11 @@ impl LightInput {
         let mut pixels = vec![0.0; 3 * width * height];
         for (i, c) in rgb.iter().enumerate() {
             for k in 0..3 {
-                pixels[k * width * height + i] = (c[k] / scale[k]).ln_1p();
+                let v = c[k] / scale[k];
+                pixels[k * width * height + i] = match texels {
+                    Texels::Log => v.ln_1p(),
+                    Texels::Linear => v,
+                };
             }
         }
         LightInput {

@@ -1,5 +1,5 @@
-//! The networks: the light encoder, dense layers and their activations, the transport tracks and
-//! their kinds, the four designs, the whole network, the Deep Shading U-Net and the Neural
+//! The networks: the light encoder or basis, dense layers and their activations, the transport tracks and
+//! their kinds, the designs, the whole network, the Deep Shading U-Net and the Neural
 //! Radiance Cache's network, each of them `crate::parameters` to the model file and the
 //! optimiser.
 
@@ -8,6 +8,8 @@ pub mod conv;
 pub mod dense;
 pub mod design;
 pub mod encoder;
+pub mod light_basis;
+pub mod light_model;
 pub mod mlp;
 pub mod nprt_net;
 pub mod radiance_cache;

@@ -1,18 +1,20 @@
-//! The whole network: light encoder plus a design's transport tracks.
+//! The whole network: light model (encoder or basis) plus a design's transport tracks.
 
 use crate::encoding::position_encoding::PositionEncoding;
 use crate::init::Init;
 use crate::network::activation::Activation;
 use crate::network::design::Design;
 use crate::network::encoder::LightEncoder;
+use crate::network::light_basis::{BasisChoice, LightBasis};
+use crate::network::light_model::LightModel;
 use crate::parameters::{child, Parameters, Visit, VisitMut};
 use crate::network::track::Track;
 
-/// Encoder plus transport: G-buffer features and a light code in, radiance out. Also (same
+/// Light model plus transport: G-buffer features and a light code in, radiance out. Also (same
 /// shapes) its gradient. The CPU engine runs it (`cpu`), the GPU kernels from its values.
 #[derive(Clone, Debug, PartialEq)]
 pub struct NprtNet {
-    pub encoder: LightEncoder,
+    pub light: LightModel,
     pub tracks: Vec<Track>,
 }
 
@@ -23,12 +25,16 @@ impl NprtNet {
         activation: Activation,
         encoder_width: usize,
         encoding: PositionEncoding,
+        basis: BasisChoice,
     ) -> Self {
-        let encoder = LightEncoder::new(init, encoder_width);
+        let light = match design.is_linear() {
+            true => LightModel::Basis(LightBasis::new(init, basis, encoder_width)),
+            false => LightModel::Encoder(LightEncoder::new(init, encoder_width)),
+        };
         let tracks = (design.spec().tracks.iter())
-            .map(|&k| Track::new(init, design, k, activation, encoding))
+            .map(|&k| Track::new(init, design, k, activation, encoding, basis.size()))
             .collect();
-        NprtNet { encoder, tracks }
+        NprtNet { light, tracks }
     }
 
     /// Adds `log_level` to every track's output bias, so that an untrained network predicts
@@ -37,16 +43,37 @@ impl NprtNet {
     /// fraction of its map): started orders of magnitude too bright, the exp output's first
     /// steps overshoot to near zero, where log-L1's gradient (∝ the prediction) vanishes and
     /// Adam, still scaled by the first steps' huge gradients, never brings it back.
+    ///
+    /// A linear track's outputs are transfer coefficients, not log-radiance: its first
+    /// coefficient (the constant function's, which a map of mean 1 projects to about √(4π)) is
+    /// raised instead, so that the tracks together start at the level, weighted by albedos of
+    /// about one half.
     pub fn shift_output_level(mut self, log_level: f32) -> Self {
+        let tracks = self.tracks.len() as f32;
         for track in &mut self.tracks {
             let last = track
                 .shading
                 .layers
                 .last_mut()
                 .expect("a network has layers");
-            last.bias.iter_mut().for_each(|b| *b += log_level);
+            match track.coefficients {
+                None => last.bias.iter_mut().for_each(|b| *b += log_level),
+                Some(k) => {
+                    let constant = (4.0 * std::f32::consts::PI).sqrt();
+                    let t0 = log_level.exp() / (tracks * constant * 0.5);
+                    for term in last.bias.chunks_exact_mut(3 * k) {
+                        term[..3].iter_mut().for_each(|b| *b += t0);
+                    }
+                }
+            }
         }
         self
+    }
+
+    /// The convolutional encoder, for the engines that run only it (see
+    /// [`LightModel::encoder`]).
+    pub fn encoder(&self) -> anyhow::Result<&LightEncoder> {
+        self.light.encoder()
     }
 
     pub fn total_params(&self) -> usize {
@@ -71,12 +98,12 @@ impl NprtNet {
 
 impl Parameters for NprtNet {
     fn visit(&self, prefix: &str, f: &mut Visit) {
-        self.encoder.visit(&child(prefix, "encoder"), f);
+        self.light.visit(prefix, f);
         self.tracks.visit(&child(prefix, "tracks"), f);
     }
 
     fn visit_mut(&mut self, prefix: &str, f: &mut VisitMut) {
-        self.encoder.visit_mut(&child(prefix, "encoder"), f);
+        self.light.visit_mut(prefix, f);
         self.tracks.visit_mut(&child(prefix, "tracks"), f);
     }
 }

@@ -12,7 +12,8 @@ use crate::parameters::{child, Parameters, Visit, VisitMut};
 use crate::network::track_kind::TrackKind;
 
 /// One transport track: an optional transfer network F_T on the pixel inputs, and the shading
-/// network Φ on [ŝ, ê] (or, for the baseline, on [ê, inputs]). With a hash grid, the inputs
+/// network Φ on [ŝ, ê] (or, for the baseline, on [ê, inputs]; for the linear design on ŝ
+/// alone, its outputs K transfer coefficients per term and channel). With a hash grid, the inputs
 /// are followed by the grid's encoding of the position. Also (same shapes) its gradient; the
 /// CPU engine runs it (`cpu::transport`).
 #[derive(Clone, Debug, PartialEq)]
@@ -21,25 +22,33 @@ pub struct Track {
     pub transfer: Option<Mlp>,
     pub shading: Mlp,
     pub kind: TrackKind,
+    /// K for the linear design: Φ's outputs are K transfer coefficients per term and channel,
+    /// at (term·K + k)·3 + channel, dotted with the light code. None: they are log-radiance.
+    pub coefficients: Option<usize>,
 }
 
 impl Track {
+    /// A track of `design`; `coefficients` is the basis size K for the linear design and
+    /// ignored otherwise.
     pub fn new(
         init: &mut Init,
         design: Design,
         kind: TrackKind,
         activation: Activation,
         encoding: PositionEncoding,
+        coefficients: usize,
     ) -> Self {
         let n_in = kind.inputs().len() + encoding.extra_inputs();
-        let outputs = kind.outputs();
+        let coefficients = design.is_linear().then_some(coefficients);
+        let outputs = kind.outputs() * coefficients.unwrap_or(1);
+        let code = if design.is_linear() { 0 } else { CODE_SIZE };
         let grid = match encoding {
             PositionEncoding::None => None,
             PositionEncoding::HashGrid => Some(HashGrid::new(init)),
         };
         match design.spec().layout {
             Layout::Direct { hidden } => {
-                let widths: Vec<usize> = std::iter::once(CODE_SIZE + n_in)
+                let widths: Vec<usize> = std::iter::once(code + n_in)
                     .chain(hidden.iter().copied())
                     .chain([outputs])
                     .collect();
@@ -48,6 +57,7 @@ impl Track {
                     transfer: None,
                     shading: Mlp::new(init, &widths, activation),
                     kind,
+                    coefficients,
                 }
             }
             Layout::Transfer { width: w } => Track {
@@ -55,10 +65,11 @@ impl Track {
                 transfer: Some(Mlp::new(init, &[n_in, w, w, TRANSPORT_CODE], activation)),
                 shading: Mlp::new(
                     init,
-                    &[TRANSPORT_CODE + CODE_SIZE, w, w, outputs],
+                    &[TRANSPORT_CODE + code, w, w, outputs],
                     Activation::Relu,
                 ),
                 kind,
+                coefficients,
             },
         }
     }

@@ -116,12 +116,7 @@ impl TrainingSet {
                 views
                     .into_par_iter()
                     .map(|i| {
-                        let light = LightInput::new(
-                            &manifest.views[i].light(&map)?,
-                            0.0,
-                            config.encoder_width,
-                            config.map_norm,
-                        );
+                        let light = config.light_input(&manifest.views[i].light(&map)?, 0.0);
                         Ok((i, light))
                     })
                     .collect()

@@ -13,10 +13,16 @@ use rand_pcg::Pcg64Mcg;
 use reference::Reference;
 
 /// Every design with the paper's inputs and each of its activations, then with a hash grid and
-/// its own activation.
+/// its own activation; the linear design also with a learned basis.
 pub fn variants() -> Vec<ModelConfig> {
     let mut all = Vec::new();
     for design in Design::ALL {
+        if design.is_linear() {
+            all.push(ModelConfig {
+                basis: Some(nprt_net::BasisChoice::Learned { size: 12 }),
+                ..ModelConfig::new(design, None)
+            });
+        }
         for activation in [Activation::Siren, Activation::Relu] {
             all.push(ModelConfig::new(design, Some(activation)));
         }

@@ -5,6 +5,7 @@
 use nprt_net::encoding::hash_grid::{self, LEVEL_FEATURES};
 use nprt_net::network::mlp::Mlp;
 use nprt_net::network::track_kind::Weight;
+use nprt_net::network::light_model::LightModel;
 use nprt_net::{Activation, Batch, Loss, NprtNet, Parameters, FEATURES, OMEGA_0};
 
 /// A network's structure and its weights in f64, one vector per tensor in visiting order.
@@ -54,11 +55,21 @@ impl<'a> Reference<'a> {
         Reference { net, params }
     }
 
-    /// The light code of one map (3 × W/2 × W).
+    /// The light code of one map (3 × W/2 × W): the encoder's, or the basis' projection.
     fn code(&self, map: &[f64], width: usize, t: &mut Tensors) -> Vec<f64> {
+        let encoder = match &self.net.light {
+            LightModel::Encoder(e) => e,
+            LightModel::Basis(b) => {
+                let functions: Vec<f64> = match self.encoder_tensors() {
+                    0 => b.functions.iter().map(|&v| v as f64).collect(),
+                    _ => t.next().to_vec(),
+                };
+                return project(&functions, b.size(), map, width);
+            }
+        };
         let (mut h, mut w) = (width / 2, width);
         let mut x = map.to_vec();
-        for conv in &self.net.encoder.convs {
+        for conv in &encoder.convs {
             let (wt, bias) = (t.next(), t.next());
             let (c_in, c_out) = (conv.c_in, conv.c_out);
             let mut y = vec![0.0; c_out * h * w];
@@ -122,9 +133,12 @@ impl<'a> Reference<'a> {
             .collect()
     }
 
-    /// How many of the tensors are the encoder's (they come first).
+    /// How many of the tensors are the light model's (they come first).
     pub fn encoder_tensors(&self) -> usize {
-        self.net.encoder.convs.len() * 2 + 2
+        match &self.net.light {
+            LightModel::Encoder(e) => e.convs.len() * 2 + 2,
+            LightModel::Basis(b) => b.choice.is_learned() as usize,
+        }
     }
 
     /// Each sample's radiance (n × 3), its map's scale applied; with `codes`, those light
@@ -154,6 +168,10 @@ impl<'a> Reference<'a> {
                     x.extend(enc);
                 }
                 let outputs = match &track.transfer {
+                    Some(ft) if track.coefficients.is_some() => {
+                        let s = mlp(ft, &mut t, x);
+                        mlp(&track.shading, &mut t, s)
+                    }
                     Some(ft) => {
                         let mut s = mlp(ft, &mut t, x);
                         s.extend_from_slice(code);
@@ -171,7 +189,13 @@ impl<'a> Reference<'a> {
                             Weight::One => 1.0,
                             Weight::Albedo(at) => f[at + c] as f64,
                         };
-                        rgb[c] += weight * outputs[3 * k + c].exp();
+                        let term = match track.coefficients {
+                            None => outputs[3 * k + c].exp(),
+                            Some(n) => (0..n)
+                                .map(|j| outputs[(k * n + j) * 3 + c] * code[j * 3 + c])
+                                .sum(),
+                        };
+                        rgb[c] += weight * term;
                     }
                 }
             }
@@ -194,7 +218,8 @@ impl<'a> Reference<'a> {
             .map(|((&p, &r), &q)| {
                 let r = r as f64;
                 match loss {
-                    Loss::LogL1 => (p.ln_1p() - r.ln_1p()).abs(),
+                    // Below 0, log(1 + p)'s tangent there (the linear design's radiance).
+                    Loss::LogL1 => (if p >= 0.0 { p.ln_1p() } else { p } - r.ln_1p()).abs(),
                     Loss::RelL2 => {
                         (p - r).powi(2) / (q * q + nprt_net::loss::RELATIVE_L2_EPS as f64)
                     }
@@ -203,4 +228,24 @@ impl<'a> Reference<'a> {
             .sum();
         sum / p.len() as f64
     }
+}
+
+/// A basis' code of one map: per function k and channel c at k·3 + c, the sum over texels of
+/// the function's value × the texel's solid angle (exact for its band of latitude) × the map.
+fn project(functions: &[f64], k: usize, map: &[f64], width: usize) -> Vec<f64> {
+    let (h, texels) = (width / 2, width * width / 2);
+    let pi = std::f64::consts::PI;
+    let solid_angle = |t: usize| {
+        let r = (t / width) as f64;
+        2.0 * pi / width as f64 * ((pi * r / h as f64).cos() - (pi * (r + 1.0) / h as f64).cos())
+    };
+    let mut code = vec![0.0; 3 * k];
+    for j in 0..k {
+        for c in 0..3 {
+            code[j * 3 + c] = (0..texels)
+                .map(|t| functions[j * texels + t] * solid_angle(t) * map[c * texels + t])
+                .sum();
+        }
+    }
+    code
 }

@@ -150,6 +150,7 @@ impl WeightFile {
 /// each atomically), with a worked example relighting `view` of its scene.
 pub fn export_model(model_dir: &Path, out: &Path, view: &ExampleView) -> Result<ExportSummary> {
     let (file, net) = load_model(model_dir)?;
+    let encoder = net.encoder().context("nprt export")?;
     if out.exists() && !out.is_dir() {
         bail!("--out '{}' is not a folder", out.display());
     }
@@ -169,7 +170,7 @@ pub fn export_model(model_dir: &Path, out: &Path, view: &ExampleView) -> Result<
     }
 
     let mut weights = WeightFile::default();
-    let (convs, to_code) = weights.encoder(&net.encoder);
+    let (convs, to_code) = weights.encoder(encoder);
     let tracks = weights.tracks(&net);
     write("weights.bin", &le_bytes(&weights.values, f32::to_le_bytes))?;
     write(

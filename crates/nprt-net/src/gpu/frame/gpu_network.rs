@@ -166,7 +166,7 @@ impl GpuNetwork {
         let gpu = GpuDevice::get()?;
         let (layout, flat) = ParameterLayout::pack_for(&gpu, net);
         let params = gpu.upload(&flat);
-        let layout = NetworkLayout::new(&gpu, &layout, net, false);
+        let layout = NetworkLayout::new(&gpu, &layout, net, false)?;
         let mut light = vec![0.0; LIGHT_CODE_VALUES];
         light.extend(gain);
         Ok(GpuNetwork {

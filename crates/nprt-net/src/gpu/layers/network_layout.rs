@@ -97,11 +97,17 @@ pub struct NetworkLayout {
 impl NetworkLayout {
     /// The places of `net`'s tensors in `layout`; each track's input
     /// indices are uploaded to `gpu`, and with `half` the transport networks' f16 weights are
-    /// made there (zero until refreshed).
-    pub fn new(gpu: &GpuDevice, layout: &ParameterLayout, net: &NprtNet, half: bool) -> Self {
+    /// made there (zero until refreshed). The kernels run the paper's encoder; the linear
+    /// design's basis is refused.
+    pub fn new(
+        gpu: &GpuDevice,
+        layout: &ParameterLayout,
+        net: &NprtNet,
+        half: bool,
+    ) -> anyhow::Result<Self> {
         // Spans in the order the network visits its tensors: the encoder's, then the tracks'.
         let mut spans = layout.spans.iter().copied();
-        let encoder = EncoderAt::new(&net.encoder, &mut spans);
+        let encoder = EncoderAt::new(net.encoder()?, &mut spans);
         let tracks: Vec<TrackAt> = net
             .tracks
             .iter()
@@ -124,7 +130,7 @@ impl NetworkLayout {
         if half {
             layout.hold_half(gpu);
         }
-        layout
+        Ok(layout)
     }
 
     /// Gives the transport networks' layers f16 copies of their weights (zero until

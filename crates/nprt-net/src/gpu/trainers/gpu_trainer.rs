@@ -149,7 +149,7 @@ impl GpuTrainer {
         }
         let shapes = net.clone();
         let (layout, flat) = ParameterLayout::pack_for(&gpu, net);
-        let net = NetworkLayout::new(&gpu, &layout, net, half);
+        let net = NetworkLayout::new(&gpu, &layout, net, half)?;
         let params = gpu.upload(&flat);
         let grads = gpu.buffer(layout.total);
         let adam = DeviceAdam::new(&gpu, layout.total, &grads, &params);

@@ -12,4 +12,5 @@ pub const SPEC: DesignSpec = DesignSpec {
     default_activation: Activation::Siren,
     paper_params: 187_718,
     cosine_rate: 5e-4,
+    linear: false,
 };

@@ -14,4 +14,5 @@ pub const SPEC: DesignSpec = DesignSpec {
     paper_params: 219_651,
     // Its deep ReLU stack collapses to a constant at 1e-3.
     cosine_rate: 3e-4,
+    linear: false,
 };

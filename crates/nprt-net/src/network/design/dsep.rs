@@ -13,4 +13,5 @@ pub const SPEC: DesignSpec = DesignSpec {
     default_activation: Activation::Siren,
     paper_params: 194_226,
     cosine_rate: 5e-4,
+    linear: false,
 };

@@ -1,4 +1,4 @@
-//! The transport designs: the paper's four (its Table 1) and any beyond them. One file per
+//! The transport designs: the paper's four (its Table 1) and the linear design beyond them. One file per
 //! design states everything that is its own ([`DesignSpec`]): its tracks, its networks' sizes,
 //! its default activation, the paper's parameter count and the measured learning rate; the
 //! networks, the engines and the training recipe read it from there.
@@ -6,6 +6,7 @@
 mod albedo;
 mod baseline;
 mod dsep;
+mod linear;
 mod prt;
 
 use crate::choice::named_choice;
@@ -36,6 +37,10 @@ pub struct DesignSpec {
     pub paper_params: usize,
     /// The peak learning rate measured best under the cosine schedule (`recipe_rate`).
     pub cosine_rate: f64,
+    /// Whether the lighting enters linearly: a basis projection e = P·E instead of the
+    /// encoder, and shading networks that read ŝ alone and output K transfer coefficients per
+    /// term and channel, dotted with e.
+    pub linear: bool,
 }
 
 /// The transport design (the paper's Table 1).
@@ -50,6 +55,9 @@ pub enum Design {
     /// Two tracks of width 172: diffuse F_T^D(x, n, kd) and specular F_T^S(x, n, ks, ωo, ωr, α),
     /// each with its own Φ; L = kd·Φ^D + ks·Φ^S.
     Dsep,
+    /// Beyond the paper: D/S's tracks, each Φ(ŝ) a transfer matrix dotted with the map's
+    /// projection on a basis; exact under any gain or mixture of maps.
+    Linear,
 }
 
 named_choice!(Design, "design", {
@@ -57,6 +65,7 @@ named_choice!(Design, "design", {
     Prt => "prt",
     Albedo => "albedo",
     Dsep => "dsep",
+    Linear => "linear",
 });
 
 impl Design {
@@ -70,6 +79,7 @@ impl Design {
             Design::Prt => &prt::SPEC,
             Design::Albedo => &albedo::SPEC,
             Design::Dsep => &dsep::SPEC,
+            Design::Linear => &linear::SPEC,
         }
     }
 
@@ -82,6 +92,11 @@ impl Design {
     /// SIREN for the transport networks F_T of the other designs.
     pub fn default_activation(self) -> Activation {
         self.spec().default_activation
+    }
+
+    /// Whether the lighting enters linearly, through a basis (see [`DesignSpec::linear`]).
+    pub fn is_linear(self) -> bool {
+        self.spec().linear
     }
 
     /// Whether the design splits transport from shading (a still camera then keeps ŝ).

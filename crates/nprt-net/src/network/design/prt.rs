@@ -11,4 +11,5 @@ pub const SPEC: DesignSpec = DesignSpec {
     default_activation: Activation::Siren,
     paper_params: 186_947,
     cosine_rate: 5e-4,
+    linear: false,
 };

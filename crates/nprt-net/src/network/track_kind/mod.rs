@@ -6,7 +6,9 @@
 //!
 //! A rule is a sum of terms, each the exp of three of the shading network's outputs (its
 //! outputs are log-radiance: exp keeps radiance positive over its high dynamic range) times a
-//! weight, 1 or a material's albedo among the pixel inputs.
+//! weight, 1 or a material's albedo among the pixel inputs. The linear design's tracks keep
+//! their kind's rule with each term's value the dot product of K transfer coefficients with the
+//! light code instead of an exp (`cpu::transport`).
 
 mod albedo;
 mod diffuse;
@@ -112,14 +114,21 @@ impl TrackKind {
         })
     }
 
-    /// The gradient at the shading outputs `d` from the gradient `dr` at the radiance of a
-    /// pixel with inputs `f` and output exps `e`.
-    pub fn output_gradients(self, f: &[f32], e: &[f32], dr: &[f32], d: &mut [f32]) {
+    /// The gradient at the terms' values `d` (3 per term) from the gradient `dr` at the
+    /// radiance of a pixel with inputs `f`: each term's weight times `dr`.
+    pub fn term_gradients(self, f: &[f32], dr: &[f32], d: &mut [f32]) {
         for (k, w) in self.spec().terms.iter().enumerate() {
             for c in 0..3 {
-                d[3 * k + c] = dr[c] * w.of(f, c) * e[3 * k + c];
+                d[3 * k + c] = dr[c] * w.of(f, c);
             }
         }
+    }
+
+    /// The gradient at the shading outputs `d` from the gradient `dr` at the radiance of a
+    /// pixel with inputs `f` and output exps `e` (the terms' values).
+    pub fn output_gradients(self, f: &[f32], e: &[f32], dr: &[f32], d: &mut [f32]) {
+        self.term_gradients(f, dr, d);
+        d.iter_mut().zip(e).for_each(|(d, e)| *d *= e);
     }
 }
 
