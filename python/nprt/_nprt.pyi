@@ -155,8 +155,10 @@ def train(
     seed: Optional[int] = None,
     progress: bool = True,
     callback: Optional[Callable[[Dict[str, Any]], Optional[bool]]] = None,
+    basis: Optional[str] = None,
 ) -> Dict[str, Any]:
-    """`nprt train`; None takes its default. ``callback`` gets each epoch's row of the loss
+    """`nprt train`; None takes its default (``basis``: the linear design's ``"sh:L"`` or
+    ``"learned:K"``). ``callback`` gets each epoch's row of the loss
     curves; returning a false value other than None (False, 0, numpy's False_), or Ctrl-C,
     ends the run there, saved, and the same call resumes it."""
 

@@ -228,6 +228,16 @@ def test_model_info_gives_the_layer_table_and_the_papers_counts(model):
         nprt.model_info(model, arch="dsep")
 
 
+def test_the_linear_design_takes_its_basis_and_no_other_design_does(dataset, tmp_path):
+    with pytest.raises(nprt.NprtError, match="only the linear design"):
+        nprt.train(dataset, "dsep", tmp_path / "m", epochs=1, basis="sh:2", progress=False)
+    with pytest.raises(ValueError, match="sh:L"):
+        nprt.train(dataset, "linear", tmp_path / "m", epochs=1, basis="sh:99", progress=False)
+    run = nprt.train(dataset, "linear", tmp_path / "m", epochs=1, basis="sh:2", progress=False)
+    assert np.isfinite(run["validation_loss"]), run
+    assert nprt.Model(tmp_path / "m").info["basis"] == "sh:2"
+
+
 def test_the_compiled_module_is_one_abi3_build():
     # One wheel for CPython 3.9 and later: the extension is built against the stable ABI.
     assert nprt._nprt.__file__.endswith(".abi3.so"), nprt._nprt.__file__

@@ -47,7 +47,11 @@ impl EvalOptions {
             bail!("--views must be at least 1 (it limits the test views evaluated)");
         }
         let side = self.timing_res;
-        Frame::check_size(side, side, &format!("--timing-res {side}: a {side}×{side} frame"))?;
+        Frame::check_size(
+            side,
+            side,
+            &format!("--timing-res {side}: a {side}×{side} frame"),
+        )?;
         if self.temporal_frames == 0 {
             return Ok(());
         }
@@ -55,7 +59,11 @@ impl EvalOptions {
             bail!("--temporal-frames must be 0 or at least 2, and --temporal-res at least 8");
         }
         let side = self.temporal_res;
-        Frame::check_size(side, side, &format!("--temporal-res {side}: a {side}×{side} frame"))?;
+        Frame::check_size(
+            side,
+            side,
+            &format!("--temporal-res {side}: a {side}×{side} frame"),
+        )?;
         // Every method's frames along the path are kept for the report, with the references'
         // two halves and the path-traced rows: 3 f32 a pixel each.
         let rows = 2 * (self.models.len() + 1) + 6;

@@ -120,7 +120,11 @@ fn temporary_name(name: &std::ffi::OsStr) -> String {
     while !name.is_char_boundary(cut) {
         cut -= 1;
     }
-    format!(".{}~{:016x}.{pid}{TMP_SUFFIX}", &name[..cut], hasher.finish())
+    format!(
+        ".{}~{:016x}.{pid}{TMP_SUFFIX}",
+        &name[..cut],
+        hasher.finish()
+    )
 }
 
 /// The temporary files [`write_atomically`] left in `dir` (runs killed mid-write leave them),
@@ -219,7 +223,10 @@ mod tests {
             let tmp = temporary_name(std::ffi::OsStr::new(&name));
             assert!(tmp.len() <= NAME_MAX && tmp.ends_with(".tmp"), "{tmp}");
         }
-        assert_eq!(temporary_name(std::ffi::OsStr::new("v.exr")), format!(".v.exr.{}.tmp", std::process::id()));
+        assert_eq!(
+            temporary_name(std::ffi::OsStr::new("v.exr")),
+            format!(".v.exr.{}.tmp", std::process::id())
+        );
         std::fs::remove_dir_all(&d).unwrap();
     }
 

@@ -111,7 +111,10 @@ mod tests {
             .to_string();
         let names = Design::ALL.map(Design::name);
         let (last, rest) = names.split_last().unwrap();
-        let want = format!("unknown design 'mlp' (expected {} or {last})", rest.join(", "));
+        let want = format!(
+            "unknown design 'mlp' (expected {} or {last})",
+            rest.join(", ")
+        );
         assert!(rest.len() >= 2 && err.contains(&want), "{err}");
     }
 }

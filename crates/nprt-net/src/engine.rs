@@ -10,12 +10,13 @@ use nprt_trace::TraceDevice;
 
 use crate::choice::named_choice;
 use crate::cpu::{CpuShading, HostCacheSteps};
+use crate::model::config::ModelConfig;
 use crate::model::folder::ModelFile;
 use crate::network::nprt_net::NprtNet;
-use crate::parameters::Parameters;
 use crate::network::radiance_cache::{RadianceCache, ADAM_BETAS};
 use crate::network::unet::DeepShading;
 use crate::optimiser::{Adam, CacheSteps};
+use crate::parameters::Parameters;
 use crate::shading::{Shading, UnetShading};
 
 /// `--device`: the CPU, a GPU (hardware adapters only), any wgpu adapter (software ones
@@ -119,15 +120,36 @@ impl Engine {
         self == Engine::Gpu
     }
 
+    /// The engine a network of `config` trains and runs on: this one, or the CPU engine for the
+    /// linear design, whose GPU kernels are not written yet (said on standard error), so that a
+    /// run of several designs on a GPU (`nprt paper`, `nprt demo`) keeps it.
+    pub fn for_network(self, config: &ModelConfig) -> Engine {
+        if self.is_gpu() && config.design.is_linear() {
+            eprintln!(
+                "{}: the linear design runs on the CPU engine (its GPU kernels are not written \
+                 yet)",
+                config.label()
+            );
+            return Engine::Cpu;
+        }
+        self
+    }
+
     /// The trained network `net` (with `file`'s settings: its encoder's input and its gain) on
     /// this engine: the one place a frame's networks choose between the CPU engine and the GPU
     /// kernels.
     pub fn network(self, file: &ModelFile, net: NprtNet) -> Result<Box<dyn Shading>> {
-        let (width, norm, gain) = (file.config.encoder_width, file.config.map_norm, file.output_gain());
+        let (width, norm, gain) = (
+            file.config.encoder_width,
+            file.config.map_norm,
+            file.output_gain(),
+        );
         match self {
             Engine::Cpu => Ok(Box::new(CpuShading::new(net, gain, width, norm))),
             #[cfg(feature = "gpu")]
-            Engine::Gpu => Ok(Box::new(crate::gpu::GpuNetwork::new(&net, gain, width, norm)?)),
+            Engine::Gpu => Ok(Box::new(crate::gpu::GpuNetwork::new(
+                &net, gain, width, norm,
+            )?)),
             #[cfg(not(feature = "gpu"))]
             Engine::Gpu => bail!("--device gpu: {WITHOUT_KERNELS}"),
         }
@@ -138,7 +160,9 @@ impl Engine {
         match self {
             Engine::Cpu => Ok(Box::new(net)),
             #[cfg(feature = "gpu")]
-            Engine::Gpu => Ok(Box::new(std::sync::Mutex::new(crate::gpu::GpuUnet::new(&net)?))),
+            Engine::Gpu => Ok(Box::new(std::sync::Mutex::new(crate::gpu::GpuUnet::new(
+                &net,
+            )?))),
             #[cfg(not(feature = "gpu"))]
             Engine::Gpu => bail!("--device gpu: {WITHOUT_KERNELS}"),
         }

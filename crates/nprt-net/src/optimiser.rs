@@ -12,8 +12,8 @@ use anyhow::{anyhow, bail, Context, Result};
 use glam::Vec3;
 use safetensors::{tensor::TensorView, Dtype, SafeTensors};
 
-use crate::parameters::Parameters;
 use crate::network::radiance_cache::{CacheQuery, RadianceCache};
+use crate::parameters::Parameters;
 
 /// Adam's ε, on every engine.
 pub const ADAM_EPSILON: f32 = 1e-8;

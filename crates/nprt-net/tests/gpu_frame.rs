@@ -7,11 +7,11 @@
 
 use glam::Vec3;
 use nprt_gpu::GpuDevice;
+use nprt_net::gpu::{GpuLightCode, GpuLightInput, GpuNetwork};
 use nprt_net::{
     gbuffer_features, Activation, Design, Init, LightInput, MapNorm, ModelConfig, NprtNet,
     PositionEncoding,
 };
-use nprt_net::gpu::{GpuLightCode, GpuLightInput, GpuNetwork};
 use nprt_scene::{load_scene, Camera, SceneOptions};
 use nprt_trace::{render_gbuffer, TraceScene};
 

@@ -2,13 +2,13 @@
 //! basis projection against analytic cases (a constant map, a map made of known spherical
 //! harmonics, a half turn about the up axis).
 
-mod common;
-
 use glam::{Vec2, Vec3};
 use nprt_net::cpu::CpuShading;
 use nprt_net::encoding::spherical_harmonics::basis;
+use nprt_net::{Texels, FEATURES};
+use rand::{RngExt, SeedableRng};
+use rand_pcg::Pcg64Mcg;
 use nprt_net::{BasisChoice, Design, Init, LightBasis, LightInput, MapNorm, ModelConfig, Shading};
-use nprt_net::Texels;
 use nprt_scene::envmap::{uv_to_direction, EnvMap};
 
 const WIDTH: usize = 128;
@@ -26,6 +26,12 @@ fn map_of(name: &str, width: usize, f: impl Fn(Vec3) -> Vec3) -> EnvMap {
         })
         .collect();
     EnvMap::from_texels(name, width, h, texels).unwrap()
+}
+
+/// `n` rows of pixel inputs in [0, 1), seeded.
+fn pixel_inputs(n: usize, seed: u64) -> Vec<f32> {
+    let mut rng = Pcg64Mcg::seed_from_u64(seed);
+    (0..n * FEATURES).map(|_| rng.random::<f32>()).collect()
 }
 
 /// A sky with a sun, and a warm lamp low on the other side: maps unlike each other.
@@ -54,9 +60,12 @@ fn mixed(first: &EnvMap, a: f32, second: &EnvMap, b: f32) -> EnvMap {
 /// bases, both normalisations and a rotated map, through the CPU engine's frame path.
 #[test]
 fn radiance_is_linear_in_the_map() {
-    let features = common::random_batch(700, 1, 3).features;
+    let features = pixel_inputs(700, 3);
     let (sky, lamp) = two_maps();
-    for choice in [BasisChoice::Sh { band: 3 }, BasisChoice::Learned { size: 20 }] {
+    for choice in [
+        BasisChoice::Sh { band: 3 },
+        BasisChoice::Learned { size: 20 },
+    ] {
         for norm in MapNorm::ALL {
             let config = ModelConfig {
                 encoder_width: 64,
@@ -75,7 +84,10 @@ fn radiance_is_linear_in_the_map() {
             let worst = (together.iter().zip(r1.iter().zip(&r2)))
                 .map(|(t, (x, y))| (t - (a * x + b * y)).abs())
                 .fold(0.0f32, f32::max);
-            assert!(largest > 1e-3, "{choice}/{norm}: the network predicts {largest} at most");
+            assert!(
+                largest > 1e-3,
+                "{choice}/{norm}: the network predicts {largest} at most"
+            );
             assert!(
                 worst < 2e-5 * largest,
                 "{choice}/{norm}: off by {worst} of at most {largest}"
@@ -97,7 +109,12 @@ fn a_constant_map_projects_on_the_constant_function_alone() {
     let constant = (4.0 * std::f32::consts::PI).sqrt();
     for (i, v) in code.iter().enumerate() {
         let want = if i < 3 { constant } else { 0.0 };
-        assert!((v - want).abs() < 1e-3, "coefficient {} channel {}: {v}", i / 3, i % 3);
+        assert!(
+            (v - want).abs() < 1e-3,
+            "coefficient {} channel {}: {v}",
+            i / 3,
+            i % 3
+        );
     }
 }
 
@@ -128,7 +145,11 @@ fn known_coefficients_round_trip_and_turn_with_the_map() {
         for (k, &w) in want.iter().enumerate() {
             let l = (k as f32).sqrt().floor() as i32;
             let m = k as i32 - l * l - l;
-            let flip = if sign { (-1f32).powi(l) * if m < 0 { -1.0 } else { 1.0 } } else { 1.0 };
+            let flip = if sign {
+                (-1f32).powi(l) * if m < 0 { -1.0 } else { 1.0 }
+            } else {
+                1.0
+            };
             for (c, gain) in [1.0, 2.0, 0.5].into_iter().enumerate() {
                 let got = code[k * 3 + c] * scale[c];
                 let w = w * gain * flip;

@@ -176,7 +176,11 @@ fn per_channel_models_relight_a_tinted_map_by_its_tint() {
             let net = config.build(&mut Init::new(5));
             let shade = |m: &nprt_scene::envmap::EnvMap| {
                 let input = config.light_input(m, 0.0);
-                let code = net.light.forward(&input.pixels, input.width).codes().to_vec();
+                let code = net
+                    .light
+                    .forward(&input.pixels, input.width)
+                    .codes()
+                    .to_vec();
                 net.radiance(&features, &code, input.scale, None)
             };
             let (a, b) = (shade(&map), shade(&tinted));

@@ -348,7 +348,10 @@ mod tests {
         assert_eq!(orderings.len(), 2);
         for o in &orderings {
             assert_eq!(o.verdict(), Verdict::Holds, "{}", o.statement);
-            assert!(o.comparisons.iter().all(|c| !c.claim.text.contains("dsep-wide")));
+            assert!(o
+                .comparisons
+                .iter()
+                .all(|c| !c.claim.text.contains("dsep-wide")));
         }
     }
 }

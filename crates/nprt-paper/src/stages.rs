@@ -196,7 +196,11 @@ fn outputs_key(report: &Path) -> String {
     let md = std::fs::read_to_string(report.join("report.md")).unwrap_or_default();
     h.update(&std::fs::read(report.join("results.json")).unwrap_or_default());
     h.update(md.as_bytes());
-    for picture in md.split("](").skip(1).filter_map(|rest| rest.split(')').next()) {
+    for picture in md
+        .split("](")
+        .skip(1)
+        .filter_map(|rest| rest.split(')').next())
+    {
         h.update(picture.as_bytes());
         // A picture gone hashes as no bytes: the key then differs.
         h.update(&std::fs::read(report.join(picture)).unwrap_or_default());

@@ -41,6 +41,9 @@ fn _nprt(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(evaluate::evaluate, m)?)?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     // The designs `train` and `model_info` take, as the command line's `--arch` lists them.
-    m.add("DESIGNS", nprt_net::Design::ALL.map(nprt_net::Design::name).to_vec())?;
+    m.add(
+        "DESIGNS",
+        nprt_net::Design::ALL.map(nprt_net::Design::name).to_vec(),
+    )?;
     Ok(())
 }

@@ -22,6 +22,9 @@ use crate::error::OrPy;
 /// the run: `epochs`, `steps`, `samples_per_s`, `train_loss`, `validation_loss`, `seconds`,
 /// `steps_on` and `resumed_from_epoch`; the loss curves are in `out`/loss.csv.
 ///
+/// `basis` is the linear design's light basis, `"sh:L"` or `"learned:K"` (`nprt train
+/// --basis`; only for `arch="linear"`).
+///
 /// `callback`, where given, is called at each epoch's end with that epoch's row of the loss
 /// curves (`step`, `epoch`, `samples`, `seconds`, `train_loss`, `val_loss`); returning a false
 /// value (False, 0, numpy's False_: anything whose `bool` is False, None aside) ends the run
@@ -32,7 +35,7 @@ use crate::error::OrPy;
 #[pyo3(signature = (
     data, arch, out, *, minutes = None, epochs = None, activation = None, device = "cpu",
     precision = None, batch_size = None, lr = None, schedule = None, seed = None,
-    progress = true, callback = None
+    progress = true, callback = None, basis = None
 ))]
 #[allow(clippy::too_many_arguments)]
 pub fn train<'py>(
@@ -51,9 +54,12 @@ pub fn train<'py>(
     seed: Option<u64>,
     progress: bool,
     callback: Option<Py<PyAny>>,
+    basis: Option<&str>,
 ) -> PyResult<Bound<'py, PyDict>> {
     let design = parse(arch)?;
-    let config = ModelConfig::new(design, activation.map(parse).transpose()?);
+    let mut config = ModelConfig::new(design, activation.map(parse).transpose()?);
+    config.basis = basis.map(parse).transpose()?.or(config.basis);
+    config.check().or_py()?;
     let d = TrainOptions::default();
     let run = RunLength {
         epochs,

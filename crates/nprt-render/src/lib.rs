@@ -42,14 +42,12 @@ pub mod view;
 pub use animation::{write_animation, Animation};
 pub use example_view::ExampleView;
 pub use frame_bench::{bench_frame, FrameBenchOptions, FrameBenchRow};
+pub use frame_stages::FrameRadiance;
 pub use frame_timings::FrameTimings;
+pub use nprt_net::LightCode;
 pub use nprt_net::Precision;
 pub use path::CameraPath;
-pub use frame_stages::FrameRadiance;
-pub use nprt_net::LightCode;
-pub use relight::{
-    background, DirectSampling, FrameCache, Pixels, Relighter, DEFAULT_DIRECT_SPP,
-};
+pub use relight::{background, DirectSampling, FrameCache, Pixels, Relighter, DEFAULT_DIRECT_SPP};
 pub use render_job::{RenderJob, RenderOptions, DEFAULT_LIGHTING};
 pub use schedule::LightingSchedule;
 pub use sequence::{render_sequence, FrameReport, Sequence, SequenceSummary};

@@ -93,6 +93,7 @@ impl Relighter {
     /// A model with `file`'s settings and the weights of `net` (on the host), to run on
     /// `engine`.
     pub fn new(file: ModelFile, net: NprtNet, engine: Engine) -> Result<Self> {
+        let engine = engine.for_network(&file.config);
         Ok(Relighter {
             shading: engine.network(&file, net)?,
             stages: frame_stages(engine)?,
@@ -228,7 +229,9 @@ impl Relighter {
         let placed = map.rotated_y(rotation_deg);
         let clock = Instant::now();
         let shown = if px.kept {
-            let direct = self.traces_direct().then_some((sampling.spp, sampling.seed));
+            let direct = self
+                .traces_direct()
+                .then_some((sampling.spp, sampling.seed));
             let shading = &*self.shading;
             let (shown, direct_ms) =
                 (self.stages).kept_frame(shading, ts, &px.rows, &code, &placed, direct, keep)?;
@@ -263,7 +266,12 @@ impl Relighter {
         }
         let bounds = &self.file.bounds;
         let kept = (self.stages).kept_pixels(&*self.shading, ts, camera, bounds)?;
-        let Some(KeptPixels { rows, gbuffer_ms, network_ms }) = kept else {
+        let Some(KeptPixels {
+            rows,
+            gbuffer_ms,
+            network_ms,
+        }) = kept
+        else {
             return Ok(None);
         };
         (t.gbuffer_ms, t.network_ms) = (gbuffer_ms, network_ms);
@@ -308,7 +316,9 @@ impl Relighter {
         if self.shading.host_waits().is_none() {
             return Ok(None);
         }
-        (self.stages).profile(&*self.shading, &px.rows, light).map(Some)
+        (self.stages)
+            .profile(&*self.shading, &px.rows, light)
+            .map(Some)
     }
 
     /// Encodes `map` rotated by `rotation_deg` about +Y: on the GPU kernels, queued there and

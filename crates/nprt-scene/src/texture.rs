@@ -103,14 +103,20 @@ impl Texture {
         let outside = |v: Vec3| unit(v) != v;
         match self {
             Texture::Constant(c) => outside(*c).then(|| Texture::Constant(unit(*c))),
-            Texture::Checkerboard { color0, color1, to_uv } => (outside(*color0)
-                || outside(*color1))
-            .then(|| Texture::Checkerboard {
+            Texture::Checkerboard {
+                color0,
+                color1,
+                to_uv,
+            } => (outside(*color0) || outside(*color1)).then(|| Texture::Checkerboard {
                 color0: unit(*color0),
                 color1: unit(*color1),
                 to_uv: *to_uv,
             }),
-            Texture::Bitmap { image, to_uv, factor } => {
+            Texture::Bitmap {
+                image,
+                to_uv,
+                factor,
+            } => {
                 let values = image.texels.iter().map(|t| *t * *factor);
                 values.clone().any(outside).then(|| Texture::Bitmap {
                     image: Arc::new(Bitmap {

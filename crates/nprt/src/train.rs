@@ -6,8 +6,9 @@ use anyhow::{Context, Result};
 use nprt_net::network::encoder::check_input_width;
 use nprt_net::training::training_set::{TrainingSet, ViewSamples};
 use nprt_net::{
-    Activation, Calibration, Design, DirectLight, Engine, Gather, Loss, MapNorm, ModelConfig,
-    PositionEncoding, Precision, TrainOptions, DEFAULT_ENCODER_WIDTH, DEFAULT_MAP_NORM,
+    Activation, BasisChoice, Calibration, Design, DirectLight, Engine, Gather, Loss, MapNorm,
+    ModelConfig, PositionEncoding, Precision, TrainOptions, DEFAULT_ENCODER_WIDTH,
+    DEFAULT_MAP_NORM,
 };
 
 use crate::flags::{design_names, DeviceArg, RunArgs};
@@ -91,6 +92,12 @@ pub struct TrainArgs {
     /// inputs; docs/model.md). The design's layers are otherwise unchanged.
     #[arg(long, default_value_t = PositionEncoding::default())]
     encoding: PositionEncoding,
+    /// The linear design's light basis (--arch linear only): sh:L, real spherical harmonics of
+    /// bands 0 to L ((L+1)² functions per colour channel, fixed), or learned:K, K functions
+    /// trained with the network, started from the harmonics that fit (docs/model.md). Default
+    /// sh:4, SH PRT 25's lighting.
+    #[arg(long)]
+    basis: Option<BasisChoice>,
     /// Minutes between checkpoints within an epoch. An epoch's end writes one once these
     /// minutes or 10 seconds have passed since the last (0: at every epoch's end); the run's
     /// end always does.
@@ -131,8 +138,10 @@ impl TryFrom<TrainArgs> for TrainJob {
             map_norm: a.map_norm,
             direct: a.direct,
             encoding: a.encoding,
+            basis: a.basis.or(ModelConfig::new(a.arch, None).basis),
             ..ModelConfig::new(a.arch, a.activation)
         };
+        config.check()?;
         let opts = TrainOptions {
             schedule: nprt_net::Schedule {
                 seed: a.seed,

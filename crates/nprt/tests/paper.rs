@@ -62,8 +62,16 @@ fn the_tiny_budget_writes_every_table_and_resumes() {
     // each design's loss and RMSE, are in paper.md.
     if let Some(tables) = common::shared("paper-tables.md") {
         let tables = std::fs::read_to_string(tables).unwrap();
-        let row = tables.lines().find(|l| l.starts_with("| KITCHEN |")).expect("Table 5's KITCHEN row");
-        let figures: Vec<&str> = row.split('|').map(str::trim).filter(|c| !c.is_empty()).skip(1).collect();
+        let row = tables
+            .lines()
+            .find(|l| l.starts_with("| KITCHEN |"))
+            .expect("Table 5's KITCHEN row");
+        let figures: Vec<&str> = row
+            .split('|')
+            .map(str::trim)
+            .filter(|c| !c.is_empty())
+            .skip(1)
+            .collect();
         assert_eq!(figures.len(), 8, "{row}");
         for pair in figures.chunks(2) {
             let cells = format!("| {} | {} |", pair[0], pair[1]);
@@ -118,8 +126,19 @@ fn the_tiny_budget_writes_every_table_and_resumes() {
     let model = |name: &str| models.join(name).to_str().unwrap().to_string();
     let data = dir.join("dataset");
     ok(&[
-        "eval", "--data", data.to_str().unwrap(), "--model", &model("dsep"), "--views", "1",
-        "--out", report.to_str().unwrap(), "--temporal-frames", "0", "--device", "cpu",
+        "eval",
+        "--data",
+        data.to_str().unwrap(),
+        "--model",
+        &model("dsep"),
+        "--views",
+        "1",
+        "--out",
+        report.to_str().unwrap(),
+        "--temporal-frames",
+        "0",
+        "--device",
+        "cpu",
     ]);
     let redone = ok(&args);
     assert!(!redone.contains("its inputs are unchanged"), "{redone}");
@@ -191,7 +210,14 @@ fn a_refused_run_claims_nothing_and_paths_must_be_utf8() {
     let out = dir.to_str().unwrap();
     fails(
         &[
-            "paper", "--budget", "tiny", "--out", out, "--device", "cpu", "--scene",
+            "paper",
+            "--budget",
+            "tiny",
+            "--out",
+            out,
+            "--device",
+            "cpu",
+            "--scene",
             "no-such-scene.xml",
         ],
         &["no-such-scene.xml"],
@@ -208,7 +234,10 @@ fn a_refused_run_claims_nothing_and_paths_must_be_utf8() {
             .unwrap();
         let err = String::from_utf8_lossy(&o.stderr);
         assert_eq!(o.status.code(), Some(1), "{err}");
-        assert!(err.contains("--out") && err.contains("not valid UTF-8"), "{err}");
+        assert!(
+            err.contains("--out") && err.contains("not valid UTF-8"),
+            "{err}"
+        );
         assert!(!odd.exists(), "nothing is made for a refused path");
     }
     std::fs::remove_dir_all(&dir).ok();

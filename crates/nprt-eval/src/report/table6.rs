@@ -66,7 +66,10 @@ mod tests {
         assert!((se - (5.0f64 / 3.0 / 4.0).sqrt()).abs() < 1e-12);
         assert!(mean_and_se([1.0].into_iter()).1.is_nan());
         // Printed: no ± over one value, no NaN over none.
-        assert_eq!(mean_and_se_text([1.0, 2.0].into_iter(), 1e3), "1500.00 ± 500.00");
+        assert_eq!(
+            mean_and_se_text([1.0, 2.0].into_iter(), 1e3),
+            "1500.00 ± 500.00"
+        );
         assert_eq!(mean_and_se_text([0.015].into_iter(), 1e3), "15.00");
         assert_eq!(mean_and_se_text(std::iter::empty(), 1e3), "–");
         assert_eq!(mean_and_se_text([f64::NAN, 1.0].into_iter(), 1e3), "–");

@@ -11,10 +11,10 @@ use crate::init::Init;
 use crate::loss::Loss;
 use crate::model::config::ModelConfig;
 use crate::network::encoder::CODE_SIZE;
-use crate::parameters::Parameters;
 use crate::optimiser::Adam;
-use crate::training::batch::Batch;
+use crate::parameters::Parameters;
 use crate::precision::Precision;
+use crate::training::batch::Batch;
 
 /// Samples/s of `steps` full steps (forward, backward, Adam) on one synthetic batch of
 /// `batch_size` samples over `views` maps, after `warmup` untimed steps: on the CPU engine, or

@@ -51,7 +51,12 @@ impl Shading for CpuShading {
         let (width, norm, texels) = (self.encoder_width, self.map_norm, self.net.light.texels());
         let input = LightInput::with_texels(map, rotation_deg, width, norm, texels);
         LightCode::new(HostCode {
-            code: self.net.light.forward(&input.pixels, input.width).codes().to_vec(),
+            code: self
+                .net
+                .light
+                .forward(&input.pixels, input.width)
+                .codes()
+                .to_vec(),
             divisor: input.scale,
         })
     }

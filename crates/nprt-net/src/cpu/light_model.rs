@@ -54,7 +54,9 @@ impl LightBasis {
         let texels = w * w / 2;
         let mut p = self.functions.clone();
         p.par_chunks_mut(texels).for_each(|row| {
-            row.iter_mut().enumerate().for_each(|(t, v)| *v *= rows[t / w]);
+            row.iter_mut()
+                .enumerate()
+                .for_each(|(t, v)| *v *= rows[t / w]);
         });
         p
     }
@@ -70,9 +72,7 @@ impl LightBasis {
                 for (j, row) in p.chunks_exact(texels).enumerate() {
                     for (c, channel) in map.chunks_exact(texels).enumerate() {
                         // Summed in f64: a sun is one texel among thousands.
-                        let dot: f64 = (row.iter().zip(channel))
-                            .map(|(a, b)| (a * b) as f64)
-                            .sum();
+                        let dot: f64 = (row.iter().zip(channel)).map(|(a, b)| (a * b) as f64).sum();
                         code[j * 3 + c] = dot as f32;
                     }
                 }
@@ -94,15 +94,18 @@ impl LightBasis {
             .par_chunks_mut(texels)
             .enumerate()
             .for_each(|(j, out)| {
-                for (map, d) in maps.chunks_exact(3 * texels).zip(d_codes.chunks_exact(3 * k)) {
+                for (map, d) in maps
+                    .chunks_exact(3 * texels)
+                    .zip(d_codes.chunks_exact(3 * k))
+                {
                     for (c, channel) in map.chunks_exact(texels).enumerate() {
                         let g = d[j * 3 + c];
-                        out.iter_mut()
-                            .zip(channel)
-                            .for_each(|(o, m)| *o += g * m);
+                        out.iter_mut().zip(channel).for_each(|(o, m)| *o += g * m);
                     }
                 }
-                out.iter_mut().enumerate().for_each(|(t, v)| *v *= rows[t / w]);
+                out.iter_mut()
+                    .enumerate()
+                    .for_each(|(t, v)| *v *= rows[t / w]);
             });
         grad
     }

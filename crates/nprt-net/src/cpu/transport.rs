@@ -16,8 +16,8 @@ use crate::network::design::TRANSPORT_CODE;
 use crate::network::encoder::CODE_SIZE;
 use crate::network::mlp::Mlp;
 use crate::network::nprt_net::NprtNet;
-use crate::parameters::Parameters;
 use crate::network::track::Track;
+use crate::parameters::Parameters;
 
 /// Rows per block: small enough that a block's activations stay in the caches, large enough
 /// for efficient matrix products.
@@ -262,7 +262,10 @@ impl Track {
     ) {
         let (outs, per_row) = (self.shading.d_out(), self.term_values());
         pass.d_out.resize(pass.terms.len() / per_row * outs, 0.0);
-        let rows = pass.d_out.chunks_exact_mut(outs).zip(pass.terms.chunks_exact(per_row));
+        let rows = pass
+            .d_out
+            .chunks_exact_mut(outs)
+            .zip(pass.terms.chunks_exact(per_row));
         let Some(k) = self.coefficients else {
             for (r, (d, e)) in rows.enumerate() {
                 let f = &features[r * FEATURES..];
@@ -274,7 +277,8 @@ impl Track {
         let mut d_terms = vec![0.0; per_row];
         for (r, (d, _)) in rows.enumerate() {
             let f = &features[r * FEATURES..];
-            self.kind.term_gradients(f, &dr[r * 3..r * 3 + 3], &mut d_terms);
+            self.kind
+                .term_gradients(f, &dr[r * 3..r * 3 + 3], &mut d_terms);
             let code = light.code(r, 3 * k);
             let at = light.view[r] as usize * 3 * k;
             let d_code = &mut d_codes[at..at + 3 * k];

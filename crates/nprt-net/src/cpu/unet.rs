@@ -12,8 +12,8 @@ use crate::encoding::features::FEATURES;
 use crate::loss::Loss;
 use crate::network::conv::Conv;
 use crate::network::encoder::{LightInput, CODE_SIZE};
-use crate::parameters::Parameters;
 use crate::network::unet::{DeepShading, LEVELS};
+use crate::parameters::Parameters;
 use crate::shading::UnetShading;
 
 /// Views of one padded size, channel-major planes each.

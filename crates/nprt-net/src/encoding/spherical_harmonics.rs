@@ -97,7 +97,10 @@ mod tests {
             basis(5, d, &mut closed);
             recurrence(5, d, &mut general);
             for (k, (a, b)) in closed.iter().zip(&general).enumerate() {
-                assert!((a - b).abs() < 1e-5, "Y{k} at {d}: {a} closed, {b} recurrence");
+                assert!(
+                    (a - b).abs() < 1e-5,
+                    "Y{k} at {d}: {a} closed, {b} recurrence"
+                );
             }
         }
     }
@@ -129,7 +132,10 @@ mod tests {
                 for j in 0..k {
                     let want = if i == j { 1.0 } else { 0.0 };
                     let got = gram[i * k + j];
-                    assert!((got - want).abs() < 3e-3, "{bands} bands: <Y{i}, Y{j}> = {got}");
+                    assert!(
+                        (got - want).abs() < 3e-3,
+                        "{bands} bands: <Y{i}, Y{j}> = {got}"
+                    );
                 }
             }
         }

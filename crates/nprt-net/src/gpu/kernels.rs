@@ -8,8 +8,8 @@
 
 use std::sync::LazyLock;
 
-use nprt_gpu::KernelSource;
 use crate::network::track_kind::kind_table_wgsl;
+use nprt_gpu::KernelSource;
 
 /// The kernel in `shaders/NAME.wgsl`, after the shared `shaders/PART.wgsl` files listed (those
 /// with `enable` directives first: WGSL takes them only before any declaration); with

@@ -65,7 +65,7 @@ impl ModelConfig {
     pub fn check(&self) -> anyhow::Result<()> {
         if let (Some(b), false) = (self.basis, self.design.is_linear()) {
             anyhow::bail!(
-                "light basis {b} given to design {}: only the linear design projects the                  lighting on a basis",
+                "light basis {b} given to design {}: only the linear design projects the lighting on a basis",
                 self.design
             );
         }

@@ -47,7 +47,12 @@ pub fn layer_table(net: &NprtNet) -> Vec<LayerRow> {
         }
         LightModel::Basis(basis) => rows.push(LayerRow {
             name: format!("basis ({})", basis.choice),
-            shape: format!("{}×{} map → {} per channel", basis.width, basis.width / 2, basis.size()),
+            shape: format!(
+                "{}×{} map → {} per channel",
+                basis.width,
+                basis.width / 2,
+                basis.size()
+            ),
             params: basis.num_params(),
         }),
     }

@@ -135,7 +135,8 @@ impl LightBasis {
         let pi = std::f64::consts::PI;
         (0..h)
             .map(|r| {
-                let band = (pi * r as f64 / h as f64).cos() - (pi * (r + 1) as f64 / h as f64).cos();
+                let band =
+                    (pi * r as f64 / h as f64).cos() - (pi * (r + 1) as f64 / h as f64).cos();
                 (2.0 * pi / self.width as f64 * band) as f32
             })
             .collect()
@@ -179,7 +180,14 @@ mod tests {
             assert_eq!(b.to_string(), s);
         }
         assert_eq!("sh:8".parse::<BasisChoice>().unwrap().size(), 81);
-        for bad in ["sh", "sh:16", "learned:0", "learned:5000", "fourier:3", "sh:-1"] {
+        for bad in [
+            "sh",
+            "sh:16",
+            "learned:0",
+            "learned:5000",
+            "fourier:3",
+            "sh:-1",
+        ] {
             let e = bad.parse::<BasisChoice>().unwrap_err();
             assert!(e.contains("sh:L") && e.contains(bad), "{e}");
         }

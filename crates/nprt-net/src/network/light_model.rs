@@ -65,3 +65,21 @@ impl Parameters for LightModel {
         }
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use crate::init::Init;
+    use crate::model::config::ModelConfig;
+    use crate::network::design::Design;
+
+    /// The engines that run only the encoder are told, by name, why a basis is not for them.
+    #[test]
+    fn a_basis_is_refused_where_only_the_encoder_runs() {
+        let linear = ModelConfig::new(Design::Linear, None).build(&mut Init::new(0));
+        let e = linear.encoder().unwrap_err().to_string();
+        assert!(e.contains("sh:4") && e.contains("--device cpu"), "{e}");
+        let dsep = ModelConfig::new(Design::Dsep, None).build(&mut Init::new(0));
+        assert!(dsep.encoder().is_ok());
+        assert_eq!((linear.light.code_size(), dsep.light.code_size()), (75, 64));
+    }
+}

@@ -7,8 +7,8 @@ use crate::network::design::Design;
 use crate::network::encoder::LightEncoder;
 use crate::network::light_basis::{BasisChoice, LightBasis};
 use crate::network::light_model::LightModel;
-use crate::parameters::{child, Parameters, Visit, VisitMut};
 use crate::network::track::Track;
+use crate::parameters::{child, Parameters, Visit, VisitMut};
 
 /// Light model plus transport: G-buffer features and a light code in, radiance out. Also (same
 /// shapes) its gradient. The CPU engine runs it (`cpu`), the GPU kernels from its values.

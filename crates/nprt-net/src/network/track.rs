@@ -8,8 +8,8 @@ use crate::network::activation::Activation;
 use crate::network::design::{Design, Layout, TRANSPORT_CODE};
 use crate::network::encoder::CODE_SIZE;
 use crate::network::mlp::Mlp;
-use crate::parameters::{child, Parameters, Visit, VisitMut};
 use crate::network::track_kind::TrackKind;
+use crate::parameters::{child, Parameters, Visit, VisitMut};
 
 /// One transport track: an optional transfer network F_T on the pixel inputs, and the shading
 /// network Φ on [ŝ, ê] (or, for the baseline, on [ê, inputs]; for the linear design on ŝ

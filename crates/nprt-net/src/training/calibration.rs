@@ -73,8 +73,8 @@ mod tests {
     use crate::encoding::map_norm::MapNorm;
     use crate::init::Init;
     use crate::model::config::ModelConfig;
-    use crate::network::encoder::LightInput;
     use crate::network::design::Design;
+    use crate::network::encoder::LightInput;
     use glam::Vec3;
     use nprt_data::dataset::{PackedDataset, PackedPixel, PackedTarget};
     use nprt_scene::envmap::EnvMap;

@@ -8,8 +8,8 @@ use anyhow::{bail, Context, Result};
 use serde::{Deserialize, Serialize};
 
 use crate::model::folder::{load_weights, save_weights};
-use crate::parameters::Parameters;
 use crate::optimiser::{is_state_file, state_file, EngineSteps};
+use crate::parameters::Parameters;
 use crate::training::loss_curves::LossRow;
 
 const DIR: &str = "checkpoint";

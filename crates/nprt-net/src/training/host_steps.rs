@@ -5,8 +5,8 @@ use std::path::Path;
 
 use anyhow::Result;
 
-use crate::parameters::Parameters;
 use crate::optimiser::{Adam, EngineSteps};
+use crate::parameters::Parameters;
 
 /// A batch's mean loss, the network's gradient (same shapes) and its samples.
 type Gradients<'a, N, B> = dyn Fn(&N, &B) -> (f64, N, u64) + 'a;

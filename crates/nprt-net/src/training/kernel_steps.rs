@@ -11,9 +11,9 @@ use crate::gpu::{DeviceDataset, GpuTrainer};
 use crate::loss::Loss;
 use crate::network::nprt_net::NprtNet;
 use crate::optimiser::EngineSteps;
+use crate::precision::Precision;
 use crate::training::batch::Batch;
 use crate::training::training_set::TrainingSet;
-use crate::precision::Precision;
 
 pub struct KernelSteps {
     trainer: GpuTrainer,

@@ -19,8 +19,9 @@ use crate::model::folder::{
     save_model, ModelFile, CONFIG_FILE, MODEL_FORMAT, MODEL_VERSION, WEIGHTS_FILE,
 };
 use crate::network::nprt_net::NprtNet;
-use crate::parameters::Parameters;
 use crate::optimiser::{EngineSteps, ADAM_EPSILON};
+use crate::parameters::Parameters;
+use crate::precision::Precision;
 use crate::training::batch::Batch;
 use crate::training::calibration::{level_gain, Calibration, LEVEL_SAMPLES};
 use crate::training::checkpoint::RunState;
@@ -31,7 +32,6 @@ use crate::training::train_options::{Gather, TrainOptions};
 use crate::training::training_loop::{self, Objective, Steps, TrainSummary, Watch};
 use crate::training::training_set::{TrainingSet, ViewSamples};
 use crate::training::validation::validation_loss;
-use crate::precision::Precision;
 
 /// A Neural PRT design learning a dataset's pixels.
 struct PixelObjective<'a> {
@@ -225,7 +225,7 @@ pub fn train(
     opts.check()?;
     // On the GPU the steps run on our own kernels, with the network's host copy (for saving)
     // on the CPU.
-    let kernels = cfg!(feature = "gpu") && engine.is_gpu();
+    let kernels = cfg!(feature = "gpu") && engine.for_network(config).is_gpu();
     if opts.precision != Precision::F32 && !kernels {
         bail!(
             "--precision {} trains on nprt's own GPU kernels only: use --device gpu (a build \

@@ -7,12 +7,12 @@ use serde::{Deserialize, Serialize};
 use crate::choice::named_choice;
 use crate::loss::Loss;
 use crate::network::design::Design;
+use crate::precision::Precision;
 use crate::training::batch::Batch;
 use crate::training::calibration::Calibration;
 use crate::training::lr_schedule::LrSchedule;
 use crate::training::run_length::RunLength;
 use crate::training::schedule::Schedule;
-use crate::precision::Precision;
 
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct TrainOptions {

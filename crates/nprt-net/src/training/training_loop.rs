@@ -19,8 +19,8 @@ use rand::SeedableRng;
 use rand_pcg::Pcg64Mcg;
 
 use crate::init::Init;
-use crate::parameters::Parameters;
 use crate::optimiser::EngineSteps;
+use crate::parameters::Parameters;
 use crate::training::checkpoint::{self, Checkpoint, RunState};
 use crate::training::loss_curves::{self as curves, LossRow};
 use crate::training::schedule::Schedule;

@@ -3,9 +3,9 @@
 //! weights as f64 copies that finite differences can nudge below f32's resolution.
 
 use nprt_net::encoding::hash_grid::{self, LEVEL_FEATURES};
+use nprt_net::network::light_model::LightModel;
 use nprt_net::network::mlp::Mlp;
 use nprt_net::network::track_kind::Weight;
-use nprt_net::network::light_model::LightModel;
 use nprt_net::{Activation, Batch, Loss, NprtNet, Parameters, FEATURES, OMEGA_0};
 
 /// A network's structure and its weights in f64, one vector per tensor in visiting order.

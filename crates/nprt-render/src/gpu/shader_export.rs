@@ -372,14 +372,22 @@ fn interface(wgsl: &str) -> Result<(Vec<Value>, u32, [u32; 3])> {
     let module = naga::front::wgsl::parse_str(wgsl)
         .map_err(|e| anyhow::anyhow!("{}", e.emit_to_string(wgsl)))?;
     let uniform = (module.global_variables.iter())
-        .find(|(_, g)| g.binding.as_ref().is_some_and(|b| b.group == 0 && b.binding == 0))
+        .find(|(_, g)| {
+            g.binding
+                .as_ref()
+                .is_some_and(|b| b.group == 0 && b.binding == 0)
+        })
         .map(|(_, g)| &module.types[g.ty].inner)
         .context("no parameters at binding 0")?;
     let naga::TypeInner::Struct { members, span } = uniform else {
         bail!("its parameters at binding 0 are not a struct");
     };
     let params = (members.iter())
-        .filter_map(|m| m.name.as_ref().map(|name| json!({ "name": name, "word": m.offset / 4 })))
+        .filter_map(|m| {
+            m.name
+                .as_ref()
+                .map(|name| json!({ "name": name, "word": m.offset / 4 }))
+        })
         .collect();
     let entry = module.entry_points.first().context("no entry point")?;
     Ok((params, span / 4, entry.workgroup_size))

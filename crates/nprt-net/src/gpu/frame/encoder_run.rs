@@ -5,9 +5,9 @@
 
 use std::sync::Arc;
 
-use nprt_gpu::{Dispatch, GpuDevice, KeptLast};
 use crate::gpu::layers::network_layout::NetworkLayout;
 use crate::network::encoder::CODE_SIZE;
+use nprt_gpu::{Dispatch, GpuDevice, KeptLast};
 
 use super::light_code::GpuLightCode;
 use super::light_input::GpuLightInput;

@@ -561,7 +561,9 @@ impl Shading for GpuNetwork {
 
     fn radiance(&self, px: &PixelRows, light: &LightCode) -> Vec<f32> {
         let px = px.get::<GpuPixels>().unwrap_or_else(|| foreign("pixels"));
-        let code = light.get::<GpuLightCode>().unwrap_or_else(|| foreign("a light code"));
+        let code = light
+            .get::<GpuLightCode>()
+            .unwrap_or_else(|| foreign("a light code"));
         GpuNetwork::radiance(self, px, code)
     }
 
@@ -579,7 +581,11 @@ impl Shading for GpuNetwork {
     fn describe(&self) -> String {
         match self.half() {
             false => format!("GPU kernels on {}", self.gpu.adapter),
-            true => format!("GPU kernels on {} ({})", self.gpu.adapter, self.precision_name()),
+            true => format!(
+                "GPU kernels on {} ({})",
+                self.gpu.adapter,
+                self.precision_name()
+            ),
         }
     }
 

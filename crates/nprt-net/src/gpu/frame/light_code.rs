@@ -1,8 +1,8 @@
 //! A lighting on the device: what the encoder made of a map, left where the shading networks
 //! read it, so that a lighting change on the GPU sends nothing back to the host.
 
-use nprt_gpu::GpuDevice;
 use crate::network::encoder::CODE_SIZE;
+use nprt_gpu::GpuDevice;
 
 /// The light code ê (`CODE_SIZE` values) and the map's divisor per channel (3 values after
 /// it) on the device.

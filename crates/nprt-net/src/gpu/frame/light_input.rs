@@ -6,9 +6,9 @@
 
 use std::sync::LazyLock;
 
-use nprt_gpu::{groups_for, Dispatch, GpuDevice, KernelSource};
 use crate::encoding::map_norm::MapNorm;
 use crate::network::encoder::LightInput;
+use nprt_gpu::{groups_for, Dispatch, GpuDevice, KernelSource};
 use nprt_scene::EnvMap;
 use nprt_trace::gpu::wgsl::{LERP, MAP_LOOKUP};
 use nprt_trace::gpu::{matrix_words, GpuMap};

@@ -3,11 +3,11 @@
 //! encoder fuses its own into `encoder_block`), the gradient at its input and its weights'
 //! gradients.
 
-use crate::gpu::products::dense_products::DenseProducts;
 use crate::gpu::kernels::{
     CONV_FORWARD, CONV_INPUT_BACKWARD, CONV_INPUT_BACKWARD_THREADS, CONV_WEIGHT_BACKWARD,
 };
 use crate::gpu::layers::layer_at::ConvAt;
+use crate::gpu::products::dense_products::DenseProducts;
 use crate::gpu::products::operands::Output;
 use nprt_gpu::{groups_for, Dispatch, GpuDevice, Part};
 

@@ -2,12 +2,12 @@
 //! batch's maps, keeping each block's pooling tape for backward) and the frame path (over one
 //! map, keeping nothing). Each convolution block halves the image; the code layer follows.
 
-use crate::gpu::products::dense_products::DenseProducts;
 use crate::gpu::kernels::{ENCODER_BLOCK, ENCODER_BLOCK_THREADS};
 use crate::gpu::layers::layer_at::{ConvAt, DenseAt};
+use crate::gpu::products::dense_products::DenseProducts;
 use crate::gpu::products::operands::{Bias, Operand, Output};
-use nprt_gpu::{groups_for, Bind, Dispatch, GpuDevice, Part, Span};
 use crate::network::encoder::{LightEncoder, CHANNELS, CODE_SIZE};
+use nprt_gpu::{groups_for, Bind, Dispatch, GpuDevice, Part, Span};
 
 /// The light encoder's tensors in the flat buffers: its blocks' convolutions and the code
 /// layer.

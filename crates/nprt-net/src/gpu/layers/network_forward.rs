@@ -3,14 +3,14 @@
 //! camera's pixels, through ping-pong activations). Both read the weights from one flat
 //! parameter buffer where [`NetworkLayout`](crate::gpu::layers::network_layout::NetworkLayout) places them.
 
+use crate::gpu::kernels::TRACK_INPUTS;
+use crate::gpu::layers::network_layout::{MlpAt, TrackAt};
 use crate::gpu::products::codes::activation_code;
 use crate::gpu::products::dense_products::DenseProducts;
 use crate::gpu::products::half_layers::{half_train_layer, pad16, HalfLayers, HalfOut, Held};
-use crate::gpu::kernels::TRACK_INPUTS;
-use crate::gpu::layers::network_layout::{MlpAt, TrackAt};
 use crate::gpu::products::operands::{Bias, Operand, Output};
-use nprt_gpu::{groups_for, Bind, Dispatch, GpuDevice, Part};
 use crate::network::encoder::CODE_SIZE;
+use nprt_gpu::{groups_for, Bind, Dispatch, GpuDevice, Part};
 
 /// How an MLP's first layer reads its input: from weight row `own_row`, `count` values per
 /// row, with `bias` (the light code's share folded in, for a shading network).

@@ -1,19 +1,19 @@
 //! Where each tensor of a network lies in the flat parameter buffers, in the network's own
 //! structure (encoder blocks, tracks, layers), as the training step's dispatches address them.
 
-use crate::gpu::layers::light_encoder::EncoderAt;
-use crate::gpu::products::half_layers::{HalfLayers, HalfWeight};
-use crate::gpu::layers::layer_at::DenseAt;
-use crate::gpu::layers::parameters::ParameterLayout;
-use nprt_gpu::Span;
-use nprt_gpu::{Dispatch, GpuDevice};
 use crate::encoding::hash_grid;
+use crate::gpu::layers::layer_at::DenseAt;
+use crate::gpu::layers::light_encoder::EncoderAt;
+use crate::gpu::layers::parameters::ParameterLayout;
+use crate::gpu::products::half_layers::{HalfLayers, HalfWeight};
 use crate::network::activation::Activation;
 use crate::network::design::TRANSPORT_CODE;
 use crate::network::encoder::CODE_SIZE;
 use crate::network::mlp::Mlp;
 use crate::network::nprt_net::NprtNet;
 use crate::network::track_kind::TrackKind;
+use nprt_gpu::Span;
+use nprt_gpu::{Dispatch, GpuDevice};
 
 pub struct MlpAt {
     pub layers: Vec<DenseAt>,

@@ -8,8 +8,8 @@ use anyhow::Result;
 
 use crate::gpu::kernels::ADAM;
 use crate::gpu::layers::parameters::ParameterLayout;
-use nprt_gpu::{groups_for, Dispatch, GpuDevice};
 use crate::optimiser::{bias_corrections_for, load_state, save_state, ADAM_BETA1, ADAM_BETA2};
+use nprt_gpu::{groups_for, Dispatch, GpuDevice};
 
 /// Adam's moments and step count for one network's flat buffers, and its dispatch.
 pub struct DeviceAdam {

@@ -12,12 +12,14 @@
 //! gradients, and Adam divides it back out; f16 values saturate instead of overflowing. The
 //! light encoder, the hash grids and the light code's share stay in f32.
 
+use crate::gpu::kernels::{HALF_WEIGHT_GRAD, HALF_WEIGHT_GRAD_COOP};
+use crate::gpu::layers::network_layout::MlpAt;
+use crate::gpu::passes::mlp_step::{row_chunks, FirstLayerBias, MlpTape, Trainable};
 use crate::gpu::products::codes::{activation_code, BACKWARD};
 use crate::gpu::products::dense_products::DenseProducts;
-use crate::gpu::products::half_layers::{half_train_layer, held_halves, pad16, HalfLayers, HalfOut};
-use crate::gpu::kernels::{HALF_WEIGHT_GRAD, HALF_WEIGHT_GRAD_COOP};
-use crate::gpu::passes::mlp_step::{row_chunks, FirstLayerBias, MlpTape, Trainable};
-use crate::gpu::layers::network_layout::MlpAt;
+use crate::gpu::products::half_layers::{
+    half_train_layer, held_halves, pad16, HalfLayers, HalfOut,
+};
 use crate::gpu::products::operands::{Bias, Output};
 use nprt_gpu::{groups_for, Bind, Dispatch, GpuDevice};
 

@@ -2,13 +2,15 @@
 //! gradient at the codes into every encoder weight, through the code layer and each block's
 //! pool, ReLU and skip.
 
-use crate::gpu::layers::conv::{record_input_gradient, record_weight_gradients, Images, InputGradient};
-use crate::gpu::products::dense_products::DenseProducts;
-use crate::gpu::layers::light_encoder::{BlockPass, EncoderAt};
 use crate::gpu::kernels::ENCODER_POOL_BACKWARD;
+use crate::gpu::layers::conv::{
+    record_input_gradient, record_weight_gradients, Images, InputGradient,
+};
+use crate::gpu::layers::light_encoder::{BlockPass, EncoderAt};
+use crate::gpu::products::dense_products::DenseProducts;
 use crate::gpu::products::operands::{Bias, Operand, Output};
-use nprt_gpu::{groups_for, Dispatch, GpuDevice};
 use crate::network::encoder::{CHANNELS, CODE_SIZE};
+use nprt_gpu::{groups_for, Dispatch, GpuDevice};
 
 impl EncoderAt {
     /// Appends to `plan` the encoder's backward pass over `views` maps from the gradient at

@@ -1,13 +1,13 @@
 //! An MLP's share of a training step: the buffers its forward pass keeps for backward, and its
 //! backward pass into every layer's gradients (the weights' summed over chunks of rows).
 
+use crate::gpu::kernels::GEMM_TILE;
+use crate::gpu::layers::network_forward::ForwardTargets;
+use crate::gpu::layers::network_layout::MlpAt;
 use crate::gpu::products::codes::{activation_code, BACKWARD};
 use crate::gpu::products::dense_products::DenseProducts;
 use crate::gpu::products::half_layers::held_halves;
 use crate::gpu::products::half_layers::Held;
-use crate::gpu::kernels::GEMM_TILE;
-use crate::gpu::layers::network_forward::ForwardTargets;
-use crate::gpu::layers::network_layout::MlpAt;
 use crate::gpu::products::operands::{Bias, Operand, Output};
 use nprt_gpu::{Dispatch, GpuDevice};
 

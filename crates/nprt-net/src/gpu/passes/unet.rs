@@ -5,24 +5,24 @@
 //! the masked loss; then backward into every weight's gradient. It computes what the CPU
 //! engine's `cpu::unet` computes, in f32, and the tests hold the two together.
 
-use crate::gpu::products::codes::loss_code;
-use crate::gpu::layers::conv::{
-    record_conv, record_input_gradient, record_weight_gradients, Images, InputGradient,
-};
-use crate::gpu::products::dense_products::DenseProducts;
-use crate::gpu::layers::light_encoder::{BlockPass, EncoderAt};
+use crate::encoding::features::FEATURES;
 use crate::gpu::kernels::{
     MAX_POOL, OFFSET_BACKWARD, PLANE_OFFSET, POOL_BACKWARD, UNET_LOSS, UPSAMPLE_BACKWARD,
     UPSAMPLE_CONCAT,
 };
+use crate::gpu::layers::conv::{
+    record_conv, record_input_gradient, record_weight_gradients, Images, InputGradient,
+};
 use crate::gpu::layers::layer_at::{ConvAt, DenseAt};
-use crate::gpu::products::operands::{Bias, Operand, Output};
+use crate::gpu::layers::light_encoder::{BlockPass, EncoderAt};
 use crate::gpu::layers::parameters::ParameterLayout;
-use nprt_gpu::{groups_for, Dispatch, GpuDevice};
-use crate::encoding::features::FEATURES;
+use crate::gpu::products::codes::loss_code;
+use crate::gpu::products::dense_products::DenseProducts;
+use crate::gpu::products::operands::{Bias, Operand, Output};
 use crate::loss::Loss;
 use crate::network::encoder::CODE_SIZE;
 use crate::network::unet::{DeepShading, LEVELS};
+use nprt_gpu::{groups_for, Dispatch, GpuDevice};
 
 /// The U-Net's tensors in the flat buffers.
 pub struct UnetAt {

@@ -2,8 +2,8 @@
 //! dense layer's, in training and in frames, and the products of their backward passes) and
 //! sums of columns, each a dispatch or a few appended to a plan.
 
-use crate::gpu::products::codes::BACKWARD;
 use crate::gpu::kernels::{COLUMN_SUM, GEMM, GEMM_TILE};
+use crate::gpu::products::codes::BACKWARD;
 use crate::gpu::products::operands::{Bias, Operand, Output};
 use nprt_gpu::{groups_for, Dispatch, GpuDevice};
 

@@ -8,8 +8,8 @@
 //! the pre-activation kept or the activation's derivative applied); its weight gradients are
 //! `half_products`'.
 
-use crate::gpu::products::codes::BACKWARD;
 use crate::gpu::kernels::{HALF_DENSE, HALF_DENSE_COOP, HALF_ROWS, HALF_TRAIN, HALF_TRAIN_COOP};
+use crate::gpu::products::codes::BACKWARD;
 use crate::gpu::products::operands::Bias;
 use nprt_gpu::{groups_for, Bind, Dispatch, GpuDevice, KernelSource};
 

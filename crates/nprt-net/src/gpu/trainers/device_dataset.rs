@@ -8,10 +8,10 @@ use nprt_data::dataset::PACKED_PIXEL_BYTES;
 
 use glam::Vec3;
 
-use nprt_gpu::GpuDevice;
 use crate::encoding::features::position_frame;
 use crate::network::encoder::LightInput;
 use nprt_data::dataset::PackedDataset;
+use nprt_gpu::GpuDevice;
 
 /// Records per upload: large enough to keep the queue's copies few, small enough that their
 /// staging stays modest.

@@ -13,21 +13,21 @@ use std::sync::Arc;
 
 use anyhow::Result;
 
-use crate::gpu::passes::device_adam::DeviceAdam;
-use crate::gpu::trainers::device_dataset::DeviceDataset;
-use crate::gpu::kernels::GATHER_SAMPLES;
-use crate::gpu::passes::mlp_step::Trainable;
-use crate::gpu::layers::network_layout::NetworkLayout;
-use crate::gpu::layers::parameters::ParameterLayout;
-use crate::gpu::trainers::plans::{Pass, Plans};
-use nprt_gpu::{groups_for, Dispatch, GpuDevice};
 use crate::cpu::Samples;
 use crate::encoding::features::FEATURES;
 use crate::encoding::hash_grid;
+use crate::gpu::kernels::GATHER_SAMPLES;
+use crate::gpu::layers::network_layout::NetworkLayout;
+use crate::gpu::layers::parameters::ParameterLayout;
+use crate::gpu::passes::device_adam::DeviceAdam;
+use crate::gpu::passes::mlp_step::Trainable;
+use crate::gpu::trainers::device_dataset::DeviceDataset;
+use crate::gpu::trainers::plans::{Pass, Plans};
 use crate::loss::Loss;
 use crate::network::encoder::CODE_SIZE;
 use crate::network::nprt_net::NprtNet;
 use crate::precision::Precision;
+use nprt_gpu::{groups_for, Dispatch, GpuDevice};
 use nprt_gpu::{KernelTime, KernelTimer};
 
 /// A network's parameters, gradients and Adam moments on the device, and the step that trains

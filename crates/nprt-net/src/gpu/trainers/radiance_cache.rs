@@ -10,24 +10,24 @@ use std::sync::Arc;
 use anyhow::Result;
 use glam::Vec3;
 
-use crate::gpu::products::codes::loss_code;
-use crate::gpu::products::dense_products::DenseProducts;
-use crate::gpu::passes::device_adam::DeviceAdam;
-use crate::gpu::products::half_layers::Held;
-use crate::gpu::kernels::{GRID_BACKWARD, RADIANCE_LOSS, TRACK_INPUTS};
-use crate::gpu::passes::mlp_step::{forward_targets, MlpTape, Trainable};
-use crate::gpu::layers::network_forward::FirstLayer;
-use crate::gpu::layers::network_layout::{mlp_at, MlpAt};
-use crate::gpu::products::operands::{Bias, Output};
-use crate::gpu::layers::parameters::ParameterLayout;
-use crate::gpu::trainers::plans::{submit, Pass, Plans};
-use nprt_gpu::{groups_for, Dispatch, GpuDevice, Part, Span};
 use crate::cpu::radiance_cache::encode_rest;
 use crate::encoding::features::FEATURES;
 use crate::encoding::hash_grid;
+use crate::gpu::kernels::{GRID_BACKWARD, RADIANCE_LOSS, TRACK_INPUTS};
+use crate::gpu::layers::network_forward::FirstLayer;
+use crate::gpu::layers::network_layout::{mlp_at, MlpAt};
+use crate::gpu::layers::parameters::ParameterLayout;
+use crate::gpu::passes::device_adam::DeviceAdam;
+use crate::gpu::passes::mlp_step::{forward_targets, MlpTape, Trainable};
+use crate::gpu::products::codes::loss_code;
+use crate::gpu::products::dense_products::DenseProducts;
+use crate::gpu::products::half_layers::Held;
+use crate::gpu::products::operands::{Bias, Output};
+use crate::gpu::trainers::plans::{submit, Pass, Plans};
 use crate::loss::Loss;
 use crate::network::radiance_cache::{CacheQuery, RadianceCache, INPUTS};
 use crate::optimiser::CacheSteps;
+use nprt_gpu::{groups_for, Dispatch, GpuDevice, Part, Span};
 
 /// Threads of `grid_backward` per chunk of rows: one per 64 slots of each level's table.
 const GRID_BACKWARD_THREADS: usize = hash_grid::LEVELS * hash_grid::TABLE_SIZE / 64;

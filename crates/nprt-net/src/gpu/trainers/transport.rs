@@ -3,20 +3,20 @@
 //! first shading layer's bias, the loss and its gradient at the tracks' outputs, and backward
 //! into every parameter, the grids' tables and the light codes.
 
-use crate::gpu::products::codes::loss_code;
-use crate::gpu::products::dense_products::DenseProducts;
-use crate::gpu::trainers::gpu_trainer::{BatchBuffers, GpuTrainer};
-use crate::gpu::products::half_layers::Held;
+use crate::encoding::hash_grid;
 use crate::gpu::kernels::{COMBINE, GRID_BACKWARD, RADIANCE_LOSS, TRACK_GRADIENT};
-use crate::gpu::passes::mlp_step::{forward_targets, MlpTape};
 use crate::gpu::layers::network_forward::FirstLayer;
 use crate::gpu::layers::network_layout::TrackAt;
+use crate::gpu::passes::mlp_step::{forward_targets, MlpTape};
+use crate::gpu::products::codes::loss_code;
+use crate::gpu::products::dense_products::DenseProducts;
+use crate::gpu::products::half_layers::Held;
 use crate::gpu::products::operands::{Bias, Operand, Output};
-use nprt_gpu::{groups_for, Dispatch};
-use crate::encoding::hash_grid;
+use crate::gpu::trainers::gpu_trainer::{BatchBuffers, GpuTrainer};
 use crate::loss::Loss;
 use crate::network::design::TRANSPORT_CODE;
 use crate::network::encoder::CODE_SIZE;
+use nprt_gpu::{groups_for, Dispatch};
 
 /// Threads of `grid_backward` per chunk of rows: one per 64 slots of each level's table.
 const GRID_BACKWARD_THREADS: usize = hash_grid::LEVELS * hash_grid::TABLE_SIZE / 64;

@@ -8,17 +8,17 @@ use std::sync::Arc;
 
 use anyhow::Result;
 
-use crate::gpu::layers::conv::Images;
-use crate::gpu::passes::device_adam::DeviceAdam;
-use crate::gpu::layers::parameters::ParameterLayout;
-use crate::gpu::trainers::plans::{submit, Pass, Plans};
-use crate::gpu::passes::unet::{loss_params, UnetAt, UnetBuffers};
-use nprt_gpu::{Dispatch, GpuDevice};
 use crate::cpu::UnetBatch;
+use crate::gpu::layers::conv::Images;
+use crate::gpu::layers::parameters::ParameterLayout;
+use crate::gpu::passes::device_adam::DeviceAdam;
+use crate::gpu::passes::unet::{loss_params, UnetAt, UnetBuffers};
+use crate::gpu::trainers::plans::{submit, Pass, Plans};
 use crate::loss::Loss;
 use crate::network::encoder::LightInput;
 use crate::network::unet::DeepShading;
 use crate::shading::UnetShading;
+use nprt_gpu::{Dispatch, GpuDevice};
 
 /// A U-Net's parameters, gradients and Adam moments on the device, and the passes that train
 /// and run it.
