@@ -136,6 +136,7 @@ def generate(
     fov: Optional[float] = None,
     device: str = "cpu",
     progress: bool = True,
+    mix_maps: Optional[int] = None,
 ) -> Dict[str, Any]:
     """`nprt generate`; None takes its default."""
 

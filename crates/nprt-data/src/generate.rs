@@ -32,6 +32,8 @@ pub struct GenerateOptions {
     pub seed: u64,
     /// Exposure and white-balance jitter of the training views' maps, in stops.
     pub jitter: Jitter,
+    /// The most maps a training view's lighting mixes (1: one map a view).
+    pub mix_maps: u32,
     /// Maps of a folder held out for testing (default: a fifth, at least one).
     pub test_maps: Option<usize>,
     /// With a folder of maps, the share of training views lit by a procedural lighting of
@@ -63,6 +65,7 @@ impl Default for GenerateOptions {
                 exposure: 1.0,
                 tint: 0.3,
             },
+            mix_maps: 1,
             test_maps: None,
             mix_builtin: None,
             camera: CameraChoice::default(),
@@ -148,6 +151,7 @@ pub fn generate(opts: &GenerateOptions, planned: impl FnOnce(Planned)) -> Result
         test_spp: opts.test_spp,
         seed: opts.seed,
         jitter: opts.jitter,
+        mix_maps: opts.mix_maps,
     };
     let ts = TraceScene::new(&scene);
     let mut manifest = dataset::plan(&request, &ts)?;

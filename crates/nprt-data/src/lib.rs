@@ -28,6 +28,7 @@
 //!     test_spp: 4,
 //!     seed: 0,
 //!     jitter: dataset::Jitter::default(),
+//!     mix_maps: 1,
 //! };
 //! let manifest = dataset::plan(&request, &ts)?;
 //! let dir = std::env::temp_dir().join(format!("nprt-data-doc-{}", std::process::id()));

@@ -249,4 +249,16 @@ mod tests {
             .contains("cpu, gpu, wgpu or auto"));
         assert_eq!("wgpu".parse::<Compute>(), Ok(Compute::Wgpu));
     }
+
+    /// A run of several designs on the GPU keeps the linear one, on the CPU engine; the others
+    /// stay where they were asked to run.
+    #[test]
+    fn the_linear_design_runs_on_the_cpu_engine() {
+        use crate::network::design::Design;
+        let linear = ModelConfig::new(Design::Linear, None);
+        let dsep = ModelConfig::new(Design::Dsep, None);
+        assert_eq!(Engine::Gpu.for_network(&linear), Engine::Cpu);
+        assert_eq!(Engine::Gpu.for_network(&dsep), Engine::Gpu);
+        assert_eq!(Engine::Cpu.for_network(&linear), Engine::Cpu);
+    }
 }

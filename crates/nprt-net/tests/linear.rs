@@ -5,11 +5,11 @@
 use glam::{Vec2, Vec3};
 use nprt_net::cpu::CpuShading;
 use nprt_net::encoding::spherical_harmonics::basis;
+use nprt_net::{BasisChoice, Design, Init, LightBasis, LightInput, MapNorm, ModelConfig, Shading};
 use nprt_net::{Texels, FEATURES};
+use nprt_scene::envmap::{uv_to_direction, EnvMap};
 use rand::{RngExt, SeedableRng};
 use rand_pcg::Pcg64Mcg;
-use nprt_net::{BasisChoice, Design, Init, LightBasis, LightInput, MapNorm, ModelConfig, Shading};
-use nprt_scene::envmap::{uv_to_direction, EnvMap};
 
 const WIDTH: usize = 128;
 

@@ -158,7 +158,7 @@ fn encoder_input_is_mean_normalised_log_of_the_rotated_map() {
 /// the same radiance, each channel times its gain. With the paper's single mean it does not.
 #[test]
 fn per_channel_models_relight_a_tinted_map_by_its_tint() {
-    use nprt_net::{LightInput, MapNorm};
+    use nprt_net::MapNorm;
     let mut texels = vec![glam::Vec3::new(0.2, 0.3, 0.5); 128 * 64];
     texels[20 * 128 + 40] = glam::Vec3::new(900.0, 700.0, 400.0);
     let map = nprt_scene::envmap::EnvMap::from_texels("sun", 128, 64, texels).unwrap();

@@ -22,7 +22,7 @@ use crate::error::OrPy;
     test_res = None, spp = None, test_spp = None, seed = None, jitter_exposure = None,
     jitter_tint = None, test_maps = None, mix_builtin = None, shard = None, camera_volume = None,
     volume_min = None, volume_max = None, look = None, spread = None, fov = None,
-    device = "cpu", progress = true
+    device = "cpu", progress = true, mix_maps = None
 ))]
 #[allow(clippy::too_many_arguments)]
 pub fn generate<'py>(
@@ -50,6 +50,7 @@ pub fn generate<'py>(
     fov: Option<f32>,
     device: &str,
     progress: bool,
+    mix_maps: Option<u32>,
 ) -> PyResult<Bound<'py, PyDict>> {
     let d = GenerateOptions::default();
     let opts = GenerateOptions {
@@ -67,6 +68,7 @@ pub fn generate<'py>(
             exposure: jitter_exposure.unwrap_or(d.jitter.exposure),
             tint: jitter_tint.unwrap_or(d.jitter.tint),
         },
+        mix_maps: mix_maps.unwrap_or(d.mix_maps),
         test_maps: test_maps.or(d.test_maps),
         mix_builtin: mix_builtin.or(d.mix_builtin),
         camera: CameraChoice {

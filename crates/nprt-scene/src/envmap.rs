@@ -211,6 +211,30 @@ impl EnvMap {
         Ok(Self::from_texels(&self.data.name, w, h, texels)?.with_to_world(self.to_world))
     }
 
+    /// This map plus each of `others`, on this map's texels and in its placement: light adds,
+    /// so the sum lights a scene as the maps together do. This map's texels are kept as they
+    /// are; the others are looked up (bilinearly, as they are rendered) in the direction of
+    /// each texel (columns at their centres, rows from pole to pole, as [`Self::eval_uv`]
+    /// places them).
+    pub fn plus(&self, others: &[EnvMap]) -> Result<Self> {
+        if others.is_empty() {
+            return Ok(self.clone());
+        }
+        let (w, h) = (self.data.width, self.data.height);
+        let texels = (self.data.texels.iter().enumerate())
+            .map(|(i, &own)| {
+                let uv = Vec2::new(
+                    ((i % w) as f32 + 0.5) / w as f32,
+                    (i / w) as f32 / (h - 1) as f32,
+                );
+                let d = self.to_world * uv_to_direction(uv);
+                others.iter().fold(own, |sum, m| sum + m.eval(d))
+            })
+            .collect();
+        let name = format!("{} + {} more", self.data.name, others.len());
+        Ok(Self::from_texels(&name, w, h, texels)?.with_to_world(self.to_world))
+    }
+
     /// The map rotated by `degrees` about +Y, on top of its current placement.
     pub fn rotated_y(&self, degrees: f32) -> Self {
         self.with_to_world(Mat3::from_rotation_y(degrees.to_radians()) * self.to_world)
@@ -350,6 +374,37 @@ mod tests {
             assert!((s.eval(d) - m.eval(d) * gain).length() < 1e-4 * m.eval(d).length());
         }
         assert_eq!(s.to_world(), m.to_world());
+    }
+
+    /// A sum keeps this map's texels and placement and adds the others where they are: twice
+    /// a map is twice its radiance; a turned map adds what it holds in each direction of this
+    /// one's texels.
+    #[test]
+    fn a_sum_of_maps_adds_their_radiance() {
+        let m = gradient_map().rotated_y(20.0);
+        let twice = m.plus(&[m.clone()]).unwrap();
+        let turned = gradient_map()
+            .rotated_y(75.0)
+            .scaled(Vec3::splat(0.5))
+            .unwrap();
+        let both = m.plus(&[m.clone(), turned.clone()]).unwrap();
+        assert_eq!(twice.to_world(), m.to_world());
+        // Not the pole rows: each is one direction, whichever column is asked for.
+        for (x, y) in [(5, 4), (0, 1), (31, 14), (17, 9)] {
+            let d =
+                m.to_world() * uv_to_direction(Vec2::new((x as f32 + 0.5) / 32.0, y as f32 / 15.0));
+            let own = m.texel(x, y);
+            assert!(
+                (twice.texel(x, y) - 2.0 * own).length() < 1e-3 * own.length(),
+                "{x} {y}"
+            );
+            let want = 2.0 * own + turned.eval(d);
+            assert!(
+                (both.texel(x, y) - want).length() < 1e-3 * want.length(),
+                "{x} {y}"
+            );
+        }
+        assert!(m.plus(&[]).unwrap().same_texels(&m));
     }
 
     #[test]

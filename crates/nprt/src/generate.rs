@@ -56,6 +56,14 @@ pub struct GenerateArgs {
     /// 2^r, 2^b (r, b uniform in ±this) against green, at unchanged luminance.
     #[arg(long, default_value_t = d().jitter.tint)]
     jitter_tint: f32,
+    /// Light each training view by a random mixture of up to this many maps (1 to 8): its own
+    /// map and, uniformly 0 to this − 1, others of the training maps, each turned at random
+    /// about +Y and scaled by 1/4 to 1 (light adds, so a mixture is a valid lighting). More
+    /// varied lighting for the same views; test views keep one held-out map. Default 1: one map
+    /// a view, as before (docs/dataset.md).
+    #[arg(long, default_value_t = d().mix_maps,
+          value_parser = clap::value_parser!(u32).range(1..=nprt_data::dataset::MAX_MIX_MAPS as i64))]
+    mix_maps: u32,
     /// Seed of every random choice (cameras, split, rotations, pixels).
     #[arg(long, default_value_t = d().seed)]
     seed: u64,
@@ -129,6 +137,7 @@ impl TryFrom<GenerateArgs> for GenerateOptions {
                 exposure: a.jitter_exposure,
                 tint: a.jitter_tint,
             },
+            mix_maps: a.mix_maps,
             test_maps: a.test_maps,
             mix_builtin: a.mix_builtin,
             camera: CameraChoice {

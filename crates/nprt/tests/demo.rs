@@ -32,6 +32,7 @@ fn quick_demo_then_render_and_eval() {
         "nprt-albedo",
         "nprt-dsep",
         "nprt-dsep+direct",
+        "nprt-linear+sh:2+direct",
         "deep-shading",
         "pt-5spp",
         "sh-prt-9",

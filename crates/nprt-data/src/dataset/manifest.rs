@@ -39,6 +39,10 @@ pub struct Settings {
     /// Random exposure and white-balance changes of the training views' maps.
     #[serde(default, skip_serializing_if = "Jitter::is_none")]
     pub jitter: Jitter,
+    /// The most maps a training view's lighting mixes (`nprt generate --mix-maps`; absent: 1,
+    /// one map a view).
+    #[serde(default = "one_map", skip_serializing_if = "is_one_map")]
+    pub mix_maps: u32,
     pub camera_volume: VolumeRecord,
     /// Which tracer began the dataset (informative: the two draw different random numbers but
     /// agree within noise, so a dataset is resumed, or trained on, with either). Absent in
@@ -130,6 +134,28 @@ pub struct ViewRecord {
     pub gain: [f32; 3],
     /// Seed of the view's per-pixel random streams.
     pub seed: u64,
+    /// Further maps added to a training view's lighting (`nprt generate --mix-maps`).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub mix: Vec<MixTerm>,
+}
+
+/// A map added to a training view's lighting: light adds, so the view is lit by its own map
+/// plus each of these, rotated about +Y and scaled.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct MixTerm {
+    /// Index into `settings.envmaps`, one of the training maps.
+    pub map: usize,
+    pub rotation_deg: f32,
+    /// What its radiance is multiplied by, in [1/64, 1].
+    pub gain: f32,
+}
+
+fn one_map() -> u32 {
+    1
+}
+
+fn is_one_map(n: &u32) -> bool {
+    *n <= 1
 }
 
 fn unit_gain() -> [f32; 3] {
@@ -199,6 +225,37 @@ impl Manifest {
         self.check_view_list()
     }
 
+    /// A view's mixed maps: training views only, at most `mix_maps` maps in all, each a
+    /// training map with a finite rotation and a gain in [1/64, 1].
+    fn check_mix(&self, v: &ViewRecord, what: &str) -> Result<()> {
+        let s = &self.settings;
+        if v.mix.is_empty() {
+            return Ok(());
+        }
+        if v.split != "train" || v.mix.len() + 1 > s.mix_maps.max(1) as usize {
+            bail!(
+                "{what}: mixes {} maps, but only training views mix, at most {} (mix_maps)",
+                v.mix.len() + 1,
+                s.mix_maps.max(1)
+            );
+        }
+        for t in &v.mix {
+            if !s.train_maps.contains(&t.map) {
+                bail!("{what}: mixed map {} is not a training map", t.map);
+            }
+            if !t.rotation_deg.is_finite() || !(1.0 / 64.0..=1.0).contains(&t.gain) {
+                bail!(
+                    "{what}: mixed map {} has rotation {} and gain {}: a finite rotation and a \
+                     gain in [1/64, 1] are needed",
+                    t.map,
+                    t.rotation_deg,
+                    t.gain
+                );
+            }
+        }
+        Ok(())
+    }
+
     /// One view against the settings: its split's maps and resolution, a plausible size and
     /// field of view, a rigid camera, a gain in range (none for a test view) and a file inside
     /// the dataset folder.
@@ -249,6 +306,7 @@ impl Manifest {
         if !v.gain.iter().all(|g| (1.0 / 64.0..=64.0).contains(g)) {
             bail!("{what}: gain {:?} is not within [1/64, 64]", v.gain);
         }
+        self.check_mix(v, &what)?;
         if v.split == "test" && !is_unit_gain(&v.gain) {
             bail!(
                 "{what}: a test view's map is never jittered, but its gain is {:?}",
@@ -362,24 +420,46 @@ impl Settings {
 }
 
 impl ViewRecord {
-    /// The view's lighting: its map, scaled by its gain and rotated by its rotation.
+    /// The view's lighting: its map, scaled by its gain and rotated by its rotation, plus its
+    /// mixed maps.
     pub fn lighting(&self, maps: &[EnvMap]) -> Result<EnvMap> {
-        let map = maps.get(self.map).with_context(|| {
-            format!(
-                "view '{}' names map {} of {}",
-                self.file,
-                self.map,
-                maps.len()
-            )
-        })?;
-        self.light(map)
+        let map = |m: usize| {
+            maps.get(m)
+                .with_context(|| format!("view '{}' names map {m} of {}", self.file, maps.len()))
+        };
+        let own = self.own_light(map(self.map)?)?;
+        let mixed = (self.mix.iter())
+            .map(|t| {
+                Ok(map(t.map)?
+                    .scaled(Vec3::splat(t.gain))?
+                    .rotated_y(t.rotation_deg))
+            })
+            .collect::<Result<Vec<EnvMap>>>()?;
+        own.plus(&mixed)
     }
 
-    /// The view's lighting made from its own map `map` (the manifest's map `self.map`).
+    /// The view's lighting made from its own map `map` (the manifest's map `self.map`); a view
+    /// that mixes maps needs them all ([`Self::lighting`]).
     pub fn light(&self, map: &EnvMap) -> Result<EnvMap> {
+        if !self.mix.is_empty() {
+            bail!(
+                "view '{}' mixes {} maps into its lighting: all of them are needed",
+                self.file,
+                self.mix.len() + 1
+            );
+        }
+        self.own_light(map)
+    }
+
+    fn own_light(&self, map: &EnvMap) -> Result<EnvMap> {
         Ok(map
             .scaled(Vec3::from_array(self.gain))?
             .rotated_y(self.rotation_deg))
+    }
+
+    /// Every map the view's lighting reads: its own, then its mixed ones.
+    pub fn maps(&self) -> impl Iterator<Item = usize> + '_ {
+        std::iter::once(self.map).chain(self.mix.iter().map(|t| t.map))
     }
 
     pub fn camera(&self) -> Camera {

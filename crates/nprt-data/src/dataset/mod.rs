@@ -14,12 +14,12 @@ mod view_file;
 
 pub use generation::{prepare, render_view, run, Summary};
 pub use manifest::{
-    check_bounds, load_manifest, load_manifest_hashed, Jitter, Manifest, MapRecord, Settings,
-    ViewRecord, VolumeRecord, FORMAT_VERSION, MANIFEST,
+    check_bounds, load_manifest, load_manifest_hashed, Jitter, Manifest, MapRecord, MixTerm,
+    Settings, ViewRecord, VolumeRecord, FORMAT_VERSION, MANIFEST,
 };
 pub use packed::{views_stamp, PackHeader, PackedDataset, PackedTarget, PACK_FORMAT, PACK_VERSION};
 pub use packed_pixel::{PackedPixel, PACKED_PIXEL_BYTES};
-pub use plan::{plan, MapAssignment, Request};
+pub use plan::{plan, MapAssignment, Request, MAX_MIX_MAPS};
 pub use scene_identity::{load_checked_scene, relit, scene_hash, scene_source};
 pub use verify::{verify, Report};
 pub use view_file::{check_view, read_view, write_view, ViewImage};

@@ -9,10 +9,13 @@ use rand::{RngExt, SeedableRng};
 use rand_pcg::Pcg64Mcg;
 
 use super::manifest::{
-    Jitter, Manifest, MapRecord, Settings, ViewRecord, VolumeRecord, FORMAT_VERSION,
+    Jitter, Manifest, MapRecord, MixTerm, Settings, ViewRecord, VolumeRecord, FORMAT_VERSION,
 };
 use super::scene_identity::scene_hash;
 use crate::cameras::place_camera;
+
+/// The most maps `--mix-maps` mixes into a training view's lighting.
+pub const MAX_MIX_MAPS: u32 = 8;
 
 /// What a run of `generate` is asked to do.
 pub struct Request<'a> {
@@ -35,6 +38,9 @@ pub struct Request<'a> {
     pub seed: u64,
     /// Exposure and white-balance changes of the training views' maps.
     pub jitter: Jitter,
+    /// The most maps a training view's lighting mixes: its own and up to this many − 1 others
+    /// of the training maps, each rotated and scaled at random (1: one map a view).
+    pub mix_maps: u32,
 }
 
 /// How the views of a dataset take their maps.
@@ -93,6 +99,12 @@ pub fn plan(req: &Request, ts: &TraceScene) -> Result<Manifest> {
         }
     };
     check_jitter(&req.jitter)?;
+    if !(1..=MAX_MIX_MAPS).contains(&req.mix_maps) {
+        bail!(
+            "mix_maps {}: a training view's lighting mixes 1 to {MAX_MIX_MAPS} maps",
+            req.mix_maps
+        );
+    }
     let envmaps = map_records(req)?;
     let v = &req.volume;
     let settings = Settings {
@@ -112,6 +124,7 @@ pub fn plan(req: &Request, ts: &TraceScene) -> Result<Manifest> {
         rr_depth: req.scene.rr_depth,
         seed: req.seed,
         jitter: req.jitter,
+        mix_maps: req.mix_maps,
         camera_volume: VolumeRecord::from(v),
         tracer: TraceDevice::Cpu,
     };
@@ -196,7 +209,15 @@ fn plan_views(
         } else {
             [1.0; 3]
         };
-        check_gain(brightest[map], &req.map_specs[map], gain, index)?;
+        // Drawn after everything else, so that datasets without mixing plan as before.
+        let mix = match train {
+            true => mix_terms(req.mix_maps, train_pool, &mut rng),
+            false => Vec::new(),
+        };
+        let lifted = (mix.iter()).fold(brightest[map] * glam::Vec3::from(gain), |sum, t| {
+            sum + brightest[t.map] * t.gain
+        });
+        check_gain(lifted, &req.map_specs[map], gain, index)?;
         let camera = place_camera(ts, &req.volume, req.seed, index, w, h)?;
         views.push(ViewRecord {
             index,
@@ -210,19 +231,37 @@ fn plan_views(
             rotation_deg,
             gain,
             seed,
+            mix,
         });
     }
     Ok(views)
 }
 
+/// A training view's mixed maps: up to `most` − 1 of the training maps `pool` (how many,
+/// uniform from none), each turned at random about +Y and scaled by 2^−2u, u uniform in [0, 1].
+fn mix_terms(most: u32, pool: &[usize], rng: &mut Pcg64Mcg) -> Vec<MixTerm> {
+    if most <= 1 {
+        return Vec::new();
+    }
+    let count = (rng.random::<u32>() % most) as usize;
+    (0..count)
+        .map(|_| MixTerm {
+            map: pool[(rng.random::<u64>() % pool.len() as u64) as usize],
+            rotation_deg: rng.random::<f32>() * 360.0,
+            gain: (-2.0 * rng.random::<f32>()).exp2(),
+        })
+        .collect()
+}
+
 /// Refuses a view whose jitter would lift its map past [`MAX_RADIANCE`] when it is rendered,
 /// before any view is: a dataset that stopped there could never be completed.
-fn check_gain(brightest: glam::Vec3, spec: &str, gain: [f32; 3], index: u64) -> Result<()> {
-    let lifted = brightest * glam::Vec3::from(gain);
+/// `lifted` is the brightest texel of the view's own map (`spec`) times its `gain`, plus those
+/// of its mixed maps times theirs: a bound on its lighting's brightest texel.
+fn check_gain(lifted: glam::Vec3, spec: &str, gain: [f32; 3], index: u64) -> Result<()> {
     if lifted.max_element() > MAX_RADIANCE {
         bail!(
-            "view {index}: map '{spec}' (brightest texel {brightest}) times its exposure/tint \
-             jitter gain {gain:?} is {lifted}, past the largest radiance a map may hold \
+            "view {index}: map '{spec}' times its exposure/tint jitter gain {gain:?} (with any \
+             maps mixed in) reaches {lifted}, past the largest radiance a map may hold \
              ({MAX_RADIANCE:e}); scale the map down or lower --jitter-exposure/--jitter-tint"
         );
     }
@@ -274,6 +313,7 @@ pub(crate) fn room_request<'a>(scene: &'a Scene, map_specs: [&str; 2]) -> Reques
         test_spp: 2,
         seed: 0,
         jitter: Jitter::default(),
+        mix_maps: 1,
     }
 }
 
@@ -347,6 +387,7 @@ mod tests {
                 test_spp: 2,
                 seed,
                 jitter: Jitter::default(),
+                mix_maps: 1,
             };
             plan(&req, &ts)
         };
@@ -373,5 +414,61 @@ mod tests {
         assert_eq!(next, pool.len() + mixed);
         let err = manifest(pool, share).unwrap_err().to_string();
         assert!(err.contains("built-in lighting of their own"), "{err}");
+    }
+
+    /// `--mix-maps 3` gives training views 0 to 2 further training maps each, turned and
+    /// scaled by 1/4 to 1, and leaves every other choice (cameras, own maps, rotations, seeds)
+    /// and the test views as without it; the manifest records it, and refuses mixes it could
+    /// not have planned.
+    #[test]
+    fn mixed_maps_join_training_views_only_and_change_nothing_else() {
+        let scene = load_scene("builtin:room", &SceneOptions::default()).unwrap();
+        let ts = TraceScene::new(&scene);
+        let specs: Vec<String> = (1..=4).map(|i| format!("builtin:indoor:{i}")).collect();
+        let req = |mix_maps| Request {
+            maps: load_all(&specs).unwrap(),
+            map_specs: specs.clone(),
+            train_views: 40,
+            mix_maps,
+            ..room_request(&scene, ["builtin:indoor:1", "builtin:indoor:2"])
+        };
+        let (one, three) = (plan(&req(1), &ts).unwrap(), plan(&req(3), &ts).unwrap());
+        let counts: Vec<usize> = three.views.iter().map(|v| v.mix.len()).collect();
+        for n in 0..3 {
+            assert!(
+                counts[..40].contains(&n),
+                "no training view mixes {n} more: {counts:?}"
+            );
+        }
+        assert!(counts[40..].iter().all(|&n| n == 0), "{counts:?}");
+        for (a, b) in one.views.iter().zip(&three.views) {
+            assert!(a.mix.is_empty());
+            let b_plain = ViewRecord {
+                mix: Vec::new(),
+                ..b.clone()
+            };
+            assert_eq!(*a, b_plain);
+            for t in &b.mix {
+                assert!(three.settings.train_maps.contains(&t.map), "{t:?}");
+                assert!((0.25..=1.0).contains(&t.gain), "{t:?}");
+            }
+        }
+        let json = serde_json::to_string(&one).unwrap();
+        assert!(!json.contains("mix"), "{json}");
+        let json = serde_json::to_string(&three).unwrap();
+        assert!(
+            json.contains("\"mix_maps\":3") && json.contains("\"mix\":["),
+            "{json}"
+        );
+        assert_eq!(serde_json::from_str::<Manifest>(&json).unwrap(), three);
+        // A test view that mixes, or a view mixing more maps than planned, is refused.
+        let mut bad = three.clone();
+        let mixing = bad.views.iter().position(|v| !v.mix.is_empty()).unwrap();
+        let term = bad.views[mixing].mix[0].clone();
+        bad.views[40].mix.push(term.clone());
+        assert!(format!("{:#}", bad.check().unwrap_err()).contains("only training views mix"));
+        let mut bad = three.clone();
+        bad.views[mixing].mix = vec![term; 3];
+        assert!(format!("{:#}", bad.check().unwrap_err()).contains("at most 3"));
     }
 }

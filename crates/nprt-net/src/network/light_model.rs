@@ -40,8 +40,8 @@ impl LightModel {
         match self {
             LightModel::Encoder(e) => Ok(e),
             LightModel::Basis(b) => bail!(
-                "the linear design (light basis {}) runs on the CPU engine only so far: use \
-                 --device cpu",
+                "the linear design (light basis {}) has no GPU kernels yet: it trains and renders \
+                 on the CPU engine (--device cpu), and the WGSL export has no form of it",
                 b.choice
             ),
         }
@@ -77,7 +77,7 @@ mod tests {
     fn a_basis_is_refused_where_only_the_encoder_runs() {
         let linear = ModelConfig::new(Design::Linear, None).build(&mut Init::new(0));
         let e = linear.encoder().unwrap_err().to_string();
-        assert!(e.contains("sh:4") && e.contains("--device cpu"), "{e}");
+        assert!(e.contains("sh:4") && e.contains("no GPU kernels"), "{e}");
         let dsep = ModelConfig::new(Design::Dsep, None).build(&mut Init::new(0));
         assert!(dsep.encoder().is_ok());
         assert_eq!((linear.light.code_size(), dsep.light.code_size()), (75, 64));

@@ -109,15 +109,26 @@ impl TrainingSet {
         for (i, v) in manifest.views.iter().enumerate() {
             by_map.entry(v.map).or_default().push(i);
         }
+        // Views that mix maps (`nprt generate --mix-maps`) need several at once: the training
+        // maps, a folder's few, are then all opened once.
+        let mixing = manifest.views.iter().any(|v| !v.mix.is_empty());
+        let all = mixing.then(|| open_recorded_maps(&manifest)).transpose()?;
         let mut lights: Vec<(usize, LightInput)> = by_map
             .into_par_iter()
             .map(|(m, views)| -> Result<Vec<(usize, LightInput)>> {
-                let map = open_recorded_map(&manifest, m)?;
+                let map = match all.as_ref().and_then(|maps| maps.get(m)) {
+                    Some(map) => map.clone(),
+                    None => open_recorded_map(&manifest, m)?,
+                };
                 views
                     .into_par_iter()
                     .map(|i| {
-                        let light = config.light_input(&manifest.views[i].light(&map)?, 0.0);
-                        Ok((i, light))
+                        let v = &manifest.views[i];
+                        let lighting = match &all {
+                            Some(maps) => v.lighting(maps)?,
+                            None => v.light(&map)?,
+                        };
+                        Ok((i, config.light_input(&lighting, 0.0)))
                     })
                     .collect()
             })
