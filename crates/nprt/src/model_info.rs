@@ -69,8 +69,12 @@ fn info(a: ModelInfoArgs) -> Result<()> {
 
 fn print_description(s: &ModelSummary) {
     let config = &s.config;
+    let light = match config.design.is_linear() {
+        true => format!("light basis {} on a", config.light_basis()),
+        false => "light encoder input".into(),
+    };
     println!(
-        "design {} ({} transport layers), light encoder input {}×{}, map normalised by its {}, direct light {}, position encoding {}",
+        "design {} ({} transport layers), {light} {}×{} map, map normalised by its {}, direct light {}, position encoding {}",
         config.design,
         config.activation,
         config.encoder_width,
