@@ -59,6 +59,8 @@ fn quick_demo_then_render_and_eval() {
         assert_eq!(equal_time_of(d), learned, "{d}");
     }
     let traced = equal_time_of("nprt-dsep+direct");
+    // The linear design traces its direct light too: the same tier.
+    assert_eq!(equal_time_of("nprt-linear+sh:2+direct"), traced);
     let equal_time_rows = names
         .iter()
         .filter(|n| n.starts_with("pt-equal-time") && !n.ends_with("+ OIDN"))
@@ -69,11 +71,11 @@ fn quick_demo_then_render_and_eval() {
         "{names:?}"
     );
     if std::env::var_os("NPRT_REQUIRE_OIDN").is_some() {
-        // Every path-tracing baseline, and the traced direct light of D/S + direct, the latter
-        // held to path tracing denoised alike.
+        // Every path-tracing baseline, and the traced direct light of D/S + direct and of the
+        // linear design, the latter held to path tracing denoised alike.
         assert_eq!(
             names.iter().filter(|n| n.ends_with("+ OIDN")).count(),
-            2 + equal_time_rows,
+            3 + equal_time_rows,
             "{names:?}"
         );
         assert!(
@@ -81,6 +83,7 @@ fn quick_demo_then_render_and_eval() {
             "{names:?}"
         );
         assert!(names.contains(&"nprt-dsep+direct + OIDN"), "{names:?}");
+        assert!(names.contains(&"nprt-linear+sh:2+direct + OIDN"), "{names:?}");
     }
     for m in results["methods"].as_array().unwrap() {
         for k in ["l1", "l2", "rmse", "dssim", "mape", "mrse", "log_l1"] {
