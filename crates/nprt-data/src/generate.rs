@@ -104,7 +104,8 @@ fn check_sizes(opts: &GenerateOptions, builtin_share: f32) -> Result<()> {
         ("training", opts.train_resolution),
         ("test", opts.test_resolution),
     ] {
-        nprt_trace::Frame::check_size(w, h, &format!("a {w}×{h} {split} view"))?;
+        opts.device
+            .check_frame(w, h, &format!("a {w}×{h} {split} view"))?;
     }
     Ok(())
 }

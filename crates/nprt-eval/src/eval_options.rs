@@ -4,7 +4,7 @@ use std::path::PathBuf;
 
 use anyhow::{bail, Result};
 use nprt_render::DEFAULT_DIRECT_SPP;
-use nprt_trace::Frame;
+use nprt_trace::TraceDevice;
 
 /// The most frames the warmed radiance caches render before the path: a cache settles in tens.
 pub const MAX_NRC_WARMUP: usize = 1_000;
@@ -38,8 +38,9 @@ pub struct EvalOptions {
 impl EvalOptions {
     /// Refuses options no evaluation can run, before any work: counts of zero, sizes whose
     /// frames the machine cannot hold (the memory check `render` and `generate` make), and a
-    /// warm-up without end. Each message names the flag.
-    pub fn check(&self) -> Result<()> {
+    /// warm-up without end, and frames past what `device` rasterises. Each message names the
+    /// flag.
+    pub fn check(&self, device: TraceDevice) -> Result<()> {
         if self.sh_spp == 0 || self.timing_res < 8 {
             bail!("--sh-spp must be at least 1 and --timing-res at least 8");
         }
@@ -47,7 +48,7 @@ impl EvalOptions {
             bail!("--views must be at least 1 (it limits the test views evaluated)");
         }
         let side = self.timing_res;
-        Frame::check_size(
+        device.check_frame(
             side,
             side,
             &format!("--timing-res {side}: a {side}×{side} frame"),
@@ -59,7 +60,7 @@ impl EvalOptions {
             bail!("--temporal-frames must be 0 or at least 2, and --temporal-res at least 8");
         }
         let side = self.temporal_res;
-        Frame::check_size(
+        device.check_frame(
             side,
             side,
             &format!("--temporal-res {side}: a {side}×{side} frame"),

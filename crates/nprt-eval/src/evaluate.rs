@@ -71,7 +71,7 @@ pub struct Evaluation {
 /// Runs the whole evaluation: the networks first (the slowest Neural PRT design sets the
 /// equal-time sample count), then path tracing, denoised path tracing and SH PRT.
 pub fn evaluate(o: &EvalOptions, engine: Engine) -> Result<Evaluation> {
-    o.check()?;
+    o.check(engine.tracer())?;
     let Loaded {
         manifest,
         scene,

@@ -31,7 +31,7 @@ impl GpuDevice {
         let most = self.device.limits().max_texture_dimension_2d;
         if width.max(height) > most {
             anyhow::bail!(
-                "{what}: {width}×{height} pixels, but the GPU ({}) rasterises frames of at most                  {most} pixels a side; use a smaller frame or --device cpu",
+                "{what}: {width}×{height} pixels, but the GPU ({}) rasterises frames of at most {most} pixels a side; use a smaller frame or --device cpu",
                 self.adapter
             );
         }

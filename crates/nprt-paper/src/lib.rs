@@ -13,9 +13,11 @@ mod paper_figures;
 mod paper_report;
 mod pipeline;
 pub mod published;
+pub mod readback;
 mod stage_log;
 mod stages;
 
 pub use budget::Budget;
 pub use experiment::Experiment;
+pub use paper_report::{report_tables, stage_table};
 pub use pipeline::Outcome;

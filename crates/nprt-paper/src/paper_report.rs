@@ -28,17 +28,11 @@ pub fn write_paper_report(
     times: &[(String, f64)],
     dir: &Path,
 ) -> Result<(PathBuf, PathBuf)> {
-    let orderings = orderings::all(e, ablation);
     let kitchen = x.scene.to_lowercase().contains("kitchen");
     let mut md = String::new();
-    header(&mut md, x, e, times)?;
-    summary(&mut md, &orderings)?;
-    table1(&mut md, e, ablation)?;
-    table2(&mut md, ablation, &orderings)?;
-    tables34(&mut md, e)?;
-    table5(&mut md, e, kitchen, &orderings)?;
-    table6(&mut md, e, &orderings)?;
-    paper_figures::papers_own_orderings(&mut md)?;
+    header(&mut md, x, e)?;
+    md += &stage_table(times)?;
+    md += &report_tables(e, ablation, kitchen)?;
     crops(&mut md, e, dir)?;
     curves(&mut md, ablation, dir)?;
     writeln!(
@@ -57,7 +51,7 @@ pub fn write_paper_report(
     Ok((md_path, html_path))
 }
 
-fn header(md: &mut String, x: &Experiment, e: &Evaluation, times: &[(String, f64)]) -> Result<()> {
+fn header(md: &mut String, x: &Experiment, e: &Evaluation) -> Result<()> {
     let b = &x.budget;
     writeln!(
         md,
@@ -85,13 +79,36 @@ fn header(md: &mut String, x: &Experiment, e: &Evaluation, times: &[(String, f64
         x.engine.name(),
         e.cpu_threads
     )?;
+    Ok(())
+}
+
+/// The table of each stage's wall time and their sum.
+pub fn stage_table(times: &[(String, f64)]) -> Result<String> {
+    let mut md = String::new();
     writeln!(md, "| stage | wall time |\n|---|---|")?;
     for (stage, secs) in times {
         writeln!(md, "| {stage} | {} |", duration(*secs))?;
     }
     let all = times.iter().map(|(_, t)| t).sum();
     writeln!(md, "| **all** | **{}** |\n", duration(all))?;
-    Ok(())
+    Ok(md)
+}
+
+/// The report's judgements and tables from the evaluation and Table 2's runs alone (what `nprt
+/// paper` reads back from results.json and table2.json): the summary, Tables 1 to 6 beside the
+/// paper's figures, and the orderings in the paper's own numbers. `kitchen`: the scene is the
+/// paper's KITCHEN, whose published row is then set beside nprt's.
+pub fn report_tables(e: &Evaluation, ablation: &[MethodResult], kitchen: bool) -> Result<String> {
+    let orderings = orderings::all(e, ablation);
+    let mut md = String::new();
+    summary(&mut md, &orderings)?;
+    table1(&mut md, e, ablation)?;
+    table2(&mut md, ablation, &orderings)?;
+    tables34(&mut md, e)?;
+    table5(&mut md, e, kitchen, &orderings)?;
+    table6(&mut md, e, &orderings)?;
+    paper_figures::papers_own_orderings(&mut md)?;
+    Ok(md)
 }
 
 fn describe_run(r: nprt_net::RunLength) -> String {

@@ -140,8 +140,7 @@ impl Experiment {
         });
         let file = self.out.join("experiment.json");
         if let Ok(bytes) = std::fs::read(&file) {
-            let before: serde_json::Value = serde_json::from_slice(&bytes)
-                .with_context(|| format!("'{}' is not an experiment record", file.display()))?;
+            let before = crate::readback::experiment_record(&bytes, &file)?;
             if before != what {
                 bail!(
                     "'{}' holds another experiment ({}); this one is {}: give another output folder, or remove it to start again",

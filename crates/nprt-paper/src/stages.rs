@@ -13,9 +13,9 @@ use nprt_net::training::training_set::TrainingSet;
 use nprt_net::{ModelConfig, TrainOptions, TrainSummary};
 use nprt_render::oidn::Oidn;
 use nprt_render::{RenderJob, RenderOptions};
-use serde::{Deserialize, Serialize};
 
 use crate::experiment::Experiment;
+use crate::readback::{self, Ablation};
 
 /// Renders (or resumes) the dataset; whether any view was rendered.
 pub fn dataset(x: &Experiment, data: &Path) -> Result<bool> {
@@ -94,7 +94,7 @@ pub fn evaluation(x: &Experiment, opts: &EvalOptions, report: &Path) -> Result<(
     let results = report.join("results.json");
     let kept = read_key(&key_file);
     if kept.as_deref() == Some(format!("{inputs}\n{}", outputs_key(report)).as_str()) {
-        match read_json::<Evaluation>(&results).and_then(|e| held(e, opts)) {
+        match held(&results, opts) {
             Ok(e) => {
                 println!(
                     "evaluation: as '{}' holds it (its inputs are unchanged)",
@@ -120,19 +120,14 @@ pub fn ablation(
     opts: &EvalOptions,
     file: &Path,
 ) -> Result<(Vec<MethodResult>, bool)> {
-    #[derive(Serialize, Deserialize)]
-    struct Scored {
-        key: String,
-        rows: Vec<MethodResult>,
-    }
     let key = inputs_key(x, opts)?;
-    if let Ok(s) = read_json::<Scored>(file) {
-        if s.key == key && s.rows.iter().all(|r| complete(r, None)) {
-            return Ok((s.rows, false));
+    if let Ok(a) = read(file).and_then(|bytes| readback::ablation(&bytes, file)) {
+        if a.key == key {
+            return Ok((a.rows, false));
         }
     }
     let rows = score_networks(opts, x.engine)?;
-    let scored = Scored { key, rows };
+    let scored = Ablation { key, rows };
     nprt_io::write_file(file, serde_json::to_vec_pretty(&scored)?)?;
     Ok((scored.rows, true))
 }
@@ -211,28 +206,13 @@ fn outputs_key(report: &Path) -> String {
 /// `e` read back, refused unless it is the evaluation `opts` asks for: every model's row and
 /// every method's figures on the dataset's test views (as many as `opts` evaluates), each
 /// finite.
-fn held(e: Evaluation, opts: &EvalOptions) -> Result<Evaluation> {
+/// The evaluation `results` keeps, where it is this run's: as many test views as the run
+/// evaluates, and a finite figure for each.
+fn held(results: &Path, opts: &EvalOptions) -> Result<Evaluation> {
     let manifest = nprt_data::dataset::load_manifest(&opts.data)?;
     let test_views = manifest.settings.test_views as usize;
     let views = opts.max_views.map_or(test_views, |n| n.min(test_views));
-    anyhow::ensure!(
-        e.test_views == views && e.methods.len() > opts.models.len(),
-        "the kept evaluation is not this run's ({} test views, {} methods)",
-        e.test_views,
-        e.methods.len()
-    );
-    if let Some(m) = e.methods.iter().find(|m| !complete(m, Some(views))) {
-        anyhow::bail!("the kept evaluation's '{}' lacks figures", m.name);
-    }
-    Ok(e)
-}
-
-/// Whether `m` has a finite figure per view (`views` of them, where known).
-fn complete(m: &MethodResult, views: Option<usize>) -> bool {
-    let finite = |v: &nprt_eval::Metrics| v.values().iter().all(|x| x.is_finite());
-    !m.per_view.is_empty()
-        && views.is_none_or(|n| m.per_view.len() == n)
-        && m.per_view.iter().all(finite)
+    readback::evaluation(&read(results)?, results, views, opts.models.len())
 }
 
 fn read(path: &Path) -> Result<Vec<u8>> {
@@ -243,7 +223,3 @@ fn read_key(path: &Path) -> Option<String> {
     std::fs::read_to_string(path).ok()
 }
 
-fn read_json<T: for<'de> Deserialize<'de>>(path: &Path) -> Result<T> {
-    serde_json::from_slice(&read(path)?)
-        .with_context(|| format!("'{}' is not what this run wrote", path.display()))
-}

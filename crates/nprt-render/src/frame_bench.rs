@@ -65,6 +65,11 @@ pub fn bench_frame(
     engine: Engine,
     mut on_row: impl FnMut(&FrameBenchRow),
 ) -> Result<()> {
+    for &[w, h] in &opts.resolutions {
+        engine
+            .tracer()
+            .check_frame(w, h, &format!("a {w}×{h} frame"))?;
+    }
     let scene = load_scene(&opts.scene, &SceneOptions::default())?;
     let volume = scene.camera_volume.as_ref().with_context(|| {
         format!(
@@ -85,7 +90,6 @@ pub fn bench_frame(
         let bounds = [lo.to_array(), hi.to_array()];
         let (model, label) = untrained(design, direct, precision, bounds, engine)?;
         for &[w, h] in &opts.resolutions {
-            nprt_trace::Frame::check_size(w, h, &format!("a {w}×{h} frame"))?;
             let camera = path.camera(0.5, w, h);
             let mut frames = Vec::new();
             let mut relights = Vec::new();

@@ -89,7 +89,9 @@ impl RenderJob {
             bail!("--frames and --fps must be at least 1");
         }
         let [w, h] = opts.resolution;
-        nprt_trace::Frame::check_size(w, h, &format!("a {w}×{h} frame"))?;
+        engine
+            .tracer()
+            .check_frame(w, h, &format!("a {w}×{h} frame"))?;
         let mut model = Relighter::load(&opts.model, engine)?;
         model.set_precision(opts.precision)?;
         let scene_spec = match (&opts.scene, model.file.scene.as_str()) {

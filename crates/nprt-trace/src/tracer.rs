@@ -22,6 +22,19 @@ impl TraceDevice {
     pub fn is_cpu(&self) -> bool {
         *self == TraceDevice::Cpu
     }
+
+    /// Refuses a `width` × `height` frame (`what`) this device cannot make, before any work:
+    /// one the machine's memory cannot hold ([`Frame::check_size`]) or, on the GPU, one with a
+    /// side past the largest texture it rasterises (wgpu would panic on it). Every command
+    /// calls it where it chooses a frame size.
+    pub fn check_frame(&self, width: u32, height: u32, what: &str) -> Result<()> {
+        Frame::check_size(width, height, what)?;
+        #[cfg(feature = "gpu")]
+        if *self == TraceDevice::Gpu {
+            nprt_gpu::GpuDevice::get()?.check_frame(width, height, what)?;
+        }
+        Ok(())
+    }
 }
 
 /// A scene ready to trace on one device: on the GPU, uploaded once for every frame.

@@ -134,13 +134,43 @@ fn a_checkpoint_with_an_impossible_training_time_is_refused() {
 }
 
 /// A frame wider or taller than the GPU rasterises is refused by name on `--device wgpu`, as the
-/// CPU route renders it.
+/// CPU route renders it, where its size is chosen: `generate` before its folder is made (so
+/// before any training view is traced for a test size it cannot make), `render` and `eval`
+/// before any frame.
 #[cfg(feature = "gpu")]
 #[test]
 fn a_frame_beyond_the_gpus_texture_size_is_refused() {
     if !common::wgpu_runs() {
         return;
     }
+    let dir = fresh_dir("bounds-texture");
+    let model = tiny_room_model(&dir, "baseline", &[]);
+    let (d, m) = (dir.join("data"), model.to_str().unwrap());
+    let out = dir.join("wide");
+    let o = out.to_str().unwrap();
+    #[rustfmt::skip]
+    fails(
+        &["generate", "--scene", "builtin:room", "--envmaps", "builtin", "--out", o,
+          "--train-views", "1", "--test-views", "1", "--train-res", "8", "--test-res", "1x20000",
+          "--device", "wgpu"],
+        &["20000", "pixels a side", "test view"],
+    );
+    assert!(!out.exists(), "generate made its folder before refusing the test size");
+    #[rustfmt::skip]
+    fails(
+        &["render", "--model", m, "--out", o, "--frames", "1", "--res", "16385x8",
+          "--device", "wgpu"],
+        &["16385", "pixels a side"],
+    );
+    #[rustfmt::skip]
+    fails(
+        &["eval", "--data", d.to_str().unwrap(), "--model", m, "--out", o,
+          "--temporal-frames", "2", "--temporal-res", "16385", "--device", "wgpu"],
+        // Square: the memory check may speak first; either names the flag.
+        &["--temporal-res 16385"],
+    );
+    assert!(!out.exists(), "a refused frame size left output behind");
+    std::fs::remove_dir_all(&dir).ok();
     for (res, side) in [("16385x1", "16385"), ("1x20000", "20000")] {
         fails(
             &[

@@ -121,7 +121,9 @@ fn load(opts: &ViewerOptions) -> Result<(Vec<Relighter>, Scene)> {
         bail!("nprt view: give at least one map");
     }
     let [w, h] = opts.resolution;
-    nprt_trace::Frame::check_size(w, h, &format!("a {w}×{h} window"))?;
+    opts.engine
+        .tracer()
+        .check_frame(w, h, &format!("a {w}×{h} window"))?;
     let models = opts
         .models
         .iter()
