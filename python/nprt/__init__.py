@@ -2,26 +2,27 @@
 evaluation, with numpy arrays in and out (docs/python.md).
 
 Every function is nprt's command of the same name with the same defaults; errors are
-:class:`NprtError` with the command line's message. Images are (H, W, 3) float32 arrays of
-linear radiance; cameras are 4 x 4 camera-to-world matrices (Mitsuba's convention) with a
-horizontal field of view in degrees.
+:class:`NprtError` (and its :class:`InputError` and :class:`Interrupted`) with the command
+line's message. Scenes, maps and files are given as a ``str``, a ``pathlib.Path`` or the
+loaded object alike. Images are (H, W, 3) float32 arrays of linear radiance; cameras are 4 x 4
+camera-to-world matrices (Mitsuba's convention) with a horizontal field of view in degrees.
+``pip install ./python`` also installs the ``nprt`` command (the same command line; also
+``python -m nprt``).
 
     >>> import nprt
-    >>> model = nprt.Model("models/dsep")
+    >>> model = nprt.Model("model")
     >>> scene, sky = nprt.load_scene("builtin:room"), nprt.open_envmap("builtin:sky")
-    >>> camera, fov, _ = scene.camera()
-    >>> frame = model.render(scene, sky, camera, 256, 192, fov)
+    >>> camera, fov, (w, h) = scene.camera()
+    >>> frame = model.render(scene, sky, camera, w, h, fov)
+    >>> nprt.write_image("frame.png", frame)
 """
 
-import csv
-import os
-
+from ._loss_curve import loss_curve
 from ._nprt import (
     DESIGNS,
     Dataset,
     EnvMap,
     Model,
-    NprtError,
     Scene,
     __version__,
     evaluate,
@@ -32,16 +33,21 @@ from ._nprt import (
     model_info,
     open_envmap,
     paper,
+    read_image,
     reference,
     render,
     train,
     train_deep_shading,
+    write_image,
 )
+from .errors import InputError, Interrupted, NprtError
 
 __all__ = [
     "DESIGNS",
     "Dataset",
     "EnvMap",
+    "InputError",
+    "Interrupted",
     "Model",
     "NprtError",
     "Scene",
@@ -55,21 +61,10 @@ __all__ = [
     "model_info",
     "open_envmap",
     "paper",
+    "read_image",
     "reference",
     "render",
     "train",
     "train_deep_shading",
+    "write_image",
 ]
-
-
-def loss_curve(model_dir):
-    """The loss curves of a training run (its model folder's loss.csv) as a dict of lists:
-    ``step``, ``epoch``, ``samples``, ``seconds``, ``train_loss`` and ``val_loss`` (None where
-    a step was not validated)."""
-    path = os.path.join(os.fspath(model_dir), "loss.csv")
-    columns = {}
-    with open(path, newline="") as f:
-        for row in csv.DictReader(f):
-            for key, value in row.items():
-                columns.setdefault(key, []).append(float(value) if value else None)
-    return columns

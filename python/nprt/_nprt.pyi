@@ -1,21 +1,20 @@
 """Type stubs of nprt's compiled module (crates/nprt-py)."""
 
 import os
-from typing import Any, Callable, Dict, List, Optional, Sequence, Tuple, Union
+from typing import Any, Callable, Dict, Iterator, List, Optional, Sequence, Tuple, Union, overload
 
 import numpy as np
 import numpy.typing as npt
 
 PathLike = Union[str, "os.PathLike[str]"]
+SceneLike = Union["Scene", str, "os.PathLike[str]"]  # a loaded scene, a file or builtin:room
+MapLike = Union["EnvMap", str, "os.PathLike[str]"]  # a loaded map, a file or a builtin: map
 Matrix = npt.ArrayLike  # 4 x 4 camera-to-world, rows first
 Image = npt.NDArray[np.float32]  # (H, W, 3) linear radiance
 
 __version__: str
 # The transport designs `train` and `model_info` take (`nprt train --arch`).
 DESIGNS: List[str]
-
-class NprtError(RuntimeError):
-    """Bad input (the file and the reason) or a failed stage, with the command line's message."""
 
 class Scene:
     """A scene: geometry, materials and, where its file has one, a camera."""
@@ -55,9 +54,15 @@ class Dataset:
     def manifest(self) -> Dict[str, Any]: ...
     def split(self, split: str) -> List[int]:
         """The indices of the views of ``split`` ("train" or "test")."""
-    def view(self, index: int) -> Dict[str, npt.NDArray[np.float32]]:
-        """radiance, direct, position, normal, view, kd, ks (H, W, 3); alpha, mask (H, W); and
-        half for a test view rendered in halves."""
+    def view(self, index: int) -> Dict[str, Any]:
+        """radiance, direct, position, normal, view, kd, ks (H, W, 3); alpha, mask (H, W);
+        half for a test view rendered in halves; index, split and lighting (map, rotation_deg,
+        gain, mix)."""
+    @overload
+    def __getitem__(self, key: int) -> Dict[str, Any]: ...
+    @overload
+    def __getitem__(self, key: slice) -> List[Dict[str, Any]]: ...
+    def __iter__(self) -> Iterator[Dict[str, Any]]: ...
     def camera(self, index: int) -> Tuple[npt.NDArray[np.float64], float, Tuple[int, int]]:
         """(4 x 4 camera-to-world, horizontal field of view in degrees, (width, height))."""
     def verify(self) -> Dict[str, Any]:
@@ -75,8 +80,8 @@ class Model:
     def device(self) -> str: ...
     def render(
         self,
-        scene: Scene,
-        envmap: EnvMap,
+        scene: SceneLike,
+        envmap: MapLike,
         camera: Matrix,
         width: int,
         height: int,
@@ -87,10 +92,10 @@ class Model:
     ) -> Image:
         """A relit frame of ``scene`` under ``envmap`` turned by ``rotation`` degrees."""
 
-def load_scene(spec: str) -> Scene:
+def load_scene(spec: PathLike) -> Scene:
     """builtin:room, or a Mitsuba .xml, glTF, .ply or .obj file."""
 
-def open_envmap(spec: str) -> EnvMap:
+def open_envmap(spec: PathLike) -> EnvMap:
     """An .exr/.hdr file, builtin:sky[:ELEV[:AZIM[:TURB]]] or builtin:indoor[:SEED]."""
 
 def look_at(
@@ -99,8 +104,8 @@ def look_at(
     """Mitsuba's lookat as a 4 x 4 camera-to-world matrix."""
 
 def reference(
-    scene: Scene,
-    envmap: EnvMap,
+    scene: SceneLike,
+    envmap: MapLike,
     camera: Matrix,
     width: int,
     height: int,
@@ -112,8 +117,8 @@ def reference(
     """A path-traced frame, as `nprt reference` renders it."""
 
 def generate(
-    scene: str,
-    envmaps: str,
+    scene: SceneLike,
+    envmaps: PathLike,
     out: PathLike,
     *,
     train_views: Optional[int] = None,
@@ -184,8 +189,8 @@ def evaluate(
     """`nprt eval`; returns results.json."""
 
 def paper(
-    scene: str,
-    envmaps: str,
+    scene: SceneLike,
+    envmaps: PathLike,
     out: PathLike,
     *,
     budget: str = "small",
@@ -241,7 +246,7 @@ def render(
     model: PathLike,
     out: PathLike,
     *,
-    scene: Optional[str] = None,
+    scene: Optional[SceneLike] = None,
     camera_path: Optional[PathLike] = None,
     camera_volume: Optional[PathLike] = None,
     lighting: Optional[str] = None,
@@ -257,3 +262,13 @@ def render(
     device: str = "cpu",
 ) -> Dict[str, Any]:
     """`nprt render`: a camera path relit into frames and an animation."""
+
+def write_image(path: PathLike, image: npt.ArrayLike, exposure: float = 0.0) -> None:
+    """Writes an (H, W, 3) image of linear radiance as .exr (exact), .hdr or .png (sRGB of the
+    radiance scaled by 2**exposure), whole or not at all."""
+
+def read_image(path: PathLike) -> Image:
+    """An image file (.exr, .hdr, .png, .jpg) as (H, W, 3) float32 linear RGB."""
+
+def cli(argv: Sequence[str]) -> int:
+    """Runs nprt's command line on ``argv`` (the program's name first); its exit status."""

@@ -13,31 +13,7 @@ import pytest
 
 import nprt
 
-REPO = pathlib.Path(__file__).resolve().parents[2]
-
-
-@pytest.fixture(scope="module")
-def room():
-    return nprt.load_scene("builtin:room")
-
-
-@pytest.fixture(scope="module")
-def dataset(tmp_path_factory):
-    out = tmp_path_factory.mktemp("data")
-    done = nprt.generate(
-        "builtin:room", "builtin", out, train_views=6, test_views=2, train_res=(24, 24),
-        test_res=(32, 24), spp=4, test_spp=8, seed=3, progress=False,
-    )
-    assert done["rendered"] == 8 and done["skipped"] == 0 and done["msamples_per_s"] > 0
-    return out
-
-
-@pytest.fixture(scope="module")
-def model(dataset, tmp_path_factory):
-    out = tmp_path_factory.mktemp("model")
-    run = nprt.train(dataset, "dsep", out, epochs=2, progress=False)
-    assert run["epochs"] == pytest.approx(2.0) and np.isfinite(run["validation_loss"])
-    return out
+from conftest import REPO
 
 
 def test_scene_and_cameras(room):
@@ -247,7 +223,7 @@ def test_errors_carry_the_cli_messages(tmp_path):
     with pytest.raises(nprt.NprtError, match="missing.xml") as raised:
         nprt.load_scene(str(tmp_path / "missing.xml"))
     # Defined as nprt.NprtError, so a worker process's failure pickles with its message.
-    assert nprt.NprtError.__module__ == "nprt"
+    assert nprt.NprtError.__module__ == "nprt.errors"
     again = pickle.loads(pickle.dumps(raised.value))
     assert type(again) is nprt.NprtError and "missing.xml" in str(again)
     with pytest.raises(nprt.NprtError, match="2:1"):

@@ -111,6 +111,13 @@ pub fn builtin_per_view(train_views: u64, test_views: u64, seed: u64) -> Vec<Str
 
 /// The .exr and .hdr files of `dir`, sorted by name.
 pub fn specs_in_dir(dir: &Path) -> Result<Vec<String>> {
+    if dir.is_file() {
+        bail!(
+            "'{}' is one map; the maps of a dataset are a folder of .exr or .hdr files (at least \
+             two: some light only the test views), or builtin",
+            dir.display()
+        );
+    }
     let entries = std::fs::read_dir(dir)
         .with_context(|| format!("cannot read environment map folder '{}'", dir.display()))?;
     let mut specs = vec![];

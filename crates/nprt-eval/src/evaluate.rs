@@ -106,9 +106,14 @@ pub fn evaluate(o: &EvalOptions, engine: Engine) -> Result<Evaluation> {
         bar: nprt_io::progress_bar(o.progress, total_steps, "evaluating", "steps"),
     };
 
+    // A stop requested (nprt_io::interrupt) ends it between stages, before any result.
+    let stop = nprt_io::interrupt::check;
     let mut results = run_networks(&mut bench, &nets, oidn.as_ref().ok().copied())?;
+    stop()?;
     let pt5 = run_path_tracing(&mut bench, "pt-5spp", 5, 0x5eed_0005);
+    stop()?;
     let equal_time = run_equal_time(&mut bench, &tiers, &pt5, &mut results);
+    stop()?;
     let equal_time_spp = equal_time.iter().map(|(n, _)| *n).max().unwrap_or(5);
     let mut baselines = Vec::new();
     if let Ok(oidn) = &oidn {
@@ -116,12 +121,15 @@ pub fn evaluate(o: &EvalOptions, engine: Engine) -> Result<Evaluation> {
             baselines.push(run_denoised(&mut bench, oidn, base)?);
         }
     }
+    stop()?;
     baselines.extend(run_sh_prt(&mut bench, o.sh_spp));
+    stop()?;
     bench.bar.finish_and_clear();
     let oidn_ok = oidn.as_ref().ok().copied();
     let (traced, with) = ((&pt5, equal_time.as_slice()), (nets.as_slice(), engine));
     let what = (&ts, &manifest);
     let (temporal, temporal_note) = temporal_run(o, what, &maps, with, traced, oidn_ok)?;
+    stop()?;
     results.push(pt5.result);
     results.extend(equal_time.into_iter().map(|(_, t)| t.result));
     results.extend(baselines);
@@ -139,6 +147,7 @@ pub fn evaluate(o: &EvalOptions, engine: Engine) -> Result<Evaluation> {
             denoiser: oidn_ok,
         },
     )?;
+    stop()?;
     check_finite(&results, &views)?;
     let fg = views.iter().map(|v| v.foreground()).sum();
     let noise_floor = noise_floor(&views);

@@ -17,6 +17,10 @@ pub fn run_sh_prt(bench: &mut TestBench, sh_spp: u32) -> Vec<MethodResult> {
     ];
     let mut pre_ms = 0.0;
     for (k, v) in bench.views.iter().enumerate() {
+        // A stop requested: the evaluation's check after this stage ends it.
+        if nprt_io::interrupt::requested() {
+            break;
+        }
         bench
             .bar
             .set_message(format!("SH transport, {sh_spp} paths per pixel"));

@@ -6,7 +6,8 @@
 //! before allocating, the one style of progress bar with an ETA, and the file formats of pixels: multi-channel OpenEXR, the one image reader (EXR, PNG,
 //! JPEG, Radiance HDR as linear RGB), tone-mapped PNG, the sRGB curve, and line plots. It sits
 //! at the bottom of the stack and must know nothing of scenes or networks: callers hand it
-//! bytes, pixels or a closure that writes a file.
+//! bytes, pixels or a closure that writes a file. It also says an error as every front end
+//! says it (each cause once), and carries a front end's request to stop long work early.
 //!
 //! ```
 //! let dir = std::env::temp_dir().join(format!("nprt-io-doc-{}", std::process::id()));
@@ -19,9 +20,12 @@
 
 mod atomic;
 mod bus_error;
+mod error_text;
 pub mod exr;
 mod image_read;
+mod image_write;
 mod input_file;
+pub mod interrupt;
 mod limits;
 mod lock_file;
 mod plot;
@@ -34,7 +38,9 @@ pub use atomic::{
     write_atomically, write_file,
 };
 pub use bus_error::name_on_bus_error;
+pub use error_text::describe_error;
 pub use image_read::{linear_rgb, read_linear_rgb, LinearImage};
+pub use image_write::write_linear_rgb;
 pub use indicatif::ProgressBar;
 pub use input_file::{check_input, read_input, read_input_string};
 pub use limits::{available_memory, check_threads, ensure_memory, thread_limit};

@@ -46,6 +46,19 @@ pub fn matrix<'py>(py: Python<'py>, m: Mat4) -> Bound<'py, PyArray2<f64>> {
         .into_pyarray(py)
 }
 
+/// `width` × `height` as a frame's size, each named where it is not a positive pixel count
+/// (Python's integers have no bound; a negative one would otherwise be an OverflowError that
+/// names no argument).
+pub fn frame_size(width: i64, height: i64) -> PyResult<(u32, u32)> {
+    let side = |v: i64, arg: &str| {
+        u32::try_from(v)
+            .ok()
+            .filter(|&v| v > 0)
+            .ok_or_else(|| crate::error::input_error(format!("{arg} must be a pixel count from 1 to {}, got {v}", u32::MAX)))
+    };
+    Ok((side(width, "width")?, side(height, "height")?))
+}
+
 /// A camera from a 4 × 4 camera-to-world matrix (rows first), a horizontal field of view and
 /// a resolution; an error naming what is wrong (shape, non-finite entries, a frame that is not
 /// a rotation and a translation, sizes).
@@ -104,6 +117,6 @@ pub fn json<'py>(py: Python<'py>, value: &serde_json::Value) -> PyResult<Bound<'
 /// an NprtError naming the file where it cannot be read.
 pub fn json_file<'py>(py: Python<'py>, path: &std::path::Path) -> PyResult<Bound<'py, PyAny>> {
     let text = std::fs::read_to_string(path)
-        .map_err(|e| crate::error::NprtError::new_err(format!("{}: {e}", path.display())))?;
+        .map_err(|e| crate::error::NprtError::new_err(format!("cannot read '{}': {e}", path.display())))?;
     py.import("json")?.call_method1("loads", (text,))
 }

@@ -4,14 +4,13 @@
 use std::str::FromStr;
 
 use nprt_net::{Compute, Engine};
-use pyo3::exceptions::PyValueError;
 use pyo3::PyResult;
 
 use crate::error::OrPy;
 
-/// `name` as a `T`; a ValueError listing the accepted names otherwise.
+/// `name` as a `T`; an InputError (a ValueError) listing the accepted names otherwise.
 pub fn parse<T: FromStr<Err = String>>(name: &str) -> PyResult<T> {
-    name.parse().map_err(PyValueError::new_err)
+    name.parse().map_err(crate::error::input_error)
 }
 
 /// The engine `device` ("cpu", "gpu", "wgpu" or "auto") names, resolved as `--device` is; an

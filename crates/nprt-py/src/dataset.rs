@@ -4,9 +4,9 @@
 use std::path::PathBuf;
 
 use nprt_data::dataset::{load_manifest, load_manifest_hashed, read_view, Manifest, PackedDataset};
-use pyo3::exceptions::{PyIndexError, PyValueError};
+use pyo3::exceptions::PyIndexError;
 use pyo3::prelude::*;
-use pyo3::types::PyDict;
+use pyo3::types::{PyDict, PyList, PySlice};
 
 use crate::arrays::{self, CameraOut};
 use crate::choice::parse;
@@ -20,6 +20,29 @@ pub struct Dataset {
 }
 
 impl Dataset {
+    /// How view `v` is lit: its map (the spec), its turn about +Y and its RGB gain, and the
+    /// maps added to it (`mix_maps`).
+    fn lighting<'py>(
+        &self,
+        py: Python<'py>,
+        v: &nprt_data::dataset::ViewRecord,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        let maps = &self.manifest.settings.envmaps;
+        let spec = |k: usize| maps.get(k).map(|m| m.spec.clone());
+        let mix: Vec<_> = v
+            .mix
+            .iter()
+            .map(|t| serde_json::json!({"map": spec(t.map), "rotation_deg": t.rotation_deg, "gain": t.gain}))
+            .collect();
+        let value = serde_json::json!({
+            "map": spec(v.map),
+            "rotation_deg": v.rotation_deg,
+            "gain": v.gain,
+            "mix": mix,
+        });
+        arrays::json(py, &value)
+    }
+
     fn record(&self, index: usize) -> PyResult<&nprt_data::dataset::ViewRecord> {
         self.manifest.views.get(index).ok_or_else(|| {
             PyIndexError::new_err(format!(
@@ -56,7 +79,7 @@ impl Dataset {
     /// The indices of the views of `split` ("train" or "test"; another name is a ValueError).
     fn split(&self, split: &str) -> PyResult<Vec<usize>> {
         if !["train", "test"].contains(&split) {
-            return Err(PyValueError::new_err(format!(
+            return Err(crate::error::input_error(format!(
                 "split must be 'train' or 'test', not '{split}'"
             )));
         }
@@ -68,7 +91,8 @@ impl Dataset {
 
     /// View `index`'s images, each an (H, W, 3) or (H, W) float32 array: `radiance`, `direct`,
     /// `position`, `normal`, `view`, `kd`, `ks`, `alpha`, `mask`, and for a test view rendered
-    /// in halves `half` (the first half's radiance).
+    /// in halves `half` (the first half's radiance); with its `index`, `split` and `lighting`
+    /// (`map`, `rotation_deg`, `gain`, and `mix`: the maps added to it).
     fn view<'py>(&self, py: Python<'py>, index: usize) -> PyResult<Bound<'py, PyDict>> {
         let v = self.record(index)?;
         let halves = self.manifest.settings.in_halves(v);
@@ -93,7 +117,39 @@ impl Dataset {
         if let Some(half) = &image.half {
             out.set_item("half", arrays::image(py, half, w, h))?;
         }
+        out.set_item("lighting", self.lighting(py, v)?)?;
+        out.set_item("index", index)?;
+        out.set_item("split", &v.split)?;
         Ok(out)
+    }
+
+    /// View `key` as [`Dataset::view`] gives it (negative indices count from the end), or a
+    /// list of them for a slice: `ds[0]`, `ds[-1]`, `ds[:4]`.
+    fn __getitem__<'py>(&self, py: Python<'py>, key: &Bound<'py, PyAny>) -> PyResult<Bound<'py, PyAny>> {
+        let len = self.manifest.views.len();
+        if let Ok(slice) = key.cast::<PySlice>() {
+            let ix = slice.indices(len as isize)?;
+            let views = (0..ix.slicelength)
+                .map(|k| self.view(py, (ix.start + k as isize * ix.step) as usize))
+                .collect::<PyResult<Vec<_>>>()?;
+            return Ok(PyList::new(py, views)?.into_any());
+        }
+        let i: isize = key.extract().map_err(|_| {
+            crate::error::input_error("a dataset is indexed by an int or a slice")
+        })?;
+        let index = if i < 0 { i + len as isize } else { i };
+        if index < 0 {
+            return Err(PyIndexError::new_err(format!("view {i} of a dataset of {len}")));
+        }
+        Ok(self.view(py, index as usize)?.into_any())
+    }
+
+    /// Every view in order, as [`Dataset::view`] gives it (each read when reached).
+    fn __iter__(slf: Bound<'_, Self>) -> DatasetViews {
+        DatasetViews {
+            dataset: slf.unbind(),
+            next: 0,
+        }
     }
 
     /// View `index`'s camera: (4 × 4 camera-to-world matrix, horizontal field of view in
@@ -171,5 +227,28 @@ impl Dataset {
             s.test_views,
             s.scene
         )
+    }
+}
+
+/// The views of a dataset one by one (`for view in dataset`).
+#[pyclass(module = "nprt")]
+pub struct DatasetViews {
+    dataset: Py<Dataset>,
+    next: usize,
+}
+
+#[pymethods]
+impl DatasetViews {
+    fn __iter__(slf: PyRef<'_, Self>) -> PyRef<'_, Self> {
+        slf
+    }
+
+    fn __next__<'py>(&mut self, py: Python<'py>) -> PyResult<Option<Bound<'py, PyDict>>> {
+        let dataset = self.dataset.bind(py).get();
+        if self.next >= dataset.manifest.views.len() {
+            return Ok(None);
+        }
+        self.next += 1;
+        dataset.view(py, self.next - 1).map(Some)
     }
 }

@@ -7,12 +7,13 @@ use pyo3::prelude::*;
 
 use crate::arrays;
 use crate::choice::engine;
-use crate::error::OrPy;
+use crate::interruptible::interruptible;
 
 /// Evaluates `models` (model folders) on the test views of the dataset `data` beside every
 /// baseline, writes the report into `out` (report.md, report.html, results.json, images/) and
 /// returns results.json as a dict. Keywords are `nprt eval`'s flags; `None` takes its default.
-/// The GIL is released while it runs.
+/// The GIL is released while it runs; Ctrl-C stops it between its stages, before the report
+/// is written (`nprt.Interrupted`).
 #[pyfunction]
 #[pyo3(signature = (
     data, models, out, *, deep_shading = None, sh_spp = None, timing_res = None, views = None,
@@ -55,10 +56,9 @@ pub fn evaluate<'py>(
         progress,
     };
     let engine = engine(device)?;
-    py.detach(|| {
+    interruptible(py, || {
         let e = run(&opts, engine)?;
         write_report(&e, &out)
-    })
-    .or_py()?;
+    })?;
     arrays::json_file(py, &out.join("results.json"))
 }

@@ -8,14 +8,18 @@ use nprt_data::{CameraChoice, GenerateOptions};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
+use crate::argument;
 use crate::choice;
-use crate::error::OrPy;
+use crate::interruptible::interruptible;
 
-/// Renders a dataset into `out` (resumed where one with the same settings is there) and
+/// Renders a dataset of `scene` (a loaded `nprt.Scene`, or a file or `builtin:room` as a `str`
+/// or a `pathlib.Path`) under `envmaps` (a folder of maps, or "builtin") into `out` (resumed
+/// where one with the same settings is there) and
 /// returns what was rendered: `rendered`, `skipped` (already complete), `seconds`,
 /// `msamples_per_s` and `warnings`. Keywords are `nprt generate`'s flags; `None` takes its
 /// default (`nprt generate --help`). `device` traces on "cpu" or the GPU ("gpu", "wgpu",
-/// "auto"). The GIL is released while it renders.
+/// "auto"). The GIL is released while it renders; Ctrl-C stops it after the view under way
+/// (`nprt.Interrupted`), and the same call resumes it.
 #[pyfunction]
 #[pyo3(signature = (
     scene, envmaps, out, *, train_views = None, test_views = None, train_res = None,
@@ -27,8 +31,8 @@ use crate::error::OrPy;
 #[allow(clippy::too_many_arguments)]
 pub fn generate<'py>(
     py: Python<'py>,
-    scene: String,
-    envmaps: String,
+    scene: &Bound<'py, PyAny>,
+    envmaps: &Bound<'py, PyAny>,
     out: PathBuf,
     train_views: Option<u64>,
     test_views: Option<u64>,
@@ -52,10 +56,11 @@ pub fn generate<'py>(
     progress: bool,
     mix_maps: Option<u32>,
 ) -> PyResult<Bound<'py, PyDict>> {
+    let (fin, fin3) = (argument::finite_or_none, finite_vec3);
     let d = GenerateOptions::default();
     let opts = GenerateOptions {
-        scene,
-        envmaps,
+        scene: argument::scene_spec(scene, "scene")?,
+        envmaps: argument::text(envmaps, "envmaps", "a folder of maps (a str or an os.PathLike) or \"builtin\"")?,
         out,
         train_views: train_views.unwrap_or(d.train_views),
         test_views: test_views.unwrap_or(d.test_views),
@@ -65,28 +70,28 @@ pub fn generate<'py>(
         test_spp: test_spp.unwrap_or(d.test_spp),
         seed: seed.unwrap_or(d.seed),
         jitter: Jitter {
-            exposure: jitter_exposure.unwrap_or(d.jitter.exposure),
-            tint: jitter_tint.unwrap_or(d.jitter.tint),
+            exposure: fin(jitter_exposure, "jitter_exposure")?.unwrap_or(d.jitter.exposure),
+            tint: fin(jitter_tint, "jitter_tint")?.unwrap_or(d.jitter.tint),
         },
         mix_maps: mix_maps.unwrap_or(d.mix_maps),
         test_maps: test_maps.or(d.test_maps),
-        mix_builtin: mix_builtin.or(d.mix_builtin),
+        mix_builtin: fin(mix_builtin, "mix_builtin")?.or(d.mix_builtin),
         camera: CameraChoice {
             file: camera_volume,
-            min: volume_min.map(Into::into),
-            max: volume_max.map(Into::into),
-            look: look.map(Into::into),
-            spread_deg: spread,
-            fov_deg: fov,
+            min: fin3(volume_min, "volume_min")?,
+            max: fin3(volume_max, "volume_max")?,
+            look: fin3(look, "look")?,
+            spread_deg: fin(spread, "spread")?,
+            fov_deg: fin(fov, "fov")?,
         },
         shard: shard.unwrap_or(d.shard),
         device: choice::engine(device)?.tracer(),
         progress,
     };
     let mut warnings = Vec::new();
-    let summary = py
-        .detach(|| nprt_data::generate(&opts, |p| warnings = p.warnings))
-        .or_py()?;
+    let summary = interruptible(py, || {
+        nprt_data::generate(&opts, |p| warnings = p.warnings)
+    })?;
     let out = PyDict::new(py);
     out.set_item("rendered", summary.rendered)?;
     out.set_item("skipped", summary.skipped)?;
@@ -98,4 +103,14 @@ pub fn generate<'py>(
     )?;
     out.set_item("warnings", warnings)?;
     Ok(out)
+}
+
+/// An optional point or direction, each coordinate finite (named `arg` otherwise).
+fn finite_vec3(v: Option<[f32; 3]>, arg: &str) -> PyResult<Option<glam::Vec3>> {
+    match v {
+        Some(v) if !v.iter().all(|c| c.is_finite()) => Err(crate::error::input_error(format!(
+            "{arg} must be three finite numbers, got {v:?}"
+        ))),
+        v => Ok(v.map(Into::into)),
+    }
 }

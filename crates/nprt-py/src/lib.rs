@@ -4,6 +4,7 @@
 //! libraries' option types' own) and nothing else: every stage's work is its library's, called
 //! as the command line calls it, with the GIL released while it runs.
 
+mod argument;
 mod arrays;
 mod choice;
 mod dataset;
@@ -11,6 +12,8 @@ mod error;
 mod evaluate;
 mod export;
 mod generate;
+mod image;
+mod interruptible;
 mod model;
 mod model_info;
 mod paper;
@@ -20,12 +23,19 @@ mod train;
 
 use pyo3::prelude::*;
 
+/// Runs nprt's command line on `argv` (the program's name first), as the `nprt` binary does;
+/// returns its exit status. The package's `nprt` command and `python -m nprt` call it.
+#[pyfunction]
+fn cli(py: Python<'_>, argv: Vec<std::ffi::OsString>) -> i32 {
+    py.detach(|| nprt::main_with(argv))
+}
+
 #[pymodule]
 fn _nprt(m: &Bound<'_, PyModule>) -> PyResult<()> {
-    m.add("NprtError", m.py().get_type::<error::NprtError>())?;
     m.add_class::<scene::Scene>()?;
     m.add_class::<scene::EnvMap>()?;
     m.add_class::<dataset::Dataset>()?;
+    m.add_class::<dataset::DatasetViews>()?;
     m.add_class::<model::Model>()?;
     m.add_function(wrap_pyfunction!(scene::load_scene, m)?)?;
     m.add_function(wrap_pyfunction!(scene::open_envmap, m)?)?;
@@ -39,6 +49,9 @@ fn _nprt(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(paper::paper, m)?)?;
     m.add_function(wrap_pyfunction!(render::render, m)?)?;
     m.add_function(wrap_pyfunction!(evaluate::evaluate, m)?)?;
+    m.add_function(wrap_pyfunction!(image::write_image, m)?)?;
+    m.add_function(wrap_pyfunction!(image::read_image, m)?)?;
+    m.add_function(wrap_pyfunction!(cli, m)?)?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     // The designs `train` and `model_info` take, as the command line's `--arch` lists them.
     m.add(

@@ -5,18 +5,45 @@ use std::path::PathBuf;
 
 use nprt_render::{DirectSampling, FrameCache, Relighter};
 use numpy::{AllowTypeChange, PyArray3, PyArrayLike2};
+use pyo3::exceptions::PyUserWarning;
 use pyo3::prelude::*;
 
+use crate::argument;
 use crate::arrays;
 use crate::choice::engine;
 use crate::error::OrPy;
-use crate::scene::{EnvMap, Scene};
+use crate::scene::Scene;
 
 /// A model folder `nprt train` wrote, ready to relight frames on `device`.
 #[pyclass(frozen, module = "nprt")]
 pub struct Model {
     dir: PathBuf,
     relighter: Relighter,
+}
+
+impl Model {
+    /// A `UserWarning` where `scene` is not the scene the model was trained on (both hashes
+    /// known and different).
+    fn warn_if_foreign(&self, py: Python<'_>, scene: &Scene) -> PyResult<()> {
+        let trained = self.relighter.file.scene_hash.as_str();
+        match scene.hash() {
+            Some(h) if !trained.is_empty() && h != trained => PyErr::warn(
+                py,
+                &py.get_type::<PyUserWarning>(),
+                &std::ffi::CString::new(format!(
+                    "model '{}' was trained on scene '{}', not on '{}' (hash {} ≠ {}): its \
+                     frames of another scene are not meaningful",
+                    self.dir.display(),
+                    self.relighter.file.scene,
+                    scene.spec,
+                    &h[..12],
+                    &trained[..12.min(trained.len())]
+                ))?,
+                1,
+            ),
+            _ => Ok(()),
+        }
+    }
 }
 
 #[pymethods]
@@ -49,28 +76,38 @@ impl Model {
     /// networks, and the background (or, for a model trained with `--direct traced`, direct
     /// light traced with `direct_spp` paths per pixel from `seed`). An (H, W, 3) float32 array
     /// of linear radiance. The GIL is released while it renders.
+    ///
+    /// `scene` and `envmap` may be loaded objects or what names them (a `str` or a
+    /// `pathlib.Path`). A scene other than the one the model was trained on (by its hash)
+    /// renders with a warning (`UserWarning`): the networks know their own scene only.
     #[pyo3(signature = (scene, envmap, camera, width, height, fov = 60.0, rotation = 0.0, direct_spp = 16, seed = 0))]
     #[allow(clippy::too_many_arguments)]
     fn render<'py>(
         &self,
         py: Python<'py>,
-        scene: &Scene,
-        envmap: &EnvMap,
+        scene: &Bound<'py, PyAny>,
+        envmap: &Bound<'py, PyAny>,
         camera: PyArrayLike2<f32, AllowTypeChange>,
-        width: u32,
-        height: u32,
+        width: i64,
+        height: i64,
         fov: f32,
         rotation: f32,
         direct_spp: u32,
         seed: u64,
     ) -> PyResult<Bound<'py, PyArray3<f32>>> {
+        let (width, height) = arrays::frame_size(width, height)?;
         let camera = arrays::camera(camera, fov, width, height).or_py()?;
+        let rotation = argument::finite(rotation, "rotation")?;
+        let scene = argument::scene(scene, "scene")?;
+        let envmap = argument::envmap(envmap, "envmap")?;
+        let scene = scene.get();
+        self.warn_if_foreign(py, scene)?;
         let sampling = DirectSampling {
             spp: direct_spp,
             seed,
             denoiser: None,
         };
-        let map = &envmap.map;
+        let map = &envmap.get().map;
         let (rgb, _) = py
             .detach(|| {
                 let mut cache = FrameCache::default();

@@ -4,7 +4,6 @@
 use std::path::PathBuf;
 
 use nprt_net::{ModelSummary, DEFAULT_ENCODER_WIDTH};
-use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 
 use crate::choice::parse;
@@ -42,7 +41,7 @@ pub fn model_info<'py>(
             (summary, None)
         }
         _ => {
-            return Err(PyValueError::new_err(
+            return Err(crate::error::input_error(
                 "give a model folder or arch=, not both",
             ))
         }

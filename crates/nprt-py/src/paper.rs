@@ -4,7 +4,6 @@ use std::path::PathBuf;
 
 use nprt_data::CameraChoice;
 use nprt_paper::{Budget, Experiment};
-use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
@@ -25,8 +24,8 @@ use crate::error::OrPy;
 #[allow(clippy::too_many_arguments)]
 pub fn paper<'py>(
     py: Python<'py>,
-    scene: &str,
-    envmaps: &str,
+    scene: &Bound<'py, PyAny>,
+    envmaps: &Bound<'py, PyAny>,
     out: PathBuf,
     budget: &str,
     camera_volume: Option<PathBuf>,
@@ -34,9 +33,15 @@ pub fn paper<'py>(
     seed: u64,
     device: &str,
 ) -> PyResult<Bound<'py, PyDict>> {
+    let scene = crate::argument::scene_spec(scene, "scene")?;
+    let envmaps = crate::argument::text(
+        envmaps,
+        "envmaps",
+        "a folder of maps (a str or an os.PathLike) or \"builtin\"",
+    )?;
     let budget: Budget = budget
         .parse()
-        .map_err(|e: anyhow::Error| PyValueError::new_err(e.to_string()))?;
+        .map_err(|e: anyhow::Error| crate::error::input_error(e.to_string()))?;
     let x = Experiment {
         camera: CameraChoice {
             file: camera_volume,
@@ -44,7 +49,7 @@ pub fn paper<'py>(
         },
         test_maps,
         seed,
-        ..Experiment::paper(scene, envmaps, &out, budget, engine(device)?)
+        ..Experiment::paper(&scene, &envmaps, &out, budget, engine(device)?)
     };
     let done = py.detach(|| x.run()).or_py()?;
     let d = PyDict::new(py);

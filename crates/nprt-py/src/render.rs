@@ -7,14 +7,15 @@ use nprt_render::{RenderJob, RenderOptions};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
+use crate::argument::{self, finite_or_none};
 use crate::choice::{engine, parse};
-use crate::error::OrPy;
+use crate::interruptible::interruptible;
 
 /// Relights a camera path of the model in `model` under a lighting schedule into `out` (PNG
 /// frames, or EXR with `exr`, and an MP4 or GIF), as `nprt render`; keywords are its flags,
 /// `None` its default. Returns `frames_dir`, `animation` and the mean per-frame milliseconds
 /// (`gbuffer_ms`, `encoder_ms`, `network_ms`, `direct_ms`, `total_ms`). The GIL is released
-/// while it renders.
+/// while it renders; Ctrl-C stops it after the frame under way (`nprt.Interrupted`).
 #[pyfunction]
 #[pyo3(signature = (
     model, out, *, scene = None, camera_path = None, camera_volume = None, lighting = None,
@@ -26,7 +27,7 @@ pub fn render<'py>(
     py: Python<'py>,
     model: PathBuf,
     out: PathBuf,
-    scene: Option<String>,
+    scene: Option<&Bound<'py, PyAny>>,
     camera_path: Option<PathBuf>,
     camera_volume: Option<PathBuf>,
     lighting: Option<String>,
@@ -45,24 +46,22 @@ pub fn render<'py>(
     let opts = RenderOptions {
         model,
         out,
-        scene,
+        scene: scene.map(|s| argument::scene_spec(s, "scene")).transpose()?,
         camera_path,
         camera_volume,
         lighting: lighting.unwrap_or(d.lighting),
-        spin_deg: spin.unwrap_or(d.spin_deg),
+        spin_deg: finite_or_none(spin, "spin")?.unwrap_or(d.spin_deg),
         frames: frames.unwrap_or(d.frames),
         resolution: res.map_or(d.resolution, |(w, h)| [w, h]),
         fps: fps.unwrap_or(d.fps),
-        exposure: exposure.unwrap_or(d.exposure),
+        exposure: finite_or_none(exposure, "exposure")?.unwrap_or(d.exposure),
         exr,
         direct_spp: direct_spp.unwrap_or(d.direct_spp),
         denoise_direct,
         precision: precision.map(parse).transpose()?.unwrap_or(d.precision),
     };
     let engine = engine(device)?;
-    let done = py
-        .detach(|| RenderJob::prepare(&opts, engine)?.run(|_| {}))
-        .or_py()?;
+    let done = interruptible(py, || RenderJob::prepare(&opts, engine)?.run(|_| {}))?;
     let m = done.mean;
     let summary = PyDict::new(py);
     summary.set_item("frames_dir", done.frames_dir)?;

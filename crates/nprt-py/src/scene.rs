@@ -9,7 +9,9 @@ use numpy::{AllowTypeChange, PyArray2, PyArray3, PyArrayLike2, PyArrayLike3};
 use pyo3::prelude::*;
 
 use crate::arrays::{self, CameraOut};
-use crate::error::OrPy;
+use crate::argument;
+use crate::interruptible::interruptible;
+use crate::error::{input_error, OrPy};
 
 /// A scene: geometry, materials and, where its file has one, a camera.
 #[pyclass(frozen, module = "nprt")]
@@ -19,6 +21,8 @@ pub struct Scene {
     /// The scene made ready for tracing (its acceleration structure), at the first frame
     /// rendered and kept for the next.
     traced: OnceLock<TraceScene<'static>>,
+    /// Its identity as datasets and models record it, made at the first check.
+    hash: OnceLock<Option<String>>,
 }
 
 impl Scene {
@@ -26,6 +30,17 @@ impl Scene {
     pub fn traced(&self) -> &TraceScene<'static> {
         self.traced
             .get_or_init(|| TraceScene::shared(self.scene.clone()))
+    }
+
+    /// Its hash as a dataset or a model records its scene's (None where its file can no
+    /// longer be read).
+    pub fn hash(&self) -> Option<&str> {
+        self.hash
+            .get_or_init(|| {
+                let source = nprt_data::dataset::scene_source(&self.spec).ok()?;
+                Some(nprt_data::dataset::scene_hash(&self.scene, &source))
+            })
+            .as_deref()
     }
 }
 
@@ -37,11 +52,11 @@ impl Scene {
         &self.spec
     }
 
-    /// The scene's bounding box, ((x, y, z) min, (x, y, z) max).
+    /// The scene's bounding box, ((x, y, z) min, (x, y, z) max), as tuples.
     #[getter]
-    fn bounds(&self) -> ([f32; 3], [f32; 3]) {
+    fn bounds(&self) -> ((f32, f32, f32), (f32, f32, f32)) {
         let (lo, hi) = self.scene.bounds();
-        (lo.to_array(), hi.to_array())
+        (lo.into(), hi.into())
     }
 
     /// Triangles in all meshes.
@@ -80,9 +95,15 @@ impl Scene {
     }
 }
 
-/// Loads a scene: `builtin:room`, or a Mitsuba .xml, glTF (.gltf/.glb), .ply or .obj file.
+/// Loads a scene: `builtin:room`, or a Mitsuba .xml, glTF (.gltf/.glb), .ply or .obj file
+/// (a `str` or a `pathlib.Path`).
 #[pyfunction]
-pub fn load_scene(py: Python<'_>, spec: &str) -> PyResult<Scene> {
+pub fn load_scene(py: Python<'_>, spec: &Bound<'_, PyAny>) -> PyResult<Scene> {
+    load(py, &argument::text(spec, "spec", "a str or an os.PathLike")?)
+}
+
+/// The scene `spec` names, loaded with the GIL released.
+pub fn load(py: Python<'_>, spec: &str) -> PyResult<Scene> {
     let scene = py
         .detach(|| nprt_scene::load_scene(spec, &SceneOptions::default()))
         .or_py()?;
@@ -90,6 +111,7 @@ pub fn load_scene(py: Python<'_>, spec: &str) -> PyResult<Scene> {
         spec: spec.to_string(),
         scene: Arc::new(scene),
         traced: OnceLock::new(),
+        hash: OnceLock::new(),
     })
 }
 
@@ -104,16 +126,33 @@ impl EnvMap {
     /// A map from an (H, 2H, 3) array of linear radiance (negative values are clamped to 0).
     #[new]
     #[pyo3(signature = (texels, name = "array"))]
-    fn new(texels: PyArrayLike3<f32, AllowTypeChange>, name: &str) -> PyResult<Self> {
-        let a = texels.as_array();
-        let (h, w, c) = a.dim();
+    fn new(texels: &Bound<'_, PyAny>, name: &str) -> PyResult<Self> {
+        let shape = || -> PyResult<Vec<usize>> { texels.getattr("shape")?.extract() };
+        let Ok(&[h, w, c]) = shape().as_deref() else {
+            let kind = texels.get_type().name()?;
+            return Err(input_error(format!(
+                "texels: an environment map is an (H, 2H, 3) array of numbers, not {kind}{}",
+                shape().map_or(String::new(), |s| format!(" of shape {s:?}"))
+            )));
+        };
         if c != 3 {
-            return Err(crate::error::NprtError::new_err(format!(
-                "{name}: an environment map is an (H, 2H, 3) array, got shape ({h}, {w}, {c})"
+            return Err(input_error(format!(
+                "texels: an environment map is an (H, 2H, 3) array, got shape ({h}, {w}, {c})"
             )));
         }
-        let texels = a.iter().copied().collect::<Vec<f32>>();
-        let texels = texels.chunks_exact(3).map(glam::Vec3::from_slice).collect();
+        // Before any copy: a broadcast view of a huge shape costs nothing until copied.
+        nprt_scene::EnvMap::check_size(w, h, name).or_py()?;
+        let texels: PyArrayLike3<f32, AllowTypeChange> = texels.extract().map_err(|e| {
+            input_error(format!("texels: not an array of numbers ({e})"))
+        })?;
+        let texels = texels
+            .as_array()
+            .iter()
+            .copied()
+            .collect::<Vec<f32>>()
+            .chunks_exact(3)
+            .map(glam::Vec3::from_slice)
+            .collect();
         let map = nprt_scene::EnvMap::from_texels(name, w, h, texels).or_py()?;
         Ok(EnvMap { map })
     }
@@ -124,10 +163,10 @@ impl EnvMap {
     }
 
     /// The same map turned by `degrees` about +Y (Mitsuba's `<rotate y="1" angle=.../>`).
-    fn rotated(&self, degrees: f32) -> EnvMap {
-        EnvMap {
-            map: self.map.rotated_y(degrees),
-        }
+    fn rotated(&self, degrees: f32) -> PyResult<EnvMap> {
+        Ok(EnvMap {
+            map: self.map.rotated_y(argument::finite(degrees, "degrees")?),
+        })
     }
 
     #[getter]
@@ -154,18 +193,24 @@ impl EnvMap {
 /// The 4 × 4 camera-to-world matrix of a camera at `origin` looking at `target` with `up`
 /// upwards (Mitsuba's `lookat`: columns left, up, forward, origin).
 #[pyfunction]
-#[pyo3(signature = (origin, target, up = [0.0, 1.0, 0.0]))]
+#[pyo3(signature = (origin, target, up = [0.0, 1.0, 0.0]), text_signature = "(origin, target, up=(0.0, 1.0, 0.0))")]
 pub fn look_at<'py>(
     py: Python<'py>,
     origin: [f32; 3],
     target: [f32; 3],
     up: [f32; 3],
 ) -> PyResult<Bound<'py, PyArray2<f64>>> {
-    let (o, t, u) = (origin.into(), target.into(), up.into());
+    for (arg, v) in [("origin", origin), ("target", target), ("up", up)] {
+        if !v.iter().all(|c| c.is_finite()) {
+            return Err(input_error(format!("{arg} must be three finite numbers, got {v:?}")));
+        }
+    }
+    let (o, t, u): (glam::Vec3, glam::Vec3, glam::Vec3) = (origin.into(), target.into(), up.into());
     if o == t {
-        return Err(crate::error::NprtError::new_err(
-            "a camera cannot look at its own origin",
-        ));
+        return Err(input_error("a camera cannot look at its own origin (origin == target)"));
+    }
+    if (t - o).cross(u).length_squared() == 0.0 {
+        return Err(input_error("up must not be parallel to the viewing direction (target - origin)"));
     }
     Ok(arrays::matrix(
         py,
@@ -173,38 +218,47 @@ pub fn look_at<'py>(
     ))
 }
 
-/// Opens an environment map: an .exr/.hdr file, `builtin:sky[:ELEV[:AZIM[:TURB]]]` or
-/// `builtin:indoor[:SEED]`.
+/// Opens an environment map: an .exr/.hdr file (a `str` or a `pathlib.Path`),
+/// `builtin:sky[:ELEV[:AZIM[:TURB]]]` or `builtin:indoor[:SEED]`.
 #[pyfunction]
-pub fn open_envmap(py: Python<'_>, spec: &str) -> PyResult<EnvMap> {
+pub fn open_envmap(py: Python<'_>, spec: &Bound<'_, PyAny>) -> PyResult<EnvMap> {
+    open(py, &argument::text(spec, "spec", "a str or an os.PathLike")?)
+}
+
+/// The map `spec` names, opened with the GIL released.
+pub fn open(py: Python<'_>, spec: &str) -> PyResult<EnvMap> {
     let map = py.detach(|| nprt_scene::open_envmap(spec)).or_py()?;
     Ok(EnvMap { map })
 }
 
 /// A path-traced frame of `scene` under `envmap` through `camera` (4 × 4 camera-to-world,
 /// horizontal field of view `fov`), `spp` paths per pixel over the pixel (box filter), as
-/// `nprt reference` renders: an (H, W, 3) float32 array of linear radiance.
+/// `nprt reference` renders: an (H, W, 3) float32 array of linear radiance. `scene` and
+/// `envmap` may be loaded objects or what names them (a `str` or a `pathlib.Path`). Ctrl-C
+/// stops it within a moment (`nprt.Interrupted`).
 #[pyfunction]
 #[pyo3(signature = (scene, envmap, camera, width, height, fov = 60.0, spp = 64, seed = 0, max_depth = None))]
 #[allow(clippy::too_many_arguments)]
 pub fn reference<'py>(
     py: Python<'py>,
-    scene: &Scene,
-    envmap: &EnvMap,
+    scene: &Bound<'py, PyAny>,
+    envmap: &Bound<'py, PyAny>,
     camera: PyArrayLike2<f32, AllowTypeChange>,
-    width: u32,
-    height: u32,
+    width: i64,
+    height: i64,
     fov: f32,
     spp: u32,
     seed: u64,
     max_depth: Option<u32>,
 ) -> PyResult<Bound<'py, PyArray3<f32>>> {
+    let (width, height) = arrays::frame_size(width, height)?;
     let camera = arrays::camera(camera, fov, width, height).or_py()?;
     if spp == 0 {
-        return Err(crate::error::NprtError::new_err(
-            "samples per pixel must be at least 1",
-        ));
+        return Err(input_error("spp (samples per pixel) must be at least 1"));
     }
+    let scene = argument::scene(scene, "scene")?;
+    let envmap = argument::envmap(envmap, "envmap")?;
+    let scene = scene.get();
     let settings = RenderSettings {
         spp,
         max_depth: max_depth.or(scene.scene.max_depth),
@@ -213,8 +267,8 @@ pub fn reference<'py>(
         filter: PixelFilter::Box,
         progress: false,
     };
-    let map = &envmap.map;
-    let frame = py.detach(|| render(scene.traced(), &camera, map, &settings));
+    let map = &envmap.get().map;
+    let frame = interruptible(py, || Ok(render(scene.traced(), &camera, map, &settings)))?;
     Ok(arrays::image(
         py,
         &frame.radiance,

@@ -12,6 +12,7 @@ use nprt_net::{ModelConfig, RunLength, TrainOptions, TrainSummary};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
+use crate::argument::finite_or_none;
 use crate::choice::{engine, parse};
 use crate::error::OrPy;
 
@@ -28,7 +29,8 @@ use crate::error::OrPy;
 /// `callback`, where given, is called at each epoch's end with that epoch's row of the loss
 /// curves (`step`, `epoch`, `samples`, `seconds`, `train_loss`, `val_loss`); returning a false
 /// value (False, 0, numpy's False_: anything whose `bool` is False, None aside) ends the run
-/// there; returning nothing goes on. Ctrl-C ends it there too, then raises KeyboardInterrupt. Either way the
+/// there; returning nothing goes on. Ctrl-C ends it there too, then raises `nprt.Interrupted` (a KeyboardInterrupt).
+/// Either way the
 /// run is saved as at the end of a time budget, and the same call resumes it. The GIL is
 /// released while it trains.
 #[pyfunction]
@@ -61,6 +63,7 @@ pub fn train<'py>(
     config.basis = basis.map(parse).transpose()?.or(config.basis);
     config.check().or_py()?;
     let d = TrainOptions::default();
+    let (minutes, lr) = (finite_or_none(minutes, "minutes")?, finite_or_none(lr, "lr")?);
     let run = RunLength {
         epochs,
         minutes,
@@ -117,6 +120,7 @@ pub fn train_deep_shading<'py>(
 ) -> PyResult<Bound<'py, PyDict>> {
     let engine = engine(device)?;
     let d = DeepShadingOptions::default();
+    let (minutes, lr) = (finite_or_none(minutes, "minutes")?, finite_or_none(lr, "lr")?);
     let run = RunLength {
         epochs,
         minutes,
@@ -161,7 +165,7 @@ impl EpochWatch {
     /// Whether the run goes on after the epoch that `row` ends.
     fn hear(&self, row: &LossRow) -> bool {
         Python::attach(|py| {
-            let go_on = py.check_signals().and_then(|()| match &self.callback {
+            let go_on = crate::error::check_interrupt(py).and_then(|()| match &self.callback {
                 None => Ok(true),
                 // No answer (None) goes on; any other by its truth (False, 0, numpy's
                 // False_ stop).

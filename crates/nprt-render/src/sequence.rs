@@ -90,6 +90,7 @@ pub fn render_sequence(
     let mut cache = FrameCache::default();
     let start = Instant::now();
     for i in 0..seq.frames {
+        nprt_io::interrupt::check()?;
         let camera = seq
             .path
             .camera(i as f32 / (seq.frames.max(2) - 1) as f32, w, h);

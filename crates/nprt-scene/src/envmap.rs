@@ -54,6 +54,19 @@ pub fn direction_to_uv(d: Vec3) -> Vec2 {
 pub const MAX_RADIANCE: f32 = 1e12;
 
 impl EnvMap {
+    /// Bytes a map holds per texel once built: its texels (12), its sampling distribution
+    /// (a density and a cumulative sum, 8) and the caller's copy on the way in (12).
+    const BYTES_PER_TEXEL: u128 = 32;
+
+    /// Refuses a `width` × `height` map (`name`) the machine's memory cannot hold once built,
+    /// before anything is allocated for it (a numpy array from Python, a decoded file).
+    pub fn check_size(width: usize, height: usize, name: &str) -> Result<()> {
+        nprt_io::ensure_memory(
+            width as u128 * height as u128 * Self::BYTES_PER_TEXEL,
+            &format!("{name}: an environment map of {width}×{height} texels"),
+        )
+    }
+
     /// Builds a map from row-major texels; `width` must be twice `height`. Negative channels
     /// (small ones occur in real captures) are clamped to zero and counted; non-finite ones
     /// are an error.
@@ -133,8 +146,8 @@ impl EnvMap {
     /// by `scale`.
     pub fn load(path: &Path, scale: f32) -> Result<Self> {
         let name = path.display().to_string();
-        let img = read_linear_rgb(path, false)
-            .with_context(|| format!("cannot read environment map '{name}'"))?;
+        // The reader's message names the file already.
+        let img = read_linear_rgb(path, false).context("environment map")?;
         let texels = img.texels.into_iter().map(|t| t * scale).collect();
         Self::from_texels(&name, img.width, img.height, texels)
             .with_context(|| format!("environment map '{name}'"))
@@ -382,7 +395,7 @@ mod tests {
     #[test]
     fn a_sum_of_maps_adds_their_radiance() {
         let m = gradient_map().rotated_y(20.0);
-        let twice = m.plus(&[m.clone()]).unwrap();
+        let twice = m.plus(std::slice::from_ref(&m)).unwrap();
         let turned = gradient_map()
             .rotated_y(75.0)
             .scaled(Vec3::splat(0.5))

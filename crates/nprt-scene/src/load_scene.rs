@@ -20,6 +20,12 @@ pub fn load_scene(spec: &str, opts: &SceneOptions) -> Result<Scene> {
     if !path.exists() {
         bail!("scene file '{spec}' does not exist");
     }
+    if path.is_dir() {
+        bail!(
+            "scene file '{spec}' is a folder; give a scene file (.xml, .gltf, .glb, .ply or .obj) \
+             or builtin:room"
+        );
+    }
     let ext = path
         .extension()
         .and_then(|e| e.to_str())

@@ -33,6 +33,7 @@ pub struct RenderSettings {
     pub progress: bool,
 }
 
+#[derive(Clone, Default)]
 struct PixelOut {
     radiance: Vec3,
     direct: Vec3,
@@ -56,8 +57,13 @@ pub fn render(ts: &TraceScene, camera: &Camera, env: &EnvMap, s: &RenderSettings
     let rows: Vec<Vec<PixelOut>> = (0..h)
         .into_par_iter()
         .map(|y| {
+            // A stop requested (nprt_io::interrupt): the rest stays black, and the caller's
+            // check ends the call before anything is written of it.
             let row = (0..w)
-                .map(|x| pixel(ts, camera, env, s, &path_settings, x, y))
+                .map(|x| match nprt_io::interrupt::requested() {
+                    true => PixelOut::default(),
+                    false => pixel(ts, camera, env, s, &path_settings, x, y),
+                })
                 .collect();
             bar.inc(1);
             row

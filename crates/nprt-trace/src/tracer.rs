@@ -76,8 +76,14 @@ impl<'a> Tracer<'a> {
         env: &EnvMap,
         settings: &RenderSettings,
     ) -> Result<Frame> {
+        nprt_io::interrupt::check()?;
         match self {
-            Tracer::Cpu(ts) => Ok(render(ts, camera, env, settings)),
+            Tracer::Cpu(ts) => {
+                let frame = render(ts, camera, env, settings);
+                // Rows skipped by a stop request: not a frame to keep.
+                nprt_io::interrupt::check()?;
+                Ok(frame)
+            }
             #[cfg(feature = "gpu")]
             Tracer::Gpu(raster) => raster.render_frame(camera, env, settings),
         }

@@ -28,8 +28,12 @@ pub fn render_transport(
     (0..w * camera.height as usize)
         .into_par_iter()
         .map(|i| {
-            let mut rng = pixel_rng(s.seed, i as u64);
             let mut t = vec![Vec3::ZERO; basis_len];
+            // A stop requested (nprt_io::interrupt): the caller's check ends the call.
+            if nprt_io::interrupt::requested() {
+                return t;
+            }
+            let mut rng = pixel_rng(s.seed, i as u64);
             let mut y_k = vec![0.0; basis_len];
             let ray = CameraRay::centre(ts, camera, i % w, i / w);
             for _ in 0..s.spp {

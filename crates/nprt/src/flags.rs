@@ -43,7 +43,7 @@ pub struct RunArgs {
     /// Wall-clock budget: stop when the run's training time reaches this many minutes (or
     /// after --epochs if given, whichever comes first). The same command continues a stopped
     /// run up to the budget.
-    #[arg(long)]
+    #[arg(long, value_parser = finite_f64)]
     pub minutes: Option<f64>,
     /// Learning-rate schedule: paper (--lr throughout, as the paper) or cosine (warm-up over
     /// the first 2% of the run, then a cosine decay to 5% of --lr at its end: the last epoch,
@@ -106,13 +106,31 @@ pub fn parse_shard(s: &str) -> Result<(u64, u64), String> {
     Ok((k, n))
 }
 
-/// `x,y,z`.
+/// A finite number: clap's own parsers take "nan" and "inf", which no flag means.
+pub fn finite_f32(s: &str) -> Result<f32, String> {
+    finite(s)
+}
+
+/// [`finite_f32`] in double precision.
+pub fn finite_f64(s: &str) -> Result<f64, String> {
+    finite(s)
+}
+
+fn finite<T: FromStr + Into<f64> + Copy>(s: &str) -> Result<T, String> {
+    match s.trim().parse::<T>() {
+        Ok(v) if v.into().is_finite() => Ok(v),
+        Ok(_) => Err(format!("'{s}' is not a finite number")),
+        Err(_) => Err(format!("'{s}' is not a number")),
+    }
+}
+
+/// `x,y,z`, each finite.
 pub fn parse_vec3(s: &str) -> Result<glam::Vec3, String> {
     let v: Vec<f32> = s
         .split(',')
-        .map(|t| t.trim().parse::<f32>())
+        .map(finite)
         .collect::<Result<_, _>>()
-        .map_err(|_| format!("'{s}' is not x,y,z"))?;
+        .map_err(|_| format!("'{s}' is not x,y,z (three finite numbers)"))?;
     match v.as_slice() {
         [x, y, z] => Ok(glam::Vec3::new(*x, *y, *z)),
         _ => Err(format!("'{s}' is not x,y,z")),

@@ -50,11 +50,11 @@ pub struct GenerateArgs {
     test_spp: u32,
     /// Exposure jitter of the training views' maps, in stops: each view's map is scaled by 2^e,
     /// e uniform in ±this (recorded per view in the manifest; test views are never jittered).
-    #[arg(long, default_value_t = d().jitter.exposure)]
+    #[arg(long, value_parser = crate::flags::finite_f32, default_value_t = d().jitter.exposure)]
     jitter_exposure: f32,
     /// White-balance jitter of the training views' maps, in stops: red and blue scaled by
     /// 2^r, 2^b (r, b uniform in ±this) against green, at unchanged luminance.
-    #[arg(long, default_value_t = d().jitter.tint)]
+    #[arg(long, value_parser = crate::flags::finite_f32, default_value_t = d().jitter.tint)]
     jitter_tint: f32,
     /// Light each training view by a random mixture of up to this many maps (1 to 8): its own
     /// map and, uniformly 0 to this − 1, others of the training maps, each turned at random
@@ -76,7 +76,7 @@ pub struct GenerateArgs {
     /// Default 0.5, which improved every error on held-out real maps against 0
     /// (docs/evaluation.md); 0 makes a folder dataset as before mixing existed. Not for
     /// --envmaps builtin.
-    #[arg(long)]
+    #[arg(long, value_parser = crate::flags::finite_f32)]
     mix_builtin: Option<f32>,
     /// Render only views with index ≡ K (mod N), e.g. 0/4 … 3/4 on four machines. Default:
     /// the task of the Slurm job array this runs in (SLURM_ARRAY_TASK_ID of
@@ -99,11 +99,11 @@ pub struct GenerateArgs {
     look: Option<glam::Vec3>,
     /// Half-angle of the pyramid of view directions, degrees (default: the volume's; 30 for
     /// corners given by hand).
-    #[arg(long)]
+    #[arg(long, value_parser = crate::flags::finite_f32)]
     spread: Option<f32>,
     /// Horizontal field of view of dataset cameras, degrees (default: the volume's; 60 for
     /// corners given by hand).
-    #[arg(long)]
+    #[arg(long, value_parser = crate::flags::finite_f32)]
     fov: Option<f32>,
     /// Where the views are path traced: cpu, gpu (the same path tracer as a WGSL kernel on
     /// the best GPU adapter, a discrete one first; needs the `gpu` feature), wgpu (any

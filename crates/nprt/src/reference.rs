@@ -27,7 +27,7 @@ pub struct ReferenceArgs {
     #[arg(long)]
     envmap: Option<String>,
     /// Rotate the environment about +Y by this many degrees.
-    #[arg(long, default_value_t = 0.0)]
+    #[arg(long, value_parser = crate::flags::finite_f32, default_value_t = 0.0)]
     rotate: f32,
     /// Override the integrator's max_depth (Mitsuba's meaning; -1 is unlimited).
     #[arg(long, allow_negative_numbers = true)]

@@ -37,7 +37,7 @@ pub struct RenderArgs {
     #[arg(long, default_value_t = d().lighting)]
     lighting: String,
     /// Degrees each map of a comma-separated schedule turns about +Y over its segment.
-    #[arg(long, default_value_t = d().spin_deg)]
+    #[arg(long, value_parser = crate::flags::finite_f32, default_value_t = d().spin_deg)]
     spin: f32,
     /// Number of frames.
     #[arg(long, default_value_t = d().frames)]
@@ -49,7 +49,7 @@ pub struct RenderArgs {
     #[arg(long, default_value_t = d().fps)]
     fps: u32,
     /// Exposure of the PNG frames and animation, in stops.
-    #[arg(long, default_value_t = d().exposure, allow_hyphen_values = true)]
+    #[arg(long, value_parser = crate::flags::finite_f32, default_value_t = d().exposure, allow_hyphen_values = true)]
     exposure: f32,
     /// Also write each frame's linear radiance as OpenEXR.
     #[arg(long)]

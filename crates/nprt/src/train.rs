@@ -46,7 +46,7 @@ pub struct TrainArgs {
     /// Adam's (peak) learning rate [default with --schedule cosine: 5e-4 for prt, albedo and
     /// dsep, 3e-4 for baseline, measured on demo-sized data (docs/model.md); with --schedule
     /// paper, the paper's 1e-4].
-    #[arg(long)]
+    #[arg(long, value_parser = crate::flags::finite_f64)]
     lr: Option<f64>,
     /// Seed of the initial weights and of the batch order.
     #[arg(long, default_value_t = d().schedule.seed)]
@@ -101,7 +101,7 @@ pub struct TrainArgs {
     /// Minutes between checkpoints within an epoch. An epoch's end writes one once these
     /// minutes or 10 seconds have passed since the last (0: at every epoch's end); the run's
     /// end always does.
-    #[arg(long, default_value_t = d().schedule.checkpoint_secs / 60.0)]
+    #[arg(long, value_parser = crate::flags::finite_f64, default_value_t = d().schedule.checkpoint_secs / 60.0)]
     checkpoint_minutes: f64,
     /// On the GPU kernels (--device gpu or wgpu), where batches are gathered: device (the
     /// dataset's records, 40 bytes a pixel, and maps are uploaded once, and each step gathers

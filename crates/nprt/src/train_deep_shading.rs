@@ -32,7 +32,7 @@ pub struct DeepShadingArgs {
     batch_views: usize,
     /// Adam learning rate (1e-3 was measured to kill this ReLU U-Net: every activation dead,
     /// the output a constant).
-    #[arg(long, default_value_t = d().schedule.learning_rate)]
+    #[arg(long, value_parser = crate::flags::finite_f64, default_value_t = d().schedule.learning_rate)]
     lr: f64,
     /// Seed of the initial weights and of the batch order.
     #[arg(long, default_value_t = d().schedule.seed)]

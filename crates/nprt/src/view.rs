@@ -29,10 +29,10 @@ pub struct ViewArgs {
     #[arg(long, default_value_t = 4)]
     direct_spp: u32,
     /// Exposure in stops (+ and - change it).
-    #[arg(long, default_value_t = 0.0, allow_hyphen_values = true)]
+    #[arg(long, value_parser = crate::flags::finite_f32, default_value_t = 0.0, allow_hyphen_values = true)]
     exposure: f32,
     /// Degrees the map turns about +Y every frame (0: the view changes only with input).
-    #[arg(long, default_value_t = 0.0, allow_hyphen_values = true)]
+    #[arg(long, value_parser = crate::flags::finite_f32, default_value_t = 0.0, allow_hyphen_values = true)]
     spin: f32,
     /// Start with the progressive path-traced reference of the view (R toggles it).
     #[arg(long)]

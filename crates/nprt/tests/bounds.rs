@@ -323,3 +323,42 @@ fn reflectances_outside_the_unit_range_are_clamped_with_a_warning() {
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stdout));
     std::fs::remove_dir_all(&dir).ok();
 }
+
+/// Every flag that takes a number refuses NaN and infinity by name, as clap's own float
+/// parsers do not (a NaN turn made an all-NaN frame, an infinite learning rate a NaN model).
+#[test]
+fn number_flags_refuse_nan_and_infinity() {
+    #[rustfmt::skip]
+    let cases: [&[&str]; 6] = [
+        &["reference", "builtin:room", "--out", "x.exr", "--rotate", "nan"],
+        &["generate", "--scene", "builtin:room", "--envmaps", "builtin", "--out", "d", "--jitter-exposure", "inf"],
+        &["generate", "--scene", "builtin:room", "--envmaps", "builtin", "--out", "d", "--look", "0,nan,1"],
+        &["train", "--data", "d", "--arch", "dsep", "--out", "m", "--lr", "NaN"],
+        &["render", "--model", "m", "--out", "o", "--spin=-inf"],
+        &["train", "--data", "d", "--arch", "dsep", "--out", "m", "--minutes", "inf"],
+    ];
+    for args in cases {
+        let o = nprt(args);
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(o.status.code(), Some(2), "{args:?}: {err}");
+        assert!(err.contains("finite"), "{args:?}: {err}");
+    }
+}
+
+/// `nprt train --out` naming the dataset folder is refused before any model file is written
+/// there (the training pack, the dataset's own, may be made first).
+#[test]
+fn a_model_is_not_written_into_its_dataset() {
+    let dir = fresh_dir("bounds-model-into-data");
+    let data = dir.join("data");
+    common::room_dataset(&data, [4, 1], 8, 2);
+    let d = data.to_str().unwrap();
+    fails(
+        &["train", "--data", d, "--arch", "baseline", "--epochs", "1", "--out", d],
+        &["is a dataset folder"],
+    );
+    for model_file in ["model.json", "weights.safetensors", "checkpoint", "loss.csv", ".lock"] {
+        assert!(!data.join(model_file).exists(), "{model_file} written into the dataset");
+    }
+    std::fs::remove_dir_all(&dir).ok();
+}

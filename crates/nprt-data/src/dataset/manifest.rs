@@ -400,7 +400,7 @@ impl Settings {
         keys.into_iter()
             .filter_map(|k| {
                 let (x, y) = (a.get(k).unwrap_or(&null), b.get(k).unwrap_or(&null));
-                (x != y).then(|| format!("{k} ({x} here, {y} asked)"))
+                (x != y).then(|| format!("{k} ({} here, {} asked)", brief(x), brief(y)))
             })
             .collect()
     }
@@ -500,3 +500,15 @@ pub fn check_bounds(bounds: &[[f32; 3]; 2]) -> Result<()> {
     }
     Ok(())
 }
+
+/// A setting's value short enough for a message: a list of maps (thousands of characters of
+/// names and hashes) by its length, anything else long cut.
+fn brief(v: &serde_json::Value) -> String {
+    let text = v.to_string();
+    match v {
+        _ if text.chars().count() <= 80 => text,
+        serde_json::Value::Array(items) => format!("{} entries", items.len()),
+        _ => format!("{}…", text.chars().take(77).collect::<String>()),
+    }
+}
+

@@ -66,16 +66,16 @@ fn recurrence(bands: usize, d: Vec3, out: &mut [f32]) {
             q[l][m] = ((2 * l - 1) as f64 * z * q[l - 1][m] - (l + m - 1) as f64 * q[l - 2][m])
                 / (l - m) as f64;
         }
-        for l in m..bands {
+        for (l, q_l) in q.iter().enumerate().take(bands).skip(m) {
             let ratio: f64 = (l - m + 1..=l + m).map(|k| 1.0 / k as f64).product();
             let mut norm = ((2 * l + 1) as f64 / (4.0 * std::f64::consts::PI) * ratio).sqrt();
             if m > 0 {
                 norm *= std::f64::consts::SQRT_2;
             }
             let at = l * l + l;
-            out[at + m] = (norm * q[l][m] * power.0) as f32;
+            out[at + m] = (norm * q_l[m] * power.0) as f32;
             if m > 0 {
-                out[at - m] = (norm * q[l][m] * power.1) as f32;
+                out[at - m] = (norm * q_l[m] * power.1) as f32;
             }
         }
         power = (power.0 * x - power.1 * y, power.0 * y + power.1 * x);

@@ -14,7 +14,8 @@ pub struct LossRow {
     pub epoch: f64,
     pub samples: u64,
     pub seconds: f64,
-    /// Mean training loss since the previous row.
+    /// Mean training loss since the previous row (at an epoch's end that follows a row
+    /// directly, that row's).
     pub train: Option<f64>,
     /// Validation loss (at epoch ends).
     pub val: Option<f64>,

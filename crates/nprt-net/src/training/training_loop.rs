@@ -155,6 +155,14 @@ pub fn train<O: Objective>(
     watch: Watch,
 ) -> Result<TrainSummary> {
     schedule.check()?;
+    if out.join(nprt_data::dataset::MANIFEST).exists() {
+        bail!(
+            "'{}' is a dataset folder (it holds {}); a model goes into a folder of its own \
+             (--out)",
+            out.display(),
+            nprt_data::dataset::MANIFEST
+        );
+    }
     let mut net = objective.build(&mut Init::new(schedule.seed));
     std::fs::create_dir_all(checkpoint::dir(out))
         .with_context(|| format!("cannot create model folder '{}'", out.display()))?;
@@ -502,12 +510,18 @@ impl<'s, O: Objective> Run<'s, O> {
             s.epoch += 1;
             s.batch = 0;
         }
+        // The steps since the previous row; where a row closed them just before, that row's
+        // figure: an epoch's row always says its training loss (Python's callback gets it).
+        let train = match self.row_n {
+            0 => self.ck.history.last().and_then(|r| r.train),
+            n => Some(self.row_sum / n as f64),
+        };
         self.ck.history.push(LossRow {
             step: s.step,
             epoch: s.epoch as f64 + s.batch as f64 / total.max(1) as f64,
             samples: s.samples,
             seconds: s.seconds,
-            train: (self.row_n > 0).then(|| self.row_sum / self.row_n as f64),
+            train,
             val: Some(val),
         });
         (self.row_sum, self.row_n) = (0.0, 0);
