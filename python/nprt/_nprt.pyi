@@ -162,9 +162,11 @@ def train(
     progress: bool = True,
     callback: Optional[Callable[[Dict[str, Any]], Optional[bool]]] = None,
     basis: Optional[str] = None,
+    snapshots: Optional[str] = None,
 ) -> Dict[str, Any]:
     """`nprt train`; None takes its default (``basis``: the linear design's ``"sh:L"`` or
-    ``"learned:K"``). ``callback`` gets each epoch's row of the loss
+    ``"learned:K"``; ``snapshots``: points such as ``"1m,2m,4m"`` at which the model is kept
+    in ``out``/snapshots/POINT). ``callback`` gets each epoch's row of the loss
     curves; returning a false value other than None (False, 0, numpy's False_), or Ctrl-C,
     ends the run there, saved, and the same call resumes it."""
 

@@ -7,6 +7,7 @@ use std::sync::Mutex;
 
 use nprt_net::deep_shading::{self, DeepShadingOptions};
 use nprt_net::training::loss_curves::LossRow;
+use nprt_net::training::snapshot::Snapshot;
 use nprt_net::training::training_set::TrainingSet;
 use nprt_net::{ModelConfig, RunLength, TrainOptions, TrainSummary};
 use pyo3::prelude::*;
@@ -23,6 +24,10 @@ use crate::error::OrPy;
 /// the run: `epochs`, `steps`, `samples_per_s`, `train_loss`, `validation_loss`, `seconds`,
 /// `steps_on` and `resumed_from_epoch`; the loss curves are in `out`/loss.csv.
 ///
+/// `snapshots` keeps the model at points of the run (`"1m,2m,4m"`: minutes of training time
+/// as `Nm`, epochs as `N`), each a model folder in `out`/snapshots/POINT (`nprt train
+/// --snapshots`).
+///
 /// `basis` is the linear design's light basis, `"sh:L"` or `"learned:K"` (`nprt train
 /// --basis`; only for `arch="linear"`).
 ///
@@ -37,7 +42,7 @@ use crate::error::OrPy;
 #[pyo3(signature = (
     data, arch, out, *, minutes = None, epochs = None, activation = None, device = "cpu",
     precision = None, batch_size = None, lr = None, schedule = None, seed = None,
-    progress = true, callback = None, basis = None
+    progress = true, callback = None, basis = None, snapshots = None
 ))]
 #[allow(clippy::too_many_arguments)]
 pub fn train<'py>(
@@ -57,6 +62,7 @@ pub fn train<'py>(
     progress: bool,
     callback: Option<Py<PyAny>>,
     basis: Option<&str>,
+    snapshots: Option<&str>,
 ) -> PyResult<Bound<'py, PyDict>> {
     let design = parse(arch)?;
     let mut config = ModelConfig::new(design, activation.map(parse).transpose()?);
@@ -73,6 +79,9 @@ pub fn train<'py>(
         schedule: nprt_net::Schedule {
             seed: seed.unwrap_or(d.schedule.seed),
             progress,
+            snapshots: (snapshots.map(Snapshot::parse_list).transpose())
+                .map_err(|e| crate::error::input_error(format!("snapshots: {e}")))?
+                .unwrap_or_default(),
             ..d.schedule
         },
         batch_size: batch_size.unwrap_or(d.batch_size),

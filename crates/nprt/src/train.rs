@@ -4,6 +4,7 @@ use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result};
 use nprt_net::network::encoder::check_input_width;
+use nprt_net::training::snapshot::Snapshot;
 use nprt_net::training::training_set::{TrainingSet, ViewSamples};
 use nprt_net::{
     Activation, BasisChoice, Calibration, Design, DirectLight, Engine, Gather, Loss, MapNorm,
@@ -51,6 +52,13 @@ pub struct TrainArgs {
     /// Seed of the initial weights and of the batch order.
     #[arg(long, default_value_t = d().schedule.seed)]
     seed: u64,
+    /// Keep the model at these points of the run, each in OUT/snapshots/POINT/ (weights and
+    /// config, no optimiser state): minutes of training time as Nm, epochs as N,
+    /// comma-separated (e.g. 1m,2m,4m,8m,16m). A resumed run keeps those it has; a point
+    /// passed before without being kept is not kept later. `nprt paper --snapshots` measures
+    /// them.
+    #[arg(long, value_name = "LIST")]
+    snapshots: Option<String>,
     /// Views whose pixels are mixed in each batch, each lit by its own rotated map.
     #[arg(long, default_value_t = d().views_per_batch)]
     views_per_batch: usize,
@@ -146,6 +154,11 @@ impl TryFrom<TrainArgs> for TrainJob {
             schedule: nprt_net::Schedule {
                 seed: a.seed,
                 checkpoint_secs: a.checkpoint_minutes * 60.0,
+                snapshots: (a.snapshots.as_deref())
+                    .map(Snapshot::parse_list)
+                    .transpose()
+                    .map_err(|e| anyhow::anyhow!("--snapshots: {e}"))?
+                    .unwrap_or_default(),
                 ..d().schedule
             },
             batch_size: a.batch_size,

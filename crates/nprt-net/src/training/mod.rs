@@ -16,6 +16,7 @@ pub mod lr_schedule;
 pub mod nprt_objective;
 pub mod run_length;
 pub mod schedule;
+pub mod snapshot;
 pub mod train_options;
 pub mod training_loop;
 pub mod training_set;

@@ -5,6 +5,7 @@ use anyhow::{bail, Result};
 use serde::{Deserialize, Serialize};
 
 use crate::training::lr_schedule::LrSchedule;
+use crate::training::snapshot::Snapshot;
 
 /// The loop's own settings, shared by every network.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -29,6 +30,10 @@ pub struct Schedule {
     pub checkpoint_secs: f64,
     #[serde(skip)]
     pub progress: bool,
+    /// Points at which the run keeps its model (`--snapshots`); they change nothing of the run
+    /// itself, so a run resumes with other ones.
+    #[serde(skip)]
+    pub snapshots: Vec<Snapshot>,
 }
 
 impl Default for Schedule {
@@ -42,6 +47,7 @@ impl Default for Schedule {
             seed: 0,
             checkpoint_secs: 300.0,
             progress: true,
+            snapshots: Vec::new(),
         }
     }
 }

@@ -24,6 +24,7 @@ use crate::parameters::Parameters;
 use crate::training::checkpoint::{self, Checkpoint, RunState};
 use crate::training::loss_curves::{self as curves, LossRow};
 use crate::training::schedule::Schedule;
+use crate::training::snapshot::SnapshotPlan;
 
 /// Training-loss rows per epoch in loss.csv.
 const TRAIN_ROWS_PER_EPOCH: u64 = 20;
@@ -188,6 +189,7 @@ pub fn train<O: Objective>(
             return Err(run.diverged(&format!("validation loss {val}"), run.ck.state.epoch));
         }
         run.end_epoch(val, total);
+        run.take_snapshots(&net)?;
         go_on = watch(run.ck.history.last().expect("an epoch's end adds a row"));
         let finished = !go_on || run.ck.state.epoch >= schedule.epochs || run.out_of_time();
         let since_saved = run.last_checkpoint.elapsed().as_secs_f64();
@@ -263,6 +265,7 @@ struct Run<'s, O: Objective> {
     guard: DivergenceGuard,
     split: TimeSplit,
     steps_on: String,
+    snapshots: SnapshotPlan,
 }
 
 impl<'s, O: Objective> Run<'s, O> {
@@ -308,6 +311,12 @@ impl<'s, O: Objective> Run<'s, O> {
             guard: DivergenceGuard::default(),
             split: TimeSplit::default(),
             steps_on: String::new(),
+            snapshots: SnapshotPlan::new(
+                &schedule.snapshots,
+                out,
+                ck.state.seconds,
+                ck.state.epoch,
+            ),
             ck,
         }
     }
@@ -365,6 +374,11 @@ impl<'s, O: Objective> Run<'s, O> {
                 self.split.steps += since(stepping);
                 if let Some((value, samples)) = done {
                     self.record_step(value, samples, epoch, total, row_every)?;
+                }
+                if self.snapshots.due(self.ck.state.seconds, epoch) {
+                    self.settle(steps, epoch, total, row_every)?;
+                    steps.store(net);
+                    self.take_snapshots(net)?;
                 }
                 if self.out_of_time() {
                     break;
@@ -538,6 +552,17 @@ impl<'s, O: Objective> Run<'s, O> {
                 )
             });
         }
+    }
+
+    /// Keeps `net` (up to date) at every snapshot point reached.
+    fn take_snapshots(&mut self, net: &O::Net) -> Result<()> {
+        let (objective, schedule, out, state) = (self.objective, self.schedule, self.out, &self.ck.state);
+        let saving = Instant::now();
+        (self.snapshots).take(out, state.seconds, state.epoch, |dir| {
+            objective.save_model(dir, net, schedule, state)
+        })?;
+        self.split.saving += since(saving);
+        Ok(())
     }
 
     /// Writes the checkpoint, the model files and the loss curves.
