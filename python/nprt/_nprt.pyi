@@ -200,6 +200,7 @@ def paper(
     test_maps: Optional[int] = None,
     seed: int = 0,
     device: str = "cpu",
+    snapshots: Optional[str] = None,
 ) -> Dict[str, Any]:
     """`nprt paper`: the paper's Tables 1-6 at ``budget`` ("tiny", "small", "medium", "paper"),
     resumable; returns ``paper_md``, ``paper_html``, ``report_html``, ``results`` (results.json)

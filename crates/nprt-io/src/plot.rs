@@ -40,6 +40,12 @@ const PALETTE: [RGBColor; 16] = [
     RGBColor(197, 176, 213),
 ];
 
+/// `v` to two significant digits.
+fn round_to_2_digits(v: f64) -> f64 {
+    let scale = 10f64.powi(1 - v.abs().log10().floor() as i32);
+    (v * scale).round() / scale
+}
+
 /// Named series as lines with markers on a log-scaled y axis, as a PNG.
 pub fn plot_lines(
     path: &Path,
@@ -64,8 +70,13 @@ pub fn plot_lines(
         (1e-3, 1.0)
     };
     let xs = || series.iter().flat_map(|s| s.1.iter().map(|p| p.0));
+    // From 0 for positive x (epochs, frames), from the least for negative x (a log of time).
     let x_min = xs().fold(0.0, f64::min);
-    let x_max = xs().fold(1e-3, f64::max);
+    let x_max = xs().fold(f64::NEG_INFINITY, f64::max).max(x_min + 1e-3);
+    // Ticks where the log axis's own (powers of ten) would leave a narrow range unlabelled.
+    let ticks: Vec<f64> = (0..=5)
+        .map(|i| round_to_2_digits(lo * (hi / lo).powf(i as f64 / 5.0)))
+        .collect();
     {
         let root = BitMapBackend::with_buffer(&mut buf, (w, h)).into_drawing_area();
         let err = |e: DrawingAreaErrorKind<_>| anyhow!("cannot draw plot '{title}': {e:?}");
@@ -75,7 +86,7 @@ pub fn plot_lines(
             .margin(12)
             .x_label_area_size(40)
             .y_label_area_size(70)
-            .build_cartesian_2d(x_min..x_max, (lo..hi).log_scale())
+            .build_cartesian_2d(x_min..x_max, (lo..hi).log_scale().with_key_points(ticks))
             .map_err(err)?;
         chart
             .configure_mesh()

@@ -5,6 +5,7 @@ use std::path::{Path, PathBuf};
 
 use anyhow::{bail, Result};
 use nprt_data::{CameraChoice, GenerateOptions};
+use nprt_net::training::snapshot::Snapshot;
 use nprt_net::{BasisChoice, Design, DirectLight, Engine, ModelConfig};
 
 use crate::budget::{Budget, DEMO, TINY};
@@ -31,6 +32,9 @@ pub struct Experiment {
     /// Also relight a camera path under the held-out maps with the last design.
     pub relight: bool,
     pub engine: Engine,
+    /// Points at which the paper's four designs keep their models as they train, each scored
+    /// on the test views and judged by the paper's orderings (`--snapshots`).
+    pub snapshots: Vec<Snapshot>,
 }
 
 /// The design beyond the paper that `nprt paper` and `nprt demo` set beside D/S in Table 6:
@@ -67,6 +71,7 @@ impl Experiment {
             paper_tables: true,
             relight: false,
             engine,
+            snapshots: Vec::new(),
         }
     }
 
@@ -95,6 +100,12 @@ impl Experiment {
                 engine,
             )
         }
+    }
+
+    /// The models that keep snapshots: the paper's four designs with their own settings.
+    pub fn snapshot_configs(&self) -> Vec<ModelConfig> {
+        let paper = Design::PAPER.map(|d| ModelConfig::new(d, None));
+        self.designs.iter().filter(|c| paper.contains(c)).cloned().collect()
     }
 
     /// Every Neural PRT model to train: the designs, then the ablation's runs not among them.

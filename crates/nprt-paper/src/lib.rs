@@ -8,6 +8,7 @@
 
 pub mod budget;
 mod experiment;
+mod growth_report;
 pub mod orderings;
 mod paper_figures;
 mod paper_report;

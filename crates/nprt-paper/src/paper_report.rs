@@ -17,14 +17,16 @@ use nprt_net::{Design, ModelConfig};
 use crate::experiment::{beyond_the_paper, Experiment};
 use crate::orderings::{self, ablation_configs, test_view_competitors, Ordering};
 use crate::paper_figures::{self, design_row, over_views};
+use crate::growth_report;
 use crate::published;
+use crate::readback::GrowthPoint;
 
 /// Writes paper.md and paper.html into `dir` (the evaluation's report folder, whose images the
 /// crops are); returns their paths.
 pub fn write_paper_report(
     x: &Experiment,
     e: &Evaluation,
-    ablation: &[MethodResult],
+    (ablation, growth): (&[MethodResult], &[GrowthPoint]),
     times: &[(String, f64)],
     dir: &Path,
 ) -> Result<(PathBuf, PathBuf)> {
@@ -33,6 +35,9 @@ pub fn write_paper_report(
     header(&mut md, x, e)?;
     md += &stage_table(times)?;
     md += &report_tables(e, ablation, kitchen)?;
+    if !x.snapshots.is_empty() {
+        growth_report::as_training_grows(&mut md, e, growth, kitchen, dir)?;
+    }
     crops(&mut md, e, dir)?;
     curves(&mut md, ablation, dir)?;
     writeln!(

@@ -92,10 +92,21 @@ impl Experiment {
             let (rows, worked) = stages::ablation(self, &opts, &report.join("table2.json"))?;
             log.end(worked)?;
             ablation = rows;
+            let mut growth = Vec::new();
+            if !self.snapshots.is_empty() {
+                log.begin(
+                    "snapshots",
+                    "scoring the four designs as kept at each snapshot point",
+                );
+                let (points, worked) =
+                    stages::snapshots(self, &data, &report.join("snapshots.json"))?;
+                log.end(worked)?;
+                growth = points;
+            }
             paper = Some(write_paper_report(
                 self,
                 &evaluation,
-                &ablation,
+                (&ablation, &growth),
                 &log.times,
                 &report,
             )?);

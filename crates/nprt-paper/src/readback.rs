@@ -1,5 +1,5 @@
 //! What `nprt paper` reads back from its own folder (experiment.json, stage-times.json,
-//! report/results.json, report/table2.json), checked as input: a file edited, truncated or left
+//! report/results.json, report/table2.json, report/snapshots.json), checked as input: a file edited, truncated or left
 //! by another run is refused (and its stage redone), never printed as NaN or as a time no run
 //! takes. Public for the fuzz targets (fuzz/), which hold every file these accept to a report
 //! without NaN or infinity.
@@ -79,6 +79,39 @@ pub fn ablation(bytes: &[u8], file: &Path) -> Result<Ablation> {
         bail!("'{}': run '{}' lacks figures", file.display(), m.name);
     }
     Ok(a)
+}
+
+/// The paper's designs as kept at one snapshot point of their training, scored on the test
+/// views (snapshots.json keeps one per point).
+#[derive(Clone, Serialize, Deserialize)]
+pub struct GrowthPoint {
+    /// The point as `--snapshots` names it (`4m`, `10`).
+    pub point: String,
+    /// The key of the scoring's inputs (the snapshots' files among them).
+    pub key: String,
+    /// The designs' mean training time at the point, minutes.
+    pub minutes: f64,
+    pub rows: Vec<MethodResult>,
+}
+
+/// The snapshot points snapshots.json (`file`) holds, where each has a finite, non-negative
+/// training time and every row a finite figure per view.
+pub fn growth(bytes: &[u8], file: &Path) -> Result<Vec<GrowthPoint>> {
+    let points: Vec<GrowthPoint> = serde_json::from_slice(bytes)
+        .with_context(|| format!("'{}' is not what this run wrote", file.display()))?;
+    for p in &points {
+        ensure!(
+            p.minutes.is_finite() && p.minutes >= 0.0,
+            "'{}': point {} says {} minutes",
+            file.display(),
+            p.point,
+            p.minutes
+        );
+        if let Some(m) = p.rows.iter().find(|m| !complete(m, None)) {
+            bail!("'{}': point {}'s '{}' lacks figures", file.display(), p.point, m.name);
+        }
+    }
+    Ok(points)
 }
 
 /// Whether `m` has a finite figure per view (`views` of them, where known).

@@ -15,7 +15,7 @@ use nprt_render::oidn::Oidn;
 use nprt_render::{RenderJob, RenderOptions};
 
 use crate::experiment::Experiment;
-use crate::readback::{self, Ablation};
+use crate::readback::{self, Ablation, GrowthPoint};
 
 /// Renders (or resumes) the dataset; whether any view was rendered.
 pub fn dataset(x: &Experiment, data: &Path) -> Result<bool> {
@@ -38,7 +38,11 @@ pub fn dataset(x: &Experiment, data: &Path) -> Result<bool> {
 /// Trains (or resumes, or finds finished) one Neural PRT model; whether it trained.
 pub fn train_model(x: &Experiment, data: &Path, config: &ModelConfig, out: &Path) -> Result<bool> {
     let set = TrainingSet::load(data, config, true, |why| eprintln!("{why}"))?;
-    let opts = TrainOptions::default().with_run(config.design, x.budget.training, None);
+    let mut opts = TrainOptions::default().with_run(config.design, x.budget.training, None);
+    // The paper's four designs keep their models as training grows (`--snapshots`).
+    if x.snapshot_configs().contains(config) {
+        opts.schedule.snapshots = x.snapshots.clone();
+    }
     let (s, _) = nprt_net::train(&set, config, &opts, out, x.engine, &|_| true)?;
     report_training(&config.label(), &s, out);
     Ok(s.split.steps > 0.0)
@@ -130,6 +134,55 @@ pub fn ablation(
     let scored = Ablation { key, rows };
     nprt_io::write_file(file, serde_json::to_vec_pretty(&scored)?)?;
     Ok((scored.rows, true))
+}
+
+/// The paper's four designs as kept at each snapshot point, scored on the test views, kept in
+/// `file` per point with the key of its inputs (a point whose models changed is scored again);
+/// whether any point was scored now. Points no design kept are left out.
+pub fn snapshots(x: &Experiment, data: &Path, file: &Path) -> Result<(Vec<GrowthPoint>, bool)> {
+    let kept: Vec<GrowthPoint> = read(file)
+        .and_then(|bytes| readback::growth(&bytes, file))
+        .unwrap_or_default();
+    let (mut points, mut worked) = (Vec::new(), false);
+    for point in &x.snapshots {
+        let dirs: Vec<PathBuf> = (x.snapshot_configs().iter())
+            .map(|c| point.dir(&x.model_dir(c)))
+            .filter(|d| d.join(WEIGHTS_FILE).is_file())
+            .collect();
+        if dirs.is_empty() {
+            continue;
+        }
+        let opts = eval_options(x, data, &dirs);
+        let key = inputs_key(x, &opts)?;
+        if let Some(p) = kept.iter().find(|p| p.key == key) {
+            points.push(p.clone());
+            continue;
+        }
+        let minutes = dirs
+            .iter()
+            .map(|d| training_seconds(d).map(|s| s / 60.0))
+            .sum::<Result<f64>>()?
+            / dirs.len() as f64;
+        let rows = score_networks(&opts, x.engine)?;
+        points.push(GrowthPoint {
+            point: point.to_string(),
+            key,
+            minutes,
+            rows,
+        });
+        worked = true;
+        nprt_io::write_file(file, serde_json::to_vec_pretty(&points)?)?;
+    }
+    Ok((points, worked))
+}
+
+/// The training time a model folder's model.json records, seconds.
+fn training_seconds(model: &Path) -> Result<f64> {
+    let file: nprt_net::model::folder::ModelFile = serde_json::from_slice(&read(&model.join(CONFIG_FILE))?)
+        .with_context(|| format!("'{}' is not a model's config", model.display()))?;
+    (file.training["seconds"].as_f64())
+        .filter(|s| s.is_finite() && *s >= 0.0)
+        .with_context(|| format!("'{}' records no training time", model.display()))
 }
 
 /// A camera path relit by `model` under the dataset's held-out maps, into `frames`.

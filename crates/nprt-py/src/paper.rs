@@ -3,6 +3,7 @@
 use std::path::PathBuf;
 
 use nprt_data::CameraChoice;
+use nprt_net::training::snapshot::Snapshot;
 use nprt_paper::{Budget, Experiment};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
@@ -14,12 +15,13 @@ use crate::error::OrPy;
 /// Runs the paper's tables on `scene` under `envmaps` at `budget` ("tiny", "small", "medium",
 /// "paper") into `out` (resuming what a run left there) and returns a dict: `paper_md`,
 /// `paper_html` and `report_html` (paths), `results` (the evaluation's results.json) and
-/// `orderings` (each ordering the paper states: table, statement, verdict). The GIL is
-/// released while it runs.
+/// `orderings` (each ordering the paper states: table, statement, verdict). `snapshots`
+/// (`"1m,2m,4m"`) keeps the four designs at points of their training and judges the orderings
+/// at each (`nprt paper --snapshots`). The GIL is released while it runs.
 #[pyfunction]
 #[pyo3(signature = (
     scene, envmaps, out, *, budget = "small", camera_volume = None, test_maps = None, seed = 0,
-    device = "cpu"
+    device = "cpu", snapshots = None
 ))]
 #[allow(clippy::too_many_arguments)]
 pub fn paper<'py>(
@@ -32,6 +34,7 @@ pub fn paper<'py>(
     test_maps: Option<usize>,
     seed: u64,
     device: &str,
+    snapshots: Option<&str>,
 ) -> PyResult<Bound<'py, PyDict>> {
     let scene = crate::argument::scene_spec(scene, "scene")?;
     let envmaps = crate::argument::text(
@@ -48,6 +51,9 @@ pub fn paper<'py>(
             ..CameraChoice::default()
         },
         test_maps,
+        snapshots: (snapshots.map(Snapshot::parse_list).transpose())
+            .map_err(|e| crate::error::input_error(format!("snapshots: {e}")))?
+            .unwrap_or_default(),
         seed,
         ..Experiment::paper(&scene, &envmaps, &out, budget, engine(device)?)
     };

@@ -5,6 +5,7 @@ use std::str::FromStr;
 
 use anyhow::{bail, Result};
 use clap::builder::{PossibleValuesParser, TypedValueParser};
+use nprt_net::training::snapshot::Snapshot;
 use nprt_net::{Compute, Design, Engine, LrSchedule, RunLength};
 
 /// `--arch`'s parser: the designs' names from `Design::ALL` as clap's possible values, which
@@ -104,6 +105,14 @@ pub fn parse_shard(s: &str) -> Result<(u64, u64), String> {
         return Err(bad());
     }
     Ok((k, n))
+}
+
+/// A `--snapshots` list (a type of its own: clap takes an `Option<Vec<_>>` for a repeated flag).
+#[derive(Clone)]
+pub struct Snapshots(pub Vec<Snapshot>);
+
+pub fn parse_snapshots(s: &str) -> Result<Snapshots, String> {
+    Snapshot::parse_list(s).map(Snapshots)
 }
 
 /// A finite number: clap's own parsers take "nan" and "inf", which no flag means.

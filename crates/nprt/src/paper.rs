@@ -7,7 +7,7 @@ use nprt_data::CameraChoice;
 use nprt_eval::claim::Verdict;
 use nprt_paper::{Budget, Experiment};
 
-use crate::flags::DeviceArg;
+use crate::flags::{parse_snapshots, DeviceArg, Snapshots};
 
 #[derive(clap::Args)]
 pub struct PaperArgs {
@@ -44,6 +44,13 @@ pub struct PaperArgs {
     /// after which `nprt paper` with the same flags finds it complete (docs/paper.md).
     #[arg(long)]
     generate_flags: bool,
+    /// Keep the paper's four designs at these points of their training (minutes of training
+    /// time as Nm, epochs as N, comma-separated: e.g. 1m,2m,4m,8m,16m, within the budget's
+    /// training) and judge the orderings of Tables 5 and 6 at each, with plots of RMSE and loss
+    /// against training time (docs/paper.md). Give it from the first run: a finished training
+    /// keeps no points it passed.
+    #[arg(long, value_name = "LIST", value_parser = parse_snapshots)]
+    snapshots: Option<Snapshots>,
     #[command(flatten)]
     device: DeviceArg,
 }
@@ -60,6 +67,7 @@ pub fn command(a: PaperArgs) -> Result<()> {
         },
         test_maps: a.test_maps,
         seed: a.seed,
+        snapshots: a.snapshots.map(|s| s.0).unwrap_or_default(),
         ..Experiment::paper(&a.scene, &a.envmaps, &a.out, a.budget, a.device.engine()?)
     };
     if a.generate_flags {

@@ -4,7 +4,6 @@ use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result};
 use nprt_net::network::encoder::check_input_width;
-use nprt_net::training::snapshot::Snapshot;
 use nprt_net::training::training_set::{TrainingSet, ViewSamples};
 use nprt_net::{
     Activation, BasisChoice, Calibration, Design, DirectLight, Engine, Gather, Loss, MapNorm,
@@ -12,7 +11,7 @@ use nprt_net::{
     DEFAULT_MAP_NORM,
 };
 
-use crate::flags::{design_names, DeviceArg, RunArgs};
+use crate::flags::{design_names, parse_snapshots, DeviceArg, RunArgs, Snapshots};
 
 /// The defaults every flag shows, from the one place that states them.
 fn d() -> TrainOptions {
@@ -57,8 +56,8 @@ pub struct TrainArgs {
     /// comma-separated (e.g. 1m,2m,4m,8m,16m). A resumed run keeps those it has; a point
     /// passed before without being kept is not kept later. `nprt paper --snapshots` measures
     /// them.
-    #[arg(long, value_name = "LIST")]
-    snapshots: Option<String>,
+    #[arg(long, value_name = "LIST", value_parser = parse_snapshots)]
+    snapshots: Option<Snapshots>,
     /// Views whose pixels are mixed in each batch, each lit by its own rotated map.
     #[arg(long, default_value_t = d().views_per_batch)]
     views_per_batch: usize,
@@ -154,11 +153,7 @@ impl TryFrom<TrainArgs> for TrainJob {
             schedule: nprt_net::Schedule {
                 seed: a.seed,
                 checkpoint_secs: a.checkpoint_minutes * 60.0,
-                snapshots: (a.snapshots.as_deref())
-                    .map(Snapshot::parse_list)
-                    .transpose()
-                    .map_err(|e| anyhow::anyhow!("--snapshots: {e}"))?
-                    .unwrap_or_default(),
+                snapshots: a.snapshots.map(|s| s.0).unwrap_or_default(),
                 ..d().schedule
             },
             batch_size: a.batch_size,

@@ -245,3 +245,53 @@ fn a_refused_run_claims_nothing_and_paths_must_be_utf8() {
     }
     std::fs::remove_dir_all(&dir).ok();
 }
+
+/// `--snapshots`: the four designs kept at each point of their training, scored, the orderings
+/// of Tables 5 and 6 judged at each point and plotted against training time; read back on a
+/// repeated run.
+#[test]
+fn orderings_are_judged_as_training_grows() {
+    let dir = fresh_dir("paper-snapshots");
+    let out = dir.to_str().unwrap();
+    #[rustfmt::skip]
+    let args = ["paper", "--budget", "tiny", "--out", out, "--device", "cpu", "--snapshots", "1,2,99"];
+    ok(&args);
+    let report = dir.join("report");
+    let md = std::fs::read_to_string(report.join("paper.md")).unwrap();
+    let section = &md[md.find("## The orderings as training grows").expect("the section")..];
+    for want in [
+        "| point | training min | nprt-baseline | nprt-prt | nprt-albedo | nprt-dsep |",
+        "| 1 | ",
+        "| 2 | ",
+        "| table | ordering | 1 | 2 | holds from |",
+        "| Table 5 | D/S is lowest of the four designs |",
+        "| Table 6 | D/S is ahead of sh-prt-9 on the test views |",
+        "images/growth-rmse.png",
+        "images/growth-loss.png",
+    ] {
+        assert!(section.contains(want), "lacks '{want}':\n{section}");
+    }
+    // A point the two-epoch budget never reaches is no row.
+    assert!(!section.contains("| 99 |"), "{section}");
+    for plot in ["growth-rmse.png", "growth-loss.png"] {
+        assert!(report.join("images").join(plot).is_file(), "{plot}");
+    }
+    // The last point's D/S is the final D/S (two epochs): its figures are the final row's.
+    let points: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(report.join("snapshots.json")).unwrap()).unwrap();
+    let results: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(report.join("results.json")).unwrap()).unwrap();
+    let ds = |rows: &serde_json::Value| {
+        rows.as_array()
+            .unwrap()
+            .iter()
+            .find(|m| m["name"] == "nprt-dsep")
+            .unwrap()["per_view"]
+            .clone()
+    };
+    assert_eq!(ds(&points[1]["rows"]), ds(&results["methods"]));
+    let again = ok(&args);
+    assert!(again.contains("its inputs are unchanged"), "{again}");
+    assert_eq!(std::fs::read_to_string(report.join("paper.md")).unwrap(), md);
+    std::fs::remove_dir_all(&dir).ok();
+}

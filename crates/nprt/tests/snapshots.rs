@@ -53,7 +53,7 @@ fn snapshots_are_the_models_of_their_points() {
     for bad in ["0m", "1,1", "1.5", "soon"] {
         let o = nprt(&["train", "--data", "d", "--arch", "dsep", "--out", "m", "--snapshots", bad]);
         let err = String::from_utf8_lossy(&o.stderr);
-        assert_eq!(o.status.code(), Some(1), "{bad}: {err}");
+        assert_eq!(o.status.code(), Some(2), "{bad}: {err}");
         assert!(err.contains("--snapshots"), "{bad}: {err}");
     }
     std::fs::remove_dir_all(&dir).ok();
