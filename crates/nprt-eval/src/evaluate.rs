@@ -106,14 +106,13 @@ pub fn evaluate(o: &EvalOptions, engine: Engine) -> Result<Evaluation> {
         bar: nprt_io::progress_bar(o.progress, total_steps, "evaluating", "steps"),
     };
 
-    // A stop requested (nprt_io::interrupt) ends it between stages, before any result.
+    // A stop requested (nprt_io::interrupt) ends it between stages, before any result; the
+    // traced stages skip their remaining pixels meanwhile.
     let stop = nprt_io::interrupt::check;
     let mut results = run_networks(&mut bench, &nets, oidn.as_ref().ok().copied())?;
     stop()?;
     let pt5 = run_path_tracing(&mut bench, "pt-5spp", 5, 0x5eed_0005);
-    stop()?;
     let equal_time = run_equal_time(&mut bench, &tiers, &pt5, &mut results);
-    stop()?;
     let equal_time_spp = equal_time.iter().map(|(n, _)| *n).max().unwrap_or(5);
     let mut baselines = Vec::new();
     if let Ok(oidn) = &oidn {
@@ -121,9 +120,7 @@ pub fn evaluate(o: &EvalOptions, engine: Engine) -> Result<Evaluation> {
             baselines.push(run_denoised(&mut bench, oidn, base)?);
         }
     }
-    stop()?;
     baselines.extend(run_sh_prt(&mut bench, o.sh_spp));
-    stop()?;
     bench.bar.finish_and_clear();
     let oidn_ok = oidn.as_ref().ok().copied();
     let (traced, with) = ((&pt5, equal_time.as_slice()), (nets.as_slice(), engine));

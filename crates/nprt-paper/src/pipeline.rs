@@ -2,7 +2,7 @@
 //! Shading, the evaluation against every baseline, the paper's tables, a relit camera path), in
 //! one output folder that a repeated run resumes.
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 use anyhow::{bail, Context, Result};
 use nprt_eval::{Evaluation, MethodResult};
@@ -81,36 +81,10 @@ impl Experiment {
         let (evaluation, worked) = stages::evaluation(self, &opts, &report)?;
         log.end(worked)?;
 
-        let (mut ablation, mut paper) = (Vec::new(), None);
-        if self.paper_tables {
-            log.begin("table 2", "scoring Table 2's ablation on the test views");
-            let dirs: Vec<PathBuf> = ablation_configs()
-                .iter()
-                .map(|c| self.model_dir(c))
-                .collect();
-            let opts = stages::eval_options(self, &data, &dirs);
-            let (rows, worked) = stages::ablation(self, &opts, &report.join("table2.json"))?;
-            log.end(worked)?;
-            ablation = rows;
-            let mut growth = Vec::new();
-            if !self.snapshots.is_empty() {
-                log.begin(
-                    "snapshots",
-                    "scoring the four designs as kept at each snapshot point",
-                );
-                let (points, worked) =
-                    stages::snapshots(self, &data, &report.join("snapshots.json"))?;
-                log.end(worked)?;
-                growth = points;
-            }
-            paper = Some(write_paper_report(
-                self,
-                &evaluation,
-                (&ablation, &growth),
-                &log.times,
-                &report,
-            )?);
-        }
+        let (ablation, paper) = match self.paper_tables {
+            true => self.paper_tables(&mut log, &data, &report, &evaluation)?,
+            false => (Vec::new(), None),
+        };
         let mut relit = None;
         if self.relight {
             log.begin(
@@ -134,6 +108,37 @@ impl Experiment {
             relit,
             seconds: log.elapsed(),
         })
+    }
+
+    /// Table 2's ablation scored, the snapshots scored (`--snapshots`), and the paper's tables
+    /// written into `report` beside the evaluation `e`.
+    fn paper_tables(
+        &self,
+        log: &mut StageLog,
+        data: &Path,
+        report: &Path,
+        e: &Evaluation,
+    ) -> Result<(Vec<MethodResult>, Option<(PathBuf, PathBuf)>)> {
+        log.begin("table 2", "scoring Table 2's ablation on the test views");
+        let dirs: Vec<PathBuf> = ablation_configs()
+            .iter()
+            .map(|c| self.model_dir(c))
+            .collect();
+        let opts = stages::eval_options(self, data, &dirs);
+        let (ablation, worked) = stages::ablation(self, &opts, &report.join("table2.json"))?;
+        log.end(worked)?;
+        let mut growth = Vec::new();
+        if !self.snapshots.is_empty() {
+            log.begin(
+                "snapshots",
+                "scoring the four designs as kept at each snapshot point",
+            );
+            let (points, worked) = stages::snapshots(self, data, &report.join("snapshots.json"))?;
+            log.end(worked)?;
+            growth = points;
+        }
+        let paper = write_paper_report(self, e, (&ablation, &growth), &log.times, report)?;
+        Ok((ablation, Some(paper)))
     }
 
     /// What the output folder is for, recorded by its first run once its settings hold: a

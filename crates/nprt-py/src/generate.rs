@@ -59,7 +59,7 @@ pub fn generate<'py>(
     let (fin, fin3) = (argument::finite_or_none, finite_vec3);
     let d = GenerateOptions::default();
     let opts = GenerateOptions {
-        scene: argument::scene_spec(scene, "scene")?,
+        scene: crate::scene::scene_spec(scene, "scene")?,
         envmaps: argument::text(envmaps, "envmaps", "a folder of maps (a str or an os.PathLike) or \"builtin\"")?,
         out,
         train_views: train_views.unwrap_or(d.train_views),

@@ -12,7 +12,7 @@ use crate::argument;
 use crate::arrays;
 use crate::choice::engine;
 use crate::error::OrPy;
-use crate::scene::Scene;
+use crate::scene::{envmap_arg, scene_arg, Scene};
 
 /// A model folder `nprt train` wrote, ready to relight frames on `device`.
 #[pyclass(frozen, module = "nprt")]
@@ -98,8 +98,8 @@ impl Model {
         let (width, height) = arrays::frame_size(width, height)?;
         let camera = arrays::camera(camera, fov, width, height).or_py()?;
         let rotation = argument::finite(rotation, "rotation")?;
-        let scene = argument::scene(scene, "scene")?;
-        let envmap = argument::envmap(envmap, "envmap")?;
+        let scene = scene_arg(scene, "scene")?;
+        let envmap = envmap_arg(envmap, "envmap")?;
         let scene = scene.get();
         self.warn_if_foreign(py, scene)?;
         let sampling = DirectSampling {

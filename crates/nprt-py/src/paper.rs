@@ -36,7 +36,7 @@ pub fn paper<'py>(
     device: &str,
     snapshots: Option<&str>,
 ) -> PyResult<Bound<'py, PyDict>> {
-    let scene = crate::argument::scene_spec(scene, "scene")?;
+    let scene = crate::scene::scene_spec(scene, "scene")?;
     let envmaps = crate::argument::text(
         envmaps,
         "envmaps",

@@ -7,7 +7,7 @@ use nprt_render::{RenderJob, RenderOptions};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
-use crate::argument::{self, finite_or_none};
+use crate::argument::finite_or_none;
 use crate::choice::{engine, parse};
 use crate::interruptible::interruptible;
 
@@ -46,7 +46,7 @@ pub fn render<'py>(
     let opts = RenderOptions {
         model,
         out,
-        scene: scene.map(|s| argument::scene_spec(s, "scene")).transpose()?,
+        scene: scene.map(|s| crate::scene::scene_spec(s, "scene")).transpose()?,
         camera_path,
         camera_volume,
         lighting: lighting.unwrap_or(d.lighting),

@@ -256,8 +256,8 @@ pub fn reference<'py>(
     if spp == 0 {
         return Err(input_error("spp (samples per pixel) must be at least 1"));
     }
-    let scene = argument::scene(scene, "scene")?;
-    let envmap = argument::envmap(envmap, "envmap")?;
+    let scene = scene_arg(scene, "scene")?;
+    let envmap = envmap_arg(envmap, "envmap")?;
     let scene = scene.get();
     let settings = RenderSettings {
         spp,
@@ -275,4 +275,34 @@ pub fn reference<'py>(
         width as usize,
         height as usize,
     ))
+}
+
+const SCENE: &str = "an nprt.Scene, a str or an os.PathLike (a scene file or builtin:room)";
+const MAP: &str =
+    "an nprt.EnvMap, a str or an os.PathLike (an .exr/.hdr file or a builtin: map)";
+
+/// The scene `obj` is or names (`builtin:room`, a file), loaded where it is named.
+pub fn scene_arg<'py>(obj: &Bound<'py, PyAny>, arg: &str) -> PyResult<Bound<'py, Scene>> {
+    if let Ok(s) = obj.cast::<Scene>() {
+        return Ok(s.clone());
+    }
+    let spec = argument::text(obj, arg, SCENE)?;
+    Bound::new(obj.py(), load(obj.py(), &spec)?)
+}
+
+/// What `obj` names as a scene, to hand a command: a loaded scene's own spec.
+pub fn scene_spec(obj: &Bound<'_, PyAny>, arg: &str) -> PyResult<String> {
+    match obj.cast::<Scene>() {
+        Ok(s) => Ok(s.get().spec.clone()),
+        Err(_) => argument::text(obj, arg, SCENE),
+    }
+}
+
+/// The map `obj` is or names, opened where it is named.
+pub fn envmap_arg<'py>(obj: &Bound<'py, PyAny>, arg: &str) -> PyResult<Bound<'py, EnvMap>> {
+    if let Ok(m) = obj.cast::<EnvMap>() {
+        return Ok(m.clone());
+    }
+    let spec = argument::text(obj, arg, MAP)?;
+    Bound::new(obj.py(), open(obj.py(), &spec)?)
 }
