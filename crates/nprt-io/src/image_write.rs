@@ -36,7 +36,10 @@ pub fn write_linear_rgb(
             crate::exr::write_channels(path, width, height, &channels)
         }
         "hdr" => {
-            if let Some(i) = rgb.iter().position(|v| !v.is_finite() || v.min_element() < 0.0) {
+            if let Some(i) = rgb
+                .iter()
+                .position(|v| !v.is_finite() || v.min_element() < 0.0)
+            {
                 bail!(
                     "refusing to write '{}': pixel ({}, {}) is {}, which Radiance HDR cannot hold",
                     path.display(),
@@ -50,7 +53,8 @@ pub fn write_linear_rgb(
                 bail!("a {width}×{height} image is too large for Radiance HDR");
             };
             write_atomically(path, |tmp| {
-                Ok(image::DynamicImage::ImageRgb32F(img).save_with_format(tmp, image::ImageFormat::Hdr)?)
+                Ok(image::DynamicImage::ImageRgb32F(img)
+                    .save_with_format(tmp, image::ImageFormat::Hdr)?)
             })
         }
         _ => bail!(
@@ -87,7 +91,10 @@ mod tests {
         let mut bad = rgb.clone();
         bad[5] = Vec3::splat(f32::NAN);
         for name in ["b.exr", "b.hdr", "b.png"] {
-            assert!(write_linear_rgb(&dir.join(name), &bad, 4, 3, 0.0).is_err(), "{name}");
+            assert!(
+                write_linear_rgb(&dir.join(name), &bad, 4, 3, 0.0).is_err(),
+                "{name}"
+            );
             assert!(!dir.join(name).exists(), "{name}");
         }
         std::fs::remove_dir_all(dir).ok();

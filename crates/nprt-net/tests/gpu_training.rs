@@ -33,7 +33,10 @@ fn network(config: &ModelConfig) -> NprtNet {
 /// The variants the GPU kernels train: all but the linear design's, which has no kernels yet
 /// (its GPU engine falls back to the CPU's, `Engine::for_network`).
 fn kernel_variants() -> Vec<ModelConfig> {
-    variants().into_iter().filter(|c| !c.design.is_linear()).collect()
+    variants()
+        .into_iter()
+        .filter(|c| !c.design.is_linear())
+        .collect()
 }
 
 /// Every design, activation and encoding, and a network of three tracks ([`three_tracks`]).

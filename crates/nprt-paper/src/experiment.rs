@@ -105,7 +105,11 @@ impl Experiment {
     /// The models that keep snapshots: the paper's four designs with their own settings.
     pub fn snapshot_configs(&self) -> Vec<ModelConfig> {
         let paper = Design::PAPER.map(|d| ModelConfig::new(d, None));
-        self.designs.iter().filter(|c| paper.contains(c)).cloned().collect()
+        self.designs
+            .iter()
+            .filter(|c| paper.contains(c))
+            .cloned()
+            .collect()
     }
 
     /// Every Neural PRT model to train: the designs, then the ablation's runs not among them.

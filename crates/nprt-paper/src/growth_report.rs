@@ -74,7 +74,12 @@ pub fn as_training_grows(
         write!(md, "| {} | {:.2} |", p.point, p.minutes)?;
         for name in &designs {
             match p.rows.iter().find(|m| &m.name == name) {
-                Some(m) => write!(md, " {} / {} |", e3(m, Metrics::LOG_L1), e3(m, Metrics::RMSE))?,
+                Some(m) => write!(
+                    md,
+                    " {} / {} |",
+                    e3(m, Metrics::LOG_L1),
+                    e3(m, Metrics::RMSE)
+                )?,
                 None => write!(md, " – |")?,
             }
         }
@@ -94,7 +99,10 @@ fn verdicts(md: &mut String, e: &Evaluation, points: &[GrowthPoint]) -> Result<(
     let judged: Vec<Vec<Ordering>> = points.iter().map(|p| judged_at(e, p)).collect();
     let mut statements: Vec<(&str, String)> = Vec::new();
     for o in judged.iter().flatten() {
-        if !statements.iter().any(|(t, s)| *t == o.table && *s == o.statement) {
+        if !statements
+            .iter()
+            .any(|(t, s)| *t == o.table && *s == o.statement)
+        {
             statements.push((o.table, o.statement.clone()));
         }
     }
@@ -104,7 +112,11 @@ fn verdicts(md: &mut String, e: &Evaluation, points: &[GrowthPoint]) -> Result<(
         "Each ordering at each point (✅ holds, ❌ fails, ≈ not resolved by the test views; Table 6 \
          sets the point's D/S against the final evaluation's competitors):\n"
     )?;
-    writeln!(md, "| table | ordering | {} | holds from |", labels.join(" | "))?;
+    writeln!(
+        md,
+        "| table | ordering | {} | holds from |",
+        labels.join(" | ")
+    )?;
     writeln!(md, "|---|---|{}---|", "---|".repeat(labels.len()))?;
     for (table, statement) in &statements {
         let verdicts: Vec<Option<Verdict>> = judged
@@ -115,12 +127,21 @@ fn verdicts(md: &mut String, e: &Evaluation, points: &[GrowthPoint]) -> Result<(
                     .map(|o| o.verdict())
             })
             .collect();
-        let marks: Vec<&str> = verdicts.iter().map(|v| v.map_or("–", |v| v.mark())).collect();
+        let marks: Vec<&str> = verdicts
+            .iter()
+            .map(|v| v.map_or("–", |v| v.mark()))
+            .collect();
         // The first point after which it holds at every point.
         let from = (0..verdicts.len())
             .find(|&i| verdicts[i..].iter().all(|v| *v == Some(Verdict::Holds)))
-            .map_or("not by the last point".to_string(), |i| labels[i].to_string());
-        writeln!(md, "| {table} | {statement} | {} | {from} |", marks.join(" | "))?;
+            .map_or("not by the last point".to_string(), |i| {
+                labels[i].to_string()
+            });
+        writeln!(
+            md,
+            "| {table} | {statement} | {} | {from} |",
+            marks.join(" | ")
+        )?;
     }
     writeln!(md)?;
     Ok(())
@@ -154,9 +175,13 @@ fn plots(
                 .collect();
             series.push((name.clone(), line));
             if kitchen {
-                let paper = published::table5(2, design).map(|f| f[usize::from(k == Metrics::RMSE)] / 1e3);
+                let paper =
+                    published::table5(2, design).map(|f| f[usize::from(k == Metrics::RMSE)] / 1e3);
                 if let Some(v) = paper {
-                    series.push((format!("paper's KITCHEN {name}"), vec![(span.0, v), (span.1, v)]));
+                    series.push((
+                        format!("paper's KITCHEN {name}"),
+                        vec![(span.0, v), (span.1, v)],
+                    ));
                 }
             }
         }

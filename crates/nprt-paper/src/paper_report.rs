@@ -15,9 +15,9 @@ use nprt_eval::{
 use nprt_net::{Design, ModelConfig};
 
 use crate::experiment::{beyond_the_paper, Experiment};
+use crate::growth_report;
 use crate::orderings::{self, ablation_configs, test_view_competitors, Ordering};
 use crate::paper_figures::{self, design_row, over_views};
-use crate::growth_report;
 use crate::published;
 use crate::readback::GrowthPoint;
 

@@ -82,7 +82,10 @@ impl Experiment {
         log.end(worked)?;
 
         let (ablation, paper) = match self.paper_tables {
-            true => self.paper_tables(&mut log, &data, &report, &evaluation)?,
+            true => {
+                let (ablation, paper) = self.paper_tables(&mut log, &data, &report, &evaluation)?;
+                (ablation, Some(paper))
+            }
             false => (Vec::new(), None),
         };
         let mut relit = None;
@@ -118,7 +121,7 @@ impl Experiment {
         data: &Path,
         report: &Path,
         e: &Evaluation,
-    ) -> Result<(Vec<MethodResult>, Option<(PathBuf, PathBuf)>)> {
+    ) -> Result<(Vec<MethodResult>, (PathBuf, PathBuf))> {
         log.begin("table 2", "scoring Table 2's ablation on the test views");
         let dirs: Vec<PathBuf> = ablation_configs()
             .iter()
@@ -138,7 +141,7 @@ impl Experiment {
             growth = points;
         }
         let paper = write_paper_report(self, e, (&ablation, &growth), &log.times, report)?;
-        Ok((ablation, Some(paper)))
+        Ok((ablation, paper))
     }
 
     /// What the output folder is for, recorded by its first run once its settings hold: a

@@ -108,7 +108,12 @@ pub fn growth(bytes: &[u8], file: &Path) -> Result<Vec<GrowthPoint>> {
             p.minutes
         );
         if let Some(m) = p.rows.iter().find(|m| !complete(m, None)) {
-            bail!("'{}': point {}'s '{}' lacks figures", file.display(), p.point, m.name);
+            bail!(
+                "'{}': point {}'s '{}' lacks figures",
+                file.display(),
+                p.point,
+                m.name
+            );
         }
     }
     Ok(points)

@@ -22,7 +22,9 @@ pub fn text(obj: &Bound<'_, PyAny>, arg: &str, takes: &str) -> PyResult<String> 
             let fspath = obj.py().import("os")?.getattr("fspath")?;
             let p = fspath.call1((obj,)).map_err(|_| refused())?;
             p.cast_into::<PyString>().map_err(|_| {
-                input_error(format!("{arg}: a path given as bytes; give a str or a pathlib.Path"))
+                input_error(format!(
+                    "{arg}: a path given as bytes; give a str or a pathlib.Path"
+                ))
             })?
         }
     };
@@ -41,7 +43,9 @@ pub fn finite<T: Copy + Into<f64> + std::fmt::Display>(value: T, arg: &str) -> P
     if value.into().is_finite() {
         Ok(value)
     } else {
-        Err(input_error(format!("{arg} must be a finite number, not {value}")))
+        Err(input_error(format!(
+            "{arg} must be a finite number, not {value}"
+        )))
     }
 }
 

@@ -51,10 +51,12 @@ pub fn matrix<'py>(py: Python<'py>, m: Mat4) -> Bound<'py, PyArray2<f64>> {
 /// names no argument).
 pub fn frame_size(width: i64, height: i64) -> PyResult<(u32, u32)> {
     let side = |v: i64, arg: &str| {
-        u32::try_from(v)
-            .ok()
-            .filter(|&v| v > 0)
-            .ok_or_else(|| crate::error::input_error(format!("{arg} must be a pixel count from 1 to {}, got {v}", u32::MAX)))
+        u32::try_from(v).ok().filter(|&v| v > 0).ok_or_else(|| {
+            crate::error::input_error(format!(
+                "{arg} must be a pixel count from 1 to {}, got {v}",
+                u32::MAX
+            ))
+        })
     };
     Ok((side(width, "width")?, side(height, "height")?))
 }
@@ -116,7 +118,8 @@ pub fn json<'py>(py: Python<'py>, value: &serde_json::Value) -> PyResult<Bound<'
 /// The JSON file `path` (a model's model.json, a report's results.json) as a Python object;
 /// an NprtError naming the file where it cannot be read.
 pub fn json_file<'py>(py: Python<'py>, path: &std::path::Path) -> PyResult<Bound<'py, PyAny>> {
-    let text = std::fs::read_to_string(path)
-        .map_err(|e| crate::error::NprtError::new_err(format!("cannot read '{}': {e}", path.display())))?;
+    let text = std::fs::read_to_string(path).map_err(|e| {
+        crate::error::NprtError::new_err(format!("cannot read '{}': {e}", path.display()))
+    })?;
     py.import("json")?.call_method1("loads", (text,))
 }

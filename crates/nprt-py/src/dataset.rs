@@ -125,7 +125,11 @@ impl Dataset {
 
     /// View `key` as [`Dataset::view`] gives it (negative indices count from the end), or a
     /// list of them for a slice: `ds[0]`, `ds[-1]`, `ds[:4]`.
-    fn __getitem__<'py>(&self, py: Python<'py>, key: &Bound<'py, PyAny>) -> PyResult<Bound<'py, PyAny>> {
+    fn __getitem__<'py>(
+        &self,
+        py: Python<'py>,
+        key: &Bound<'py, PyAny>,
+    ) -> PyResult<Bound<'py, PyAny>> {
         let len = self.manifest.views.len();
         if let Ok(slice) = key.cast::<PySlice>() {
             let ix = slice.indices(len as isize)?;
@@ -134,12 +138,14 @@ impl Dataset {
                 .collect::<PyResult<Vec<_>>>()?;
             return Ok(PyList::new(py, views)?.into_any());
         }
-        let i: isize = key.extract().map_err(|_| {
-            crate::error::input_error("a dataset is indexed by an int or a slice")
-        })?;
+        let i: isize = key
+            .extract()
+            .map_err(|_| crate::error::input_error("a dataset is indexed by an int or a slice"))?;
         let index = if i < 0 { i + len as isize } else { i };
         if index < 0 {
-            return Err(PyIndexError::new_err(format!("view {i} of a dataset of {len}")));
+            return Err(PyIndexError::new_err(format!(
+                "view {i} of a dataset of {len}"
+            )));
         }
         Ok(self.view(py, index as usize)?.into_any())
     }

@@ -17,13 +17,55 @@ pub fn to_py(e: anyhow::Error) -> PyErr {
 /// The flags that are keyword arguments of the same name in Python (`--train-res` is
 /// `train_res=`); others (`--help`, cargo's) are left as they are.
 const KEYWORDS: &[&str] = &[
-    "activation", "arch", "basis", "batch-size", "budget", "camera-path", "camera-volume",
-    "data", "device", "direct-spp", "envmaps", "epochs", "exposure", "fov", "fps", "frames",
-    "jitter-exposure", "jitter-tint", "lighting", "look", "lr", "minutes", "mix-builtin",
-    "mix-maps", "model", "nrc-warmup", "out", "precision", "res", "scene", "schedule", "seed",
-    "sh-spp", "shard", "spin", "spp", "spread", "temporal-frames", "temporal-res", "test-maps",
-    "test-res", "test-spp", "test-views", "timing-res", "train-res", "train-views", "views",
-    "volume-max", "volume-min",
+    "activation",
+    "arch",
+    "basis",
+    "batch-size",
+    "budget",
+    "camera-path",
+    "camera-volume",
+    "data",
+    "device",
+    "direct-spp",
+    "envmaps",
+    "epochs",
+    "exposure",
+    "fov",
+    "fps",
+    "frames",
+    "jitter-exposure",
+    "jitter-tint",
+    "lighting",
+    "look",
+    "lr",
+    "minutes",
+    "mix-builtin",
+    "mix-maps",
+    "model",
+    "nrc-warmup",
+    "out",
+    "precision",
+    "res",
+    "scene",
+    "schedule",
+    "seed",
+    "sh-spp",
+    "shard",
+    "spin",
+    "spp",
+    "spread",
+    "temporal-frames",
+    "temporal-res",
+    "test-maps",
+    "test-res",
+    "test-spp",
+    "test-views",
+    "timing-res",
+    "train-res",
+    "train-views",
+    "views",
+    "volume-max",
+    "volume-min",
 ];
 
 /// `message` with each `--flag` that is a Python keyword written `flag=`.
@@ -55,7 +97,9 @@ fn pythonic(message: &str) -> String {
 pub fn check_interrupt(py: pyo3::Python<'_>) -> pyo3::PyResult<()> {
     py.check_signals().map_err(|e| {
         if e.is_instance_of::<pyo3::exceptions::PyKeyboardInterrupt>(py) {
-            Interrupted::new_err("interrupted (Ctrl-C); what was written is kept and the same call resumes it")
+            Interrupted::new_err(
+                "interrupted (Ctrl-C); what was written is kept and the same call resumes it",
+            )
         } else {
             e
         }

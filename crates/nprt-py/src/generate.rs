@@ -60,7 +60,11 @@ pub fn generate<'py>(
     let d = GenerateOptions::default();
     let opts = GenerateOptions {
         scene: crate::scene::scene_spec(scene, "scene")?,
-        envmaps: argument::text(envmaps, "envmaps", "a folder of maps (a str or an os.PathLike) or \"builtin\"")?,
+        envmaps: argument::text(
+            envmaps,
+            "envmaps",
+            "a folder of maps (a str or an os.PathLike) or \"builtin\"",
+        )?,
         out,
         train_views: train_views.unwrap_or(d.train_views),
         test_views: test_views.unwrap_or(d.test_views),
@@ -89,9 +93,7 @@ pub fn generate<'py>(
         progress,
     };
     let mut warnings = Vec::new();
-    let summary = interruptible(py, || {
-        nprt_data::generate(&opts, |p| warnings = p.warnings)
-    })?;
+    let summary = interruptible(py, || nprt_data::generate(&opts, |p| warnings = p.warnings))?;
     let out = PyDict::new(py);
     out.set_item("rendered", summary.rendered)?;
     out.set_item("skipped", summary.skipped)?;

@@ -30,10 +30,12 @@ pub fn interruptible<R: Send>(
             worker
                 .join()
                 .unwrap_or_else(|panic| std::panic::resume_unwind(panic))
-                .map_err(|e| match e.downcast_ref::<nprt_io::interrupt::Interrupted>() {
-                    Some(i) => Interrupted::new_err(i.to_string()),
-                    None => to_py(e),
-                })
+                .map_err(
+                    |e| match e.downcast_ref::<nprt_io::interrupt::Interrupted>() {
+                        Some(i) => Interrupted::new_err(i.to_string()),
+                        None => to_py(e),
+                    },
+                )
         })
     });
     nprt_io::interrupt::clear();

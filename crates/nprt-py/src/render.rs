@@ -46,7 +46,9 @@ pub fn render<'py>(
     let opts = RenderOptions {
         model,
         out,
-        scene: scene.map(|s| crate::scene::scene_spec(s, "scene")).transpose()?,
+        scene: scene
+            .map(|s| crate::scene::scene_spec(s, "scene"))
+            .transpose()?,
         camera_path,
         camera_volume,
         lighting: lighting.unwrap_or(d.lighting),

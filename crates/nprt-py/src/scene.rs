@@ -8,10 +8,10 @@ use nprt_trace::{render, PixelFilter, RenderSettings, TraceScene};
 use numpy::{AllowTypeChange, PyArray2, PyArray3, PyArrayLike2, PyArrayLike3};
 use pyo3::prelude::*;
 
-use crate::arrays::{self, CameraOut};
 use crate::argument;
-use crate::interruptible::interruptible;
+use crate::arrays::{self, CameraOut};
 use crate::error::{input_error, OrPy};
+use crate::interruptible::interruptible;
 
 /// A scene: geometry, materials and, where its file has one, a camera.
 #[pyclass(frozen, module = "nprt")]
@@ -99,7 +99,10 @@ impl Scene {
 /// (a `str` or a `pathlib.Path`).
 #[pyfunction]
 pub fn load_scene(py: Python<'_>, spec: &Bound<'_, PyAny>) -> PyResult<Scene> {
-    load(py, &argument::text(spec, "spec", "a str or an os.PathLike")?)
+    load(
+        py,
+        &argument::text(spec, "spec", "a str or an os.PathLike")?,
+    )
 }
 
 /// The scene `spec` names, loaded with the GIL released.
@@ -142,9 +145,9 @@ impl EnvMap {
         }
         // Before any copy: a broadcast view of a huge shape costs nothing until copied.
         nprt_scene::EnvMap::check_size(w, h, name).or_py()?;
-        let texels: PyArrayLike3<f32, AllowTypeChange> = texels.extract().map_err(|e| {
-            input_error(format!("texels: not an array of numbers ({e})"))
-        })?;
+        let texels: PyArrayLike3<f32, AllowTypeChange> = texels
+            .extract()
+            .map_err(|e| input_error(format!("texels: not an array of numbers ({e})")))?;
         let texels = texels
             .as_array()
             .iter()
@@ -202,15 +205,21 @@ pub fn look_at<'py>(
 ) -> PyResult<Bound<'py, PyArray2<f64>>> {
     for (arg, v) in [("origin", origin), ("target", target), ("up", up)] {
         if !v.iter().all(|c| c.is_finite()) {
-            return Err(input_error(format!("{arg} must be three finite numbers, got {v:?}")));
+            return Err(input_error(format!(
+                "{arg} must be three finite numbers, got {v:?}"
+            )));
         }
     }
     let (o, t, u): (glam::Vec3, glam::Vec3, glam::Vec3) = (origin.into(), target.into(), up.into());
     if o == t {
-        return Err(input_error("a camera cannot look at its own origin (origin == target)"));
+        return Err(input_error(
+            "a camera cannot look at its own origin (origin == target)",
+        ));
     }
     if (t - o).cross(u).length_squared() == 0.0 {
-        return Err(input_error("up must not be parallel to the viewing direction (target - origin)"));
+        return Err(input_error(
+            "up must not be parallel to the viewing direction (target - origin)",
+        ));
     }
     Ok(arrays::matrix(
         py,
@@ -222,7 +231,10 @@ pub fn look_at<'py>(
 /// `builtin:sky[:ELEV[:AZIM[:TURB]]]` or `builtin:indoor[:SEED]`.
 #[pyfunction]
 pub fn open_envmap(py: Python<'_>, spec: &Bound<'_, PyAny>) -> PyResult<EnvMap> {
-    open(py, &argument::text(spec, "spec", "a str or an os.PathLike")?)
+    open(
+        py,
+        &argument::text(spec, "spec", "a str or an os.PathLike")?,
+    )
 }
 
 /// The map `spec` names, opened with the GIL released.
@@ -278,8 +290,7 @@ pub fn reference<'py>(
 }
 
 const SCENE: &str = "an nprt.Scene, a str or an os.PathLike (a scene file or builtin:room)";
-const MAP: &str =
-    "an nprt.EnvMap, a str or an os.PathLike (an .exr/.hdr file or a builtin: map)";
+const MAP: &str = "an nprt.EnvMap, a str or an os.PathLike (an .exr/.hdr file or a builtin: map)";
 
 /// The scene `obj` is or names (`builtin:room`, a file), loaded where it is named.
 pub fn scene_arg<'py>(obj: &Bound<'py, PyAny>, arg: &str) -> PyResult<Bound<'py, Scene>> {

@@ -69,7 +69,10 @@ pub fn train<'py>(
     config.basis = basis.map(parse).transpose()?.or(config.basis);
     config.check().or_py()?;
     let d = TrainOptions::default();
-    let (minutes, lr) = (finite_or_none(minutes, "minutes")?, finite_or_none(lr, "lr")?);
+    let (minutes, lr) = (
+        finite_or_none(minutes, "minutes")?,
+        finite_or_none(lr, "lr")?,
+    );
     let run = RunLength {
         epochs,
         minutes,
@@ -129,7 +132,10 @@ pub fn train_deep_shading<'py>(
 ) -> PyResult<Bound<'py, PyDict>> {
     let engine = engine(device)?;
     let d = DeepShadingOptions::default();
-    let (minutes, lr) = (finite_or_none(minutes, "minutes")?, finite_or_none(lr, "lr")?);
+    let (minutes, lr) = (
+        finite_or_none(minutes, "minutes")?,
+        finite_or_none(lr, "lr")?,
+    );
     let run = RunLength {
         epochs,
         minutes,

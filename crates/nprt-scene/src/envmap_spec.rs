@@ -21,7 +21,10 @@ pub fn open_envmap(spec: &str) -> Result<EnvMap> {
         .collect::<Result<_>>()?;
     let most = if kind == "sky" { 3 } else { 1 };
     if nums.len() > most {
-        bail!("environment map '{spec}': builtin:{kind} takes at most {most} numbers, got {}", nums.len());
+        bail!(
+            "environment map '{spec}': builtin:{kind} takes at most {most} numbers, got {}",
+            nums.len()
+        );
     }
     match kind {
         "sky" => {

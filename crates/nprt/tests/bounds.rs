@@ -155,7 +155,10 @@ fn a_frame_beyond_the_gpus_texture_size_is_refused() {
           "--device", "wgpu"],
         &["20000", "pixels a side", "test view"],
     );
-    assert!(!out.exists(), "generate made its folder before refusing the test size");
+    assert!(
+        !out.exists(),
+        "generate made its folder before refusing the test size"
+    );
     #[rustfmt::skip]
     fails(
         &["render", "--model", m, "--out", o, "--frames", "1", "--res", "16385x8",
@@ -354,11 +357,22 @@ fn a_model_is_not_written_into_its_dataset() {
     common::room_dataset(&data, [4, 1], 8, 2);
     let d = data.to_str().unwrap();
     fails(
-        &["train", "--data", d, "--arch", "baseline", "--epochs", "1", "--out", d],
+        &[
+            "train", "--data", d, "--arch", "baseline", "--epochs", "1", "--out", d,
+        ],
         &["is a dataset folder"],
     );
-    for model_file in ["model.json", "weights.safetensors", "checkpoint", "loss.csv", ".lock"] {
-        assert!(!data.join(model_file).exists(), "{model_file} written into the dataset");
+    for model_file in [
+        "model.json",
+        "weights.safetensors",
+        "checkpoint",
+        "loss.csv",
+        ".lock",
+    ] {
+        assert!(
+            !data.join(model_file).exists(),
+            "{model_file} written into the dataset"
+        );
     }
     std::fs::remove_dir_all(&dir).ok();
 }

@@ -83,7 +83,10 @@ fn quick_demo_then_render_and_eval() {
             "{names:?}"
         );
         assert!(names.contains(&"nprt-dsep+direct + OIDN"), "{names:?}");
-        assert!(names.contains(&"nprt-linear+sh:2+direct + OIDN"), "{names:?}");
+        assert!(
+            names.contains(&"nprt-linear+sh:2+direct + OIDN"),
+            "{names:?}"
+        );
     }
     for m in results["methods"].as_array().unwrap() {
         for k in ["l1", "l2", "rmse", "dssim", "mape", "mrse", "log_l1"] {

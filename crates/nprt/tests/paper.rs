@@ -258,7 +258,9 @@ fn orderings_are_judged_as_training_grows() {
     ok(&args);
     let report = dir.join("report");
     let md = std::fs::read_to_string(report.join("paper.md")).unwrap();
-    let section = &md[md.find("## The orderings as training grows").expect("the section")..];
+    let section = &md[md
+        .find("## The orderings as training grows")
+        .expect("the section")..];
     for want in [
         "| point | training min | nprt-baseline | nprt-prt | nprt-albedo | nprt-dsep |",
         "| 1 | ",
@@ -292,6 +294,9 @@ fn orderings_are_judged_as_training_grows() {
     assert_eq!(ds(&points[1]["rows"]), ds(&results["methods"]));
     let again = ok(&args);
     assert!(again.contains("its inputs are unchanged"), "{again}");
-    assert_eq!(std::fs::read_to_string(report.join("paper.md")).unwrap(), md);
+    assert_eq!(
+        std::fs::read_to_string(report.join("paper.md")).unwrap(),
+        md
+    );
     std::fs::remove_dir_all(&dir).ok();
 }

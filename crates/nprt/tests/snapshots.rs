@@ -33,7 +33,11 @@ fn snapshots_are_the_models_of_their_points() {
     // Kept at epochs 1 and 2 of 3: the models runs of 1 and 2 epochs end with (the paper's
     // constant rate: a run's first epochs do not depend on its length).
     let three = dir.join("three");
-    train(&data, &three, &["--epochs", "3", "--snapshots", "1,2,0.0001m"]);
+    train(
+        &data,
+        &three,
+        &["--epochs", "3", "--snapshots", "1,2,0.0001m"],
+    );
     for (point, epochs) in [("1", "1"), ("2", "2")] {
         let alone = dir.join(format!("alone{point}"));
         train(&data, &alone, &["--epochs", epochs]);
@@ -42,7 +46,10 @@ fn snapshots_are_the_models_of_their_points() {
         ok(&["model", "info", "--model", kept.to_str().unwrap()]);
     }
     assert!(three.join("snapshots/0.0001m/model.json").is_file());
-    assert!(!three.join("snapshots/1/checkpoint").exists(), "no optimiser state");
+    assert!(
+        !three.join("snapshots/1/checkpoint").exists(),
+        "no optimiser state"
+    );
     // A run resumed keeps what it has; a point it passed before being asked is not kept later.
     let parts = dir.join("parts");
     train(&data, &parts, &["--epochs", "1"]);
@@ -51,7 +58,17 @@ fn snapshots_are_the_models_of_their_points() {
     assert!(!parts.join("snapshots/1").exists());
     assert!(weights(&parts.join("snapshots/3")) == weights(&parts));
     for bad in ["0m", "1,1", "1.5", "soon"] {
-        let o = nprt(&["train", "--data", "d", "--arch", "dsep", "--out", "m", "--snapshots", bad]);
+        let o = nprt(&[
+            "train",
+            "--data",
+            "d",
+            "--arch",
+            "dsep",
+            "--out",
+            "m",
+            "--snapshots",
+            bad,
+        ]);
         let err = String::from_utf8_lossy(&o.stderr);
         assert_eq!(o.status.code(), Some(2), "{bad}: {err}");
         assert!(err.contains("--snapshots"), "{bad}: {err}");

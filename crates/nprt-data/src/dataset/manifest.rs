@@ -511,4 +511,3 @@ fn brief(v: &serde_json::Value) -> String {
         _ => format!("{}…", text.chars().take(77).collect::<String>()),
     }
 }
-

@@ -36,7 +36,9 @@ impl Snapshot {
 
     /// Whether its model files are in `out` already (kept by an earlier part of the run).
     pub fn taken(&self, out: &Path) -> bool {
-        self.dir(out).join(crate::model::folder::WEIGHTS_FILE).is_file()
+        self.dir(out)
+            .join(crate::model::folder::WEIGHTS_FILE)
+            .is_file()
     }
 
     /// `LIST` as `--snapshots` takes it: comma-separated points, `Nm` minutes or `N` epochs,
@@ -161,8 +163,12 @@ mod tests {
         let labels: Vec<String> = list.iter().map(|p| p.to_string()).collect();
         assert_eq!(labels, ["1m", "0.5m", "16m", "10"]);
         // Each label parses back to its point.
-        assert!(list.iter().all(|p| p.to_string().parse::<Snapshot>() == Ok(*p)));
-        for bad in ["0m", "-1m", "nanm", "infm", "0", "1.5", "m", "4min", "1m,1m", ""] {
+        assert!(list
+            .iter()
+            .all(|p| p.to_string().parse::<Snapshot>() == Ok(*p)));
+        for bad in [
+            "0m", "-1m", "nanm", "infm", "0", "1.5", "m", "4min", "1m,1m", "",
+        ] {
             assert!(Snapshot::parse_list(bad).is_err(), "{bad}");
         }
         assert!(Snapshot::Minutes(2.0).reached(120.0, 0));

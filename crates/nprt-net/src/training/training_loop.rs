@@ -556,7 +556,8 @@ impl<'s, O: Objective> Run<'s, O> {
 
     /// Keeps `net` (up to date) at every snapshot point reached.
     fn take_snapshots(&mut self, net: &O::Net) -> Result<()> {
-        let (objective, schedule, out, state) = (self.objective, self.schedule, self.out, &self.ck.state);
+        let (objective, schedule, out, state) =
+            (self.objective, self.schedule, self.out, &self.ck.state);
         let saving = Instant::now();
         (self.snapshots).take(out, state.seconds, state.epoch, |dir| {
             objective.save_model(dir, net, schedule, state)
