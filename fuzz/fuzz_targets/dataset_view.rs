@@ -8,10 +8,14 @@ use libfuzzer_sys::fuzz_target;
 use nprt_data::dataset::{read_view, Manifest};
 
 fuzz_target!(|data: &[u8]| {
-    let Some((len, rest)) = data.split_first_chunk::<4>() else { return };
+    let Some((len, rest)) = data.split_first_chunk::<4>() else {
+        return;
+    };
     let len = (u32::from_le_bytes(*len) as usize).min(rest.len());
     let (json, exr) = rest.split_at(len);
-    let Ok(manifest) = Manifest::from_json(json) else { return };
+    let Ok(manifest) = Manifest::from_json(json) else {
+        return;
+    };
     let view = &manifest.views[0];
     // Views larger than libFuzzer's 2 GB allocation limit may be real; refusing what this
     // machine cannot hold is nprt_io::ensure_memory's job, tested apart.
@@ -30,8 +34,18 @@ fuzz_target!(|data: &[u8]| {
     }
     if let Ok(image) = read_view(&path, view, manifest.settings.in_halves(view)) {
         let f = &image.frame;
-        assert_eq!((f.width, f.height), (view.width as usize, view.height as usize));
-        assert!(f.radiance.iter().all(|c| c.is_finite() && c.min_element() >= 0.0));
-        assert!(image.half.iter().flatten().all(|c| c.is_finite() && c.min_element() >= 0.0));
+        assert_eq!(
+            (f.width, f.height),
+            (view.width as usize, view.height as usize)
+        );
+        assert!(f
+            .radiance
+            .iter()
+            .all(|c| c.is_finite() && c.min_element() >= 0.0));
+        assert!(image
+            .half
+            .iter()
+            .flatten()
+            .all(|c| c.is_finite() && c.min_element() >= 0.0));
     }
 });

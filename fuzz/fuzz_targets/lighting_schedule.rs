@@ -11,7 +11,10 @@ fuzz_target!(|data: &[u8]| {
             for frames in [1usize, 2, 7, 100] {
                 for i in 0..frames {
                     let (k, rot) = segment_at(&segments, i, frames);
-                    assert!(k < segments.len() && rot.is_finite(), "frame {i}/{frames}: ({k}, {rot})");
+                    assert!(
+                        k < segments.len() && rot.is_finite(),
+                        "frame {i}/{frames}: ({k}, {rot})"
+                    );
                 }
             }
         }

@@ -8,7 +8,9 @@ use libfuzzer_sys::fuzz_target;
 use nprt_net::model::folder::{CONFIG_FILE, WEIGHTS_FILE};
 
 fuzz_target!(|data: &[u8]| {
-    let Some((len, rest)) = data.split_first_chunk::<4>() else { return };
+    let Some((len, rest)) = data.split_first_chunk::<4>() else {
+        return;
+    };
     let len = (u32::from_le_bytes(*len) as usize).min(rest.len());
     let (json, weights) = rest.split_at(len);
     let dir = std::env::temp_dir().join(format!("nprt-fuzz-model-{}", std::process::id()));

@@ -8,10 +8,14 @@ use libfuzzer_sys::fuzz_target;
 use nprt_data::dataset::{Manifest, PackedDataset, PackedTarget};
 
 fuzz_target!(|data: &[u8]| {
-    let Some((len, rest)) = data.split_first_chunk::<4>() else { return };
+    let Some((len, rest)) = data.split_first_chunk::<4>() else {
+        return;
+    };
     let len = (u32::from_le_bytes(*len) as usize).min(rest.len());
     let (json, pack) = rest.split_at(len);
-    let Ok(manifest) = Manifest::from_json(json) else { return };
+    let Ok(manifest) = Manifest::from_json(json) else {
+        return;
+    };
     let hash = blake3::hash(json).to_hex().to_string();
     let dir = std::env::temp_dir().join(format!("nprt-fuzz-pack-{}", std::process::id()));
     let path = PackedDataset::path(&dir, PackedTarget::Radiance);

@@ -7,7 +7,8 @@ use std::path::Path;
 use libfuzzer_sys::fuzz_target;
 
 fuzz_target!(|data: &[u8]| {
-    if let Ok(record) = nprt_paper::readback::experiment_record(data, Path::new("experiment.json")) {
+    if let Ok(record) = nprt_paper::readback::experiment_record(data, Path::new("experiment.json"))
+    {
         assert!(record.is_object());
     }
 });

@@ -12,10 +12,14 @@ use libfuzzer_sys::fuzz_target;
 mod paper_oracle;
 
 fuzz_target!(|data: &[u8]| {
-    let Some(([views, models], json)) = data.split_first_chunk::<2>() else { return };
+    let Some(([views, models], json)) = data.split_first_chunk::<2>() else {
+        return;
+    };
     let file = Path::new("results.json");
     let (views, models) = ((views & 7) as usize + 1, (models % 6) as usize);
-    let Ok(e) = nprt_paper::readback::evaluation(json, file, views, models) else { return };
+    let Ok(e) = nprt_paper::readback::evaluation(json, file, views, models) else {
+        return;
+    };
     let md = nprt_paper::report_tables(&e, &[], data[0] & 128 != 0).unwrap();
     assert!(!paper_oracle::shows_non_finite(&md, json), "{md}");
 });

@@ -18,6 +18,9 @@ fuzz_target!(|data: &[u8]| {
     // Each row's last cell is its duration (a stage's name is free text).
     for row in md.lines().filter(|l| l.ends_with(" |")) {
         let duration = row.trim_end_matches(" |").rsplit("| ").next().unwrap_or("");
-        assert!(!duration.trim_start_matches("**").starts_with('-'), "a negative time: {row}");
+        assert!(
+            !duration.trim_start_matches("**").starts_with('-'),
+            "a negative time: {row}"
+        );
     }
 });

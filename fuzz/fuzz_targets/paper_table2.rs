@@ -12,8 +12,12 @@ use libfuzzer_sys::fuzz_target;
 mod paper_oracle;
 
 fuzz_target!(|data: &[u8]| {
-    let Some((results, table2)) = paper_oracle::split_pair(data) else { return };
-    let Ok(a) = nprt_paper::readback::ablation(table2, Path::new("table2.json")) else { return };
+    let Some((results, table2)) = paper_oracle::split_pair(data) else {
+        return;
+    };
+    let Ok(a) = nprt_paper::readback::ablation(table2, Path::new("table2.json")) else {
+        return;
+    };
     let Ok(e) = nprt_paper::readback::evaluation(results, Path::new("results.json"), 2, 4) else {
         return;
     };

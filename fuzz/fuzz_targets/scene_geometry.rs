@@ -35,7 +35,11 @@ fuzz_target!(|data: &[u8]| {
         };
         let shape = match s {
             0 => "rectangle".to_string(),
-            1 => format!(r#"sphere"><float name="radius" value="{:e}"/><point name="center" value="{:e}, 0, 0""#, next(), next()),
+            1 => format!(
+                r#"sphere"><float name="radius" value="{:e}"/><point name="center" value="{:e}, 0, 0""#,
+                next(),
+                next()
+            ),
             2 => "cube".to_string(),
             _ => "rectangle".to_string(),
         };
