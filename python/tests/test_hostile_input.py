@@ -25,6 +25,11 @@ def test_a_map_that_is_no_array_of_texels_names_the_argument(bad):
         nprt.EnvMap(bad)
 
 
+def test_a_map_from_nested_lists_is_taken_as_an_array():
+    texels = np.arange(4 * 8 * 3, dtype=np.float32).reshape(4, 8, 3) / 96
+    np.testing.assert_array_equal(nprt.EnvMap(texels.tolist()).to_array(), texels)
+
+
 @pytest.mark.parametrize("value", [float("nan"), float("inf"), -float("inf")])
 def test_non_finite_floats_are_refused_by_name(room, dataset, model, tmp_path, value):
     sky = nprt.open_envmap("builtin:sky")

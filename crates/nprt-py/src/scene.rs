@@ -130,9 +130,13 @@ impl EnvMap {
     #[new]
     #[pyo3(signature = (texels, name = "array"))]
     fn new(texels: &Bound<'_, PyAny>, name: &str) -> PyResult<Self> {
-        let shape = || -> PyResult<Vec<usize>> { texels.getattr("shape")?.extract() };
+        let kind = texels.get_type().name()?;
+        // A view stays a view (a broadcast array is not copied); nested lists become an array.
+        let array = (texels.py().import("numpy")?)
+            .call_method1("asarray", (texels,))
+            .map_err(|e| input_error(format!("texels: not an array of numbers ({e})")))?;
+        let shape = || -> PyResult<Vec<usize>> { array.getattr("shape")?.extract() };
         let Ok(&[h, w, c]) = shape().as_deref() else {
-            let kind = texels.get_type().name()?;
             return Err(input_error(format!(
                 "texels: an environment map is an (H, 2H, 3) array of numbers, not {kind}{}",
                 shape().map_or(String::new(), |s| format!(" of shape {s:?}"))
@@ -145,8 +149,7 @@ impl EnvMap {
         }
         // Before any copy: a broadcast view of a huge shape costs nothing until copied.
         nprt_scene::EnvMap::check_size(w, h, name).or_py()?;
-        let texels: PyArrayLike3<f32, AllowTypeChange> = texels
-            .extract()
+        let texels: PyArrayLike3<f32, AllowTypeChange> = (array.extract())
             .map_err(|e| input_error(format!("texels: not an array of numbers ({e})")))?;
         let texels = texels
             .as_array()
