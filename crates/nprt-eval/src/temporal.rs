@@ -250,6 +250,7 @@ fn network_rows(
             let mut rgb = Vec::new();
             let mut frame_ms = refs.gbuffer_ms;
             for (i, (f, g)) in frames.iter().zip(&refs.gbuffers).enumerate() {
+                nprt_io::interrupt::check()?;
                 let sampling = DirectSampling {
                     spp: setup.direct_spp,
                     seed: setup.seed ^ 0x7e3a_d1ec ^ i as u64,
@@ -398,11 +399,13 @@ fn run_cache(
     let mut nrc = Nrc::new(settings, &setup.bounds, seed, setup.engine)?;
     let first = setup.lit(&frames[0]);
     for _ in 0..warmup {
+        nprt_io::interrupt::check()?;
         nrc.frame(setup.ts, &frames[0].camera, &first, &path);
     }
     let mut rgb = Vec::new();
     let mut total_ms = 0.0;
     for f in frames {
+        nprt_io::interrupt::check()?;
         let map = setup.lit(f);
         let start = Instant::now();
         rgb.push(nrc.frame(setup.ts, &f.camera, &map, &path));

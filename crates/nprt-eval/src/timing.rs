@@ -71,15 +71,18 @@ const RUNS: usize = 3;
 
 /// The median of [`RUNS`] timed calls of `f`, in milliseconds.
 fn median_of_runs(mut f: impl FnMut()) -> f64 {
-    median(
-        (0..RUNS)
-            .map(|_| {
-                let t = Instant::now();
-                f();
-                ms(t)
-            })
-            .collect(),
-    )
+    let mut runs = Vec::new();
+    for _ in 0..RUNS {
+        let t = Instant::now();
+        f();
+        runs.push(ms(t));
+        // A stop requested (nprt_io::interrupt): no further runs; the evaluation's check after
+        // its timings ends it.
+        if nprt_io::interrupt::requested() {
+            break;
+        }
+    }
+    median(runs)
 }
 
 /// The frame every network is timed on.

@@ -433,7 +433,10 @@ mod tests {
     fn stage_times_never_print_a_negative_zero() {
         for times in [vec![], vec![("dataset".to_string(), -0.0)]] {
             let md = stage_table(&times).unwrap();
-            assert!(!md.contains("-0") && md.contains("| **all** | **0 s** |"), "{md}");
+            assert!(
+                !md.contains("-0") && md.contains("| **all** | **0 s** |"),
+                "{md}"
+            );
         }
     }
 }
