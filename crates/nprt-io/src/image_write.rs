@@ -36,18 +36,9 @@ pub fn write_linear_rgb(
             crate::exr::write_channels(path, width, height, &channels)
         }
         "hdr" => {
-            if let Some(i) = rgb
-                .iter()
-                .position(|v| !v.is_finite() || v.min_element() < 0.0)
-            {
-                bail!(
-                    "refusing to write '{}': pixel ({}, {}) is {}, which Radiance HDR cannot hold",
-                    path.display(),
-                    i % width.max(1),
-                    i / width.max(1),
-                    rgb[i]
-                );
-            }
+            let ok = |v: Vec3| v.is_finite() && v.min_element() >= 0.0;
+            let want = "finite and non-negative, as Radiance HDR holds";
+            crate::png::check_pixels(path, rgb, width, ok, want)?;
             let flat: Vec<f32> = rgb.iter().flat_map(|c| c.to_array()).collect();
             let Some(img) = image::Rgb32FImage::from_raw(width as u32, height as u32, flat) else {
                 bail!("a {width}×{height} image is too large for Radiance HDR");

@@ -22,6 +22,27 @@ pub fn to_image(rgb: &[Vec3], width: usize, height: usize, exposure: f32) -> Rgb
     })
 }
 
+/// Refuses to write `rgb` (rows of `width`) to `path` where a pixel is not `ok`, naming the
+/// first such pixel and what a pixel must be (`want`).
+pub(crate) fn check_pixels(
+    path: &Path,
+    rgb: &[Vec3],
+    width: usize,
+    ok: impl Fn(Vec3) -> bool,
+    want: &str,
+) -> Result<()> {
+    if let Some(i) = rgb.iter().position(|&v| !ok(v)) {
+        bail!(
+            "refusing to write '{}': the radiance at pixel ({}, {}) is {}, not {want}",
+            path.display(),
+            i % width.max(1),
+            i / width.max(1),
+            rgb[i]
+        );
+    }
+    Ok(())
+}
+
 /// Writes a tone-mapped PNG atomically; refuses non-finite radiance (which tone-maps to a
 /// plausible-looking black or white), naming the pixel.
 pub fn write_png(
@@ -31,15 +52,7 @@ pub fn write_png(
     exposure: f32,
     path: &Path,
 ) -> Result<()> {
-    if let Some(i) = rgb.iter().position(|v| !v.is_finite()) {
-        bail!(
-            "refusing to write '{}': the radiance at pixel ({}, {}) is {}",
-            path.display(),
-            i % width.max(1),
-            i / width.max(1),
-            rgb[i]
-        );
-    }
+    check_pixels(path, rgb, width, |v| v.is_finite(), "a finite radiance")?;
     let img = to_image(rgb, width, height, exposure);
     write_atomically(path, |tmp| {
         Ok(img.save_with_format(tmp, image::ImageFormat::Png)?)

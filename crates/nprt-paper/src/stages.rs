@@ -178,9 +178,7 @@ pub fn snapshots(x: &Experiment, data: &Path, file: &Path) -> Result<(Vec<Growth
 
 /// The training time a model folder's model.json records, seconds.
 fn training_seconds(model: &Path) -> Result<f64> {
-    let file: nprt_net::model::folder::ModelFile =
-        serde_json::from_slice(&read(&model.join(CONFIG_FILE))?)
-            .with_context(|| format!("'{}' is not a model's config", model.display()))?;
+    let file = nprt_net::model::folder::read_model_file(model)?;
     (file.training["seconds"].as_f64())
         .filter(|s| s.is_finite() && *s >= 0.0)
         .with_context(|| format!("'{}' records no training time", model.display()))
