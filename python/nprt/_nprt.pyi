@@ -201,10 +201,13 @@ def paper(
     seed: int = 0,
     device: str = "cpu",
     snapshots: Optional[str] = None,
+    training_minutes: Optional[float] = None,
 ) -> Dict[str, Any]:
     """`nprt paper`: the paper's Tables 1-6 at ``budget`` ("tiny", "small", "medium", "paper"),
     resumable; returns ``paper_md``, ``paper_html``, ``report_html``, ``results`` (results.json)
-    and ``orderings`` (table, statement, verdict)."""
+    and ``orderings`` (table, statement, verdict). ``snapshots`` (``"1m,2m,4m"``) judges the
+    orderings as training grows; ``training_minutes`` trains every network that long instead
+    of the budget's."""
 
 def train_deep_shading(
     data: PathLike,

@@ -6,7 +6,7 @@ use std::path::{Path, PathBuf};
 use anyhow::{bail, Result};
 use nprt_data::{CameraChoice, GenerateOptions};
 use nprt_net::training::snapshot::Snapshot;
-use nprt_net::{BasisChoice, Design, DirectLight, Engine, ModelConfig};
+use nprt_net::{BasisChoice, Design, DirectLight, Engine, ModelConfig, RunLength};
 
 use crate::budget::{Budget, DEMO, TINY};
 use crate::orderings::ablation_configs;
@@ -35,6 +35,9 @@ pub struct Experiment {
     /// Points at which the paper's four designs keep their models as they train, each scored
     /// on the test views and judged by the paper's orderings (`--snapshots`).
     pub snapshots: Vec<Snapshot>,
+    /// Every network's training in wall-clock minutes instead of the budget's (`--training-minutes`):
+    /// the budget's sizes with longer training, recorded with the experiment.
+    pub training_minutes: Option<f64>,
 }
 
 /// The design beyond the paper that `nprt paper` and `nprt demo` set beside D/S in Table 6:
@@ -72,6 +75,7 @@ impl Experiment {
             relight: false,
             engine,
             snapshots: Vec::new(),
+            training_minutes: None,
         }
     }
 
@@ -147,10 +151,25 @@ impl Experiment {
         }
     }
 
-    /// Refuses paths that are not UTF-8, naming the flag, before any work: the experiment
-    /// writes them into its records, the report and `nprt generate`'s flags, which would hold
-    /// another path.
-    pub fn check_paths(&self) -> Result<()> {
+    /// Each Neural PRT network's training: the budget's, or `training_minutes`.
+    pub fn training(&self) -> RunLength {
+        self.training_minutes
+            .map_or(self.budget.training, RunLength::minutes)
+    }
+
+    /// Deep Shading's training: the budget's, or `training_minutes` (equal cost with the designs).
+    pub fn deep_shading_training(&self) -> RunLength {
+        self.training_minutes
+            .map_or(self.budget.deep_shading, RunLength::minutes)
+    }
+
+    /// Refuses, before any work, paths that are not UTF-8 (the experiment writes them into its
+    /// records, the report and `nprt generate`'s flags, which would hold another path) and a
+    /// training time that is not a positive number of minutes, naming the flag.
+    pub fn check_settings(&self) -> Result<()> {
+        if let Some(m) = self.training_minutes.filter(|m| !(m.is_finite() && *m > 0.0)) {
+            bail!("--training-minutes {m} is not a positive number of minutes");
+        }
         let paths = [
             ("--out", Some(&self.out)),
             ("--camera-volume", self.camera.file.as_ref()),
@@ -171,7 +190,7 @@ impl Experiment {
     /// for a cluster to render it first (`scripts/slurm-generate N -- FLAGS`, docs/paper.md);
     /// a run then finds it complete.
     pub fn generate_flags(&self) -> Result<Vec<String>> {
-        self.check_paths()?;
+        self.check_settings()?;
         let o = self.generate_options(&self.dataset_dir());
         let mut flags: Vec<String> = [
             ("--scene", o.scene.clone()),
@@ -203,5 +222,26 @@ impl Experiment {
 
     pub(crate) fn model_dir(&self, config: &ModelConfig) -> PathBuf {
         self.out.join("models").join(config.label())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::budget::SMALL;
+
+    #[test]
+    fn training_minutes_replace_the_budgets_training_for_every_network() {
+        let mut x = Experiment::paper("builtin:room", "builtin", Path::new("o"), SMALL, Engine::Cpu);
+        assert_eq!(x.training(), SMALL.training);
+        assert_eq!(x.deep_shading_training(), SMALL.deep_shading);
+        x.training_minutes = Some(16.0);
+        assert_eq!(x.training(), RunLength::minutes(16.0));
+        assert_eq!(x.deep_shading_training(), RunLength::minutes(16.0));
+        for bad in [0.0, -1.0, f64::NAN, f64::INFINITY] {
+            x.training_minutes = Some(bad);
+            let err = x.check_settings().unwrap_err().to_string();
+            assert!(err.contains("--training-minutes"), "{err}");
+        }
     }
 }

@@ -65,7 +65,7 @@ fn header(md: &mut String, x: &Experiment, e: &Evaluation) -> Result<()> {
     )?;
     writeln!(
         md,
-        "Lighting `{}`. The budget takes {}. Dataset: {} training views of {}² at {} spp; {} test views of {}² under \
+        "Lighting `{}`. The budget takes {}{}. Dataset: {} training views of {}² at {} spp; {} test views of {}² under \
          held-out lighting, references at {} spp. Networks trained {} each on the {} ({} CPU \
          threads). Every figure below is a mean over the test views with its standard error, and \
          every ordering is judged on per-view (or per-frame) differences: ✅ holds (two standard \
@@ -74,13 +74,21 @@ fn header(md: &mut String, x: &Experiment, e: &Evaluation) -> Result<()> {
          [report.html](report.html).\n",
         x.envmaps,
         b.wall_time,
+        match x.training_minutes {
+            Some(_) => format!(
+                " with its own training ({} a network); this run trains longer \
+                 (--training-minutes)",
+                describe_run(b.training)
+            ),
+            None => String::new(),
+        },
         b.train_views,
         b.train_res,
         b.spp,
         e.test_views,
         e.resolution[0],
         e.reference_spp,
-        describe_run(b.training),
+        describe_run(x.training()),
         x.engine.name(),
         e.cpu_threads
     )?;

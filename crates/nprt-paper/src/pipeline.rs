@@ -30,7 +30,7 @@ pub struct Outcome {
 impl Experiment {
     /// Runs every stage not already done, in order.
     pub fn run(&self) -> Result<Outcome> {
-        self.check_paths()?;
+        self.check_settings()?;
         std::fs::create_dir_all(&self.out)
             .with_context(|| format!("cannot create '{}'", self.out.display()))?;
         let _lock = nprt_io::lock_folder(&self.out, "experiment folder", "--out")?;
@@ -145,10 +145,10 @@ impl Experiment {
     }
 
     /// What the output folder is for, recorded by its first run once its settings hold: a
-    /// later run with another scene, lighting, budget or seed is refused rather than mixed into
+    /// later run with another scene, lighting, budget, training time or seed is refused rather than mixed into
     /// it. None where the folder is this experiment's already; the record to write otherwise.
     fn claim(&self) -> Result<Option<Claim>> {
-        let what = json!({
+        let mut what = json!({
             "scene": self.scene,
             "envmaps": self.envmaps,
             "budget": self.budget.name,
@@ -157,6 +157,10 @@ impl Experiment {
             "camera_volume": self.camera.file,
             "models": self.models().iter().map(|c| c.label()).collect::<Vec<_>>(),
         });
+        // Only where given, so that folders recorded before the flag existed still resume.
+        if let Some(m) = self.training_minutes {
+            what["training_minutes"] = json!(m);
+        }
         let file = self.out.join("experiment.json");
         if let Ok(bytes) = std::fs::read(&file) {
             let before = crate::readback::experiment_record(&bytes, &file)?;

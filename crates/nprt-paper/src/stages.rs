@@ -38,7 +38,7 @@ pub fn dataset(x: &Experiment, data: &Path) -> Result<bool> {
 /// Trains (or resumes, or finds finished) one Neural PRT model; whether it trained.
 pub fn train_model(x: &Experiment, data: &Path, config: &ModelConfig, out: &Path) -> Result<bool> {
     let set = TrainingSet::load(data, config, true, |why| eprintln!("{why}"))?;
-    let mut opts = TrainOptions::default().with_run(config.design, x.budget.training, None);
+    let mut opts = TrainOptions::default().with_run(config.design, x.training(), None);
     // The paper's four designs keep their models as training grows (`--snapshots`).
     if x.snapshot_configs().contains(config) {
         opts.schedule.snapshots = x.snapshots.clone();
@@ -52,7 +52,7 @@ pub fn train_model(x: &Experiment, data: &Path, config: &ModelConfig, out: &Path
 pub fn train_deep_shading(x: &Experiment, data: &Path, out: &Path) -> Result<bool> {
     let defaults = DeepShadingOptions::default();
     let opts = DeepShadingOptions {
-        schedule: x.budget.deep_shading.apply(defaults.schedule.clone()),
+        schedule: x.deep_shading_training().apply(defaults.schedule.clone()),
         ..defaults
     };
     let (s, _) = deep_shading::train(data, &opts, x.engine, out, &|_| true)?;

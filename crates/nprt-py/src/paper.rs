@@ -17,11 +17,12 @@ use crate::error::OrPy;
 /// `paper_html` and `report_html` (paths), `results` (the evaluation's results.json) and
 /// `orderings` (each ordering the paper states: table, statement, verdict). `snapshots`
 /// (`"1m,2m,4m"`) keeps the four designs at points of their training and judges the orderings
-/// at each (`nprt paper --snapshots`). The GIL is released while it runs.
+/// at each (`nprt paper --snapshots`); `training_minutes` trains every network that long
+/// instead of the budget's (`nprt paper --training-minutes`). The GIL is released while it runs.
 #[pyfunction]
 #[pyo3(signature = (
     scene, envmaps, out, *, budget = "small", camera_volume = None, test_maps = None, seed = 0,
-    device = "cpu", snapshots = None
+    device = "cpu", snapshots = None, training_minutes = None
 ))]
 #[allow(clippy::too_many_arguments)]
 pub fn paper<'py>(
@@ -35,6 +36,7 @@ pub fn paper<'py>(
     seed: u64,
     device: &str,
     snapshots: Option<&str>,
+    training_minutes: Option<f64>,
 ) -> PyResult<Bound<'py, PyDict>> {
     let scene = crate::scene::scene_spec(scene, "scene")?;
     let envmaps = crate::argument::text(
@@ -55,6 +57,7 @@ pub fn paper<'py>(
             .map_err(|e| crate::error::input_error(format!("snapshots: {e}")))?
             .unwrap_or_default(),
         seed,
+        training_minutes,
         ..Experiment::paper(&scene, &envmaps, &out, budget, engine(device)?)
     };
     let done = py.detach(|| x.run()).or_py()?;
