@@ -120,14 +120,15 @@ impl Engine {
         self == Engine::Gpu
     }
 
-    /// The engine a network of `config` trains and runs on: this one, or the CPU engine for the
-    /// linear design, whose GPU kernels are not written yet (said on standard error), so that a
-    /// run of several designs on a GPU (`nprt paper`, `nprt demo`) keeps it.
-    pub fn for_network(self, config: &ModelConfig) -> Engine {
+    /// The engine a network of `config` trains on: this one, or the CPU engine for the linear
+    /// design, whose GPU training kernels are not written yet (said on standard error), so that
+    /// a run of several designs on a GPU (`nprt paper`, `nprt demo`) keeps it. Its frames run
+    /// on either.
+    pub fn for_training(self, config: &ModelConfig) -> Engine {
         if self.is_gpu() && config.design.is_linear() {
             eprintln!(
-                "{}: the linear design runs on the CPU engine (its GPU kernels are not written \
-                 yet)",
+                "{}: the linear design trains on the CPU engine (its GPU training kernels are \
+                 not written yet); its frames run on the GPU",
                 config.label()
             );
             return Engine::Cpu;
@@ -250,15 +251,15 @@ mod tests {
         assert_eq!("wgpu".parse::<Compute>(), Ok(Compute::Wgpu));
     }
 
-    /// A run of several designs on the GPU keeps the linear one, on the CPU engine; the others
-    /// stay where they were asked to run.
+    /// A run of several designs on the GPU keeps the linear one, trained on the CPU engine;
+    /// the others stay where they were asked to run.
     #[test]
-    fn the_linear_design_runs_on_the_cpu_engine() {
+    fn the_linear_design_trains_on_the_cpu_engine() {
         use crate::network::design::Design;
         let linear = ModelConfig::new(Design::Linear, None);
         let dsep = ModelConfig::new(Design::Dsep, None);
-        assert_eq!(Engine::Gpu.for_network(&linear), Engine::Cpu);
-        assert_eq!(Engine::Gpu.for_network(&dsep), Engine::Gpu);
-        assert_eq!(Engine::Cpu.for_network(&linear), Engine::Cpu);
+        assert_eq!(Engine::Gpu.for_training(&linear), Engine::Cpu);
+        assert_eq!(Engine::Gpu.for_training(&dsep), Engine::Gpu);
+        assert_eq!(Engine::Cpu.for_training(&linear), Engine::Cpu);
     }
 }

@@ -322,3 +322,64 @@ fn a_new_viewpoint_reusing_the_last_ones_buffers_gets_its_own_radiance() {
         assert_eq!(got, want, "half precision: {half}");
     }
 }
+
+/// The linear design on the frame path: its light code (the map made into the basis' input and
+/// projected, all on the device) and its radiance agree with the CPU engine's, for the fixed
+/// basis and a learned one, and a frame under a·E₁ + b·E₂ is a·(the frame under E₁) +
+/// b·(under E₂) to rounding, as on the CPU engine.
+#[test]
+fn the_linear_design_shades_as_on_the_cpu_engine() {
+    if !GpuDevice::probe() {
+        return;
+    }
+    let device = GpuDevice::get().unwrap();
+    let features = room_features();
+    let sky = nprt_scene::open_envmap("builtin:sky:25:40").unwrap();
+    let gain = [4.0, 1.0, 0.5];
+    for (seed, basis) in [(50, "sh:2"), (51, "learned:8")] {
+        let config = ModelConfig {
+            encoder_width: 64,
+            basis: Some(basis.parse().unwrap()),
+            ..ModelConfig::new(Design::Linear, None)
+        };
+        let net = config.build(&mut Init::new(seed));
+        let gpu = GpuNetwork::new(&net, gain, 64, MapNorm::Channel).unwrap();
+        let px = gpu.pixels(&features);
+        let frame = |map: &nprt_scene::EnvMap| {
+            let code = gpu.encode_map(map, 30.0, 64, MapNorm::Channel);
+            (code.read(&device), gpu.radiance(&px, &code))
+        };
+        let ((code, divisor), rgb) = frame(&sky);
+        let input = config.light_input(&sky, 30.0);
+        let want_code = net.light.forward(&input.pixels, 64).codes().to_vec();
+        let scale = std::array::from_fn(|k| input.scale[k] * gain[k]);
+        let want = net.radiance(&features, &want_code, scale, None);
+        let (code_error, error) = (
+            relative_difference(&code, &want_code),
+            relative_difference(&rgb, &want),
+        );
+        eprintln!("linear {basis}: code {code_error:.2e}, radiance {error:.2e}");
+        // The divisor: the map's mean, summed in f32 on the device and in f64 on the host.
+        let divisor_error = relative_difference(&divisor, &input.scale);
+        assert!(divisor_error < 1e-6, "{basis}: divisor off by {divisor_error}");
+        assert!(code_error < 1e-5, "{basis}: light code off by {code_error}");
+        assert!(error < 1e-5, "{basis}: radiance off by {error}");
+
+        // Linearity through the whole device path (input, projection, networks, combine).
+        let (a, b) = (0.3f32, 2.5f32);
+        let room = nprt_scene::open_envmap("builtin:indoor:3").unwrap();
+        assert_eq!(room.width(), sky.width(), "maps of one size, to add");
+        let texels = (sky.texels().iter().zip(room.texels()))
+            .map(|(x, y)| *x * a + *y * b)
+            .collect();
+        let (w, h) = (sky.width(), sky.height());
+        let mixed = nprt_scene::EnvMap::from_texels("mix", w, h, texels).unwrap();
+        let (_, one) = frame(&sky);
+        let (_, two) = frame(&room);
+        let (_, both) = frame(&mixed);
+        let sum: Vec<f32> = one.iter().zip(&two).map(|(x, y)| a * x + b * y).collect();
+        let error = relative_difference(&both, &sum);
+        eprintln!("linear {basis}: mixture {error:.2e}");
+        assert!(error < 1e-5, "{basis}: a mixture's frame off by {error}");
+    }
+}

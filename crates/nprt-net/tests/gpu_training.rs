@@ -31,7 +31,7 @@ fn network(config: &ModelConfig) -> NprtNet {
 }
 
 /// The variants the GPU kernels train: all but the linear design's, which has no kernels yet
-/// (its GPU engine falls back to the CPU's, `Engine::for_network`).
+/// (its GPU engine falls back to the CPU's, `Engine::for_training`).
 fn kernel_variants() -> Vec<ModelConfig> {
     variants()
         .into_iter()

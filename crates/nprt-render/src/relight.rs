@@ -93,7 +93,6 @@ impl Relighter {
     /// A model with `file`'s settings and the weights of `net` (on the host), to run on
     /// `engine`.
     pub fn new(file: ModelFile, net: NprtNet, engine: Engine) -> Result<Self> {
-        let engine = engine.for_network(&file.config);
         Ok(Relighter {
             shading: engine.network(&file, net)?,
             stages: frame_stages(engine)?,

@@ -16,7 +16,13 @@ use base64::Engine;
 use common::{fails, fresh_dir, ok, tiny_room_model};
 use serde_json::Value;
 
-const KERNELS: [&str; 4] = ["encoder_block", "track_inputs", "gemm", "combine"];
+const KERNELS: [&str; 5] = [
+    "encoder_block",
+    "light_project",
+    "track_inputs",
+    "gemm",
+    "combine",
+];
 
 #[test]
 fn export_writes_kernels_weights_and_a_worked_example_that_webgpu_runs() {
@@ -124,6 +130,47 @@ fn export_writes_kernels_weights_and_a_worked_example_that_webgpu_runs() {
         ],
         &["nowhere", "not a model folder"],
     );
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+/// The linear design exports too: its basis (the functions times their texels' solid angles)
+/// instead of an encoder, a code of 3K values, tracks whose shading networks read no code, and
+/// a worked example whose page (`light_project`, then the dot products in `combine`) makes
+/// the CPU engine's image.
+#[test]
+fn a_linear_model_exports_and_its_page_matches_the_cpu_engine() {
+    let dir = fresh_dir("export-linear");
+    let model = tiny_room_model(&dir, "linear", &["--basis", "learned:8"]);
+    let out = dir.join("export");
+    #[rustfmt::skip]
+    ok(&["export", model.to_str().unwrap(), "--out", out.to_str().unwrap(), "--example-res", "48x36"]);
+    let manifest: Value =
+        serde_json::from_slice(&std::fs::read(out.join("export.json")).unwrap()).unwrap();
+    assert!(manifest["encoder"].is_null(), "{manifest}");
+    assert_eq!(manifest["basis"]["choice"], "learned:8");
+    assert_eq!(manifest["code_size"], 24);
+    for t in manifest["tracks"].as_array().unwrap() {
+        assert_eq!(t["coefficients"], 8, "{t}");
+        assert!(t["code_rows"].is_null(), "{t}");
+    }
+    let (file, net) = nprt_net::load_model(&model).unwrap();
+    let nprt_net::LightModel::Basis(basis) = &net.light else {
+        panic!("a linear model has a basis")
+    };
+    let functions = manifest["weights"]["tensors"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .find(|t| t["name"] == "basis.weighted")
+        .expect("the basis' functions");
+    let w = file.config.encoder_width;
+    assert_eq!(functions["shape"], serde_json::json!([8, w * w / 2]));
+    let example: Value =
+        serde_json::from_slice(&std::fs::read(out.join("example/example.json")).unwrap())
+            .unwrap();
+    assert_eq!(example["light"]["log"], false, "a basis reads the map's texels as they are");
+    assert_eq!(basis.weighted().len(), 8 * w * w / 2);
+    page_matches_the_cpu_engine(&out);
     std::fs::remove_dir_all(&dir).unwrap();
 }
 

@@ -49,6 +49,8 @@ pub const RADIANCE_LOSS: KernelSource = kernel!("radiance_loss", "loss_element")
 pub static TRACK_GRADIENT: LazyLock<KernelSource> =
     LazyLock::new(|| with_kinds(kernel!("track_gradient", "track_radiance")));
 pub const ADAM: KernelSource = kernel!("adam");
+/// The linear design's light code: the map's projection on its basis.
+pub const LIGHT_PROJECT: KernelSource = kernel!("light_project");
 pub const GATHER_SAMPLES: KernelSource = kernel!("gather_samples", "pixel_features");
 /// The network inputs of a G-buffer left on the device (nprt-render's frame path).
 pub const GBUFFER_FEATURES: KernelSource = kernel!("gbuffer_features", "pixel_features");

@@ -34,14 +34,13 @@ impl LightModel {
         }
     }
 
-    /// The convolutional encoder, which nprt's GPU kernels and the export run; a basis is
-    /// refused there, by name.
+    /// The convolutional encoder; a basis is refused, by name.
     pub fn encoder(&self) -> Result<&LightEncoder> {
         match self {
             LightModel::Encoder(e) => Ok(e),
             LightModel::Basis(b) => bail!(
-                "the linear design (light basis {}) has no GPU kernels yet: it trains and renders \
-                 on the CPU engine (--device cpu), and the WGSL export has no form of it",
+                "the linear design (light basis {}) has no encoder: its light code is the map's \
+                 projection on that basis",
                 b.choice
             ),
         }
@@ -72,12 +71,12 @@ mod tests {
     use crate::model::config::ModelConfig;
     use crate::network::design::Design;
 
-    /// The engines that run only the encoder are told, by name, why a basis is not for them.
+    /// Where only an encoder will do, a basis is refused by name.
     #[test]
     fn a_basis_is_refused_where_only_the_encoder_runs() {
         let linear = ModelConfig::new(Design::Linear, None).build(&mut Init::new(0));
         let e = linear.encoder().unwrap_err().to_string();
-        assert!(e.contains("sh:4") && e.contains("no GPU kernels"), "{e}");
+        assert!(e.contains("sh:4") && e.contains("no encoder"), "{e}");
         let dsep = ModelConfig::new(Design::Dsep, None).build(&mut Init::new(0));
         assert!(dsep.encoder().is_ok());
         assert_eq!((linear.light.code_size(), dsep.light.code_size()), (75, 64));

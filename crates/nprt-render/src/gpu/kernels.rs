@@ -4,13 +4,15 @@
 
 use nprt_gpu::KernelSource;
 use nprt_net::gpu::kernels::{
-    COMBINE, ENCODER_BLOCK, GEMM, HALF_DENSE, HALF_DENSE_COOP, HALF_ROWS, TRACK_INPUTS,
+    COMBINE, ENCODER_BLOCK, GEMM, HALF_DENSE, HALF_DENSE_COOP, HALF_ROWS, LIGHT_PROJECT,
+    TRACK_INPUTS,
 };
 
 /// Every network kernel of the frame path, in the order a frame first uses them: what
-/// `nprt export` writes (an engine brings its own G-buffer and background).
-pub fn sources() -> [&'static KernelSource; 4] {
-    [&ENCODER_BLOCK, &TRACK_INPUTS, &GEMM, &COMBINE]
+/// `nprt export` writes (an engine brings its own G-buffer and background). A model runs the
+/// encoder's or, for the linear design, the basis' projection.
+pub fn sources() -> [&'static KernelSource; 5] {
+    [&ENCODER_BLOCK, &LIGHT_PROJECT, &TRACK_INPUTS, &GEMM, &COMBINE]
 }
 
 /// The kernels `--precision f16` runs the transport networks' dense layers with instead of

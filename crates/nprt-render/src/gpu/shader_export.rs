@@ -14,7 +14,7 @@ use nprt_net::network::dense::Dense;
 use nprt_net::network::encoder::CODE_SIZE;
 use nprt_net::network::mlp::Mlp;
 use nprt_net::{
-    gbuffer_features, load_model, LightEncoder, LightInput, NprtNet, FEATURES, TRANSPORT_CODE,
+    gbuffer_features, load_model, LightEncoder, LightModel, NprtNet, FEATURES, TRANSPORT_CODE,
 };
 use nprt_trace::{render_gbuffer, TraceScene};
 use serde_json::{json, Value};
@@ -27,7 +27,7 @@ use super::kernels::{sources, HALF_SOURCES};
 use crate::{CameraPath, ExampleView, Relighter};
 
 /// Version of the export's layout, bumped whenever a reader would read it differently.
-pub const EXPORT_VERSION: u32 = 6;
+pub const EXPORT_VERSION: u32 = 7;
 
 /// What an export wrote.
 pub struct ExportSummary {
@@ -100,6 +100,34 @@ impl WeightFile {
         json!({ "hidden_activation": m.activation.to_string(), "layers": layers })
     }
 
+    /// The light model, its tensors added: `encoder` (the paper's blocks and its dense layer
+    /// into the code) or, for the linear design, `basis` (the functions already times their
+    /// texels' solid angles, which `light_project` multiplies the map by).
+    fn light_model(&mut self, net: &NprtNet, input_width: usize) -> Value {
+        match &net.light {
+            LightModel::Encoder(e) => {
+                let (convs, to_code) = self.encoder(e);
+                json!({ "encoder": {
+                    "input_width": input_width,
+                    "blocks": convs,
+                    "to_code": to_code,
+                    // `encoder_block` runs this many threads per output value.
+                    "block_threads_per_output": ENCODER_BLOCK_THREADS,
+                }, "basis": null })
+            }
+            LightModel::Basis(b) => {
+                let texels = b.width * b.width / 2;
+                let functions = self.add("basis.weighted", &[b.size(), texels], &b.weighted());
+                json!({ "encoder": null, "basis": {
+                    "choice": b.choice.to_string(),
+                    "input_width": b.width,
+                    "size": b.size(),
+                    "functions": functions,
+                }})
+            }
+        }
+    }
+
     /// The encoder's blocks and its dense layer into the code, their tensors added.
     fn encoder(&mut self, encoder: &LightEncoder) -> (Vec<Value>, Value) {
         let convs: Vec<Value> = (encoder.convs.iter().enumerate())
@@ -138,8 +166,15 @@ impl WeightFile {
                     "transfer": transfer,
                     "shading": self.mlp(&format!("track{i}.shading"), &t.shading),
                     // Which weight rows of the shading network's first layer multiply the light
-                    // code: after ŝ, or first for the baseline's [ê, inputs].
-                    "code_rows": if t.transfer.is_some() { [TRANSPORT_CODE, TRANSPORT_CODE + CODE_SIZE] } else { [0, CODE_SIZE] },
+                    // code: after ŝ, or first for the baseline's [ê, inputs]; none for a
+                    // linear track, whose shading network reads ŝ alone.
+                    "code_rows": match (t.coefficients, &t.transfer) {
+                        (Some(_), _) => None,
+                        (None, Some(_)) => Some([TRANSPORT_CODE, TRANSPORT_CODE + CODE_SIZE]),
+                        (None, None) => Some([0, CODE_SIZE]),
+                    },
+                    // A linear track's K transfer coefficients per term and channel.
+                    "coefficients": t.coefficients,
                 })
             })
             .collect()
@@ -150,7 +185,6 @@ impl WeightFile {
 /// each atomically), with a worked example relighting `view` of its scene.
 pub fn export_model(model_dir: &Path, out: &Path, view: &ExampleView) -> Result<ExportSummary> {
     let (file, net) = load_model(model_dir)?;
-    let encoder = net.encoder().context("nprt export")?;
     if out.exists() && !out.is_dir() {
         bail!("--out '{}' is not a folder", out.display());
     }
@@ -170,7 +204,7 @@ pub fn export_model(model_dir: &Path, out: &Path, view: &ExampleView) -> Result<
     }
 
     let mut weights = WeightFile::default();
-    let (convs, to_code) = weights.encoder(encoder);
+    let light = weights.light_model(&net, file.config.encoder_width);
     let tracks = weights.tracks(&net);
     write("weights.bin", &le_bytes(&weights.values, f32::to_le_bytes))?;
     write(
@@ -189,17 +223,12 @@ pub fn export_model(model_dir: &Path, out: &Path, view: &ExampleView) -> Result<
             "map_norm": config.map_norm.to_string(),
             "scene": file.scene,
         },
-        "encoder": {
-            "input_width": config.encoder_width,
-            "blocks": convs,
-            "to_code": to_code,
-            // `encoder_block` runs this many threads per output value.
-            "block_threads_per_output": ENCODER_BLOCK_THREADS,
-        },
+        "encoder": light["encoder"],
+        "basis": light["basis"],
         // Each pixel's network inputs (the G-buffer's 19 values, nprt-net's `FEATURES`) and
         // the light code's size.
         "inputs_per_pixel": FEATURES,
-        "code_size": CODE_SIZE,
+        "code_size": net.light.code_size(),
         // `gemm` computes a tile of this many rows and columns of its product per workgroup.
         "gemm_tile": GEMM_TILE,
         "tracks": tracks,
@@ -283,7 +312,7 @@ fn example(model_dir: &Path, file: &nprt_net::ModelFile, view: &ExampleView) -> 
     let relighter = Relighter::load(model_dir, nprt_net::Engine::Cpu)?;
     let reference = relighter.shade(&g, &relighter.light_code(&map, 0.0));
     let config = &file.config;
-    let input = LightInput::new(&map, 0.0, config.encoder_width, config.map_norm);
+    let input = config.light_input(&map, 0.0);
     let gain = file.output_gain();
     let scale: [f32; 3] = std::array::from_fn(|k| input.scale[k] * gain[k]);
     let gbuffer: Vec<f32> = (0..g.mask.len())
@@ -300,7 +329,9 @@ fn example(model_dir: &Path, file: &nprt_net::ModelFile, view: &ExampleView) -> 
         "map": view.map,
         "rotation_deg": 0.0,
         "gbuffer": { "file": "gbuffer.bin", "floats_per_pixel": FEATURES + 1, "layout": "19 network inputs, then the foreground mask, per pixel in row order" },
-        "light": { "file": "light.bin", "shape": [3, config.encoder_width / 2, config.encoder_width], "scale": scale },
+        // The map made into the light model's input: its texels divided by the divisor and,
+        // for the encoder, through ln(1 + x); as they are for a basis.
+        "light": { "file": "light.bin", "shape": [3, config.encoder_width / 2, config.encoder_width], "scale": scale, "log": !config.design.is_linear() },
         "reference": { "file": "reference.bin", "floats_per_pixel": 3, "engine": "nprt's CPU engine" },
         // A model that traces direct light leaves it to the renderer: its networks give the rest.
         "network_radiance": if config.direct.is_learned() { "all of it" } else { "indirect light only" },

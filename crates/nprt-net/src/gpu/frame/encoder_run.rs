@@ -1,24 +1,25 @@
-//! The light encoder on the frame path's device: its dispatches over inputs of one width
-//! (`EncoderAt::record`: convolution blocks, each halving the image, then the dense
-//! layer into the code, on the network's flat weights) kept for the next lighting of that
-//! width.
+//! The light model on the frame path's device: its dispatches over inputs of one width kept
+//! for the next lighting of that width: the encoder's (`EncoderAt::record`: convolution
+//! blocks, each halving the image, then the dense layer into the code, on the network's flat
+//! weights) or the linear design's projection on its basis (`light_project`).
 
 use std::sync::Arc;
 
-use crate::gpu::layers::network_layout::NetworkLayout;
-use crate::network::encoder::CODE_SIZE;
-use nprt_gpu::{Dispatch, GpuDevice, KeptLast};
+use crate::gpu::kernels::LIGHT_PROJECT;
+use crate::gpu::layers::network_layout::{LightAt, NetworkLayout};
+use nprt_gpu::{groups_for, Dispatch, GpuDevice, KeptLast};
 
 use super::light_code::GpuLightCode;
 use super::light_input::GpuLightInput;
 
-/// The encoder's dispatches for inputs of the last width (its weights are the network's).
+/// The light model's dispatches for inputs of the last width (its weights are the network's).
 #[derive(Default)]
 pub(super) struct GpuEncoder {
     runs: KeptLast<usize, Arc<EncoderRun>>,
 }
 
-/// The encoder's dispatches over inputs of one width, with the buffers they read and write.
+/// The light model's dispatches over inputs of one width, with the buffers they read and
+/// write.
 pub(super) struct EncoderRun {
     /// The input a lighting's map is copied into (`3 × width/2 × width`).
     input: wgpu::Buffer,
@@ -39,8 +40,8 @@ impl GpuEncoder {
         self.runs.kept()
     }
 
-    /// Records the encoder of `net` (its weights in `params`) over `input` (its dispatches
-    /// kept per input width) into a new [`GpuLightCode`].
+    /// Records the light model of `net` (its weights in `params`) over `input` (its
+    /// dispatches kept per input width) into a new [`GpuLightCode`].
     pub fn record_code(
         &self,
         gpu: &GpuDevice,
@@ -50,20 +51,30 @@ impl GpuEncoder {
         input: &GpuLightInput,
     ) -> GpuLightCode {
         let run = self.runs.get(input.width, || {
-            let pixels = gpu.buffer(3 * input.width * (input.width / 2));
-            let code = gpu.buffer(CODE_SIZE);
+            let texels = input.width * (input.width / 2);
+            let pixels = gpu.buffer(3 * texels);
+            let code = gpu.buffer(net.light.code_size());
             let mut dispatches = Vec::new();
-            let size = [1, input.width];
-            net.encoder
-                .record(gpu, &mut dispatches, params, &pixels, size, &code, false);
+            match &net.light {
+                LightAt::Encoder(e) => {
+                    let size = [1, input.width];
+                    e.record(gpu, &mut dispatches, params, &pixels, size, &code, false);
+                }
+                LightAt::Basis { size, functions } => dispatches.push(gpu.prepare(
+                    &LIGHT_PROJECT,
+                    &[*size as u32, texels as u32, 0, 0],
+                    &[functions, &pixels, &code],
+                    groups_for(3 * size),
+                )),
+            }
             Arc::new(EncoderRun {
                 input: pixels,
                 code,
                 dispatches,
             })
         });
-        let light = GpuLightCode::room(gpu);
-        let code_bytes = 4 * CODE_SIZE as u64;
+        let light = GpuLightCode::room(gpu, net.light.code_size());
+        let code_bytes = 4 * light.values as u64;
         encoder.copy_buffer_to_buffer(&input.pixels, 0, &run.input, 0, run.input.size());
         {
             let mut pass = encoder.begin_compute_pass(&Default::default());

@@ -15,7 +15,7 @@ use nprt_scene::EnvMap;
 use nprt_trace::gpu::{GpuMap, SameTexels};
 
 use super::encoder_run::GpuEncoder;
-use super::light_code::{GpuLightCode, LIGHT_CODE_VALUES};
+use super::light_code::GpuLightCode;
 use super::light_input::GpuLightInput;
 use crate::encoding::features::{position_frame, FEATURES};
 use crate::encoding::hash_grid;
@@ -26,7 +26,7 @@ use crate::gpu::layers::network_layout::{MlpAt, NetworkLayout};
 use crate::gpu::layers::parameters::ParameterLayout;
 use crate::gpu::products::half_layers::{held_halves, HalfLayers, Held, HALF_ROW_BLOCK};
 use crate::gpu::products::operands::Bias;
-use crate::network::encoder::CODE_SIZE;
+use crate::network::encoder::Texels;
 use crate::network::nprt_net::NprtNet;
 use crate::precision::Precision;
 use crate::shading::{foreign, LightCode, PixelRows, Shading};
@@ -38,7 +38,7 @@ use crate::shading::{foreign, LightCode, PixelRows, Shading};
 /// (`gemm`: 4,096 tiles of 128 rows).
 const MAX_CHUNK: usize = 1 << 19;
 
-/// A model's encoder and transport networks on the GPU, and the last map it was lit by.
+/// A model's light model and transport networks on the GPU, and the last map it was lit by.
 pub struct GpuNetwork {
     gpu: Arc<GpuDevice>,
     /// The weights, as a training step holds them: one flat buffer, and where each tensor
@@ -57,7 +57,7 @@ pub struct GpuNetwork {
     /// lighting change, then the model's gain per channel.
     light: wgpu::Buffer,
     /// Each track's first shading bias with the light code's share folded in, made anew from
-    /// `light` at each lighting change.
+    /// `light` at each lighting change (a linear track's shading network does not read it).
     biases: Vec<wgpu::Buffer>,
     /// The last map's input dispatches, by map, input width and normalisation.
     inputs: KeptLast<(SameTexels, usize, MapNorm), Arc<GpuLightInput>>,
@@ -67,9 +67,10 @@ pub struct GpuNetwork {
     /// Tells the pixels this network made from another's (their kept dispatches read its
     /// buffers).
     id: u64,
-    /// The encoder's input a map is made into: its width and normalisation.
+    /// The light model's input a map is made into: its width, normalisation and texels.
     encoder_width: usize,
     map_norm: MapNorm,
+    texels: Texels,
 }
 
 /// The buffers a camera's pixels run their networks through, which the network keeps for the
@@ -166,8 +167,8 @@ impl GpuNetwork {
         let gpu = GpuDevice::get()?;
         let (layout, flat) = ParameterLayout::pack_for(&gpu, net);
         let params = gpu.upload(&flat);
-        let layout = NetworkLayout::new(&gpu, &layout, net, false)?;
-        let mut light = vec![0.0; LIGHT_CODE_VALUES];
+        let layout = NetworkLayout::new(&gpu, &layout, net, false);
+        let mut light = vec![0.0; layout.light.code_size() + 3];
         light.extend(gain);
         Ok(GpuNetwork {
             light: gpu.upload(&light),
@@ -179,6 +180,7 @@ impl GpuNetwork {
             id: NETWORKS.fetch_add(1, Ordering::Relaxed),
             encoder_width,
             map_norm,
+            texels: net.light.texels(),
             encoder: GpuEncoder::default(),
             params,
             net: layout,
@@ -244,7 +246,7 @@ impl GpuNetwork {
         norm: MapNorm,
     ) -> GpuLightInput {
         let gpu = &*self.gpu;
-        let input = GpuLightInput::for_map(gpu, &self.map, map, width, norm);
+        let input = GpuLightInput::for_map(gpu, &self.map, map, width, norm, self.texels);
         let mut encoder = gpu.device.create_command_encoder(&Default::default());
         input.record(gpu, &mut encoder, map, rotation_deg);
         gpu.queue.submit([encoder.finish()]);
@@ -264,7 +266,7 @@ impl GpuNetwork {
         let gpu = &*self.gpu;
         let key = (SameTexels(map.clone()), width, norm);
         let input = self.inputs.get(key, || {
-            Arc::new(GpuLightInput::for_map(gpu, &self.map, map, width, norm))
+            Arc::new(GpuLightInput::for_map(gpu, &self.map, map, width, norm, self.texels))
         });
         let _one_at_a_time = self.encoding.lock().unwrap_or_else(|e| e.into_inner());
         let mut encoder = gpu.device.create_command_encoder(&Default::default());
@@ -452,7 +454,9 @@ impl GpuNetwork {
         let params = &self.params;
         // b' = b + ê·W[code rows]: the light slot's code through the first layer's code rows.
         for (t, bias) in self.net.tracks.iter().zip(&self.biases) {
-            list.push(t.record_code_share(gpu, params, &self.light, 1, bias));
+            if t.coefficients.is_none() {
+                list.push(t.record_code_share(gpu, params, &self.light, 1, bias));
+            }
         }
         for chunk in &px.chunks {
             for ((t, kept), (bias, out)) in (self.net.tracks.iter())
@@ -460,10 +464,14 @@ impl GpuNetwork {
                 .zip(self.biases.iter().zip(&px.work.outputs))
             {
                 // [ŝ, ê] (ŝ's rows first), or the baseline's [ê, inputs].
+                let bias = match t.coefficients {
+                    None => Bias::Column(bias, 0),
+                    Some(_) => Bias::Column(params, t.shading.layers[0].bias.offset),
+                };
                 let first = FirstLayer {
                     own_row: t.code_and_own_rows().1,
                     count: t.own_width(),
-                    bias: Bias::Column(bias, 0),
+                    bias,
                 };
                 let to = px.work.targets(&t.shading, Held::F32(out));
                 let x = px.work.held(kept);
@@ -479,8 +487,8 @@ impl GpuNetwork {
                     usize::from(k > 0),
                     usize::from(k + 1 == n),
                     chunk.first,
-                    CODE_SIZE,
-                    0,
+                    self.net.light.code_size(),
+                    t.coefficients.unwrap_or(0),
                     0,
                 ];
                 list.push(gpu.prepare(
@@ -510,9 +518,15 @@ impl GpuNetwork {
         self.gpu.profile(&dispatches)
     }
 
-    /// Records the copy of `code` into the light slot the shading networks read.
+    /// Records the copy of `code` (and its divisor) into the light slot the shading networks
+    /// read.
     fn use_light(&self, encoder: &mut wgpu::CommandEncoder, code: &GpuLightCode) {
-        let bytes = 4 * LIGHT_CODE_VALUES as u64;
+        assert_eq!(
+            code.values,
+            self.net.light.code_size(),
+            "a light code of another light model"
+        );
+        let bytes = 4 * (code.values + 3) as u64;
         encoder.copy_buffer_to_buffer(&code.buffer, 0, &self.light, 0, bytes);
     }
 

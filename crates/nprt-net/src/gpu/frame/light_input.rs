@@ -1,13 +1,13 @@
-//! The encoder's input made on the device (what `LightInput::new` makes on the host): the map,
-//! rotated, looked up ss × ss times per input texel and averaged, then divided by its
-//! `MapNorm` divisor and taken through ln(1 + x). A lighting change on the GPU then sends only
+//! The light model's input made on the device (what `LightInput::with_texels` makes on the
+//! host): the map, rotated, looked up ss × ss times per input texel and averaged, then divided
+//! by its `MapNorm` divisor and, for the encoder, taken through ln(1 + x). A lighting change on the GPU then sends only
 //! the map's rotation, into dispatches prepared once per map; on the host the lookups took a
 //! frame milliseconds (64 per texel of a 128-wide input from a 1024-wide map).
 
 use std::sync::LazyLock;
 
 use crate::encoding::map_norm::MapNorm;
-use crate::network::encoder::LightInput;
+use crate::network::encoder::{LightInput, Texels};
 use nprt_gpu::{groups_for, Dispatch, GpuDevice, KernelSource};
 use nprt_scene::EnvMap;
 use nprt_trace::gpu::wgsl::{LERP, MAP_LOOKUP};
@@ -38,15 +38,16 @@ pub struct GpuLightInput {
 }
 
 impl GpuLightInput {
-    /// The dispatches that make `map`'s input for a `width`-wide encoder normalised by `norm`
-    /// (its texels uploaded into `kept` unless they are the last map's), prepared, not queued:
-    /// [`Self::record`] queues them for a rotation.
+    /// The dispatches that make `map`'s input for a `width`-wide light model normalised by
+    /// `norm` and held as `held` (its texels uploaded into `kept` unless they are the last
+    /// map's), prepared, not queued: [`Self::record`] queues them for a rotation.
     pub(super) fn for_map(
         gpu: &GpuDevice,
         kept: &GpuMap,
         map: &EnvMap,
         width: usize,
         norm: MapNorm,
+        held: Texels,
     ) -> Self {
         let count = width * (width / 2);
         let texels = kept.texels(gpu, map);
@@ -65,7 +66,7 @@ impl GpuLightInput {
             ),
             gpu.prepare(
                 &LIGHT_NORMALISE,
-                &[count as u32, norm_code, 0, 0],
+                &[count as u32, norm_code, u32::from(held == Texels::Log), 0],
                 &[&rgb, &pixels, &scale],
                 [1, 1],
             ),

@@ -9,6 +9,7 @@ use crate::gpu::products::half_layers::{HalfLayers, HalfWeight};
 use crate::network::activation::Activation;
 use crate::network::design::TRANSPORT_CODE;
 use crate::network::encoder::CODE_SIZE;
+use crate::network::light_model::LightModel;
 use crate::network::mlp::Mlp;
 use crate::network::nprt_net::NprtNet;
 use crate::network::track_kind::TrackKind;
@@ -55,9 +56,35 @@ impl MlpAt {
     }
 }
 
+/// A network's light model on the device: the paper's encoder in the flat buffers, or the
+/// linear design's basis, its functions already weighted by their texels' solid angles (P as
+/// it multiplies a map: a frame network's weights do not change).
+pub enum LightAt {
+    Encoder(EncoderAt),
+    Basis {
+        /// K: the functions.
+        size: usize,
+        /// K × texels.
+        functions: wgpu::Buffer,
+    },
+}
+
+impl LightAt {
+    /// The light code's values per lighting.
+    pub fn code_size(&self) -> usize {
+        match self {
+            LightAt::Encoder(_) => CODE_SIZE,
+            LightAt::Basis { size, .. } => 3 * size,
+        }
+    }
+}
+
 /// One track's networks on the device.
 pub struct TrackAt {
     pub kind: TrackKind,
+    /// The linear design's K transfer coefficients per term and channel (its shading network
+    /// reads ŝ alone and its terms are dot products with the code); None for the paper's.
+    pub coefficients: Option<usize>,
     /// The feature indices the track reads, in its input order.
     pub index: wgpu::Buffer,
     pub count: usize,
@@ -90,24 +117,30 @@ impl TrackAt {
 
 /// A network's tensors in the flat buffers.
 pub struct NetworkLayout {
-    pub encoder: EncoderAt,
+    pub light: LightAt,
     pub tracks: Vec<TrackAt>,
 }
 
 impl NetworkLayout {
-    /// The places of `net`'s tensors in `layout`; each track's input
-    /// indices are uploaded to `gpu`, and with `half` the transport networks' f16 weights are
-    /// made there (zero until refreshed). The kernels run the paper's encoder; the linear
-    /// design's basis is refused.
-    pub fn new(
-        gpu: &GpuDevice,
-        layout: &ParameterLayout,
-        net: &NprtNet,
-        half: bool,
-    ) -> anyhow::Result<Self> {
-        // Spans in the order the network visits its tensors: the encoder's, then the tracks'.
+    /// The places of `net`'s tensors in `layout`; each track's input indices (and a basis'
+    /// weighted functions) are uploaded to `gpu`, and with `half` the transport networks' f16
+    /// weights are made there (zero until refreshed).
+    pub fn new(gpu: &GpuDevice, layout: &ParameterLayout, net: &NprtNet, half: bool) -> Self {
+        // Spans in the order the network visits its tensors: the light model's, then the
+        // tracks'.
         let mut spans = layout.spans.iter().copied();
-        let encoder = EncoderAt::new(net.encoder()?, &mut spans);
+        let light = match &net.light {
+            LightModel::Encoder(e) => LightAt::Encoder(EncoderAt::new(e, &mut spans)),
+            LightModel::Basis(b) => {
+                if b.choice.is_learned() {
+                    spans.next().expect("a learned basis' span");
+                }
+                LightAt::Basis {
+                    size: b.size(),
+                    functions: gpu.upload(&b.weighted()),
+                }
+            }
+        };
         let tracks: Vec<TrackAt> = net
             .tracks
             .iter()
@@ -117,6 +150,7 @@ impl NetworkLayout {
                 let transfer = t.transfer.as_ref().map(|s| mlp_at(s, &mut spans));
                 TrackAt {
                     kind: t.kind,
+                    coefficients: t.coefficients,
                     index: gpu.upload(&index),
                     count: index.len(),
                     width: index.len() + grid.map_or(0, |_| hash_grid::OUTPUTS),
@@ -126,11 +160,22 @@ impl NetworkLayout {
                 }
             })
             .collect();
-        let mut layout = NetworkLayout { encoder, tracks };
+        let mut layout = NetworkLayout { light, tracks };
         if half {
             layout.hold_half(gpu);
         }
-        Ok(layout)
+        layout
+    }
+
+    /// The paper's encoder, which the training kernels run; the linear design's basis is
+    /// refused there, by name.
+    pub fn encoder(&self) -> anyhow::Result<&EncoderAt> {
+        match &self.light {
+            LightAt::Encoder(e) => Ok(e),
+            LightAt::Basis { .. } => anyhow::bail!(
+                "the linear design has no GPU training kernels yet: it trains on the CPU engine"
+            ),
+        }
     }
 
     /// Gives the transport networks' layers f16 copies of their weights (zero until

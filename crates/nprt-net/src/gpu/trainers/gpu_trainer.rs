@@ -149,7 +149,8 @@ impl GpuTrainer {
         }
         let shapes = net.clone();
         let (layout, flat) = ParameterLayout::pack_for(&gpu, net);
-        let net = NetworkLayout::new(&gpu, &layout, net, half)?;
+        let net = NetworkLayout::new(&gpu, &layout, net, half);
+        net.encoder()?;
         let params = gpu.upload(&flat);
         let grads = gpu.buffer(layout.total);
         let adam = DeviceAdam::new(&gpu, layout.total, &grads, &params);
@@ -391,7 +392,8 @@ impl GpuTrainer {
             None => {
                 let b = self.batch_buffers(rows, views, light_width);
                 let mut dispatches = Vec::new();
-                let (gpu, encoder) = (&self.gpu, &self.net.encoder);
+                let gpu = &self.gpu;
+                let encoder = self.net.encoder().expect("refused when the trainer was made");
                 let maps = [b.views, b.light_width];
                 let tape = encoder.record(
                     gpu,

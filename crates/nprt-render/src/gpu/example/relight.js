@@ -100,12 +100,13 @@ async function main() {
     });
   };
 
-  // The networks.
-  const blocks = exp.encoder.blocks.map((b) => ({
+  // The networks: the paper's encoder, or the linear design's basis (export.json has one).
+  const blocks = (exp.encoder?.blocks ?? []).map((b) => ({
     cIn: b.in_channels, cOut: b.out_channels, weight: tensor(b.weight).buffer, bias: tensor(b.bias).buffer,
   }));
   const [codeSize, perRow] = [exp.code_size, exp.inputs_per_pixel];
-  const toCode = dense(exp.encoder.to_code);
+  const toCode = exp.encoder ? dense(exp.encoder.to_code) : null;
+  const functions = exp.basis ? tensor(exp.basis.functions).buffer : null;
   const resolutions = upload(new Uint32Array(exp.tracks.find((t) => t.grid)?.grid.resolutions ?? [0, 0, 0, 0]));
   const tracks = exp.tracks.map((t) => ({
     kind: t.kind_code,
@@ -116,6 +117,7 @@ async function main() {
     transfer: t.transfer ? mlp(t.transfer) : null,
     shading: mlp(t.shading),
     codeRows: t.code_rows,
+    coefficients: t.coefficients ?? 0,
   }));
   const empty = room(4);
 
@@ -133,15 +135,20 @@ async function main() {
   const outputs = tracks.map((t) => room(rows * t.shading.layers.at(-1).dOut));
   const rgb = room(rows * 3);
 
-  // 1. The light code: the convolution blocks, then a dense layer (once per lighting change).
-  // After its values, the factors combine.wgsl multiplies each channel by: the map's divisor
-  // times the model's gain (here already one product), then 1.
+  // 1. The light code (once per lighting change): the convolution blocks, then a dense layer;
+  // or the map's projection on the basis. After its values, the factors combine.wgsl
+  // multiplies each channel by: the map's divisor times the model's gain (here already one
+  // product), then 1.
   const code = room(codeSize + 6);
   device.queue.writeBuffer(code, codeSize * 4, new Float32Array([...ex.light.scale, 1, 1, 1]));
   let encoder = device.createCommandEncoder();
   let pass = encoder.beginComputePass();
   let [h, w] = [ex.light.shape[1], ex.light.shape[2]];
   let x = upload(light);
+  if (functions) {
+    dispatch(pass, 'light_project', { size: exp.basis.size, texels: h * w }, [functions, x, code],
+      groups('light_project', codeSize));
+  }
   for (const b of blocks) {
     const outputs = b.cOut * (h / 2) * (w / 2);
     const out = room(outputs);
@@ -150,7 +157,7 @@ async function main() {
       groups('encoder_block', threads));
     [x, h, w] = [out, h / 2, w / 2];
   }
-  denseLayer(pass, toCode, x, 1, toCode.dIn, 0, toCode.bias, 0, code);
+  if (toCode) denseLayer(pass, toCode, x, 1, toCode.dIn, 0, toCode.bias, 0, code);
 
   // 2. What does not depend on the lighting (once per camera): each track's inputs and, where
   // it has one, its transfer network's output ŝ.
@@ -167,12 +174,18 @@ async function main() {
   device.queue.submit([encoder.finish()]);
 
   // 3. Per lighting: the code's share of each shading network's first layer, the shading
-  // networks, and exp, kd/ks and the map's scale (combine.wgsl).
+  // networks, and exp (or, for a linear track, the dot products of its transfer coefficients
+  // with the code), kd/ks and the map's scale (combine.wgsl).
   const relight = () => {
     const encoder = device.createCommandEncoder();
     const pass = encoder.beginComputePass();
     tracks.forEach((t, i) => {
       const first = t.shading.layers[0];
+      if (!t.codeRows) {
+        // A linear track's shading network reads ŝ alone.
+        runMlp(pass, t.shading, kept[i], rows, { dIn: first.dIn, wRow: 0 }, scratch, outputs[i]);
+        return;
+      }
       const bias = room(first.dOut);
       // b' = b + ê·W[code rows]: the first layer's code rows over one row.
       denseLayer(pass, first, code, 1, codeSize, t.codeRows[0], first.bias, 0, bias);
@@ -183,7 +196,10 @@ async function main() {
     });
     // The tracks' radiance summed into rgb one track per dispatch, the last scaled.
     tracks.forEach((t, i) => {
-      const params = { rows, kind: t.kind, accumulate: i > 0 ? 1 : 0, scaled: i === tracks.length - 1 ? 1 : 0, scale_at: codeSize };
+      const params = {
+        rows, kind: t.kind, accumulate: i > 0 ? 1 : 0, scaled: i === tracks.length - 1 ? 1 : 0,
+        scale_at: codeSize, coefficients: t.coefficients,
+      };
       dispatch(pass, 'combine', params, [features, outputs[i], code, rgb], groups('combine', rows));
     });
     pass.end();

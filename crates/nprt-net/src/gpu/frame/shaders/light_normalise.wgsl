@@ -1,13 +1,15 @@
-// The encoder's input on the device, second pass (LightInput::new's normalisation), one
-// workgroup: the texels' mean per channel (each thread adds every 256th texel in order, then a
-// fixed tree), the divisor MapNorm::scale makes of it, and each channel plane of the input,
-// ln(1 + c / scale), channel-major as the encoder reads it. The divisor is written to `scale`.
+// The light model's input on the device, second pass (LightInput::with_texels'
+// normalisation), one workgroup: the texels' mean per channel (each thread adds every 256th
+// texel in order, then a fixed tree), the divisor MapNorm::scale makes of it, and each channel
+// plane of the input, ln(1 + c / scale) for the encoder or c / scale for a basis (Texels),
+// channel-major as the light model reads it. The divisor is written to `scale`.
 
 struct LightNormalise {
     texels: u32,
     // 0: MapNorm::Mean (one divisor, the mean over channels); 1: MapNorm::Channel.
     norm: u32,
-    _pad0: u32,
+    // 1: Texels::Log; 0: Texels::Linear.
+    log: u32,
     _pad1: u32,
 }
 
@@ -60,9 +62,12 @@ fn main(@builtin(local_invocation_index) t: u32) {
         scale[2] = d.z;
     }
     for (var i = t; i < p.texels; i += THREADS) {
-        let c = texel(i);
-        pixels[i] = log_1p(c.x / d.x);
-        pixels[p.texels + i] = log_1p(c.y / d.y);
-        pixels[2u * p.texels + i] = log_1p(c.z / d.z);
+        var c = texel(i) / d;
+        if p.log == 1u {
+            c = vec3<f32>(log_1p(c.x), log_1p(c.y), log_1p(c.z));
+        }
+        pixels[i] = c.x;
+        pixels[p.texels + i] = c.y;
+        pixels[2u * p.texels + i] = c.z;
     }
 }
