@@ -1,7 +1,8 @@
 //! The paper's orderings as training grows (`nprt paper --snapshots`): the four designs'
 //! Table 5 figures at each snapshot point, each ordering of Tables 5 and 6 judged at each point
 //! (the snapshot's D/S against the evaluation's competitors), the point from which each holds,
-//! and plots of RMSE and loss against training time with the paper's KITCHEN figures as marks.
+//! plots of RMSE and loss against training time with the paper's KITCHEN figures as marks, and
+//! on KITCHEN each design's RMSE projected to the paper's by a power law.
 
 use std::fmt::Write as _;
 use std::path::Path;
@@ -13,6 +14,7 @@ use nprt_net::{Design, ModelConfig};
 
 use crate::orderings::{self, Ordering};
 use crate::paper_figures::over_views;
+use crate::power_law::PowerLaw;
 use crate::published;
 use crate::readback::GrowthPoint;
 
@@ -87,7 +89,66 @@ pub fn as_training_grows(
     }
     writeln!(md)?;
     verdicts(md, e, points)?;
-    plots(md, points, &designs, kitchen, dir)
+    plots(md, points, &designs, kitchen, dir)?;
+    if kitchen {
+        projection(md, points, &designs)?;
+    }
+    Ok(())
+}
+
+/// Each design's RMSE against training time fitted by a power law, and when it would reach
+/// the paper's KITCHEN RMSE if the law held.
+fn projection(md: &mut String, points: &[GrowthPoint], designs: &[String]) -> Result<()> {
+    writeln!(
+        md,
+        "### Projected: when each design would reach the paper's KITCHEN RMSE
+
+         A projection, not a measurement: RMSE ≈ a·t^b fitted by least squares to the          logarithms of the points above (t in training minutes), extended to the paper's          figure. It assumes the trend holds far past the last point (each run's cosine schedule          spans its own length; the paper trained 500 epochs at a constant rate) and sets          nprt's test views beside the paper's, which are other views at another size.
+"
+    )?;
+    writeln!(
+        md,
+        "| design | a × 10³ | b | R² | last point: RMSE × 10³ at min | the paper's RMSE × 10³ | reached at (projected) |
+         |---|---|---|---|---|---|---|"
+    )?;
+    for (name, &design) in designs.iter().zip(&Design::PAPER) {
+        let line: Vec<(f64, f64)> = (points.iter())
+            .filter_map(|p| {
+                let m = p.rows.iter().find(|m| &m.name == name)?;
+                Some((p.minutes, over_views(m, Metrics::RMSE).0))
+            })
+            .collect();
+        let paper = published::table5(2, design).map(|f| f[1]);
+        let (Some(fit), Some(&(t, last))) = (PowerLaw::fit(&line), line.last()) else {
+            writeln!(md, "| {name} | fewer than 3 points | | | | | |")?;
+            continue;
+        };
+        let reached = match paper.and_then(|p| fit.reaches(p / 1e3)) {
+            Some(at) if fit.exponent < 0.0 => duration_of_minutes(at),
+            _ => "never on this trend".into(),
+        };
+        writeln!(
+            md,
+            "| {name} | {:.2} | {:.3} | {:.2} | {:.2} at {t:.1} | {} | {reached} |",
+            fit.scale * 1e3,
+            fit.exponent,
+            fit.r2,
+            last * 1e3,
+            paper.map_or("–".into(), |p| format!("{p:.2}")),
+        )?;
+    }
+    writeln!(md)?;
+    Ok(())
+}
+
+/// Minutes said in the largest unit that keeps them readable.
+fn duration_of_minutes(m: f64) -> String {
+    match m {
+        m if m < 120.0 => format!("{m:.0} min"),
+        m if m < 48.0 * 60.0 => format!("{:.1} h", m / 60.0),
+        m if m < 730.0 * 24.0 * 60.0 => format!("{:.1} days", m / 1440.0),
+        m => format!("{:.1e} years", m / 525_960.0),
+    }
 }
 
 fn e3(m: &MethodResult, k: usize) -> String {
@@ -195,4 +256,69 @@ fn plots(
         writeln!(md, "![{title}]({file})\n")?;
     }
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use nprt_eval::Family;
+
+    /// A design's row at one point: every view's RMSE `rmse`.
+    fn row(name: &str, rmse: f64) -> MethodResult {
+        let per_view = vec![
+            Metrics {
+                rmse,
+                ..Metrics::default()
+            };
+            4
+        ];
+        MethodResult {
+            mean: Metrics::mean(&per_view),
+            per_view,
+            ..MethodResult::new(name, Family::NeuralPrt, None)
+        }
+    }
+
+    /// D/S on an exact power law reaches the paper's RMSE where the law says; a design that
+    /// does not improve never does; one with two points is not fitted.
+    #[test]
+    fn each_design_is_projected_to_the_papers_kitchen_rmse() {
+        let designs: Vec<String> = (Design::PAPER.iter())
+            .map(|&d| row_name(&ModelConfig::new(d, None)))
+            .collect();
+        let paper = published::table5(2, Design::Dsep).unwrap()[1] / 1e3;
+        // D/S: 4·paper at 1 minute, falling as t^-0.5: the paper's at 16 minutes.
+        let points: Vec<GrowthPoint> = [1.0, 2.0, 4.0, 8.0]
+            .iter()
+            .enumerate()
+            .map(|(i, &t): (usize, &f64)| GrowthPoint {
+                point: format!("{t}m"),
+                key: String::new(),
+                minutes: t,
+                rows: [
+                    (i < 2).then(|| row(&designs[0], 0.2)),
+                    Some(row(&designs[1], 0.1)),
+                    Some(row(&designs[3], 4.0 * paper * t.powf(-0.5))),
+                ]
+                .into_iter()
+                .flatten()
+                .collect(),
+            })
+            .collect();
+        let mut md = String::new();
+        projection(&mut md, &points, &designs).unwrap();
+        let line = |name: &str| {
+            md.lines()
+                .find(|l| l.starts_with(&format!("| {name} |")))
+                .unwrap_or_else(|| panic!("no row for {name}:\n{md}"))
+                .to_string()
+        };
+        assert!(line(&designs[3]).ends_with("| 16 min |"), "{md}");
+        assert!(line(&designs[3]).contains("| -0.500 | 1.00 |"), "{md}");
+        assert!(line(&designs[1]).ends_with("| never on this trend |"), "{md}");
+        assert!(line(&designs[0]).contains("fewer than 3 points"), "{md}");
+        assert!(line(&designs[2]).contains("fewer than 3 points"), "{md}");
+        assert_eq!(duration_of_minutes(30.0 * 60.0), "30.0 h");
+        assert_eq!(duration_of_minutes(5.0 * 1440.0), "5.0 days");
+    }
 }

@@ -13,6 +13,7 @@ pub mod orderings;
 mod paper_figures;
 mod paper_report;
 mod pipeline;
+pub mod power_law;
 pub mod published;
 pub mod readback;
 mod stage_log;
