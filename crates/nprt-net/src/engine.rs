@@ -10,7 +10,6 @@ use nprt_trace::TraceDevice;
 
 use crate::choice::named_choice;
 use crate::cpu::{CpuShading, HostCacheSteps};
-use crate::model::config::ModelConfig;
 use crate::model::folder::ModelFile;
 use crate::network::nprt_net::NprtNet;
 use crate::network::radiance_cache::{RadianceCache, ADAM_BETAS};
@@ -118,22 +117,6 @@ impl From<TraceDevice> for Engine {
 impl Engine {
     pub fn is_gpu(self) -> bool {
         self == Engine::Gpu
-    }
-
-    /// The engine a network of `config` trains on: this one, or the CPU engine for the linear
-    /// design, whose GPU training kernels are not written yet (said on standard error), so that
-    /// a run of several designs on a GPU (`nprt paper`, `nprt demo`) keeps it. Its frames run
-    /// on either.
-    pub fn for_training(self, config: &ModelConfig) -> Engine {
-        if self.is_gpu() && config.design.is_linear() {
-            eprintln!(
-                "{}: the linear design trains on the CPU engine (its GPU training kernels are \
-                 not written yet); its frames run on the GPU",
-                config.label()
-            );
-            return Engine::Cpu;
-        }
-        self
     }
 
     /// The trained network `net` (with `file`'s settings: its encoder's input and its gain) on
@@ -249,17 +232,5 @@ mod tests {
             .unwrap_err()
             .contains("cpu, gpu, wgpu or auto"));
         assert_eq!("wgpu".parse::<Compute>(), Ok(Compute::Wgpu));
-    }
-
-    /// A run of several designs on the GPU keeps the linear one, trained on the CPU engine;
-    /// the others stay where they were asked to run.
-    #[test]
-    fn the_linear_design_trains_on_the_cpu_engine() {
-        use crate::network::design::Design;
-        let linear = ModelConfig::new(Design::Linear, None);
-        let dsep = ModelConfig::new(Design::Dsep, None);
-        assert_eq!(Engine::Gpu.for_training(&linear), Engine::Cpu);
-        assert_eq!(Engine::Gpu.for_training(&dsep), Engine::Gpu);
-        assert_eq!(Engine::Cpu.for_training(&linear), Engine::Cpu);
     }
 }

@@ -1,6 +1,7 @@
 //! The GPU training step (nprt-net's own kernels, `gpu::GpuTrainer`) against the CPU engine
-//! it must agree with: loss and every parameter's gradient (light encoder, transport networks,
-//! hash grids) for every design, activation and encoding, both losses; two Adam steps against
+//! it must agree with: loss and every parameter's gradient (light encoder or learned basis,
+//! transport networks, hash grids) for every design, the linear one included, activation and
+//! encoding, both losses; two Adam steps against
 //! the host's Adam. Overfitting and exact resume through `nprt train --device wgpu` are in nprt's
 //! tests/train.rs. Runs on
 //! whatever adapter wgpu finds; CI's is Mesa's software Vulkan (scripts/vulkan.sh). Without
@@ -16,8 +17,8 @@ use nprt_gpu::GpuDevice;
 use nprt_net::gpu::GpuTrainer;
 use nprt_net::optimiser::Adam;
 use nprt_net::{
-    cpu, Activation, Design, Init, Loss, ModelConfig, NprtNet, Parameters, PositionEncoding,
-    Precision,
+    cpu, Activation, Design, Init, LightModel, Loss, ModelConfig, NprtNet, Parameters,
+    PositionEncoding, Precision,
 };
 
 /// `config` with an encoder for the test batches' 64-wide maps, built from seed 4 with loud
@@ -30,15 +31,6 @@ fn network(config: &ModelConfig) -> NprtNet {
     loud_grids(config.build(&mut Init::new(4)))
 }
 
-/// The variants the GPU kernels train: all but the linear design's, which has no kernels yet
-/// (its GPU engine falls back to the CPU's, `Engine::for_training`).
-fn kernel_variants() -> Vec<ModelConfig> {
-    variants()
-        .into_iter()
-        .filter(|c| !c.design.is_linear())
-        .collect()
-}
-
 /// Every design, activation and encoding, and a network of three tracks ([`three_tracks`]).
 #[test]
 fn gpu_gradients_match_the_cpu_engine_for_every_design() {
@@ -47,7 +39,7 @@ fn gpu_gradients_match_the_cpu_engine_for_every_design() {
     }
     let batch = random_batch(300, 3, 22);
     let samples = batch.samples();
-    let designs = kernel_variants().into_iter().map(|config| {
+    let designs = variants().into_iter().map(|config| {
         let name = format!("{} {}", config.label(), config.activation);
         (name, network(&config))
     });
@@ -57,13 +49,16 @@ fn gpu_gradients_match_the_cpu_engine_for_every_design() {
             let mut gpu = GpuTrainer::new(&net, Precision::F32).unwrap();
             let value = gpu.backward(&samples, loss);
             let errors = tensor_errors(&gpu.gradients(), &want);
-            let encoder_tensors = 2 * net.encoder().unwrap().convs.len() + 2;
-            let (encoder, transport) = errors.split_at(encoder_tensors);
+            let light_tensors = match &net.light {
+                LightModel::Encoder(e) => 2 * e.convs.len() + 2,
+                LightModel::Basis(b) => usize::from(b.choice.is_learned()),
+            };
+            let (light, transport) = errors.split_at(light_tensors);
             let loss_error = (value - want_loss).abs() / want_loss;
             let name = format!("{name} {loss}");
             eprintln!(
-                "{name}: loss {loss_error:.1e}, encoder gradients {:.1e}, transport gradients {:.1e}",
-                worst(encoder),
+                "{name}: loss {loss_error:.1e}, light model gradients {:.1e}, transport gradients {:.1e}",
+                worst(light),
                 worst(transport)
             );
             // Lavapipe: loss within 6.7e-7, gradients within 1.2e-6 (sums in another order;
@@ -207,7 +202,7 @@ fn mixed_precision_gradients_follow_the_cpu_engine_for_every_design() {
     let samples = batch.samples();
     let mut worst_loss = 0.0f64;
     let mut worst_gradient = 0.0f64;
-    for config in kernel_variants() {
+    for config in variants() {
         let net = network(&config);
         for loss in [Loss::LogL1, Loss::RelL2] {
             let (want_loss, want) = cpu::gradients(&net, &samples, loss);

@@ -68,8 +68,7 @@ pub struct BenchFrameArgs {
 /// The designs a benchmark measures.
 #[derive(clap::Args)]
 pub struct BenchDesigns {
-    /// Designs to measure, comma-separated (default: the paper's four; the linear design's
-    /// training runs on the CPU engine only so far).
+    /// Designs to measure, comma-separated (default: the paper's four).
     #[arg(long, value_delimiter = ',', value_parser = design_names(), default_values_t = Design::PAPER)]
     arch: Vec<Design>,
 }

@@ -49,7 +49,7 @@ impl LightModel {
 
 impl LightBasis {
     /// Each function times its texel's solid angle, K × texels: P as it multiplies a map.
-    pub fn weighted(&self) -> Vec<f32> {
+    fn weighted(&self) -> Vec<f32> {
         let (w, rows) = (self.width, self.row_solid_angles());
         let texels = w * w / 2;
         let mut p = self.functions.clone();

@@ -49,8 +49,10 @@ pub const RADIANCE_LOSS: KernelSource = kernel!("radiance_loss", "loss_element")
 pub static TRACK_GRADIENT: LazyLock<KernelSource> =
     LazyLock::new(|| with_kinds(kernel!("track_gradient", "track_radiance")));
 pub const ADAM: KernelSource = kernel!("adam");
-/// The linear design's light code: the map's projection on its basis.
+/// The linear design's light codes, the maps' projections on its basis, and the gradient of a
+/// learned basis' functions.
 pub const LIGHT_PROJECT: KernelSource = kernel!("light_project");
+pub const LIGHT_PROJECT_BACKWARD: KernelSource = kernel!("light_project_backward");
 pub const GATHER_SAMPLES: KernelSource = kernel!("gather_samples", "pixel_features");
 /// The network inputs of a G-buffer left on the device (nprt-render's frame path).
 pub const GBUFFER_FEATURES: KernelSource = kernel!("gbuffer_features", "pixel_features");

@@ -225,7 +225,7 @@ pub fn train(
     opts.check()?;
     // On the GPU the steps run on our own kernels, with the network's host copy (for saving)
     // on the CPU.
-    let kernels = cfg!(feature = "gpu") && engine.for_training(config).is_gpu();
+    let kernels = cfg!(feature = "gpu") && engine.is_gpu();
     if opts.precision != Precision::F32 && !kernels {
         bail!(
             "--precision {} trains on nprt's own GPU kernels only: use --device gpu (a build \

@@ -101,8 +101,8 @@ impl WeightFile {
     }
 
     /// The light model, its tensors added: `encoder` (the paper's blocks and its dense layer
-    /// into the code) or, for the linear design, `basis` (the functions already times their
-    /// texels' solid angles, which `light_project` multiplies the map by).
+    /// into the code) or, for the linear design, `basis` (its functions' values at the texels
+    /// and each texel's solid angle, which `light_project` multiplies the map by).
     fn light_model(&mut self, net: &NprtNet, input_width: usize) -> Value {
         match &net.light {
             LightModel::Encoder(e) => {
@@ -116,13 +116,14 @@ impl WeightFile {
                 }, "basis": null })
             }
             LightModel::Basis(b) => {
-                let texels = b.width * b.width / 2;
-                let functions = self.add("basis.weighted", &[b.size(), texels], &b.weighted());
+                let (w, rows) = (b.width, b.row_solid_angles());
+                let solid: Vec<f32> = (0..w * w / 2).map(|t| rows[t / w]).collect();
                 json!({ "encoder": null, "basis": {
                     "choice": b.choice.to_string(),
-                    "input_width": b.width,
+                    "input_width": w,
                     "size": b.size(),
-                    "functions": functions,
+                    "functions": self.add("basis.functions", &[b.size(), solid.len()], &b.functions),
+                    "solid_angles": self.add("basis.solid_angles", &[solid.len()], &solid),
                 }})
             }
         }

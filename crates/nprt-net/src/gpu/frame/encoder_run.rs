@@ -5,9 +5,8 @@
 
 use std::sync::Arc;
 
-use crate::gpu::kernels::LIGHT_PROJECT;
 use crate::gpu::layers::network_layout::{LightAt, NetworkLayout};
-use nprt_gpu::{groups_for, Dispatch, GpuDevice, KeptLast};
+use nprt_gpu::{Dispatch, GpuDevice, KeptLast};
 
 use super::light_code::GpuLightCode;
 use super::light_input::GpuLightInput;
@@ -60,12 +59,10 @@ impl GpuEncoder {
                     let size = [1, input.width];
                     e.record(gpu, &mut dispatches, params, &pixels, size, &code, false);
                 }
-                LightAt::Basis { size, functions } => dispatches.push(gpu.prepare(
-                    &LIGHT_PROJECT,
-                    &[*size as u32, texels as u32, 0, 0],
-                    &[functions, &pixels, &code],
-                    groups_for(3 * size),
-                )),
+                LightAt::Basis(b) => {
+                    assert_eq!(b.texels, texels, "the basis' map width");
+                    dispatches.push(b.record_project(gpu, params, &pixels, 1, &code));
+                }
             }
             Arc::new(EncoderRun {
                 input: pixels,

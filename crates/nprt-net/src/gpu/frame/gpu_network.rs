@@ -491,10 +491,11 @@ impl GpuNetwork {
                     t.coefficients.unwrap_or(0),
                     0,
                 ];
+                // One code for every row (code_stride 0): the views binding is not read.
                 list.push(gpu.prepare(
                     &COMBINE,
                     &params.map(|v| v as u32),
-                    &[&chunk.features, out, &self.light, &px.rgb],
+                    &[&chunk.features, out, &self.light, &chunk.features, &px.rgb],
                     groups_for(chunk.rows),
                 ));
             }

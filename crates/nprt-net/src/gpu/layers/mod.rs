@@ -1,12 +1,14 @@
 //! Where each tensor of a network lies in the flat parameter buffer (`parameters`,
 //! `layer_at`, `network_layout`: encoder blocks, tracks, layers and their f16 copies) and how
 //! each layer's forward pass is recorded on it: the light encoder's convolution blocks
-//! (`light_encoder`, the CPU's `cpu/light_encoder.rs`), the U-Net's convolutions (`conv`,
+//! (`light_encoder`, the CPU's `cpu/light_encoder.rs`) or the linear design's basis
+//! (`light_basis`, `cpu/light_model.rs`), the U-Net's convolutions (`conv`,
 //! `cpu/conv.rs`), a track's inputs and an MLP in f32 or f16 (`network_forward`, the forward
 //! half of `cpu/transport.rs` and `cpu/dense.rs`). Uses `products` below it.
 
 pub(crate) mod conv;
 pub(crate) mod layer_at;
+pub(crate) mod light_basis;
 pub(crate) mod light_encoder;
 pub(crate) mod network_forward;
 pub(crate) mod network_layout;

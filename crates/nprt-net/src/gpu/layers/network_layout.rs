@@ -3,6 +3,7 @@
 
 use crate::encoding::hash_grid;
 use crate::gpu::layers::layer_at::DenseAt;
+use crate::gpu::layers::light_basis::BasisAt;
 use crate::gpu::layers::light_encoder::EncoderAt;
 use crate::gpu::layers::parameters::ParameterLayout;
 use crate::gpu::products::half_layers::{HalfLayers, HalfWeight};
@@ -56,17 +57,10 @@ impl MlpAt {
     }
 }
 
-/// A network's light model on the device: the paper's encoder in the flat buffers, or the
-/// linear design's basis, its functions already weighted by their texels' solid angles (P as
-/// it multiplies a map: a frame network's weights do not change).
+/// A network's light model on the device: the paper's encoder or the linear design's basis.
 pub enum LightAt {
     Encoder(EncoderAt),
-    Basis {
-        /// K: the functions.
-        size: usize,
-        /// K × texels.
-        functions: wgpu::Buffer,
-    },
+    Basis(BasisAt),
 }
 
 impl LightAt {
@@ -74,7 +68,7 @@ impl LightAt {
     pub fn code_size(&self) -> usize {
         match self {
             LightAt::Encoder(_) => CODE_SIZE,
-            LightAt::Basis { size, .. } => 3 * size,
+            LightAt::Basis(b) => 3 * b.size,
         }
     }
 }
@@ -122,8 +116,8 @@ pub struct NetworkLayout {
 }
 
 impl NetworkLayout {
-    /// The places of `net`'s tensors in `layout`; each track's input indices (and a basis'
-    /// weighted functions) are uploaded to `gpu`, and with `half` the transport networks' f16
+    /// The places of `net`'s tensors in `layout`; each track's input indices (and a fixed
+    /// basis' functions) are uploaded to `gpu`, and with `half` the transport networks' f16
     /// weights are made there (zero until refreshed).
     pub fn new(gpu: &GpuDevice, layout: &ParameterLayout, net: &NprtNet, half: bool) -> Self {
         // Spans in the order the network visits its tensors: the light model's, then the
@@ -131,15 +125,7 @@ impl NetworkLayout {
         let mut spans = layout.spans.iter().copied();
         let light = match &net.light {
             LightModel::Encoder(e) => LightAt::Encoder(EncoderAt::new(e, &mut spans)),
-            LightModel::Basis(b) => {
-                if b.choice.is_learned() {
-                    spans.next().expect("a learned basis' span");
-                }
-                LightAt::Basis {
-                    size: b.size(),
-                    functions: gpu.upload(&b.weighted()),
-                }
-            }
+            LightModel::Basis(b) => LightAt::Basis(BasisAt::new(gpu, b, &mut spans)),
         };
         let tracks: Vec<TrackAt> = net
             .tracks
@@ -165,17 +151,6 @@ impl NetworkLayout {
             layout.hold_half(gpu);
         }
         layout
-    }
-
-    /// The paper's encoder, which the training kernels run; the linear design's basis is
-    /// refused there, by name.
-    pub fn encoder(&self) -> anyhow::Result<&EncoderAt> {
-        match &self.light {
-            LightAt::Encoder(e) => Ok(e),
-            LightAt::Basis { .. } => anyhow::bail!(
-                "the linear design has no GPU training kernels yet: it trains on the CPU engine"
-            ),
-        }
     }
 
     /// Gives the transport networks' layers f16 copies of their weights (zero until

@@ -16,18 +16,21 @@ struct Combine {
     first: u32,
     // Index in `light` of the divisor's 3 values, the gain's 3 following.
     scale_at: u32,
-    // K for a linear track: its outputs are K transfer coefficients per term and channel,
-    // each term the dot product of its coefficients with the code at the start of `light`.
-    // 0: the outputs are log-radiance.
+    // K for a linear track (its outputs are K transfer coefficients per term and channel, each
+    // term their dot product with the code in `light`); 0: the outputs are log-radiance.
     coefficients: u32,
-    _pad2: u32,
+    // Values between one view's code and the next in `light`, row r's code starting at
+    // views[r] · code_stride (training: a code per view); 0: one code for every row.
+    code_stride: u32,
 }
 
 @group(0) @binding(0) var<uniform> p: Combine;
 @group(0) @binding(1) var<storage, read> features: array<f32>;
 @group(0) @binding(2) var<storage, read> out: array<f32>;
 @group(0) @binding(3) var<storage, read> light: array<f32>;
-@group(0) @binding(4) var<storage, read_write> rgb: array<f32>;
+// Each row's view (u32; read only with code_stride > 0: bind any buffer otherwise).
+@group(0) @binding(4) var<storage, read> views: array<u32>;
+@group(0) @binding(5) var<storage, read_write> rgb: array<f32>;
 
 @compute @workgroup_size(64)
 fn main(@builtin(global_invocation_id) id: vec3<u32>, @builtin(num_workgroups) groups: vec3<u32>) {
@@ -37,13 +40,7 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>, @builtin(num_workgroups) g
         return;
     }
     let o = 3u * (p.first + r);
-    var e: array<vec3<f32>, MAX_TERMS>;
-    if (p.coefficients == 0u) {
-        e = exps(p.kind, r);
-    } else {
-        e = transfer_terms(p.kind, r, p.coefficients);
-    }
-    var c = track_radiance(p.kind, r, e);
+    var c = track_radiance(p.kind, r, terms(p.kind, r, p.coefficients, code_at(r, p.code_stride)));
     if (p.accumulate == 1u) {
         c = vec3<f32>(rgb[o], rgb[o + 1u], rgb[o + 2u]) + c;
     }
@@ -54,21 +51,4 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>, @builtin(num_workgroups) g
     rgb[o] = c.x;
     rgb[o + 1u] = c.y;
     rgb[o + 2u] = c.z;
-}
-
-// A linear track's terms (cpu::transport): term t, channel c is
-// Σ_j out[(t·K + j)·3 + c] · light[j·3 + c] over the row's K coefficients per term.
-fn transfer_terms(kind: u32, r: u32, k: u32) -> array<vec3<f32>, MAX_TERMS> {
-    let n = outputs(kind) * k * r;
-    var e: array<vec3<f32>, MAX_TERMS>;
-    for (var t = 0u; t < KIND_TERMS[kind]; t++) {
-        var s = vec3<f32>(0.0);
-        for (var j = 0u; j < k; j++) {
-            let i = n + 3u * (t * k + j);
-            let code = vec3<f32>(light[3u * j], light[3u * j + 1u], light[3u * j + 2u]);
-            s += vec3<f32>(out[i], out[i + 1u], out[i + 2u]) * code;
-        }
-        e[t] = s;
-    }
-    return e;
 }

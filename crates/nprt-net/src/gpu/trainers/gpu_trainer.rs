@@ -17,14 +17,13 @@ use crate::cpu::Samples;
 use crate::encoding::features::FEATURES;
 use crate::encoding::hash_grid;
 use crate::gpu::kernels::GATHER_SAMPLES;
-use crate::gpu::layers::network_layout::NetworkLayout;
+use crate::gpu::layers::network_layout::{LightAt, NetworkLayout};
 use crate::gpu::layers::parameters::ParameterLayout;
 use crate::gpu::passes::device_adam::DeviceAdam;
 use crate::gpu::passes::mlp_step::Trainable;
 use crate::gpu::trainers::device_dataset::DeviceDataset;
 use crate::gpu::trainers::plans::{Pass, Plans};
 use crate::loss::Loss;
-use crate::network::encoder::CODE_SIZE;
 use crate::network::nprt_net::NprtNet;
 use crate::precision::Precision;
 use nprt_gpu::{groups_for, Dispatch, GpuDevice};
@@ -150,7 +149,6 @@ impl GpuTrainer {
         let shapes = net.clone();
         let (layout, flat) = ParameterLayout::pack_for(&gpu, net);
         let net = NetworkLayout::new(&gpu, &layout, net, half);
-        net.encoder()?;
         let params = gpu.upload(&flat);
         let grads = gpu.buffer(layout.total);
         let adam = DeviceAdam::new(&gpu, layout.total, &grads, &params);
@@ -392,21 +390,35 @@ impl GpuTrainer {
             None => {
                 let b = self.batch_buffers(rows, views, light_width);
                 let mut dispatches = Vec::new();
-                let gpu = &self.gpu;
-                let encoder = self.net.encoder().expect("refused when the trainer was made");
-                let maps = [b.views, b.light_width];
-                let tape = encoder.record(
-                    gpu,
-                    &mut dispatches,
-                    &self.params,
-                    &b.lights,
-                    maps,
-                    &b.codes,
-                    true,
-                );
+                let (gpu, params) = (&self.gpu, &self.params);
+                // The light model's forward pass, then the transport's, then the light
+                // model's backward.
+                let tape = match &self.net.light {
+                    LightAt::Encoder(e) => {
+                        let maps = [b.views, b.light_width];
+                        let lights = &b.lights;
+                        Some(e.record(gpu, &mut dispatches, params, lights, maps, &b.codes, true))
+                    }
+                    LightAt::Basis(basis) => {
+                        dispatches.push(basis.record_project(gpu, params, &b.lights, b.views, &b.codes));
+                        None
+                    }
+                };
                 let forward = self.record_transport(&mut dispatches, &b, loss);
-                let buffers = [&self.params, &self.grads];
-                encoder.record_backward(gpu, &mut dispatches, buffers, b.views, &b.d_codes, &tape);
+                match (&self.net.light, &tape) {
+                    (LightAt::Encoder(e), Some(tape)) => {
+                        let buffers = [params, &self.grads];
+                        e.record_backward(gpu, &mut dispatches, buffers, b.views, &b.d_codes, tape);
+                    }
+                    (LightAt::Basis(basis), _) => dispatches.extend(basis.record_backward(
+                        gpu,
+                        &self.grads,
+                        &b.lights,
+                        b.views,
+                        &b.d_codes,
+                    )),
+                    (LightAt::Encoder(_), None) => unreachable!("an encoder keeps its tape"),
+                }
                 StepPlan {
                     loss,
                     gathers: self.gathers(&b),
@@ -493,8 +505,8 @@ impl GpuTrainer {
             radiance: gpu.buffer(rows * 3),
             scale: gpu.buffer(rows * 3),
             view: gpu.buffer(rows),
-            codes: gpu.buffer(views * CODE_SIZE),
-            d_codes: gpu.buffer(views * CODE_SIZE),
+            codes: gpu.buffer(views * self.net.light.code_size()),
+            d_codes: gpu.buffer(views * self.net.light.code_size()),
             radiance_sum: gpu.buffer(rows * 3),
             d_radiance: gpu.buffer(rows * 3),
             row_loss: gpu.buffer(rows),

@@ -6,7 +6,8 @@
 use crate::encoding::hash_grid;
 use crate::gpu::kernels::{COMBINE, GRID_BACKWARD, RADIANCE_LOSS, TRACK_GRADIENT};
 use crate::gpu::layers::network_forward::FirstLayer;
-use crate::gpu::layers::network_layout::TrackAt;
+use crate::gpu::layers::light_basis::{BasisAt, BasisFunctions};
+use crate::gpu::layers::network_layout::{LightAt, TrackAt};
 use crate::gpu::passes::mlp_step::{forward_targets, MlpTape};
 use crate::gpu::products::codes::loss_code;
 use crate::gpu::products::dense_products::DenseProducts;
@@ -53,7 +54,9 @@ impl GpuTrainer {
             .map(|t| self.track_forward(plan, t, b))
             .collect();
         // The tracks' radiance summed into `radiance`, one track per dispatch (any number of
-        // tracks), then the loss and its gradient at that sum.
+        // tracks), then the loss and its gradient at that sum. A linear track reads its row's
+        // view's code.
+        let code_size = self.net.light.code_size();
         for (k, (t, tape)) in self.net.tracks.iter().zip(&tapes).enumerate() {
             let params = [
                 b.rows,
@@ -62,8 +65,8 @@ impl GpuTrainer {
                 0,
                 0,
                 0,
-                0,
-                0,
+                t.coefficients.unwrap_or(0),
+                code_size,
             ];
             plan.push(self.gpu.prepare(
                 &COMBINE,
@@ -71,7 +74,8 @@ impl GpuTrainer {
                 &[
                     &b.features,
                     tape.shading.outputs.last().expect("a layer"),
-                    &self.gpu.empty,
+                    &b.codes,
+                    &b.view,
                     &b.radiance_sum,
                 ],
                 groups_for(b.rows),
@@ -101,18 +105,49 @@ impl GpuTrainer {
             Output::to(&b.loss, 0, 1),
         );
         let forward = plan.len();
+        // A learned basis needs the gradient at each view's code: per row, then per view.
+        let learned = matches!(
+            &self.net.light,
+            LightAt::Basis(BasisAt {
+                functions: BasisFunctions::Learned(_),
+                ..
+            })
+        );
+        let d_row_codes = learned.then(|| self.gpu.buffer(b.rows * code_size));
         for (t, tape) in self.net.tracks.iter().zip(&tapes) {
+            let d_rows = d_row_codes.as_ref().filter(|_| t.coefficients.is_some());
+            let params = [
+                b.rows,
+                t.kind.code() as usize,
+                t.coefficients.unwrap_or(0),
+                code_size,
+                usize::from(d_rows.is_some()),
+                0,
+                0,
+                0,
+            ];
             plan.push(self.gpu.prepare(
                 &TRACK_GRADIENT,
-                &[b.rows as u32, t.kind.code(), 0, 0],
+                &params.map(|v| v as u32),
                 &[
                     &b.features,
                     tape.shading.outputs.last().expect("a layer"),
+                    &b.codes,
+                    &b.view,
                     &b.d_radiance,
                     &tape.d_out,
+                    d_rows.unwrap_or(&self.gpu.empty),
                 ],
                 groups_for(b.rows),
             ));
+            if let Some(d_rows) = d_rows {
+                let to = Output {
+                    accumulate: true,
+                    ..Output::to(&b.d_codes, 0, code_size)
+                };
+                let views = Some((&b.view, b.views));
+                self.gpu.column_sum(plan, d_rows, b.rows, code_size, views, to);
+            }
             self.track_backward(plan, t, tape, b);
         }
         forward
@@ -135,10 +170,17 @@ impl GpuTrainer {
             m.record_forward(gpu, plan, params, Held::F32(&x), rows, first, &to);
             tape
         });
-        // The light code's share of the first shading layer, once per view.
+        // The light code's share of the first shading layer, once per view (a linear track's
+        // shading network reads ŝ alone).
         let first = &t.shading.layers[0];
         let group_bias = gpu.buffer(b.views * first.d_out);
-        plan.push(t.record_code_share(gpu, params, &b.codes, b.views, &group_bias));
+        let bias = match t.coefficients {
+            None => {
+                plan.push(t.record_code_share(gpu, params, &b.codes, b.views, &group_bias));
+                Bias::Group(&group_bias, &b.view)
+            }
+            Some(_) => Bias::Column(params, first.bias.offset),
+        };
         let shading = self.trainable().tape(&t.shading, rows);
         let input = transfer
             .as_ref()
@@ -146,7 +188,7 @@ impl GpuTrainer {
         let first_layer = FirstLayer {
             own_row: t.code_and_own_rows().1,
             count: t.own_width(),
-            bias: Bias::Group(&group_bias, &b.view),
+            bias,
         };
         let to = forward_targets(&t.shading, &shading);
         let input = Held::F32(input);
@@ -184,9 +226,15 @@ impl GpuTrainer {
             .as_ref()
             .map_or(&tape.x, |tr| tr.outputs.last().expect("a layer"));
         // Each view's sum of the first layer's pre-activation gradients: its bias's, its code
-        // rows' and the code's gradients all follow from it.
+        // rows' and the code's gradients all follow from it. A linear track's first layer has
+        // its bias alone.
         let d_views = gpu.buffer(b.views * first.d_out);
         let on_first = |plan: &mut Vec<Dispatch>, dz: &wgpu::Buffer| {
+            if t.coefficients.is_some() {
+                let to = Output::to(&self.grads, first.bias.offset, first.d_out);
+                self.gpu.column_sum(plan, dz, b.rows, first.d_out, None, to);
+                return;
+            }
             self.gpu.column_sum(
                 plan,
                 dz,

@@ -106,7 +106,7 @@ async function main() {
   }));
   const [codeSize, perRow] = [exp.code_size, exp.inputs_per_pixel];
   const toCode = exp.encoder ? dense(exp.encoder.to_code) : null;
-  const functions = exp.basis ? tensor(exp.basis.functions).buffer : null;
+  const basis = exp.basis && [tensor(exp.basis.functions).buffer, tensor(exp.basis.solid_angles).buffer];
   const resolutions = upload(new Uint32Array(exp.tracks.find((t) => t.grid)?.grid.resolutions ?? [0, 0, 0, 0]));
   const tracks = exp.tracks.map((t) => ({
     kind: t.kind_code,
@@ -145,8 +145,8 @@ async function main() {
   let pass = encoder.beginComputePass();
   let [h, w] = [ex.light.shape[1], ex.light.shape[2]];
   let x = upload(light);
-  if (functions) {
-    dispatch(pass, 'light_project', { size: exp.basis.size, texels: h * w }, [functions, x, code],
+  if (basis) {
+    dispatch(pass, 'light_project', { size: exp.basis.size, texels: h * w, views: 1 }, [...basis, x, code],
       groups('light_project', codeSize));
   }
   for (const b of blocks) {
@@ -200,7 +200,8 @@ async function main() {
         rows, kind: t.kind, accumulate: i > 0 ? 1 : 0, scaled: i === tracks.length - 1 ? 1 : 0,
         scale_at: codeSize, coefficients: t.coefficients,
       };
-      dispatch(pass, 'combine', params, [features, outputs[i], code, rgb], groups('combine', rows));
+      // One code for every row (code_stride 0): the views binding is not read.
+      dispatch(pass, 'combine', params, [features, outputs[i], code, features, rgb], groups('combine', rows));
     });
     pass.end();
     const readback = device.createBuffer({ size: rows * 12, usage: GPUBufferUsage.MAP_READ | GPUBufferUsage.COPY_DST });
