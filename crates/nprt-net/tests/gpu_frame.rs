@@ -361,7 +361,10 @@ fn the_linear_design_shades_as_on_the_cpu_engine() {
         eprintln!("linear {basis}: code {code_error:.2e}, radiance {error:.2e}");
         // The divisor: the map's mean, summed in f32 on the device and in f64 on the host.
         let divisor_error = relative_difference(&divisor, &input.scale);
-        assert!(divisor_error < 1e-6, "{basis}: divisor off by {divisor_error}");
+        assert!(
+            divisor_error < 1e-6,
+            "{basis}: divisor off by {divisor_error}"
+        );
         assert!(code_error < 1e-5, "{basis}: light code off by {code_error}");
         assert!(error < 1e-5, "{basis}: radiance off by {error}");
 

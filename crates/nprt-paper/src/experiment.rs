@@ -167,7 +167,10 @@ impl Experiment {
     /// records, the report and `nprt generate`'s flags, which would hold another path) and a
     /// training time that is not a positive number of minutes, naming the flag.
     pub fn check_settings(&self) -> Result<()> {
-        if let Some(m) = self.training_minutes.filter(|m| !(m.is_finite() && *m > 0.0)) {
+        if let Some(m) = self
+            .training_minutes
+            .filter(|m| !(m.is_finite() && *m > 0.0))
+        {
             bail!("--training-minutes {m} is not a positive number of minutes");
         }
         let paths = [
@@ -232,7 +235,13 @@ mod tests {
 
     #[test]
     fn training_minutes_replace_the_budgets_training_for_every_network() {
-        let mut x = Experiment::paper("builtin:room", "builtin", Path::new("o"), SMALL, Engine::Cpu);
+        let mut x = Experiment::paper(
+            "builtin:room",
+            "builtin",
+            Path::new("o"),
+            SMALL,
+            Engine::Cpu,
+        );
         assert_eq!(x.training(), SMALL.training);
         assert_eq!(x.deep_shading_training(), SMALL.deep_shading);
         x.training_minutes = Some(16.0);

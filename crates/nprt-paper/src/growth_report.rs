@@ -315,7 +315,10 @@ mod tests {
         };
         assert!(line(&designs[3]).ends_with("| 16 min |"), "{md}");
         assert!(line(&designs[3]).contains("| -0.500 | 1.00 |"), "{md}");
-        assert!(line(&designs[1]).ends_with("| never on this trend |"), "{md}");
+        assert!(
+            line(&designs[1]).ends_with("| never on this trend |"),
+            "{md}"
+        );
         assert!(line(&designs[0]).contains("fewer than 3 points"), "{md}");
         assert!(line(&designs[2]).contains("fewer than 3 points"), "{md}");
         assert_eq!(duration_of_minutes(30.0 * 60.0), "30.0 h");

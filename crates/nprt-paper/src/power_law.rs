@@ -82,6 +82,9 @@ mod tests {
     fn noise_lowers_the_fits_r2() {
         let points = [(1.0, 0.1), (2.0, 0.07), (4.0, 0.09), (8.0, 0.05)];
         let fit = PowerLaw::fit(&points).unwrap();
-        assert!(fit.exponent < 0.0 && fit.r2 < 0.9 && fit.r2 > 0.0, "{fit:?}");
+        assert!(
+            fit.exponent < 0.0 && fit.r2 < 0.9 && fit.r2 > 0.0,
+            "{fit:?}"
+        );
     }
 }

@@ -173,9 +173,11 @@ fn a_linear_model_exports_and_its_page_matches_the_cpu_engine() {
     assert_eq!(shape("basis.functions"), serde_json::json!([9, w * w / 2]));
     assert_eq!(shape("basis.solid_angles"), serde_json::json!([w * w / 2]));
     let example: Value =
-        serde_json::from_slice(&std::fs::read(out.join("example/example.json")).unwrap())
-            .unwrap();
-    assert_eq!(example["light"]["log"], false, "a basis reads the map's texels as they are");
+        serde_json::from_slice(&std::fs::read(out.join("example/example.json")).unwrap()).unwrap();
+    assert_eq!(
+        example["light"]["log"], false,
+        "a basis reads the map's texels as they are"
+    );
     assert_eq!(basis.functions.len(), 9 * w * w / 2);
     page_matches_the_cpu_engine(&out);
     std::fs::remove_dir_all(&dir).unwrap();

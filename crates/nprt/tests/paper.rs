@@ -178,7 +178,10 @@ fn the_tiny_budget_writes_every_table_and_resumes() {
     // So is a longer training at the same budget: the record holds it once given.
     #[rustfmt::skip]
     let longer = ["paper", "--budget", "tiny", "--out", out, "--device", "cpu", "--training-minutes", "0.5"];
-    fails(&longer, &["holds another experiment", "\"training_minutes\":0.5"]);
+    fails(
+        &longer,
+        &["holds another experiment", "\"training_minutes\":0.5"],
+    );
     let o = nprt(&["paper", "--budget", "huge", "--out", out]);
     let err = String::from_utf8_lossy(&o.stderr);
     assert!(

@@ -12,7 +12,13 @@ use nprt_net::gpu::kernels::{
 /// `nprt export` writes (an engine brings its own G-buffer and background). A model runs the
 /// encoder's or, for the linear design, the basis' projection.
 pub fn sources() -> [&'static KernelSource; 5] {
-    [&ENCODER_BLOCK, &LIGHT_PROJECT, &TRACK_INPUTS, &GEMM, &COMBINE]
+    [
+        &ENCODER_BLOCK,
+        &LIGHT_PROJECT,
+        &TRACK_INPUTS,
+        &GEMM,
+        &COMBINE,
+    ]
 }
 
 /// The kernels `--precision f16` runs the transport networks' dense layers with instead of

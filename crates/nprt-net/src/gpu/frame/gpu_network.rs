@@ -266,7 +266,14 @@ impl GpuNetwork {
         let gpu = &*self.gpu;
         let key = (SameTexels(map.clone()), width, norm);
         let input = self.inputs.get(key, || {
-            Arc::new(GpuLightInput::for_map(gpu, &self.map, map, width, norm, self.texels))
+            Arc::new(GpuLightInput::for_map(
+                gpu,
+                &self.map,
+                map,
+                width,
+                norm,
+                self.texels,
+            ))
         });
         let _one_at_a_time = self.encoding.lock().unwrap_or_else(|e| e.into_inner());
         let mut encoder = gpu.device.create_command_encoder(&Default::default());

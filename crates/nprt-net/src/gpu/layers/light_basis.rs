@@ -26,7 +26,11 @@ pub struct BasisAt {
 
 impl BasisAt {
     /// `basis` on `gpu`, a learned one's span taken from `spans` (its visiting order).
-    pub fn new(gpu: &GpuDevice, basis: &LightBasis, spans: &mut impl Iterator<Item = Span>) -> Self {
+    pub fn new(
+        gpu: &GpuDevice,
+        basis: &LightBasis,
+        spans: &mut impl Iterator<Item = Span>,
+    ) -> Self {
         let w = basis.width;
         let rows = basis.row_solid_angles();
         let solid: Vec<f32> = (0..w * w / 2).map(|t| rows[t / w]).collect();

@@ -400,7 +400,8 @@ impl GpuTrainer {
                         Some(e.record(gpu, &mut dispatches, params, lights, maps, &b.codes, true))
                     }
                     LightAt::Basis(basis) => {
-                        dispatches.push(basis.record_project(gpu, params, &b.lights, b.views, &b.codes));
+                        dispatches
+                            .push(basis.record_project(gpu, params, &b.lights, b.views, &b.codes));
                         None
                     }
                 };

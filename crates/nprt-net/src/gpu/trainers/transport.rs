@@ -5,8 +5,8 @@
 
 use crate::encoding::hash_grid;
 use crate::gpu::kernels::{COMBINE, GRID_BACKWARD, RADIANCE_LOSS, TRACK_GRADIENT};
-use crate::gpu::layers::network_forward::FirstLayer;
 use crate::gpu::layers::light_basis::{BasisAt, BasisFunctions};
+use crate::gpu::layers::network_forward::FirstLayer;
 use crate::gpu::layers::network_layout::{LightAt, TrackAt};
 use crate::gpu::passes::mlp_step::{forward_targets, MlpTape};
 use crate::gpu::products::codes::loss_code;
@@ -105,6 +105,15 @@ impl GpuTrainer {
             Output::to(&b.loss, 0, 1),
         );
         let forward = plan.len();
+        self.record_gradients(plan, b, &tapes);
+        forward
+    }
+
+    /// Backward from the gradient at the radiance in `b`: each track's gradient at its outputs
+    /// (and, for a learned basis, at its rows' codes, summed per view into `d_codes`), then
+    /// through its networks.
+    fn record_gradients(&self, plan: &mut Vec<Dispatch>, b: &BatchBuffers, tapes: &[TrackTape]) {
+        let code_size = self.net.light.code_size();
         // A learned basis needs the gradient at each view's code: per row, then per view.
         let learned = matches!(
             &self.net.light,
@@ -114,7 +123,7 @@ impl GpuTrainer {
             })
         );
         let d_row_codes = learned.then(|| self.gpu.buffer(b.rows * code_size));
-        for (t, tape) in self.net.tracks.iter().zip(&tapes) {
+        for (t, tape) in self.net.tracks.iter().zip(tapes) {
             let d_rows = d_row_codes.as_ref().filter(|_| t.coefficients.is_some());
             let params = [
                 b.rows,
@@ -146,11 +155,11 @@ impl GpuTrainer {
                     ..Output::to(&b.d_codes, 0, code_size)
                 };
                 let views = Some((&b.view, b.views));
-                self.gpu.column_sum(plan, d_rows, b.rows, code_size, views, to);
+                self.gpu
+                    .column_sum(plan, d_rows, b.rows, code_size, views, to);
             }
             self.track_backward(plan, t, tape, b);
         }
-        forward
     }
 
     /// A track's forward pass over the batch.
@@ -293,20 +302,33 @@ impl GpuTrainer {
                 None,
             );
         }
-        if let (Some(span), Some(dx)) = (t.grid, &tape.dx) {
-            // At most GRID_CHUNKS copies of the tables, each summing at least 256 rows.
-            let chunk = b.rows.div_ceil(GRID_CHUNKS).max(256);
-            let chunks = b.rows.div_ceil(chunk);
-            let partial = gpu.buffer(chunks * span.len);
-            let params = [b.rows, t.count, t.width, chunk].map(|v| v as u32);
-            plan.push(gpu.prepare(
-                &GRID_BACKWARD,
-                &params,
-                &[&b.features, &self.resolutions, dx, &partial],
-                groups_for(chunks * GRID_BACKWARD_THREADS),
-            ));
-            let d_table = Output::to(&self.grads, span.offset, span.len);
-            gpu.column_sum(plan, &partial, chunks, span.len, None, d_table);
-        }
+        self.grid_backward(plan, t, tape, b);
+    }
+
+    /// A hash grid's table gradient from the gradient at the track's inputs.
+    fn grid_backward(
+        &self,
+        plan: &mut Vec<Dispatch>,
+        t: &TrackAt,
+        tape: &TrackTape,
+        b: &BatchBuffers,
+    ) {
+        let (Some(span), Some(dx)) = (t.grid, &tape.dx) else {
+            return;
+        };
+        let gpu = &self.gpu;
+        // At most GRID_CHUNKS copies of the tables, each summing at least 256 rows.
+        let chunk = b.rows.div_ceil(GRID_CHUNKS).max(256);
+        let chunks = b.rows.div_ceil(chunk);
+        let partial = gpu.buffer(chunks * span.len);
+        let params = [b.rows, t.count, t.width, chunk].map(|v| v as u32);
+        plan.push(gpu.prepare(
+            &GRID_BACKWARD,
+            &params,
+            &[&b.features, &self.resolutions, dx, &partial],
+            groups_for(chunks * GRID_BACKWARD_THREADS),
+        ));
+        let d_table = Output::to(&self.grads, span.offset, span.len);
+        gpu.column_sum(plan, &partial, chunks, span.len, None, d_table);
     }
 }
