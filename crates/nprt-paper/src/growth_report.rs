@@ -101,15 +101,17 @@ pub fn as_training_grows(
 fn projection(md: &mut String, points: &[GrowthPoint], designs: &[String]) -> Result<()> {
     writeln!(
         md,
-        "### Projected: when each design would reach the paper's KITCHEN RMSE
-
-         A projection, not a measurement: RMSE ≈ a·t^b fitted by least squares to the          logarithms of the points above (t in training minutes), extended to the paper's          figure. It assumes the trend holds far past the last point (each run's cosine schedule          spans its own length; the paper trained 500 epochs at a constant rate) and sets          nprt's test views beside the paper's, which are other views at another size.
-"
+        "### Projected: when each design would reach the paper's KITCHEN RMSE\n\n\
+         A projection, not a measurement: RMSE ≈ a·t^b fitted by least squares to the \
+         logarithms of the points above (t in training minutes), extended to the paper's \
+         figure. It assumes the trend holds far past the last point (each run's cosine schedule \
+         spans its own length; the paper trained 500 epochs at a constant rate) and sets \
+         nprt's test views beside the paper's, which are other views at another size.\n"
     )?;
     writeln!(
         md,
-        "| design | a × 10³ | b | R² | last point: RMSE × 10³ at min | the paper's RMSE × 10³ | reached at (projected) |
-         |---|---|---|---|---|---|---|"
+        "| design | a × 10³ | b | R² | last point: RMSE × 10³ at min | the paper's RMSE × 10³ \
+         | reached at (projected) |\n|---|---|---|---|---|---|---|"
     )?;
     for (name, &design) in designs.iter().zip(&Design::PAPER) {
         let line: Vec<(f64, f64)> = (points.iter())
@@ -313,6 +315,13 @@ mod tests {
                 .unwrap_or_else(|| panic!("no row for {name}:\n{md}"))
                 .to_string()
         };
+        // One paragraph, then a table Markdown reads as one: no line indented (4 spaces make
+        // a code block), no runs of spaces, the separator right under the header.
+        assert!(
+            !md.lines().any(|l| l.starts_with(' ')) && !md.contains("  "),
+            "{md}"
+        );
+        assert!(md.contains("(projected) |\n|---|"), "{md}");
         assert!(line(&designs[3]).ends_with("| 16 min |"), "{md}");
         assert!(line(&designs[3]).contains("| -0.500 | 1.00 |"), "{md}");
         assert!(
