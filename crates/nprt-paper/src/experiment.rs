@@ -35,8 +35,9 @@ pub struct Experiment {
     /// Points at which the paper's four designs keep their models as they train, each scored
     /// on the test views and judged by the paper's orderings (`--snapshots`).
     pub snapshots: Vec<Snapshot>,
-    /// Every network's training in wall-clock minutes instead of the budget's (`--training-minutes`):
-    /// the budget's sizes with longer training, recorded with the experiment.
+    /// Every network's training in wall-clock minutes instead of the budget's
+    /// (`--training-minutes`): the budget's sizes with longer training, recorded with the
+    /// experiment.
     pub training_minutes: Option<f64>,
 }
 

@@ -145,8 +145,9 @@ impl Experiment {
     }
 
     /// What the output folder is for, recorded by its first run once its settings hold: a
-    /// later run with another scene, lighting, budget, training time or seed is refused rather than mixed into
-    /// it. None where the folder is this experiment's already; the record to write otherwise.
+    /// later run with another scene, lighting, budget, training time or seed is refused rather
+    /// than mixed into it. None where the folder is this experiment's already; the record to
+    /// write otherwise.
     fn claim(&self) -> Result<Option<Claim>> {
         let mut what = json!({
             "scene": self.scene,

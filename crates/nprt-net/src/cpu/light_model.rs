@@ -50,13 +50,10 @@ impl LightModel {
 impl LightBasis {
     /// Each function times its texel's solid angle, K × texels: P as it multiplies a map.
     fn weighted(&self) -> Vec<f32> {
-        let (w, rows) = (self.width, self.row_solid_angles());
-        let texels = w * w / 2;
+        let solid = self.texel_solid_angles();
         let mut p = self.functions.clone();
-        p.par_chunks_mut(texels).for_each(|row| {
-            row.iter_mut()
-                .enumerate()
-                .for_each(|(t, v)| *v *= rows[t / w]);
+        p.par_chunks_mut(solid.len()).for_each(|row| {
+            row.iter_mut().zip(&solid).for_each(|(v, s)| *v *= s);
         });
         p
     }
@@ -88,8 +85,8 @@ impl LightBasis {
         if !self.choice.is_learned() {
             return grad;
         }
-        let (k, w) = (self.size(), self.width);
-        let (texels, rows) = (w * w / 2, self.row_solid_angles());
+        let (k, solid) = (self.size(), self.texel_solid_angles());
+        let texels = solid.len();
         grad.functions
             .par_chunks_mut(texels)
             .enumerate()
@@ -103,9 +100,7 @@ impl LightBasis {
                         out.iter_mut().zip(channel).for_each(|(o, m)| *o += g * m);
                     }
                 }
-                out.iter_mut()
-                    .enumerate()
-                    .for_each(|(t, v)| *v *= rows[t / w]);
+                out.iter_mut().zip(&solid).for_each(|(v, s)| *v *= s);
             });
         grad
     }

@@ -77,13 +77,19 @@ impl ModelConfig {
         self.basis.unwrap_or_default()
     }
 
-    /// `map` turned by `rotation_deg` about +Y as this model's light model takes it.
-    pub fn light_input(&self, map: &EnvMap, rotation_deg: f32) -> LightInput {
-        let texels = match self.design.is_linear() {
+    /// How this model's light model takes a map's texels: as they are for the linear design's
+    /// basis, through log(1 + x) for the encoder.
+    pub fn texels(&self) -> Texels {
+        match self.design.is_linear() {
             true => Texels::Linear,
             false => Texels::Log,
-        };
-        LightInput::with_texels(map, rotation_deg, self.encoder_width, self.map_norm, texels)
+        }
+    }
+
+    /// `map` turned by `rotation_deg` about +Y as this model's light model takes it.
+    pub fn light_input(&self, map: &EnvMap, rotation_deg: f32) -> LightInput {
+        let (width, norm) = (self.encoder_width, self.map_norm);
+        LightInput::with_texels(map, rotation_deg, width, norm, self.texels())
     }
 
     /// The design's name, marked `+siren` or `+relu` with an activation other than the paper's

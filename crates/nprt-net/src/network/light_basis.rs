@@ -129,15 +129,17 @@ impl LightBasis {
         self.choice.size()
     }
 
-    /// The solid angle of each texel row of the W × W/2 map (exact for its band of latitude).
-    pub fn row_solid_angles(&self) -> Vec<f32> {
-        let h = self.width / 2;
+    /// The solid angle of each texel of the W × W/2 map, row-major (exact for its row's band
+    /// of latitude): what both engines and the export multiply the functions by.
+    pub fn texel_solid_angles(&self) -> Vec<f32> {
+        let (w, h) = (self.width, self.width / 2);
         let pi = std::f64::consts::PI;
-        (0..h)
-            .map(|r| {
+        (0..w * h)
+            .map(|t| {
+                let r = t / w;
                 let band =
                     (pi * r as f64 / h as f64).cos() - (pi * (r + 1) as f64 / h as f64).cos();
-                (2.0 * pi / self.width as f64 * band) as f32
+                (2.0 * pi / w as f64 * band) as f32
             })
             .collect()
     }

@@ -116,11 +116,10 @@ impl WeightFile {
                 }, "basis": null })
             }
             LightModel::Basis(b) => {
-                let (w, rows) = (b.width, b.row_solid_angles());
-                let solid: Vec<f32> = (0..w * w / 2).map(|t| rows[t / w]).collect();
+                let solid = b.texel_solid_angles();
                 json!({ "encoder": null, "basis": {
                     "choice": b.choice.to_string(),
-                    "input_width": w,
+                    "input_width": b.width,
                     "size": b.size(),
                     "functions": self.add("basis.functions", &[b.size(), solid.len()], &b.functions),
                     "solid_angles": self.add("basis.solid_angles", &[solid.len()], &solid),
@@ -332,7 +331,7 @@ fn example(model_dir: &Path, file: &nprt_net::ModelFile, view: &ExampleView) -> 
         "gbuffer": { "file": "gbuffer.bin", "floats_per_pixel": FEATURES + 1, "layout": "19 network inputs, then the foreground mask, per pixel in row order" },
         // The map made into the light model's input: its texels divided by the divisor and,
         // for the encoder, through ln(1 + x); as they are for a basis.
-        "light": { "file": "light.bin", "shape": [3, config.encoder_width / 2, config.encoder_width], "scale": scale, "log": !config.design.is_linear() },
+        "light": { "file": "light.bin", "shape": [3, config.encoder_width / 2, config.encoder_width], "scale": scale, "log": config.texels() == nprt_net::Texels::Log },
         "reference": { "file": "reference.bin", "floats_per_pixel": 3, "engine": "nprt's CPU engine" },
         // A model that traces direct light leaves it to the renderer: its networks give the rest.
         "network_radiance": if config.direct.is_learned() { "all of it" } else { "indirect light only" },

@@ -1,8 +1,9 @@
 //! The light model's input made on the device (what `LightInput::with_texels` makes on the
 //! host): the map, rotated, looked up ss × ss times per input texel and averaged, then divided
-//! by its `MapNorm` divisor and, for the encoder, taken through ln(1 + x). A lighting change on the GPU then sends only
-//! the map's rotation, into dispatches prepared once per map; on the host the lookups took a
-//! frame milliseconds (64 per texel of a 128-wide input from a 1024-wide map).
+//! by its `MapNorm` divisor and, for the encoder, taken through ln(1 + x). A lighting change
+//! on the GPU then sends only the map's rotation, into dispatches prepared once per map; on
+//! the host the lookups took a frame milliseconds (64 per texel of a 128-wide input from a
+//! 1024-wide map).
 
 use std::sync::LazyLock;
 

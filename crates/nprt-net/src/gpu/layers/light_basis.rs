@@ -31,9 +31,7 @@ impl BasisAt {
         basis: &LightBasis,
         spans: &mut impl Iterator<Item = Span>,
     ) -> Self {
-        let w = basis.width;
-        let rows = basis.row_solid_angles();
-        let solid: Vec<f32> = (0..w * w / 2).map(|t| rows[t / w]).collect();
+        let solid = basis.texel_solid_angles();
         let functions = match basis.choice.is_learned() {
             true => BasisFunctions::Learned(spans.next().expect("a learned basis' span")),
             false => BasisFunctions::Fixed(gpu.upload(&basis.functions)),

@@ -182,9 +182,10 @@ impl GpuTrainer {
         // The light code's share of the first shading layer, once per view (a linear track's
         // shading network reads ŝ alone).
         let first = &t.shading.layers[0];
-        let group_bias = gpu.buffer(b.views * first.d_out);
+        let group_bias;
         let bias = match t.coefficients {
             None => {
+                group_bias = gpu.buffer(b.views * first.d_out);
                 plan.push(t.record_code_share(gpu, params, &b.codes, b.views, &group_bias));
                 Bias::Group(&group_bias, &b.view)
             }
@@ -237,13 +238,13 @@ impl GpuTrainer {
         // Each view's sum of the first layer's pre-activation gradients: its bias's, its code
         // rows' and the code's gradients all follow from it. A linear track's first layer has
         // its bias alone.
-        let d_views = gpu.buffer(b.views * first.d_out);
         let on_first = |plan: &mut Vec<Dispatch>, dz: &wgpu::Buffer| {
             if t.coefficients.is_some() {
                 let to = Output::to(&self.grads, first.bias.offset, first.d_out);
                 self.gpu.column_sum(plan, dz, b.rows, first.d_out, None, to);
                 return;
             }
+            let d_views = gpu.buffer(b.views * first.d_out);
             self.gpu.column_sum(
                 plan,
                 dz,
