@@ -18,7 +18,8 @@
 #
 # usage: bench/kitchen.sh --out DIR [--device cpu|gpu|wgpu] [--budget cpu|gpu|tiny] [--minutes M]
 #                         [--precision f16|f32] [--cpu-model MODEL] [--scene K/scene.xml]
-#                         [--maps DIR] [--nprt BIN] [--no-eval]
+#                         [--maps DIR] [--nprt BIN] [--no-eval] [--pause-by UNIX_TIME]
+#                         [--data-hash FILE]
 #   --out        the run's folder: data/, model/, report/ and summary.md (a dataset or model
 #                already there is resumed, as nprt resumes them)
 #   --device     where the views are traced and D/S trained (default cpu)
@@ -32,6 +33,11 @@
 #   --nprt       the nprt binary (default target/release/nprt; build it with `--features gpu`
 #                for --device gpu)
 #   --no-eval    stop after training (bring the model back and evaluate it where OIDN is)
+#   --pause-by   end this call's training by this time (seconds since 1970), saved, the run's
+#                --minutes and schedule kept (`nprt train --pause-after`): how
+#                bench/kitchen-visit.sh advances one long run a GPU loan at a time
+#   --data-hash  the dataset's identity (SHA-256 of manifest.json) kept in FILE: written by the
+#                first run; a later run whose dataset differs stops before training
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
@@ -45,6 +51,8 @@ scene=../shared/scenes/kitchen/scene.xml
 maps=../shared/envmaps
 nprt=target/release/nprt
 evaluate=1
+pause_by=
+data_hash=
 while [ $# -gt 0 ]; do
   case "$1" in
     --out) out=$2; shift 2 ;;
@@ -57,6 +65,8 @@ while [ $# -gt 0 ]; do
     --maps) maps=$2; shift 2 ;;
     --nprt) nprt=$2; shift 2 ;;
     --no-eval) evaluate=; shift ;;
+    --pause-by) pause_by=$2; shift 2 ;;
+    --data-hash) data_hash=$2; shift 2 ;;
     -h|--help) sed -n '2,/^set -e/p' "$0" | sed '$d; s/^# \{0,1\}//'; exit 0 ;;
     *) echo "bench/kitchen.sh: unknown argument '$1' (see --help)" >&2; exit 2 ;;
   esac
@@ -99,11 +109,30 @@ t0=$SECONDS
 echo "wall $((SECONDS - t0)) s" >>"$summary"
 end_stage
 
-log "training D/S for $minutes minutes on $device"
-stage "D/S: nprt train --minutes $minutes --device $device --precision $precision"
+if [ -n "$data_hash" ]; then
+  hash=$(sha256sum "$out/data/manifest.json" | cut -d' ' -f1)
+  if [ ! -s "$data_hash" ]; then
+    echo "$hash" >"$data_hash"
+  elif [ "$(cat "$data_hash")" != "$hash" ]; then
+    echo "dataset manifest $hash differs from the $(cat "$data_hash") of '$data_hash': not trained" >>"$summary"
+    log "the dataset is not the one '$data_hash' names; not training on it"
+    exit 1
+  fi
+  echo "dataset manifest SHA-256 $hash" >>"$summary"
+fi
+
+# A pause leaves 40 s for the last validation and save before the time asked.
+pause=()
+if [ -n "$pause_by" ]; then
+  left=$((pause_by - $(date +%s) - 40))
+  [ "$left" -ge 30 ] || { log "no time left to train before --pause-by"; echo "no time left to train" >>"$summary"; exit 0; }
+  pause=(--pause-after "$(awk -v s="$left" 'BEGIN { printf "%.2f", s / 60 }')")
+fi
+log "training D/S for $minutes minutes on $device ${pause[*]}"
+stage "D/S: nprt train --minutes $minutes --device $device --precision $precision ${pause[*]}"
 "$nprt" train --data "$out/data" --arch dsep --minutes "$minutes" --device "$device" \
-  --precision "$precision" --out "$out/model" 2>&1 | tee "$out/train.txt" |
-  grep -E '^(trained|time:|dataset)' >>"$summary"
+  --precision "$precision" --checkpoint-minutes 1 "${pause[@]}" --out "$out/model" 2>&1 |
+  tee "$out/train.txt" | grep -E '^(trained|time:|dataset|resumed|paused)' >>"$summary"
 end_stage
 
 # The paper's schedule from the rates above: its data (3000 views of 256² at 3200 spp) and its

@@ -110,6 +110,11 @@ pub struct TrainArgs {
     /// end always does.
     #[arg(long, value_parser = crate::flags::finite_f64, default_value_t = d().schedule.checkpoint_secs / 60.0)]
     checkpoint_minutes: f64,
+    /// Stop this call after these minutes of training, saved, wherever the run stands (its
+    /// length, learning-rate schedule and --snapshots unchanged); the same command continues
+    /// it. How a long run is advanced a few minutes at a time (bench/kitchen-visit.sh).
+    #[arg(long, value_name = "MINUTES", value_parser = crate::flags::finite_f64)]
+    pause_after: Option<f64>,
     /// On the GPU kernels (--device gpu or wgpu), where batches are gathered: device (the
     /// dataset's records, 40 bytes a pixel, and maps are uploaded once, and each step gathers
     /// its batch there from the picked samples) or host (each batch is gathered here and uploaded, for a dataset the
@@ -154,6 +159,7 @@ impl TryFrom<TrainArgs> for TrainJob {
                 seed: a.seed,
                 checkpoint_secs: a.checkpoint_minutes * 60.0,
                 snapshots: a.snapshots.map(|s| s.0).unwrap_or_default(),
+                pause_after: a.pause_after,
                 ..d().schedule
             },
             batch_size: a.batch_size,
@@ -205,6 +211,13 @@ pub fn run(job: &TrainJob, engine: Engine) -> Result<()> {
         s.final_val
     );
     println!("time: {} (steps on {})", s.split.describe(), s.steps_on);
+    if s.paused {
+        println!(
+            "paused (--pause-after {}) at {:.2} minutes of training; the same command continues",
+            job.opts.schedule.pause_after.unwrap_or(0.0),
+            s.seconds / 60.0
+        );
+    }
     if let Some([r, g, b]) = file.level_gain {
         println!(
             "level gain (training targets' mean over the network's, per channel): R {r:.3} G {g:.3} B {b:.3}"

@@ -14,6 +14,10 @@ pub struct ViewArgs {
     /// Scene (default: the one the models were trained on); must be that scene.
     #[arg(long)]
     scene: Option<String>,
+    /// Start the camera in this camera volume's JSON file instead of the scene's (its sidecar
+    /// NAME.camera.json): the KITCHEN's is docs/kitchen.camera.json.
+    #[arg(long)]
+    camera_volume: Option<PathBuf>,
     /// Lightings M switches among, comma-separated: .exr/.hdr maps (e.g. a dataset's held-out
     /// maps) or built-in specs.
     #[arg(
@@ -65,6 +69,7 @@ pub fn run(a: ViewArgs) -> Result<()> {
     nprt_render::view::run_viewer(nprt_render::view::ViewerOptions {
         models: a.models,
         scene: a.scene,
+        camera_volume: a.camera_volume,
         maps: a.maps,
         resolution: a.res.0,
         engine: a.device.engine()?,

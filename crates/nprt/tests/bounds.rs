@@ -376,3 +376,30 @@ fn a_model_is_not_written_into_its_dataset() {
     }
     std::fs::remove_dir_all(&dir).ok();
 }
+
+/// An evaluation over one test view with a temporal path of two frames (one frame pair) has no
+/// spread to show: its report prints each mean without ± and no NaN or infinity anywhere (it
+/// printed "± NaN" and "± inf").
+#[test]
+fn a_report_over_one_view_and_one_frame_pair_shows_no_nan_or_infinity() {
+    let dir = fresh_dir("bounds-one-view");
+    let model = tiny_room_model(&dir, "baseline", &[]);
+    let (data, out) = (dir.join("data"), dir.join("report"));
+    #[rustfmt::skip]
+    common::ok(&[
+        "eval", "--data", data.to_str().unwrap(), "--model", model.to_str().unwrap(),
+        "--out", out.to_str().unwrap(), "--views", "1", "--timing-res", "8", "--sh-spp", "1",
+        "--temporal-frames", "2", "--temporal-res", "8",
+    ]);
+    let md = std::fs::read_to_string(out.join("report.md")).unwrap();
+    let words: Vec<&str> = md.split(|c: char| !c.is_alphanumeric()).collect();
+    for bad in ["nan", "inf"] {
+        assert!(
+            !words.iter().any(|w| w.eq_ignore_ascii_case(bad)),
+            "report.md shows {bad}:\n{md}"
+        );
+    }
+    assert!(md.contains("1 test view"), "{md}");
+    assert!(md.contains("no spread"), "{md}");
+    std::fs::remove_dir_all(&dir).ok();
+}

@@ -734,3 +734,42 @@ fn resumes_across_engines() {
     assert_eq!(val.len(), 3, "one validation row per epoch: {val:?}");
     assert!(val.iter().all(|v| v.is_finite()), "{val:?}");
 }
+
+/// `--pause-after` stops a call, saved, inside the run (its length and its cosine schedule over
+/// --minutes kept); the same command continues it from there, and the call that reaches the
+/// run's end is not said to pause.
+#[test]
+fn a_paused_run_is_continued_by_the_same_command() {
+    let out = fresh_dir("pause");
+    let seconds = || -> f64 {
+        let state = std::fs::read_to_string(out.join("checkpoint/state.json")).unwrap();
+        serde_json::from_str::<serde_json::Value>(&state).unwrap()["seconds"]
+            .as_f64()
+            .unwrap()
+    };
+    let run = |pause: &[&str]| {
+        let mut args = vec!["--minutes", "0.1", "--checkpoint-minutes", "0"];
+        args.extend_from_slice(pause);
+        train(&out, "baseline", &args)
+    };
+    let first = run(&["--pause-after", "0.02"]);
+    assert!(first.contains("paused (--pause-after 0.02)"), "{first}");
+    let after_first = seconds();
+    assert!((1.2..6.0).contains(&after_first), "{after_first} s");
+    let second = run(&["--pause-after", "0.02"]);
+    assert!(second.contains("resumed from epoch"), "{second}");
+    assert!(second.contains("paused (--pause-after"), "{second}");
+    assert!(seconds() >= after_first + 1.2, "{} s", seconds());
+    let last = run(&[]);
+    assert!(!last.contains("paused"), "{last}");
+    assert!(seconds() >= 6.0, "{} s", seconds());
+    fails(
+        &train_args(
+            &out,
+            "baseline",
+            &["--minutes", "0.1", "--pause-after", "0"],
+        ),
+        &["pause", "positive number of minutes"],
+    );
+    std::fs::remove_dir_all(&out).ok();
+}

@@ -166,6 +166,31 @@ fn the_viewer_opens_a_window_and_shows_what_render_makes() {
         assert!(lit * 2 > 160 * 120, "{device}: the frame shows the room");
     }
 
+    // --camera-volume starts the camera in that volume instead of the scene's sidecar (the
+    // KITCHEN's lives in docs/): here, at the back wall looking out of the room's open side, so
+    // that the sky fills much of a frame the default view shows none of.
+    let volume = dir.join("volume.json");
+    std::fs::write(
+        &volume,
+        r#"{"min": [-0.1, 1.4, -2.6], "max": [0.1, 1.5, -2.5], "look": [0, 0.1, 1],
+            "spread_deg": 0, "fov_deg": 60}"#,
+    )
+    .unwrap();
+    let elsewhere = dir.join("elsewhere.png");
+    #[rustfmt::skip]
+    view(&display, &[m, "--res", "160x120", "--frames", "1", "--no-overlay",
+        "--camera-volume", volume.to_str().unwrap(), "--screenshot", elsewhere.to_str().unwrap()]);
+    let elsewhere = image::open(&elsewhere).unwrap().to_rgb8();
+    let moved = elsewhere
+        .pixels()
+        .zip(rendered.pixels())
+        .filter(|(a, b)| a.0.iter().zip(b.0).any(|(x, y)| x.abs_diff(y) > 16))
+        .count();
+    assert!(
+        moved * 4 > 160 * 120,
+        "the view did not move: {moved} pixels differ"
+    );
+
     // The progressive reference (the R key) on the GPU, where the kernels run: path traced on
     // the device, it converges to what the CPU's tracer shows.
     if wgpu_runs() {

@@ -34,6 +34,11 @@ pub struct Schedule {
     /// itself, so a run resumes with other ones.
     #[serde(skip)]
     pub snapshots: Vec<Snapshot>,
+    /// Minutes of training after which this call stops, saved, wherever the run stands
+    /// (`--pause-after`): a long run advanced a loan at a time. Not part of the run, which the
+    /// same call continues.
+    #[serde(skip)]
+    pub pause_after: Option<f64>,
 }
 
 impl Default for Schedule {
@@ -48,6 +53,7 @@ impl Default for Schedule {
             checkpoint_secs: 300.0,
             progress: true,
             snapshots: Vec::new(),
+            pause_after: None,
         }
     }
 }
@@ -67,6 +73,11 @@ impl Schedule {
         if let Some(m) = self.minutes {
             if !(m > 0.0 && m.is_finite()) {
                 bail!("the time budget must be a positive number of minutes, got {m}");
+            }
+        }
+        if let Some(m) = self.pause_after {
+            if !(m > 0.0 && m.is_finite()) {
+                bail!("the pause must come after a positive number of minutes, got {m}");
             }
         }
         Ok(())

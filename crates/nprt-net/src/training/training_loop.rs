@@ -95,6 +95,8 @@ pub struct TrainSummary {
     pub final_train: f64,
     pub final_val: f64,
     pub resumed_from_epoch: Option<f64>,
+    /// This call stopped at its `pause_after` with the run unfinished.
+    pub paused: bool,
     /// Where the steps ran: "cpu", or "GPU kernels on …".
     pub steps_on: String,
     /// Where this invocation's time went.
@@ -321,8 +323,17 @@ impl<'s, O: Objective> Run<'s, O> {
         }
     }
 
+    /// Whether the run's time budget is spent, or this call's pause has come.
     fn out_of_time(&self) -> bool {
-        self.budget.is_some_and(|b| self.ck.state.seconds >= b)
+        self.budget.is_some_and(|b| self.ck.state.seconds >= b) || self.pausing()
+    }
+
+    /// Whether this call has trained its `pause_after`.
+    fn pausing(&self) -> bool {
+        let this_call = self.ck.state.seconds - self.seconds_before;
+        self.schedule
+            .pause_after
+            .is_some_and(|m| this_call >= m * 60.0)
     }
 
     /// Batches in `epoch`.
@@ -591,6 +602,9 @@ impl<'s, O: Objective> Run<'s, O> {
             final_train: last(|r| r.train).unwrap_or(self.last_train),
             final_val: last(|r| r.val).unwrap_or(f64::NAN),
             resumed_from_epoch,
+            paused: self.pausing()
+                && state.epoch < self.schedule.epochs
+                && self.budget.is_none_or(|b| state.seconds < b),
             steps_on: self.steps_on.clone(),
             split: self.split,
         }

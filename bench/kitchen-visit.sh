@@ -1,0 +1,195 @@
+#!/usr/bin/env bash
+# The pretrained KITCHEN: one D/S run of a fixed total (60 minutes of f16 training on the GPU
+# kernels, its cosine learning rate over the whole 60, on bench/kitchen.sh's `gpu` dataset:
+# 1000 training views of 128² at 64 spp, 32 test views at 1024 spp, 3 maps held out) that every
+# GPU loan advances from where the last stopped. The run lives in pretrained/kitchen-dsep/
+# (committed): model/ (weights, config, loss curves and the resumable checkpoint with Adam's
+# moments), dataset.sha256 (the dataset's identity, written by the first visit) and visits.csv
+# (a row per visit). docs/kitchen.md keeps the table by GPU-minutes done.
+#
+#   bench/kitchen-visit.sh prepare
+#       here, without a GPU: bench/gpu-prepare.sh's binaries and tests, the KITCHEN scene and
+#       the maps packed into .visit/bundle.tar.xz (about 35 MiB, inside a loan's 64 MiB).
+#   bench/kitchen-visit.sh run [--minutes M] [--skip-tests]
+#       on the GPU machine, with .visit carried, in at most M wall minutes (default 8.5): the
+#       GPU kernels' correctness tests; the dataset path traced on the device from the fixed
+#       flags (timed; its manifest checked against dataset.sha256); training resumed until the
+#       visit's time is nearly spent (`nprt train --pause-after`); `nprt bench train` and
+#       `bench frame` of D/S; then in $OUT (default .visit/out): summary.md, visit.log,
+#       model.tar.xz and the test views (testviews.tar.part-*, 15 MiB each), 8 files at most.
+#   bench/kitchen-visit.sh land DIR [--cpu-model MODEL]
+#       here, on what a visit brought back in DIR: the model replaces pretrained/kitchen-dsep/
+#       model, the row joins visits.csv, and `nprt eval` (CPU; OIDN where scripts/oidn.sh put it)
+#       scores it on the visit's test views against their references, beside equal-time path
+#       tracing with and without OIDN and, with --cpu-model, D/S trained on the CPU.
+#
+# Scene and maps sit at .visit/kitchen and .visit/envmaps on both machines (links to ../shared
+# here), so the dataset's manifest names the same paths wherever it is read.
+# Environment, to try the script without a GPU: VISIT_DEVICE (default gpu; wgpu runs on
+# lavapipe), VISIT_BUDGET (default gpu; tiny), VISIT_PRETRAINED (default pretrained/kitchen-dsep).
+set -euo pipefail
+cd "$(dirname "$0")/.."
+
+total_minutes=60
+device=${VISIT_DEVICE:-gpu}
+budget=${VISIT_BUDGET:-gpu}
+pretrained=${VISIT_PRETRAINED:-pretrained/kitchen-dsep}
+log() { echo "bench/kitchen-visit.sh: $*" >&2; }
+die() { log "$*"; exit 1; }
+usage() { sed -n '2,/^set -euo/p' "$0" | sed '$d; s/^# \{0,1\}//'; }
+
+# .visit/kitchen and .visit/envmaps: links to ../shared here, the unpacked bundle there.
+link_shared() {
+  mkdir -p .visit
+  for pair in kitchen:../shared/scenes/kitchen envmaps:../shared/envmaps; do
+    local name=${pair%%:*} target=${pair#*:}
+    [ -d "$target" ] || die "'$target' is missing (the KITCHEN and the maps come from ../shared)"
+    [ -e ".visit/$name" ] || ln -s "$(realpath "$target")" ".visit/$name"
+  done
+}
+
+prepare() {
+  bench/gpu-prepare.sh --out .gpu
+  link_shared
+  log "packing .visit/bundle.tar.xz"
+  XZ_OPT=-T0 tar -cJhf .visit/bundle.tar.xz --transform 's,^\.gpu,gpu,; s,^\.visit/,,' \
+    .gpu/nprt .gpu/commit .gpu/lib .gpu/tests/gpu_training .gpu/tests/gpu_frame \
+    .visit/kitchen .visit/envmaps
+  du -h .visit/bundle.tar.xz
+  log "ready: carry '.visit/bundle.tar.xz' and run 'bench/kitchen-visit.sh run' on the GPU machine"
+}
+
+run_visit() {
+  local minutes=8.5 tests=1
+  while [ $# -gt 0 ]; do
+    case "$1" in
+      --minutes) minutes=$2; shift 2 ;;
+      --skip-tests) tests=; shift ;;
+      *) die "unknown argument '$1' (--help lists them)" ;;
+    esac
+  done
+  local deadline=$(($(date +%s) + $(awk -v m="$minutes" 'BEGIN { printf "%d", m * 60 }')))
+  local out=${OUT:-.visit/out} work=.visit/work
+  mkdir -p "$out" "$work"
+  exec > >(tee -a "$out/visit.log") 2>&1
+  if [ -f .visit/bundle.tar.xz ] && [ ! -x .visit/gpu/nprt ]; then
+    log "unpacking the bundle"
+    python3 -c 'import sys, tarfile; tarfile.open(sys.argv[1]).extractall(sys.argv[2])' \
+      .visit/bundle.tar.xz .visit
+  fi
+  local nprt=${VISIT_NPRT:-.visit/gpu/nprt}
+  [ -x "$nprt" ] || die "no '$nprt': run 'bench/kitchen-visit.sh prepare' where the code builds"
+  [ -f .visit/kitchen/scene.xml ] || link_shared
+  # The prepared loader where the machine has none; the NVIDIA driver's ICD where the loader's
+  # own folders list none.
+  if ! ldconfig -p | grep -q 'libvulkan\.so\.1' && [ -f .visit/gpu/lib/libvulkan.so.1 ]; then
+    export LD_LIBRARY_PATH=$(realpath .visit/gpu/lib)${LD_LIBRARY_PATH:+:$LD_LIBRARY_PATH}
+  fi
+  local icd=/usr/local/nvidia/share/vulkan/icd.d/nvidia_icd.json
+  if [ -z "${VK_DRIVER_FILES:-}" ] && [ -f "$icd" ] &&
+    ! ls /usr/share/vulkan/icd.d/*.json /etc/vulkan/icd.d/*.json >/dev/null 2>&1; then
+    export VK_DRIVER_FILES=$icd
+  fi
+  local summary=$out/summary.md
+  {
+    echo "# A visit to the pretrained KITCHEN: $(date -u +%Y-%m-%dT%H:%MZ)"
+    echo
+    echo "nprt $(cat .visit/gpu/commit 2>/dev/null || git rev-parse --short HEAD 2>/dev/null || echo unknown)"
+    nvidia-smi --query-gpu=name,driver_version --format=csv,noheader 2>/dev/null || echo "device $device"
+  } >"$summary"
+
+  if [ -n "$tests" ]; then
+    printf '\n## The GPU kernels'"'"' correctness tests\n\n```\n' >>"$summary"
+    for t in .visit/gpu/tests/*; do
+      log "correctness: $(basename "$t")"
+      NPRT_REQUIRE_VULKAN=1 timeout 150 "$t" 2>&1 | tee "$work/$(basename "$t").txt" |
+        grep -E '^test result|panicked|FAILED' >>"$summary" || true
+      grep -q '^test result: ok' "$work/$(basename "$t").txt" ||
+        die "$(basename "$t") failed on this device: not training on kernels that disagree with the CPU engine"
+    done
+    echo '```' >>"$summary"
+  fi
+
+  # The model as the last visit left it (a first visit starts the run).
+  if [ -f "$pretrained/model/checkpoint/state.json" ] && [ ! -e "$work/model" ]; then
+    cp -a "$pretrained/model" "$work/model"
+  fi
+  mkdir -p "$pretrained"
+  # Benches and packing take about 90 s after training.
+  bench/kitchen.sh --out "$work" --device "$device" --budget "$budget" --precision f16 \
+    --minutes "$total_minutes" --pause-by $((deadline - 90)) --data-hash "$pretrained/dataset.sha256" \
+    --scene .visit/kitchen/scene.xml --maps .visit/envmaps --nprt "$nprt" --no-eval
+  sed -n '2,$p' "$work/summary.md" >>"$summary"
+
+  if [ $(($(date +%s) + 60)) -lt "$deadline" ]; then
+    printf '\n## nprt bench train and bench frame (D/S)\n\n```\n' >>"$summary"
+    # Beside PyTorch on CUDA where the machine's python3 has it.
+    timeout 60 "$nprt" bench train --arch dsep --device "$device" --precision f32,f16 \
+      --rounds 1 --python python3 --peer-variants eager-f32,eager-bf16 2>&1 |
+      tail -n 8 >>"$summary" || true
+    timeout 40 "$nprt" bench frame --arch dsep --device "$device" --res 512 \
+      --precision f32,f16 2>&1 | tail -n 10 >>"$summary" || true
+    echo '```' >>"$summary"
+  fi
+
+  log "packing what comes back"
+  cp "$pretrained/dataset.sha256" "$out/" 2>/dev/null || true
+  [ -f "$work/model/checkpoint/state.json" ] || die "no model was trained in this visit"
+  tar -cJf "$out/model.tar.xz" -C "$work" --exclude snapshots model
+  (cd "$work" && tar -cf - data/manifest.json data/views/test_*) |
+    split -b 15M -d - "$out/testviews.tar.part-"
+  log "done: $(ls "$out" | tr '\n' ' ')"
+}
+
+land() {
+  local from=${1:-} cpu_model=
+  [ -n "$from" ] && [ -d "$from" ] || die "give the folder a visit's files came back to"
+  shift
+  while [ $# -gt 0 ]; do
+    case "$1" in
+      --cpu-model) cpu_model=$2; shift 2 ;;
+      *) die "unknown argument '$1' (--help lists them)" ;;
+    esac
+  done
+  [ -f "$from/model.tar.xz" ] || die "'$from' holds no model.tar.xz (did the visit train?)"
+  local nprt=${VISIT_NPRT:-target/release/nprt} work=target/kitchen-visit
+  [ -x "$nprt" ] || cargo build --release -p nprt
+  link_shared
+  rm -rf "$work" && mkdir -p "$work"
+  tar -xJf "$from/model.tar.xz" -C "$work"
+  cat "$from"/testviews.tar.part-* | tar -xf - -C "$work"
+  local hash
+  hash=$(sha256sum "$work/data/manifest.json" | cut -d' ' -f1)
+  mkdir -p "$pretrained"
+  if [ -s "$pretrained/dataset.sha256" ] && [ "$(cat "$pretrained/dataset.sha256")" != "$hash" ]; then
+    die "the visit's dataset ($hash) is not the run's ($(cat "$pretrained/dataset.sha256"))"
+  fi
+  echo "$hash" >"$pretrained/dataset.sha256"
+  rm -rf "$pretrained/model.new" && cp -a "$work/model" "$pretrained/model.new"
+  rm -rf "$pretrained/model" && mv "$pretrained/model.new" "$pretrained/model"
+  # GPU-minutes done, samples seen and the last validation loss, from the checkpoint.
+  local row
+  row=$(python3 - "$pretrained/model/checkpoint/state.json" <<'EOF'
+import json, sys
+s = json.load(open(sys.argv[1]))
+val = next((r["val"] for r in reversed(s["history"]) if r.get("val") is not None), None)
+print(f'{s["seconds"] / 60:.2f},{s["samples"]},{s["epoch"]},{val:.5f}')
+EOF
+)
+  [ -f "$pretrained/visits.csv" ] || echo "landed,gpu_minutes,samples,epochs,val_loss" >"$pretrained/visits.csv"
+  echo "$(date -u +%Y-%m-%dT%H:%MZ),$row" >>"$pretrained/visits.csv"
+  log "model landed in $pretrained/model ($row); evaluating on the CPU"
+  local models=$pretrained/model
+  [ -z "$cpu_model" ] || models=$models,$cpu_model
+  [ -d target/oidn/lib ] && export NPRT_OIDN_DIR=${NPRT_OIDN_DIR:-$PWD/target/oidn/lib}
+  "$nprt" eval --data "$work/data" --model "$models" --device cpu --out "$work/report"
+  log "report in $work/report/report.md; add the row to docs/kitchen.md's table and commit $pretrained"
+}
+
+case "${1:-}" in
+  prepare) prepare ;;
+  run) shift; run_visit "$@" ;;
+  land) shift; land "$@" ;;
+  -h | --help) usage ;;
+  *) usage >&2; exit 2 ;;
+esac
