@@ -52,7 +52,7 @@ prepare() {
   bench/gpu-prepare.sh --out .gpu
   link_shared
   log "packing .visit/bundle.tar.xz"
-  XZ_OPT=-T0 tar -cJhf .visit/bundle.tar.xz --transform 's,^\.gpu,gpu,; s,^\.visit/,,' \
+  XZ_OPT=-T0 tar -cJhf .visit/bundle.tar.xz --transform 's,^\.gpu,gpu,' --transform 's,^\.visit/,,' \
     .gpu/nprt .gpu/commit .gpu/lib .gpu/tests/gpu_training .gpu/tests/gpu_frame \
     .visit/kitchen .visit/envmaps
   du -h .visit/bundle.tar.xz
