@@ -14,7 +14,7 @@ use nprt_net::{ModelConfig, TrainOptions, TrainSummary};
 use nprt_render::oidn::Oidn;
 use nprt_render::{RenderJob, RenderOptions};
 
-use crate::experiment::Experiment;
+use crate::experiment::{calibration, Experiment};
 use crate::readback::{self, Ablation, GrowthPoint};
 
 /// Renders (or resumes) the dataset; whether any view was rendered.
@@ -39,6 +39,7 @@ pub fn dataset(x: &Experiment, data: &Path) -> Result<bool> {
 pub fn train_model(x: &Experiment, data: &Path, config: &ModelConfig, out: &Path) -> Result<bool> {
     let set = TrainingSet::load(data, config, true, |why| eprintln!("{why}"))?;
     let mut opts = TrainOptions::default().with_run(config.design, x.training(), None);
+    opts.calibration = calibration(config);
     // The paper's four designs keep their models as training grows (`--snapshots`).
     if x.snapshot_configs().contains(config) {
         opts.schedule.snapshots = x.snapshots.clone();

@@ -15,6 +15,13 @@ fn the_tiny_budget_writes_every_table_and_resumes() {
     assert!(stdout.contains("the paper's orderings here: "), "{stdout}");
     let report = dir.join("report");
     let md = std::fs::read_to_string(report.join("paper.md")).unwrap();
+    // The design beyond the paper is saved with its level calibrated (its measured recipe); the
+    // paper's designs keep their raw output.
+    let config = |name: &str| {
+        std::fs::read_to_string(dir.join("models").join(name).join("model.json")).unwrap()
+    };
+    assert!(config("linear+sh:2+direct").contains("\"level_gain\""));
+    assert!(!config("dsep").contains("\"level_gain\""));
     for want in [
         "## What this run says",
         "## Table 1: transport parameters",
