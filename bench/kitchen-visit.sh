@@ -9,7 +9,7 @@
 #
 #   bench/kitchen-visit.sh prepare
 #       here, without a GPU: bench/gpu-prepare.sh's binaries and tests, the KITCHEN scene and
-#       the maps packed into .visit/bundle.tar.xz (about 35 MiB, inside a loan's 64 MiB).
+#       the maps packed into .visit/bundle.tar.xz (27 MiB, inside a loan's 64 MiB).
 #   bench/kitchen-visit.sh run [--minutes M] [--skip-tests]
 #       on the GPU machine, with .visit carried, in at most M wall minutes (default 8.5): the
 #       GPU kernels' correctness tests; the dataset path traced on the device from the fixed
@@ -133,7 +133,6 @@ run_visit() {
   fi
 
   log "packing what comes back"
-  cp "$pretrained/dataset.sha256" "$out/" 2>/dev/null || true
   [ -f "$work/model/checkpoint/state.json" ] || die "no model was trained in this visit"
   tar -cJf "$out/model.tar.xz" -C "$work" --exclude snapshots model
   (cd "$work" && tar -cf - data/manifest.json data/views/test_*) |

@@ -2,7 +2,7 @@
 //! networks, direct light), per design and resolution, on the device the networks run on.
 //! Untrained networks are timed: a frame's cost does not depend on the weights.
 
-use anyhow::{Context, Result};
+use anyhow::Result;
 use nprt_net::model::folder::ModelFile;
 use nprt_net::{Design, DirectLight, Engine, Init, ModelConfig};
 use nprt_scene::{load_scene, SceneOptions};
@@ -71,13 +71,12 @@ pub fn bench_frame(
             .check_frame(w, h, &format!("a {w}×{h} frame"))?;
     }
     let scene = load_scene(&opts.scene, &SceneOptions::default())?;
-    let volume = scene.camera_volume.as_ref().with_context(|| {
-        format!(
-            "scene '{}' has no camera volume (sidecar NAME.camera.json) to place the camera",
-            opts.scene
-        )
-    })?;
-    let path = CameraPath::through_volume(volume);
+    let path = CameraPath::through_volume_of(
+        None,
+        &scene,
+        &opts.scene,
+        "bench frame places its camera in one",
+    )?;
     let map = &nprt_scene::open_envmap(&opts.map)?;
     let (lo, hi) = scene.bounds();
     let ts = TraceScene::new(&scene);

@@ -86,6 +86,23 @@ impl CameraPath {
         Ok(())
     }
 
+    /// [`Self::through_volume`] of the camera volume in the JSON file `file`, or else of
+    /// `scene`'s own (its sidecar NAME.camera.json); where there is neither, an error that
+    /// names the scene `spec` and ends with `hint`.
+    pub fn through_volume_of(
+        file: Option<&Path>,
+        scene: &nprt_scene::Scene,
+        spec: &str,
+        hint: &str,
+    ) -> Result<Self> {
+        Ok(Self::through_volume(&match file {
+            Some(f) => CameraVolume::load(f)?,
+            None => scene.camera_volume.clone().with_context(|| {
+                format!("scene '{spec}' has no camera volume (no sidecar NAME.camera.json); {hint}")
+            })?,
+        }))
+    }
+
     /// A slow sweep through a scene's camera volume: across the volume and back, panning
     /// within the volume's spread of view directions.
     pub fn through_volume(v: &CameraVolume) -> Self {

@@ -6,7 +6,7 @@ use std::path::PathBuf;
 
 use anyhow::{bail, Context, Result};
 use nprt_net::Engine;
-use nprt_scene::{CameraVolume, Scene};
+use nprt_scene::Scene;
 use nprt_trace::TraceScene;
 
 use crate::oidn::Oidn;
@@ -109,10 +109,12 @@ impl RenderJob {
         )?;
         let path = match (&opts.camera_path, &opts.camera_volume) {
             (Some(p), _) => CameraPath::load(p)?,
-            (None, Some(v)) => CameraPath::through_volume(&CameraVolume::load(v)?),
-            (None, None) => CameraPath::through_volume(scene.camera_volume.as_ref().with_context(|| {
-                format!("scene '{scene_spec}' has no camera volume (no sidecar NAME.camera.json); give --camera-path or --camera-volume")
-            })?),
+            (None, v) => CameraPath::through_volume_of(
+                v.as_deref(),
+                &scene,
+                &scene_spec,
+                "give --camera-path or --camera-volume",
+            )?,
         };
         let lighting = LightingSchedule::parse(&opts.lighting, opts.spin_deg)?;
         let denoiser = match (opts.denoise_direct, model.traces_direct()) {

@@ -88,6 +88,11 @@ impl Schedule {
         self.minutes.map(|m| m * 60.0)
     }
 
+    /// This call's training before it pauses, in seconds, if it pauses.
+    pub(crate) fn pause_secs(&self) -> Option<f64> {
+        self.pause_after.map(|m| m * 60.0)
+    }
+
     /// "epoch 3/20", or "epoch 3" for a run bounded by its time budget alone.
     pub(crate) fn epoch_label(&self, epoch: usize) -> String {
         if self.epochs == usize::MAX {

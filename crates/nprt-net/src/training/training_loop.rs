@@ -325,15 +325,18 @@ impl<'s, O: Objective> Run<'s, O> {
 
     /// Whether the run's time budget is spent, or this call's pause has come.
     fn out_of_time(&self) -> bool {
-        self.budget.is_some_and(|b| self.ck.state.seconds >= b) || self.pausing()
+        self.budget_spent() || self.pausing()
+    }
+
+    /// Whether the run's time budget, if it has one, is spent.
+    fn budget_spent(&self) -> bool {
+        self.budget.is_some_and(|b| self.ck.state.seconds >= b)
     }
 
     /// Whether this call has trained its `pause_after`.
     fn pausing(&self) -> bool {
         let this_call = self.ck.state.seconds - self.seconds_before;
-        self.schedule
-            .pause_after
-            .is_some_and(|m| this_call >= m * 60.0)
+        self.schedule.pause_secs().is_some_and(|p| this_call >= p)
     }
 
     /// Batches in `epoch`.
@@ -602,9 +605,7 @@ impl<'s, O: Objective> Run<'s, O> {
             final_train: last(|r| r.train).unwrap_or(self.last_train),
             final_val: last(|r| r.val).unwrap_or(f64::NAN),
             resumed_from_epoch,
-            paused: self.pausing()
-                && state.epoch < self.schedule.epochs
-                && self.budget.is_none_or(|b| state.seconds < b),
+            paused: self.pausing() && state.epoch < self.schedule.epochs && !self.budget_spent(),
             steps_on: self.steps_on.clone(),
             split: self.split,
         }

@@ -9,7 +9,7 @@ use std::time::Instant;
 use anyhow::{anyhow, bail, Context, Result};
 use glam::Vec3;
 use nprt_net::Engine;
-use nprt_scene::{CameraVolume, EnvMap, Scene};
+use nprt_scene::{EnvMap, Scene};
 use nprt_trace::{PixelFilter, RenderSettings, TraceScene};
 use winit::application::ApplicationHandler;
 use winit::dpi::PhysicalSize;
@@ -167,12 +167,12 @@ impl<'a> Viewer<'a> {
             .scene
             .clone()
             .unwrap_or_else(|| models[0].file.scene.clone());
-        let path = match &opts.camera_volume {
-            Some(file) => CameraPath::through_volume(&CameraVolume::load(file)?),
-            None => CameraPath::through_volume(scene.camera_volume.as_ref().with_context(|| {
-                format!("scene '{spec}' has no camera volume (sidecar NAME.camera.json) to start the camera in; give --camera-volume")
-            })?),
-        };
+        let path = CameraPath::through_volume_of(
+            opts.camera_volume.as_deref(),
+            scene,
+            &spec,
+            "give --camera-volume to start the camera in",
+        )?;
         let k = &path.keyframes[0];
         let camera = OrbitCamera::new(k.position.into(), k.target.into(), k.fov_x_deg);
         let maps = opts
