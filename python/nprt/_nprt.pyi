@@ -142,8 +142,10 @@ def generate(
     device: str = "cpu",
     progress: bool = True,
     mix_maps: Optional[int] = None,
+    transfer: Optional[str] = None,
 ) -> Dict[str, Any]:
-    """`nprt generate`; None takes its default."""
+    """`nprt generate`; None takes its default (``transfer``: ``"sh:L"`` records each
+    training pixel's transfer vector on SH bands 0..L)."""
 
 def train(
     data: PathLike,
@@ -163,10 +165,12 @@ def train(
     callback: Optional[Callable[[Dict[str, Any]], Optional[bool]]] = None,
     basis: Optional[str] = None,
     snapshots: Optional[str] = None,
+    targets: Optional[str] = None,
 ) -> Dict[str, Any]:
     """`nprt train`; None takes its default (``basis``: the linear design's ``"sh:L"`` or
     ``"learned:K"``; ``snapshots``: points such as ``"1m,2m,4m"`` at which the model is kept
-    in ``out``/snapshots/POINT). ``callback`` gets each epoch's row of the loss
+    in ``out``/snapshots/POINT; ``targets``: ``"radiance"`` or ``"transfer"``, the vectors
+    ``generate(transfer=...)`` recorded). ``callback`` gets each epoch's row of the loss
     curves; returning a false value other than None (False, 0, numpy's False_), or Ctrl-C,
     ends the run there, saved, and the same call resumes it."""
 

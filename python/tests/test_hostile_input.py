@@ -77,6 +77,16 @@ def test_enum_like_strings_list_their_choices(dataset):
         nprt.Model("anything", device="tpu")
 
 
+def test_transfer_choices_are_refused_by_name(dataset, tmp_path):
+    with pytest.raises(nprt.InputError, match="transfer: .*at most sh:8"):
+        nprt.generate("builtin:room", "builtin", tmp_path / "d", transfer="sh:9")
+    with pytest.raises(nprt.InputError, match="radiance or transfer"):
+        nprt.train(dataset, "linear", tmp_path / "m", targets="vectors")
+    # A dataset made without them: the call says how to make one with them.
+    with pytest.raises(nprt.NprtError, match="holds no transfer vectors"):
+        nprt.train(dataset, "linear", tmp_path / "m", targets="transfer", basis="sh:1")
+
+
 def test_a_model_warns_when_it_renders_another_scene(model, tmp_path):
     cube = tmp_path / "cube.obj"
     cube.write_text("v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nf 1 2 3\nf 1 2 4\nf 1 3 4\nf 2 3 4\n")

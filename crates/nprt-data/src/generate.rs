@@ -8,7 +8,7 @@ use nprt_scene::load_scene;
 use nprt_trace::{TraceDevice, TraceScene, Tracer};
 
 use crate::camera_choice::CameraChoice;
-use crate::dataset::{self, Jitter, Manifest, Request, Summary};
+use crate::dataset::{self, Jitter, Manifest, Request, Summary, TransferBasis};
 use crate::lighting;
 
 /// What to render and where. `Default` is the recipe for a 2-core CPU (400 + 40 views at 128²,
@@ -34,6 +34,8 @@ pub struct GenerateOptions {
     pub jitter: Jitter,
     /// The most maps a training view's lighting mixes (1: one map a view).
     pub mix_maps: u32,
+    /// Record the training pixels' transfer vectors on this basis (CPU tracer only).
+    pub transfer: Option<TransferBasis>,
     /// Maps of a folder held out for testing (default: a fifth, at least one).
     pub test_maps: Option<usize>,
     /// With a folder of maps, the share of training views lit by a procedural lighting of
@@ -66,6 +68,7 @@ impl Default for GenerateOptions {
                 tint: 0.3,
             },
             mix_maps: 1,
+            transfer: None,
             test_maps: None,
             mix_builtin: None,
             camera: CameraChoice::default(),
@@ -100,6 +103,21 @@ fn check_sizes(opts: &GenerateOptions, builtin_share: f32) -> Result<()> {
         views * BYTES_PER_VIEW + own_maps * BYTES_PER_BUILTIN_MAP,
         &format!("planning {views} views"),
     )?;
+    if let Some(basis) = opts.transfer {
+        if !opts.device.is_cpu() {
+            anyhow::bail!(
+                "--transfer {basis}: transfer vectors are recorded by the CPU tracer only; \
+                 generate with --device cpu"
+            );
+        }
+        // A training view's transfer as traced (a vector per pixel) and as written.
+        let [w, h] = opts.train_resolution;
+        let floats = 2 * basis.floats() as u128;
+        nprt_io::ensure_memory(
+            w as u128 * h as u128 * floats * 4 * 3,
+            &format!("the transfer vectors ({basis}) of a {w}×{h} training view"),
+        )?;
+    }
     for (split, [w, h]) in [
         ("training", opts.train_resolution),
         ("test", opts.test_resolution),
@@ -157,6 +175,7 @@ pub fn generate(opts: &GenerateOptions, planned: impl FnOnce(Planned)) -> Result
     let ts = TraceScene::new(&scene);
     let mut manifest = dataset::plan(&request, &ts)?;
     manifest.settings.tracer = opts.device;
+    manifest.settings.transfer = opts.transfer;
     // Opened before the folder is made: a GPU that does not open leaves nothing behind.
     let tracer = Tracer::new(opts.device, &ts)?;
     dataset::prepare(&opts.out, &manifest)?;

@@ -3,7 +3,7 @@
 
 use std::path::Path;
 
-use crate::dataset::{read_view, Manifest, ViewRecord};
+use crate::dataset::{read_view, Manifest, Transfer, ViewRecord};
 use anyhow::{Context, Result};
 use glam::Vec3;
 use nprt_scene::Camera;
@@ -20,6 +20,8 @@ pub struct ImageView {
     pub gbuffer: GBuffer,
     /// Radiance of the first half of the samples, for a test view rendered in halves.
     pub half: Option<Vec<Vec3>>,
+    /// Transfer vectors, for a training view of a dataset made with `--transfer`.
+    pub transfer: Option<Transfer>,
 }
 
 impl ImageView {
@@ -41,7 +43,7 @@ pub fn load_views(dir: &Path, manifest: &Manifest, split: &str) -> Result<Vec<Im
 /// Reads one view, refusing a file whose channels or size disagree with the manifest.
 pub fn load_view(dir: &Path, manifest: &Manifest, view: &ViewRecord) -> Result<ImageView> {
     let path = dir.join(&view.file);
-    let image = read_view(&path, view, manifest.settings.in_halves(view)).with_context(|| {
+    let image = read_view(&path, view, manifest.settings.parts(view)).with_context(|| {
         format!(
             "dataset view '{}' is unusable (run `nprt generate` again to redo it)",
             path.display()
@@ -57,5 +59,6 @@ pub fn load_view(dir: &Path, manifest: &Manifest, view: &ViewRecord) -> Result<I
         direct: frame.direct,
         gbuffer: frame.gbuffer,
         half: image.half,
+        transfer: image.transfer,
     })
 }

@@ -57,7 +57,7 @@ impl ShTransport {
         bands: usize,
         settings: &RenderSettings,
     ) -> Self {
-        let transport = render_transport(ts, camera, settings, bands * bands, &|d, out| {
+        let transport = render_transport(ts, camera, settings, bands * bands, &|d, _, out| {
             basis(bands, d, out)
         });
         ShTransport { bands, transport }

@@ -81,6 +81,6 @@ pub use training::lr_schedule::LrSchedule;
 pub use training::nprt_objective::train;
 pub use training::run_length::RunLength;
 pub use training::schedule::Schedule;
-pub use training::train_options::{recipe_rate, Gather, TrainOptions};
+pub use training::train_options::{recipe_rate, Gather, Targets, TrainOptions};
 pub use training::training_loop::{Objective, TrainSummary, Watch};
 pub use training::validation::validation_loss;

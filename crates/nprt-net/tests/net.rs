@@ -5,10 +5,11 @@
 mod common;
 
 use common::reference::Reference;
-use common::{check_gradients, loud_grids, random_batch, variants};
+use common::{check_against, check_gradients, loud_grids, random_batch, variants};
 use nprt_net::model::folder::{load_weights, save_weights};
 use nprt_net::FEATURES;
 use nprt_net::{cpu, Activation, Batch, Design, Init, Loss, ModelConfig, NprtNet, Parameters};
+use nprt_net::{BasisChoice, PositionEncoding};
 use rand::{RngExt, SeedableRng};
 use rand_pcg::Pcg64Mcg;
 
@@ -48,6 +49,62 @@ fn gradients_match_finite_differences() {
             // The encoder is the same in every design; a learned basis is checked where it is.
             let light = v == 0 || config.basis.is_some_and(|b| b.is_learned());
             check_gradients(&name, &net, &batch, loss, &grads, light);
+        }
+    }
+}
+
+/// Transfer targets (`--targets transfer`): the CPU engine's gradients of the mean squared
+/// error of the linear design's transfer vectors, against central differences of the f64
+/// reference's, whose vector is its radiance under each basis function alone as the light
+/// code (scale 1); every track's tensors, with and without a hash grid.
+#[test]
+fn transfer_gradients_match_finite_differences() {
+    let mut batch = random_batch(6, 2, 11);
+    for band in [1usize, 2] {
+        let k = (band + 1) * (band + 1);
+        let mut rng = Pcg64Mcg::seed_from_u64(band as u64);
+        batch.transfer = (0..batch.len() * 3 * k)
+            .map(|_| rng.random::<f32>() - 0.3)
+            .collect();
+        for encoding in [PositionEncoding::None, PositionEncoding::HashGrid] {
+            let config = ModelConfig {
+                encoder_width: 64,
+                basis: Some(BasisChoice::Sh { band }),
+                encoding,
+                ..ModelConfig::new(Design::Linear, None)
+            };
+            let net = loud_grids(config.build(&mut Init::new(5)));
+            let (loss, grads) = cpu::gradients(&net, &batch.samples(), Loss::LogL1);
+            let reference = Reference::new(&net);
+            let unlit = Batch {
+                features: batch.features.clone(),
+                radiance: batch.radiance.clone(),
+                transfer: Vec::new(),
+                view: vec![0; batch.len()],
+                scale: vec![1.0; batch.len() * 3],
+                lights: Vec::new(),
+                light_width: 64,
+                picks: None,
+            };
+            let value = |r: &Reference, _| {
+                let mut sum = 0.0;
+                for j in 0..k {
+                    let mut code = vec![0.0; 3 * k];
+                    code[3 * j..3 * j + 3].fill(1.0);
+                    let p = r.predict(&unlit, Some(&[code]));
+                    for (i, p) in p.iter().enumerate() {
+                        let want = batch.transfer[(i / 3 * k + j) * 3 + i % 3] as f64;
+                        sum += (p - want).powi(2);
+                    }
+                }
+                sum / batch.transfer.len() as f64
+            };
+            let name = format!("sh:{band} {encoding:?}");
+            assert!(
+                (loss - value(&reference, 0)).abs() < 1e-5 * loss,
+                "{name}: {loss}"
+            );
+            check_against(&name, reference, &grads, 0, value);
         }
     }
 }
@@ -211,6 +268,7 @@ fn cpu_engine_matches_the_reference_on_a_large_batch() {
     let half = |range: std::ops::Range<usize>| Batch {
         features: batch.features[range.start * FEATURES..range.end * FEATURES].to_vec(),
         radiance: batch.radiance[range.start * 3..range.end * 3].to_vec(),
+        transfer: Vec::new(),
         view: batch.view[range.clone()].to_vec(),
         scale: batch.scale[range.start * 3..range.end * 3].to_vec(),
         lights: batch.lights.clone(),
@@ -299,6 +357,7 @@ fn cpu_engine_radiance_matches_the_reference() {
     let batch = Batch {
         features: features.clone(),
         radiance: vec![0.0; 3 * n],
+        transfer: Vec::new(),
         view: vec![0; n],
         scale: scale.repeat(n),
         lights: Vec::new(),

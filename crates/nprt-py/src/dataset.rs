@@ -95,9 +95,9 @@ impl Dataset {
     /// (`map`, `rotation_deg`, `gain`, and `mix`: the maps added to it).
     fn view<'py>(&self, py: Python<'py>, index: usize) -> PyResult<Bound<'py, PyDict>> {
         let v = self.record(index)?;
-        let halves = self.manifest.settings.in_halves(v);
+        let parts = self.manifest.settings.parts(v);
         let path = self.dir.join(&v.file);
-        let image = py.detach(|| read_view(&path, v, halves)).or_py()?;
+        let image = py.detach(|| read_view(&path, v, parts)).or_py()?;
         let (w, h) = (v.width as usize, v.height as usize);
         let (f, g) = (&image.frame, &image.frame.gbuffer);
         let out = PyDict::new(py);

@@ -26,7 +26,7 @@ use crate::interruptible::interruptible;
     test_res = None, spp = None, test_spp = None, seed = None, jitter_exposure = None,
     jitter_tint = None, test_maps = None, mix_builtin = None, shard = None, camera_volume = None,
     volume_min = None, volume_max = None, look = None, spread = None, fov = None,
-    device = "cpu", progress = true, mix_maps = None
+    device = "cpu", progress = true, mix_maps = None, transfer = None
 ))]
 #[allow(clippy::too_many_arguments)]
 pub fn generate<'py>(
@@ -55,6 +55,7 @@ pub fn generate<'py>(
     device: &str,
     progress: bool,
     mix_maps: Option<u32>,
+    transfer: Option<&str>,
 ) -> PyResult<Bound<'py, PyDict>> {
     let (fin, fin3) = (argument::finite_or_none, finite_vec3);
     let d = GenerateOptions::default();
@@ -78,6 +79,9 @@ pub fn generate<'py>(
             tint: fin(jitter_tint, "jitter_tint")?.unwrap_or(d.jitter.tint),
         },
         mix_maps: mix_maps.unwrap_or(d.mix_maps),
+        transfer: (transfer.map(str::parse).transpose())
+            .map_err(|e: anyhow::Error| crate::error::input_error(format!("transfer: {e}")))?
+            .or(d.transfer),
         test_maps: test_maps.or(d.test_maps),
         mix_builtin: fin(mix_builtin, "mix_builtin")?.or(d.mix_builtin),
         camera: CameraChoice {

@@ -42,7 +42,7 @@ use crate::error::OrPy;
 #[pyo3(signature = (
     data, arch, out, *, minutes = None, epochs = None, activation = None, device = "cpu",
     precision = None, batch_size = None, lr = None, schedule = None, seed = None,
-    progress = true, callback = None, basis = None, snapshots = None
+    progress = true, callback = None, basis = None, snapshots = None, targets = None
 ))]
 #[allow(clippy::too_many_arguments)]
 pub fn train<'py>(
@@ -63,6 +63,7 @@ pub fn train<'py>(
     callback: Option<Py<PyAny>>,
     basis: Option<&str>,
     snapshots: Option<&str>,
+    targets: Option<&str>,
 ) -> PyResult<Bound<'py, PyDict>> {
     let design = parse(arch)?;
     let mut config = ModelConfig::new(design, activation.map(parse).transpose()?);
@@ -89,6 +90,7 @@ pub fn train<'py>(
         },
         batch_size: batch_size.unwrap_or(d.batch_size),
         precision: precision.map(parse).transpose()?.unwrap_or(d.precision),
+        targets: targets.map(parse).transpose()?.unwrap_or(d.targets),
         ..d
     }
     .with_run(design, run, lr);

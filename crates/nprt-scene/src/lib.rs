@@ -3,7 +3,7 @@
 //!
 //! This crate owns geometry (triangle meshes in world space), materials (the DESIGN.md model:
 //! diffuse `kd`, GGX specular `ks`, GGX `alpha`, with textures), cameras, environment maps
-//! (lat-long, Mitsuba 3's mapping, importance sampling) and the procedural built-in content, plus
+//! (lat-long, Mitsuba 3's mapping, importance sampling, the spherical-harmonics basis) and the procedural built-in content, plus
 //! the loaders for glTF 2.0, Mitsuba 3 XML, PLY and OBJ. It must not trace rays, sample paths or
 //! know about datasets and networks: those belong to `nprt-trace` and later stages.
 //!
@@ -35,6 +35,7 @@ pub mod mitsuba;
 mod procedural;
 mod scene;
 mod scene_options;
+pub mod spherical_harmonics;
 mod texture;
 
 pub use bump_map::BumpMap;

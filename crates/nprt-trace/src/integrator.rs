@@ -323,17 +323,17 @@ pub(crate) fn escaped(env: &EnvMap, e: &Escape) -> Vec3 {
 }
 
 /// Follows one path by BSDF sampling alone until it leaves the scene; returns the escape
-/// direction and the path throughput, or `None` when the path ends on a surface (absorbed,
+/// direction, the surface vertices before it (1: direct light) and the path throughput, or `None` when the path ends on a surface (absorbed,
 /// Russian roulette, `max_depth`) or misses the scene from the start (no scattered light).
 pub fn trace_escape(
     ts: &TraceScene,
     ray: &CameraRay,
     s: &PathSettings,
     rng: &mut Pcg64Mcg,
-) -> Option<(Vec3, Vec3)> {
+) -> Option<(Vec3, u32, Vec3)> {
     walk(ts, ray, s, rng, |_, _| ControlFlow::Continue(()))
         .filter(|e| e.depth > 0)
-        .map(|e| (e.dir, e.beta))
+        .map(|e| (e.dir, e.depth, e.beta))
 }
 
 #[cfg(test)]

@@ -11,14 +11,16 @@ use crate::trace_scene::TraceScene;
 
 /// Per-pixel transport of a frame onto a basis of the distant lighting: for each pixel, an
 /// estimate of E[path throughput × basis(escape direction)] (one RGB value per basis function),
-/// so that radiance under lighting with basis coefficients c is Σ_k T_k ⊙ c_k. Paths sample the
-/// BSDF only (the lighting is unknown here); the same seed gives the same transport.
+/// so that radiance under lighting with basis coefficients c is Σ_k T_k ⊙ c_k. `basis(d, depth,
+/// out)` writes the `basis_len` values a path escaping along `d` after `depth` surface vertices
+/// adds (1: the direct light), so a caller can keep parts of the transport apart. Paths sample
+/// the BSDF only (the lighting is unknown here); the same seed gives the same transport.
 pub fn render_transport(
     ts: &TraceScene,
     camera: &Camera,
     s: &RenderSettings,
     basis_len: usize,
-    basis: &(dyn Fn(Vec3, &mut [f32]) + Sync),
+    basis: &(dyn Fn(Vec3, u32, &mut [f32]) + Sync),
 ) -> Vec<Vec<Vec3>> {
     let w = camera.width as usize;
     let ps = PathSettings {
@@ -37,8 +39,8 @@ pub fn render_transport(
             let mut y_k = vec![0.0; basis_len];
             let ray = CameraRay::centre(ts, camera, i % w, i / w);
             for _ in 0..s.spp {
-                if let Some((dir, beta)) = trace_escape(ts, &ray, &ps, &mut rng) {
-                    basis(dir, &mut y_k);
+                if let Some((dir, depth, beta)) = trace_escape(ts, &ray, &ps, &mut rng) {
+                    basis(dir, depth, &mut y_k);
                     for (tk, yk) in t.iter_mut().zip(&y_k) {
                         *tk += beta * *yk;
                     }

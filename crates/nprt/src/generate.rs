@@ -64,6 +64,14 @@ pub struct GenerateArgs {
     #[arg(long, default_value_t = d().mix_maps,
           value_parser = clap::value_parser!(u32).range(1..=nprt_data::dataset::MAX_MIX_MAPS as i64))]
     mix_maps: u32,
+    /// Record each training pixel's light transport on the real spherical harmonics of bands
+    /// 0..L (sh:L, L ≤ 8: (L+1)² coefficients per channel, its direct part kept apart), from
+    /// as many BSDF-sampled paths per pixel as its radiance: a target that holds every
+    /// lighting at once, which `nprt train --arch linear --basis sh:L' --targets transfer`
+    /// (L' ≤ L) learns. Adds about three quarters to the training views' time; CPU tracer only
+    /// (docs/dataset.md).
+    #[arg(long)]
+    transfer: Option<nprt_data::dataset::TransferBasis>,
     /// Seed of every random choice (cameras, split, rotations, pixels).
     #[arg(long, default_value_t = d().seed)]
     seed: u64,
@@ -138,6 +146,7 @@ impl TryFrom<GenerateArgs> for GenerateOptions {
                 tint: a.jitter_tint,
             },
             mix_maps: a.mix_maps,
+            transfer: a.transfer,
             test_maps: a.test_maps,
             mix_builtin: a.mix_builtin,
             camera: CameraChoice {

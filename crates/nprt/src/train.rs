@@ -7,7 +7,7 @@ use nprt_net::network::encoder::check_input_width;
 use nprt_net::training::training_set::{TrainingSet, ViewSamples};
 use nprt_net::{
     Activation, BasisChoice, Calibration, Design, DirectLight, Engine, Gather, Loss, MapNorm,
-    ModelConfig, PositionEncoding, Precision, TrainOptions, DEFAULT_ENCODER_WIDTH,
+    ModelConfig, PositionEncoding, Precision, Targets, TrainOptions, DEFAULT_ENCODER_WIDTH,
     DEFAULT_MAP_NORM,
 };
 
@@ -68,6 +68,14 @@ pub struct TrainArgs {
     /// docs/model.md). The validation loss is log-L1 either way.
     #[arg(long, default_value_t = d().loss)]
     loss: Loss,
+    /// What the network learns: radiance (each pixel under its view's lighting, the paper's)
+    /// or transfer (the linear design on an SH basis, --arch linear --basis sh:L, learns each
+    /// pixel's transfer vector as `nprt generate --transfer sh:L` recorded it, by the mean
+    /// squared error of its coefficients: one target for every lighting at once, whose
+    /// minimiser on noisy vectors is their mean; --loss then does not apply). CPU engine only;
+    /// docs/model.md.
+    #[arg(long, default_value_t = d().targets)]
+    targets: Targets,
     /// none (the network's output as it is, the paper) or level (each channel of the saved
     /// model's radiance multiplied by the training targets' mean over its own, measured on
     /// training pixels whenever the model is saved, and again when a finished run is asked
@@ -167,6 +175,7 @@ impl TryFrom<TrainArgs> for TrainJob {
             val_samples: a.val_samples,
             loss: a.loss,
             calibration: a.calibrate,
+            targets: a.targets,
             gather: a.gather,
             precision: a.precision,
         }

@@ -479,8 +479,8 @@ fn frames(dir: &Path) -> Vec<nprt_trace::Frame> {
         .views
         .iter()
         .map(|v| {
-            let halves = manifest.settings.in_halves(v);
-            read_view(&dir.join(&v.file), v, halves).unwrap().frame
+            let parts = manifest.settings.parts(v);
+            read_view(&dir.join(&v.file), v, parts).unwrap().frame
         })
         .collect()
 }

@@ -45,8 +45,12 @@ pub fn prepare(dir: &Path, manifest: &Manifest) -> Result<()> {
 /// Salt of the second half's random streams of a view rendered in halves.
 const SECOND_HALF: u64 = 0x9e37_79b9_7f4a_7c15;
 
+/// Salt of the transfer vectors' paths (BSDF-sampled, apart from the radiance's).
+const TRANSFER_PATHS: u64 = 0x7a4e_5f3e_c0ef_f1c1;
+
 /// Renders one view to its file: a test view of a dataset with `test_spp` as two independent
-/// halves, averaged, the first kept apart.
+/// halves, averaged, the first kept apart; a training view of a dataset with `--transfer`
+/// with its transfer vectors, from as many paths per pixel as its radiance.
 pub fn render_view(
     tracer: &Tracer,
     maps: &[EnvMap],
@@ -88,14 +92,29 @@ pub fn render_view(
         ViewImage {
             frame,
             half: Some(first.radiance),
+            transfer: None,
         }
     } else {
         ViewImage {
             frame: tracer.render(&view.camera(), &env, &settings)?,
             half: None,
+            transfer: None,
         }
     };
-    write_view(&dir.join(&view.file), &image)
+    let transfer = match (s.parts(view).transfer, tracer) {
+        (None, _) => None,
+        (Some(basis), Tracer::Cpu(ts)) => {
+            let seed = view.seed ^ TRANSFER_PATHS;
+            let t = basis.record(ts, &view.camera(), &RenderSettings { seed, ..settings });
+            nprt_io::interrupt::check()?;
+            Some(t)
+        }
+        #[cfg(feature = "gpu")]
+        (Some(_), Tracer::Gpu(_)) => bail!(
+            "transfer vectors are recorded by the CPU tracer only; generate with --device cpu"
+        ),
+    };
+    write_view(&dir.join(&view.file), &ViewImage { transfer, ..image })
 }
 
 #[derive(Debug, Default)]
@@ -133,7 +152,7 @@ pub fn run(
         let path = dir.join(&v.file);
         match path
             .exists()
-            .then(|| check_view(&path, v, manifest.settings.in_halves(v)))
+            .then(|| check_view(&path, v, manifest.settings.parts(v)))
         {
             Some(Ok(())) => summary.skipped += 1,
             Some(Err(e)) => {
@@ -213,14 +232,17 @@ mod tests {
         let (train, test) = (view("train"), view("test"));
         assert!(!manifest.settings.in_halves(train) && manifest.settings.in_halves(test));
         let train_file = dir.join(&train.file);
-        assert!(read_view(&train_file, train, false).unwrap().half.is_none());
-        let err = read_view(&train_file, train, true)
+        assert!(read_view(&train_file, train, Default::default())
+            .unwrap()
+            .half
+            .is_none());
+        let err = read_view(&train_file, train, manifest.settings.parts(test))
             .err()
             .unwrap()
             .to_string();
         assert!(err.contains("half.R"), "{err}");
 
-        let image = read_view(&dir.join(&test.file), test, true).unwrap();
+        let image = read_view(&dir.join(&test.file), test, manifest.settings.parts(test)).unwrap();
         let (whole, half) = (&image.frame.radiance, image.half.unwrap());
         let env = test.lighting(&request.maps).unwrap();
         let at = |spp, seed| RenderSettings {

@@ -9,6 +9,9 @@ use nprt_scene::{Camera, CameraVolume, EnvMap, FovAxis};
 use nprt_trace::TraceDevice;
 use serde::{Deserialize, Serialize};
 
+use super::transfer::TransferBasis;
+use super::view_parts::ViewParts;
+
 pub const FORMAT_VERSION: u32 = 1;
 pub const MANIFEST: &str = "manifest.json";
 
@@ -44,6 +47,10 @@ pub struct Settings {
     #[serde(default = "one_map", skip_serializing_if = "is_one_map")]
     pub mix_maps: u32,
     pub camera_volume: VolumeRecord,
+    /// The basis the training views' transfer vectors are recorded on (`nprt generate
+    /// --transfer`); absent: none recorded.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub transfer: Option<TransferBasis>,
     /// Which tracer began the dataset (informative: the two draw different random numbers but
     /// agree within noise, so a dataset is resumed, or trained on, with either). Absent in
     /// datasets made before the GPU tracer: the CPU's.
@@ -408,6 +415,15 @@ impl Settings {
     /// Whether `view`'s file holds the first half of its samples apart (see [`Settings::test_spp`]).
     pub fn in_halves(&self, view: &ViewRecord) -> bool {
         view.split == "test" && self.test_spp.is_some()
+    }
+
+    /// What `view`'s file holds beside its frame: the first half's radiance (a test view in
+    /// halves), transfer vectors (a training view of a dataset with `--transfer`).
+    pub fn parts(&self, view: &ViewRecord) -> ViewParts {
+        ViewParts {
+            halves: self.in_halves(view),
+            transfer: self.transfer.filter(|_| view.split == "train"),
+        }
     }
 
     /// Samples per pixel of `view`.

@@ -7,10 +7,13 @@ mod generation;
 mod manifest;
 mod packed;
 mod packed_pixel;
+mod packed_transfer;
 mod plan;
 mod scene_identity;
+mod transfer;
 mod verify;
 mod view_file;
+mod view_parts;
 
 pub use generation::{prepare, render_view, run, Summary};
 pub use manifest::{
@@ -19,7 +22,10 @@ pub use manifest::{
 };
 pub use packed::{views_stamp, PackHeader, PackedDataset, PackedTarget, PACK_FORMAT, PACK_VERSION};
 pub use packed_pixel::{PackedPixel, PACKED_PIXEL_BYTES};
+pub use packed_transfer::{PackedTransfer, TransferSection};
 pub use plan::{plan, MapAssignment, Request, MAX_MIX_MAPS};
 pub use scene_identity::{load_checked_scene, relit, scene_hash, scene_source};
+pub use transfer::{Transfer, TransferBasis, MAX_TRANSFER_BAND};
 pub use verify::{verify, Report};
 pub use view_file::{check_view, read_view, write_view, ViewImage};
+pub use view_parts::ViewParts;

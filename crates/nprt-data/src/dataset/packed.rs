@@ -3,7 +3,8 @@
 //! training, so that a set larger than memory trains with only the views in use resident. The
 //! views stay the dataset: a pack is derived from them, made at first use, and made again when
 //! the manifest or any view file changes. It is written atomically under a lock, so concurrent
-//! trainings of one dataset pack it once.
+//! trainings of one dataset pack it once. A dataset with transfer vectors (`--transfer`) packs
+//! them after the records, one vector per record ([`super::packed_transfer`]).
 
 use std::fs::File;
 use std::io::{BufWriter, Seek, SeekFrom, Write};
@@ -17,6 +18,7 @@ use serde::{Deserialize, Serialize};
 
 use super::manifest::{Manifest, ViewRecord};
 use super::packed_pixel::{PackedPixel, PACKED_PIXEL_BYTES};
+use super::packed_transfer::{self, PackedTransfer, TransferSection};
 
 /// What a pack's radiance holds.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
@@ -69,7 +71,9 @@ struct Prelude {
     records_len: u64,
     header_offset: u64,
     header_len: u64,
-    reserved: [u64; 2],
+    /// Bytes of transfer vectors between the records and the header (0: none).
+    transfer_len: u64,
+    reserved: u64,
 }
 
 /// The pack's description, JSON after the records.
@@ -88,6 +92,9 @@ pub struct PackHeader {
     pub views: Vec<[u64; 2]>,
     /// BLAKE3 of the records.
     pub records_hash: String,
+    /// The transfer vectors after the records, for a dataset made with `--transfer`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub transfer: Option<PackedTransfer>,
 }
 
 /// A pack opened for reading.
@@ -97,10 +104,12 @@ pub struct PackedDataset {
 }
 
 enum Records {
-    /// The file at `path`, `len` bytes of records after the prelude.
+    /// The file at `path`, `len` bytes of records after the prelude, then `transfer_len`
+    /// bytes of transfer vectors.
     Mapped {
         map: Mmap,
         len: usize,
+        transfer_len: usize,
         path: PathBuf,
     },
     /// Built in memory (tests, small sets).
@@ -175,7 +184,7 @@ impl PackedDataset {
         // file stays as it was while mapped.
         let map = unsafe { Mmap::map(&file) }
             .with_context(|| format!("cannot map '{}'", path.display()))?;
-        let (header, len) = read_header(&map)
+        let (header, len, transfer_len) = read_header(&map)
             .with_context(|| format!("'{}' is not a usable pack", path.display()))?;
         ensure!(
             header.dataset_hash == dataset_hash,
@@ -188,12 +197,17 @@ impl PackedDataset {
             path.display()
         );
         check_view_ranges(&header, manifest, len / PACKED_PIXEL_BYTES)
+            .and_then(|()| {
+                let records = len / PACKED_PIXEL_BYTES;
+                packed_transfer::check(header.transfer.as_ref(), manifest, records, transfer_len)
+            })
             .with_context(|| format!("'{}' does not match its manifest", path.display()))?;
         let pack = PackedDataset {
             header,
             records: Records::Mapped {
                 map,
                 len,
+                transfer_len,
                 path: path.to_path_buf(),
             },
         };
@@ -223,6 +237,14 @@ impl PackedDataset {
             "the records of '{}' are damaged (their hash differs from the one written)",
             path.display()
         );
+        if let Some(t) = &self.header.transfer {
+            let bytes: &[u8] = bytemuck::cast_slice(self.transfer_values());
+            ensure!(
+                blake3::Hasher::new().update_rayon(bytes).finalize().to_hex().as_str() == t.hash,
+                "the transfer vectors of '{}' are damaged (their hash differs from the one written)",
+                path.display()
+            );
+        }
         Ok(())
     }
 
@@ -249,6 +271,7 @@ impl PackedDataset {
             bounds,
             views: ranges,
             records_hash: String::new(),
+            transfer: None,
         };
         PackedDataset {
             header,
@@ -270,6 +293,31 @@ impl PackedDataset {
         }
     }
 
+    /// Every record's transfer vector, one after another (empty without them).
+    fn transfer_values(&self) -> &[u16] {
+        match &self.records {
+            Records::Mapped {
+                map,
+                len,
+                transfer_len,
+                ..
+            } => bytemuck::cast_slice(&map[PRELUDE_BYTES + len..][..*transfer_len]),
+            Records::Memory(_) => &[],
+        }
+    }
+
+    /// The transfer vectors of the manifest's view `i` (None: the pack holds none).
+    pub fn transfer(&self, i: usize) -> Option<TransferSection<'_>> {
+        let t = self.header.transfer.as_ref()?;
+        let [first, count] = self.header.views[i];
+        let n = t.basis.floats();
+        let values = &self.transfer_values()[first as usize * n..(first + count) as usize * n];
+        Some(TransferSection {
+            basis: t.basis,
+            values,
+        })
+    }
+
     /// The records of the manifest's view `i`.
     pub fn view(&self, i: usize) -> &[PackedPixel] {
         let [first, count] = self.header.views[i];
@@ -289,6 +337,10 @@ impl PackedDataset {
             first as usize * PACKED_PIXEL_BYTES,
             count as usize * PACKED_PIXEL_BYTES,
         );
+        if let (Some(t), Records::Mapped { len, .. }) = (&self.header.transfer, &self.records) {
+            let per = t.basis.floats() * 2;
+            self.release_bytes(len + first as usize * per, count as usize * per);
+        }
     }
 
     fn release_bytes(&self, start: usize, len: usize) {
@@ -356,21 +408,29 @@ fn pack(
         let mut hasher = blake3::Hasher::new();
         let mut views = Vec::with_capacity(manifest.views.len());
         let mut next = 0u64;
+        let mut transfer = packed_transfer::Writer::new(dir, manifest)?;
         for chunk in manifest.views.chunks(PACK_CHUNK) {
-            let records: Vec<Vec<PackedPixel>> = chunk
+            let records: Vec<(Vec<PackedPixel>, Vec<u16>)> = chunk
                 .par_iter()
-                .map(|v| view_records(dir, manifest, v, target))
+                .map(|v| view_records(dir, manifest, v, target, transfer.is_some()))
                 .collect::<Result<_>>()?;
-            for r in records {
+            for (r, t) in records {
                 let bytes: &[u8] = bytemuck::cast_slice(&r);
                 hasher.update(bytes);
                 w.write_all(bytes)?;
+                if let Some(transfer) = &mut transfer {
+                    transfer.add(&t, r.len())?;
+                }
                 views.push([next, r.len() as u64]);
                 next += r.len() as u64;
                 bar.inc(1);
             }
         }
         bar.finish_and_clear();
+        let (transfer, transfer_len) = match transfer {
+            Some(t) => t.append_to(&mut w)?,
+            None => (None, 0),
+        };
         let header = PackHeader {
             format: PACK_FORMAT.into(),
             version: PACK_VERSION,
@@ -380,6 +440,7 @@ fn pack(
             bounds: manifest.bounds,
             views,
             records_hash: hasher.finalize().to_hex().to_string(),
+            transfer,
         };
         let json = serde_json::to_vec(&header)?;
         w.write_all(&json)?;
@@ -391,9 +452,10 @@ fn pack(
             record_bytes: PACKED_PIXEL_BYTES as u32,
             records_offset: PRELUDE_BYTES as u64,
             records_len,
-            header_offset: PRELUDE_BYTES as u64 + records_len,
+            header_offset: PRELUDE_BYTES as u64 + records_len + transfer_len,
             header_len: json.len() as u64,
-            reserved: [0; 2],
+            transfer_len,
+            reserved: 0,
         };
         file.seek(SeekFrom::Start(0))?;
         file.write_all(bytemuck::bytes_of(&prelude))?;
@@ -403,13 +465,15 @@ fn pack(
 }
 
 /// The records of one view's foreground pixels, refusing a position outside the scene bounds
-/// (it could not be stored).
+/// (it could not be stored), and (`transfer`) their transfer vectors as `target` has them
+/// (zero for a view without).
 fn view_records(
     dir: &Path,
     manifest: &Manifest,
     view: &ViewRecord,
     target: PackedTarget,
-) -> Result<Vec<PackedPixel>> {
+    transfer: bool,
+) -> Result<(Vec<PackedPixel>, Vec<u16>)> {
     let image = crate::views::load_view(dir, manifest, view)?;
     let g = &image.gbuffer;
     let [lo, hi] = manifest.bounds.map(Vec3::from);
@@ -429,12 +493,18 @@ fn view_records(
         let r = target.of(image.radiance[i], image.direct[i]);
         records.push(PackedPixel::encode(&s, r, &manifest.bounds));
     }
-    Ok(records)
+    let vectors = match (transfer, manifest.settings.transfer) {
+        (true, Some(basis)) => {
+            packed_transfer::vectors(&image, basis, target == PackedTarget::Indirect)
+        }
+        _ => vec![],
+    };
+    Ok((records, vectors))
 }
 
-/// The header of a mapped pack and its records' length in bytes, after checking that every part
-/// lies where the prelude says.
-fn read_header(bytes: &[u8]) -> Result<(PackHeader, usize)> {
+/// The header of a mapped pack, its records' and its transfer vectors' lengths in bytes, after
+/// checking that every part lies where the prelude says.
+fn read_header(bytes: &[u8]) -> Result<(PackHeader, usize, usize)> {
     ensure!(bytes.len() >= PRELUDE_BYTES, "shorter than its prelude");
     let p: Prelude = bytemuck::pod_read_unaligned(&bytes[..PRELUDE_BYTES]);
     ensure!(
@@ -452,7 +522,8 @@ fn read_header(bytes: &[u8]) -> Result<(PackHeader, usize)> {
     ensure!(
         p.records_offset == PRELUDE_BYTES as u64
             && p.records_len.is_multiple_of(PACKED_PIXEL_BYTES as u64)
-            && p.header_offset == p.records_offset + p.records_len
+            && Some(p.header_offset)
+                == (p.records_offset + p.records_len).checked_add(p.transfer_len)
             && fits(p.header_offset, p.header_len)
             && p.header_offset + p.header_len == len,
         "its parts do not fit its {len} bytes (truncated or not written to the end)"
@@ -465,7 +536,7 @@ fn read_header(bytes: &[u8]) -> Result<(PackHeader, usize)> {
         header.format,
         header.version
     );
-    Ok((header, p.records_len as usize))
+    Ok((header, p.records_len as usize, p.transfer_len as usize))
 }
 
 /// Each view's records lie within the file, one after another, at most one per pixel.

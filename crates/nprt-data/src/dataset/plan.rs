@@ -126,6 +126,7 @@ pub fn plan(req: &Request, ts: &TraceScene) -> Result<Manifest> {
         jitter: req.jitter,
         mix_maps: req.mix_maps,
         camera_volume: VolumeRecord::from(v),
+        transfer: None,
         tracer: TraceDevice::Cpu,
     };
     let views = plan_views(req, ts, &train_pool, &test_maps, mixed, own_map)?;

@@ -33,7 +33,7 @@ pub fn verify(dir: &Path) -> Result<Report> {
             if !path.exists() {
                 return Err(String::new());
             }
-            check_view(&path, v, manifest.settings.in_halves(v)).map_err(|e| format!("{e:#}"))
+            check_view(&path, v, manifest.settings.parts(v)).map_err(|e| format!("{e:#}"))
         })
         .collect();
     let mut report = Report {

@@ -1,6 +1,7 @@
 //! One view's OpenEXR file: written from its render, read back and checked against its
 //! manifest record. A test view rendered in two halves also holds the first half's radiance
-//! (`half.R/G/B`), from which evaluation measures the reference's own noise.
+//! (`half.R/G/B`), from which evaluation measures the reference's own noise; a training view of
+//! a dataset made with `--transfer` holds its transfer vectors too.
 
 use std::path::Path;
 
@@ -11,6 +12,8 @@ use nprt_scene::envmap::MAX_RADIANCE;
 use nprt_trace::Frame;
 
 use super::manifest::ViewRecord;
+use super::transfer::Transfer;
+use super::view_parts::ViewParts;
 
 const HALF: [&str; 3] = ["half.R", "half.G", "half.B"];
 
@@ -19,11 +22,13 @@ pub struct ViewImage {
     pub frame: Frame,
     /// Radiance of the first half of the samples, for a view rendered in halves.
     pub half: Option<Vec<Vec3>>,
+    /// The pixels' transfer vectors, for a training view of a dataset made with `--transfer`.
+    pub transfer: Option<Transfer>,
 }
 
 /// Checks that a view file reads back complete: right size, every channel, finite values.
-pub fn check_view(path: &Path, view: &ViewRecord, in_halves: bool) -> Result<()> {
-    read_view(path, view, in_halves).map(|_| ())
+pub fn check_view(path: &Path, view: &ViewRecord, parts: ViewParts) -> Result<()> {
+    read_view(path, view, parts).map(|_| ())
 }
 
 /// Writes a view file atomically.
@@ -34,6 +39,9 @@ pub fn write_view(path: &Path, image: &ViewImage) -> Result<()> {
         for (k, name) in HALF.iter().enumerate() {
             channels.push((name.to_string(), half.iter().map(|v| v[k]).collect()));
         }
+    }
+    if let Some(t) = &image.transfer {
+        channels.extend(t.channels());
     }
     // Each channel is held below the top of the range a reader accepts (a half's as radiance):
     // only a firefly under a map near the radiance limit could pass it.
@@ -46,9 +54,9 @@ pub fn write_view(path: &Path, image: &ViewImage) -> Result<()> {
 }
 
 /// Reads a view file, refusing one whose size disagrees with its record, that lacks a channel
-/// (the half's too, when `in_halves`) or that holds a value past its channel's range (radiance
-/// outside [0, 1e12], reflectances, α or mask outside [0, 1]).
-pub fn read_view(path: &Path, view: &ViewRecord, in_halves: bool) -> Result<ViewImage> {
+/// (of `parts` too) or that holds a value past its channel's range (radiance outside [0, 1e12],
+/// reflectances, α or mask outside [0, 1], a transfer value that is not finite).
+pub fn read_view(path: &Path, view: &ViewRecord, parts: ViewParts) -> Result<ViewImage> {
     // The size is checked from the header, before a corrupt one makes the decoder allocate.
     let (w, h) = checked_size(path)?;
     if (w, h) != (view.width as usize, view.height as usize) {
@@ -56,7 +64,7 @@ pub fn read_view(path: &Path, view: &ViewRecord, in_halves: bool) -> Result<View
     }
     let (_, _, ch) = read_channels(path)?;
     let frame = Frame::from_channels(w, h, &ch)?;
-    let half = if in_halves {
+    let half = if parts.halves {
         let [r, g, b] = HALF.map(|name| {
             ch.get(name)
                 .with_context(|| format!("lacks channel '{name}'"))
@@ -81,5 +89,12 @@ pub fn read_view(path: &Path, view: &ViewRecord, in_halves: bool) -> Result<View
     } else {
         None
     };
-    Ok(ViewImage { frame, half })
+    let transfer = (parts.transfer)
+        .map(|basis| Transfer::from_channels(basis, w * h, &ch))
+        .transpose()?;
+    Ok(ViewImage {
+        frame,
+        half,
+        transfer,
+    })
 }

@@ -65,6 +65,7 @@ fn synthetic_batch(config: &ModelConfig, batch_size: usize, views: usize) -> any
     Ok(Batch {
         features: random(batch_size * FEATURES, 1.0),
         radiance: random(batch_size * 3, 4.0),
+        transfer: Vec::new(),
         view: (0..batch_size).map(|i| (i % views) as i64).collect(),
         scale: random(batch_size * 3, 1.0)
             .into_iter()

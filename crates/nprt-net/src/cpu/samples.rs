@@ -8,6 +8,9 @@ pub struct Samples<'a> {
     pub features: &'a [f32],
     /// `[n, 3]` reference radiance.
     pub radiance: &'a [f32],
+    /// `[n, K, 3]` reference transfer vectors, for a linear design trained on them (empty:
+    /// the radiance is the target).
+    pub transfer: &'a [f32],
     /// `[n]`: which map lights each sample.
     pub view: &'a [i64],
     /// `[n, 3]`: what the prediction's channels are multiplied by (the map's normalisation).

@@ -5,4 +5,6 @@ pub mod features;
 pub mod hash_grid;
 pub mod map_norm;
 pub mod position_encoding;
-pub mod spherical_harmonics;
+/// The SH basis lives with the lighting it describes (nprt-scene), where the dataset
+/// generator records transport on it too.
+pub use nprt_scene::spherical_harmonics;

@@ -10,6 +10,8 @@ use crate::training::training_set::ViewSamples;
 pub struct Batch {
     pub features: Vec<f32>,
     pub radiance: Vec<f32>,
+    /// [n, K, 3] transfer vectors, where the model learns them (else empty).
+    pub transfer: Vec<f32>,
     /// Index into `lights` of each sample.
     pub view: Vec<i64>,
     /// [n, 3] what the prediction's channels are multiplied by (the map's `LightInput::scale`).
@@ -45,11 +47,13 @@ impl Batch {
         nprt_io::ensure_memory(bytes, &what)
     }
 
-    /// Gathers `samples` ((view position in `views`, pixel) pairs) from `views`.
-    pub fn gather(views: &[&ViewSamples], samples: &[(u32, u32)]) -> Self {
+    /// Gathers `samples` ((view position in `views`, pixel) pairs) from `views`, with the first
+    /// `transfer` coefficients of their transfer vectors (0: none).
+    pub fn gather(views: &[&ViewSamples], samples: &[(u32, u32)], transfer: usize) -> Self {
         let mut b = Batch {
             features: Vec::with_capacity(samples.len() * FEATURES),
             radiance: Vec::with_capacity(samples.len() * 3),
+            transfer: Vec::with_capacity(samples.len() * 3 * transfer),
             view: Vec::with_capacity(samples.len()),
             scale: Vec::with_capacity(samples.len() * 3),
             lights: views
@@ -64,6 +68,9 @@ impl Batch {
             let (features, radiance) = view.sample(p as usize);
             b.features.extend_from_slice(&features);
             b.radiance.extend_from_slice(&radiance);
+            if transfer > 0 {
+                view.transfer_into(p as usize, transfer, &mut b.transfer);
+            }
             b.view.push(v as i64);
             b.scale.extend_from_slice(&view.light.scale);
         }
@@ -80,6 +87,7 @@ impl Batch {
         Batch {
             features: Vec::new(),
             radiance: Vec::new(),
+            transfer: Vec::new(),
             view: samples.iter().map(|&(v, _)| v as i64).collect(),
             scale: Vec::new(),
             lights: Vec::new(),
@@ -117,7 +125,7 @@ impl Batch {
                 .map(|&(v, p)| (used.partition_point(|&u| u < v) as u32, p))
                 .collect();
             let sub: Vec<&ViewSamples> = used.iter().map(|&v| views[v as usize]).collect();
-            Batch::gather(&sub, &local)
+            Batch::gather(&sub, &local, 0)
         })
     }
 
@@ -130,6 +138,7 @@ impl Batch {
         Samples {
             features: &self.features,
             radiance: &self.radiance,
+            transfer: &self.transfer,
             view: &self.view,
             scale: &self.scale,
             lights: &self.lights,

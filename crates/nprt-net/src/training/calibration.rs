@@ -136,7 +136,7 @@ mod tests {
             .iter()
             .map(|view| {
                 let all: Vec<(u32, u32)> = (0..view.len() as u32).map(|p| (0, p)).collect();
-                crate::cpu::predict(&net, &Batch::gather(&[view], &all).samples())
+                crate::cpu::predict(&net, &Batch::gather(&[view], &all, 0).samples())
             })
             .collect();
         let scaled = views(records(&|v, p| {

@@ -28,7 +28,7 @@ use crate::training::checkpoint::RunState;
 use crate::training::epoch_plan::{group_batches, EpochPlan};
 use crate::training::host_steps::HostSteps;
 use crate::training::schedule::Schedule;
-use crate::training::train_options::{Gather, TrainOptions};
+use crate::training::train_options::{Gather, Targets, TrainOptions};
 use crate::training::training_loop::{self, Objective, Steps, TrainSummary, Watch};
 use crate::training::training_set::{TrainingSet, ViewSamples};
 use crate::training::validation::validation_loss;
@@ -42,6 +42,8 @@ struct PixelObjective<'a> {
     saved: Mutex<Option<ModelFile>>,
     /// Whether the steps run on our own GPU kernels (`--device gpu` or `wgpu`).
     kernels: bool,
+    /// Transfer coefficients per channel the model learns (`--targets transfer`; 0: radiance).
+    transfer: usize,
 }
 
 impl PixelObjective<'_> {
@@ -81,6 +83,9 @@ impl Objective for PixelObjective<'_> {
         if self.opts.precision != Precision::F32 {
             key["precision"] = serde_json::json!(self.opts.precision);
         }
+        if self.opts.targets != Targets::Radiance {
+            key["targets"] = serde_json::json!(self.opts.targets);
+        }
         key
     }
 
@@ -118,7 +123,7 @@ impl Objective for PixelObjective<'_> {
                     .skip(from.saturating_sub(start))
                     .map(move |samples| match self.resident() {
                         true => Batch::picked(&group, &views.0, &samples),
-                        false => Batch::gather(&views.0, &samples),
+                        false => Batch::gather(&views.0, &samples, self.transfer),
                     })
             })
     }
@@ -192,6 +197,7 @@ impl Objective for PixelObjective<'_> {
                 "seconds": state.seconds,
                 "adam_epsilon": ADAM_EPSILON,
                 "loss": self.opts.loss.name(),
+                "targets": self.opts.targets.name(),
             }),
             level_gain: (self.opts.calibration == Calibration::Level)
                 .then(|| level_gain(net, &self.set.train, LEVEL_SAMPLES, self.opts.batch_size)),
@@ -233,12 +239,26 @@ pub fn train(
             opts.precision
         );
     }
+    let transfer = match opts.targets {
+        Targets::Radiance => 0,
+        Targets::Transfer if kernels => bail!(
+            "--targets transfer trains on the CPU engine only (--device cpu): nprt's GPU \
+             kernels learn radiance targets"
+        ),
+        Targets::Transfer => {
+            let k = set.transfer(config)?;
+            let bytes = opts.batch_size as u128 * 12 * k as u128;
+            nprt_io::ensure_memory(bytes, "the transfer vectors of a batch")?;
+            k
+        }
+    };
     let objective = PixelObjective {
         set,
         config,
         opts,
         saved: Mutex::new(None),
         kernels,
+        transfer,
     };
     let summary = training_loop::train(&objective, &opts.schedule, out, watch)?;
     // The loop saves the model on every path that returns a summary.

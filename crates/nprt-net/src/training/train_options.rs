@@ -38,7 +38,27 @@ pub struct TrainOptions {
     /// f32 on tensor cores where the adapter has them, with f32 master weights.
     #[serde(default)]
     pub precision: Precision,
+    /// What the network is trained to predict: each pixel's radiance under its view's
+    /// lighting, or (the linear design on an SH basis) its transfer vector.
+    #[serde(default)]
+    pub targets: Targets,
 }
+
+/// What a training sample's target is.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Targets {
+    /// The radiance under the view's lighting (the paper's).
+    #[default]
+    Radiance,
+    /// The transfer vector `nprt generate --transfer` recorded: the linear design's
+    /// coefficients, for every lighting at once, by their mean squared error.
+    Transfer,
+}
+
+named_choice!(Targets, "targets", {
+    Radiance => "radiance",
+    Transfer => "transfer",
+});
 
 /// Where a GPU step's batches are gathered.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -71,6 +91,7 @@ impl Default for TrainOptions {
             calibration: Calibration::None,
             gather: Gather::Device,
             precision: Precision::F32,
+            targets: Targets::Radiance,
         }
     }
 }

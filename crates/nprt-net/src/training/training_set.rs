@@ -13,6 +13,7 @@ use rayon::prelude::*;
 use crate::encoding::features::{sample_features, FEATURES};
 use crate::model::config::ModelConfig;
 use crate::network::encoder::LightInput;
+use crate::network::light_basis::BasisChoice;
 
 /// The foreground pixels of one view: its records in the dataset's pack and its map.
 pub struct ViewSamples {
@@ -51,6 +52,15 @@ impl ViewSamples {
         let bounds = &self.pack.header().bounds;
         let (s, radiance) = self.pixels()[p].decode(bounds);
         (sample_features(bounds, &s), radiance.to_array())
+    }
+
+    /// Appends pixel `p`'s first `coefficients` transfer coefficients (R G B each) to `out`;
+    /// zeros where the pack holds none (refused before training: [`TrainingSet::transfer`]).
+    pub fn transfer_into(&self, p: usize, coefficients: usize, out: &mut Vec<f32>) {
+        match self.pack.transfer(self.view) {
+            Some(t) => out.extend(t.vector(p, coefficients)),
+            None => out.resize(out.len() + 3 * coefficients, 0.0),
+        }
     }
 
     /// Lets go of the view's records in memory until they are read again.
@@ -158,6 +168,33 @@ impl TrainingSet {
             train,
             test,
         })
+    }
+
+    /// The coefficients per channel a model with `config` learns of this set's transfer
+    /// vectors: its SH basis', which the dataset must hold (`nprt generate --transfer sh:L`,
+    /// L at least the model's band).
+    pub fn transfer(&self, config: &ModelConfig) -> Result<usize> {
+        let scene = &self.manifest.settings.scene;
+        let band = match (config.design.is_linear(), config.light_basis()) {
+            (true, BasisChoice::Sh { band }) => band,
+            _ => bail!(
+                "--targets transfer trains the linear design on an SH basis (--arch linear \
+                 --basis sh:L), whose coefficients the transfer vectors are; this is {}",
+                config.label()
+            ),
+        };
+        match self.manifest.settings.transfer {
+            Some(t) if t.band as usize >= band => Ok(config.light_basis().size()),
+            Some(t) => bail!(
+                "the dataset's transfer vectors are {t}, fewer bands than the model's sh:{band}: \
+                 train with --basis sh:{} or lower, or generate with --transfer sh:{band}",
+                t.band
+            ),
+            None => bail!(
+                "the dataset (of {scene}) holds no transfer vectors: generate it with --transfer \
+                 sh:{band} to train on them"
+            ),
+        }
     }
 
     /// Bytes the views' maps take in memory.

@@ -59,6 +59,7 @@ pub fn random_batch(n: usize, views: usize, seed: u64) -> Batch {
     Batch {
         features: r(0.0, 1.0, n * FEATURES),
         radiance: r(0.0, 3.0, n * 3),
+        transfer: Vec::new(),
         view: (0..n as i64)
             .map(|i| (i * 7 + i / 5) % views as i64)
             .collect(),
@@ -70,10 +71,8 @@ pub fn random_batch(n: usize, views: usize, seed: u64) -> Batch {
 }
 
 /// Checks `grads` (the CPU engine's gradient of `loss` on `batch` for `net`) against central
-/// differences of the f64 reference's loss: in every tensor (the encoder's only with
-/// `encoder`), two entries, one at random and the largest. Where differences with two steps
-/// disagree a ReLU, max or |·| switches within the step and the entry is skipped; such entries
-/// must be few. Returns how many entries were checked.
+/// differences of the f64 reference's loss (see [`check_against`]; the encoder's tensors only
+/// with `encoder`). Returns how many entries were checked.
 pub fn check_gradients(
     name: &str,
     net: &NprtNet,
@@ -82,7 +81,7 @@ pub fn check_gradients(
     grads: &NprtNet,
     encoder: bool,
 ) -> usize {
-    let mut reference = Reference::new(net);
+    let reference = Reference::new(net);
     let fixed = reference.predict(batch, None);
     let codes = reference.light_codes(batch);
     let first = if encoder {
@@ -90,6 +89,23 @@ pub fn check_gradients(
     } else {
         reference.encoder_tensors()
     };
+    check_against(name, reference, grads, first, |r, t| {
+        let through = (t >= r.encoder_tensors()).then_some(codes.as_slice());
+        r.loss(batch, loss, through, &fixed)
+    })
+}
+
+/// Checks `grads` against central differences of `value` (the f64 reference's loss, given the
+/// tensor nudged): in every tensor from `first` on, two entries, one at random and the largest.
+/// Where differences with two steps disagree a ReLU, max or |·| switches within the step and
+/// the entry is skipped; such entries must be few. Returns how many entries were checked.
+pub fn check_against(
+    name: &str,
+    mut reference: Reference,
+    grads: &NprtNet,
+    first: usize,
+    value: impl Fn(&Reference, usize) -> f64,
+) -> usize {
     let mut engine = Vec::new();
     nprt_net::Parameters::visit(grads, "", &mut |name, _, v| {
         engine.push((name.to_string(), v.to_vec()))
@@ -105,10 +121,9 @@ pub fn check_gradients(
             let mut at = |delta: f64| {
                 let kept = reference.params[t][index];
                 reference.params[t][index] += delta;
-                let through = (t >= reference.encoder_tensors()).then_some(codes.as_slice());
-                let value = reference.loss(batch, loss, through, &fixed);
+                let v = value(&reference, t);
                 reference.params[t][index] = kept;
-                value
+                v
             };
             let mut fd = |h: f64| (at(h) - at(-h)) / (2.0 * h);
             let (coarse, fine) = (fd(1e-6), fd(5e-7));

@@ -1,8 +1,9 @@
 //! The real spherical-harmonics basis: bands up to 4 (25 functions) written out in closed form
 //! (a few lines each), as the radiance cache evaluates them for every sample, and any band by
 //! the associated Legendre recurrence, which the tests hold to the closed form. SH PRT projects
-//! light and transport on it (nprt-eval), the linear design its lighting (`LightBasis`), and
-//! the radiance cache encodes directions with it.
+//! light and transport on it (nprt-eval), the dataset generator records transport on it
+//! (`nprt generate --transfer`), the linear design projects its lighting on it (`LightBasis`),
+//! and the radiance cache encodes directions with it.
 
 use glam::Vec3;
 
@@ -85,7 +86,7 @@ fn recurrence(bands: usize, d: Vec3, out: &mut [f32]) {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use nprt_scene::envmap::uv_to_direction;
+    use crate::envmap::uv_to_direction;
 
     #[test]
     fn the_recurrence_is_the_closed_form() {
