@@ -75,6 +75,44 @@ fn gpu_gradients_match_the_cpu_engine_for_every_design() {
     }
 }
 
+/// Transfer targets (`--targets transfer`): the loss on the linear design's transfer vectors
+/// and every gradient, on an SH basis with and without a hash grid, as the CPU engine makes
+/// them; the forward passes alone make the same loss.
+#[test]
+fn gpu_gradients_on_transfer_vectors_match_the_cpu_engine() {
+    if !GpuDevice::probe() {
+        return;
+    }
+    let mut batch = random_batch(300, 3, 24);
+    let k = 9;
+    batch.transfer = (0..batch.len() * 3 * k)
+        .map(|i| ((i * 37 % 101) as f32 / 101.0 - 0.3) * 0.5)
+        .collect();
+    let samples = batch.samples();
+    for encoding in [PositionEncoding::None, PositionEncoding::HashGrid] {
+        let net = network(&ModelConfig {
+            basis: Some(nprt_net::BasisChoice::Sh { band: 2 }),
+            encoding,
+            ..ModelConfig::new(Design::Linear, None)
+        });
+        let (want_loss, want) = cpu::gradients(&net, &samples, Loss::LogL1);
+        let mut gpu = GpuTrainer::new(&net, Precision::F32).unwrap();
+        let value = gpu.backward(&samples, Loss::LogL1);
+        let errors = tensor_errors(&gpu.gradients(), &want);
+        let loss_error = (value - want_loss).abs() / want_loss;
+        eprintln!(
+            "transfer {encoding:?}: loss {loss_error:.1e}, gradients {:.1e}",
+            worst(&errors)
+        );
+        assert!(loss_error < 1e-5, "{encoding:?}: loss off by {loss_error}");
+        assert!(
+            worst(&errors) < 1e-4,
+            "{encoding:?}: a gradient off by {errors:?}"
+        );
+        assert_eq!(gpu.loss(&samples, Loss::LogL1), value, "forward-only loss");
+    }
+}
+
 /// A network of three tracks, beyond every design (D/S's two and a full one): the kernels sum
 /// and differentiate any number of tracks, one dispatch per track, as the CPU engine does.
 fn three_tracks() -> NprtNet {

@@ -69,6 +69,15 @@ impl<'a> Tracer<'a> {
         }
     }
 
+    /// The scene as the CPU tracer holds it (None on the GPU), for what only it records.
+    pub fn cpu_scene(&self) -> Option<&TraceScene<'a>> {
+        match self {
+            Tracer::Cpu(ts) => Some(ts),
+            #[cfg(feature = "gpu")]
+            Tracer::Gpu(_) => None,
+        }
+    }
+
     /// A frame of `camera` under `env` as [`render`] makes it with `settings`.
     pub fn render(
         &self,

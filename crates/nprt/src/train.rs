@@ -72,7 +72,7 @@ pub struct TrainArgs {
     /// or transfer (the linear design on an SH basis, --arch linear --basis sh:L, learns each
     /// pixel's transfer vector as `nprt generate --transfer sh:L` recorded it, by the mean
     /// squared error of its coefficients: one target for every lighting at once, whose
-    /// minimiser on noisy vectors is their mean; --loss then does not apply). CPU engine only;
+    /// minimiser on noisy vectors is their mean; --loss then does not apply). On either engine;
     /// docs/model.md.
     #[arg(long, default_value_t = d().targets)]
     targets: Targets,

@@ -205,27 +205,32 @@ fn a_linear_model_learns_transfer_vectors_and_wrong_pairings_are_refused() {
     let data = transfer_dataset("transfer-train");
     let d = data.to_str().unwrap();
     let model = data.parent().unwrap().join("model");
-    let m = model.to_str().unwrap();
-    let mut args = vec!["train", "--data", d, "--out", m, "--device", "cpu"];
-    args.extend(["--arch", "linear", "--basis", "sh:1", "--direct", "traced"]);
-    args.extend([
-        "--targets",
-        "transfer",
-        "--epochs",
-        "12",
-        "--batch-size",
-        "256",
-    ]);
-    ok(&args);
-    let csv = std::fs::read_to_string(model.join("loss.csv")).unwrap();
-    // step,epoch,samples,seconds,train_loss,val_loss
-    let losses: Vec<f64> = (csv.lines().skip(1))
-        .filter_map(|l| l.split(',').nth(4)?.parse().ok())
-        .collect();
-    let (first, last) = (losses[0], *losses.last().unwrap());
-    assert!(last < 0.7 * first, "training loss {first} -> {last}");
-    let saved = std::fs::read_to_string(model.join("model.json")).unwrap();
-    assert!(saved.contains("\"targets\": \"transfer\""), "{saved}");
+    // On the CPU engine, and on the GPU kernels where an adapter runs them (lavapipe in CI).
+    let devices = match common::wgpu_runs() {
+        true => &["cpu", "wgpu"][..],
+        false => &["cpu"][..],
+    };
+    for device in devices {
+        let model = model.with_extension(device);
+        let m = model.to_str().unwrap();
+        let mut args = vec!["train", "--data", d, "--out", m, "--device", device];
+        args.extend(["--arch", "linear", "--basis", "sh:1", "--direct", "traced"]);
+        args.extend(["--targets", "transfer", "--epochs", "12"]);
+        args.extend(["--batch-size", "256"]);
+        ok(&args);
+        let csv = std::fs::read_to_string(model.join("loss.csv")).unwrap();
+        // step,epoch,samples,seconds,train_loss,val_loss
+        let losses: Vec<f64> = (csv.lines().skip(1))
+            .filter_map(|l| l.split(',').nth(4)?.parse().ok())
+            .collect();
+        let (first, last) = (losses[0], *losses.last().unwrap());
+        assert!(
+            last < 0.7 * first,
+            "{device}: training loss {first} -> {last}"
+        );
+        let saved = std::fs::read_to_string(model.join("model.json")).unwrap();
+        assert!(saved.contains("\"targets\": \"transfer\""), "{saved}");
+    }
 
     let elsewhere = data.parent().unwrap().join("refused");
     let refused = |extra: &[&str], needles: &[&str]| {

@@ -101,18 +101,20 @@ pub fn render_view(
             transfer: None,
         }
     };
-    let transfer = match (s.parts(view).transfer, tracer) {
-        (None, _) => None,
-        (Some(basis), Tracer::Cpu(ts)) => {
+    let transfer = match s.parts(view).transfer {
+        None => None,
+        Some(basis) => {
+            let Some(ts) = tracer.cpu_scene() else {
+                bail!(
+                    "transfer vectors are recorded by the CPU tracer only; generate with \
+                     --device cpu"
+                );
+            };
             let seed = view.seed ^ TRANSFER_PATHS;
             let t = basis.record(ts, &view.camera(), &RenderSettings { seed, ..settings });
             nprt_io::interrupt::check()?;
             Some(t)
         }
-        #[cfg(feature = "gpu")]
-        (Some(_), Tracer::Gpu(_)) => bail!(
-            "transfer vectors are recorded by the CPU tracer only; generate with --device cpu"
-        ),
     };
     write_view(&dir.join(&view.file), &ViewImage { transfer, ..image })
 }

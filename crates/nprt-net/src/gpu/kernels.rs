@@ -46,6 +46,9 @@ pub const COLUMN_SUM: KernelSource = kernel!("column_sum");
 pub static COMBINE: LazyLock<KernelSource> =
     LazyLock::new(|| with_kinds(kernel!("combine", "track_radiance")));
 pub const RADIANCE_LOSS: KernelSource = kernel!("radiance_loss", "loss_element");
+/// The loss on transfer vectors (`--targets transfer`) and its gradient at them.
+pub static TRANSFER_LOSS: LazyLock<KernelSource> =
+    LazyLock::new(|| with_kinds(kernel!("transfer_loss", "track_radiance")));
 pub static TRACK_GRADIENT: LazyLock<KernelSource> =
     LazyLock::new(|| with_kinds(kernel!("track_gradient", "track_radiance")));
 pub const ADAM: KernelSource = kernel!("adam");

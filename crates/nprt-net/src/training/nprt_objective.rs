@@ -48,9 +48,10 @@ struct PixelObjective<'a> {
 
 impl PixelObjective<'_> {
     /// Whether the kernels hold the dataset (their steps are refused where it cannot go up),
-    /// so that batches are only picked on the host.
+    /// so that batches are only picked on the host. Transfer vectors are not uploaded with
+    /// it: their batches are gathered on the host.
     fn resident(&self) -> bool {
-        self.kernels && self.opts.gather == Gather::Device
+        self.kernels && self.opts.gather == Gather::Device && self.transfer == 0
     }
 }
 
@@ -241,10 +242,6 @@ pub fn train(
     }
     let transfer = match opts.targets {
         Targets::Radiance => 0,
-        Targets::Transfer if kernels => bail!(
-            "--targets transfer trains on the CPU engine only (--device cpu): nprt's GPU \
-             kernels learn radiance targets"
-        ),
         Targets::Transfer => {
             let k = set.transfer(config)?;
             let bytes = opts.batch_size as u128 * 12 * k as u128;

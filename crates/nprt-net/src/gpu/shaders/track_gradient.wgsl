@@ -2,7 +2,9 @@
 // same for every track: the prediction is their sum): each term's weight times dr times the
 // term's slope in the output, its exp, or for a linear track the light code's value. A linear
 // track's gradient at its row's light code, Σ_t dr · weight_t · its coefficients, is written
-// per row into `d_code` (code_gradient 1) for a per-view sum.
+// per row into `d_code` (code_gradient 1) for a per-view sum. Trained on transfer vectors
+// (`transfer` 1), `dr` holds the gradient at each row's vector (rows × 3K, transfer_loss's) and
+// coefficient j of term t takes its value times the term's weight; the code has no gradient.
 
 struct TrackGradient {
     rows: u32,
@@ -14,7 +16,8 @@ struct TrackGradient {
     code_stride: u32,
     // 1: write each row's gradient at its light code into `d_code` (rows × 3K).
     code_gradient: u32,
-    _pad0: u32,
+    // 1: `dr` is the gradient at the rows' transfer vectors.
+    transfer: u32,
     _pad1: u32,
     _pad2: u32,
 }
@@ -35,9 +38,23 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>, @builtin(num_workgroups) g
     if (r >= p.rows) {
         return;
     }
-    let g = vec3<f32>(dr[3u * r], dr[3u * r + 1u], dr[3u * r + 2u]);
     let k = p.coefficients;
     let n = outputs(p.kind, k) * r;
+    if (p.transfer == 1u) {
+        for (var j = 0u; j < k; j++) {
+            let o = 3u * (r * k + j);
+            let g = vec3<f32>(dr[o], dr[o + 1u], dr[o + 2u]);
+            for (var t = 0u; t < KIND_TERMS[p.kind]; t++) {
+                let d = g * term_weight(p.kind, t, r);
+                let i = n + 3u * (t * k + j);
+                d_out[i] = d.x;
+                d_out[i + 1u] = d.y;
+                d_out[i + 2u] = d.z;
+            }
+        }
+        return;
+    }
+    let g = vec3<f32>(dr[3u * r], dr[3u * r + 1u], dr[3u * r + 2u]);
     if (k == 0u) {
         let e = terms(p.kind, r, 0u, 0u);
         for (var t = 0u; t < KIND_TERMS[p.kind]; t++) {

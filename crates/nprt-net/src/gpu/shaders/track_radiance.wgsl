@@ -59,6 +59,18 @@ fn terms(kind: u32, r: u32, k: u32, code: u32) -> array<vec3<f32>, MAX_TERMS> {
     return e;
 }
 
+// Coefficient j of a linear track's part of row r's transfer vector: each term's coefficient j
+// times the term's weight (what the radiance is under the code of function j alone).
+fn transfer_value(kind: u32, r: u32, k: u32, j: u32) -> vec3<f32> {
+    let n = outputs(kind, k) * r;
+    var v = vec3<f32>(0.0);
+    for (var t = 0u; t < KIND_TERMS[kind]; t++) {
+        let i = n + 3u * (t * k + j);
+        v += term_weight(kind, t, r) * vec3<f32>(out[i], out[i + 1u], out[i + 2u]);
+    }
+    return v;
+}
+
 fn track_radiance(kind: u32, r: u32, e: array<vec3<f32>, MAX_TERMS>) -> vec3<f32> {
     var c = term_weight(kind, 0u, r) * e[0];
     for (var t = 1u; t < KIND_TERMS[kind]; t++) {

@@ -74,19 +74,21 @@ enum Inputs<'a> {
 }
 
 impl Inputs<'_> {
-    /// Rows, views and the maps' width.
-    fn shape(&self) -> (usize, usize, usize) {
+    /// Rows, views, the maps' width and the transfer vectors' coefficients per channel (0:
+    /// radiance targets).
+    fn shape(&self) -> (usize, usize, usize, usize) {
         match *self {
             Inputs::Host(b) => (
                 b.len(),
                 b.lights.len() / (3 * b.light_width * b.light_width / 2),
                 b.light_width,
+                b.transfer.len() / (3 * b.len().max(1)),
             ),
             Inputs::Picked {
                 records,
                 views,
                 light_width,
-            } => (records.len() / 2, views.len(), light_width),
+            } => (records.len() / 2, views.len(), light_width, 0),
         }
     }
 }
@@ -135,6 +137,17 @@ pub(crate) struct BatchBuffers {
     /// A picked batch's records and views (u32; see [`GpuTrainer::queue_picked_step`]).
     pub picks: wgpu::Buffer,
     pub batch_views: wgpu::Buffer,
+    /// A batch whose targets are transfer vectors.
+    pub transfer: Option<TransferBuffers>,
+}
+
+/// A batch's transfer vectors (`rows × 3K` each): the recorded ones, the tracks' sum and the
+/// loss's gradient there.
+pub(crate) struct TransferBuffers {
+    pub coefficients: usize,
+    pub target: wgpu::Buffer,
+    pub sum: wgpu::Buffer,
+    pub d_transfer: wgpu::Buffer,
 }
 
 impl GpuTrainer {
@@ -380,15 +393,16 @@ impl GpuTrainer {
     /// Makes the plan for `inputs`' shape and `loss` the last of the kept plans (made unless
     /// one fits), and writes the batch (or its picks) into its buffers.
     fn prepare(&mut self, inputs: Inputs, loss: Loss) {
-        let (rows, views, light_width) = inputs.shape();
+        let shape = inputs.shape();
         let fits = self.plans.take(|p| {
             let b = &p.batch;
-            p.loss == loss && (b.rows, b.views, b.light_width) == (rows, views, light_width)
+            let transfer = b.transfer.as_ref().map_or(0, |t| t.coefficients);
+            p.loss == loss && (b.rows, b.views, b.light_width, transfer) == shape
         });
         let plan = match fits {
             Some(plan) => plan,
             None => {
-                let b = self.batch_buffers(rows, views, light_width);
+                let b = self.batch_buffers(shape);
                 let mut dispatches = Vec::new();
                 let (gpu, params) = (&self.gpu, &self.params);
                 // The light model's forward pass, then the transport's, then the light
@@ -439,6 +453,9 @@ impl GpuTrainer {
                 self.gpu.write(&b.radiance, batch.radiance);
                 self.gpu.write(&b.scale, batch.scale);
                 self.gpu.write(&b.view, &view);
+                if let Some(t) = &b.transfer {
+                    self.gpu.write(&t.target, batch.transfer);
+                }
             }
             Inputs::Picked { records, views, .. } => {
                 self.gpu.write(&b.picks, records);
@@ -489,8 +506,12 @@ impl GpuTrainer {
         self.adam.load(&self.gpu, &self.layout, path)
     }
 
-    /// Buffers for batches of `rows` samples over `views` maps `light_width` wide.
-    fn batch_buffers(&self, rows: usize, views: usize, light_width: usize) -> BatchBuffers {
+    /// Buffers for batches of `rows` samples over `views` maps `light_width` wide, with
+    /// transfer vectors of `transfer` coefficients per channel (0: none).
+    fn batch_buffers(
+        &self,
+        (rows, views, light_width, transfer): (usize, usize, usize, usize),
+    ) -> BatchBuffers {
         let gpu = &self.gpu;
         let grad_scale = match self.precision() {
             Precision::F32 => 1.0,
@@ -514,6 +535,12 @@ impl GpuTrainer {
             loss: gpu.buffer(1),
             picks: gpu.buffer(2 * rows),
             batch_views: gpu.buffer(views),
+            transfer: (transfer > 0).then(|| TransferBuffers {
+                coefficients: transfer,
+                target: gpu.buffer(rows * 3 * transfer),
+                sum: gpu.buffer(rows * 3 * transfer),
+                d_transfer: gpu.buffer(rows * 3 * transfer),
+            }),
         }
     }
 }

@@ -4,7 +4,7 @@
 //! into every parameter, the grids' tables and the light codes.
 
 use crate::encoding::hash_grid;
-use crate::gpu::kernels::{COMBINE, GRID_BACKWARD, RADIANCE_LOSS, TRACK_GRADIENT};
+use crate::gpu::kernels::{COMBINE, GRID_BACKWARD, RADIANCE_LOSS, TRACK_GRADIENT, TRANSFER_LOSS};
 use crate::gpu::layers::light_basis::{BasisAt, BasisFunctions};
 use crate::gpu::layers::network_forward::FirstLayer;
 use crate::gpu::layers::network_layout::{LightAt, TrackAt};
@@ -13,7 +13,7 @@ use crate::gpu::products::codes::loss_code;
 use crate::gpu::products::dense_products::DenseProducts;
 use crate::gpu::products::half_layers::Held;
 use crate::gpu::products::operands::{Bias, Operand, Output};
-use crate::gpu::trainers::gpu_trainer::{BatchBuffers, GpuTrainer};
+use crate::gpu::trainers::gpu_trainer::{BatchBuffers, GpuTrainer, TransferBuffers};
 use crate::loss::Loss;
 use crate::network::design::TRANSPORT_CODE;
 use crate::network::encoder::CODE_SIZE;
@@ -53,11 +53,35 @@ impl GpuTrainer {
             .iter()
             .map(|t| self.track_forward(plan, t, b))
             .collect();
-        // The tracks' radiance summed into `radiance`, one track per dispatch (any number of
-        // tracks), then the loss and its gradient at that sum. A linear track reads its row's
-        // view's code.
+        match &b.transfer {
+            Some(transfer) => self.record_transfer_loss(plan, b, transfer, &tapes),
+            None => self.record_radiance_loss(plan, b, loss, &tapes),
+        }
+        self.gpu.column_sum(
+            plan,
+            &b.row_loss,
+            b.rows,
+            1,
+            None,
+            Output::to(&b.loss, 0, 1),
+        );
+        let forward = plan.len();
+        self.record_gradients(plan, b, &tapes);
+        forward
+    }
+
+    /// Each row's loss on `b`'s radiance and its gradient there: the tracks' radiance summed
+    /// into `radiance_sum`, one track per dispatch (any number of tracks), then the loss and
+    /// its gradient at that sum. A linear track reads its row's view's code.
+    fn record_radiance_loss(
+        &self,
+        plan: &mut Vec<Dispatch>,
+        b: &BatchBuffers,
+        loss: Loss,
+        tapes: &[TrackTape],
+    ) {
         let code_size = self.net.light.code_size();
-        for (k, (t, tape)) in self.net.tracks.iter().zip(&tapes).enumerate() {
+        for (k, (t, tape)) in self.net.tracks.iter().zip(tapes).enumerate() {
             let params = [
                 b.rows,
                 t.kind.code() as usize,
@@ -96,17 +120,44 @@ impl GpuTrainer {
             ],
             groups_for(b.rows),
         ));
-        self.gpu.column_sum(
-            plan,
-            &b.row_loss,
-            b.rows,
-            1,
-            None,
-            Output::to(&b.loss, 0, 1),
-        );
-        let forward = plan.len();
-        self.record_gradients(plan, b, &tapes);
-        forward
+    }
+
+    /// Each row's loss on `b`'s transfer vectors and its gradient there, one track per
+    /// dispatch (transfer_loss.wgsl).
+    fn record_transfer_loss(
+        &self,
+        plan: &mut Vec<Dispatch>,
+        b: &BatchBuffers,
+        transfer: &TransferBuffers,
+        tapes: &[TrackTape],
+    ) {
+        let k = transfer.coefficients;
+        let tracks = self.net.tracks.len();
+        for (i, (t, tape)) in self.net.tracks.iter().zip(tapes).enumerate() {
+            let mut params = vec![
+                b.rows as u32,
+                t.kind.code(),
+                k as u32,
+                u32::from(i > 0),
+                u32::from(i + 1 == tracks),
+                0,
+                0,
+            ];
+            params.push((b.grad_scale / (3 * k * b.rows.max(1)) as f32).to_bits());
+            plan.push(self.gpu.prepare(
+                &TRANSFER_LOSS,
+                &params,
+                &[
+                    &b.features,
+                    tape.shading.outputs.last().expect("a layer"),
+                    &transfer.target,
+                    &transfer.sum,
+                    &transfer.d_transfer,
+                    &b.row_loss,
+                ],
+                groups_for(b.rows),
+            ));
+        }
     }
 
     /// Backward from the gradient at the radiance in `b`: each track's gradient at its outputs
@@ -131,7 +182,7 @@ impl GpuTrainer {
                 t.coefficients.unwrap_or(0),
                 code_size,
                 usize::from(d_rows.is_some()),
-                0,
+                usize::from(b.transfer.is_some()),
                 0,
                 0,
             ];
@@ -143,7 +194,7 @@ impl GpuTrainer {
                     tape.shading.outputs.last().expect("a layer"),
                     &b.codes,
                     &b.view,
-                    &b.d_radiance,
+                    b.transfer.as_ref().map_or(&b.d_radiance, |t| &t.d_transfer),
                     &tape.d_out,
                     d_rows.unwrap_or(&self.gpu.empty),
                 ],
