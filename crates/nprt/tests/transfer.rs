@@ -254,6 +254,21 @@ fn a_linear_model_learns_transfer_vectors_and_wrong_pairings_are_refused() {
     args.extend(["--out", elsewhere.to_str().unwrap(), "--arch", "linear"]);
     args.extend(["--basis", "sh:1", "--targets", "transfer"]);
     fails(&args, &["holds no transfer vectors", "--transfer sh:1"]);
+    // On a device the GPU tracer runs on, the recording refuses it; elsewhere the device is
+    // refused first, also naming --device cpu.
+    let mut args = vec![
+        "generate",
+        "--scene",
+        "builtin:room",
+        "--envmaps",
+        "builtin",
+    ];
+    args.extend(["--out", d, "--transfer", "sh:1", "--device", "wgpu"]);
+    let why = match devices.len() {
+        2 => "CPU tracer only",
+        _ => "--device",
+    };
+    fails(&args, &[why, "--device cpu"]);
     // A flag's value clap refuses (exit 2), with the parser's reason.
     let o = common::nprt(&["generate", "--out", d, "--transfer", "sh:9"]);
     let err = String::from_utf8_lossy(&o.stderr);
