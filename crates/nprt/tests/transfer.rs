@@ -183,6 +183,10 @@ fn a_pack_holds_the_vectors_and_tells_when_they_are_damaged() {
         }
     }
     assert_eq!(compared, pack.records().len());
+    assert!(
+        !data.join(".packing-transfer.part").exists(),
+        "the part file is left"
+    );
     let file = PackedDataset::path(&data, target);
     let mut bytes = std::fs::read(&file).unwrap();
     bytes[64 + 40 * pack.records().len() + 7] ^= 0x10;

@@ -223,24 +223,16 @@ impl PackedDataset {
         let Records::Mapped { path, .. } = &self.records else {
             return Ok(());
         };
-        // In pieces, each let go once hashed, so that checking a pack larger than memory
-        // never holds more than one piece.
-        let mut hasher = blake3::Hasher::new();
-        let bytes: &[u8] = bytemuck::cast_slice(self.records());
-        for (i, piece) in bytes.chunks(HASH_PIECE).enumerate() {
-            hasher.update_rayon(piece);
-            self.release_bytes(i * HASH_PIECE, piece.len());
-        }
-        let hash = hasher.finalize();
         ensure!(
-            hash.to_hex().as_str() == self.header.records_hash,
+            self.hash_released(0, bytemuck::cast_slice(self.records())) == self.header.records_hash,
             "the records of '{}' are damaged (their hash differs from the one written)",
             path.display()
         );
         if let Some(t) = &self.header.transfer {
-            let bytes: &[u8] = bytemuck::cast_slice(self.transfer_values());
+            let start = self.bytes();
+            let hash = self.hash_released(start, bytemuck::cast_slice(self.transfer_values()));
             ensure!(
-                blake3::Hasher::new().update_rayon(bytes).finalize().to_hex().as_str() == t.hash,
+                hash == t.hash,
                 "the transfer vectors of '{}' are damaged (their hash differs from the one written)",
                 path.display()
             );
@@ -291,6 +283,17 @@ impl PackedDataset {
             }
             Records::Memory(r) => r,
         }
+    }
+
+    /// BLAKE3 of `bytes`, the file's from `start` after the prelude, in pieces, each let go once
+    /// hashed, so that checking a pack larger than memory never holds more than one piece.
+    fn hash_released(&self, start: usize, bytes: &[u8]) -> String {
+        let mut hasher = blake3::Hasher::new();
+        for (i, piece) in bytes.chunks(HASH_PIECE).enumerate() {
+            hasher.update_rayon(piece);
+            self.release_bytes(start + i * HASH_PIECE, piece.len());
+        }
+        hasher.finalize().to_hex().to_string()
     }
 
     /// Every record's transfer vector, one after another (empty without them).
@@ -409,7 +412,10 @@ fn pack(
         let mut views = Vec::with_capacity(manifest.views.len());
         let mut next = 0u64;
         let mut transfer = packed_transfer::Writer::new(dir, manifest)?;
-        for chunk in manifest.views.chunks(PACK_CHUNK) {
+        for chunk in manifest
+            .views
+            .chunks(packed_transfer::views_at_once(manifest, PACK_CHUNK))
+        {
             let records: Vec<(Vec<PackedPixel>, Vec<u16>)> = chunk
                 .par_iter()
                 .map(|v| view_records(dir, manifest, v, target, transfer.is_some()))

@@ -54,8 +54,19 @@ pub(crate) fn vectors(image: &ImageView, basis: TransferBasis, indirect: bool) -
         .collect()
 }
 
+/// Views to pack at once, at most `most`: fewer where their transfer vectors, as read (f32,
+/// whole and direct), would pass 1 GiB.
+pub(crate) fn views_at_once(manifest: &Manifest, most: usize) -> usize {
+    let Some(basis) = manifest.settings.transfer else {
+        return most;
+    };
+    let [w, h] = manifest.settings.train_resolution;
+    let per_view = w as usize * h as usize * 2 * basis.floats() * 4;
+    ((1 << 30) / per_view.max(1)).clamp(1, most)
+}
+
 /// Collects the vectors while the records are written, in a file beside the pack (the records
-/// come first in it), then appends them after the records.
+/// come first in it), then appends them after the records; the file goes with the writer.
 pub(crate) struct Writer {
     path: PathBuf,
     file: BufWriter<File>,
@@ -98,21 +109,26 @@ impl Writer {
     }
 
     /// Appends the vectors to `out`; returns the header's part and their length in bytes.
-    pub fn append_to(self, out: &mut impl Write) -> Result<(Option<PackedTransfer>, u64)> {
-        let file = self.file.into_inner().map_err(|e| e.into_error())?;
-        drop(file);
+    pub fn append_to(mut self, out: &mut impl Write) -> Result<(Option<PackedTransfer>, u64)> {
+        self.file.flush()?;
         let mut part = File::open(&self.path)?;
         let copied = std::io::copy(&mut part, out)?;
         ensure!(
             copied == self.bytes,
             "the transfer vectors' part file was cut short"
         );
-        std::fs::remove_file(&self.path)?;
         let header = PackedTransfer {
             basis: self.basis,
             hash: self.hasher.finalize().to_hex().to_string(),
         };
         Ok((Some(header), self.bytes))
+    }
+}
+
+impl Drop for Writer {
+    fn drop(&mut self) {
+        // Done or failed, the part file is not kept (a killed packing's is truncated by the next).
+        let _ = std::fs::remove_file(&self.path);
     }
 }
 
