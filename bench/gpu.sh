@@ -102,16 +102,8 @@ if [ -n "$quick" ]; then
   }
   [ -n "$nprt_given" ] || nprt=$prepared/nprt
   variants=eager-f32,eager-bf16
-  # The prepared loader, where the machine has none; the NVIDIA driver's ICD where the loader's
-  # own folders list none.
-  if ! ldconfig -p | grep -q 'libvulkan\.so\.1' && [ -f "$prepared/lib/libvulkan.so.1" ]; then
-    export LD_LIBRARY_PATH=$(realpath "$prepared/lib")${LD_LIBRARY_PATH:+:$LD_LIBRARY_PATH}
-  fi
-  icd=/usr/local/nvidia/share/vulkan/icd.d/nvidia_icd.json
-  if [ -z "${VK_DRIVER_FILES:-}" ] && [ -f "$icd" ] &&
-    ! ls /usr/share/vulkan/icd.d/*.json /etc/vulkan/icd.d/*.json >/dev/null 2>&1; then
-    export VK_DRIVER_FILES=$icd
-  fi
+  source bench/gpu-vulkan.sh
+  use_prepared_vulkan "$prepared/lib"
 fi
 
 # What the run needs, each missing piece named.

@@ -7,15 +7,19 @@
 # moments), dataset.sha256 (the dataset's identity, written by the first visit) and visits.csv
 # (a row per visit). docs/kitchen.md keeps the table by GPU-minutes done.
 #
-#   bench/kitchen-visit.sh prepare
+#   bench/kitchen-visit.sh prepare [--ab-base REV]
 #       here, without a GPU: bench/gpu-prepare.sh's binaries and tests, the KITCHEN scene and
-#       the maps packed into .visit/bundle.tar.xz (27 MiB, inside a loan's 64 MiB).
+#       the maps packed into .visit/bundle.tar.xz (about 35 MiB, inside a loan's 64 MiB), with
+#       nprt built at REV too (default below; `none` for no A/B): the kernels a visit times
+#       beside the current ones (bench/gpu-ab.sh).
 #   bench/kitchen-visit.sh run [--minutes M] [--skip-tests]
 #       on the GPU machine, with .visit carried, in at most M wall minutes (default 8.5): the
 #       GPU kernels' correctness tests; the dataset path traced on the device from the fixed
 #       flags (timed; its manifest checked against dataset.sha256); training resumed until the
 #       visit's time is nearly spent (`nprt train --pause-after`); `nprt bench train` and
-#       `bench frame` of D/S; then in $OUT (default .visit/out): summary.md, visit.log,
+#       `bench frame` of D/S; the A/B of the prepared base's training kernels against the
+#       current ones (`bench/gpu-ab.sh run`, 2 rounds, D/S f16 at both batch sizes, about
+#       100 s); then in $OUT (default .visit/out): summary.md, visit.log,
 #       model.tar.xz and the test views (testviews.tar.part-*, 15 MiB each), 8 files at most.
 #   bench/kitchen-visit.sh land DIR [--cpu-model MODEL]
 #       here, on what a visit brought back in DIR: the model replaces pretrained/kitchen-dsep/
@@ -26,7 +30,11 @@
 # Scene and maps sit at .visit/kitchen and .visit/envmaps on both machines (links to ../shared
 # here), so the dataset's manifest names the same paths wherever it is read.
 # Environment, to try the script without a GPU: VISIT_DEVICE (default gpu; wgpu runs on
-# lavapipe), VISIT_BUDGET (default gpu; tiny), VISIT_PRETRAINED (default pretrained/kitchen-dsep).
+# lavapipe), VISIT_BUDGET (default gpu; tiny), VISIT_PRETRAINED (default pretrained/kitchen-dsep),
+# VISIT_AB_BATCH (the A/B's batch sizes; default 16384,262144).
+# The A/B base: the kernels before the latest change to them that no GPU has timed yet (the
+# training step's bias gradients folded into the weight gradients' products). Move it on when a
+# visit has timed a change and another follows.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
@@ -34,6 +42,7 @@ total_minutes=60
 device=${VISIT_DEVICE:-gpu}
 budget=${VISIT_BUDGET:-gpu}
 pretrained=${VISIT_PRETRAINED:-pretrained/kitchen-dsep}
+ab_base=8d12764
 log() { echo "bench/kitchen-visit.sh: $*" >&2; }
 die() { log "$*"; exit 1; }
 usage() { sed -n '2,/^set -euo/p' "$0" | sed '$d; s/^# \{0,1\}//'; }
@@ -49,12 +58,25 @@ link_shared() {
 }
 
 prepare() {
+  while [ $# -gt 0 ]; do
+    case "$1" in
+      --ab-base) ab_base=$2; shift 2 ;;
+      *) die "unknown argument '$1' (--help lists them)" ;;
+    esac
+  done
   bench/gpu-prepare.sh --out .gpu
+  local base=()
+  rm -f .gpu/nprt-base .gpu/nprt-base.commit
+  if [ "$ab_base" != none ]; then
+    bench/gpu-ab.sh build "$ab_base" .gpu/nprt-base
+    base=(.gpu/nprt-base .gpu/nprt-base.commit)
+  fi
+  cp .gpu/commit .gpu/nprt.commit
   link_shared
   log "packing .visit/bundle.tar.xz"
   XZ_OPT=-T0 tar -cJhf .visit/bundle.tar.xz --transform 's,^\.gpu,gpu,' --transform 's,^\.visit/,,' \
-    .gpu/nprt .gpu/commit .gpu/lib .gpu/tests/gpu_training .gpu/tests/gpu_frame \
-    .visit/kitchen .visit/envmaps
+    .gpu/nprt .gpu/commit .gpu/nprt.commit "${base[@]}" .gpu/lib .gpu/tests/gpu_training \
+    .gpu/tests/gpu_frame .visit/kitchen .visit/envmaps
   du -h .visit/bundle.tar.xz
   log "ready: carry '.visit/bundle.tar.xz' and run 'bench/kitchen-visit.sh run' on the GPU machine"
 }
@@ -80,16 +102,8 @@ run_visit() {
   local nprt=${VISIT_NPRT:-.visit/gpu/nprt}
   [ -x "$nprt" ] || die "no '$nprt': run 'bench/kitchen-visit.sh prepare' where the code builds"
   [ -f .visit/kitchen/scene.xml ] || link_shared
-  # The prepared loader where the machine has none; the NVIDIA driver's ICD where the loader's
-  # own folders list none.
-  if ! ldconfig -p | grep -q 'libvulkan\.so\.1' && [ -f .visit/gpu/lib/libvulkan.so.1 ]; then
-    export LD_LIBRARY_PATH=$(realpath .visit/gpu/lib)${LD_LIBRARY_PATH:+:$LD_LIBRARY_PATH}
-  fi
-  local icd=/usr/local/nvidia/share/vulkan/icd.d/nvidia_icd.json
-  if [ -z "${VK_DRIVER_FILES:-}" ] && [ -f "$icd" ] &&
-    ! ls /usr/share/vulkan/icd.d/*.json /etc/vulkan/icd.d/*.json >/dev/null 2>&1; then
-    export VK_DRIVER_FILES=$icd
-  fi
+  source bench/gpu-vulkan.sh
+  use_prepared_vulkan .visit/gpu/lib
   local summary=$out/summary.md
   {
     echo "# A visit to the pretrained KITCHEN: $(date -u +%Y-%m-%dT%H:%MZ)"
@@ -115,9 +129,11 @@ run_visit() {
     cp -a "$pretrained/model" "$work/model"
   fi
   mkdir -p "$pretrained"
-  # Benches and packing take about 90 s after training.
+  # Benches and packing take about 90 s after training, the A/B about 100 s more.
+  local after=90 base=.visit/gpu/nprt-base
+  [ ! -x "$base" ] || after=190
   bench/kitchen.sh --out "$work" --device "$device" --budget "$budget" --precision f16 \
-    --minutes "$total_minutes" --pause-by $((deadline - 90)) --data-hash "$pretrained/dataset.sha256" \
+    --minutes "$total_minutes" --pause-by $((deadline - after)) --data-hash "$pretrained/dataset.sha256" \
     --scene .visit/kitchen/scene.xml --maps .visit/envmaps --nprt "$nprt" --no-eval
   sed -n '2,$p' "$work/summary.md" >>"$summary"
 
@@ -130,6 +146,12 @@ run_visit() {
     timeout 40 "$nprt" bench frame --arch dsep --device "$device" --res 512 \
       --precision f32,f16 2>&1 | tail -n 10 >>"$summary" || true
     echo '```' >>"$summary"
+  fi
+  if [ -x "$base" ] && [ $(($(date +%s) + 60)) -lt "$deadline" ]; then
+    printf '\n## The training kernels, A/B (bench/gpu-ab.sh)\n\n' >>"$summary"
+    timeout $((deadline - $(date +%s) - 45)) bench/gpu-ab.sh run "$base" "$nprt" --rounds 2 \
+      --device "$device" --batch-size "${VISIT_AB_BATCH:-16384,262144}" >>"$summary" ||
+      echo "(the A/B did not finish: $?)" >>"$summary"
   fi
 
   log "packing what comes back"
@@ -186,7 +208,7 @@ EOF
 }
 
 case "${1:-}" in
-  prepare) prepare ;;
+  prepare) shift; prepare "$@" ;;
   run) shift; run_visit "$@" ;;
   land) shift; land "$@" ;;
   -h | --help) usage ;;

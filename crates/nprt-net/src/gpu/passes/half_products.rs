@@ -6,8 +6,9 @@
 //! same sums (what the tests run). A layer's three products are its forward pass (`half_train`
 //! with bias, activation and the pre-activation kept in f32), its input gradient dz·Wᵀ (the
 //! same kernel on the transposed copy, times the activation's derivative) and its weight
-//! gradient xᵀ·dz over chunks of rows (`half_weight_grad`), whose chunks and the biases'
-//! gradients are added in f32 as in an f32 step. The loss's gradient is multiplied by a power
+//! gradient xᵀ·dz over chunks of rows (`half_weight_grad`), which also sums each chunk's dz
+//! columns, the bias's gradient, in the same dispatch; the chunks are added in f32 as in an
+//! f32 step. The loss's gradient is multiplied by a power
 //! of two near the batch's values (`BatchBuffers::grad_scale`) so that f16 keeps the small
 //! gradients, and Adam divides it back out; f16 values saturate instead of overflowing. The
 //! light encoder, the hash grids and the light code's share stay in f32.
@@ -24,34 +25,49 @@ use crate::gpu::products::operands::{Bias, Output};
 use nprt_gpu::{groups_for, Bind, Dispatch, GpuDevice};
 
 /// The dispatch of xᵀ·dz, `[m, n]`, over `rows` rows cut into chunks of `chunk` rows, chunk
-/// c's sums into `partial` from c · m · n (`half_weight_sums.wgsl`).
+/// c's sums into `partial` from c · m' · n; with `bias`, m' = m + 1 and row m holds dz's
+/// column sums, the bias's gradient (`half_weight_sums.wgsl`).
 fn half_weight_grad(
     gpu: &GpuDevice,
     [m, n, rows]: [usize; 3],
     (x, k_pad): (&wgpu::Buffer, usize),
     (dz, n_pad): (&wgpu::Buffer, usize),
     [chunk, chunks]: [usize; 2],
+    bias: bool,
     partial: &wgpu::Buffer,
 ) -> Dispatch {
-    let params = [rows.next_multiple_of(16), chunk, m, n, k_pad, n_pad, 0, 0].map(|v| v as u32);
+    let bias = usize::from(bias);
+    let params = [
+        rows.next_multiple_of(16),
+        chunk,
+        m,
+        n,
+        k_pad,
+        n_pad,
+        bias,
+        0,
+    ];
+    let params = params.map(|v| v as u32);
     let buffers: [&dyn Bind; 3] = [x, dz, partial];
     if gpu.tensor_cores {
+        // The bias's sums take a row of workgroups of their own.
         let groups = [
             n_pad.div_ceil(64) as u32,
-            k_pad.div_ceil(256) as u32,
+            (k_pad.div_ceil(256) + bias) as u32,
             chunks as u32,
         ];
         gpu.prepare_grid(&HALF_WEIGHT_GRAD_COOP, &params, &buffers, groups)
     } else {
-        let groups = groups_for(chunks * m * n);
+        let groups = groups_for(chunks * (m + bias) * n);
         gpu.prepare(&HALF_WEIGHT_GRAD, &params, &buffers, groups)
     }
 }
 
 impl Trainable<'_> {
     /// [`Self::mlp_backward`] in a mixed-precision step: the gradient at each layer's output
-    /// as f16 rows for the products and as f32 rows for the bias's gradient (and `on_first`),
-    /// the gradient at the first layer's input into `d_input` (f32) where given.
+    /// as f16 rows, and as f32 rows too where `on_first` takes it; the gradient at the first
+    /// layer's input into `d_input` (f32) where given. A bias's gradient is made with its
+    /// weight's (`half_weight_grad`).
     pub(crate) fn half_mlp_backward(
         &self,
         plan: &mut Vec<Dispatch>,
@@ -65,15 +81,17 @@ impl Trainable<'_> {
         let last = m.layers.len() - 1;
         let widest = m.widest();
         let dz16 = [0, 1].map(|_| gpu.half_buffer(held_halves(rows, widest)));
-        let dz32 = [0, 1].map(|_| gpu.buffer(rows * widest));
+        // Only `on_first` reads a hidden layer's gradient in f32: layer 0's, here.
+        let dz32 = (on_first.is_some() && last > 0).then(|| gpu.buffer(rows * widest));
         let out_width = m.layers[last].d_out;
         let d_last16 = gpu.half_buffer(held_halves(rows, out_width));
         plan.push(gpu.half_rows([rows, out_width, out_width], d_last, &d_last16));
         for (i, (layer, copies)) in m.half_layers().enumerate().rev() {
             let (g16, g32) = match i == last {
-                true => (&d_last16, d_last),
-                false => (&dz16[i % 2], &dz32[i % 2]),
+                true => (&d_last16, Some(d_last)),
+                false => (&dz16[i % 2], dz32.as_ref().filter(|_| i == 0)),
             };
+            let first_bias = on_first.filter(|_| i == 0);
             let x16 = match i {
                 0 => tape.input16.as_ref().expect("a mixed-precision tape"),
                 _ => &tape.outputs[i - 1],
@@ -85,17 +103,10 @@ impl Trainable<'_> {
                 x16,
                 g16,
                 layer.weight.offset + copies.row * layer.d_out,
+                first_bias.is_none().then_some(layer.bias.offset),
             );
-            match on_first.filter(|_| i == 0) {
-                Some(f) => f(plan, g32),
-                None => self.gpu.column_sum(
-                    plan,
-                    g32,
-                    rows,
-                    layer.d_out,
-                    None,
-                    Output::to(self.grads, layer.bias.offset, layer.d_out),
-                ),
+            if let Some(f) = first_bias {
+                f(plan, g32.expect("layer 0's gradient in f32 for on_first"));
             }
             let (derivative, out) = match i {
                 0 => match d_input {
@@ -114,7 +125,7 @@ impl Trainable<'_> {
                     HalfOut {
                         z: Some(&tape.pre[i - 1]),
                         y16: Some(&dz16[(i - 1) % 2]),
-                        y32: Some(&dz32[(i - 1) % 2]),
+                        y32: dz32.as_ref().filter(|_| i == 1),
                     },
                 ),
             };
@@ -131,7 +142,8 @@ impl Trainable<'_> {
     }
 
     /// Records a weight's gradient, `[m, n, rows]`: xᵀ·dz over the rows (f16 operands), per
-    /// chunk of rows, the chunks added in order into `grads` from `offset`.
+    /// chunk of rows, the chunks added in order into `grads` from `offset`; with `bias` (its
+    /// offset in `grads`) the bias's, dz's column sums, beside them.
     fn half_weight_gradient(
         &self,
         plan: &mut Vec<Dispatch>,
@@ -139,24 +151,96 @@ impl Trainable<'_> {
         x: &wgpu::Buffer,
         dz: &wgpu::Buffer,
         offset: usize,
+        bias: Option<usize>,
     ) {
         let [chunk, chunks] = row_chunks(rows.next_multiple_of(16), 16);
-        let partial = self.gpu.buffer(chunks * m * n);
+        let rows_of_c = m + usize::from(bias.is_some());
+        let partial = self.gpu.buffer(chunks * rows_of_c * n);
         plan.push(half_weight_grad(
             self.gpu,
             [m, n, rows],
             (x, pad16(m)),
             (dz, pad16(n)),
             [chunk, chunks],
+            bias.is_some(),
             &partial,
         ));
-        self.gpu.column_sum(
-            plan,
-            &partial,
-            chunks,
-            m * n,
-            None,
-            Output::to(self.grads, offset, n),
-        );
+        let out = Output {
+            tail: bias.map(|at| [m * n, at]),
+            ..Output::to(self.grads, offset, n)
+        };
+        self.gpu
+            .column_sum(plan, &partial, chunks, rows_of_c * n, None, out);
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::gpu::passes::mlp_step::Trainable;
+    use half::f16;
+
+    /// A weight's gradient with its bias's folded in, against f64 sums of the same f16 values:
+    /// the weight's xᵀ·dz and the bias's dz column sums, each in its own place in `grads`
+    /// across chunks of rows; without the bias, its place is left alone. The sums are f32 over
+    /// f16 products, so they agree to f32's rounding, far below the 10⁻² an f16 step's
+    /// gradients carry (where a bias a few percent off would hide).
+    #[test]
+    fn a_weight_gradient_folds_its_bias_gradient_in() {
+        if !GpuDevice::probe() || !GpuDevice::get().unwrap().half {
+            return;
+        }
+        let gpu = GpuDevice::get().unwrap();
+        // 20 × 24 sums over 1,000 rows: four chunks, and padded columns on both sides.
+        let [m, n, rows] = [20, 24, 1000];
+        let [k_pad, n_pad] = [pad16(m), pad16(n)];
+        let value = |i: usize, salt: usize| ((i * 7919 + salt) % 1009) as f32 / 504.5 - 1.0;
+        let held = |cols: usize, pad: usize, salt: usize| {
+            let mut h = vec![0u16; held_halves(rows, cols)];
+            for r in 0..rows {
+                for c in 0..cols {
+                    h[r * pad + c] = f16::from_f32(value(r * cols + c, salt)).to_bits();
+                }
+            }
+            h
+        };
+        let (x, dz) = (held(m, k_pad, 1), held(n, n_pad, 2));
+        let at =
+            |h: &[u16], pad: usize, r: usize, c: usize| f64::from(f16::from_bits(h[r * pad + c]));
+        let [weight, bias] = [0, m * n];
+        for with_bias in [true, false] {
+            let grads = gpu.upload(&vec![-1.0f32; (m + 1) * n]);
+            let trainable = Trainable {
+                gpu: &gpu,
+                params: &gpu.spare,
+                grads: &grads,
+            };
+            let mut plan = Vec::new();
+            let [x16, dz16] = [&x, &dz].map(|h| gpu.upload(h));
+            let fold = with_bias.then_some(bias);
+            trainable.half_weight_gradient(&mut plan, [m, n, rows], &x16, &dz16, weight, fold);
+            let mut encoder = gpu.device.create_command_encoder(&Default::default());
+            let mut pass = encoder.begin_compute_pass(&Default::default());
+            plan.iter().for_each(|d| d.record(&mut pass));
+            drop(pass);
+            gpu.queue.submit([encoder.finish()]);
+            let got = gpu.read(&grads, (m + 1) * n);
+            for i in 0..=m {
+                for j in 0..n {
+                    let want = match (i == m, with_bias) {
+                        (false, _) => (0..rows)
+                            .map(|r| at(&x, k_pad, r, i) * at(&dz, n_pad, r, j))
+                            .sum(),
+                        (true, true) => (0..rows).map(|r| at(&dz, n_pad, r, j)).sum(),
+                        (true, false) => -1.0,
+                    };
+                    let g = f64::from(got[i * n + j]);
+                    assert!(
+                        (g - want).abs() < 1e-4 * (1.0 + want.abs()),
+                        "bias {with_bias}: ({i}, {j}) is {g}, not {want}"
+                    );
+                }
+            }
+        }
     }
 }

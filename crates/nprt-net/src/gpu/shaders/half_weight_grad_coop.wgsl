@@ -4,13 +4,34 @@
 // loads of x as stored (`coopLoad`), dz's row-major (`coopLoadT`). A workgroup covers 256 rows
 // × 64 columns of the gradient for chunk `workgroup_id.z`; tiles past x's or dz's padded
 // columns read the last tile again and are not written (`finish` keeps to m × n). A tile leaves
-// through `coop_drain`.
+// through `coop_drain`. With `bias` set, one more row of workgroups (past k_pad's) sums dz's
+// columns instead, two threads a column over half the chunk's rows each.
 
 @compute @workgroup_size(128)
 fn main(@builtin(workgroup_id) group: vec3<u32>, @builtin(local_invocation_index) t: u32) {
     let sg = t / 32u;
     let lane = t % 32u;
     chunk_of = group.z;
+    if (group.y * 256u >= p.k_pad) {
+        let j = group.x * 64u + t % 64u;
+        let r0 = group.z * p.chunk;
+        let r1 = min(p.rows, r0 + p.chunk);
+        let mid = r0 + (r1 - r0) / 2u;
+        var sum = 0.0;
+        if (j < p.n) {
+            if (t < 64u) {
+                sum = dz_sum(j, r0, mid);
+            } else {
+                sum = dz_sum(j, mid, r1);
+            }
+        }
+        staged[t] = sum;
+        workgroupBarrier();
+        if (t < 64u) {
+            finish(p.m, j, staged[t] + staged[t + 64u]);
+        }
+        return;
+    }
     let row0 = group.y * 256u + sg * 64u;
     let col0 = group.x * 64u;
     let i_last = p.k_pad - 16u;
