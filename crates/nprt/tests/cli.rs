@@ -567,3 +567,77 @@ fn the_gpu_benchmark_script_explains_itself_and_names_what_it_lacks() {
         );
     }
 }
+
+/// bench/gpu-ab.sh explains itself and names what is wrong with its arguments; where the GPU
+/// kernels run (lavapipe here), it times two builds (here one binary twice) alternately and
+/// prints a row of the A/B table per design, precision and batch size.
+#[test]
+fn the_ab_script_times_two_builds_side_by_side() {
+    let script = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../bench/gpu-ab.sh");
+    let run = |args: &[&str]| {
+        std::process::Command::new("bash")
+            .arg(&script)
+            .args(args)
+            .output()
+            .unwrap()
+    };
+    let help = run(&["--help"]);
+    assert!(help.status.success());
+    let text = String::from_utf8_lossy(&help.stdout);
+    assert!(
+        text.contains("build REV FILE") && text.contains("alternately"),
+        "{text}"
+    );
+    let nprt = env!("CARGO_BIN_EXE_nprt");
+    for (args, why) in [
+        (
+            &["run", nprt, nprt, "--frobnicate"][..],
+            "unknown argument '--frobnicate'",
+        ),
+        (
+            &["run", "/nonexistent", nprt][..],
+            "A, '/nonexistent', is not an executable nprt",
+        ),
+        (
+            &["run", nprt, nprt, "--rounds", "0"][..],
+            "--rounds must be a positive count",
+        ),
+        (
+            &["build", "no-such-commit", "/nonexistent/nprt"][..],
+            "'no-such-commit' names no commit",
+        ),
+    ] {
+        let out = run(args);
+        assert_eq!(out.status.code(), Some(1), "{args:?}");
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert!(err.contains(why), "{args:?}: {err}");
+    }
+    if !common::wgpu_runs() {
+        return;
+    }
+    let args = "--device wgpu --arch prt --precision f32 --batch-size 64 --steps 1 --rounds 1";
+    let out = run(&[
+        &["run", nprt, nprt][..],
+        &args.split(' ').collect::<Vec<_>>(),
+    ]
+    .concat());
+    let table = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        out.status.success(),
+        "{table}{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let row = table.lines().find(|l| l.starts_with("| prt | f32 | 64 |"));
+    let cells: Vec<&str> = row
+        .expect("a row for prt")
+        .split('|')
+        .map(str::trim)
+        .collect();
+    // Design, precision, batch, A's and B's samples/s, B/A and the rounds' range.
+    let rate = |c: &str| c.parse::<f64>().unwrap_or_else(|_| panic!("{table}"));
+    assert!(rate(cells[4]) > 0.0 && rate(cells[5]) > 0.0, "{table}");
+    assert!(
+        cells[6].ends_with('×') && cells[7].ends_with('×'),
+        "{table}"
+    );
+}
