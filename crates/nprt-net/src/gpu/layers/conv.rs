@@ -129,28 +129,21 @@ pub fn record_weight_gradients(
     let chunk_rows = rows.div_ceil(CONV_CHUNKS);
     let chunks = rows.div_ceil(chunk_rows);
     let taps = conv.c_in * conv.k * conv.k;
-    let (weight_sums, bias_sums) = (
-        gpu.buffer(chunks * conv.c_out * taps),
-        gpu.buffer(chunks * conv.c_out),
-    );
+    // Per chunk the weights' sums, then the biases'.
+    let block = conv.c_out * (taps + 1);
+    let sums = gpu.buffer(chunks * block);
     let p = [
         conv.c_in, conv.c_out, h, w, views, conv.k, chunk_rows, chunks,
     ];
     plan.push(gpu.prepare(
         &CONV_WEIGHT_BACKWARD,
         &p.map(|v| v as u32),
-        &[input, dz, &weight_sums, &bias_sums],
-        groups_for(chunks * conv.c_out * (taps + 1)),
+        &[input, dz, &sums],
+        groups_for(chunks * block),
     ));
-    for (partial, span) in [(&weight_sums, conv.weight), (&bias_sums, conv.bias)] {
-        let n = span.len;
-        gpu.column_sum(
-            plan,
-            partial,
-            chunks,
-            n,
-            None,
-            Output::to(grads, span.offset, n),
-        );
-    }
+    let out = Output {
+        tail: Some([conv.c_out * taps, conv.bias.offset]),
+        ..Output::to(grads, conv.weight.offset, conv.weight.len)
+    };
+    gpu.column_sum(plan, &sums, chunks, block, None, out);
 }

@@ -2,7 +2,8 @@
 // the sum over the chunk's rows of dz[c] times the input tap it multiplied, and per channel c
 // the sum of dz[c] (its bias). The rows of all views are cut into `chunks` chunks of
 // `chunk_rows` rows (view-major), one thread per value and chunk, each adding in a fixed
-// order; a column sum then adds the chunks in order. One thread per value over every row left
+// order; a column sum then adds the chunks in order, the weights' and the biases' in one pass
+// (they sit in one block per chunk, the biases last). One thread per value over every row left
 // a few hundred threads each walking a whole batch of maps: most of a step's time on a GPU.
 
 struct WeightBackward {
@@ -19,9 +20,8 @@ struct WeightBackward {
 @group(0) @binding(0) var<uniform> p: WeightBackward;
 @group(0) @binding(1) var<storage, read> input: array<f32>;
 @group(0) @binding(2) var<storage, read> dz: array<f32>;
-// Per chunk, the weights' sums (c_out × c_in · k²) and the biases' (c_out).
-@group(0) @binding(3) var<storage, read_write> weight_sums: array<f32>;
-@group(0) @binding(4) var<storage, read_write> bias_sums: array<f32>;
+// Per chunk, the weights' sums (c_out × c_in · k²), then the biases' (c_out).
+@group(0) @binding(3) var<storage, read_write> sums: array<f32>;
 
 @compute @workgroup_size(64)
 fn main(@builtin(global_invocation_id) id: vec3<u32>, @builtin(num_workgroups) groups: vec3<u32>) {
@@ -48,7 +48,7 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>, @builtin(num_workgroups) g
                 s += dz[d + x];
             }
         }
-        bias_sums[chunk * p.c_out + c] = s;
+        sums[chunk * per_chunk + p.c_out * taps + c] = s;
         return;
     }
     let ci = j / kk;
@@ -72,5 +72,5 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>, @builtin(num_workgroups) g
             s += dz[d + x] * input[src + u32(sx)];
         }
     }
-    weight_sums[chunk * p.c_out * taps + c * taps + j] = s;
+    sums[chunk * per_chunk + c * taps + j] = s;
 }
