@@ -78,6 +78,8 @@ pub const HALF_TRAIN_COOP: KernelSource = kernel!(
     "coop_drain"
 );
 pub const HALF_WEIGHT_GRAD: KernelSource = kernel!("half_weight_grad", "half_weight_sums");
+/// A mixed-precision step's f16 copies of a weight, as stored and transposed, after Adam.
+pub const HALF_WEIGHT_COPIES: KernelSource = kernel!("half_weight_copies");
 pub const HALF_WEIGHT_GRAD_COOP: KernelSource = kernel!(
     "half_weight_grad_coop",
     "coop_matrix",

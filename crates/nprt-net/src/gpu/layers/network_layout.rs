@@ -2,11 +2,12 @@
 //! structure (encoder blocks, tracks, layers), as the training step's dispatches address them.
 
 use crate::encoding::hash_grid;
+use crate::gpu::kernels::HALF_WEIGHT_COPIES;
 use crate::gpu::layers::layer_at::DenseAt;
 use crate::gpu::layers::light_basis::BasisAt;
 use crate::gpu::layers::light_encoder::EncoderAt;
 use crate::gpu::layers::parameters::ParameterLayout;
-use crate::gpu::products::half_layers::{HalfLayers, HalfWeight};
+use crate::gpu::products::half_layers::{pad16, HalfLayers, HalfWeight};
 use crate::network::activation::Activation;
 use crate::network::design::TRANSPORT_CODE;
 use crate::network::encoder::CODE_SIZE;
@@ -15,7 +16,7 @@ use crate::network::mlp::Mlp;
 use crate::network::nprt_net::NprtNet;
 use crate::network::track_kind::TrackKind;
 use nprt_gpu::Span;
-use nprt_gpu::{Dispatch, GpuDevice};
+use nprt_gpu::{groups_for, Bind, Dispatch, GpuDevice};
 
 pub struct MlpAt {
     pub layers: Vec<DenseAt>,
@@ -176,13 +177,13 @@ impl NetworkLayout {
     }
 
     /// The dispatches that copy the transport layers' current weights from `params` into
-    /// their f16 copies (none in f32).
+    /// their f16 copies, one per layer (none in f32).
     pub fn half_refresh(&self, gpu: &GpuDevice, params: &wgpu::Buffer) -> Vec<Dispatch> {
         self.tracks
             .iter()
             .flat_map(|t| t.transfer.iter().chain([&t.shading]))
             .flat_map(|m| m.half_layers())
-            .flat_map(|(layer, copies)| copies.refresh(gpu, params, layer))
+            .map(|(layer, copies)| copies.refresh(gpu, params, layer))
             .collect()
     }
 }
@@ -217,25 +218,82 @@ impl HalfCopies {
         }
     }
 
-    /// The dispatches that copy `layer`'s current weight from `params` into both copies.
-    pub fn refresh(
-        &self,
-        gpu: &GpuDevice,
-        params: &wgpu::Buffer,
-        layer: &DenseAt,
-    ) -> [Dispatch; 2] {
+    /// The dispatch that copies `layer`'s current weight from `params` into both copies.
+    pub fn refresh(&self, gpu: &GpuDevice, params: &wgpu::Buffer, layer: &DenseAt) -> Dispatch {
         let (n, k) = (layer.d_out, self.count);
         let offset = layer.weight.offset + self.row * n;
-        [
-            gpu.half_matrix([k, n], [n, 1], offset, k + 16, params, &self.stored.buffer),
-            gpu.half_matrix(
-                [n, k],
-                [1, n],
+        let p = [k, n, offset, pad16(n), pad16(k), 0, 0, 0];
+        let values = (k + 16) * pad16(n) + (n + 16) * pad16(k);
+        let buffers: [&dyn Bind; 3] = [params, &self.stored.buffer, &self.transposed.buffer];
+        gpu.prepare(
+            &HALF_WEIGHT_COPIES,
+            &p.map(|v| v as u32),
+            &buffers,
+            groups_for(values),
+        )
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::gpu::products::half_layers::half_weight_bits;
+
+    /// A layer's f16 copies of rows 3..23 of its 30 × 21 weight, made in one dispatch: the
+    /// stored copy is the host's layout of those rows (`half_weight_bits`, what the frame path
+    /// and `nprt export` read) and the transposed one its transpose, padding zero, each value
+    /// within f16's rounding (a copy 1% off fails).
+    #[test]
+    fn both_f16_copies_of_a_weight_come_from_one_dispatch() {
+        if !GpuDevice::probe() || !GpuDevice::get().unwrap().half {
+            return;
+        }
+        let gpu = GpuDevice::get().unwrap();
+        let [d_in, d_out, row, count] = [30, 21, 3, 20];
+        let offset = 5;
+        let weight: Vec<f32> = (0..d_in * d_out)
+            .map(|i| ((i * 37 % 101) as f32 - 50.0) / 7.0)
+            .collect();
+        let params = gpu.upload(&[vec![9.0; offset], weight.clone()].concat());
+        let layer = DenseAt {
+            weight: Span {
                 offset,
-                n + 16,
-                params,
-                &self.transposed.buffer,
+                len: d_in * d_out,
+            },
+            bias: Span { offset: 0, len: 0 },
+            d_in,
+            d_out,
+        };
+        let copies = HalfCopies::new(&gpu, &layer, row, count);
+        let mut encoder = gpu.device.create_command_encoder(&Default::default());
+        let mut pass = encoder.begin_compute_pass(&Default::default());
+        copies.refresh(&gpu, &params, &layer).record(&mut pass);
+        drop(pass);
+        gpu.queue.submit([encoder.finish()]);
+        let halves = |w: &HalfWeight, n: usize| -> Vec<f32> {
+            let words = gpu.read(&w.buffer, n.div_ceil(2));
+            let bits: &[u16] = bytemuck::cast_slice(&words);
+            bits[..n]
+                .iter()
+                .map(|&b| half::f16::from_bits(b).to_f32())
+                .collect()
+        };
+        let rows = &weight[row * d_out..(row + count) * d_out];
+        let transposed: Vec<f32> = (0..d_out * count)
+            .map(|e| rows[(e % count) * d_out + e / count])
+            .collect();
+        for (w, want) in [
+            (&copies.stored, half_weight_bits(rows, count, d_out)),
+            (
+                &copies.transposed,
+                half_weight_bits(&transposed, d_out, count),
             ),
-        ]
+        ] {
+            let got = halves(w, want.len());
+            for (e, (&g, &b)) in got.iter().zip(&want).enumerate() {
+                let v = half::f16::from_bits(b).to_f32();
+                assert!((g - v).abs() <= 1e-3 * v.abs(), "value {e}: {g}, not {v}");
+            }
+        }
     }
 }

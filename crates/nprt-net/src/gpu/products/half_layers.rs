@@ -76,20 +76,6 @@ pub trait HalfLayers {
     /// rows up to the next multiple of [`HALF_ROW_BLOCK`].
     fn half_rows(&self, shape: [usize; 3], src: &wgpu::Buffer, dst: &wgpu::Buffer) -> Dispatch;
 
-    /// The dispatch that writes the `rows` × `cols` matrix whose element (i, j) is
-    /// `src[offset + i · strides[0] + j · strides[1]]` to `dst` as f16 rows of `pad16(cols)`
-    /// values, zeros in the padding and in the rows up to `padded`: [`Self::half_rows`], and a
-    /// weight's f16 copies in a mixed-precision training step (transposed with other strides).
-    fn half_matrix(
-        &self,
-        shape: [usize; 2],
-        strides: [usize; 2],
-        offset: usize,
-        padded: usize,
-        src: &wgpu::Buffer,
-        dst: &wgpu::Buffer,
-    ) -> Dispatch;
-
     /// The dispatch of one half-precision dense layer, `act(x·W[w_row..] + bias)` over `rows`
     /// rows of `x` (f16 rows of `k_pad` values, a multiple of 16, held up to the next multiple
     /// of [`HALF_ROW_BLOCK`] rows), `activation` 0 linear, 1 ReLU, 2 SIREN.
@@ -123,20 +109,9 @@ impl HalfLayers for GpuDevice {
         dst: &wgpu::Buffer,
     ) -> Dispatch {
         let padded = rows.next_multiple_of(HALF_ROW_BLOCK);
-        self.half_matrix([rows, cols], [stride, 1], 0, padded, src, dst)
-    }
-
-    fn half_matrix(
-        &self,
-        [rows, cols]: [usize; 2],
-        [stride, col_stride]: [usize; 2],
-        offset: usize,
-        padded: usize,
-        src: &wgpu::Buffer,
-        dst: &wgpu::Buffer,
-    ) -> Dispatch {
         let k_pad = pad16(cols);
-        let params = [rows, padded, cols, stride, k_pad, offset, col_stride, 0].map(|v| v as u32);
+        // Offset 0 and column stride 1: export version 3 documents both for engines.
+        let params = [rows, padded, cols, stride, k_pad, 0, 1, 0].map(|v| v as u32);
         let groups = groups_for(padded * k_pad);
         self.prepare(&HALF_ROWS, &params, &[src, dst], groups)
     }

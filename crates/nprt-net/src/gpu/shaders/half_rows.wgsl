@@ -3,8 +3,8 @@ enable f16;
 // f32 rows (rows × cols: element (i, j) at offset + i · stride + j · col_stride) as f16 rows
 // padded with zeros to k_pad columns, up to `padded` rows (the rows past `rows` get zeros): the
 // input of a half-precision dense layer (`half_layer`), whose workgroups also read the padding
-// rows, and in a mixed-precision training step a weight's f16 copies, as stored and transposed,
-// and the loss's gradient.
+// rows, and in a mixed-precision training step the loss's gradient. nprt's own dispatches pass
+// offset 0 and column stride 1; the two stay in the uniform that export version 3 documents.
 
 struct HalfRows {
     rows: u32,
