@@ -32,9 +32,10 @@
 # Environment, to try the script without a GPU: VISIT_DEVICE (default gpu; wgpu runs on
 # lavapipe), VISIT_BUDGET (default gpu; tiny), VISIT_PRETRAINED (default pretrained/kitchen-dsep),
 # VISIT_AB_BATCH (the A/B's batch sizes; default 16384,262144).
-# The A/B base: the kernels before the latest change to them that no GPU has timed yet (the
-# training step's bias gradients folded into the weight gradients' products). Move it on when a
-# visit has timed a change and another follows.
+# The A/B base: the kernels before the latest changes to them that no GPU has timed yet (the
+# training step's f16 bias gradients made with their weights', a convolution's weight and bias
+# sums added in one pass, both f16 copies of a weight in one dispatch: 172 → 122 dispatches a
+# D/S f16 step). Move it on when a visit has timed them and another change follows.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
