@@ -81,6 +81,15 @@ impl Dispatch {
 }
 
 impl crate::GpuDevice {
+    /// Submits `dispatches` in one compute pass, in order; the caller reads back what it needs.
+    pub fn submit<'a>(&self, dispatches: impl IntoIterator<Item = &'a Dispatch>) {
+        let mut encoder = self.device.create_command_encoder(&Default::default());
+        let mut pass = encoder.begin_compute_pass(&Default::default());
+        dispatches.into_iter().for_each(|d| d.record(&mut pass));
+        drop(pass);
+        self.queue.submit([encoder.finish()]);
+    }
+
     /// A dispatch of `kernel` with `params` (the shader's uniform struct, as u32 words or f32
     /// bit patterns) and `buffers` (whole buffers or parts) at bindings 1, 2, ….
     pub fn prepare(

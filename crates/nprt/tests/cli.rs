@@ -520,14 +520,7 @@ fn bench_frame_times_half_precision_and_profiles_kernels_on_the_gpu() {
 /// (CI's) says so before it builds or measures anything.
 #[test]
 fn the_gpu_benchmark_script_explains_itself_and_names_what_it_lacks() {
-    let script = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../bench/gpu.sh");
-    let run = |args: &[&str]| {
-        std::process::Command::new("bash")
-            .arg(&script)
-            .args(args)
-            .output()
-            .unwrap()
-    };
+    let run = |args: &[&str]| common::script("bench/gpu.sh", args);
     let help = run(&["--help"]);
     assert!(help.status.success());
     let text = String::from_utf8_lossy(&help.stdout);
@@ -573,14 +566,7 @@ fn the_gpu_benchmark_script_explains_itself_and_names_what_it_lacks() {
 /// prints a row of the A/B table per design, precision and batch size.
 #[test]
 fn the_ab_script_times_two_builds_side_by_side() {
-    let script = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../bench/gpu-ab.sh");
-    let run = |args: &[&str]| {
-        std::process::Command::new("bash")
-            .arg(&script)
-            .args(args)
-            .output()
-            .unwrap()
-    };
+    let run = |args: &[&str]| common::script("bench/gpu-ab.sh", args);
     let help = run(&["--help"]);
     assert!(help.status.success());
     let text = String::from_utf8_lossy(&help.stdout);

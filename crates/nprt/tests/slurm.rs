@@ -122,13 +122,11 @@ fn unsharded(name: &str, spp: &str) -> PathBuf {
 /// cluster needed.
 #[test]
 fn shard_counts_slurm_cannot_run_are_refused_by_name() {
-    let script = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scripts/slurm-generate");
     for shards in ["0", "-3", "4x", "4000002", "99999999999999999999"] {
-        let out = Command::new("bash")
-            .arg(&script)
-            .args([shards, "--", "--out", "/nonexistent"])
-            .output()
-            .unwrap();
+        let out = common::script(
+            "scripts/slurm-generate",
+            &[shards, "--", "--out", "/nonexistent"],
+        );
         assert_eq!(out.status.code(), Some(2), "{shards}");
         let err = String::from_utf8_lossy(&out.stderr);
         assert!(

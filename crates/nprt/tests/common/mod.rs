@@ -19,6 +19,15 @@ pub fn nprt(args: &[&str]) -> Output {
         .expect("run nprt")
 }
 
+/// Runs one of the repository's bash scripts (`path` from the repository's root).
+pub fn script(path: &str, args: &[&str]) -> Output {
+    Command::new("bash")
+        .arg(repo().join(path))
+        .args(args)
+        .output()
+        .expect("run bash")
+}
+
 /// Runs nprt expecting success; returns stdout.
 pub fn ok(args: &[&str]) -> String {
     let o = nprt(args);

@@ -7,7 +7,7 @@ use crate::gpu::layers::layer_at::DenseAt;
 use crate::gpu::layers::light_basis::BasisAt;
 use crate::gpu::layers::light_encoder::EncoderAt;
 use crate::gpu::layers::parameters::ParameterLayout;
-use crate::gpu::products::half_layers::{pad16, HalfLayers, HalfWeight};
+use crate::gpu::products::half_layers::{half_weight_halves, pad16, HalfLayers, HalfWeight};
 use crate::network::activation::Activation;
 use crate::network::design::TRANSPORT_CODE;
 use crate::network::encoder::CODE_SIZE;
@@ -223,7 +223,7 @@ impl HalfCopies {
         let (n, k) = (layer.d_out, self.count);
         let offset = layer.weight.offset + self.row * n;
         let p = [k, n, offset, pad16(n), pad16(k), 0, 0, 0];
-        let values = (k + 16) * pad16(n) + (n + 16) * pad16(k);
+        let values = half_weight_halves(k, n) + half_weight_halves(n, k);
         let buffers: [&dyn Bind; 3] = [params, &self.stored.buffer, &self.transposed.buffer];
         gpu.prepare(
             &HALF_WEIGHT_COPIES,
@@ -265,11 +265,7 @@ mod tests {
             d_out,
         };
         let copies = HalfCopies::new(&gpu, &layer, row, count);
-        let mut encoder = gpu.device.create_command_encoder(&Default::default());
-        let mut pass = encoder.begin_compute_pass(&Default::default());
-        copies.refresh(&gpu, &params, &layer).record(&mut pass);
-        drop(pass);
-        gpu.queue.submit([encoder.finish()]);
+        gpu.submit([&copies.refresh(&gpu, &params, &layer)]);
         let halves = |w: &HalfWeight, n: usize| -> Vec<f32> {
             let words = gpu.read(&w.buffer, n.div_ceil(2));
             let bits: &[u16] = bytemuck::cast_slice(&words);

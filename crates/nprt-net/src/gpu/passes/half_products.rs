@@ -219,11 +219,7 @@ mod tests {
             let [x16, dz16] = [&x, &dz].map(|h| gpu.upload(h));
             let fold = with_bias.then_some(bias);
             trainable.half_weight_gradient(&mut plan, [m, n, rows], &x16, &dz16, weight, fold);
-            let mut encoder = gpu.device.create_command_encoder(&Default::default());
-            let mut pass = encoder.begin_compute_pass(&Default::default());
-            plan.iter().for_each(|d| d.record(&mut pass));
-            drop(pass);
-            gpu.queue.submit([encoder.finish()]);
+            gpu.submit(&plan);
             let got = gpu.read(&grads, (m + 1) * n);
             for i in 0..=m {
                 for j in 0..n {

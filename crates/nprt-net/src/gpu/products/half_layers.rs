@@ -48,7 +48,7 @@ pub enum Held<'a> {
 
 /// f16 values a `d_in × d_out` weight takes as [`HalfWeight`] holds it: `d_in + 16` rows of
 /// `pad16(d_out)`.
-fn half_weight_halves(d_in: usize, d_out: usize) -> usize {
+pub(crate) fn half_weight_halves(d_in: usize, d_out: usize) -> usize {
     (d_in + 16) * pad16(d_out)
 }
 

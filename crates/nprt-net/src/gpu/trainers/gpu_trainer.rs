@@ -167,11 +167,7 @@ impl GpuTrainer {
         let adam = DeviceAdam::new(&gpu, layout.total, &grads, &params);
         let half_refresh = net.half_refresh(&gpu, &params);
         if !half_refresh.is_empty() {
-            let mut encoder = gpu.device.create_command_encoder(&Default::default());
-            let mut pass = encoder.begin_compute_pass(&Default::default());
-            half_refresh.iter().for_each(|d| d.record(&mut pass));
-            drop(pass);
-            gpu.queue.submit([encoder.finish()]);
+            gpu.submit(&half_refresh);
         }
         let loss_copy = || {
             gpu.device.create_buffer(&wgpu::BufferDescriptor {

@@ -86,17 +86,9 @@ pub fn submit(
     pass: Pass,
     (adam, total): (&mut DeviceAdam, usize),
 ) {
-    if let Some(lr) = pass.learning_rate() {
+    let step = pass.learning_rate().map(|lr| {
         adam.next_step(gpu, total, lr, 1.0);
-    }
-    let mut encoder = gpu.device.create_command_encoder(&Default::default());
-    let mut compute = encoder.begin_compute_pass(&Default::default());
-    pass.of(dispatches, forward)
-        .iter()
-        .for_each(|d| d.record(&mut compute));
-    if pass.learning_rate().is_some() {
-        adam.dispatch.record(&mut compute);
-    }
-    drop(compute);
-    gpu.queue.submit([encoder.finish()]);
+        &adam.dispatch
+    });
+    gpu.submit(pass.of(dispatches, forward).iter().chain(step));
 }
