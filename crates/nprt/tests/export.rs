@@ -8,6 +8,7 @@ mod common;
 
 use std::io::{BufRead, BufReader, Read, Write};
 use std::net::{TcpListener, TcpStream};
+use std::os::unix::process::CommandExt;
 use std::path::{Path, PathBuf};
 use std::sync::mpsc;
 use std::time::{Duration, Instant};
@@ -276,11 +277,11 @@ fn page_matches_the_cpu_engine(export: &Path) {
         .arg(format!("http://127.0.0.1:{port}/example/?report"))
         .stdout(std::process::Stdio::null())
         .stderr(std::process::Stdio::null())
+        .process_group(0)
         .spawn()
         .expect("start chromium");
     let result = results.recv_timeout(Duration::from_secs(240));
-    browser.kill().ok();
-    browser.wait().ok();
+    end_process_group(&mut browser);
     let result: Value =
         serde_json::from_str(&result.expect("the page reports within 4 minutes")).unwrap();
     assert!(result["error"].is_f64(), "the page failed: {result}");
@@ -318,6 +319,21 @@ fn page_matches_the_cpu_engine(export: &Path) {
 }
 
 /// Debian's Chromium, or None (the page test skipped) where it is not installed and not required.
+/// Kills a process started in its own group and every process of that group, and waits until
+/// none is left: Chromium's GPU and renderer processes outlive its main one and go on writing
+/// its profile, which would race the test's removal of the folder.
+fn end_process_group(leader: &mut std::process::Child) {
+    let group = leader.id() as libc::pid_t;
+    // SAFETY: killpg only sends a signal; the group is the one this test created.
+    unsafe { libc::killpg(group, libc::SIGKILL) };
+    leader.wait().ok();
+    let deadline = Instant::now() + Duration::from_secs(30);
+    // SAFETY: signal 0 only asks whether any process of the group is left.
+    while unsafe { libc::killpg(group, 0) } == 0 && Instant::now() < deadline {
+        std::thread::sleep(Duration::from_millis(50));
+    }
+}
+
 fn chromium() -> Option<PathBuf> {
     let found = std::env::var_os("PATH")
         .into_iter()
