@@ -18,8 +18,8 @@
 #       flags (timed; its manifest checked against dataset.sha256); training resumed until the
 #       visit's time is nearly spent (`nprt train --pause-after`); `nprt bench train` and
 #       `bench frame` of D/S; the A/B of the prepared base's training kernels against the
-#       current ones (`bench/gpu-ab.sh run`, 2 rounds, D/S f16 at both batch sizes, about
-#       100 s); then in $OUT (default .visit/out): summary.md, visit.log,
+#       current ones (`bench/gpu-ab.sh run`, 2 rounds, D/S f16 at both batch sizes and a new
+#       viewpoint's frame at 512² and 1920×1080, about 140 s); then in $OUT (default .visit/out): summary.md, visit.log,
 #       model.tar.xz and the test views (testviews.tar.part-*, 15 MiB each), 8 files at most.
 #   bench/kitchen-visit.sh land DIR [--cpu-model MODEL]
 #       here, on what a visit brought back in DIR: the model replaces pretrained/kitchen-dsep/
@@ -31,11 +31,13 @@
 # here), so the dataset's manifest names the same paths wherever it is read.
 # Environment, to try the script without a GPU: VISIT_DEVICE (default gpu; wgpu runs on
 # lavapipe), VISIT_BUDGET (default gpu; tiny), VISIT_PRETRAINED (default pretrained/kitchen-dsep),
-# VISIT_AB_BATCH (the A/B's batch sizes; default 16384,262144).
+# VISIT_AB_BATCH (the A/B's batch sizes; default 16384,262144), VISIT_AB_FRAMES (its frame
+# sizes; default 512,1920x1080).
 # The A/B base: the kernels before the latest changes to them that no GPU has timed yet (the
 # training step's f16 bias gradients made with their weights', a convolution's weight and bias
 # sums added in one pass, both f16 copies of a weight in one dispatch: 172 → 122 dispatches a
-# D/S f16 step). Move it on when a visit has timed them and another change follows.
+# D/S f16 step; and a frame's MLPs fused into one dispatch each, `half_mlp`). Move it on when
+# a visit has timed them and another change follows.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
@@ -130,9 +132,9 @@ run_visit() {
     cp -a "$pretrained/model" "$work/model"
   fi
   mkdir -p "$pretrained"
-  # Benches and packing take about 90 s after training, the A/B about 100 s more.
+  # Benches and packing take about 90 s after training, the A/B about 140 s more.
   local after=90 base=.visit/gpu/nprt-base
-  [ ! -x "$base" ] || after=190
+  [ ! -x "$base" ] || after=230
   bench/kitchen.sh --out "$work" --device "$device" --budget "$budget" --precision f16 \
     --minutes "$total_minutes" --pause-by $((deadline - after)) --data-hash "$pretrained/dataset.sha256" \
     --scene .visit/kitchen/scene.xml --maps .visit/envmaps --nprt "$nprt" --no-eval
@@ -149,9 +151,10 @@ run_visit() {
     echo '```' >>"$summary"
   fi
   if [ -x "$base" ] && [ $(($(date +%s) + 60)) -lt "$deadline" ]; then
-    printf '\n## The training kernels, A/B (bench/gpu-ab.sh)\n\n' >>"$summary"
+    printf '\n## The training and frame kernels, A/B (bench/gpu-ab.sh)\n\n' >>"$summary"
     timeout $((deadline - $(date +%s) - 45)) bench/gpu-ab.sh run "$base" "$nprt" --rounds 2 \
-      --device "$device" --batch-size "${VISIT_AB_BATCH:-16384,262144}" >>"$summary" ||
+      --device "$device" --batch-size "${VISIT_AB_BATCH:-16384,262144}" \
+      --frames "${VISIT_AB_FRAMES:-512,1920x1080}" >>"$summary" ||
       echo "(the A/B did not finish: $?)" >>"$summary"
   fi
 

@@ -267,8 +267,15 @@ fn mean_relative_difference(a: &[f32], b: &[f32]) -> f32 {
 /// `mixed_precision_gradients_follow_the_cpu_engine_for_every_design`.
 #[test]
 fn the_tensor_core_kernels_translate_to_spirv() {
-    use nprt_net::gpu::kernels::{HALF_DENSE_COOP, HALF_TRAIN_COOP, HALF_WEIGHT_GRAD_COOP};
-    for kernel in [&HALF_DENSE_COOP, &HALF_TRAIN_COOP, &HALF_WEIGHT_GRAD_COOP] {
+    use nprt_net::gpu::kernels::{
+        HALF_DENSE_COOP, HALF_MLP_COOP, HALF_TRAIN_COOP, HALF_WEIGHT_GRAD_COOP,
+    };
+    for kernel in [
+        &HALF_DENSE_COOP,
+        &HALF_MLP_COOP,
+        &HALF_TRAIN_COOP,
+        &HALF_WEIGHT_GRAD_COOP,
+    ] {
         let module = naga::front::wgsl::parse_str(kernel.wgsl)
             .unwrap_or_else(|e| panic!("{}: {}", kernel.name, e.emit_to_string(kernel.wgsl)));
         let info = naga::valid::Validator::new(

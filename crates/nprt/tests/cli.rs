@@ -601,7 +601,8 @@ fn the_ab_script_times_two_builds_side_by_side() {
     if !common::wgpu_runs() {
         return;
     }
-    let args = "--device wgpu --arch prt --precision f32 --batch-size 64 --steps 1 --rounds 1";
+    let args = "--device wgpu --arch prt --precision f32 --batch-size 64 --steps 1 --rounds 1 \
+                --frames 32";
     let out = run(&[
         &["run", nprt, nprt][..],
         &args.split(' ').collect::<Vec<_>>(),
@@ -626,4 +627,13 @@ fn the_ab_script_times_two_builds_side_by_side() {
         cells[6].ends_with('×') && cells[7].ends_with('×'),
         "{table}"
     );
+    // And a 32² frame's new viewpoint, in ms.
+    let row = table.lines().find(|l| l.starts_with("| prt | f32 | 32 |"));
+    let cells: Vec<&str> = row
+        .expect("a frame row")
+        .split('|')
+        .map(str::trim)
+        .collect();
+    assert!(rate(cells[4]) > 0.0 && rate(cells[5]) > 0.0, "{table}");
+    assert!(cells[6].ends_with('×'), "{table}");
 }

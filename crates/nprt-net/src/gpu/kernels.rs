@@ -67,6 +67,12 @@ pub const HALF_DENSE: KernelSource = kernel!("half_dense", "half_layer");
 pub const HALF_DENSE_COOP: KernelSource =
     kernel!("half_dense_coop", "coop_matrix", "half_layer", "coop_drain");
 
+/// The frame path's whole MLP in half precision in one dispatch (`half_mlp`), without tensor
+/// cores and with them.
+pub const HALF_MLP_PLAIN: KernelSource = kernel!("half_mlp_plain", "half_mlp");
+pub const HALF_MLP_COOP: KernelSource =
+    kernel!("half_mlp_coop", "coop_matrix", "half_mlp", "coop_drain");
+
 /// A mixed-precision training step's products (`half_products`): the dense layers' forward
 /// and input-gradient products (the frame path's products under `half_train_layer`'s
 /// epilogue), and the weight gradients, each with tensor cores and without.

@@ -8,6 +8,7 @@ use crate::gpu::layers::network_layout::{MlpAt, TrackAt};
 use crate::gpu::products::codes::activation_code;
 use crate::gpu::products::dense_products::DenseProducts;
 use crate::gpu::products::half_layers::{half_train_layer, pad16, HalfLayers, HalfOut, Held};
+use crate::gpu::products::half_mlp::{fits, half_mlp, FusedLayer};
 use crate::gpu::products::operands::{Bias, Operand, Output};
 use crate::network::encoder::CODE_SIZE;
 use nprt_gpu::{groups_for, Bind, Dispatch, GpuDevice, Part};
@@ -92,6 +93,12 @@ impl MlpAt {
         first: FirstLayer,
         to: &ForwardTargets,
     ) {
+        if to.pre.is_none() {
+            if let Some(fused) = self.fused_forward(gpu, params, x, rows, &first, to) {
+                plan.push(fused);
+                return;
+            }
+        }
         let x16 = match x {
             Held::F16(x) => x,
             Held::F32(x) => {
@@ -134,21 +141,41 @@ impl MlpAt {
                     )
                 }
                 None => {
-                    let Bias::Column(buffer, offset) = bias else {
-                        unreachable!("a grouped bias outside training");
-                    };
-                    let bias = Part {
-                        buffer,
-                        span: nprt_gpu::Span {
-                            offset,
-                            len: layer.d_out,
-                        },
-                    };
+                    let bias = frame_bias(bias, layer.d_out);
                     let y = to.outputs[i];
                     gpu.half_layer(rows, input, k_pad, &copies.stored, 0, &bias, activation, y)
                 }
             });
         }
+    }
+
+    /// A frame's forward pass of this MLP in one dispatch (`half_mlp`), from `x` as it is held
+    /// into the last of `to.outputs`; `None` where the fused pass cannot hold the MLP.
+    fn fused_forward(
+        &self,
+        gpu: &GpuDevice,
+        params: &wgpu::Buffer,
+        x: Held,
+        rows: usize,
+        first: &FirstLayer,
+        to: &ForwardTargets,
+    ) -> Option<Dispatch> {
+        let last = self.layers.len() - 1;
+        let layers: Vec<FusedLayer> = (self.half_layers().enumerate())
+            .map(|(i, (layer, copies))| FusedLayer {
+                weight: &copies.stored,
+                k_pad: pad16(copies.count),
+                bias_at: layer.bias.offset,
+                activation: self.activation_of(i, last),
+            })
+            .collect();
+        if !fits(&layers) {
+            return None;
+        }
+        let bias0 = frame_bias(first.bias, self.layers[0].d_out);
+        let y = to.outputs[last];
+        let x = (x, first.count);
+        Some(half_mlp(gpu, rows, x, &layers, &bias0, params, y))
     }
 
     /// Layer `i`'s activation code: the MLP's for a hidden layer, linear for the last.
@@ -219,6 +246,17 @@ impl TrackAt {
             Output::to(out, 0, first.d_out),
             None,
         )
+    }
+}
+
+/// A frame's bias of `len` values as one binding (a grouped bias is a training step's).
+fn frame_bias(bias: Bias, len: usize) -> Part {
+    let Bias::Column(buffer, offset) = bias else {
+        unreachable!("a grouped bias outside training");
+    };
+    Part {
+        buffer,
+        span: nprt_gpu::Span { offset, len },
     }
 }
 

@@ -29,13 +29,17 @@ impl MlpAt {
     /// Gives each layer f16 copies of its weight: the first layer's rows `[row, row + count)`
     /// (what it multiplies its input by), every other layer's whole.
     fn hold_half(&mut self, gpu: &GpuDevice, [row, count]: [usize; 2]) {
-        self.half = self
-            .layers
-            .iter()
-            .enumerate()
-            .map(|(i, l)| match i {
-                0 => HalfCopies::new(gpu, l, row, count),
-                _ => HalfCopies::new(gpu, l, 0, l.d_in),
+        let rows: Vec<[usize; 2]> = (self.layers.iter().enumerate())
+            .map(|(i, l)| if i == 0 { [row, count] } else { [0, l.d_in] })
+            .collect();
+        let stored = gpu.half_weights(&zip_shapes(&rows, &self.layers, false));
+        let transposed = gpu.half_weights(&zip_shapes(&rows, &self.layers, true));
+        self.half = (rows.iter().zip(stored).zip(transposed))
+            .map(|((&[row, count], stored), transposed)| HalfCopies {
+                row,
+                count,
+                stored,
+                transposed,
             })
             .collect();
     }
@@ -199,8 +203,20 @@ pub fn mlp_at(stack: &Mlp, spans: &mut impl Iterator<Item = Span>) -> MlpAt {
     }
 }
 
+/// The `[d_in, d_out]` shapes of layers' f16 copies of rows `[row, row + count)` each, as
+/// stored or `transposed`.
+fn zip_shapes(rows: &[[usize; 2]], layers: &[DenseAt], transposed: bool) -> Vec<[usize; 2]> {
+    (rows.iter().zip(layers))
+        .map(|(&[_, count], l)| match transposed {
+            false => [count, l.d_out],
+            true => [l.d_out, count],
+        })
+        .collect()
+}
+
 /// A dense layer's f16 copies of its weight rows `[row, row + count)`: as stored (the forward
-/// product's right operand) and transposed (the input gradient's).
+/// product's right operand) and transposed (the input gradient's); an MLP's layers keep each
+/// kind in one buffer.
 pub struct HalfCopies {
     pub row: usize,
     pub count: usize,
@@ -209,20 +225,12 @@ pub struct HalfCopies {
 }
 
 impl HalfCopies {
-    pub fn new(gpu: &GpuDevice, layer: &DenseAt, row: usize, count: usize) -> Self {
-        HalfCopies {
-            row,
-            count,
-            stored: gpu.half_weight(count, layer.d_out),
-            transposed: gpu.half_weight(layer.d_out, count),
-        }
-    }
-
     /// The dispatch that copies `layer`'s current weight from `params` into both copies.
     pub fn refresh(&self, gpu: &GpuDevice, params: &wgpu::Buffer, layer: &DenseAt) -> Dispatch {
         let (n, k) = (layer.d_out, self.count);
         let offset = layer.weight.offset + self.row * n;
-        let p = [k, n, offset, pad16(n), pad16(k), 0, 0, 0];
+        let [stored, transposed] = [&self.stored, &self.transposed].map(|w| w.offset);
+        let p = [k, n, offset, pad16(n), pad16(k), stored, transposed, 0];
         let values = half_weight_halves(k, n) + half_weight_halves(n, k);
         let buffers: [&dyn Bind; 3] = [params, &self.stored.buffer, &self.transposed.buffer];
         gpu.prepare(
@@ -239,56 +247,72 @@ mod tests {
     use super::*;
     use crate::gpu::products::half_layers::half_weight_bits;
 
-    /// A layer's f16 copies of rows 3..23 of its 30 × 21 weight, made in one dispatch: the
-    /// stored copy is the host's layout of those rows (`half_weight_bits`, what the frame path
-    /// and `nprt export` read) and the transposed one its transpose, padding zero, each value
-    /// within f16's rounding (a copy 1% off fails).
+    /// An MLP's f16 copies, made one dispatch a layer: its first layer's of rows 3..23 of a
+    /// 30 × 21 weight, its second's of a whole 21 × 7 one, each kind in one buffer (the second
+    /// layer's past the first's). Each stored copy is the host's layout of its rows
+    /// (`half_weight_bits`, what the frame path and `nprt export` read) and each transposed one
+    /// its transpose, padding zero, each value within f16's rounding (a copy 1% off fails, and
+    /// so does a second layer written over the first's).
     #[test]
     fn both_f16_copies_of_a_weight_come_from_one_dispatch() {
         if !GpuDevice::probe() || !GpuDevice::get().unwrap().half {
             return;
         }
         let gpu = GpuDevice::get().unwrap();
-        let [d_in, d_out, row, count] = [30, 21, 3, 20];
-        let offset = 5;
-        let weight: Vec<f32> = (0..d_in * d_out)
-            .map(|i| ((i * 37 % 101) as f32 - 50.0) / 7.0)
-            .collect();
-        let params = gpu.upload(&[vec![9.0; offset], weight.clone()].concat());
-        let layer = DenseAt {
-            weight: Span {
-                offset,
-                len: d_in * d_out,
-            },
-            bias: Span { offset: 0, len: 0 },
-            d_in,
-            d_out,
+        let (row, count) = (3, 20);
+        let shapes = [[30, 21], [21, 7]];
+        let mut flat = vec![9.0; 5];
+        let mut layers = Vec::new();
+        for [d_in, d_out] in shapes {
+            let offset = flat.len();
+            flat.extend((0..d_in * d_out).map(|i| ((i * 37 % 101) as f32 - 50.0) / 7.0));
+            layers.push(DenseAt {
+                weight: Span {
+                    offset,
+                    len: d_in * d_out,
+                },
+                bias: Span { offset: 0, len: 0 },
+                d_in,
+                d_out,
+            });
+        }
+        let params = gpu.upload(&flat);
+        let mut mlp = MlpAt {
+            layers,
+            activation: Activation::Relu,
+            half: Vec::new(),
         };
-        let copies = HalfCopies::new(&gpu, &layer, row, count);
-        gpu.submit([&copies.refresh(&gpu, &params, &layer)]);
+        mlp.hold_half(&gpu, [row, count]);
+        let refresh: Vec<Dispatch> = (mlp.half_layers())
+            .map(|(layer, copies)| copies.refresh(&gpu, &params, layer))
+            .collect();
+        gpu.submit(&refresh);
         let halves = |w: &HalfWeight, n: usize| -> Vec<f32> {
-            let words = gpu.read(&w.buffer, n.div_ceil(2));
+            let words = gpu.read(&w.buffer, (w.offset + n).div_ceil(2));
             let bits: &[u16] = bytemuck::cast_slice(&words);
-            bits[..n]
+            bits[w.offset..][..n]
                 .iter()
                 .map(|&b| half::f16::from_bits(b).to_f32())
                 .collect()
         };
-        let rows = &weight[row * d_out..(row + count) * d_out];
-        let transposed: Vec<f32> = (0..d_out * count)
-            .map(|e| rows[(e % count) * d_out + e / count])
-            .collect();
-        for (w, want) in [
-            (&copies.stored, half_weight_bits(rows, count, d_out)),
-            (
-                &copies.transposed,
-                half_weight_bits(&transposed, d_out, count),
-            ),
-        ] {
-            let got = halves(w, want.len());
-            for (e, (&g, &b)) in got.iter().zip(&want).enumerate() {
-                let v = half::f16::from_bits(b).to_f32();
-                assert!((g - v).abs() <= 1e-3 * v.abs(), "value {e}: {g}, not {v}");
+        assert_eq!(mlp.half[1].stored.offset, half_weight_halves(count, 21));
+        for (layer, copies) in mlp.half_layers() {
+            let d_out = layer.d_out;
+            let start = layer.weight.offset + copies.row * d_out;
+            let rows = &flat[start..][..copies.count * d_out];
+            let k = copies.count;
+            let transposed: Vec<f32> = (0..d_out * k)
+                .map(|e| rows[(e % k) * d_out + e / k])
+                .collect();
+            for (w, want) in [
+                (&copies.stored, half_weight_bits(rows, k, d_out)),
+                (&copies.transposed, half_weight_bits(&transposed, d_out, k)),
+            ] {
+                let got = halves(w, want.len());
+                for (e, (&g, &b)) in got.iter().zip(&want).enumerate() {
+                    let v = half::f16::from_bits(b).to_f32();
+                    assert!((g - v).abs() <= 1e-3 * v.abs(), "value {e}: {g}, not {v}");
+                }
             }
         }
     }

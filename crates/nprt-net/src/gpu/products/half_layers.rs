@@ -29,10 +29,13 @@ pub fn held_halves(rows: usize, cols: usize) -> usize {
     rows.next_multiple_of(HALF_ROW_BLOCK) * pad16(cols)
 }
 
-/// A dense layer's weight (`d_in × d_out`, row-major) as f16 on the device: columns padded to
-/// `n_pad`, and 16 rows of zeros past the last, which a product over a padded k reads.
+/// A dense layer's weight (`d_in × d_out`, row-major) as f16 on the device, from value
+/// `offset` of `buffer`: columns padded to `n_pad`, and 16 rows of zeros past the last, which a
+/// product over a padded k reads. An MLP's layers share one buffer for their stored copies,
+/// which its fused forward pass binds once (`half_mlp`).
 pub struct HalfWeight {
     pub buffer: wgpu::Buffer,
+    pub offset: usize,
     pub d_out: usize,
     pub n_pad: usize,
 }
@@ -67,9 +70,10 @@ pub fn half_weight_bits(weight: &[f32], d_in: usize, d_out: usize) -> Vec<u16> {
 
 /// The half-precision dense layers on the device: f16 weights and rows, and their products.
 pub trait HalfLayers {
-    /// A `d_in × d_out` weight in the layout [`HalfWeight`] describes, zero (a mixed-precision
-    /// training step copies its weights in on the device).
-    fn half_weight(&self, d_in: usize, d_out: usize) -> HalfWeight;
+    /// `[d_in, d_out]` weights one after another in one buffer, each in the layout
+    /// [`HalfWeight`] describes, zero (the frame path and a mixed-precision training step copy
+    /// their weights in on the device).
+    fn half_weights(&self, shapes: &[[usize; 2]]) -> Vec<HalfWeight>;
 
     /// The dispatch that writes `rows` rows of `cols` f32 values of `src` (row stride
     /// `stride`) to `dst` as f16 rows of `pad16(cols)` values, zeros in the padding and in the
@@ -94,12 +98,23 @@ pub trait HalfLayers {
 }
 
 impl HalfLayers for GpuDevice {
-    fn half_weight(&self, d_in: usize, d_out: usize) -> HalfWeight {
-        HalfWeight {
-            buffer: self.half_buffer(half_weight_halves(d_in, d_out)),
-            d_out,
-            n_pad: pad16(d_out),
-        }
+    fn half_weights(&self, shapes: &[[usize; 2]]) -> Vec<HalfWeight> {
+        let sizes = shapes
+            .iter()
+            .map(|&[d_in, d_out]| half_weight_halves(d_in, d_out));
+        let buffer = self.half_buffer(sizes.clone().sum());
+        let mut offset = 0;
+        (shapes.iter().zip(sizes))
+            .map(|(&[_, d_out], size)| {
+                offset += size;
+                HalfWeight {
+                    buffer: buffer.clone(),
+                    offset: offset - size,
+                    d_out,
+                    n_pad: pad16(d_out),
+                }
+            })
+            .collect()
     }
 
     fn half_rows(
@@ -136,7 +151,7 @@ impl HalfLayers for GpuDevice {
             w.d_out,
             w.n_pad,
             k_pad,
-            w_row * w.n_pad,
+            w.offset + w_row * w.n_pad,
             activation as usize,
             half_out,
             0,
@@ -200,7 +215,7 @@ pub(crate) fn half_train_layer(
         w.d_out,
         w.n_pad,
         k_pad,
-        0,
+        w.offset,
         activation as usize,
         bias_mode,
         bias_off,

@@ -38,6 +38,7 @@ impl<'a> Operand<'a> {
 }
 
 /// What a product adds before its activation.
+#[derive(Clone, Copy)]
 pub enum Bias<'a> {
     None,
     /// `d_out` values from an offset of a buffer.

@@ -11,8 +11,15 @@ fn main(@builtin(workgroup_id) group: vec3<u32>, @builtin(local_invocation_index
     for (var r = 0u; r < ROWS; r++) {
         let i = group.y * ROWS + r;
         var sum = 0.0;
-        for (var k = 0u; k < p.k_pad; k++) {
-            sum += f32(x[i * p.k_pad + k]) * f32(w[p.w_off + k * p.n_pad + j]);
+        // Four terms an iteration: llvmpipe ends a loop past 65,535 iterations of one
+        // invocation, which 256 rows of a 256-wide x reach (the last row lost its last term).
+        for (var k = 0u; k < p.k_pad; k += 4u) {
+            let a = i * p.k_pad + k;
+            let b = p.w_off + k * p.n_pad + j;
+            sum += f32(x[a]) * f32(w[b]);
+            sum += f32(x[a + 1u]) * f32(w[b + p.n_pad]);
+            sum += f32(x[a + 2u]) * f32(w[b + 2u * p.n_pad]);
+            sum += f32(x[a + 3u]) * f32(w[b + 3u * p.n_pad]);
         }
         finish(i, j, sum);
     }

@@ -12,9 +12,10 @@ struct Copies {
     offset: u32,
     n_pad: u32,
     k_pad: u32,
-    _pad0: u32,
-    _pad1: u32,
-    _pad2: u32,
+    // Where each copy starts in its buffer (an MLP's layers share one of each).
+    stored_off: u32,
+    transposed_off: u32,
+    _pad: u32,
 }
 
 @group(0) @binding(0) var<uniform> p: Copies;
@@ -36,11 +37,11 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>, @builtin(num_workgroups) g
     let e = id.x + id.y * groups.x * 64u;
     let first = (p.k + 16u) * p.n_pad;
     if (e < first) {
-        stored[e] = weight(e / p.n_pad, e % p.n_pad);
+        stored[p.stored_off + e] = weight(e / p.n_pad, e % p.n_pad);
         return;
     }
     let t = e - first;
     if (t < (p.n + 16u) * p.k_pad) {
-        transposed[t] = weight(t % p.k_pad, t / p.k_pad);
+        transposed[p.transposed_off + t] = weight(t % p.k_pad, t / p.k_pad);
     }
 }

@@ -1,0 +1,104 @@
+enable f16;
+
+// A whole MLP's forward pass in half precision in one dispatch (the frame path's, after
+// tiny-cuda-nn's fully fused MLP): a workgroup takes 64 rows through every layer, their
+// activations held in workgroup memory as f16 between layers instead of written out and read
+// back, the sums kept in f32. The weights are the layers' f16 copies in one buffer
+// (`half_layer`'s layout: k_pad rows of n_pad values, 16 rows of zeros past them). What both of
+// its products share: the parameters, the buffers, the input's staging and the epilogue. The
+// product is `half_mlp_coop` (tensor cores) where the adapter has cooperative matrices and
+// `half_mlp_plain` elsewhere.
+
+struct HalfMlp {
+    rows: u32,
+    layers: u32,
+    // 1: x32 holds the input, f32 rows of x_cols values, made f16 as they are staged; 0: x16
+    // does, f16 rows of the first layer's k_pad values.
+    x_f32: u32,
+    x_cols: u32,
+    // 1: the last layer writes y16 (f16 rows of its n_pad values, the next network's input);
+    // 0: y32 (f32 rows of its n values).
+    half_out: u32,
+    _pad0: u32,
+    _pad1: u32,
+    _pad2: u32,
+    // Per layer: its input's padded width k_pad, its outputs n, their padding n_pad (both
+    // multiples of 16, at most ACT), its activation (0 linear, 1 ReLU, 2 SIREN).
+    shape: array<vec4<u32>, 8>,
+    // Per layer: where its weight starts in w, and its bias in bias (layer 0's is bias0).
+    at: array<vec4<u32>, 8>,
+}
+
+@group(0) @binding(0) var<uniform> p: HalfMlp;
+@group(0) @binding(1) var<storage, read> x16: array<f16>;
+@group(0) @binding(2) var<storage, read> x32: array<f32>;
+@group(0) @binding(3) var<storage, read> w: array<f16>;
+@group(0) @binding(4) var<storage, read> bias0: array<f32>;
+@group(0) @binding(5) var<storage, read> bias: array<f32>;
+@group(0) @binding(6) var<storage, read_write> y16: array<f16>;
+@group(0) @binding(7) var<storage, read_write> y32: array<f32>;
+
+const OMEGA_0: f32 = 30.0;
+const F16_MAX: f32 = 65504.0;
+// Rows a workgroup takes through the MLP, its threads, and the widest layer it holds.
+const MLP_ROWS: u32 = 64u;
+const THREADS: u32 = 128u;
+const ACT: u32 = 256u;
+
+// The workgroup's rows of the layer being computed: its input, then (once every thread has
+// read it) its output, the next layer's input.
+var<workgroup> act: array<f16, 16384>;
+// The workgroup's first row, and the layer the epilogue finishes.
+var<private> row0: u32;
+var<private> layer: u32;
+
+// The workgroup's rows of the input into `act`, zeros past the input's columns (and, for an
+// f32 input, past its rows).
+fn stage_input(t: u32) {
+    let k_pad = p.shape[0].x;
+    for (var e = t; e < MLP_ROWS * k_pad; e += THREADS) {
+        let r = e / k_pad;
+        let k = e % k_pad;
+        let i = row0 + r;
+        var v = f16(0.0);
+        if (p.x_f32 == 0u) {
+            v = x16[i * k_pad + k];
+        } else if (i < p.rows && k < p.x_cols) {
+            v = f16(clamp(x32[i * p.x_cols + k], -F16_MAX, F16_MAX));
+        }
+        act[r * ACT + k] = v;
+    }
+}
+
+// Finishes the current layer's output (r, j), r among the workgroup's rows, from its sum: into
+// `act` for the next layer, the last layer's into y16 or y32. Padding columns get zeros, so
+// that the next layer's padded k adds nothing.
+fn finish(r: u32, j: u32, sum: f32) {
+    let s = p.shape[layer];
+    if (j >= s.z) {
+        return;
+    }
+    var v = 0.0;
+    if (j < s.y) {
+        if (layer == 0u) {
+            v = sum + bias0[j];
+        } else {
+            v = sum + bias[p.at[layer].y + j];
+        }
+        if (s.w == 1u) {
+            v = max(v, 0.0);
+        } else if (s.w == 2u) {
+            v = sin(OMEGA_0 * v);
+        }
+    }
+    if (layer + 1u < p.layers) {
+        act[r * ACT + j] = f16(v);
+        return;
+    }
+    let i = row0 + r;
+    if (p.half_out == 1u) {
+        y16[i * s.z + j] = f16(v);
+    } else if (i < p.rows && j < s.y) {
+        y32[i * s.y + j] = v;
+    }
+}
