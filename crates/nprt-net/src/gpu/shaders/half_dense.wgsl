@@ -12,7 +12,7 @@ fn main(@builtin(workgroup_id) group: vec3<u32>, @builtin(local_invocation_index
         let i = group.y * ROWS + r;
         var sum = 0.0;
         // Four terms an iteration: llvmpipe ends a loop past 65,535 iterations of one
-        // invocation, which 256 rows of a 256-wide x reach (the last row lost its last term).
+        // invocation, which 256 rows of a 256-wide x reach (the last row's sum came out short).
         for (var k = 0u; k < p.k_pad; k += 4u) {
             let a = i * p.k_pad + k;
             let b = p.w_off + k * p.n_pad + j;
