@@ -25,7 +25,9 @@
 #       here, on what a visit brought back in DIR: the model replaces pretrained/kitchen-dsep/
 #       model, the row joins visits.csv, and `nprt eval` (CPU; OIDN where scripts/oidn.sh put it)
 #       scores it on the visit's test views against their references, beside equal-time path
-#       tracing with and without OIDN and, with --cpu-model, D/S trained on the CPU.
+#       tracing with and without OIDN and D/S trained on the CPU: MODEL, by default
+#       pretrained/kitchen-dsep/cpu-f32 (15 CPU-minutes in f32 on the visit's flags, traced on
+#       the CPU; its summary.md says how).
 #
 # Scene and maps sit at .visit/kitchen and .visit/envmaps on both machines (links to ../shared
 # here), so the dataset's manifest names the same paths wherever it is read.
@@ -167,7 +169,7 @@ run_visit() {
 }
 
 land() {
-  local from=${1:-} cpu_model=
+  local from=${1:-} cpu_model=$pretrained/cpu-f32
   [ -n "$from" ] && [ -d "$from" ] || die "give the folder a visit's files came back to"
   shift
   while [ $# -gt 0 ]; do
@@ -176,6 +178,8 @@ land() {
       *) die "unknown argument '$1' (--help lists them)" ;;
     esac
   done
+  [ -f "$cpu_model/model.json" ] || [ "$cpu_model" = "$pretrained/cpu-f32" ] ||
+    die "--cpu-model: '$cpu_model' holds no model.json"
   [ -f "$from/model.tar.xz" ] || die "'$from' holds no model.tar.xz (did the visit train?)"
   local nprt=${VISIT_NPRT:-target/release/nprt} work=target/kitchen-visit
   [ -x "$nprt" ] || cargo build --release -p nprt
@@ -205,7 +209,7 @@ EOF
   echo "$(date -u +%Y-%m-%dT%H:%MZ),$row" >>"$pretrained/visits.csv"
   log "model landed in $pretrained/model ($row); evaluating on the CPU"
   local models=$pretrained/model
-  [ -z "$cpu_model" ] || models=$models,$cpu_model
+  [ ! -f "$cpu_model/model.json" ] || models=$models,$cpu_model
   [ -d target/oidn/lib ] && export NPRT_OIDN_DIR=${NPRT_OIDN_DIR:-$PWD/target/oidn/lib}
   "$nprt" eval --data "$work/data" --model "$models" --device cpu --out "$work/report"
   log "report in $work/report/report.md; add the row to docs/kitchen.md's table and commit $pretrained"
