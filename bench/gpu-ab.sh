@@ -7,8 +7,8 @@
 #   bench/gpu-ab.sh build REV FILE
 #       here: nprt at commit REV (checked out in a temporary git worktree), built in release
 #       with the GPU kernels (`--features gpu`) and stripped into FILE, its commit in
-#       FILE.commit. bench/kitchen-visit.sh prepare builds the A side of a visit this way from
-#       pretrained/kitchen-dsep/ab-base.
+#       FILE.commit. bench/kitchen-visit.sh prepare builds the A side of a visit this way
+#       (its --ab-base REV, with a default the script names).
 #   bench/gpu-ab.sh run A B [--arch LIST] [--precision LIST] [--batch-size LIST]
 #                          [--rounds N] [--steps N] [--device D] [--frames LIST] [--profile]
 #       on the GPU machine: `nprt bench train` of each design, precision and batch size (comma-
