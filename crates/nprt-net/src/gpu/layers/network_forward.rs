@@ -169,7 +169,7 @@ impl MlpAt {
                 activation: self.activation_of(i, last),
             })
             .collect();
-        if !fits(&layers) {
+        if !fits(gpu, &layers) {
             return None;
         }
         let bias0 = frame_bias(first.bias, self.layers[0].d_out);

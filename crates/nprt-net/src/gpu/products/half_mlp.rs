@@ -3,7 +3,8 @@
 //! every layer, their activations kept in workgroup memory between layers. Where the adapter
 //! has cooperative matrices the products run on tensor cores (`half_mlp_coop`), elsewhere
 //! without (`half_mlp_plain`). An MLP it cannot hold (a layer wider than 256 or more than 8
-//! layers) runs a layer a dispatch instead (`half_layers`).
+//! layers), or an adapter with less workgroup memory than it takes (32 KiB, 36 on tensor
+//! cores), runs a layer a dispatch instead (`half_layers`).
 
 use crate::gpu::kernels::{HALF_MLP_COOP, HALF_MLP_PLAIN};
 use crate::gpu::products::half_layers::{pad16, HalfWeight, Held, HALF_ROW_BLOCK};
@@ -25,14 +26,24 @@ pub struct FusedLayer<'a> {
     pub activation: u32,
 }
 
-/// Whether a fused pass holds `layers`: at most [`MAX_LAYERS`], each at most [`MAX_WIDTH`] in
-/// and out, their weights in one buffer.
-pub fn fits(layers: &[FusedLayer]) -> bool {
+/// Workgroup memory a fused pass takes: its rows' activations as f16, and on tensor cores a
+/// subgroup's tile of sums each (`coop_drain`) and the pass count.
+fn workgroup_bytes(tensor_cores: bool) -> u32 {
+    let tiles = if tensor_cores { 4 * 256 * 4 + 4 } else { 0 };
+    (ROWS * MAX_WIDTH * 2 + tiles) as u32
+}
+
+/// Whether a fused pass on `gpu` holds `layers`: at most [`MAX_LAYERS`], each at most
+/// [`MAX_WIDTH`] in and out, their weights in one buffer, and the adapter's workgroup memory
+/// enough for it (an adapter with less runs a layer a dispatch).
+pub fn fits(gpu: &GpuDevice, layers: &[FusedLayer]) -> bool {
     let shared = layers
         .windows(2)
         .all(|w| w[0].weight.buffer == w[1].weight.buffer);
+    let memory = gpu.device.limits().max_compute_workgroup_storage_size;
     (1..=MAX_LAYERS).contains(&layers.len())
         && shared
+        && workgroup_bytes(gpu.tensor_cores) <= memory
         && layers
             .iter()
             .all(|l| l.k_pad <= MAX_WIDTH && l.weight.n_pad <= MAX_WIDTH)
@@ -51,7 +62,7 @@ pub fn half_mlp(
     biases: &wgpu::Buffer,
     y: Held,
 ) -> Dispatch {
-    assert!(fits(layers), "an MLP a fused pass cannot hold");
+    assert!(fits(gpu, layers), "an MLP a fused pass cannot hold");
     let (x16, x32, x_f32) = match x {
         Held::F16(b) => (b, &gpu.empty, 0),
         Held::F32(b) => (&gpu.empty, b, 1),
@@ -189,6 +200,22 @@ mod tests {
         let peak = want.iter().fold(0.0f32, |m, v| m.max(v.abs()));
         let worst = (got.iter().zip(&want)).fold(0.0f32, |m, (g, w)| m.max((g - w).abs()));
         worst / peak
+    }
+
+    /// The workgroup memory `fits` asks the adapter for is what the kernels declare: their
+    /// `var<workgroup>` variables' sizes, as naga lays them out.
+    #[test]
+    fn the_workgroup_memory_asked_for_is_what_the_kernels_declare() {
+        for (kernel, tensor_cores) in [(&HALF_MLP_PLAIN, false), (&HALF_MLP_COOP, true)] {
+            let module = naga::front::wgsl::parse_str(kernel.wgsl).unwrap();
+            let mut layouter = naga::proc::Layouter::default();
+            layouter.update(module.to_ctx()).unwrap();
+            let declared: u32 = (module.global_variables.iter())
+                .filter(|(_, v)| v.space == naga::AddressSpace::WorkGroup)
+                .map(|(_, v)| layouter[v.ty].size)
+                .sum();
+            assert_eq!(declared, workgroup_bytes(tensor_cores), "{}", kernel.name);
+        }
     }
 
     /// The fused pass against the host layer by layer: D/S's transfer network (51 → 172 →
