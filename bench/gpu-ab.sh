@@ -79,7 +79,11 @@ alternate() {
   local values_a=() values_b=() r side
   for ((r = 0; r < rounds; r++)); do
     for side in $([ $((r % 2)) -eq 0 ] && echo "A B" || echo "B A"); do
-      if [ "$side" = A ]; then values_a+=("$("$measure" "$a" "$@")"); else values_b+=("$("$measure" "$b" "$@")"); fi
+      if [ "$side" = A ]; then
+        values_a+=("$("$measure" "$a" "$@")")
+      else
+        values_b+=("$("$measure" "$b" "$@")")
+      fi
     done
   done
   local ratios

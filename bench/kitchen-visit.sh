@@ -19,8 +19,9 @@
 #       visit's time is nearly spent (`nprt train --pause-after`); `nprt bench train` and
 #       `bench frame` of D/S; the A/B of the prepared base's training kernels against the
 #       current ones (`bench/gpu-ab.sh run`, 2 rounds, D/S f16 at both batch sizes and a new
-#       viewpoint's frame at 512² and 1920×1080, about 140 s); then in $OUT (default .visit/out): summary.md, visit.log,
-#       model.tar.xz and the test views (testviews.tar.part-*, 15 MiB each), 8 files at most.
+#       viewpoint's frame at 512² and 1920×1080, about 140 s); then in $OUT (default
+#       .visit/out): summary.md, visit.log, model.tar.xz and the test views
+#       (testviews.tar.part-*, 15 MiB each), 8 files at most.
 #   bench/kitchen-visit.sh land DIR [--cpu-model MODEL]
 #       here, on what a visit brought back in DIR: the model replaces pretrained/kitchen-dsep/
 #       model, the row joins visits.csv, and `nprt eval` (CPU; OIDN where scripts/oidn.sh put it)
@@ -169,7 +170,7 @@ run_visit() {
 }
 
 land() {
-  local from=${1:-} cpu_model=$pretrained/cpu-f32
+  local from=${1:-} cpu_model=
   [ -n "$from" ] && [ -d "$from" ] || die "give the folder a visit's files came back to"
   shift
   while [ $# -gt 0 ]; do
@@ -178,8 +179,12 @@ land() {
       *) die "unknown argument '$1' (--help lists them)" ;;
     esac
   done
-  [ -f "$cpu_model/model.json" ] || [ "$cpu_model" = "$pretrained/cpu-f32" ] ||
-    die "--cpu-model: '$cpu_model' holds no model.json"
+  # The model asked for must be one; the committed one is compared where it is present.
+  if [ -n "$cpu_model" ]; then
+    [ -f "$cpu_model/model.json" ] || die "--cpu-model: '$cpu_model' holds no model.json"
+  elif [ -f "$pretrained/cpu-f32/model.json" ]; then
+    cpu_model=$pretrained/cpu-f32
+  fi
   [ -f "$from/model.tar.xz" ] || die "'$from' holds no model.tar.xz (did the visit train?)"
   local nprt=${VISIT_NPRT:-target/release/nprt} work=target/kitchen-visit
   [ -x "$nprt" ] || cargo build --release -p nprt
@@ -209,7 +214,7 @@ EOF
   echo "$(date -u +%Y-%m-%dT%H:%MZ),$row" >>"$pretrained/visits.csv"
   log "model landed in $pretrained/model ($row); evaluating on the CPU"
   local models=$pretrained/model
-  [ ! -f "$cpu_model/model.json" ] || models=$models,$cpu_model
+  [ -z "$cpu_model" ] || models=$models,$cpu_model
   [ -d target/oidn/lib ] && export NPRT_OIDN_DIR=${NPRT_OIDN_DIR:-$PWD/target/oidn/lib}
   "$nprt" eval --data "$work/data" --model "$models" --device cpu --out "$work/report"
   log "report in $work/report/report.md; add the row to docs/kitchen.md's table and commit $pretrained"

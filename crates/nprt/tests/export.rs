@@ -318,7 +318,6 @@ fn page_matches_the_cpu_engine(export: &Path) {
     eprintln!("page: {result:.80}", result = result.to_string());
 }
 
-/// Debian's Chromium, or None (the page test skipped) where it is not installed and not required.
 /// Kills a process started in its own group and every process of that group, and waits until
 /// none is left: Chromium's GPU and renderer processes outlive its main one and go on writing
 /// its profile, which would race the test's removal of the folder.
@@ -334,6 +333,7 @@ fn end_process_group(leader: &mut std::process::Child) {
     }
 }
 
+/// Debian's Chromium, or None (the page test skipped) where it is not installed and not required.
 fn chromium() -> Option<PathBuf> {
     let found = std::env::var_os("PATH")
         .into_iter()

@@ -204,14 +204,7 @@ impl GpuNetwork {
         if !self.half() {
             let gpu = &*self.gpu;
             self.net.hold_half(gpu);
-            let mut encoder = gpu.device.create_command_encoder(&Default::default());
-            {
-                let mut pass = encoder.begin_compute_pass(&Default::default());
-                for d in self.net.half_refresh(gpu, &self.params) {
-                    d.record(&mut pass);
-                }
-            }
-            gpu.queue.submit([encoder.finish()]);
+            gpu.submit(&self.net.half_refresh(gpu, &self.params));
         }
         Ok(())
     }
