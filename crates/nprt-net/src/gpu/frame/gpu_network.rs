@@ -98,7 +98,7 @@ impl Workspace {
     /// takes the first), its last into `out`.
     fn targets<'a>(&'a self, m: &MlpAt, out: Held<'a>) -> ForwardTargets<'a> {
         let last = m.layers.len() - 1;
-        ForwardTargets {
+        ForwardTargets::Frame {
             outputs: (0..=last)
                 .map(|i| match (i == last, &self.f16) {
                     (true, _) => out,
@@ -106,7 +106,6 @@ impl Workspace {
                     (false, None) => Held::F32(&self.f32[(i + 1) % 2]),
                 })
                 .collect(),
-            pre: None,
             input16: self.f16.as_ref().map(|f16| &f16[0]),
         }
     }

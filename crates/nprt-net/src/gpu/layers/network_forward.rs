@@ -5,10 +5,11 @@
 
 use crate::gpu::kernels::TRACK_INPUTS;
 use crate::gpu::layers::network_layout::{MlpAt, TrackAt};
+use crate::gpu::passes::mlp_step::MlpTape;
 use crate::gpu::products::codes::activation_code;
 use crate::gpu::products::dense_products::DenseProducts;
 use crate::gpu::products::half_layers::{half_train_layer, pad16, HalfLayers, HalfOut, Held};
-use crate::gpu::products::half_mlp::{fits, half_mlp, FusedLayer};
+use crate::gpu::products::half_mlp::{fits, half_mlp, FusedLayer, Kept};
 use crate::gpu::products::operands::{Bias, Operand, Output};
 use crate::network::encoder::CODE_SIZE;
 use nprt_gpu::{groups_for, Bind, Dispatch, GpuDevice, Part};
@@ -21,13 +22,34 @@ pub struct FirstLayer<'a> {
     pub bias: Bias<'a>,
 }
 
-/// Where an MLP's forward pass writes: each layer's output (f32 rows, or in half precision the
-/// hidden layers' f16 rows, which the next layer reads), and for training each hidden layer's
-/// pre-activation; in half precision, `input16` takes an f32 input made f16.
-pub struct ForwardTargets<'a> {
-    pub outputs: Vec<Held<'a>>,
-    pub pre: Option<&'a [wgpu::Buffer]>,
-    pub input16: Option<&'a wgpu::Buffer>,
+/// Where an MLP's forward pass writes.
+pub enum ForwardTargets<'a> {
+    /// A frame's: each layer's output (f32 rows, or in half precision the hidden layers' f16
+    /// rows, which the next layer reads); `input16` takes an f32 input made f16 where a half
+    /// precision pass runs a layer a dispatch.
+    Frame {
+        outputs: Vec<Held<'a>>,
+        input16: Option<&'a wgpu::Buffer>,
+    },
+    /// A training step's: what backward reads too.
+    Tape(&'a MlpTape),
+}
+
+impl ForwardTargets<'_> {
+    /// Layer `i` of `last`'s output in an f32 pass: its buffer and first value.
+    fn f32_output(&self, i: usize, last: usize) -> (&wgpu::Buffer, usize) {
+        match self {
+            ForwardTargets::Frame { outputs, .. } => match outputs[i] {
+                Held::F32(b) => (b, 0),
+                Held::F16(_) => unreachable!("f16 rows in an f32 pass"),
+            },
+            ForwardTargets::Tape(tape) if i == last => (&tape.output, 0),
+            ForwardTargets::Tape(tape) => {
+                let part = tape.hidden(i);
+                (part.buffer, part.span.offset)
+            }
+        }
+    }
 }
 
 impl MlpAt {
@@ -45,7 +67,15 @@ impl MlpAt {
         to: &ForwardTargets,
     ) {
         if !self.half.is_empty() {
-            return self.record_half_forward(gpu, plan, params, x, rows, first, to);
+            return match to {
+                ForwardTargets::Tape(tape) => {
+                    self.record_half_training(gpu, plan, params, x, rows, first, tape)
+                }
+                ForwardTargets::Frame { outputs, input16 } => {
+                    let to = (outputs.as_slice(), *input16);
+                    self.record_half_frame(gpu, plan, params, x, rows, first, to)
+                }
+            };
         }
         let Held::F32(x) = x else {
             unreachable!("f16 rows outside half precision");
@@ -53,18 +83,23 @@ impl MlpAt {
         let last = self.layers.len() - 1;
         let mut first = Some(first);
         for (i, layer) in self.layers.iter().enumerate() {
-            let (input, own_row, count, bias) = match first.take() {
-                Some(f) => (x, f.own_row, f.count, f.bias),
+            let ((input, input_at), own_row, count, bias) = match first.take() {
+                Some(f) => ((x, 0), f.own_row, f.count, f.bias),
                 None => (
-                    f32_rows(to.outputs[i - 1]),
+                    to.f32_output(i - 1, last),
                     0,
                     layer.d_in,
                     Bias::Column(params, layer.bias.offset),
                 ),
             };
+            let (output, output_at) = to.f32_output(i, last);
+            let pre = match to {
+                ForwardTargets::Tape(tape) if i < last => Some(tape.pre(i)),
+                _ => None,
+            };
             plan.push(gpu.product(
                 [rows, layer.d_out, count],
-                Operand::plain(input, 0, count),
+                Operand::plain(input, input_at, count),
                 Operand::plain(
                     params,
                     layer.weight.offset + own_row * layer.d_out,
@@ -72,18 +107,18 @@ impl MlpAt {
                 ),
                 bias,
                 self.activation_of(i, last),
-                Output::to(f32_rows(to.outputs[i]), 0, layer.d_out),
-                to.pre.and_then(|p| p.get(i)),
+                Output::to(output, output_at, layer.d_out),
+                pre.as_ref().map(|p| p as &dyn Bind),
             ));
         }
     }
 
-    /// [`Self::record_forward`] in half precision: `x` made f16 unless it is, then each layer's
-    /// product from the f16 output of the one before, on the layers' f16 copies of their
-    /// weights (the first layer's of its own rows). Training keeps the pre-activations
-    /// (`half_train_layer`); frames keep nothing (`half_layer`, what `nprt export` ships).
+    /// [`Self::record_forward`] of a frame in half precision: in one dispatch where the fused
+    /// pass holds the MLP (`half_mlp`), else `x` made f16 unless it is, then a layer a dispatch
+    /// (`half_layer`, what `nprt export` ships), each from the f16 output of the one before,
+    /// on the layers' f16 copies of their weights (the first layer's of its own rows).
     #[allow(clippy::too_many_arguments)]
-    fn record_half_forward(
+    fn record_half_frame(
         &self,
         gpu: &GpuDevice,
         plan: &mut Vec<Dispatch>,
@@ -91,91 +126,139 @@ impl MlpAt {
         x: Held,
         rows: usize,
         first: FirstLayer,
-        to: &ForwardTargets,
+        (outputs, input16): (&[Held], Option<&wgpu::Buffer>),
     ) {
-        if to.pre.is_none() {
-            if let Some(fused) = self.fused_forward(gpu, params, x, rows, &first, to) {
-                plan.push(fused);
-                return;
-            }
+        let last = self.layers.len() - 1;
+        if let Some(fused) = self.fused_forward(gpu, params, (x, rows), &first, outputs[last], None)
+        {
+            plan.push(fused);
+            return;
         }
         let x16 = match x {
             Held::F16(x) => x,
             Held::F32(x) => {
-                let input = to.input16.expect("room for the input in f16");
+                let input = input16.expect("room for the input in f16");
                 plan.push(gpu.half_rows([rows, first.count, first.count], x, input));
                 input
             }
         };
-        let last = self.layers.len() - 1;
         let mut first_bias = Some(first.bias);
         for (i, (layer, copies)) in self.half_layers().enumerate() {
             let (input, bias) = match first_bias.take() {
                 Some(bias) => (x16, bias),
-                None => (
-                    half_rows(to.outputs[i - 1]),
-                    Bias::Column(params, layer.bias.offset),
-                ),
+                None => match outputs[i - 1] {
+                    Held::F16(b) => (b, Bias::Column(params, layer.bias.offset)),
+                    Held::F32(_) => unreachable!("a hidden layer's f32 rows in half precision"),
+                },
             };
-            let activation = self.activation_of(i, last);
+            let bias = frame_bias(bias, layer.d_out);
             let k_pad = pad16(copies.count);
-            plan.push(match to.pre {
-                Some(pre) => {
-                    let (y16, y32) = match to.outputs[i] {
-                        Held::F16(y) => (Some(y), None),
-                        Held::F32(y) => (None, Some(y)),
-                    };
-                    let out = HalfOut {
-                        z: pre.get(i),
-                        y16,
-                        y32,
-                    };
-                    half_train_layer(
-                        gpu,
-                        rows,
-                        (input, k_pad),
-                        &copies.stored,
-                        bias,
-                        activation,
-                        out,
-                    )
-                }
-                None => {
-                    let bias = frame_bias(bias, layer.d_out);
-                    let y = to.outputs[i];
-                    gpu.half_layer(rows, input, k_pad, &copies.stored, 0, &bias, activation, y)
-                }
-            });
+            let activation = self.activation_of(i, last);
+            let y = outputs[i];
+            plan.push(gpu.half_layer(rows, input, k_pad, &copies.stored, 0, &bias, activation, y));
         }
     }
 
-    /// A frame's forward pass of this MLP in one dispatch (`half_mlp`), from `x` as it is held
-    /// into the last of `to.outputs`; `None` where the fused pass cannot hold the MLP.
-    fn fused_forward(
+    /// [`Self::record_forward`] of a training step in half precision, keeping what backward
+    /// reads in `tape`: in one dispatch where the fused pass holds the MLP, else `x` made f16
+    /// and a layer a dispatch (`half_train_layer`).
+    #[allow(clippy::too_many_arguments)]
+    fn record_half_training(
         &self,
         gpu: &GpuDevice,
+        plan: &mut Vec<Dispatch>,
         params: &wgpu::Buffer,
         x: Held,
         rows: usize,
-        first: &FirstLayer,
-        to: &ForwardTargets,
-    ) -> Option<Dispatch> {
+        first: FirstLayer,
+        tape: &MlpTape,
+    ) {
+        let Held::F32(x) = x else {
+            unreachable!("a training step's input in f16");
+        };
         let last = self.layers.len() - 1;
-        let layers: Vec<FusedLayer> = (self.half_layers().enumerate())
+        if let Some(kept) = tape.kept() {
+            let (x, y) = ((Held::F32(x), rows), Held::F32(&tape.output));
+            let fused = self.fused_forward(gpu, params, x, &first, y, Some(&kept));
+            plan.push(fused.expect("a tape laid out for a fused pass"));
+            return;
+        }
+        let x16 = tape.input16().expect("a mixed-precision tape");
+        plan.push(gpu.half_rows([rows, first.count, first.count], x, &x16));
+        let mut first_bias = Some(first.bias);
+        for (i, (layer, copies)) in self.half_layers().enumerate() {
+            let hidden_in;
+            let (input, bias): (&dyn Bind, _) = match first_bias.take() {
+                Some(bias) => (&x16, bias),
+                None => {
+                    hidden_in = tape.hidden(i - 1);
+                    (&hidden_in, Bias::Column(params, layer.bias.offset))
+                }
+            };
+            let kept = (i < last).then(|| [tape.pre(i), tape.hidden(i)]);
+            let out = match &kept {
+                Some([z, y16]) => HalfOut {
+                    z: Some(z),
+                    y16: Some(y16),
+                    y32: None,
+                },
+                None => HalfOut {
+                    z: None,
+                    y16: None,
+                    y32: Some(&tape.output),
+                },
+            };
+            let activation = self.activation_of(i, last);
+            let k_pad = pad16(copies.count);
+            let layer = half_train_layer(
+                gpu,
+                rows,
+                (input, k_pad),
+                &copies.stored,
+                bias,
+                activation,
+                out,
+            );
+            plan.push(layer);
+        }
+    }
+
+    /// Whether a fused pass on `gpu` holds this MLP (`half_mlp`).
+    pub fn fuses(&self, gpu: &GpuDevice) -> bool {
+        fits(gpu, &self.fused_layers())
+    }
+
+    /// This MLP's layers as a fused pass takes them.
+    fn fused_layers(&self) -> Vec<FusedLayer<'_>> {
+        let last = self.layers.len() - 1;
+        (self.half_layers().enumerate())
             .map(|(i, (layer, copies))| FusedLayer {
                 weight: &copies.stored,
                 k_pad: pad16(copies.count),
                 bias_at: layer.bias.offset,
                 activation: self.activation_of(i, last),
             })
-            .collect();
+            .collect()
+    }
+
+    /// This MLP's forward pass in one dispatch (`half_mlp`), from `x` as it is held into `y`,
+    /// keeping what backward reads where `kept` is given; `None` where the fused pass cannot
+    /// hold the MLP.
+    fn fused_forward(
+        &self,
+        gpu: &GpuDevice,
+        params: &wgpu::Buffer,
+        (x, rows): (Held, usize),
+        first: &FirstLayer,
+        y: Held,
+        kept: Option<&Kept>,
+    ) -> Option<Dispatch> {
+        let layers = self.fused_layers();
         if !fits(gpu, &layers) {
             return None;
         }
-        let bias0 = frame_bias(first.bias, self.layers[0].d_out);
-        let y = to.outputs[last];
         let x = (x, first.count);
-        Some(half_mlp(gpu, rows, x, &layers, &bias0, params, y))
+        Some(half_mlp(gpu, rows, x, &layers, first.bias, params, y, kept))
     }
 
     /// Layer `i`'s activation code: the MLP's for a hidden layer, linear for the last.
@@ -257,19 +340,5 @@ fn frame_bias(bias: Bias, len: usize) -> Part {
     Part {
         buffer,
         span: nprt_gpu::Span { offset, len },
-    }
-}
-
-fn f32_rows<'a>(held: Held<'a>) -> &'a wgpu::Buffer {
-    match held {
-        Held::F32(b) => b,
-        Held::F16(_) => unreachable!("f16 rows in an f32 pass"),
-    }
-}
-
-fn half_rows<'a>(held: Held<'a>) -> &'a wgpu::Buffer {
-    match held {
-        Held::F16(b) => b,
-        Held::F32(_) => unreachable!("a hidden layer's f32 rows in a half-precision pass"),
     }
 }

@@ -30,7 +30,7 @@ use nprt_gpu::{groups_for, Bind, Dispatch, GpuDevice};
 fn half_weight_grad(
     gpu: &GpuDevice,
     [m, n, rows]: [usize; 3],
-    (x, k_pad): (&wgpu::Buffer, usize),
+    (x, k_pad): (&dyn Bind, usize),
     (dz, n_pad): (&wgpu::Buffer, usize),
     [chunk, chunks]: [usize; 2],
     bias: bool,
@@ -93,14 +93,14 @@ impl Trainable<'_> {
             };
             let first_bias = on_first.filter(|_| i == 0);
             let x16 = match i {
-                0 => tape.input16.as_ref().expect("a mixed-precision tape"),
-                _ => &tape.outputs[i - 1],
+                0 => tape.input16().expect("a mixed-precision tape"),
+                _ => tape.hidden(i - 1),
             };
             let n_pad = pad16(layer.d_out);
             self.half_weight_gradient(
                 plan,
                 [copies.count, layer.d_out, rows],
-                x16,
+                &x16,
                 g16,
                 layer.weight.offset + copies.row * layer.d_out,
                 first_bias.is_none().then_some(layer.bias.offset),
@@ -108,24 +108,25 @@ impl Trainable<'_> {
             if let Some(f) = first_bias {
                 f(plan, g32.expect("layer 0's gradient in f32 for on_first"));
             }
-            let (derivative, out) = match i {
-                0 => match d_input {
+            let pre = (i > 0).then(|| tape.pre(i - 1));
+            let (derivative, out) = match (i, &pre) {
+                (0, _) => match d_input {
                     Some(d) => (
                         0,
                         HalfOut {
                             z: None,
                             y16: None,
-                            y32: Some(d),
+                            y32: Some(d as &dyn Bind),
                         },
                     ),
                     None => continue,
                 },
-                _ => (
+                (_, pre) => (
                     activation_code(m.activation) + BACKWARD,
                     HalfOut {
-                        z: Some(&tape.pre[i - 1]),
+                        z: pre.as_ref().map(|p| p as &dyn Bind),
                         y16: Some(&dz16[(i - 1) % 2]),
-                        y32: dz32.as_ref().filter(|_| i == 1),
+                        y32: dz32.as_ref().filter(|_| i == 1).map(|d| d as &dyn Bind),
                     },
                 ),
             };
@@ -148,7 +149,7 @@ impl Trainable<'_> {
         &self,
         plan: &mut Vec<Dispatch>,
         [m, n, rows]: [usize; 3],
-        x: &wgpu::Buffer,
+        x: &dyn Bind,
         dz: &wgpu::Buffer,
         offset: usize,
         bias: Option<usize>,

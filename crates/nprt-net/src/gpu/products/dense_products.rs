@@ -5,7 +5,7 @@
 use crate::gpu::kernels::{COLUMN_SUM, GEMM, GEMM_TILE};
 use crate::gpu::products::codes::BACKWARD;
 use crate::gpu::products::operands::{Bias, Operand, Output};
-use nprt_gpu::{groups_for, Dispatch, GpuDevice};
+use nprt_gpu::{groups_for, Bind, Dispatch, GpuDevice};
 
 /// Rows a `column_sum` thread adds before the chunks' sums are added in a further pass (and
 /// theirs in another, as a tree). Short: a thread's adds are a chain of dependent loads, and on
@@ -28,7 +28,7 @@ pub trait DenseProducts {
         bias: Bias,
         activation: u32,
         c: Output,
-        z: Option<&wgpu::Buffer>,
+        z: Option<&dyn Bind>,
     ) -> Dispatch;
 
     /// The dispatch of `chunks` products, each over `k_chunk` consecutive values of k (the last
@@ -108,7 +108,7 @@ impl DenseProducts for GpuDevice {
         bias: Bias,
         activation: u32,
         c: Output,
-        z: Option<&wgpu::Buffer>,
+        z: Option<&dyn Bind>,
     ) -> Dispatch {
         gemm(self, shape, a, b, bias, activation, c, z, None)
     }
@@ -145,7 +145,7 @@ fn gemm(
     bias: Bias,
     activation: u32,
     c: Output,
-    z: Option<&wgpu::Buffer>,
+    z: Option<&dyn Bind>,
     split: Option<[usize; 2]>,
 ) -> Dispatch {
     let (bias_mode, bias_buffer, bias_off, groups) = bias.binding(gpu);

@@ -78,7 +78,7 @@ pub trait HalfLayers {
     /// The dispatch that writes `rows` rows of `cols` f32 values of `src` (row stride
     /// `stride`) to `dst` as f16 rows of `pad16(cols)` values, zeros in the padding and in the
     /// rows up to the next multiple of [`HALF_ROW_BLOCK`].
-    fn half_rows(&self, shape: [usize; 3], src: &wgpu::Buffer, dst: &wgpu::Buffer) -> Dispatch;
+    fn half_rows(&self, shape: [usize; 3], src: &wgpu::Buffer, dst: &dyn Bind) -> Dispatch;
 
     /// The dispatch of one half-precision dense layer, `act(x·W[w_row..] + bias)` over `rows`
     /// rows of `x` (f16 rows of `k_pad` values, a multiple of 16, held up to the next multiple
@@ -121,7 +121,7 @@ impl HalfLayers for GpuDevice {
         &self,
         [rows, cols, stride]: [usize; 3],
         src: &wgpu::Buffer,
-        dst: &wgpu::Buffer,
+        dst: &dyn Bind,
     ) -> Dispatch {
         let padded = rows.next_multiple_of(HALF_ROW_BLOCK);
         let k_pad = pad16(cols);
@@ -189,11 +189,11 @@ fn half_dense(
 pub(crate) struct HalfOut<'a> {
     /// The pre-activation: kept here by a forward product, read for the activation's
     /// derivative by a backward one.
-    pub z: Option<&'a wgpu::Buffer>,
+    pub z: Option<&'a dyn Bind>,
     /// f16 rows padded as `half_layers` holds them (the next product's operand).
-    pub y16: Option<&'a wgpu::Buffer>,
+    pub y16: Option<&'a dyn Bind>,
     /// f32 rows of the layer's width.
-    pub y32: Option<&'a wgpu::Buffer>,
+    pub y32: Option<&'a dyn Bind>,
 }
 
 /// The dispatch of `act(x·W + bias)` over `rows` rows of `x` (f16 rows of `k_pad` values)
@@ -202,7 +202,7 @@ pub(crate) struct HalfOut<'a> {
 pub(crate) fn half_train_layer(
     gpu: &GpuDevice,
     rows: usize,
-    (x, k_pad): (&wgpu::Buffer, usize),
+    (x, k_pad): (&dyn Bind, usize),
     w: &HalfWeight,
     bias: Bias,
     activation: u32,

@@ -1,13 +1,13 @@
 enable f16;
 
-// A whole MLP's forward pass in half precision in one dispatch (the frame path's, after
-// tiny-cuda-nn's fully fused MLP): a workgroup takes 64 rows through every layer, their
-// activations held in workgroup memory as f16 between layers instead of written out and read
-// back, the sums kept in f32. The weights are the layers' f16 copies in one buffer
-// (`half_layer`'s layout: k_pad rows of n_pad values, 16 rows of zeros past them). What both of
-// its products share: the parameters, the buffers, the input's staging and the epilogue. The
-// product is `half_mlp_coop` (tensor cores) where the adapter has cooperative matrices and
-// `half_mlp_plain` elsewhere.
+// A whole MLP's forward pass in half precision in one dispatch (a frame's, and a training
+// step's, which also keeps what backward reads; after tiny-cuda-nn's fully fused MLP): a
+// workgroup takes 64 rows through every layer, their activations held in workgroup memory as
+// f16 between layers instead of written out and read back, the sums kept in f32. The weights
+// are the layers' f16 copies in one buffer (`half_layer`'s layout: k_pad rows of n_pad values,
+// 16 rows of zeros past them). What both of its products share: the parameters, the buffers,
+// the input's staging and the epilogue. The product is `half_mlp_coop` (tensor cores) where
+// the adapter has cooperative matrices and `half_mlp_plain` elsewhere.
 
 struct HalfMlp {
     rows: u32,
@@ -16,16 +16,27 @@ struct HalfMlp {
     // does, f16 rows of the first layer's k_pad values.
     x_f32: u32,
     x_cols: u32,
-    // 1: the last layer writes y16 (f16 rows of its n_pad values, the next network's input);
-    // 0: y32 (f32 rows of its n values).
+    // 1: the last layer writes y16 (f16 rows of its n_pad values, the next network's input,
+    // from at.z); 0: y32 (f32 rows of its n values).
     half_out: u32,
+    // 1 (a training step's pass): the input is also kept, as f16 rows from in_at of y16, and
+    // each hidden layer's output, as f16 rows from its at.z of y16 (zeros past the rows, so
+    // that a weight's gradient summed over the held rows adds nothing there), and its
+    // pre-activation, f32 rows of n from its at.w of z.
+    keep: u32,
+    in_at: u32,
+    // The first layer's bias: 1: bias0[bias0_at + j]; 2: bias0[group_of[i] · n + j] (the light
+    // code's share of a shading network's first layer in training, a row per view).
+    bias0_mode: u32,
+    bias0_at: u32,
     _pad0: u32,
     _pad1: u32,
     _pad2: u32,
     // Per layer: its input's padded width k_pad, its outputs n, their padding n_pad (both
     // multiples of 16, at most ACT), its activation (0 linear, 1 ReLU, 2 SIREN).
     shape: array<vec4<u32>, 8>,
-    // Per layer: where its weight starts in w, and its bias in bias (layer 0's is bias0).
+    // Per layer: where its weight starts in w, its bias in bias (layer 0's is bias0's), its f16
+    // output in y16 and its pre-activation in z.
     at: array<vec4<u32>, 8>,
 }
 
@@ -35,8 +46,10 @@ struct HalfMlp {
 @group(0) @binding(3) var<storage, read> w: array<f16>;
 @group(0) @binding(4) var<storage, read> bias0: array<f32>;
 @group(0) @binding(5) var<storage, read> bias: array<f32>;
-@group(0) @binding(6) var<storage, read_write> y16: array<f16>;
-@group(0) @binding(7) var<storage, read_write> y32: array<f32>;
+@group(0) @binding(6) var<storage, read> group_of: array<u32>;
+@group(0) @binding(7) var<storage, read_write> y16: array<f16>;
+@group(0) @binding(8) var<storage, read_write> y32: array<f32>;
+@group(0) @binding(9) var<storage, read_write> z: array<f32>;
 
 const OMEGA_0: f32 = 30.0;
 const F16_MAX: f32 = 65504.0;
@@ -67,23 +80,35 @@ fn stage_input(t: u32) {
             v = f16(clamp(x32[i * p.x_cols + k], -F16_MAX, F16_MAX));
         }
         act[r * ACT + k] = v;
+        if (p.keep == 1u) {
+            y16[p.in_at + i * k_pad + k] = v;
+        }
     }
 }
 
 // Finishes the current layer's output (r, j), r among the workgroup's rows, from its sum: into
-// `act` for the next layer, the last layer's into y16 or y32. Padding columns get zeros, so
-// that the next layer's padded k adds nothing.
+// `act` for the next layer (and, in training, the tape), the last layer's into y16 or y32.
+// Padding columns get zeros, so that the next layer's padded k adds nothing. f16 values
+// saturate at ±65504 rather than overflow to infinity.
 fn finish(r: u32, j: u32, sum: f32) {
     let s = p.shape[layer];
     if (j >= s.z) {
         return;
     }
+    let i = row0 + r;
+    let hidden = layer + 1u < p.layers;
     var v = 0.0;
     if (j < s.y) {
-        if (layer == 0u) {
-            v = sum + bias0[j];
-        } else {
-            v = sum + bias[p.at[layer].y + j];
+        v = sum;
+        if (layer > 0u) {
+            v += bias[p.at[layer].y + j];
+        } else if (p.bias0_mode == 1u) {
+            v += bias0[p.bias0_at + j];
+        } else if (p.bias0_mode == 2u && i < p.rows) {
+            v += bias0[group_of[i] * s.y + j];
+        }
+        if (p.keep == 1u && hidden && i < p.rows) {
+            z[p.at[layer].w + i * s.y + j] = v;
         }
         if (s.w == 1u) {
             v = max(v, 0.0);
@@ -91,13 +116,16 @@ fn finish(r: u32, j: u32, sum: f32) {
             v = sin(OMEGA_0 * v);
         }
     }
-    if (layer + 1u < p.layers) {
-        act[r * ACT + j] = f16(v);
+    let h = f16(clamp(v, -F16_MAX, F16_MAX));
+    if (hidden) {
+        act[r * ACT + j] = h;
+        if (p.keep == 1u) {
+            y16[p.at[layer].z + i * s.z + j] = select(f16(0.0), h, i < p.rows);
+        }
         return;
     }
-    let i = row0 + r;
     if (p.half_out == 1u) {
-        y16[i * s.z + j] = f16(v);
+        y16[p.at[layer].z + i * s.z + j] = h;
     } else if (i < p.rows && j < s.y) {
         y32[i * s.y + j] = v;
     }

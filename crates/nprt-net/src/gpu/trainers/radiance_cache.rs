@@ -14,11 +14,11 @@ use crate::cpu::radiance_cache::encode_rest;
 use crate::encoding::features::FEATURES;
 use crate::encoding::hash_grid;
 use crate::gpu::kernels::{GRID_BACKWARD, RADIANCE_LOSS, TRACK_INPUTS};
-use crate::gpu::layers::network_forward::FirstLayer;
+use crate::gpu::layers::network_forward::{FirstLayer, ForwardTargets};
 use crate::gpu::layers::network_layout::{mlp_at, MlpAt};
 use crate::gpu::layers::parameters::ParameterLayout;
 use crate::gpu::passes::device_adam::DeviceAdam;
-use crate::gpu::passes::mlp_step::{forward_targets, MlpTape, Trainable};
+use crate::gpu::passes::mlp_step::{MlpTape, Trainable};
 use crate::gpu::products::codes::loss_code;
 use crate::gpu::products::dense_products::DenseProducts;
 use crate::gpu::products::half_layers::Held;
@@ -102,9 +102,7 @@ impl GpuCache {
             self.upload(chunk, None);
             self.submit(Pass::Forward);
             let plan = self.plans.last().expect("uploaded");
-            let y = self
-                .gpu
-                .read(plan.tape.outputs.last().expect("a layer"), 3 * chunk.len());
+            let y = self.gpu.read(&plan.tape.output, 3 * chunk.len());
             let radiance = (chunk.iter().zip(y.chunks_exact(3)))
                 .map(|(q, o)| Vec3::from_slice(o) * q.albedo());
             out.extend(radiance);
@@ -201,14 +199,14 @@ impl GpuCache {
             count: INPUTS,
             bias: Bias::Column(&self.params, self.mlp.layers[0].bias.offset),
         };
-        let to = forward_targets(&self.mlp, &tape);
+        let to = ForwardTargets::Tape(&tape);
         let input = Held::F32(&x);
         (self.mlp).record_forward(gpu, &mut dispatches, &self.params, input, rows, first, &to);
         let forward = dispatches.len();
         let (d_out, row_loss, loss) = (gpu.buffer(rows * 3), gpu.buffer(rows), gpu.buffer(1));
         let mut p = vec![rows as u32, loss_code(Loss::RelL2), 0, 0];
         p.extend([1.0 / (3 * rows.max(1)) as f32, 0.0, 0.0, 0.0].map(f32::to_bits));
-        let y = tape.outputs.last().expect("a layer");
+        let y = &tape.output;
         dispatches.push(gpu.prepare(
             &RADIANCE_LOSS,
             &p,

@@ -6,9 +6,9 @@
 use crate::encoding::hash_grid;
 use crate::gpu::kernels::{COMBINE, GRID_BACKWARD, RADIANCE_LOSS, TRACK_GRADIENT, TRANSFER_LOSS};
 use crate::gpu::layers::light_basis::{BasisAt, BasisFunctions};
-use crate::gpu::layers::network_forward::FirstLayer;
+use crate::gpu::layers::network_forward::{FirstLayer, ForwardTargets};
 use crate::gpu::layers::network_layout::{LightAt, TrackAt};
-use crate::gpu::passes::mlp_step::{forward_targets, MlpTape};
+use crate::gpu::passes::mlp_step::MlpTape;
 use crate::gpu::products::codes::loss_code;
 use crate::gpu::products::dense_products::DenseProducts;
 use crate::gpu::products::half_layers::Held;
@@ -97,7 +97,7 @@ impl GpuTrainer {
                 &params.map(|v| v as u32),
                 &[
                     &b.features,
-                    tape.shading.outputs.last().expect("a layer"),
+                    &tape.shading.output,
                     &b.codes,
                     &b.view,
                     &b.radiance_sum,
@@ -149,7 +149,7 @@ impl GpuTrainer {
                 &params,
                 &[
                     &b.features,
-                    tape.shading.outputs.last().expect("a layer"),
+                    &tape.shading.output,
                     &transfer.target,
                     &transfer.sum,
                     &transfer.d_transfer,
@@ -191,7 +191,7 @@ impl GpuTrainer {
                 &params.map(|v| v as u32),
                 &[
                     &b.features,
-                    tape.shading.outputs.last().expect("a layer"),
+                    &tape.shading.output,
                     &b.codes,
                     &b.view,
                     b.transfer.as_ref().map_or(&b.d_radiance, |t| &t.d_transfer),
@@ -226,7 +226,7 @@ impl GpuTrainer {
                 count: t.width,
                 bias: Bias::Column(params, m.layers[0].bias.offset),
             };
-            let to = forward_targets(m, &tape);
+            let to = ForwardTargets::Tape(&tape);
             m.record_forward(gpu, plan, params, Held::F32(&x), rows, first, &to);
             tape
         });
@@ -243,15 +243,13 @@ impl GpuTrainer {
             Some(_) => Bias::Column(params, first.bias.offset),
         };
         let shading = self.trainable().tape(&t.shading, rows);
-        let input = transfer
-            .as_ref()
-            .map_or(&x, |tape| tape.outputs.last().expect("a layer"));
+        let input = transfer.as_ref().map_or(&x, |tape| &tape.output);
         let first_layer = FirstLayer {
             own_row: t.code_and_own_rows().1,
             count: t.own_width(),
             bias,
         };
-        let to = forward_targets(&t.shading, &shading);
+        let to = ForwardTargets::Tape(&shading);
         let input = Held::F32(input);
         (t.shading).record_forward(gpu, plan, params, input, rows, first_layer, &to);
         TrackTape {
@@ -282,10 +280,7 @@ impl GpuTrainer {
             .as_ref()
             .map(|_| gpu.buffer(b.rows * TRANSPORT_CODE));
         let d_input = d_s.as_ref().or(tape.dx.as_ref());
-        let input = tape
-            .transfer
-            .as_ref()
-            .map_or(&tape.x, |tr| tr.outputs.last().expect("a layer"));
+        let input = tape.transfer.as_ref().map_or(&tape.x, |tr| &tr.output);
         // Each view's sum of the first layer's pre-activation gradients: its bias's, its code
         // rows' and the code's gradients all follow from it. A linear track's first layer has
         // its bias alone.
