@@ -240,7 +240,13 @@ fn mixed_precision_gradients_follow_the_cpu_engine_for_every_design() {
     let samples = batch.samples();
     let mut worst_loss = 0.0f64;
     let mut worst_gradient = 0.0f64;
-    for config in variants() {
+    // A basis of 96 makes the linear design's last layer 288 wide, more than a fused pass
+    // holds (256): its MLP runs a layer a dispatch, forward and backward.
+    let wide = ModelConfig {
+        basis: Some(nprt_net::BasisChoice::Learned { size: 96 }),
+        ..ModelConfig::new(Design::Linear, None)
+    };
+    for config in variants().into_iter().chain([wide]) {
         let net = network(&config);
         for loss in [Loss::LogL1, Loss::RelL2] {
             let (want_loss, want) = cpu::gradients(&net, &samples, loss);

@@ -4,12 +4,14 @@
 //! (`light_encoder`, the CPU's `cpu/light_encoder.rs`) or the linear design's basis
 //! (`light_basis`, `cpu/light_model.rs`), the U-Net's convolutions (`conv`,
 //! `cpu/conv.rs`), a track's inputs and an MLP in f32 or f16 (`network_forward`, the forward
-//! half of `cpu/transport.rs` and `cpu/dense.rs`). Uses `products` below it.
+//! half of `cpu/transport.rs` and `cpu/dense.rs`) with what a training step keeps of it
+//! (`mlp_tape`). Uses `products` below it.
 
 pub(crate) mod conv;
 pub(crate) mod layer_at;
 pub(crate) mod light_basis;
 pub(crate) mod light_encoder;
+pub(crate) mod mlp_tape;
 pub(crate) mod network_forward;
 pub(crate) mod network_layout;
 pub(crate) mod parameters;

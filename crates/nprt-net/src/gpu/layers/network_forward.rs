@@ -4,12 +4,12 @@
 //! parameter buffer where [`NetworkLayout`](crate::gpu::layers::network_layout::NetworkLayout) places them.
 
 use crate::gpu::kernels::TRACK_INPUTS;
+use crate::gpu::layers::mlp_tape::MlpTape;
 use crate::gpu::layers::network_layout::{MlpAt, TrackAt};
-use crate::gpu::passes::mlp_step::MlpTape;
 use crate::gpu::products::codes::activation_code;
 use crate::gpu::products::dense_products::DenseProducts;
 use crate::gpu::products::half_layers::{half_train_layer, pad16, HalfLayers, HalfOut, Held};
-use crate::gpu::products::half_mlp::{fits, half_mlp, FusedLayer, Kept};
+use crate::gpu::products::half_mlp::{fits, half_mlp, FusedIo, FusedLayer};
 use crate::gpu::products::operands::{Bias, Operand, Output};
 use crate::network::encoder::CODE_SIZE;
 use nprt_gpu::{groups_for, Bind, Dispatch, GpuDevice, Part};
@@ -129,9 +129,25 @@ impl MlpAt {
         (outputs, input16): (&[Held], Option<&wgpu::Buffer>),
     ) {
         let last = self.layers.len() - 1;
-        if let Some(fused) = self.fused_forward(gpu, params, (x, rows), &first, outputs[last], None)
-        {
-            plan.push(fused);
+        let layers = self.fused_layers(&[]);
+        if fits(gpu, &layers) {
+            let (y16, y32) = match outputs[last] {
+                Held::F16(y) => (Some(y), None),
+                Held::F32(y) => (None, Some(y)),
+            };
+            let io = FusedIo {
+                rows,
+                x,
+                x_cols: first.count,
+                bias0: first.bias,
+                biases: Some(params),
+                y16,
+                out16: y16.is_some(),
+                kept_input: None,
+                y32,
+                pre: None,
+            };
+            plan.push(half_mlp(gpu, &layers, &io));
             return;
         }
         let x16 = match x {
@@ -178,9 +194,19 @@ impl MlpAt {
         };
         let last = self.layers.len() - 1;
         if let Some(kept) = tape.kept() {
-            let (x, y) = ((Held::F32(x), rows), Held::F32(&tape.output));
-            let fused = self.fused_forward(gpu, params, x, &first, y, Some(&kept));
-            plan.push(fused.expect("a tape laid out for a fused pass"));
+            let io = FusedIo {
+                rows,
+                x: Held::F32(x),
+                x_cols: first.count,
+                bias0: first.bias,
+                biases: Some(params),
+                y16: Some(kept.held),
+                out16: false,
+                kept_input: Some(kept.input_at),
+                y32: Some(&tape.output),
+                pre: Some((kept.pre, true)),
+            };
+            plan.push(half_mlp(gpu, &self.fused_layers(&kept.layers), &io));
             return;
         }
         let x16 = tape.input16().expect("a mixed-precision tape");
@@ -225,40 +251,26 @@ impl MlpAt {
 
     /// Whether a fused pass on `gpu` holds this MLP (`half_mlp`).
     pub fn fuses(&self, gpu: &GpuDevice) -> bool {
-        fits(gpu, &self.fused_layers())
+        fits(gpu, &self.fused_layers(&[]))
     }
 
-    /// This MLP's layers as a fused pass takes them.
-    fn fused_layers(&self) -> Vec<FusedLayer<'_>> {
+    /// This MLP's layers as a fused forward pass takes them, the hidden ones' places in a
+    /// training tape from `kept` (`[f16 output, pre-activation]`; none for a frame).
+    fn fused_layers(&self, kept: &[[usize; 2]]) -> Vec<FusedLayer<'_>> {
         let last = self.layers.len() - 1;
         (self.half_layers().enumerate())
-            .map(|(i, (layer, copies))| FusedLayer {
-                weight: &copies.stored,
-                k_pad: pad16(copies.count),
-                bias_at: layer.bias.offset,
-                activation: self.activation_of(i, last),
+            .map(|(i, (layer, copies))| {
+                let [held_at, pre_at] = kept.get(i).copied().unwrap_or_default();
+                FusedLayer {
+                    weight: &copies.stored,
+                    k_pad: pad16(copies.count),
+                    bias_at: layer.bias.offset,
+                    activation: self.activation_of(i, last),
+                    held_at,
+                    pre_at,
+                }
             })
             .collect()
-    }
-
-    /// This MLP's forward pass in one dispatch (`half_mlp`), from `x` as it is held into `y`,
-    /// keeping what backward reads where `kept` is given; `None` where the fused pass cannot
-    /// hold the MLP.
-    fn fused_forward(
-        &self,
-        gpu: &GpuDevice,
-        params: &wgpu::Buffer,
-        (x, rows): (Held, usize),
-        first: &FirstLayer,
-        y: Held,
-        kept: Option<&Kept>,
-    ) -> Option<Dispatch> {
-        let layers = self.fused_layers();
-        if !fits(gpu, &layers) {
-            return None;
-        }
-        let x = (x, first.count);
-        Some(half_mlp(gpu, rows, x, &layers, first.bias, params, y, kept))
     }
 
     /// Layer `i`'s activation code: the MLP's for a hidden layer, linear for the last.

@@ -3,26 +3,30 @@
 //! after every Adam step; the activations and the gradients between layers are held as f16
 //! rows in the frame path's layout (`half_layers`); every product sums in f32, on tensor cores
 //! where the adapter has cooperative matrices, elsewhere on plain kernels that compute the
-//! same sums (what the tests run). A layer's three products are its forward pass (`half_train`
-//! with bias, activation and the pre-activation kept in f32), its input gradient dz·Wᵀ (the
-//! same kernel on the transposed copy, times the activation's derivative) and its weight
-//! gradient xᵀ·dz over chunks of rows (`half_weight_grad`), which also sums each chunk's dz
-//! columns, the bias's gradient, in the same dispatch; the chunks are added in f32 as in an
-//! f32 step. The loss's gradient is multiplied by a power
+//! same sums (what the tests run). A layer's three products are its forward pass (with bias,
+//! activation and the pre-activation kept in f32), its input gradient dz·Wᵀ (on the transposed
+//! copy, times the activation's derivative) and its weight gradient xᵀ·dz over chunks of rows
+//! (`half_weight_grad`), which also sums each chunk's dz columns, the bias's gradient, in the
+//! same dispatch; the chunks are added in f32 as in an f32 step. An MLP's forward passes, and
+//! its input gradients down to its first layer's output, each take one dispatch where the
+//! fused pass holds the MLP (`half_mlp`), else a dispatch a layer (`half_train`). The loss's
+//! gradient is multiplied by a power
 //! of two near the batch's values (`BatchBuffers::grad_scale`) so that f16 keeps the small
 //! gradients, and Adam divides it back out; f16 values saturate instead of overflowing. The
 //! light encoder, the hash grids and the light code's share stay in f32.
 
 use crate::gpu::kernels::{HALF_WEIGHT_GRAD, HALF_WEIGHT_GRAD_COOP};
+use crate::gpu::layers::mlp_tape::{held_rows, MlpTape};
 use crate::gpu::layers::network_layout::MlpAt;
-use crate::gpu::passes::mlp_step::{row_chunks, FirstLayerBias, MlpTape, Trainable};
+use crate::gpu::passes::mlp_step::{row_chunks, FirstLayerBias, Trainable};
 use crate::gpu::products::codes::{activation_code, BACKWARD};
 use crate::gpu::products::dense_products::DenseProducts;
 use crate::gpu::products::half_layers::{
-    half_train_layer, held_halves, pad16, HalfLayers, HalfOut,
+    half_train_layer, held_halves, pad16, HalfLayers, HalfOut, Held,
 };
+use crate::gpu::products::half_mlp::{fits, half_mlp, FusedIo, FusedLayer};
 use crate::gpu::products::operands::{Bias, Output};
-use nprt_gpu::{groups_for, Bind, Dispatch, GpuDevice};
+use nprt_gpu::{groups_for, Bind, Dispatch, GpuDevice, Part, Span};
 
 /// The dispatch of xᵀ·dz, `[m, n]`, over `rows` rows cut into chunks of `chunk` rows, chunk
 /// c's sums into `partial` from c · m' · n; with `bias`, m' = m + 1 and row m holds dz's
@@ -31,7 +35,7 @@ fn half_weight_grad(
     gpu: &GpuDevice,
     [m, n, rows]: [usize; 3],
     (x, k_pad): (&dyn Bind, usize),
-    (dz, n_pad): (&wgpu::Buffer, usize),
+    (dz, n_pad): (&dyn Bind, usize),
     [chunk, chunks]: [usize; 2],
     bias: bool,
     partial: &wgpu::Buffer,
@@ -63,11 +67,21 @@ fn half_weight_grad(
     }
 }
 
+/// Rows a layer at a time: a buffer each, or one buffer's parts (`held_rows`).
+type HeldRows = Vec<(wgpu::Buffer, Span)>;
+
+fn part(rows: &HeldRows, i: usize) -> Part<'_> {
+    Part {
+        buffer: &rows[i].0,
+        span: rows[i].1,
+    }
+}
+
 impl Trainable<'_> {
-    /// [`Self::mlp_backward`] in a mixed-precision step: the gradient at each layer's output
-    /// as f16 rows, and as f32 rows too where `on_first` takes it; the gradient at the first
-    /// layer's input into `d_input` (f32) where given. A bias's gradient is made with its
-    /// weight's (`half_weight_grad`).
+    /// [`Self::mlp_backward`] in a mixed-precision step: the gradient at each layer's
+    /// pre-activation (`layer_gradients`), then each weight's gradient with its bias's
+    /// (`half_weight_grad`), and the gradient at the first layer's input into `d_input` (f32)
+    /// where given.
     pub(crate) fn half_mlp_backward(
         &self,
         plan: &mut Vec<Dispatch>,
@@ -78,68 +92,112 @@ impl Trainable<'_> {
         on_first: Option<FirstLayerBias>,
     ) {
         let (gpu, rows) = (&self.gpu, tape.rows);
-        let last = m.layers.len() - 1;
-        let widest = m.widest();
-        let dz16 = [0, 1].map(|_| gpu.half_buffer(held_halves(rows, widest)));
-        // Only `on_first` reads a hidden layer's gradient in f32: layer 0's, here.
-        let dz32 = (on_first.is_some() && last > 0).then(|| gpu.buffer(rows * widest));
-        let out_width = m.layers[last].d_out;
-        let d_last16 = gpu.half_buffer(held_halves(rows, out_width));
-        plan.push(gpu.half_rows([rows, out_width, out_width], d_last, &d_last16));
+        let (dz, dz32) = self.layer_gradients(plan, m, tape, d_last, on_first.is_some());
         for (i, (layer, copies)) in m.half_layers().enumerate().rev() {
-            let (g16, g32) = match i == last {
-                true => (&d_last16, Some(d_last)),
-                false => (&dz16[i % 2], dz32.as_ref().filter(|_| i == 0)),
-            };
-            let first_bias = on_first.filter(|_| i == 0);
             let x16 = match i {
                 0 => tape.input16().expect("a mixed-precision tape"),
                 _ => tape.hidden(i - 1),
             };
-            let n_pad = pad16(layer.d_out);
+            let first_bias = on_first.is_some() && i == 0;
             self.half_weight_gradient(
                 plan,
                 [copies.count, layer.d_out, rows],
                 &x16,
-                g16,
+                &part(&dz, i),
                 layer.weight.offset + copies.row * layer.d_out,
-                first_bias.is_none().then_some(layer.bias.offset),
+                (!first_bias).then_some(layer.bias.offset),
             );
-            if let Some(f) = first_bias {
-                f(plan, g32.expect("layer 0's gradient in f32 for on_first"));
-            }
-            let pre = (i > 0).then(|| tape.pre(i - 1));
-            let (derivative, out) = match (i, &pre) {
-                (0, _) => match d_input {
-                    Some(d) => (
-                        0,
-                        HalfOut {
-                            z: None,
-                            y16: None,
-                            y32: Some(d as &dyn Bind),
-                        },
-                    ),
-                    None => continue,
-                },
-                (_, pre) => (
-                    activation_code(m.activation) + BACKWARD,
-                    HalfOut {
-                        z: pre.as_ref().map(|p| p as &dyn Bind),
-                        y16: Some(&dz16[(i - 1) % 2]),
-                        y32: dz32.as_ref().filter(|_| i == 1).map(|d| d as &dyn Bind),
-                    },
-                ),
+        }
+        if let Some(f) = on_first {
+            f(plan, dz32.as_ref().unwrap_or(d_last));
+        }
+        if let Some(d) = d_input {
+            let (layer, copies) = (&m.layers[0], &m.half[0]);
+            let out = HalfOut {
+                z: None,
+                y16: None,
+                y32: Some(d),
             };
+            let g = (&part(&dz, 0) as &dyn Bind, pad16(layer.d_out));
+            let t = &copies.transposed;
+            plan.push(half_train_layer(gpu, rows, g, t, Bias::None, 0, out));
+        }
+    }
+
+    /// The gradient at each layer's pre-activation as f16 rows, from `d_last` at the output
+    /// down (each layer's input gradient on its transposed weight, times the activation's
+    /// derivative at the pre-activation below): in one dispatch where the fused pass holds the
+    /// transposed layers (`half_mlp`), else a layer a dispatch. With `f32_first`, layer 0's as
+    /// f32 rows too (`d_last` itself for a single layer).
+    fn layer_gradients(
+        &self,
+        plan: &mut Vec<Dispatch>,
+        m: &MlpAt,
+        tape: &MlpTape,
+        d_last: &wgpu::Buffer,
+        f32_first: bool,
+    ) -> (HeldRows, Option<wgpu::Buffer>) {
+        let (gpu, rows) = (&self.gpu, tape.rows);
+        let last = m.layers.len() - 1;
+        let layers: Vec<_> = m.half_layers().collect();
+        let derivative = activation_code(m.activation) + BACKWARD;
+        let mut stages: Vec<FusedLayer> = (1..=last)
+            .rev()
+            .map(|i| FusedLayer {
+                weight: &layers[i].1.transposed,
+                k_pad: pad16(layers[i].0.d_out),
+                bias_at: 0,
+                activation: derivative,
+                held_at: 0,
+                pre_at: tape.pre(i - 1).span.offset,
+            })
+            .collect();
+        let fused = last > 0 && fits(gpu, &stages);
+        let words = layers.iter().map(|(l, _)| held_halves(rows, l.d_out) / 2);
+        let dz = held_rows(gpu, words, fused);
+        let dz32 = (f32_first && last > 0).then(|| gpu.buffer(rows * layers[0].0.d_out));
+        let out_width = layers[last].0.d_out;
+        if fused {
+            for (stage, i) in stages.iter_mut().zip((1..=last).rev()) {
+                stage.held_at = 2 * dz[i - 1].1.offset;
+            }
+            let io = FusedIo {
+                rows,
+                x: Held::F32(d_last),
+                x_cols: out_width,
+                bias0: Bias::None,
+                biases: None,
+                y16: Some(&dz[0].0),
+                out16: true,
+                kept_input: Some(2 * dz[last].1.offset),
+                y32: dz32.as_ref(),
+                pre: Some((tape.pre(0).buffer, false)),
+            };
+            plan.push(half_mlp(gpu, &stages, &io));
+            return (dz, dz32);
+        }
+        plan.push(gpu.half_rows([rows, out_width, out_width], d_last, &part(&dz, last)));
+        for i in (1..=last).rev() {
+            let pre = tape.pre(i - 1);
+            let out = HalfOut {
+                z: Some(&pre),
+                y16: Some(&part(&dz, i - 1)),
+                y32: dz32.as_ref().filter(|_| i == 1).map(|d| d as &dyn Bind),
+            };
+            let (layer, copies) = layers[i];
+            let g = (&part(&dz, i) as &dyn Bind, pad16(layer.d_out));
+            let t = &copies.transposed;
             plan.push(half_train_layer(
                 gpu,
                 rows,
-                (g16, n_pad),
-                &copies.transposed,
+                g,
+                t,
                 Bias::None,
                 derivative,
                 out,
             ));
         }
+        (dz, dz32)
     }
 
     /// Records a weight's gradient, `[m, n, rows]`: xᵀ·dz over the rows (f16 operands), per
@@ -150,7 +208,7 @@ impl Trainable<'_> {
         plan: &mut Vec<Dispatch>,
         [m, n, rows]: [usize; 3],
         x: &dyn Bind,
-        dz: &wgpu::Buffer,
+        dz: &dyn Bind,
         offset: usize,
         bias: Option<usize>,
     ) {

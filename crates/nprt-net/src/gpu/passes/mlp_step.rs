@@ -1,14 +1,13 @@
-//! An MLP's share of a training step: the buffers its forward pass keeps for backward, and its
-//! backward pass into every layer's gradients (the weights' summed over chunks of rows).
+//! An MLP's share of a training step: its backward pass into every layer's gradients (the
+//! weights' summed over chunks of rows) from what its forward pass kept (`MlpTape`).
 
 use crate::gpu::kernels::GEMM_TILE;
+use crate::gpu::layers::mlp_tape::MlpTape;
 use crate::gpu::layers::network_layout::MlpAt;
 use crate::gpu::products::codes::{activation_code, BACKWARD};
 use crate::gpu::products::dense_products::DenseProducts;
-use crate::gpu::products::half_layers::held_halves;
-use crate::gpu::products::half_mlp::Kept;
 use crate::gpu::products::operands::{Bias, Operand, Output};
-use nprt_gpu::{Bind, Dispatch, GpuDevice, Part, Span};
+use nprt_gpu::{Bind, Dispatch, GpuDevice};
 
 /// A weight gradient's product is split into chunks of at least ROW_CHUNK rows, at most
 /// ROW_CHUNKS of them (a 256 × 256 layer at batch 16,384: 32 chunks of 512 rows, 512
@@ -29,66 +28,6 @@ pub(crate) fn row_chunks(rows: usize, align: usize) -> [usize; 2] {
 /// What takes a first layer's bias gradient, given the gradient at its pre-activation.
 pub type FirstLayerBias<'a> = &'a dyn Fn(&mut Vec<Dispatch>, &wgpu::Buffer);
 
-/// What an MLP's forward pass keeps for backward: each hidden layer's output and
-/// pre-activation, the last layer's output, and in a mixed-precision step the input as f16 rows
-/// too (the hidden outputs are f16 rows there, `half_products`). The pre-activations share a
-/// buffer, each from an offset a kernel can bind alone. So do the input and hidden outputs
-/// where a fused pass writes them all in one dispatch (`half_mlp`); elsewhere each has a buffer
-/// of its own, since a layer a dispatch reads the layer before's output while it writes its
-/// own, and a dispatch cannot bind one buffer both ways.
-pub struct MlpTape {
-    pub rows: usize,
-    pub output: wgpu::Buffer,
-    /// The input's f16 rows first in a mixed-precision step, then the hidden outputs.
-    held: Vec<(wgpu::Buffer, Span)>,
-    pre: wgpu::Buffer,
-    pre_at: Vec<Span>,
-    half: bool,
-}
-
-impl MlpTape {
-    /// Hidden layer `i`'s output: f32 rows, or f16 rows as `Held::F16` holds them.
-    pub fn hidden(&self, i: usize) -> Part<'_> {
-        self.held(i + usize::from(self.half))
-    }
-
-    /// Hidden layer `i`'s pre-activation, f32 rows.
-    pub fn pre(&self, i: usize) -> Part<'_> {
-        Part {
-            buffer: &self.pre,
-            span: self.pre_at[i],
-        }
-    }
-
-    /// The input as f16 rows, in a mixed-precision step.
-    pub fn input16(&self) -> Option<Part<'_>> {
-        self.half.then(|| self.held(0))
-    }
-
-    /// Where a fused forward pass writes this tape (`half_mlp`), its f16 rows' places counted
-    /// in halves; `None` for a tape a layer a dispatch writes.
-    pub fn kept(&self) -> Option<Kept<'_>> {
-        let (buffer, input) = self.held.first().filter(|_| self.half)?;
-        let shared = self.held.iter().all(|(b, _)| b == buffer);
-        shared.then(|| Kept {
-            held: buffer,
-            pre: &self.pre,
-            input_at: 2 * input.offset,
-            layers: (self.held[1..].iter().zip(&self.pre_at))
-                .map(|((_, h), z)| [2 * h.offset, z.offset])
-                .collect(),
-        })
-    }
-
-    fn held(&self, i: usize) -> Part<'_> {
-        let (buffer, span) = &self.held[i];
-        Part {
-            buffer,
-            span: *span,
-        }
-    }
-}
-
 /// What an MLP's training records against: the device, the flat parameters it reads and the
 /// gradients it writes (a design's trainer's, or the radiance cache's).
 pub struct Trainable<'a> {
@@ -98,57 +37,6 @@ pub struct Trainable<'a> {
 }
 
 impl Trainable<'_> {
-    /// Buffers for an MLP's forward pass over `rows` rows; in a mixed-precision step its input
-    /// and hidden layers' outputs as f16 rows (`half_products`), in one buffer where a fused
-    /// pass runs the MLP.
-    pub fn tape(&self, m: &MlpAt, rows: usize) -> MlpTape {
-        let half = !m.half.is_empty();
-        let last = m.layers.len() - 1;
-        // f16 rows take half a word a value (a held row block is a whole number of words).
-        let words = |width: usize| match half {
-            true => held_halves(rows, width) / 2,
-            false => rows * width,
-        };
-        let input = half.then(|| words(m.half[0].count));
-        let widths = m.layers[..last].iter().map(|l| l.d_out);
-        let held_words = input.into_iter().chain(widths.clone().map(words));
-        let held = match half && m.fuses(self.gpu) {
-            true => {
-                let (spans, end) = self.spans(held_words);
-                let buffer = self.gpu.buffer(end);
-                let shared = spans.into_iter().map(|s| (buffer.clone(), s));
-                shared.collect()
-            }
-            false => held_words
-                .map(|len| (self.gpu.buffer(len.max(1)), Span { offset: 0, len }))
-                .collect(),
-        };
-        let (pre_at, pre_end) = self.spans(widths.map(|d| rows * d));
-        MlpTape {
-            rows,
-            output: self.gpu.buffer(rows * m.layers[last].d_out),
-            held,
-            pre: self.gpu.buffer(pre_end),
-            pre_at,
-            half,
-        }
-    }
-
-    /// Spans of `lens` words one after another, each from a multiple of the device's
-    /// storage-binding alignment, and the words they take (at least one).
-    fn spans(&self, lens: impl Iterator<Item = usize>) -> (Vec<Span>, usize) {
-        let align = self.gpu.device.limits().min_storage_buffer_offset_alignment as usize / 4;
-        let mut end = 0;
-        let spans = lens
-            .map(|len| {
-                let offset = end;
-                end = (offset + len).next_multiple_of(align.max(1));
-                Span { offset, len }
-            })
-            .collect();
-        (spans, end.max(1))
-    }
-
     /// Records the backward pass of `m` from the gradient `d_last` at its output: every
     /// layer's weight and bias gradient into `grads`, and the gradient at its input into
     /// `d_input` where given. `input` is what the first layer read: the buffer, its first

@@ -1,17 +1,19 @@
-//! A whole MLP's forward pass in half precision in one dispatch, a frame's or a training step's
-//! (`half_mlp.wgsl`, after tiny-cuda-nn's fully fused MLP): a workgroup takes 64 rows through
-//! every layer, their activations kept in workgroup memory between layers; a training step's
-//! pass also writes what backward reads (the input and each hidden layer's output as f16 rows,
-//! and its pre-activation). Where the adapter
-//! has cooperative matrices the products run on tensor cores (`half_mlp_coop`), elsewhere
-//! without (`half_mlp_plain`). An MLP it cannot hold (a layer wider than 256 or more than 8
-//! layers), or an adapter with less workgroup memory than it takes (32 KiB, 36 on tensor
-//! cores), runs a layer a dispatch instead (`half_layers`).
+//! An MLP's layers in half precision in one dispatch (`half_mlp.wgsl`, after tiny-cuda-nn's
+//! fully fused MLP): a workgroup takes 64 rows through every layer, their activations kept in
+//! workgroup memory between layers. Three passes use it: a frame's forward pass; a training
+//! step's, which also writes what backward reads (the input and each hidden layer's output
+//! as f16 rows, and its pre-activation); and a training step's input gradients from the last
+//! layer down, on the transposed weights, each layer's gradient times the activation's
+//! derivative at the pre-activation the forward pass kept, and kept for the weight gradients.
+//! Where the adapter has cooperative matrices the products run on tensor cores
+//! (`half_mlp_coop`), elsewhere without (`half_mlp_plain`). An MLP it cannot hold (a layer
+//! wider than 256 or more than 8 layers), or an adapter with less workgroup memory than it
+//! takes (32 KiB, 36 on tensor cores), runs a layer a dispatch instead (`half_layers`).
 
 use crate::gpu::kernels::{HALF_MLP_COOP, HALF_MLP_PLAIN};
 use crate::gpu::products::half_layers::{pad16, HalfWeight, Held, HALF_ROW_BLOCK};
 use crate::gpu::products::operands::Bias;
-use nprt_gpu::{Dispatch, GpuDevice};
+use nprt_gpu::{Bind, Dispatch, GpuDevice};
 
 /// The widest layer input or output (padded to 16) a fused pass holds, its most layers, and the
 /// rows a workgroup takes.
@@ -21,12 +23,17 @@ const ROWS: usize = 64;
 
 /// One layer of a fused pass: its f16 weight (in the buffer the pass's layers share), its
 /// input's padded width, where its bias starts in the pass's biases (the first layer's has its
-/// own binding) and its activation (0 linear, 1 ReLU, 2 SIREN).
+/// own binding), its activation (`half_mlp.wgsl`'s codes: 0 linear, 1 ReLU, 2 SIREN; 3 and 4
+/// their derivatives, backward) and, in training, where its f16 output lies in
+/// [`FusedIo::y16`] and its pre-activation in [`FusedIo::pre`] (values from the buffer's
+/// start, each place a multiple of the storage-binding alignment).
 pub struct FusedLayer<'a> {
     pub weight: &'a HalfWeight,
     pub k_pad: usize,
     pub bias_at: usize,
     pub activation: u32,
+    pub held_at: usize,
+    pub pre_at: usize,
 }
 
 /// Workgroup memory a fused pass takes: its rows' activations as f16, and on tensor cores a
@@ -52,72 +59,55 @@ pub fn fits(gpu: &GpuDevice, layers: &[FusedLayer]) -> bool {
             .all(|l| l.k_pad <= MAX_WIDTH && l.weight.n_pad <= MAX_WIDTH)
 }
 
-/// Where a training step's fused pass keeps what backward reads: the input as f16 rows from
-/// `input_at` of `held`, and per hidden layer `[its f16 output's start in held, its
-/// pre-activation's in pre]` (in values, each a multiple of the storage-binding alignment).
-pub struct Kept<'a> {
-    pub held: &'a wgpu::Buffer,
-    pub pre: &'a wgpu::Buffer,
-    pub input_at: usize,
-    pub layers: Vec<[usize; 2]>,
+/// What a fused pass reads and writes beside its layers' weights.
+pub struct FusedIo<'a> {
+    pub rows: usize,
+    /// f32 rows of `x_cols` values (made f16 as they are read), or f16 rows of the first
+    /// layer's padded width.
+    pub x: Held<'a>,
+    pub x_cols: usize,
+    /// The first layer's bias, and the buffer the others' lie in (`None`: they have none, as
+    /// in a backward pass).
+    pub bias0: Bias<'a>,
+    pub biases: Option<&'a wgpu::Buffer>,
+    /// f16 rows padded as [`Held::F16`] holds them, each layer's from its `held_at`: the last
+    /// layer's output where `out16`, and with `kept_input` (its place) the input and every
+    /// hidden layer's output too (what a training step's backward reads).
+    pub y16: Option<&'a wgpu::Buffer>,
+    pub out16: bool,
+    pub kept_input: Option<usize>,
+    /// The last layer's output as f32 rows of its width.
+    pub y32: Option<&'a wgpu::Buffer>,
+    /// The hidden layers' pre-activations, each from its `pre_at`: kept by a training forward
+    /// pass (`true`), read by a backward pass's derivatives (`false`).
+    pub pre: Option<(&'a wgpu::Buffer, bool)>,
 }
 
-/// The dispatch of `layers` over `rows` rows of `x` into `y`: `x` f32 rows of `x_cols` values
-/// (made f16 as they are read) or f16 rows of the first layer's padded width; `y` the last
-/// layer's f32 rows of its width or f16 rows padded as [`Held::F16`] holds them. `bias0` is the
-/// first layer's bias, `biases` the buffer the others' lie in; with `kept` (training, an f32
-/// input and output) the pass also writes what backward reads there. The layers must
-/// [`fits`].
-#[allow(clippy::too_many_arguments)]
-pub fn half_mlp(
-    gpu: &GpuDevice,
-    rows: usize,
-    (x, x_cols): (Held, usize),
-    layers: &[FusedLayer],
-    bias0: Bias,
-    biases: &wgpu::Buffer,
-    y: Held,
-    kept: Option<&Kept>,
-) -> Dispatch {
+/// The dispatch of `layers` over `io`'s rows (`half_mlp.wgsl`). The layers must [`fits`].
+pub fn half_mlp(gpu: &GpuDevice, layers: &[FusedLayer], io: &FusedIo) -> Dispatch {
     assert!(fits(gpu, layers), "an MLP a fused pass cannot hold");
-    let (x16, x32, x_f32) = match x {
+    let (x16, x32, x_f32) = match io.x {
         Held::F16(b) => (b, &gpu.empty, 0),
         Held::F32(b) => (&gpu.empty, b, 1),
     };
-    let (mut y16, y32, half_out) = match y {
-        Held::F16(b) => (b, &gpu.spare, 1),
-        Held::F32(b) => (&gpu.spare, b, 0),
-    };
-    let (bias0_mode, bias0, bias0_at, group_of) = bias0.binding(gpu);
-    let (mut z, mut input_at) = (&gpu.spare, 0);
+    let (bias0_mode, bias0, bias0_at, group_of) = io.bias0.binding(gpu);
+    let mut params = vec![io.rows, layers.len(), x_f32, io.x_cols];
+    params.extend([io.out16, io.y32.is_some(), io.kept_input.is_some()].map(usize::from));
+    params.extend([
+        usize::from(io.pre.is_some_and(|(_, keep)| keep)),
+        io.kept_input.unwrap_or(0),
+        bias0_mode,
+        bias0_at,
+        usize::from(io.biases.is_some()),
+    ]);
     let mut shape = [[0; 4]; MAX_LAYERS];
     let mut at = [[0; 4]; MAX_LAYERS];
-    if let Some(k) = kept {
-        assert!(
-            x_f32 == 1 && half_out == 0,
-            "a training pass from f32 rows to f32 rows"
-        );
-        (y16, z, input_at) = (k.held, k.pre, k.input_at);
-        for (at, &[held_at, pre_at]) in at.iter_mut().zip(&k.layers) {
-            at[2..].copy_from_slice(&[held_at, pre_at]);
-        }
-    }
     for (i, l) in layers.iter().enumerate() {
         let w = l.weight;
         debug_assert_eq!(l.k_pad, pad16(l.k_pad));
         shape[i] = [l.k_pad, w.d_out, w.n_pad, l.activation as usize];
-        at[i][..2].copy_from_slice(&[w.offset, l.bias_at]);
+        at[i] = [w.offset, l.bias_at, l.held_at, l.pre_at];
     }
-    let mut params = vec![rows, layers.len(), x_f32, x_cols, half_out];
-    params.extend([
-        usize::from(kept.is_some()),
-        input_at,
-        bias0_mode,
-        bias0_at,
-        0,
-        0,
-        0,
-    ]);
     params.extend(shape.iter().chain(&at).flatten());
     let kernel = match gpu.tensor_cores {
         true => &HALF_MLP_COOP,
@@ -125,14 +115,21 @@ pub fn half_mlp(
     };
     // Every row the f16 buffers hold (a multiple of HALF_ROW_BLOCK), as a layer a dispatch
     // writes them.
-    let groups = rows.next_multiple_of(HALF_ROW_BLOCK) / ROWS;
+    let groups = io.rows.next_multiple_of(HALF_ROW_BLOCK) / ROWS;
     let weights = &layers[0].weight.buffer;
-    gpu.prepare(
-        kernel,
-        &params.iter().map(|&v| v as u32).collect::<Vec<_>>(),
-        &[x16, x32, weights, bias0, biases, group_of, y16, y32, z],
-        [groups as u32, 1],
-    )
+    let buffers: [&dyn Bind; 9] = [
+        x16,
+        x32,
+        weights,
+        bias0,
+        io.biases.unwrap_or(&gpu.empty),
+        group_of,
+        io.y16.unwrap_or(&gpu.spare),
+        io.y32.unwrap_or(&gpu.spare),
+        io.pre.map_or(&gpu.spare, |(b, _)| b),
+    ];
+    let params: Vec<u32> = params.iter().map(|&v| v as u32).collect();
+    gpu.prepare(kernel, &params, &buffers, [groups as u32, 1])
 }
 
 #[cfg(test)]
@@ -156,6 +153,7 @@ mod tests {
     struct Mlp {
         shapes: Vec<[usize; 2]>,
         weights: Vec<HalfWeight>,
+        transposed: Vec<HalfWeight>,
         host: Vec<(Vec<f32>, Vec<f32>)>,
         params: wgpu::Buffer,
         bias_at: Vec<usize>,
@@ -165,6 +163,8 @@ mod tests {
         fn new(gpu: &GpuDevice, widths: &[usize]) -> Self {
             let shapes: Vec<[usize; 2]> = widths.windows(2).map(|w| [w[0], w[1]]).collect();
             let weights = gpu.half_weights(&shapes);
+            let flipped: Vec<[usize; 2]> = shapes.iter().map(|&[i, o]| [o, i]).collect();
+            let transposed = gpu.half_weights(&flipped);
             let mut host = Vec::new();
             let mut biases = vec![0.0; 64];
             let mut bias_at = Vec::new();
@@ -174,6 +174,13 @@ mod tests {
                 let bits = half_weight_bits(&weight, d_in, d_out);
                 gpu.queue
                     .write_buffer(&w.buffer, 2 * w.offset as u64, bytemuck::cast_slice(&bits));
+                let t = &transposed[l];
+                let flip: Vec<f32> = (0..d_in * d_out)
+                    .map(|e| weight[e % d_in * d_out + e / d_in])
+                    .collect();
+                let bits = half_weight_bits(&flip, d_out, d_in);
+                gpu.queue
+                    .write_buffer(&t.buffer, 2 * t.offset as u64, bytemuck::cast_slice(&bits));
                 let bias: Vec<f32> = (0..d_out).map(|j| value(j + 3 * l, 0.2)).collect();
                 bias_at.push(biases.len());
                 biases.extend(&bias);
@@ -184,19 +191,26 @@ mod tests {
             Mlp {
                 shapes,
                 weights,
+                transposed,
                 host,
                 params,
                 bias_at,
             }
         }
 
-        fn layers(&self) -> Vec<FusedLayer<'_>> {
+        /// The forward pass's layers, the hidden ones' places in a tape from `kept`.
+        fn layers(&self, kept: &[[usize; 2]]) -> Vec<FusedLayer<'_>> {
             (self.weights.iter().enumerate())
-                .map(|(l, w)| FusedLayer {
-                    weight: w,
-                    k_pad: pad16(self.shapes[l][0]),
-                    bias_at: self.bias_at[l],
-                    activation: u32::from(l + 1 < self.shapes.len()),
+                .map(|(l, w)| {
+                    let [held_at, pre_at] = kept.get(l).copied().unwrap_or_default();
+                    FusedLayer {
+                        weight: w,
+                        k_pad: pad16(self.shapes[l][0]),
+                        bias_at: self.bias_at[l],
+                        activation: u32::from(l + 1 < self.shapes.len()),
+                        held_at,
+                        pre_at,
+                    }
                 })
                 .collect()
         }
@@ -292,15 +306,20 @@ mod tests {
             true => gpu.half_buffer(held_halves(rows, last)),
             false => gpu.buffer(rows * last),
         };
-        let y = match half_out {
-            true => Held::F16(&out),
-            false => Held::F32(&out),
-        };
         let bias0 = gpu.upload(&mlp.host[0].1);
-        let (layers, bias0) = (mlp.layers(), Bias::Column(&bias0, 0));
-        let x = (x_held, widths[0]);
-        let dispatch = half_mlp(&gpu, rows, x, &layers, bias0, &mlp.params, y, None);
-        gpu.submit([&dispatch]);
+        let io = FusedIo {
+            rows,
+            x: x_held,
+            x_cols: widths[0],
+            bias0: Bias::Column(&bias0, 0),
+            biases: Some(&mlp.params),
+            y16: half_out.then_some(&out),
+            out16: half_out,
+            kept_input: None,
+            y32: (!half_out).then_some(&out),
+            pre: None,
+        };
+        gpu.submit([&half_mlp(&gpu, &mlp.layers(&[]), &io)]);
         let got: Vec<f32> = match half_out {
             true => {
                 let held = held_rows(&gpu, &out, 0, rows, last);
@@ -392,31 +411,23 @@ mod tests {
             pre_at[1] + rows * 172 + 64,
         );
         let canary = -7.0;
-        let held = gpu.upload(&vec![
-            half::f16::from_f32(canary).to_bits();
-            held_at[1] + held_len(172) + 256
-        ]);
+        let held = gpu.upload(&vec![half::f16::from_f32(canary).to_bits(); held_end]);
         let pre = gpu.upload(&vec![canary; pre_end]);
         let out = gpu.buffer(rows * 3);
-        let kept = Kept {
-            held: &held,
-            pre: &pre,
-            input_at,
-            layers: vec![[held_at[0], pre_at[0]], [held_at[1], pre_at[1]]],
-        };
-        let layers = mlp.layers();
-        let bias = Bias::Group(&bias0, &groups);
-        let dispatch = half_mlp(
-            &gpu,
+        let kept = [[held_at[0], pre_at[0]], [held_at[1], pre_at[1]]];
+        let io = FusedIo {
             rows,
-            (Held::F32(&x), 64),
-            &layers,
-            bias,
-            &mlp.params,
-            Held::F32(&out),
-            Some(&kept),
-        );
-        gpu.submit([&dispatch]);
+            x: Held::F32(&x),
+            x_cols: 64,
+            bias0: Bias::Group(&bias0, &groups),
+            biases: Some(&mlp.params),
+            y16: Some(&held),
+            out16: false,
+            kept_input: Some(input_at),
+            y32: Some(&out),
+            pre: Some((&pre, true)),
+        };
+        gpu.submit([&half_mlp(&gpu, &mlp.layers(&kept), &io)]);
         let want = mlp.host_layers(&values, rows, &|i| rows_of_bias[group[i] as usize].clone());
         let input = held_rows(&gpu, &held, input_at, rows, 64);
         let want_input: Vec<f32> = padded(&values, rows, 64)
@@ -456,6 +467,136 @@ mod tests {
         assert!(
             pre_outside.clone().all(|e| pre_got[e] == canary),
             "a pre-activation written outside its place"
+        );
+    }
+
+    /// A training step's fused backward pass (`half_products`' input gradients: D/S's shading
+    /// network, 64 → 172 → 172 → 3, from the last layer down to the first's output, on the
+    /// transposed weights) against the host: the gradient at the output kept as held f16
+    /// rows, each layer's gradient at its pre-activation (times ReLU's derivative at the
+    /// pre-activations the forward pass kept) as held f16 rows, the first layer's as f32 rows
+    /// too, each within 1% of its largest value; nothing written outside its place.
+    #[test]
+    fn a_backward_pass_keeps_every_layers_gradient() {
+        if !GpuDevice::probe() || !GpuDevice::get().unwrap().half {
+            return;
+        }
+        let gpu = GpuDevice::get().unwrap();
+        let (widths, rows) = ([64, 172, 172, 3], 300);
+        let mlp = Mlp::new(&gpu, &widths);
+        let values: Vec<f32> = (0..rows * widths[0]).map(|i| value(i, 2.0)).collect();
+        let forward = mlp.host_layers(&values, rows, &|_| mlp.host[0].1.clone());
+        let d_last: Vec<f32> = (0..rows * 3).map(|i| value(i + 5, 0.5)).collect();
+        let canary = -7.0;
+        // The pre-activations where the forward pass keeps them, canaries around them.
+        let pre_at = [64, 64 + rows * 172 + 64];
+        let mut pre_values = vec![canary; pre_at[1] + rows * 172 + 64];
+        for l in 0..2 {
+            pre_values[pre_at[l]..pre_at[l] + rows * 172].copy_from_slice(&forward[l][0]);
+        }
+        let pre = gpu.upload(&pre_values);
+        // The gradients' places: at the output, then at layers 1 and 0.
+        let held_len = |w: usize| held_halves(rows, w);
+        let out_at = 256;
+        let at1 = out_at + held_len(3) + 256;
+        let at0 = at1 + held_len(172) + 256;
+        let held_end = at0 + held_len(172) + 256;
+        let held = gpu.upload(&vec![half::f16::from_f32(canary).to_bits(); held_end]);
+        let dz32 = gpu.buffer(rows * 172);
+        let stage = |l: usize, held_at: usize| FusedLayer {
+            weight: &mlp.transposed[l],
+            k_pad: pad16(widths[l + 1]),
+            bias_at: 0,
+            activation: 3,
+            held_at,
+            pre_at: pre_at[l - 1],
+        };
+        let io = FusedIo {
+            rows,
+            x: Held::F32(&gpu.upload(&d_last)),
+            x_cols: 3,
+            bias0: Bias::None,
+            biases: None,
+            y16: Some(&held),
+            out16: true,
+            kept_input: Some(out_at),
+            y32: Some(&dz32),
+            pre: Some((&pre, false)),
+        };
+        gpu.submit([&half_mlp(&gpu, &[stage(2, at1), stage(1, at0)], &io)]);
+        // The host's: each gradient from the one above as f16, times Wᵀ, times ReLU'.
+        let back = |g: &[f32], l: usize| -> Vec<f32> {
+            let [d_in, d_out] = mlp.shapes[l];
+            let w = &mlp.host[l].0;
+            let z = &forward[l - 1][0];
+            (0..rows * d_in)
+                .map(|e| {
+                    let (i, k) = (e / d_in, e % d_in);
+                    let sum: f32 = (0..d_out)
+                        .map(|j| g[i * d_out + j] * w[k * d_out + j])
+                        .sum();
+                    if z[e] > 0.0 {
+                        sum
+                    } else {
+                        0.0
+                    }
+                })
+                .collect()
+        };
+        let round = |v: &[f32]| v.iter().map(|&v| round16(v)).collect::<Vec<_>>();
+        let g2 = round(&d_last);
+        let g1 = back(&g2, 2);
+        let g0 = back(&round(&g1), 1);
+        let errors = [
+            (
+                "output's",
+                relative(
+                    &held_rows(&gpu, &held, out_at, rows, 3),
+                    &padded(&g2, rows, 3),
+                ),
+            ),
+            (
+                "layer 1's",
+                relative(
+                    &held_rows(&gpu, &held, at1, rows, 172),
+                    &padded(&round(&g1), rows, 172),
+                ),
+            ),
+            (
+                "layer 0's",
+                relative(
+                    &held_rows(&gpu, &held, at0, rows, 172),
+                    &padded(&round(&g0), rows, 172),
+                ),
+            ),
+            ("layer 0's f32", relative(&gpu.read(&dz32, rows * 172), &g0)),
+        ];
+        eprintln!("gradients within {errors:?} of each one's largest value");
+        for (what, error) in errors {
+            assert!(
+                error < 1e-2,
+                "the {what} gradient: off by {error} of its largest value"
+            );
+        }
+        let words = gpu.read(&held, held_end / 2);
+        let bits: &[u16] = bytemuck::cast_slice(&words);
+        let places = [
+            (out_at, held_len(3)),
+            (at1, held_len(172)),
+            (at0, held_len(172)),
+        ];
+        let outside =
+            (0..held_end).filter(|&e| !places.iter().any(|&(a, n)| (a..a + n).contains(&e)));
+        assert!(
+            outside
+                .clone()
+                .all(|e| half::f16::from_bits(bits[e]).to_f32() == canary),
+            "an f16 value written outside its place"
+        );
+        assert_eq!(
+            gpu.read(&pre, pre_values.len()),
+            pre_values,
+            "the pre-activations changed"
         );
     }
 }

@@ -16,24 +16,27 @@ struct HalfMlp {
     // does, f16 rows of the first layer's k_pad values.
     x_f32: u32,
     x_cols: u32,
-    // 1: the last layer writes y16 (f16 rows of its n_pad values, the next network's input,
-    // from at.z); 0: y32 (f32 rows of its n values).
-    half_out: u32,
+    // What the last layer writes: 1 in out16, f16 rows of its n_pad values from its at.z of y16
+    // (the next network's input, or a backward pass's gradient at the first layer's output);
+    // 1 in out32, f32 rows of its n values in y32.
+    out16: u32,
+    out32: u32,
     // 1 (a training step's pass): the input is also kept, as f16 rows from in_at of y16, and
-    // each hidden layer's output, as f16 rows from its at.z of y16 (zeros past the rows, so
-    // that a weight's gradient summed over the held rows adds nothing there), and its
-    // pre-activation, f32 rows of n from its at.w of z.
+    // each hidden layer's output, as f16 rows from its at.z of y16.
     keep: u32,
+    // 1 (a training step's forward pass): each hidden layer's pre-activation is kept, f32 rows
+    // of n from its at.w of z, which a backward pass's derivatives read there.
+    keep_z: u32,
     in_at: u32,
-    // The first layer's bias: 1: bias0[bias0_at + j]; 2: bias0[group_of[i] · n + j] (the light
-    // code's share of a shading network's first layer in training, a row per view).
+    // The first layer's bias: 0 none; 1 bias0[bias0_at + j]; 2 bias0[group_of[i] · n + j] (the
+    // light code's share of a shading network's first layer in training, a row per view).
     bias0_mode: u32,
     bias0_at: u32,
-    _pad0: u32,
-    _pad1: u32,
-    _pad2: u32,
+    // 1: the other layers add their bias from bias; 0 (a backward pass): none.
+    hidden_bias: u32,
     // Per layer: its input's padded width k_pad, its outputs n, their padding n_pad (both
-    // multiples of 16, at most ACT), its activation (0 linear, 1 ReLU, 2 SIREN).
+    // multiples of 16, at most ACT), its activation: 0 linear, 1 ReLU, 2 SIREN, sin(30 v);
+    // backward, times the derivative at the pre-activation z holds: 3 ReLU's, 4 SIREN's.
     shape: array<vec4<u32>, 8>,
     // Per layer: where its weight starts in w, its bias in bias (layer 0's is bias0's), its f16
     // output in y16 and its pre-activation in z.
@@ -87,9 +90,10 @@ fn stage_input(t: u32) {
 }
 
 // Finishes the current layer's output (r, j), r among the workgroup's rows, from its sum: into
-// `act` for the next layer (and, in training, the tape), the last layer's into y16 or y32.
-// Padding columns get zeros, so that the next layer's padded k adds nothing. f16 values
-// saturate at ±65504 rather than overflow to infinity.
+// `act` for the next layer (and, in training, the tape), the last layer's into y16 and/or y32.
+// Padding columns and rows past the batch get zeros, so that the next layer's padded k adds
+// nothing, nor a weight's gradient summed over the held rows. f16 values saturate at ±65504
+// rather than overflow to infinity.
 fn finish(r: u32, j: u32, sum: f32) {
     let s = p.shape[layer];
     if (j >= s.z) {
@@ -97,36 +101,46 @@ fn finish(r: u32, j: u32, sum: f32) {
     }
     let i = row0 + r;
     let hidden = layer + 1u < p.layers;
+    let live = i < p.rows && j < s.y;
     var v = 0.0;
-    if (j < s.y) {
+    if (live) {
         v = sum;
         if (layer > 0u) {
-            v += bias[p.at[layer].y + j];
+            if (p.hidden_bias == 1u) {
+                v += bias[p.at[layer].y + j];
+            }
         } else if (p.bias0_mode == 1u) {
             v += bias0[p.bias0_at + j];
-        } else if (p.bias0_mode == 2u && i < p.rows) {
+        } else if (p.bias0_mode == 2u) {
             v += bias0[group_of[i] * s.y + j];
         }
-        if (p.keep == 1u && hidden && i < p.rows) {
-            z[p.at[layer].w + i * s.y + j] = v;
+        let at_z = p.at[layer].w + i * s.y + j;
+        if (p.keep_z == 1u && hidden) {
+            z[at_z] = v;
         }
         if (s.w == 1u) {
             v = max(v, 0.0);
         } else if (s.w == 2u) {
             v = sin(OMEGA_0 * v);
+        } else if (s.w == 3u) {
+            v = select(0.0, v, z[at_z] > 0.0);
+        } else if (s.w == 4u) {
+            v *= OMEGA_0 * cos(OMEGA_0 * z[at_z]);
         }
     }
     let h = f16(clamp(v, -F16_MAX, F16_MAX));
+    let at16 = p.at[layer].z + i * s.z + j;
     if (hidden) {
         act[r * ACT + j] = h;
         if (p.keep == 1u) {
-            y16[p.at[layer].z + i * s.z + j] = select(f16(0.0), h, i < p.rows);
+            y16[at16] = h;
         }
         return;
     }
-    if (p.half_out == 1u) {
-        y16[p.at[layer].z + i * s.z + j] = h;
-    } else if (i < p.rows && j < s.y) {
+    if (p.out16 == 1u) {
+        y16[at16] = h;
+    }
+    if (p.out32 == 1u && live) {
         y32[i * s.y + j] = v;
     }
 }

@@ -14,11 +14,12 @@ use crate::cpu::radiance_cache::encode_rest;
 use crate::encoding::features::FEATURES;
 use crate::encoding::hash_grid;
 use crate::gpu::kernels::{GRID_BACKWARD, RADIANCE_LOSS, TRACK_INPUTS};
+use crate::gpu::layers::mlp_tape::MlpTape;
 use crate::gpu::layers::network_forward::{FirstLayer, ForwardTargets};
 use crate::gpu::layers::network_layout::{mlp_at, MlpAt};
 use crate::gpu::layers::parameters::ParameterLayout;
 use crate::gpu::passes::device_adam::DeviceAdam;
-use crate::gpu::passes::mlp_step::{MlpTape, Trainable};
+use crate::gpu::passes::mlp_step::Trainable;
 use crate::gpu::products::codes::loss_code;
 use crate::gpu::products::dense_products::DenseProducts;
 use crate::gpu::products::half_layers::Held;
@@ -193,7 +194,7 @@ impl GpuCache {
             &[&features, &gpu.empty, &table, &self.resolutions, &x],
             groups_for(rows),
         )];
-        let tape = t.tape(&self.mlp, rows);
+        let tape = MlpTape::new(t.gpu, &self.mlp, rows);
         let first = FirstLayer {
             own_row: 0,
             count: INPUTS,

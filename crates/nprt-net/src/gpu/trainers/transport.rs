@@ -6,9 +6,9 @@
 use crate::encoding::hash_grid;
 use crate::gpu::kernels::{COMBINE, GRID_BACKWARD, RADIANCE_LOSS, TRACK_GRADIENT, TRANSFER_LOSS};
 use crate::gpu::layers::light_basis::{BasisAt, BasisFunctions};
+use crate::gpu::layers::mlp_tape::MlpTape;
 use crate::gpu::layers::network_forward::{FirstLayer, ForwardTargets};
 use crate::gpu::layers::network_layout::{LightAt, TrackAt};
-use crate::gpu::passes::mlp_step::MlpTape;
 use crate::gpu::products::codes::loss_code;
 use crate::gpu::products::dense_products::DenseProducts;
 use crate::gpu::products::half_layers::Held;
@@ -220,7 +220,7 @@ impl GpuTrainer {
         let (params, rows) = (&self.params, b.rows);
         plan.push(t.record_inputs(gpu, params, &self.resolutions, [&b.features, &x], rows));
         let transfer = t.transfer.as_ref().map(|m| {
-            let tape = self.trainable().tape(m, rows);
+            let tape = MlpTape::new(&self.gpu, m, rows);
             let first = FirstLayer {
                 own_row: 0,
                 count: t.width,
@@ -242,7 +242,7 @@ impl GpuTrainer {
             }
             Some(_) => Bias::Column(params, first.bias.offset),
         };
-        let shading = self.trainable().tape(&t.shading, rows);
+        let shading = MlpTape::new(&self.gpu, &t.shading, rows);
         let input = transfer.as_ref().map_or(&x, |tape| &tape.output);
         let first_layer = FirstLayer {
             own_row: t.code_and_own_rows().1,
