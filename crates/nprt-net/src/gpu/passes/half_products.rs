@@ -62,7 +62,8 @@ fn half_weight_grad(
         ];
         gpu.prepare_grid(&HALF_WEIGHT_GRAD_COOP, &params, &buffers, groups)
     } else {
-        let groups = groups_for(chunks * (m + bias) * n);
+        // 4 × 4 sums a thread.
+        let groups = groups_for(chunks * (m + bias).div_ceil(4) * n.div_ceil(4));
         gpu.prepare(&HALF_WEIGHT_GRAD, &params, &buffers, groups)
     }
 }
