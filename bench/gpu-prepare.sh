@@ -4,8 +4,9 @@
 # ignores it; about 50 MiB, inside a 64 MiB transfer):
 #   nprt        the release binary with the GPU kernels (`--features gpu`), stripped;
 #   tests/      the GPU kernels' correctness tests (nprt-net's gpu_training, gpu_unet, gpu_cache,
-#               nprt-render's gpu_frame: f32 and the f16/tensor-core paths against the CPU
-#               engine; nprt-trace's gpu_trace: the path tracer against the CPU's), stripped;
+#               gpu_frame: f32 and the f16/tensor-core paths against the CPU engine; nprt_net,
+#               its library's own tests, among them each tensor-core kernel's against the host;
+#               nprt-trace's gpu_trace: the path tracer against the CPU's), stripped;
 #   cooperative_matrix  nprt-render's bench of the tensor-core products (frame and training
 #               shapes), stripped;
 #   lib/        the Vulkan loader (libvulkan.so.1) and glvnd's libraries (Debian's), for a GPU
@@ -36,24 +37,29 @@ strip -o "$out/nprt" target/release/nprt
 echo "$(git rev-parse --short HEAD)$(git diff --quiet HEAD || echo ' with uncommitted changes')" >"$out/commit"
 
 # Test and bench executables: cargo prints each one's path as JSON; both profiles optimise.
+# Test `lib` is the package's library's own tests, named after the library.
 test_binary() {
   local command=$1 package=$2 features=$3 test=$4
-  cargo "$command" -p "$package" --features "$features" --"$command" "$test" --no-run \
+  local target=(--"$command" "$test") name=$test
+  if [ "$test" = lib ]; then target=(--lib) name=${package//-/_}; fi
+  cargo "$command" -p "$package" --features "$features" "${target[@]}" --no-run \
     --message-format=json 2>/dev/null |
     python3 -c 'import json, sys
 for line in sys.stdin:
     m = json.loads(line)
     if m.get("reason") == "compiler-artifact" and m.get("executable") and m["target"]["name"] == sys.argv[1]:
-        print(m["executable"])' "$test"
+        print(m["executable"])' "$name"
 }
 log "building the GPU kernels' tests"
 for spec in nprt-net:gpu:gpu_training nprt-net:gpu:gpu_unet nprt-net:gpu:gpu_cache \
-  nprt-net:gpu:gpu_frame \
+  nprt-net:gpu:gpu_frame nprt-net:gpu:lib \
   nprt-trace:gpu:gpu_trace; do
   IFS=: read -r package features test <<<"$spec"
   exe=$(test_binary test "$package" "$features" "$test")
   [ -x "$exe" ] || { log "no test executable for $spec"; exit 1; }
-  strip -o "$out/tests/$test" "$exe"
+  name=$test
+  [ "$test" = lib ] && name=${package//-/_}
+  strip -o "$out/tests/$name" "$exe"
 done
 log "building the cooperative-matrix benchmark"
 exe=$(test_binary bench nprt-render gpu cooperative_matrix)

@@ -39,8 +39,9 @@
 # The A/B base: the kernels before the latest changes to them that no GPU has timed yet (the
 # training step's f16 bias gradients made with their weights', a convolution's weight and bias
 # sums added in one pass, both f16 copies of a weight in one dispatch: 172 → 122 dispatches a
-# D/S f16 step; and a frame's MLPs fused into one dispatch each, `half_mlp`). Move it on when
-# a visit has timed them and another change follows.
+# D/S f16 step; a frame's MLPs fused into one dispatch each, `half_mlp`; a training step's MLPs
+# fused forward and backward: 122 → 102). Move it on when a visit has timed them and another
+# change follows.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
@@ -82,7 +83,7 @@ prepare() {
   log "packing .visit/bundle.tar.xz"
   XZ_OPT=-T0 tar -cJhf .visit/bundle.tar.xz --transform 's,^\.gpu,gpu,' --transform 's,^\.visit/,,' \
     .gpu/nprt .gpu/commit .gpu/nprt.commit "${base[@]}" .gpu/lib .gpu/tests/gpu_training \
-    .gpu/tests/gpu_frame .visit/kitchen .visit/envmaps
+    .gpu/tests/gpu_frame .gpu/tests/nprt_net .visit/kitchen .visit/envmaps
   du -h .visit/bundle.tar.xz
   log "ready: carry '.visit/bundle.tar.xz' and run 'bench/kitchen-visit.sh run' on the GPU machine"
 }
