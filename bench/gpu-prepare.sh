@@ -57,9 +57,9 @@ for spec in nprt-net:gpu:gpu_training nprt-net:gpu:gpu_unet nprt-net:gpu:gpu_cac
   IFS=: read -r package features test <<<"$spec"
   exe=$(test_binary test "$package" "$features" "$test")
   [ -x "$exe" ] || { log "no test executable for $spec"; exit 1; }
-  name=$test
-  [ "$test" = lib ] && name=${package//-/_}
-  strip -o "$out/tests/$name" "$exe"
+  # Named as cargo names it, less its hash: gpu_training, nprt_net (a library's tests).
+  exe_name=$(basename "$exe")
+  strip -o "$out/tests/${exe_name%-*}" "$exe"
 done
 log "building the cooperative-matrix benchmark"
 exe=$(test_binary bench nprt-render gpu cooperative_matrix)

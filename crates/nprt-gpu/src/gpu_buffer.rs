@@ -46,6 +46,12 @@ impl GpuDevice {
             .min(limits.max_buffer_size)
     }
 
+    /// The storage-binding alignment in 4-byte words (at least one): where a tensor bound on
+    /// its own (a [`crate::Part`]) may start.
+    pub fn binding_alignment(&self) -> usize {
+        (self.device.limits().min_storage_buffer_offset_alignment as usize / 4).max(1)
+    }
+
     /// A storage buffer holding `values` (f32, u32 or any plain words).
     pub fn upload<T: bytemuck::Pod>(&self, values: &[T]) -> wgpu::Buffer {
         // wgpu refuses empty bindings: an empty input still gets 16 bytes.

@@ -17,54 +17,12 @@ pub struct MlpTape {
     pub rows: usize,
     pub output: wgpu::Buffer,
     /// The input's f16 rows first in a mixed-precision step, then the hidden outputs.
-    held: Vec<(wgpu::Buffer, Span)>,
+    held: HeldRows,
     pre: wgpu::Buffer,
     pre_at: Vec<Span>,
     half: bool,
     /// Whether a fused pass writes it (its held rows in one buffer).
     fused: bool,
-}
-
-impl MlpTape {
-    /// Hidden layer `i`'s output: f32 rows, or f16 rows as `Held::F16` holds them.
-    pub fn hidden(&self, i: usize) -> Part<'_> {
-        self.held(i + usize::from(self.half))
-    }
-
-    /// Hidden layer `i`'s pre-activation, f32 rows.
-    pub fn pre(&self, i: usize) -> Part<'_> {
-        Part {
-            buffer: &self.pre,
-            span: self.pre_at[i],
-        }
-    }
-
-    /// The input as f16 rows, in a mixed-precision step.
-    pub fn input16(&self) -> Option<Part<'_>> {
-        self.half.then(|| self.held(0))
-    }
-
-    /// Where a fused forward pass writes this tape (`half_mlp`), its f16 rows' places counted
-    /// in halves; `None` for a tape a layer a dispatch writes.
-    pub fn kept(&self) -> Option<Kept<'_>> {
-        let (buffer, input) = self.held.first().filter(|_| self.fused)?;
-        Some(Kept {
-            held: buffer,
-            pre: &self.pre,
-            input_at: 2 * input.offset,
-            layers: (self.held[1..].iter().zip(&self.pre_at))
-                .map(|((_, h), z)| [2 * h.offset, z.offset])
-                .collect(),
-        })
-    }
-
-    fn held(&self, i: usize) -> Part<'_> {
-        let (buffer, span) = &self.held[i];
-        Part {
-            buffer,
-            span: *span,
-        }
-    }
 }
 
 /// Where a fused forward pass writes a tape (`half_mlp`): the buffer of f16 rows, the input's
@@ -105,21 +63,70 @@ impl MlpTape {
             fused,
         }
     }
+
+    /// Hidden layer `i`'s output: f32 rows, or f16 rows as `Held::F16` holds them.
+    pub fn hidden(&self, i: usize) -> Part<'_> {
+        self.held.part(i + usize::from(self.half))
+    }
+
+    /// Hidden layer `i`'s pre-activation, f32 rows.
+    pub fn pre(&self, i: usize) -> Part<'_> {
+        Part {
+            buffer: &self.pre,
+            span: self.pre_at[i],
+        }
+    }
+
+    /// The input as f16 rows, in a mixed-precision step.
+    pub fn input16(&self) -> Option<Part<'_>> {
+        self.half.then(|| self.held.part(0))
+    }
+
+    /// Where a fused forward pass writes this tape (`half_mlp`), its f16 rows' places counted
+    /// in halves; `None` for a tape a layer a dispatch writes.
+    pub fn kept(&self) -> Option<Kept<'_>> {
+        self.fused.then(|| {
+            let input = self.held.part(0);
+            Kept {
+                held: input.buffer,
+                pre: &self.pre,
+                input_at: 2 * input.span.offset,
+                layers: (self.held.0[1..].iter().zip(&self.pre_at))
+                    .map(|((_, h), z)| [2 * h.offset, z.offset])
+                    .collect(),
+            }
+        })
+    }
 }
 
 /// Spans of `lens` words one after another, each from a multiple of `gpu`'s storage-binding
 /// alignment, and the words they take (at least one).
 fn spans(gpu: &GpuDevice, lens: impl Iterator<Item = usize>) -> (Vec<Span>, usize) {
-    let align = gpu.device.limits().min_storage_buffer_offset_alignment as usize / 4;
+    let align = gpu.binding_alignment();
     let mut end = 0;
     let spans = lens
         .map(|len| {
             let offset = end;
-            end = (offset + len).next_multiple_of(align.max(1));
+            end = (offset + len).next_multiple_of(align);
             Span { offset, len }
         })
         .collect();
     (spans, end.max(1))
+}
+
+/// Rows a layer at a time, each bound alone (`held_rows`): a buffer each, or one buffer's
+/// parts.
+pub(crate) struct HeldRows(Vec<(wgpu::Buffer, Span)>);
+
+impl HeldRows {
+    /// Layer `i`'s rows.
+    pub fn part(&self, i: usize) -> Part<'_> {
+        let (buffer, span) = &self.0[i];
+        Part {
+            buffer,
+            span: *span,
+        }
+    }
 }
 
 /// Rows of `lens` words each: in one buffer at offsets a kernel can bind alone where `shared`
@@ -129,12 +136,12 @@ pub(crate) fn held_rows(
     gpu: &GpuDevice,
     lens: impl Iterator<Item = usize>,
     shared: bool,
-) -> Vec<(wgpu::Buffer, Span)> {
+) -> HeldRows {
     if !shared {
         let own = |len: usize| (gpu.buffer(len.max(1)), Span { offset: 0, len });
-        return lens.map(own).collect();
+        return HeldRows(lens.map(own).collect());
     }
     let (spans, end) = spans(gpu, lens);
     let buffer = gpu.buffer(end);
-    spans.into_iter().map(|s| (buffer.clone(), s)).collect()
+    HeldRows(spans.into_iter().map(|s| (buffer.clone(), s)).collect())
 }

@@ -19,8 +19,7 @@ impl ParameterLayout {
     /// of `gpu`'s storage-binding alignment (so a kernel can bind it on its own), and their
     /// values packed in it.
     pub fn pack_for<N: Parameters>(gpu: &GpuDevice, net: &N) -> (ParameterLayout, Vec<f32>) {
-        let align = gpu.device.limits().min_storage_buffer_offset_alignment as usize / 4;
-        Self::pack(net, align.max(1))
+        Self::pack(net, gpu.binding_alignment())
     }
 
     /// [`Self::pack_for`] at an alignment of `align` elements.

@@ -16,7 +16,7 @@
 //! light encoder, the hash grids and the light code's share stay in f32.
 
 use crate::gpu::kernels::{HALF_WEIGHT_GRAD, HALF_WEIGHT_GRAD_COOP};
-use crate::gpu::layers::mlp_tape::{held_rows, MlpTape};
+use crate::gpu::layers::mlp_tape::{held_rows, HeldRows, MlpTape};
 use crate::gpu::layers::network_layout::MlpAt;
 use crate::gpu::passes::mlp_step::{row_chunks, FirstLayerBias, Trainable};
 use crate::gpu::products::codes::{activation_code, BACKWARD};
@@ -26,7 +26,7 @@ use crate::gpu::products::half_layers::{
 };
 use crate::gpu::products::half_mlp::{fits, half_mlp, FusedIo, FusedLayer};
 use crate::gpu::products::operands::{Bias, Output};
-use nprt_gpu::{groups_for, Bind, Dispatch, GpuDevice, Part, Span};
+use nprt_gpu::{groups_for, Bind, Dispatch, GpuDevice};
 
 /// The dispatch of xᵀ·dz, `[m, n]`, over `rows` rows cut into chunks of `chunk` rows, chunk
 /// c's sums into `partial` from c · m' · n; with `bias`, m' = m + 1 and row m holds dz's
@@ -68,16 +68,6 @@ fn half_weight_grad(
     }
 }
 
-/// Rows a layer at a time: a buffer each, or one buffer's parts (`held_rows`).
-type HeldRows = Vec<(wgpu::Buffer, Span)>;
-
-fn part(rows: &HeldRows, i: usize) -> Part<'_> {
-    Part {
-        buffer: &rows[i].0,
-        span: rows[i].1,
-    }
-}
-
 impl Trainable<'_> {
     /// [`Self::mlp_backward`] in a mixed-precision step: the gradient at each layer's
     /// pre-activation (`layer_gradients`), then each weight's gradient with its bias's
@@ -104,7 +94,7 @@ impl Trainable<'_> {
                 plan,
                 [copies.count, layer.d_out, rows],
                 &x16,
-                &part(&dz, i),
+                &dz.part(i),
                 layer.weight.offset + copies.row * layer.d_out,
                 (!first_bias).then_some(layer.bias.offset),
             );
@@ -119,7 +109,7 @@ impl Trainable<'_> {
                 y16: None,
                 y32: Some(d),
             };
-            let g = (&part(&dz, 0) as &dyn Bind, pad16(layer.d_out));
+            let g = (&dz.part(0) as &dyn Bind, pad16(layer.d_out));
             let t = &copies.transposed;
             plan.push(half_train_layer(gpu, rows, g, t, Bias::None, 0, out));
         }
@@ -160,7 +150,7 @@ impl Trainable<'_> {
         let out_width = layers[last].0.d_out;
         if fused {
             for (stage, i) in stages.iter_mut().zip((1..=last).rev()) {
-                stage.held_at = 2 * dz[i - 1].1.offset;
+                stage.held_at = 2 * dz.part(i - 1).span.offset;
             }
             let io = FusedIo {
                 rows,
@@ -168,25 +158,25 @@ impl Trainable<'_> {
                 x_cols: out_width,
                 bias0: Bias::None,
                 biases: None,
-                y16: Some(&dz[0].0),
+                y16: Some(dz.part(0).buffer),
                 out16: true,
-                kept_input: Some(2 * dz[last].1.offset),
+                kept_input: Some(2 * dz.part(last).span.offset),
                 y32: dz32.as_ref(),
                 pre: Some((tape.pre(0).buffer, false)),
             };
             plan.push(half_mlp(gpu, &stages, &io));
             return (dz, dz32);
         }
-        plan.push(gpu.half_rows([rows, out_width, out_width], d_last, &part(&dz, last)));
+        plan.push(gpu.half_rows([rows, out_width, out_width], d_last, &dz.part(last)));
         for i in (1..=last).rev() {
             let pre = tape.pre(i - 1);
             let out = HalfOut {
                 z: Some(&pre),
-                y16: Some(&part(&dz, i - 1)),
+                y16: Some(&dz.part(i - 1)),
                 y32: dz32.as_ref().filter(|_| i == 1).map(|d| d as &dyn Bind),
             };
             let (layer, copies) = layers[i];
-            let g = (&part(&dz, i) as &dyn Bind, pad16(layer.d_out));
+            let g = (&dz.part(i) as &dyn Bind, pad16(layer.d_out));
             let t = &copies.transposed;
             plan.push(half_train_layer(
                 gpu,
