@@ -26,53 +26,83 @@ use crate::gpu::products::half_layers::{
 };
 use crate::gpu::products::half_mlp::{fits, half_mlp, FusedIo, FusedLayer};
 use crate::gpu::products::operands::{Bias, Output};
-use nprt_gpu::{groups_for, Bind, Dispatch, GpuDevice};
+use nprt_gpu::{groups_for, Bind, Dispatch, GpuDevice, Part};
 
-/// The dispatch of xᵀ·dz, `[m, n]`, over `rows` rows cut into chunks of `chunk` rows, chunk
-/// c's sums into `partial` from c · m' · n; with `bias`, m' = m + 1 and row m holds dz's
-/// column sums, the bias's gradient (`half_weight_sums.wgsl`).
-fn half_weight_grad(
+/// Layers a weight-gradient dispatch takes at most (`half_weight_sums.wgsl`'s tables).
+const GRAD_LAYERS: usize = 8;
+
+/// One layer of a weight-gradient pass: the gradient's `[m, n]`, its x rows and dz rows (f16,
+/// padded to 16 values a row, as [`Held::F16`] holds them), and where its weight's sums and,
+/// with a bias, its bias's start in a chunk's block.
+pub(crate) struct GradLayer<'a> {
+    pub shape: [usize; 2],
+    pub x: Part<'a>,
+    pub dz: Part<'a>,
+    pub w_at: usize,
+    pub b_at: Option<usize>,
+}
+
+/// The dispatches of `layers`' weight gradients, xᵀ·dz over `rows` rows cut into chunks of
+/// `chunk`, chunk c's sums into `partial` from c · stride, each layer's at its places
+/// (`half_weight_sums.wgsl`): one dispatch for up to [`GRAD_LAYERS`] consecutive layers whose x
+/// rows lie in one buffer and dz rows in another (a fused pass's), else a dispatch a layer.
+fn half_weight_grads(
     gpu: &GpuDevice,
-    [m, n, rows]: [usize; 3],
-    (x, k_pad): (&dyn Bind, usize),
-    (dz, n_pad): (&dyn Bind, usize),
-    [chunk, chunks]: [usize; 2],
-    bias: bool,
+    layers: &[GradLayer],
+    rows: usize,
+    [chunk, chunks, stride]: [usize; 3],
     partial: &wgpu::Buffer,
-) -> Dispatch {
-    let bias = usize::from(bias);
-    let params = [
-        rows.next_multiple_of(16),
-        chunk,
-        m,
-        n,
-        k_pad,
-        n_pad,
-        bias,
-        0,
-    ];
-    let params = params.map(|v| v as u32);
-    let buffers: [&dyn Bind; 3] = [x, dz, partial];
-    if gpu.tensor_cores {
-        // The bias's sums take a row of workgroups of their own.
-        let groups = [
-            n_pad.div_ceil(64) as u32,
-            (k_pad.div_ceil(256) + bias) as u32,
-            chunks as u32,
-        ];
-        gpu.prepare_grid(&HALF_WEIGHT_GRAD_COOP, &params, &buffers, groups)
-    } else {
-        // 4 × 4 sums a thread.
-        let groups = groups_for(chunks * (m + bias).div_ceil(4) * n.div_ceil(4));
-        gpu.prepare(&HALF_WEIGHT_GRAD, &params, &buffers, groups)
-    }
+) -> Vec<Dispatch> {
+    let shared =
+        |a: &GradLayer, b: &GradLayer| a.x.buffer == b.x.buffer && a.dz.buffer == b.dz.buffer;
+    (layers.chunk_by(shared))
+        .flat_map(|run| run.chunks(GRAD_LAYERS))
+        .map(|group| {
+            let mut shape = [[0; 4]; GRAD_LAYERS];
+            let mut at = [[0; 4]; GRAD_LAYERS];
+            let mut work = [[0; 4]; GRAD_LAYERS + 1];
+            let (mut items, mut most) = (0, 0);
+            for (i, l) in group.iter().enumerate() {
+                let [m, n] = l.shape;
+                let [k_pad, n_pad] = [pad16(m), pad16(n)];
+                let bias = usize::from(l.b_at.is_some());
+                shape[i] = [m, n, k_pad, n_pad];
+                let [x_at, dz_at] = [&l.x, &l.dz].map(|rows| 2 * rows.span.offset);
+                at[i] = [x_at, dz_at, l.w_at, l.b_at.unwrap_or(0)];
+                work[i] = [items, bias, 0, 0];
+                // A plain thread's 4 × 4 sums; a tensor-core workgroup's 256 × 64 (and the
+                // bias's row of them), a row of workgroups a layer.
+                items += (m + bias).div_ceil(4) * n.div_ceil(4);
+                most = most.max(n_pad.div_ceil(64) * (k_pad.div_ceil(256) + bias));
+            }
+            work[group.len()][0] = items;
+            let mut params = vec![rows.next_multiple_of(16), chunk, group.len(), stride];
+            params.extend(shape.iter().chain(&at).chain(&work).flatten());
+            let params: Vec<u32> = params.iter().map(|&v| v as u32).collect();
+            let buffers: [&dyn Bind; 3] = [group[0].x.buffer, group[0].dz.buffer, partial];
+            match gpu.tensor_cores {
+                true => gpu.prepare_grid(
+                    &HALF_WEIGHT_GRAD_COOP,
+                    &params,
+                    &buffers,
+                    [most, group.len(), chunks].map(|v| v as u32),
+                ),
+                false => gpu.prepare(
+                    &HALF_WEIGHT_GRAD,
+                    &params,
+                    &buffers,
+                    groups_for(chunks * items),
+                ),
+            }
+        })
+        .collect()
 }
 
 impl Trainable<'_> {
     /// [`Self::mlp_backward`] in a mixed-precision step: the gradient at each layer's
-    /// pre-activation (`layer_gradients`), then each weight's gradient with its bias's
-    /// (`half_weight_grad`), and the gradient at the first layer's input into `d_input` (f32)
-    /// where given.
+    /// pre-activation (`layer_gradients`), then every weight's gradient with its bias's
+    /// (`half_weight_gradients`), and the gradient at the first layer's input into `d_input`
+    /// (f32) where given.
     pub(crate) fn half_mlp_backward(
         &self,
         plan: &mut Vec<Dispatch>,
@@ -84,21 +114,22 @@ impl Trainable<'_> {
     ) {
         let (gpu, rows) = (&self.gpu, tape.rows);
         let (dz, dz32) = self.layer_gradients(plan, m, tape, d_last, on_first.is_some());
-        for (i, (layer, copies)) in m.half_layers().enumerate().rev() {
-            let x16 = match i {
-                0 => tape.input16().expect("a mixed-precision tape"),
-                _ => tape.hidden(i - 1),
-            };
-            let first_bias = on_first.is_some() && i == 0;
-            self.half_weight_gradient(
-                plan,
-                [copies.count, layer.d_out, rows],
-                &x16,
-                &dz.part(i),
-                layer.weight.offset + copies.row * layer.d_out,
-                (!first_bias).then_some(layer.bias.offset),
-            );
-        }
+        // The MLP's tensors lie in the parameters one after another, the first weight's first.
+        let base = m.layers[0].weight.offset;
+        let layers: Vec<GradLayer> = (m.half_layers().enumerate())
+            .map(|(i, (layer, copies))| GradLayer {
+                shape: [copies.count, layer.d_out],
+                x: match i {
+                    0 => tape.input16().expect("a mixed-precision tape"),
+                    _ => tape.hidden(i - 1),
+                },
+                dz: dz.part(i),
+                w_at: layer.weight.offset + copies.row * layer.d_out - base,
+                b_at: (on_first.is_none() || i > 0).then(|| layer.bias.offset - base),
+            })
+            .collect();
+        let last = &m.layers[m.layers.len() - 1].bias;
+        self.half_weight_gradients(plan, &layers, rows, [base, last.offset + last.len - base]);
         if let Some(f) = on_first {
             f(plan, dz32.as_ref().unwrap_or(d_last));
         }
@@ -191,36 +222,29 @@ impl Trainable<'_> {
         (dz, dz32)
     }
 
-    /// Records a weight's gradient, `[m, n, rows]`: xᵀ·dz over the rows (f16 operands), per
-    /// chunk of rows, the chunks added in order into `grads` from `offset`; with `bias` (its
-    /// offset in `grads`) the bias's, dz's column sums, beside them.
-    fn half_weight_gradient(
+    /// Records `layers`' weight gradients over `rows` rows into `grads[at..at + len]`, the
+    /// span their places (each layer's `w_at` and `b_at`) are counted from: xᵀ·dz (f16
+    /// operands) per chunk of rows (`half_weight_grads`), then one column sum adds the chunks
+    /// in order over the whole span. What no layer's sums take there (a first layer's rows of
+    /// the light code, a bias left out, the gaps between tensors) it writes as zeros, for
+    /// `on_first` to overwrite after.
+    fn half_weight_gradients(
         &self,
         plan: &mut Vec<Dispatch>,
-        [m, n, rows]: [usize; 3],
-        x: &dyn Bind,
-        dz: &dyn Bind,
-        offset: usize,
-        bias: Option<usize>,
+        layers: &[GradLayer],
+        rows: usize,
+        [at, len]: [usize; 2],
     ) {
+        for l in layers {
+            let [m, n] = l.shape;
+            assert!(l.w_at + m * n <= len && l.b_at.is_none_or(|b| b + n <= len));
+        }
         let [chunk, chunks] = row_chunks(rows.next_multiple_of(16), 16);
-        let rows_of_c = m + usize::from(bias.is_some());
-        let partial = self.gpu.buffer(chunks * rows_of_c * n);
-        plan.push(half_weight_grad(
-            self.gpu,
-            [m, n, rows],
-            (x, pad16(m)),
-            (dz, pad16(n)),
-            [chunk, chunks],
-            bias.is_some(),
-            &partial,
-        ));
-        let out = Output {
-            tail: bias.map(|at| [m * n, at]),
-            ..Output::to(self.grads, offset, n)
-        };
-        self.gpu
-            .column_sum(plan, &partial, chunks, rows_of_c * n, None, out);
+        let partial = self.gpu.buffer(chunks * len);
+        let split = [chunk, chunks, len];
+        plan.extend(half_weight_grads(self.gpu, layers, rows, split, &partial));
+        let out = Output::to(self.grads, at, len);
+        self.gpu.column_sum(plan, &partial, chunks, len, None, out);
     }
 }
 
@@ -229,23 +253,28 @@ mod tests {
     use super::*;
     use crate::gpu::passes::mlp_step::Trainable;
     use half::f16;
+    use nprt_gpu::Span;
 
-    /// A weight's gradient with its bias's folded in, against f64 sums of the same f16 values:
-    /// the weight's xᵀ·dz and the bias's dz column sums, each in its own place in `grads`
-    /// across chunks of rows; without the bias, its place is left alone. The sums are f32 over
-    /// f16 products, so they agree to f32's rounding, far below the 10⁻² an f16 step's
-    /// gradients carry (where a bias a few percent off would hide).
+    /// Three layers' weight gradients with their biases folded in, against f64 sums of the
+    /// same f16 values: two layers whose rows share an x buffer and a dz buffer (as a fused
+    /// pass keeps them) in one dispatch, a third (with no bias) in buffers of its own in
+    /// another, and one column sum over the span they lie in. Each weight's xᵀ·dz and each
+    /// bias's dz column sums land in their own places, across chunks of rows; what no sums
+    /// take in the span (the third bias, the gaps) is zero, and nothing outside it is
+    /// touched. The sums are f32 over f16 products, so they agree to f32's rounding, far below
+    /// the 10⁻² an f16 step's gradients carry (where a bias a few percent off would hide).
     #[test]
-    fn a_weight_gradient_folds_its_bias_gradient_in() {
+    fn an_mlps_weight_gradients_come_from_one_dispatch_with_their_biases() {
         if !GpuDevice::probe() || !GpuDevice::get().unwrap().half {
             return;
         }
         let gpu = GpuDevice::get().unwrap();
-        // 20 × 24 sums over 1,000 rows: four chunks, and padded columns on both sides.
-        let [m, n, rows] = [20, 24, 1000];
-        let [k_pad, n_pad] = [pad16(m), pad16(n)];
+        let rows = 1000;
+        // [m, n] and whether a bias: padded columns on both sides; over 1,000 rows, 4 chunks.
+        let shapes = [([20, 24], true), ([24, 3], true), ([40, 17], false)];
         let value = |i: usize, salt: usize| ((i * 7919 + salt) % 1009) as f32 / 504.5 - 1.0;
-        let held = |cols: usize, pad: usize, salt: usize| {
+        let held = |cols: usize, salt: usize| {
+            let pad = pad16(cols);
             let mut h = vec![0u16; held_halves(rows, cols)];
             for r in 0..rows {
                 for c in 0..cols {
@@ -254,39 +283,96 @@ mod tests {
             }
             h
         };
-        let (x, dz) = (held(m, k_pad, 1), held(n, n_pad, 2));
-        let at =
-            |h: &[u16], pad: usize, r: usize, c: usize| f64::from(f16::from_bits(h[r * pad + c]));
-        let [weight, bias] = [0, m * n];
-        for with_bias in [true, false] {
-            let grads = gpu.upload(&vec![-1.0f32; (m + 1) * n]);
-            let trainable = Trainable {
-                gpu: &gpu,
-                params: &gpu.spare,
-                grads: &grads,
+        let hosts: Vec<[Vec<u16>; 2]> = (shapes.iter().enumerate())
+            .map(|(l, ([m, n], _))| [held(*m, 2 * l), held(*n, 2 * l + 1)])
+            .collect();
+        // The first two layers' x rows in one buffer, their dz rows in another, each at a
+        // binding-aligned offset; the third's alone.
+        let align = gpu.binding_alignment();
+        let shared = |which: usize| {
+            let mut words: Vec<u32> = Vec::new();
+            let mut spans = Vec::new();
+            for h in &hosts[..2] {
+                let offset = words.len().next_multiple_of(align);
+                words.resize(offset, 0);
+                words.extend(bytemuck::cast_slice::<u16, u32>(&h[which]));
+                spans.push(Span {
+                    offset,
+                    len: h[which].len() / 2,
+                });
+            }
+            (gpu.upload(&words), spans)
+        };
+        let [(x01, x_spans), (dz01, dz_spans)] = [0, 1].map(shared);
+        let [x2, dz2] = [0, 1].map(|w| gpu.upload(&hosts[2][w]));
+        let part = |buffer, span| Part { buffer, span };
+        let own = |h: &Vec<u16>| Span {
+            offset: 0,
+            len: h.len() / 2,
+        };
+        let rows_of = [
+            (part(&x01, x_spans[0]), part(&dz01, dz_spans[0])),
+            (part(&x01, x_spans[1]), part(&dz01, dz_spans[1])),
+            (part(&x2, own(&hosts[2][0])), part(&dz2, own(&hosts[2][1]))),
+        ];
+        // The tensors' places in the span as a parameter layout has them: a gap of 5 before
+        // each.
+        let mut end = 0;
+        let mut place = |len: usize| {
+            end += 5 + len;
+            end - len
+        };
+        let mut layers = Vec::new();
+        for (&([m, n], bias), (x, dz)) in shapes.iter().zip(rows_of) {
+            let w_at = place(m * n);
+            let b_at = place(n);
+            layers.push(GradLayer {
+                shape: [m, n],
+                x,
+                dz,
+                w_at,
+                b_at: bias.then_some(b_at),
+            });
+        }
+        let [at, len] = [7, end];
+        let grads = gpu.upload(&vec![-1.0f32; at + len + 7]);
+        let trainable = Trainable {
+            gpu: &gpu,
+            params: &gpu.spare,
+            grads: &grads,
+        };
+        let mut plan = Vec::new();
+        trainable.half_weight_gradients(&mut plan, &layers, rows, [at, len]);
+        assert_eq!(plan.len(), 3, "two products and a column sum");
+        gpu.submit(&plan);
+        let got = gpu.read(&grads, at + len + 7);
+        let mut want = vec![-1.0f64; at + len + 7];
+        want[at..at + len].fill(0.0);
+        for (l, layer) in layers.iter().enumerate() {
+            let [m, n] = layer.shape;
+            let [x, dz] = &hosts[l];
+            let value = |h: &[u16], cols: usize, r: usize, c: usize| {
+                f64::from(f16::from_bits(h[r * pad16(cols) + c]))
             };
-            let mut plan = Vec::new();
-            let [x16, dz16] = [&x, &dz].map(|h| gpu.upload(h));
-            let fold = with_bias.then_some(bias);
-            trainable.half_weight_gradient(&mut plan, [m, n, rows], &x16, &dz16, weight, fold);
-            gpu.submit(&plan);
-            let got = gpu.read(&grads, (m + 1) * n);
-            for i in 0..=m {
+            for i in 0..m {
                 for j in 0..n {
-                    let want = match (i == m, with_bias) {
-                        (false, _) => (0..rows)
-                            .map(|r| at(&x, k_pad, r, i) * at(&dz, n_pad, r, j))
-                            .sum(),
-                        (true, true) => (0..rows).map(|r| at(&dz, n_pad, r, j)).sum(),
-                        (true, false) => -1.0,
-                    };
-                    let g = f64::from(got[i * n + j]);
-                    assert!(
-                        (g - want).abs() < 1e-4 * (1.0 + want.abs()),
-                        "bias {with_bias}: ({i}, {j}) is {g}, not {want}"
-                    );
+                    want[at + layer.w_at + i * n + j] = (0..rows)
+                        .map(|r| value(x, m, r, i) * value(dz, n, r, j))
+                        .sum();
                 }
             }
+            if let Some(b) = layer.b_at {
+                for j in 0..n {
+                    want[at + b + j] = (0..rows).map(|r| value(dz, n, r, j)).sum();
+                }
+            }
+        }
+        for (e, (&g, &w)) in got.iter().zip(&want).enumerate() {
+            let g = f64::from(g);
+            assert!(
+                (g - w).abs() < 1e-4 * (1.0 + w.abs()),
+                "value {e} is {g}, not {w}"
+            );
         }
     }
 }

@@ -2,9 +2,11 @@
 // matrices). Four subgroups of 32 each compute 64 rows × 64 columns of one chunk's sums (4 × 4
 // tiles, as `half_dense_coop`), read straight from storage: xᵀ's tiles through column-major
 // loads of x as stored (`coopLoad`), dz's row-major (`coopLoadT`). A workgroup covers 256 rows
-// × 64 columns of the gradient for chunk `workgroup_id.z`; tiles past x's or dz's padded
-// columns read the last tile again and are not written (`finish` keeps to m × n). A tile leaves
-// through `coop_drain`. With `bias` set, one more row of workgroups (past k_pad's) sums dz's
+// × 64 columns of layer `workgroup_id.y`'s gradient for chunk `workgroup_id.z`, the layer's
+// column blocks first along `workgroup_id.x` (as many as the layer with the most needs; the
+// others' spare workgroups return at once); tiles past x's or dz's padded columns read the
+// last tile again and are not written (`finish` keeps to m × n). A tile leaves through
+// `coop_drain`. With a bias, one more row of the layer's blocks (past k_pad's) sums dz's
 // columns instead, two threads a column over half the chunk's rows each.
 
 @compute @workgroup_size(128)
@@ -12,13 +14,24 @@ fn main(@builtin(workgroup_id) group: vec3<u32>, @builtin(local_invocation_index
     let sg = t / 32u;
     let lane = t % 32u;
     chunk_of = group.z;
-    if (group.y * 256u >= p.k_pad) {
-        let j = group.x * 64u + t % 64u;
+    l = layer_at(group.y, group.x);
+    // The layer's shape read here rather than from l, which naga's uniformity analysis cannot
+    // follow through a private variable.
+    let shape = p.shape[group.y];
+    let blocks_n = (shape.w + 63u) / 64u;
+    let block_i = group.x / blocks_n;
+    let block_j = group.x % blocks_n;
+    let blocks_k = (shape.z + 255u) / 256u;
+    if (block_i >= blocks_k + p.work[group.y].y) {
+        return;
+    }
+    if (block_i >= blocks_k) {
+        let j = block_j * 64u + t % 64u;
         let r0 = group.z * p.chunk;
         let r1 = min(p.rows, r0 + p.chunk);
         let mid = r0 + (r1 - r0) / 2u;
         var sum = 0.0;
-        if (j < p.n) {
+        if (j < l.n) {
             if (t < 64u) {
                 sum = dz_sum(j, r0, mid);
             } else {
@@ -28,14 +41,14 @@ fn main(@builtin(workgroup_id) group: vec3<u32>, @builtin(local_invocation_index
         staged[t] = sum;
         workgroupBarrier();
         if (t < 64u) {
-            finish(p.m, j, staged[t] + staged[t + 64u]);
+            finish(l.m, j, staged[t] + staged[t + 64u]);
         }
         return;
     }
-    let row0 = group.y * 256u + sg * 64u;
-    let col0 = group.x * 64u;
-    let i_last = p.k_pad - 16u;
-    let j_last = p.n_pad - 16u;
+    let row0 = block_i * 256u + sg * 64u;
+    let col0 = block_j * 64u;
+    let i_last = shape.z - 16u;
+    let j_last = shape.w - 16u;
     let i0 = min(row0, i_last);
     let i1 = min(row0 + 16u, i_last);
     let i2 = min(row0 + 32u, i_last);
@@ -63,24 +76,24 @@ fn main(@builtin(workgroup_id) group: vec3<u32>, @builtin(local_invocation_index
     let r0 = group.z * p.chunk;
     let r1 = min(p.rows, r0 + p.chunk);
     for (var r = r0; r < r1; r += 16u) {
-        let xr = r * p.k_pad;
+        let xr = l.x_at + r * l.k_pad;
         let x0 = xr + i0;
-        let a0 = coopLoad<coop_mat16x16<f16, A>>(&x[x0], p.k_pad);
+        let a0 = coopLoad<coop_mat16x16<f16, A>>(&x[x0], l.k_pad);
         let x1 = xr + i1;
-        let a1 = coopLoad<coop_mat16x16<f16, A>>(&x[x1], p.k_pad);
+        let a1 = coopLoad<coop_mat16x16<f16, A>>(&x[x1], l.k_pad);
         let x2 = xr + i2;
-        let a2 = coopLoad<coop_mat16x16<f16, A>>(&x[x2], p.k_pad);
+        let a2 = coopLoad<coop_mat16x16<f16, A>>(&x[x2], l.k_pad);
         let x3 = xr + i3;
-        let a3 = coopLoad<coop_mat16x16<f16, A>>(&x[x3], p.k_pad);
-        let dr = r * p.n_pad;
+        let a3 = coopLoad<coop_mat16x16<f16, A>>(&x[x3], l.k_pad);
+        let dr = l.dz_at + r * l.n_pad;
         let d0 = dr + j0;
-        let b0 = coopLoadT<coop_mat16x16<f16, B>>(&dz[d0], p.n_pad);
+        let b0 = coopLoadT<coop_mat16x16<f16, B>>(&dz[d0], l.n_pad);
         let d1 = dr + j1;
-        let b1 = coopLoadT<coop_mat16x16<f16, B>>(&dz[d1], p.n_pad);
+        let b1 = coopLoadT<coop_mat16x16<f16, B>>(&dz[d1], l.n_pad);
         let d2 = dr + j2;
-        let b2 = coopLoadT<coop_mat16x16<f16, B>>(&dz[d2], p.n_pad);
+        let b2 = coopLoadT<coop_mat16x16<f16, B>>(&dz[d2], l.n_pad);
         let d3 = dr + j3;
-        let b3 = coopLoadT<coop_mat16x16<f16, B>>(&dz[d3], p.n_pad);
+        let b3 = coopLoadT<coop_mat16x16<f16, B>>(&dz[d3], l.n_pad);
         c00 = coopMultiplyAdd(a0, b0, c00);
         c01 = coopMultiplyAdd(a0, b1, c01);
         c02 = coopMultiplyAdd(a0, b2, c02);
