@@ -181,13 +181,12 @@ impl NetworkLayout {
     }
 
     /// The dispatches that copy the transport layers' current weights from `params` into
-    /// their f16 copies, one per layer (none in f32).
+    /// their f16 copies, one per MLP (none in f32).
     pub fn half_refresh(&self, gpu: &GpuDevice, params: &wgpu::Buffer) -> Vec<Dispatch> {
         self.tracks
             .iter()
             .flat_map(|t| t.transfer.iter().chain([&t.shading]))
-            .flat_map(|m| m.half_layers())
-            .map(|(layer, copies)| copies.refresh(gpu, params, layer))
+            .flat_map(|m| m.half_refresh(gpu, params))
             .collect()
     }
 }
@@ -224,21 +223,40 @@ pub struct HalfCopies {
     pub transposed: HalfWeight,
 }
 
-impl HalfCopies {
-    /// The dispatch that copies `layer`'s current weight from `params` into both copies.
-    pub fn refresh(&self, gpu: &GpuDevice, params: &wgpu::Buffer, layer: &DenseAt) -> Dispatch {
-        let (n, k) = (layer.d_out, self.count);
-        let offset = layer.weight.offset + self.row * n;
-        let [stored, transposed] = [&self.stored, &self.transposed].map(|w| w.offset);
-        let p = [k, n, offset, pad16(n), pad16(k), stored, transposed, 0];
-        let values = half_weight_halves(k, n) + half_weight_halves(n, k);
-        let buffers: [&dyn Bind; 3] = [params, &self.stored.buffer, &self.transposed.buffer];
-        gpu.prepare(
-            &HALF_WEIGHT_COPIES,
-            &p.map(|v| v as u32),
-            &buffers,
-            groups_for(values),
-        )
+/// Layers a copying dispatch takes at most (`half_weight_copies.wgsl`'s tables).
+const COPY_LAYERS: usize = 8;
+
+impl MlpAt {
+    /// The dispatches that copy the layers' current weights from `params` into both of their
+    /// f16 copies: one for up to [`COPY_LAYERS`] layers (none in f32).
+    pub fn half_refresh(&self, gpu: &GpuDevice, params: &wgpu::Buffer) -> Vec<Dispatch> {
+        let layers: Vec<_> = self.half_layers().collect();
+        (layers.chunks(COPY_LAYERS))
+            .map(|group| {
+                let mut shape = [[0; 4]; COPY_LAYERS];
+                let mut at = [[0; 4]; COPY_LAYERS];
+                let mut threads = 0;
+                for (i, (layer, copies)) in group.iter().enumerate() {
+                    let (n, k) = (layer.d_out, copies.count);
+                    let offset = layer.weight.offset + copies.row * n;
+                    shape[i] = [k, n, pad16(k), pad16(n)];
+                    at[i] = [
+                        offset,
+                        copies.stored.offset,
+                        copies.transposed.offset,
+                        threads,
+                    ];
+                    threads += half_weight_halves(k, n) + half_weight_halves(n, k);
+                }
+                let mut p = vec![group.len(), threads, 0, 0];
+                p.extend(shape.iter().chain(&at).flatten());
+                let p: Vec<u32> = p.iter().map(|&v| v as u32).collect();
+                let copies = group[0].1;
+                let buffers: [&dyn Bind; 3] =
+                    [params, &copies.stored.buffer, &copies.transposed.buffer];
+                gpu.prepare(&HALF_WEIGHT_COPIES, &p, &buffers, groups_for(threads))
+            })
+            .collect()
     }
 }
 
@@ -247,9 +265,9 @@ mod tests {
     use super::*;
     use crate::gpu::products::half_layers::half_weight_bits;
 
-    /// An MLP's f16 copies, made one dispatch a layer: its first layer's of rows 3..23 of a
-    /// 30 × 21 weight, its second's of a whole 21 × 7 one, each kind in one buffer (the second
-    /// layer's past the first's). Each stored copy is the host's layout of its rows
+    /// An MLP's f16 copies, made in one dispatch: its first layer's of rows 3..23 of a 30 × 21
+    /// weight, its second's of a whole 21 × 7 one, each kind in one buffer (the second layer's
+    /// past the first's). Each stored copy is the host's layout of its rows
     /// (`half_weight_bits`, what the frame path and `nprt export` read) and each transposed one
     /// its transpose, padding zero, each value within f16's rounding (a copy 1% off fails, and
     /// so does a second layer written over the first's).
@@ -283,9 +301,8 @@ mod tests {
             half: Vec::new(),
         };
         mlp.hold_half(&gpu, [row, count]);
-        let refresh: Vec<Dispatch> = (mlp.half_layers())
-            .map(|(layer, copies)| copies.refresh(&gpu, &params, layer))
-            .collect();
+        let refresh = mlp.half_refresh(&gpu, &params);
+        assert_eq!(refresh.len(), 1);
         gpu.submit(&refresh);
         let halves = |w: &HalfWeight, n: usize| -> Vec<f32> {
             let words = gpu.read(&w.buffer, (w.offset + n).div_ceil(2));
