@@ -113,9 +113,81 @@ pub fn record_input_gradient(
     ));
 }
 
-/// Appends to `plan` the gradients of a convolution's weights and biases, into their spans of
-/// `grads`, from its `input` and the gradient `dz` at its pre-activation: sums over chunks of
-/// image rows, then over the chunks in order.
+/// Chunks of image rows a convolution over `images` sums its weight gradients over, and the
+/// rows a chunk.
+fn row_chunks(images: Images) -> [usize; 2] {
+    let rows = images.views * images.h;
+    let chunk_rows = rows.div_ceil(CONV_CHUNKS);
+    [chunk_rows, rows.div_ceil(chunk_rows)]
+}
+
+/// Where convolutions' weight and bias gradients are summed per chunk of image rows: a block
+/// a chunk laid out as the parameters from the first convolution's weight to the last's bias,
+/// so that one column sum adds the chunks of them all, in order (a convolution with fewer
+/// chunks leaves the rest of its blocks zero).
+pub struct ConvSums {
+    sums: wgpu::Buffer,
+    base: usize,
+    stride: usize,
+    chunks: usize,
+}
+
+impl ConvSums {
+    /// Blocks for `convs`, each with the images it runs over; they lie in the parameters one
+    /// after another.
+    pub fn new(gpu: &GpuDevice, convs: &[(&ConvAt, Images)]) -> Self {
+        let base = convs[0].0.weight.offset;
+        let last = &convs[convs.len() - 1].0.bias;
+        let stride = last.offset + last.len - base;
+        let chunks = (convs.iter())
+            .map(|&(_, images)| row_chunks(images)[1])
+            .max()
+            .unwrap_or(1);
+        ConvSums {
+            sums: gpu.buffer(chunks * stride),
+            base,
+            stride,
+            chunks,
+        }
+    }
+
+    /// Appends to `plan` the sums over the chunks into `grads`: every convolution's weight and
+    /// bias gradients, and zeros in the gaps between them.
+    pub fn record_total(&self, gpu: &GpuDevice, plan: &mut Vec<Dispatch>, grads: &wgpu::Buffer) {
+        let out = Output::to(grads, self.base, self.stride);
+        gpu.column_sum(plan, &self.sums, self.chunks, self.stride, None, out);
+    }
+}
+
+/// Appends to `plan` the sums per chunk of image rows of a convolution's weight and bias
+/// gradients into `to`'s blocks, from its `input` and the gradient `dz` at its pre-activation
+/// ([`ConvSums::record_total`] then adds the chunks).
+pub fn record_weight_sums(
+    gpu: &GpuDevice,
+    plan: &mut Vec<Dispatch>,
+    (conv, to): (&ConvAt, &ConvSums),
+    images: Images,
+    input: &wgpu::Buffer,
+    dz: &wgpu::Buffer,
+) {
+    let Images { views, h, w } = images;
+    let [chunk_rows, chunks] = row_chunks(images);
+    let taps = conv.c_in * conv.k * conv.k;
+    let [w_at, b_at] = [conv.weight, conv.bias].map(|s| s.offset - to.base);
+    assert!(w_at + conv.c_out * taps <= to.stride && b_at + conv.c_out <= to.stride);
+    let p = [
+        conv.c_in, conv.c_out, h, w, views, conv.k, chunk_rows, chunks, to.stride, w_at, b_at, 0,
+    ];
+    plan.push(gpu.prepare(
+        &CONV_WEIGHT_BACKWARD,
+        &p.map(|v| v as u32),
+        &[input, dz, &to.sums],
+        groups_for(chunks * conv.c_out * (taps + 1)),
+    ));
+}
+
+/// Appends to `plan` the gradients of one convolution's weights and biases, into their spans
+/// of `grads`: [`record_weight_sums`] and their total.
 pub fn record_weight_gradients(
     gpu: &GpuDevice,
     plan: &mut Vec<Dispatch>,
@@ -124,26 +196,7 @@ pub fn record_weight_gradients(
     input: &wgpu::Buffer,
     dz: &wgpu::Buffer,
 ) {
-    let Images { views, h, w } = images;
-    let rows = views * h;
-    let chunk_rows = rows.div_ceil(CONV_CHUNKS);
-    let chunks = rows.div_ceil(chunk_rows);
-    let taps = conv.c_in * conv.k * conv.k;
-    // Per chunk the weights' sums, then the biases'.
-    let block = conv.c_out * (taps + 1);
-    let sums = gpu.buffer(chunks * block);
-    let p = [
-        conv.c_in, conv.c_out, h, w, views, conv.k, chunk_rows, chunks,
-    ];
-    plan.push(gpu.prepare(
-        &CONV_WEIGHT_BACKWARD,
-        &p.map(|v| v as u32),
-        &[input, dz, &sums],
-        groups_for(chunks * block),
-    ));
-    let out = Output {
-        tail: Some([conv.c_out * taps, conv.bias.offset]),
-        ..Output::to(grads, conv.weight.offset, conv.weight.len)
-    };
-    gpu.column_sum(plan, &sums, chunks, block, None, out);
+    let sums = ConvSums::new(gpu, &[(conv, images)]);
+    record_weight_sums(gpu, plan, (conv, &sums), images, input, dz);
+    sums.record_total(gpu, plan, grads);
 }

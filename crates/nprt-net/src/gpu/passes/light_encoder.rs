@@ -4,7 +4,7 @@
 
 use crate::gpu::kernels::ENCODER_POOL_BACKWARD;
 use crate::gpu::layers::conv::{
-    record_input_gradient, record_weight_gradients, Images, InputGradient,
+    record_input_gradient, record_weight_sums, ConvSums, Images, InputGradient,
 };
 use crate::gpu::layers::light_encoder::{BlockPass, EncoderAt};
 use crate::gpu::products::dense_products::DenseProducts;
@@ -53,9 +53,17 @@ impl EncoderAt {
             Output::to(&d, 0, flat),
             None,
         ));
-        for (k, conv) in self.convs.iter().enumerate().rev() {
+        let images = |k: usize| {
             let (h, w) = tape.sizes[k];
-            let images = Images { views, h, w };
+            Images { views, h, w }
+        };
+        let at: Vec<_> = (self.convs.iter().enumerate())
+            .map(|(k, conv)| (conv, images(k)))
+            .collect();
+        // Every block's weight gradients summed per chunk into one set of blocks, added once.
+        let sums = ConvSums::new(gpu, &at);
+        for (k, conv) in self.convs.iter().enumerate().rev() {
+            let images @ Images { h, w, .. } = images(k);
             let dz = gpu.buffer(images.values(CHANNELS));
             // The gradient at the block's input; block 0's input is the map, which needs none.
             let d_input = match k {
@@ -69,7 +77,7 @@ impl EncoderAt {
                 &[&tape.tapes[k], &d, &dz, &d_input],
                 groups_for(images.values(CHANNELS)),
             ));
-            record_weight_gradients(gpu, plan, (conv, grads), images, &tape.inputs[k], &dz);
+            record_weight_sums(gpu, plan, (conv, &sums), images, &tape.inputs[k], &dz);
             if k > 0 {
                 // Added to the skip's share, which the pool's backward wrote.
                 let at = (conv, params);
@@ -77,5 +85,6 @@ impl EncoderAt {
             }
             d = d_input;
         }
+        sums.record_total(gpu, plan, grads);
     }
 }

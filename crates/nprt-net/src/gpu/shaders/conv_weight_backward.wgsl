@@ -3,8 +3,9 @@
 // the sum of dz[c] (its bias). The rows of all views are cut into `chunks` chunks of
 // `chunk_rows` rows (view-major), one thread per value and chunk, each adding in a fixed
 // order; a column sum then adds the chunks in order, the weights' and the biases' in one pass
-// (they sit in one block per chunk, the biases last). One thread per value over every row left
-// a few hundred threads each walking a whole batch of maps: most of a step's time on a GPU.
+// (they sit in one block per chunk, laid out as the parameters, where the other convolutions
+// of an encoder put theirs too). One thread per value over every row left a few hundred
+// threads each walking a whole batch of maps: most of a step's time on a GPU.
 
 struct WeightBackward {
     c_in: u32,
@@ -15,12 +16,17 @@ struct WeightBackward {
     k: u32,
     chunk_rows: u32,
     chunks: u32,
+    // A chunk's block of sums, and where the weights' and the biases' start in it.
+    stride: u32,
+    w_at: u32,
+    b_at: u32,
+    _pad: u32,
 }
 
 @group(0) @binding(0) var<uniform> p: WeightBackward;
 @group(0) @binding(1) var<storage, read> input: array<f32>;
 @group(0) @binding(2) var<storage, read> dz: array<f32>;
-// Per chunk, the weights' sums (c_out × c_in · k²), then the biases' (c_out).
+// Per chunk, the weights' sums (c_out × c_in · k²) and the biases' (c_out).
 @group(0) @binding(3) var<storage, read_write> sums: array<f32>;
 
 @compute @workgroup_size(64)
@@ -48,7 +54,7 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>, @builtin(num_workgroups) g
                 s += dz[d + x];
             }
         }
-        sums[chunk * per_chunk + p.c_out * taps + c] = s;
+        sums[chunk * p.stride + p.b_at + c] = s;
         return;
     }
     let ci = j / kk;
@@ -72,5 +78,5 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>, @builtin(num_workgroups) g
             s += dz[d + x] * input[src + u32(sx)];
         }
     }
-    sums[chunk * per_chunk + c * taps + j] = s;
+    sums[chunk * p.stride + p.w_at + c * taps + j] = s;
 }
