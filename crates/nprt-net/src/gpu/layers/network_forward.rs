@@ -9,7 +9,7 @@ use crate::gpu::layers::network_layout::{MlpAt, TrackAt};
 use crate::gpu::products::codes::activation_code;
 use crate::gpu::products::dense_products::DenseProducts;
 use crate::gpu::products::half_layers::{half_train_layer, pad16, HalfLayers, HalfOut, Held};
-use crate::gpu::products::half_mlp::{fits, half_mlp, FusedIo, FusedLayer};
+use crate::gpu::products::half_mlp::{fits, half_mlp, FusedIo, FusedLayer, Pre};
 use crate::gpu::products::operands::{Bias, Operand, Output};
 use crate::network::encoder::CODE_SIZE;
 use nprt_gpu::{groups_for, Bind, Dispatch, GpuDevice, Part};
@@ -204,7 +204,7 @@ impl MlpAt {
                 out16: false,
                 kept_input: Some(kept.input_at),
                 y32: Some(&tape.output),
-                pre: Some((kept.pre, true)),
+                pre: Some((kept.pre, Pre::Keep)),
             };
             plan.push(half_mlp(gpu, &self.fused_layers(&kept.layers), &io));
             return;

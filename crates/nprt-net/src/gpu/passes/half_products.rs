@@ -24,9 +24,19 @@ use crate::gpu::products::dense_products::DenseProducts;
 use crate::gpu::products::half_layers::{
     half_train_layer, held_halves, pad16, HalfLayers, HalfOut, Held,
 };
-use crate::gpu::products::half_mlp::{fits, half_mlp, FusedIo, FusedLayer};
+use crate::gpu::products::half_mlp::{fits, half_mlp, FusedIo, FusedLayer, Pre};
 use crate::gpu::products::operands::{Bias, Output};
 use nprt_gpu::{groups_for, Bind, Dispatch, GpuDevice, Part};
+
+/// What an MLP's backward pass leaves for its weight gradients: each layer's gradient at its
+/// pre-activation as f16 rows (`dz`), the first layer's as f32 rows where asked
+/// (`first32`), and whether the gradient at the first layer's input is made too
+/// (`to_input`).
+struct LayerGradients {
+    dz: HeldRows,
+    first32: Option<wgpu::Buffer>,
+    to_input: bool,
+}
 
 /// Layers a weight-gradient dispatch takes at most (`half_weight_sums.wgsl`'s tables).
 const GRAD_LAYERS: usize = 8;
@@ -113,7 +123,12 @@ impl Trainable<'_> {
         on_first: Option<FirstLayerBias>,
     ) {
         let (gpu, rows) = (&self.gpu, tape.rows);
-        let (dz, dz32) = self.layer_gradients(plan, m, tape, d_last, on_first.is_some());
+        let first = (on_first.is_some(), d_input);
+        let LayerGradients {
+            dz,
+            first32,
+            to_input,
+        } = self.layer_gradients(plan, m, tape, d_last, first);
         // The MLP's tensors lie in the parameters one after another, the first weight's first.
         let base = m.layers[0].weight.offset;
         let layers: Vec<GradLayer> = (m.half_layers().enumerate())
@@ -131,9 +146,9 @@ impl Trainable<'_> {
         let last = &m.layers[m.layers.len() - 1].bias;
         self.half_weight_gradients(plan, &layers, rows, [base, last.offset + last.len - base]);
         if let Some(f) = on_first {
-            f(plan, dz32.as_ref().unwrap_or(d_last));
+            f(plan, first32.as_ref().unwrap_or(d_last));
         }
-        if let Some(d) = d_input {
+        if let Some(d) = d_input.filter(|_| !to_input) {
             let (layer, copies) = (&m.layers[0], &m.half[0]);
             let out = HalfOut {
                 z: None,
@@ -149,16 +164,19 @@ impl Trainable<'_> {
     /// The gradient at each layer's pre-activation as f16 rows, from `d_last` at the output
     /// down (each layer's input gradient on its transposed weight, times the activation's
     /// derivative at the pre-activation below): in one dispatch where the fused pass holds the
-    /// transposed layers (`half_mlp`), else a layer a dispatch. With `f32_first`, layer 0's as
-    /// f32 rows too (`d_last` itself for a single layer).
+    /// transposed layers (`half_mlp`), which then also goes on to the gradient at the first
+    /// layer's input, into `d_input`, where given and it holds that layer too; else a layer a
+    /// dispatch. With `f32_first`, layer 0's as f32 rows too (`d_last` itself for a single
+    /// layer; the tape's place of layer 0's pre-activation where the pass goes on to the
+    /// input, `FusedIo::pre`).
     fn layer_gradients(
         &self,
         plan: &mut Vec<Dispatch>,
         m: &MlpAt,
         tape: &MlpTape,
         d_last: &wgpu::Buffer,
-        f32_first: bool,
-    ) -> (HeldRows, Option<wgpu::Buffer>) {
+        (f32_first, d_input): (bool, Option<&wgpu::Buffer>),
+    ) -> LayerGradients {
         let (gpu, rows) = (&self.gpu, tape.rows);
         let last = m.layers.len() - 1;
         let layers: Vec<_> = m.half_layers().collect();
@@ -175,14 +193,44 @@ impl Trainable<'_> {
             })
             .collect();
         let fused = last > 0 && fits(gpu, &stages);
+        // The first layer's input gradient as one more stage, linear, where the pass holds it.
+        let mut to_input = None;
+        if let (true, Some(d)) = (fused, d_input) {
+            stages.push(FusedLayer {
+                weight: &layers[0].1.transposed,
+                k_pad: pad16(layers[0].0.d_out),
+                bias_at: 0,
+                activation: 0,
+                held_at: 0,
+                pre_at: 0,
+            });
+            match fits(gpu, &stages) {
+                true => to_input = Some(d),
+                false => drop(stages.pop()),
+            }
+        }
         let words = layers.iter().map(|(l, _)| held_halves(rows, l.d_out) / 2);
         let dz = held_rows(gpu, words, fused);
-        let dz32 = (f32_first && last > 0).then(|| gpu.buffer(rows * layers[0].0.d_out));
+        let first32 = (f32_first && last > 0).then(|| match to_input {
+            Some(_) => {
+                let pre = tape.pre(0);
+                assert_eq!(
+                    pre.span.offset, 0,
+                    "layer 0's pre-activation first in the tape"
+                );
+                pre.buffer.clone()
+            }
+            None => gpu.buffer(rows * layers[0].0.d_out),
+        });
         let out_width = layers[last].0.d_out;
         if fused {
             for (stage, i) in stages.iter_mut().zip((1..=last).rev()) {
                 stage.held_at = 2 * dz.part(i - 1).span.offset;
             }
+            let derive = match to_input.is_some() && first32.is_some() {
+                true => Pre::DeriveInPlace,
+                false => Pre::Derive,
+            };
             let io = FusedIo {
                 rows,
                 x: Held::F32(d_last),
@@ -190,13 +238,17 @@ impl Trainable<'_> {
                 bias0: Bias::None,
                 biases: None,
                 y16: Some(dz.part(0).buffer),
-                out16: true,
+                out16: to_input.is_none(),
                 kept_input: Some(2 * dz.part(last).span.offset),
-                y32: dz32.as_ref(),
-                pre: Some((tape.pre(0).buffer, false)),
+                y32: to_input.or(first32.as_ref()),
+                pre: Some((tape.pre(0).buffer, derive)),
             };
             plan.push(half_mlp(gpu, &stages, &io));
-            return (dz, dz32);
+            return LayerGradients {
+                dz,
+                first32,
+                to_input: to_input.is_some(),
+            };
         }
         plan.push(gpu.half_rows([rows, out_width, out_width], d_last, &dz.part(last)));
         for i in (1..=last).rev() {
@@ -204,7 +256,7 @@ impl Trainable<'_> {
             let out = HalfOut {
                 z: Some(&pre),
                 y16: Some(&dz.part(i - 1)),
-                y32: dz32.as_ref().filter(|_| i == 1).map(|d| d as &dyn Bind),
+                y32: first32.as_ref().filter(|_| i == 1).map(|d| d as &dyn Bind),
             };
             let (layer, copies) = layers[i];
             let g = (&dz.part(i) as &dyn Bind, pad16(layer.d_out));
@@ -219,7 +271,11 @@ impl Trainable<'_> {
                 out,
             ));
         }
-        (dz, dz32)
+        LayerGradients {
+            dz,
+            first32,
+            to_input: false,
+        }
     }
 
     /// Records `layers`' weight gradients over `rows` rows into `grads[at..at + len]`, the

@@ -78,9 +78,23 @@ pub struct FusedIo<'a> {
     pub kept_input: Option<usize>,
     /// The last layer's output as f32 rows of its width.
     pub y32: Option<&'a wgpu::Buffer>,
-    /// The hidden layers' pre-activations, each from its `pre_at`: kept by a training forward
-    /// pass (`true`), read by a backward pass's derivatives (`false`).
-    pub pre: Option<(&'a wgpu::Buffer, bool)>,
+    /// The hidden layers' pre-activations, each from its `pre_at`, and what the pass does
+    /// with them.
+    pub pre: Option<(&'a wgpu::Buffer, Pre)>,
+}
+
+/// What a fused pass does with the hidden layers' pre-activations ([`FusedIo::pre`]).
+#[derive(Clone, Copy, PartialEq)]
+pub enum Pre {
+    /// Writes them (a training step's forward pass).
+    Keep,
+    /// Reads them for the activations' derivatives (a backward pass).
+    Derive,
+    /// [`Pre::Derive`], and the last hidden layer's output, f32, then replaces the
+    /// pre-activation it was derived at, which nothing reads again: a backward pass that goes
+    /// on to the first layer's input leaves the gradient at the first layer's pre-activation
+    /// there.
+    DeriveInPlace,
 }
 
 /// The dispatch of `layers` over `io`'s rows (`half_mlp.wgsl`). The layers must [`fits`].
@@ -94,7 +108,11 @@ pub fn half_mlp(gpu: &GpuDevice, layers: &[FusedLayer], io: &FusedIo) -> Dispatc
     let mut params = vec![io.rows, layers.len(), x_f32, io.x_cols];
     params.extend([io.out16, io.y32.is_some(), io.kept_input.is_some()].map(usize::from));
     params.extend([
-        usize::from(io.pre.is_some_and(|(_, keep)| keep)),
+        match io.pre {
+            Some((_, Pre::Keep)) => 1,
+            Some((_, Pre::DeriveInPlace)) => 2,
+            _ => 0,
+        },
         io.kept_input.unwrap_or(0),
         bias0_mode,
         bias0_at,
@@ -425,7 +443,7 @@ mod tests {
             out16: false,
             kept_input: Some(input_at),
             y32: Some(&out),
-            pre: Some((&pre, true)),
+            pre: Some((&pre, Pre::Keep)),
         };
         gpu.submit([&half_mlp(&gpu, &mlp.layers(&kept), &io)]);
         let want = mlp.host_layers(&values, rows, &|i| rows_of_bias[group[i] as usize].clone());
@@ -475,7 +493,10 @@ mod tests {
     /// transposed weights) against the host: the gradient at the output kept as held f16
     /// rows, each layer's gradient at its pre-activation (times ReLU's derivative at the
     /// pre-activations the forward pass kept) as held f16 rows, the first layer's as f32 rows
-    /// too, each within 1% of its largest value; nothing written outside its place.
+    /// too, each within 1% of its largest value; nothing written outside its place. Then
+    /// again on to the first layer's input (one more stage, linear): the input's gradient as
+    /// f32 rows, the first layer's f32 gradient in place of its pre-activation, which alone
+    /// changes.
     #[test]
     fn a_backward_pass_keeps_every_layers_gradient() {
         if !GpuDevice::probe() || !GpuDevice::get().unwrap().half {
@@ -494,51 +515,34 @@ mod tests {
         for l in 0..2 {
             pre_values[pre_at[l]..pre_at[l] + rows * 172].copy_from_slice(&forward[l][0]);
         }
-        let pre = gpu.upload(&pre_values);
         // The gradients' places: at the output, then at layers 1 and 0.
         let held_len = |w: usize| held_halves(rows, w);
         let out_at = 256;
         let at1 = out_at + held_len(3) + 256;
         let at0 = at1 + held_len(172) + 256;
         let held_end = at0 + held_len(172) + 256;
-        let held = gpu.upload(&vec![half::f16::from_f32(canary).to_bits(); held_end]);
-        let dz32 = gpu.buffer(rows * 172);
         let stage = |l: usize, held_at: usize| FusedLayer {
             weight: &mlp.transposed[l],
             k_pad: pad16(widths[l + 1]),
             bias_at: 0,
-            activation: 3,
+            activation: if l > 0 { 3 } else { 0 },
             held_at,
-            pre_at: pre_at[l - 1],
+            pre_at: if l > 0 { pre_at[l - 1] } else { 0 },
         };
-        let io = FusedIo {
-            rows,
-            x: Held::F32(&gpu.upload(&d_last)),
-            x_cols: 3,
-            bias0: Bias::None,
-            biases: None,
-            y16: Some(&held),
-            out16: true,
-            kept_input: Some(out_at),
-            y32: Some(&dz32),
-            pre: Some((&pre, false)),
-        };
-        gpu.submit([&half_mlp(&gpu, &[stage(2, at1), stage(1, at0)], &io)]);
-        // The host's: each gradient from the one above as f16, times Wᵀ, times ReLU'.
+        // The host's: each gradient from the one above as f16, times Wᵀ, times ReLU' but at
+        // the input.
         let back = |g: &[f32], l: usize| -> Vec<f32> {
             let [d_in, d_out] = mlp.shapes[l];
             let w = &mlp.host[l].0;
-            let z = &forward[l - 1][0];
             (0..rows * d_in)
                 .map(|e| {
                     let (i, k) = (e / d_in, e % d_in);
                     let sum: f32 = (0..d_out)
                         .map(|j| g[i * d_out + j] * w[k * d_out + j])
                         .sum();
-                    if z[e] > 0.0 {
-                        sum
-                    } else {
-                        0.0
+                    match l == 0 || forward[l - 1][0][e] > 0.0 {
+                        true => sum,
+                        false => 0.0,
                     }
                 })
                 .collect()
@@ -547,56 +551,95 @@ mod tests {
         let g2 = round(&d_last);
         let g1 = back(&g2, 2);
         let g0 = back(&round(&g1), 1);
-        let errors = [
-            (
-                "output's",
-                relative(
-                    &held_rows(&gpu, &held, out_at, rows, 3),
-                    &padded(&g2, rows, 3),
+        let d_input = back(&round(&g0), 0);
+        for to_input in [false, true] {
+            let pre = gpu.upload(&pre_values);
+            let held = gpu.upload(&vec![half::f16::from_f32(canary).to_bits(); held_end]);
+            let y32 = gpu.buffer(rows * if to_input { 64 } else { 172 });
+            let mut stages = vec![stage(2, at1), stage(1, at0)];
+            if to_input {
+                stages.push(stage(0, 0));
+            }
+            let io = FusedIo {
+                rows,
+                x: Held::F32(&gpu.upload(&d_last)),
+                x_cols: 3,
+                bias0: Bias::None,
+                biases: None,
+                y16: Some(&held),
+                out16: !to_input,
+                kept_input: Some(out_at),
+                y32: Some(&y32),
+                pre: Some((
+                    &pre,
+                    if to_input {
+                        Pre::DeriveInPlace
+                    } else {
+                        Pre::Derive
+                    },
+                )),
+            };
+            gpu.submit([&half_mlp(&gpu, &stages, &io)]);
+            let pre_got = gpu.read(&pre, pre_values.len());
+            let first32 = match to_input {
+                true => pre_got[pre_at[0]..][..rows * 172].to_vec(),
+                false => gpu.read(&y32, rows * 172),
+            };
+            let mut errors = vec![
+                (
+                    "output's",
+                    relative(
+                        &held_rows(&gpu, &held, out_at, rows, 3),
+                        &padded(&g2, rows, 3),
+                    ),
                 ),
-            ),
-            (
-                "layer 1's",
-                relative(
-                    &held_rows(&gpu, &held, at1, rows, 172),
-                    &padded(&round(&g1), rows, 172),
+                (
+                    "layer 1's",
+                    relative(
+                        &held_rows(&gpu, &held, at1, rows, 172),
+                        &padded(&round(&g1), rows, 172),
+                    ),
                 ),
-            ),
-            (
-                "layer 0's",
-                relative(
-                    &held_rows(&gpu, &held, at0, rows, 172),
-                    &padded(&round(&g0), rows, 172),
+                (
+                    "layer 0's",
+                    relative(
+                        &held_rows(&gpu, &held, at0, rows, 172),
+                        &padded(&round(&g0), rows, 172),
+                    ),
                 ),
-            ),
-            ("layer 0's f32", relative(&gpu.read(&dz32, rows * 172), &g0)),
-        ];
-        eprintln!("gradients within {errors:?} of each one's largest value");
-        for (what, error) in errors {
+                ("layer 0's f32", relative(&first32, &g0)),
+            ];
+            if to_input {
+                errors.push(("input's", relative(&gpu.read(&y32, rows * 64), &d_input)));
+            }
+            eprintln!("to the input {to_input}: gradients within {errors:?} of each one's largest");
+            for (what, error) in errors {
+                assert!(
+                    error < 1e-2,
+                    "to the input {to_input}: the {what} gradient off by {error} of its largest"
+                );
+            }
+            let words = gpu.read(&held, held_end / 2);
+            let bits: &[u16] = bytemuck::cast_slice(&words);
+            let places = [
+                (out_at, held_len(3)),
+                (at1, held_len(172)),
+                (at0, held_len(172)),
+            ];
+            let outside =
+                (0..held_end).filter(|&e| !places.iter().any(|&(a, n)| (a..a + n).contains(&e)));
             assert!(
-                error < 1e-2,
-                "the {what} gradient: off by {error} of its largest value"
+                outside
+                    .clone()
+                    .all(|e| half::f16::from_bits(bits[e]).to_f32() == canary),
+                "an f16 value written outside its place"
+            );
+            // Only layer 0's pre-activation, and only when the pass goes on to the input.
+            let replaced = |e: usize| to_input && (pre_at[0]..pre_at[0] + rows * 172).contains(&e);
+            assert!(
+                (0..pre_values.len()).all(|e| replaced(e) || pre_got[e] == pre_values[e]),
+                "to the input {to_input}: a pre-activation changed"
             );
         }
-        let words = gpu.read(&held, held_end / 2);
-        let bits: &[u16] = bytemuck::cast_slice(&words);
-        let places = [
-            (out_at, held_len(3)),
-            (at1, held_len(172)),
-            (at0, held_len(172)),
-        ];
-        let outside =
-            (0..held_end).filter(|&e| !places.iter().any(|&(a, n)| (a..a + n).contains(&e)));
-        assert!(
-            outside
-                .clone()
-                .all(|e| half::f16::from_bits(bits[e]).to_f32() == canary),
-            "an f16 value written outside its place"
-        );
-        assert_eq!(
-            gpu.read(&pre, pre_values.len()),
-            pre_values,
-            "the pre-activations changed"
-        );
     }
 }
