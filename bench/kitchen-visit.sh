@@ -40,8 +40,9 @@
 # training step's f16 bias gradients made with their weights', a convolution's weight and bias
 # sums added in one pass, both f16 copies of a weight in one dispatch: 172 → 122 dispatches a
 # D/S f16 step; a frame's MLPs fused into one dispatch each, `half_mlp`; a training step's MLPs
-# fused forward and backward: 122 → 102). Move it on when a visit has timed them and another
-# change follows.
+# fused forward and backward: 122 → 102; an MLP's weight gradients and f16 copies a dispatch
+# each, the encoder's sums added once, the backward pass on to the input: 102 → 70). Move it
+# on when a visit has timed them and another change follows.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 

@@ -1,19 +1,20 @@
 //! A mixed-precision training step's dense layers (`--precision f16`): each transport layer's
 //! weight is also held as f16, as stored and transposed, copied from the f32 master weights
-//! after every Adam step; the activations and the gradients between layers are held as f16
-//! rows in the frame path's layout (`half_layers`); every product sums in f32, on tensor cores
-//! where the adapter has cooperative matrices, elsewhere on plain kernels that compute the
-//! same sums (what the tests run). A layer's three products are its forward pass (with bias,
-//! activation and the pre-activation kept in f32), its input gradient dz·Wᵀ (on the transposed
-//! copy, times the activation's derivative) and its weight gradient xᵀ·dz over chunks of rows
-//! (`half_weight_grad`), which also sums each chunk's dz columns, the bias's gradient, in the
-//! same dispatch; the chunks are added in f32 as in an f32 step. An MLP's forward passes, and
-//! its input gradients down to its first layer's output, each take one dispatch where the
-//! fused pass holds the MLP (`half_mlp`), else a dispatch a layer (`half_train`). The loss's
-//! gradient is multiplied by a power
-//! of two near the batch's values (`BatchBuffers::grad_scale`) so that f16 keeps the small
-//! gradients, and Adam divides it back out; f16 values saturate instead of overflowing. The
-//! light encoder, the hash grids and the light code's share stay in f32.
+//! after every Adam step (an MLP's layers in one dispatch); the activations and the gradients
+//! between layers are held as f16 rows in the frame path's layout (`half_layers`); every
+//! product sums in f32, on tensor cores where the adapter has cooperative matrices, elsewhere
+//! on plain kernels that compute the same sums (what the tests run). A layer's three products
+//! are its forward pass (with bias, activation and the pre-activation kept in f32), its input
+//! gradient dz·Wᵀ (on the transposed copy, times the activation's derivative) and its weight
+//! gradient xᵀ·dz over chunks of rows, which also sums each chunk's dz columns, the bias's
+//! gradient. An MLP's forward pass, and its input gradients from the last layer down to the
+//! first layer's input, each take one dispatch where the fused pass holds the MLP
+//! (`half_mlp`), else a dispatch a layer (`half_train`); its weight gradients one more
+//! (`half_weight_grad`, every layer's chunks into one block laid out as the parameters), and
+//! one column sum adds the chunks in f32, as in an f32 step. The loss's gradient is multiplied
+//! by a power of two near the batch's values (`BatchBuffers::grad_scale`) so that f16 keeps
+//! the small gradients, and Adam divides it back out; f16 values saturate instead of
+//! overflowing. The light encoder, the hash grids and the light code's share stay in f32.
 
 use crate::gpu::kernels::{HALF_WEIGHT_GRAD, HALF_WEIGHT_GRAD_COOP};
 use crate::gpu::layers::mlp_tape::{held_rows, HeldRows, MlpTape};
