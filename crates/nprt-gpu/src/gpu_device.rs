@@ -26,7 +26,7 @@ pub struct GpuDevice {
     /// Whether kernels may hold f16 values (`half_layer`, the frame path's `--precision f16`).
     pub half: bool,
     /// Whether `half_layer`'s products run on cooperative matrices (tensor cores): 16 × 16 × 16
-    /// f16 products into f32, in subgroups of 32.
+    /// f16 products into f32, in subgroups of 32; never with `NPRT_TENSOR_CORES=off`.
     pub tensor_cores: bool,
     pub(crate) pipelines: Pipelines,
     /// Bound where a kernel's read-only input is unused, and where a written one is (two
@@ -96,7 +96,9 @@ impl GpuDevice {
             })?;
         let info = adapter.get_info();
         let half = adapter.features().contains(wgpu::Features::SHADER_F16);
-        let tensor_cores = half && tensor_cores(&adapter);
+        let asked = std::env::var_os(TENSOR_CORES_VAR).map(|v| v.to_string_lossy().into_owned());
+        let tensor_cores =
+            half && tensor_cores_allowed(asked.as_deref())? && tensor_cores(&adapter);
         // Timestamps only serve `nprt bench train --profile`; an adapter without them still
         // trains. f16 and tensor cores serve the frame path's `--precision f16`.
         let mut features = adapter.features() & wgpu::Features::TIMESTAMP_QUERY;
@@ -193,6 +195,24 @@ fn adapter_rank(kind: wgpu::DeviceType) -> u8 {
     }
 }
 
+/// The environment variable that turns the tensor-core kernels off (`off`) where the adapter
+/// has them.
+const TENSOR_CORES_VAR: &str = "NPRT_TENSOR_CORES";
+
+/// Whether the tensor-core kernels may run, from [`TENSOR_CORES_VAR`]'s value: unset or `on`,
+/// where the adapter has them; `off`, never (the plain kernels, which compute the same sums,
+/// run instead: the way past a tensor-core kernel that fails on a device, and a way to time
+/// the two on one GPU).
+fn tensor_cores_allowed(value: Option<&str>) -> Result<bool> {
+    match value {
+        None | Some("on") => Ok(true),
+        Some("off") => Ok(false),
+        Some(other) => Err(anyhow!(
+            "{TENSOR_CORES_VAR} is '{other}': set it to on or off, or leave it unset"
+        )),
+    }
+}
+
 /// Whether `adapter` offers cooperative matrices of 16 × 16 × 16 f16 products into f32 in
 /// subgroups of 32 (what `half_dense_coop` is written for).
 fn tensor_cores(adapter: &wgpu::Adapter) -> bool {
@@ -207,4 +227,20 @@ fn tensor_cores(adapter: &wgpu::Adapter) -> bool {
                 && c.ab_type == wgpu::CooperativeScalarType::F16
                 && c.cr_type == wgpu::CooperativeScalarType::F32
         })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// NPRT_TENSOR_CORES: unset or `on` leaves the choice to the adapter, `off` refuses tensor
+    /// cores, anything else is an error that names the variable and its value.
+    #[test]
+    fn the_tensor_core_switch_takes_on_and_off_only() {
+        assert!(tensor_cores_allowed(None).unwrap());
+        assert!(tensor_cores_allowed(Some("on")).unwrap());
+        assert!(!tensor_cores_allowed(Some("off")).unwrap());
+        let e = tensor_cores_allowed(Some("0")).unwrap_err().to_string();
+        assert!(e.contains("NPRT_TENSOR_CORES is '0'"), "{e}");
+    }
 }

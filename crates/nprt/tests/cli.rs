@@ -562,43 +562,6 @@ fn the_gpu_benchmark_script_explains_itself_and_names_what_it_lacks() {
     }
 }
 
-/// bench/kitchen-visit.sh's `land` names what it cannot land before it changes anything: no
-/// folder, a folder without a visit's model, a CPU model to compare that is not a model; and the
-/// CPU-trained D/S it compares by default is in the repository.
-#[test]
-fn the_visit_script_refuses_what_it_cannot_land() {
-    let run = |args: &[&str]| common::script("bench/kitchen-visit.sh", args);
-    let empty = fresh_dir("visit-empty");
-    std::fs::create_dir_all(&empty).unwrap();
-    let empty = empty.to_str().unwrap();
-    for (args, why) in [
-        (
-            &["land"][..],
-            "give the folder a visit's files came back to",
-        ),
-        (
-            &["land", empty],
-            "holds no model.tar.xz (did the visit train?)",
-        ),
-        (&["land", empty, "--cpu-model", empty], "--cpu-model: '"),
-        (
-            &["land", empty, "--frobnicate"],
-            "unknown argument '--frobnicate'",
-        ),
-    ] {
-        let out = run(args);
-        assert_eq!(out.status.code(), Some(1), "{args:?}");
-        let err = String::from_utf8_lossy(&out.stderr);
-        assert!(err.contains(why), "{args:?}: {err}");
-    }
-    let cpu = common::repo().join("pretrained/kitchen-dsep/cpu-f32");
-    let config: serde_json::Value =
-        serde_json::from_slice(&std::fs::read(cpu.join("model.json")).unwrap()).unwrap();
-    assert_eq!(config["design"], "dsep");
-    assert!(cpu.join("weights.safetensors").is_file());
-    std::fs::remove_dir_all(empty).unwrap();
-}
-
 /// bench/gpu-ab.sh explains itself and names what is wrong with its arguments; where the GPU
 /// kernels run (lavapipe here), it times two builds (here one binary twice) alternately and
 /// prints a row of the A/B table per design, precision and batch size.
