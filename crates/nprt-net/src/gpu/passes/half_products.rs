@@ -223,8 +223,8 @@ impl Trainable<'_> {
             }
             None => gpu.buffer(rows * layers[0].0.d_out),
         });
-        let out_width = layers[last].0.d_out;
         if fused {
+            let out_width = layers[last].0.d_out;
             for (stage, i) in stages.iter_mut().zip((1..=last).rev()) {
                 stage.held_at = 2 * dz.part(i - 1).span.offset;
             }
@@ -251,15 +251,36 @@ impl Trainable<'_> {
                 to_input: to_input.is_some(),
             };
         }
+        self.layer_gradients_apart(plan, m, tape, d_last, (&dz, first32.as_ref()));
+        LayerGradients {
+            dz,
+            first32,
+            to_input: false,
+        }
+    }
+
+    /// [`Self::layer_gradients`] a layer a dispatch (`half_train`), where the fused pass cannot
+    /// hold the MLP: into `dz`'s rows, layer 0's also into `first32` where given.
+    fn layer_gradients_apart(
+        &self,
+        plan: &mut Vec<Dispatch>,
+        m: &MlpAt,
+        tape: &MlpTape,
+        d_last: &wgpu::Buffer,
+        (dz, first32): (&HeldRows, Option<&wgpu::Buffer>),
+    ) {
+        let (gpu, rows) = (&self.gpu, tape.rows);
+        let last = m.layers.len() - 1;
+        let out_width = m.layers[last].d_out;
+        let derivative = activation_code(m.activation) + BACKWARD;
         plan.push(gpu.half_rows([rows, out_width, out_width], d_last, &dz.part(last)));
-        for i in (1..=last).rev() {
+        for (i, (layer, copies)) in m.half_layers().enumerate().skip(1).rev() {
             let pre = tape.pre(i - 1);
             let out = HalfOut {
                 z: Some(&pre),
                 y16: Some(&dz.part(i - 1)),
-                y32: first32.as_ref().filter(|_| i == 1).map(|d| d as &dyn Bind),
+                y32: first32.filter(|_| i == 1).map(|d| d as &dyn Bind),
             };
-            let (layer, copies) = layers[i];
             let g = (&dz.part(i) as &dyn Bind, pad16(layer.d_out));
             let t = &copies.transposed;
             plan.push(half_train_layer(
@@ -271,11 +292,6 @@ impl Trainable<'_> {
                 derivative,
                 out,
             ));
-        }
-        LayerGradients {
-            dz,
-            first32,
-            to_input: false,
         }
     }
 
