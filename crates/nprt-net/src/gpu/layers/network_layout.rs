@@ -18,6 +18,9 @@ use crate::network::track_kind::TrackKind;
 use nprt_gpu::Span;
 use nprt_gpu::{groups_for, Bind, Dispatch, GpuDevice};
 
+/// Layers a copying dispatch takes at most (`half_weight_copies.wgsl`'s tables).
+const COPY_LAYERS: usize = 8;
+
 pub struct MlpAt {
     pub layers: Vec<DenseAt>,
     pub activation: Activation,
@@ -59,6 +62,38 @@ impl MlpAt {
         &self,
     ) -> impl DoubleEndedIterator<Item = (&DenseAt, &HalfCopies)> + ExactSizeIterator {
         self.layers.iter().zip(&self.half)
+    }
+
+    /// The dispatches that copy the layers' current weights from `params` into both of their
+    /// f16 copies: one for up to [`COPY_LAYERS`] layers (none in f32).
+    pub fn half_refresh(&self, gpu: &GpuDevice, params: &wgpu::Buffer) -> Vec<Dispatch> {
+        let layers: Vec<_> = self.half_layers().collect();
+        (layers.chunks(COPY_LAYERS))
+            .map(|group| {
+                let mut shape = [[0; 4]; COPY_LAYERS];
+                let mut at = [[0; 4]; COPY_LAYERS];
+                let mut threads = 0;
+                for (i, (layer, copies)) in group.iter().enumerate() {
+                    let (n, k) = (layer.d_out, copies.count);
+                    let offset = layer.weight.offset + copies.row * n;
+                    shape[i] = [k, n, pad16(k), pad16(n)];
+                    at[i] = [
+                        offset,
+                        copies.stored.offset,
+                        copies.transposed.offset,
+                        threads,
+                    ];
+                    threads += half_weight_halves(k, n) + half_weight_halves(n, k);
+                }
+                let mut p = vec![group.len(), threads, 0, 0];
+                p.extend(shape.iter().chain(&at).flatten());
+                let p: Vec<u32> = p.iter().map(|&v| v as u32).collect();
+                let copies = group[0].1;
+                let buffers: [&dyn Bind; 3] =
+                    [params, &copies.stored.buffer, &copies.transposed.buffer];
+                gpu.prepare(&HALF_WEIGHT_COPIES, &p, &buffers, groups_for(threads))
+            })
+            .collect()
     }
 }
 
@@ -221,43 +256,6 @@ pub struct HalfCopies {
     pub count: usize,
     pub stored: HalfWeight,
     pub transposed: HalfWeight,
-}
-
-/// Layers a copying dispatch takes at most (`half_weight_copies.wgsl`'s tables).
-const COPY_LAYERS: usize = 8;
-
-impl MlpAt {
-    /// The dispatches that copy the layers' current weights from `params` into both of their
-    /// f16 copies: one for up to [`COPY_LAYERS`] layers (none in f32).
-    pub fn half_refresh(&self, gpu: &GpuDevice, params: &wgpu::Buffer) -> Vec<Dispatch> {
-        let layers: Vec<_> = self.half_layers().collect();
-        (layers.chunks(COPY_LAYERS))
-            .map(|group| {
-                let mut shape = [[0; 4]; COPY_LAYERS];
-                let mut at = [[0; 4]; COPY_LAYERS];
-                let mut threads = 0;
-                for (i, (layer, copies)) in group.iter().enumerate() {
-                    let (n, k) = (layer.d_out, copies.count);
-                    let offset = layer.weight.offset + copies.row * n;
-                    shape[i] = [k, n, pad16(k), pad16(n)];
-                    at[i] = [
-                        offset,
-                        copies.stored.offset,
-                        copies.transposed.offset,
-                        threads,
-                    ];
-                    threads += half_weight_halves(k, n) + half_weight_halves(n, k);
-                }
-                let mut p = vec![group.len(), threads, 0, 0];
-                p.extend(shape.iter().chain(&at).flatten());
-                let p: Vec<u32> = p.iter().map(|&v| v as u32).collect();
-                let copies = group[0].1;
-                let buffers: [&dyn Bind; 3] =
-                    [params, &copies.stored.buffer, &copies.transposed.buffer];
-                gpu.prepare(&HALF_WEIGHT_COPIES, &p, &buffers, groups_for(threads))
-            })
-            .collect()
-    }
 }
 
 #[cfg(test)]
