@@ -71,21 +71,26 @@ fn a_tiny_dataset_is_overfit() {
 }
 
 /// The GPU training steps (nprt-net's own kernels, parameters and Adam's moments kept on the
-/// device) on wgpu, which CI runs on a software Vulkan device: it learns, and resumes exactly
-/// (the hash grid's gradient is summed in a fixed order for that).
+/// device) on wgpu, which CI runs on a software Vulkan device: it learns.
 #[test]
-fn the_gpu_path_overfits_and_resumes_exactly() {
+fn the_gpu_path_overfits() {
     if !common::wgpu_runs() {
         return;
     }
     // A third of the CPU's epochs: the software device is about ten times slower than the CPU
     // engine, and by then the loss has fallen to a tenth.
     overfits(&[("dsep", "hash-grid")], "wgpu", 100);
+}
+
+/// The GPU training steps resume exactly (the hash grid's gradient is summed in a fixed order
+/// for that), and a run started on them continues on the CPU engine.
+#[test]
+fn the_gpu_path_resumes_exactly() {
+    if !common::wgpu_runs() {
+        return;
+    }
     resumes_exactly("wgpu");
     resumes_across_engines();
-    batches_gathered_on_the_gpu_equal_the_hosts();
-    mixed_precision_trains_as_f32_does();
-    deep_shading_on_the_kernels_trains_as_on_the_cpu();
 }
 
 /// `train-deep-shading --device wgpu`: the U-Net on the kernels takes the CPU engine's path
@@ -93,7 +98,11 @@ fn the_gpu_path_overfits_and_resumes_exactly() {
 /// validation loss within 1e-3 of the CPU's; lavapipe: 2.4e-7; eval's L1 within 1e-5, lavapipe:
 /// 4.7e-8), resumes exactly on the kernels,
 /// and a run started there continues on the CPU.
+#[test]
 fn deep_shading_on_the_kernels_trains_as_on_the_cpu() {
+    if !common::wgpu_runs() {
+        return;
+    }
     let (cpu, gpu, parts) = (
         fresh_dir("deep-cpu"),
         fresh_dir("deep-gpu"),
@@ -170,7 +179,11 @@ fn deep_shading_on_the_kernels_trains_as_on_the_cpu() {
 /// validation loss rises again as they overfit; lavapipe: 2.1% apart at most, the last f16's
 /// 2.1% below f32's), and it resumes exactly (its f16 weights are made again from the saved
 /// f32 ones).
+#[test]
 fn mixed_precision_trains_as_f32_does() {
+    if !common::wgpu_runs() {
+        return;
+    }
     let run = |precision: &str, epochs: &str, out: &Path| {
         let args = [
             "--epochs",
@@ -226,7 +239,11 @@ fn mixed_precision_trains_as_f32_does() {
 /// records in the host's f32 operations, rounded as it rounds a division, a square root or a
 /// multiply-add, so every training and validation loss of two epochs agrees to 10⁻⁵
 /// (lavapipe: 1.9·10⁻⁷).
+#[test]
 fn batches_gathered_on_the_gpu_equal_the_hosts() {
+    if !common::wgpu_runs() {
+        return;
+    }
     let run = |gather: &str| {
         let out = fresh_dir(&format!("gather-{gather}"));
         let args = [
