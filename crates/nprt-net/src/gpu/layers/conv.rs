@@ -6,9 +6,8 @@
 use crate::gpu::kernels::{
     CONV_FORWARD, CONV_INPUT_BACKWARD, CONV_INPUT_BACKWARD_THREADS, CONV_WEIGHT_BACKWARD,
 };
+use crate::gpu::layers::chunk_sums::ChunkSums;
 use crate::gpu::layers::layer_at::ConvAt;
-use crate::gpu::products::dense_products::DenseProducts;
-use crate::gpu::products::operands::Output;
 use nprt_gpu::{groups_for, Dispatch, GpuDevice, Part};
 
 /// Chunks of image rows a convolution's weight gradients are summed over, at most: enough
@@ -121,51 +120,26 @@ fn row_chunks(images: Images) -> [usize; 2] {
     [chunk_rows, rows.div_ceil(chunk_rows)]
 }
 
-/// Where convolutions' weight and bias gradients are summed per chunk of image rows: a block
-/// a chunk laid out as the parameters from the first convolution's weight to the last's bias,
-/// so that one column sum adds the chunks of them all, in order (a convolution with fewer
-/// chunks leaves the rest of its blocks zero).
-pub struct ConvSums {
-    sums: wgpu::Buffer,
-    base: usize,
-    stride: usize,
-    chunks: usize,
-}
-
-impl ConvSums {
-    /// Blocks for `convs`, each with the images it runs over; they lie in the parameters one
-    /// after another.
-    pub fn new(gpu: &GpuDevice, convs: &[(&ConvAt, Images)]) -> Self {
-        let base = convs[0].0.weight.offset;
-        let last = &convs[convs.len() - 1].0.bias;
-        let stride = last.offset + last.len - base;
-        let chunks = (convs.iter())
-            .map(|&(_, images)| row_chunks(images)[1])
-            .max()
-            .unwrap_or(1);
-        ConvSums {
-            sums: gpu.buffer(chunks * stride),
-            base,
-            stride,
-            chunks,
-        }
-    }
-
-    /// Appends to `plan` the sums over the chunks into `grads`: every convolution's weight and
-    /// bias gradients, and zeros in the gaps between them.
-    pub fn record_total(&self, gpu: &GpuDevice, plan: &mut Vec<Dispatch>, grads: &wgpu::Buffer) {
-        let out = Output::to(grads, self.base, self.stride);
-        gpu.column_sum(plan, &self.sums, self.chunks, self.stride, None, out);
-    }
+/// Where `convs`' weight and bias gradients are summed per chunk of image rows, each with the
+/// images it runs over (they lie in the parameters one after another): blocks laid out as the
+/// parameters from the first's weight to the last's bias, as many as the convolution with the
+/// most chunks needs (one with fewer leaves the rest of its blocks zero).
+pub fn conv_sums(gpu: &GpuDevice, convs: &[(&ConvAt, Images)]) -> ChunkSums {
+    let chunks = (convs.iter())
+        .map(|&(_, images)| row_chunks(images)[1])
+        .max()
+        .unwrap_or(1);
+    let last = convs[convs.len() - 1].0.bias;
+    ChunkSums::spanning(gpu, [convs[0].0.weight, last], chunks)
 }
 
 /// Appends to `plan` the sums per chunk of image rows of a convolution's weight and bias
 /// gradients into `to`'s blocks, from its `input` and the gradient `dz` at its pre-activation
-/// ([`ConvSums::record_total`] then adds the chunks).
+/// ([`ChunkSums::record_total`] then adds the chunks).
 pub fn record_weight_sums(
     gpu: &GpuDevice,
     plan: &mut Vec<Dispatch>,
-    (conv, to): (&ConvAt, &ConvSums),
+    (conv, to): (&ConvAt, &ChunkSums),
     images: Images,
     input: &wgpu::Buffer,
     dz: &wgpu::Buffer,
@@ -173,10 +147,9 @@ pub fn record_weight_sums(
     let Images { views, h, w } = images;
     let [chunk_rows, chunks] = row_chunks(images);
     let taps = conv.c_in * conv.k * conv.k;
-    let [w_at, b_at] = [conv.weight, conv.bias].map(|s| s.offset - to.base);
-    assert!(w_at + conv.c_out * taps <= to.stride && b_at + conv.c_out <= to.stride);
+    let [w_at, b_at] = [conv.weight, conv.bias].map(|s| to.at(s));
     let p = [
-        conv.c_in, conv.c_out, h, w, views, conv.k, chunk_rows, chunks, to.stride, w_at, b_at, 0,
+        conv.c_in, conv.c_out, h, w, views, conv.k, chunk_rows, chunks, to.len, w_at, b_at, 0,
     ];
     plan.push(gpu.prepare(
         &CONV_WEIGHT_BACKWARD,
@@ -196,7 +169,7 @@ pub fn record_weight_gradients(
     input: &wgpu::Buffer,
     dz: &wgpu::Buffer,
 ) {
-    let sums = ConvSums::new(gpu, &[(conv, images)]);
+    let sums = conv_sums(gpu, &[(conv, images)]);
     record_weight_sums(gpu, plan, (conv, &sums), images, input, dz);
     sums.record_total(gpu, plan, grads);
 }

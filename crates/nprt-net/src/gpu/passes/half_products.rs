@@ -17,16 +17,16 @@
 //! overflowing. The light encoder, the hash grids and the light code's share stay in f32.
 
 use crate::gpu::kernels::{HALF_WEIGHT_GRAD, HALF_WEIGHT_GRAD_COOP};
+use crate::gpu::layers::chunk_sums::ChunkSums;
 use crate::gpu::layers::mlp_tape::{held_rows, HeldRows, MlpTape};
 use crate::gpu::layers::network_layout::MlpAt;
 use crate::gpu::passes::mlp_step::{row_chunks, FirstLayerBias, Trainable};
 use crate::gpu::products::codes::{activation_code, BACKWARD};
-use crate::gpu::products::dense_products::DenseProducts;
 use crate::gpu::products::half_layers::{
     half_train_layer, held_halves, pad16, HalfLayers, HalfOut, Held,
 };
 use crate::gpu::products::half_mlp::{fits, half_mlp, FusedIo, FusedLayer, Pre};
-use crate::gpu::products::operands::{Bias, Output};
+use crate::gpu::products::operands::Bias;
 use nprt_gpu::{groups_for, Bind, Dispatch, GpuDevice, Part};
 
 /// What an MLP's backward pass leaves for its weight gradients: each layer's gradient at its
@@ -313,11 +313,10 @@ impl Trainable<'_> {
             assert!(l.w_at + m * n <= len && l.b_at.is_none_or(|b| b + n <= len));
         }
         let [chunk, chunks] = row_chunks(rows.next_multiple_of(16), 16);
-        let partial = self.gpu.buffer(chunks * len);
+        let sums = ChunkSums::new(self.gpu, [at, len], chunks);
         let split = [chunk, chunks, len];
-        plan.extend(half_weight_grads(self.gpu, layers, rows, split, &partial));
-        let out = Output::to(self.grads, at, len);
-        self.gpu.column_sum(plan, &partial, chunks, len, None, out);
+        plan.extend(half_weight_grads(self.gpu, layers, rows, split, &sums.sums));
+        sums.record_total(self.gpu, plan, self.grads);
     }
 }
 

@@ -4,7 +4,7 @@
 
 use crate::gpu::kernels::ENCODER_POOL_BACKWARD;
 use crate::gpu::layers::conv::{
-    record_input_gradient, record_weight_sums, ConvSums, Images, InputGradient,
+    conv_sums, record_input_gradient, record_weight_sums, Images, InputGradient,
 };
 use crate::gpu::layers::light_encoder::{BlockPass, EncoderAt};
 use crate::gpu::products::dense_products::DenseProducts;
@@ -61,7 +61,7 @@ impl EncoderAt {
             .map(|(k, conv)| (conv, images(k)))
             .collect();
         // Every block's weight gradients summed per chunk into one set of blocks, added once.
-        let sums = ConvSums::new(gpu, &at);
+        let sums = conv_sums(gpu, &at);
         for (k, conv) in self.convs.iter().enumerate().rev() {
             let images @ Images { h, w, .. } = images(k);
             let dz = gpu.buffer(images.values(CHANNELS));
