@@ -149,7 +149,7 @@ pub fn record_weight_sums(
     let taps = conv.c_in * conv.k * conv.k;
     let [w_at, b_at] = [conv.weight, conv.bias].map(|s| to.at(s));
     let p = [
-        conv.c_in, conv.c_out, h, w, views, conv.k, chunk_rows, chunks, to.len, w_at, b_at, 0,
+        conv.c_in, conv.c_out, h, w, views, conv.k, chunk_rows, chunks, to.stride, w_at, b_at, 0,
     ];
     plan.push(gpu.prepare(
         &CONV_WEIGHT_BACKWARD,
@@ -171,5 +171,5 @@ pub fn record_weight_gradients(
 ) {
     let sums = conv_sums(gpu, &[(conv, images)]);
     record_weight_sums(gpu, plan, (conv, &sums), images, input, dz);
-    sums.record_total(gpu, plan, grads);
+    sums.record_total(gpu, plan, grads, None);
 }

@@ -20,7 +20,7 @@ use crate::gpu::kernels::{HALF_WEIGHT_GRAD, HALF_WEIGHT_GRAD_COOP};
 use crate::gpu::layers::chunk_sums::ChunkSums;
 use crate::gpu::layers::mlp_tape::{held_rows, HeldRows, MlpTape};
 use crate::gpu::layers::network_layout::MlpAt;
-use crate::gpu::passes::mlp_step::{row_chunks, FirstLayerBias, Trainable};
+use crate::gpu::passes::mlp_step::{row_chunks, Trainable, ViewSums};
 use crate::gpu::products::codes::{activation_code, BACKWARD};
 use crate::gpu::products::half_layers::{
     half_train_layer, held_halves, pad16, HalfLayers, HalfOut, Held,
@@ -30,12 +30,10 @@ use crate::gpu::products::operands::Bias;
 use nprt_gpu::{groups_for, Bind, Dispatch, GpuDevice, Part};
 
 /// What an MLP's backward pass leaves for its weight gradients: each layer's gradient at its
-/// pre-activation as f16 rows (`dz`), the first layer's as f32 rows where asked
-/// (`first32`), and whether the gradient at the first layer's input is made too
-/// (`to_input`).
+/// pre-activation as f16 rows (`dz`), and whether the gradient at the first layer's input is
+/// made too (`to_input`).
 struct LayerGradients {
     dz: HeldRows,
-    first32: Option<wgpu::Buffer>,
     to_input: bool,
 }
 
@@ -43,20 +41,32 @@ struct LayerGradients {
 const GRAD_LAYERS: usize = 8;
 
 /// One layer of a weight-gradient pass: the gradient's `[m, n]`, its x rows and dz rows (f16,
-/// padded to 16 values a row, as [`Held::F16`] holds them), and where its weight's sums and,
-/// with a bias, its bias's start in a chunk's block.
+/// padded to 16 values a row, as [`Held::F16`] holds them), where its weight's sums and, with
+/// a bias, its bias's start in a chunk's block, and with `views` (and a bias) dz's sums per
+/// view too.
 pub(crate) struct GradLayer<'a> {
     pub shape: [usize; 2],
     pub x: Part<'a>,
     pub dz: Part<'a>,
     pub w_at: usize,
     pub b_at: Option<usize>,
+    pub views: Option<PerView<'a>>,
+}
+
+/// A weight-gradient pass's sums per view: each batch row's view, the views' number, and
+/// where their sums go in a chunk's block, past the parameters' span (`n` a view).
+#[derive(Clone, Copy)]
+pub(crate) struct PerView<'a> {
+    pub view: &'a wgpu::Buffer,
+    pub count: usize,
+    pub at: usize,
 }
 
 /// The dispatches of `layers`' weight gradients, xᵀ·dz over `rows` rows cut into chunks of
 /// `chunk`, chunk c's sums into `partial` from c · stride, each layer's at its places
 /// (`half_weight_sums.wgsl`): one dispatch for up to [`GRAD_LAYERS`] consecutive layers whose x
-/// rows lie in one buffer and dz rows in another (a fused pass's), else a dispatch a layer.
+/// rows lie in one buffer and dz rows in another (a fused pass's), and whose sums per view,
+/// if any, read one buffer of views, else a dispatch a layer.
 fn half_weight_grads(
     gpu: &GpuDevice,
     layers: &[GradLayer],
@@ -64,8 +74,13 @@ fn half_weight_grads(
     [chunk, chunks, stride]: [usize; 3],
     partial: &wgpu::Buffer,
 ) -> Vec<Dispatch> {
-    let shared =
-        |a: &GradLayer, b: &GradLayer| a.x.buffer == b.x.buffer && a.dz.buffer == b.dz.buffer;
+    fn view<'a>(l: &GradLayer<'a>) -> Option<&'a wgpu::Buffer> {
+        l.views.map(|v| v.view)
+    }
+    let shared = |a: &GradLayer, b: &GradLayer| {
+        let views = view(a).is_none() || view(b).is_none() || view(a) == view(b);
+        a.x.buffer == b.x.buffer && a.dz.buffer == b.dz.buffer && views
+    };
     (layers.chunk_by(shared))
         .flat_map(|run| run.chunks(GRAD_LAYERS))
         .map(|group| {
@@ -77,20 +92,27 @@ fn half_weight_grads(
                 let [m, n] = l.shape;
                 let [k_pad, n_pad] = [pad16(m), pad16(n)];
                 let bias = usize::from(l.b_at.is_some());
+                assert!(
+                    l.views.is_none() || l.b_at.is_some(),
+                    "view sums with a bias"
+                );
+                let [views, g_at] = l.views.map_or([0, 0], |v| [v.count, v.at]);
                 shape[i] = [m, n, k_pad, n_pad];
                 let [x_at, dz_at] = [&l.x, &l.dz].map(|rows| 2 * rows.span.offset);
                 at[i] = [x_at, dz_at, l.w_at, l.b_at.unwrap_or(0)];
-                work[i] = [items, bias, 0, 0];
-                // A plain thread's 4 × 4 sums; a tensor-core workgroup's 256 × 64 (and the
-                // bias's row of them), a row of workgroups a layer.
-                items += (m + bias).div_ceil(4) * n.div_ceil(4);
-                most = most.max(n_pad.div_ceil(64) * (k_pad.div_ceil(256) + bias));
+                work[i] = [items, bias, views, g_at];
+                // A plain thread's 4 × 4 sums; a tensor-core workgroup's 256 × 64 (and a row
+                // of them for the bias and each view), a row of workgroups a layer.
+                let sum_rows = bias + views;
+                items += (m + sum_rows).div_ceil(4) * n.div_ceil(4);
+                most = most.max(n_pad.div_ceil(64) * (k_pad.div_ceil(256) + sum_rows));
             }
             work[group.len()][0] = items;
             let mut params = vec![rows.next_multiple_of(16), chunk, group.len(), stride];
             params.extend(shape.iter().chain(&at).chain(&work).flatten());
             let params: Vec<u32> = params.iter().map(|&v| v as u32).collect();
-            let buffers: [&dyn Bind; 3] = [group[0].x.buffer, group[0].dz.buffer, partial];
+            let views = group.iter().find_map(view).unwrap_or(&gpu.empty);
+            let buffers: [&dyn Bind; 4] = [group[0].x.buffer, group[0].dz.buffer, partial, views];
             match gpu.tensor_cores {
                 true => gpu.prepare_grid(
                     &HALF_WEIGHT_GRAD_COOP,
@@ -111,9 +133,9 @@ fn half_weight_grads(
 
 impl Trainable<'_> {
     /// [`Self::mlp_backward`] in a mixed-precision step: the gradient at each layer's
-    /// pre-activation (`layer_gradients`), then every weight's gradient with its bias's
-    /// (`half_weight_gradients`), and the gradient at the first layer's input into `d_input`
-    /// (f32) where given.
+    /// pre-activation (`layer_gradients`), then every weight's gradient with its bias's and
+    /// the sums per view where asked (`half_weight_gradients`), and the gradient at the first
+    /// layer's input into `d_input` (f32) where given.
     pub(crate) fn half_mlp_backward(
         &self,
         plan: &mut Vec<Dispatch>,
@@ -121,17 +143,15 @@ impl Trainable<'_> {
         tape: &MlpTape,
         d_last: &wgpu::Buffer,
         d_input: Option<&wgpu::Buffer>,
-        on_first: Option<FirstLayerBias>,
+        view_sums: Option<&ViewSums>,
     ) {
         let (gpu, rows) = (&self.gpu, tape.rows);
-        let first = (on_first.is_some(), d_input);
-        let LayerGradients {
-            dz,
-            first32,
-            to_input,
-        } = self.layer_gradients(plan, m, tape, d_last, first);
-        // The MLP's tensors lie in the parameters one after another, the first weight's first.
+        let LayerGradients { dz, to_input } = self.layer_gradients(plan, m, tape, d_last, d_input);
+        // The MLP's tensors lie in the parameters one after another, the first weight's first;
+        // the sums per view come after them in a chunk's block.
         let base = m.layers[0].weight.offset;
+        let last = &m.layers[m.layers.len() - 1].bias;
+        let len = last.offset + last.len - base;
         let layers: Vec<GradLayer> = (m.half_layers().enumerate())
             .map(|(i, (layer, copies))| GradLayer {
                 shape: [copies.count, layer.d_out],
@@ -141,13 +161,18 @@ impl Trainable<'_> {
                 },
                 dz: dz.part(i),
                 w_at: layer.weight.offset + copies.row * layer.d_out - base,
-                b_at: (on_first.is_none() || i > 0).then(|| layer.bias.offset - base),
+                b_at: Some(layer.bias.offset - base),
+                views: view_sums.filter(|_| i == 0).map(|v| PerView {
+                    view: v.view,
+                    count: v.views,
+                    at: len,
+                }),
             })
             .collect();
-        let last = &m.layers[m.layers.len() - 1].bias;
-        self.half_weight_gradients(plan, &layers, rows, [base, last.offset + last.len - base]);
-        if let Some(f) = on_first {
-            f(plan, first32.as_ref().unwrap_or(d_last));
+        let d_views = view_sums.map(|v| v.d_views);
+        self.half_weight_gradients(plan, &layers, rows, [base, len], d_views);
+        if let Some(v) = view_sums {
+            (v.then)(plan);
         }
         if let Some(d) = d_input.filter(|_| !to_input) {
             let (layer, copies) = (&m.layers[0], &m.half[0]);
@@ -167,16 +192,14 @@ impl Trainable<'_> {
     /// derivative at the pre-activation below): in one dispatch where the fused pass holds the
     /// transposed layers (`half_mlp`), which then also goes on to the gradient at the first
     /// layer's input, into `d_input`, where given and it holds that layer too; else a layer a
-    /// dispatch. With `f32_first`, layer 0's as f32 rows too (`d_last` itself for a single
-    /// layer; the tape's place of layer 0's pre-activation where the pass goes on to the
-    /// input, `FusedIo::pre`).
+    /// dispatch.
     fn layer_gradients(
         &self,
         plan: &mut Vec<Dispatch>,
         m: &MlpAt,
         tape: &MlpTape,
         d_last: &wgpu::Buffer,
-        (f32_first, d_input): (bool, Option<&wgpu::Buffer>),
+        d_input: Option<&wgpu::Buffer>,
     ) -> LayerGradients {
         let (gpu, rows) = (&self.gpu, tape.rows);
         let last = m.layers.len() - 1;
@@ -212,26 +235,11 @@ impl Trainable<'_> {
         }
         let words = layers.iter().map(|(l, _)| held_halves(rows, l.d_out) / 2);
         let dz = held_rows(gpu, words, fused);
-        let first32 = (f32_first && last > 0).then(|| match to_input {
-            Some(_) => {
-                let pre = tape.pre(0);
-                assert_eq!(
-                    pre.span.offset, 0,
-                    "layer 0's pre-activation first in the tape"
-                );
-                pre.buffer.clone()
-            }
-            None => gpu.buffer(rows * layers[0].0.d_out),
-        });
         if fused {
             let out_width = layers[last].0.d_out;
             for (stage, i) in stages.iter_mut().zip((1..=last).rev()) {
                 stage.held_at = 2 * dz.part(i - 1).span.offset;
             }
-            let derive = match to_input.is_some() && first32.is_some() {
-                true => Pre::DeriveInPlace,
-                false => Pre::Derive,
-            };
             let io = FusedIo {
                 rows,
                 x: Held::F32(d_last),
@@ -241,33 +249,31 @@ impl Trainable<'_> {
                 y16: Some(dz.part(0).buffer),
                 out16: to_input.is_none(),
                 kept_input: Some(2 * dz.part(last).span.offset),
-                y32: to_input.or(first32.as_ref()),
-                pre: Some((tape.pre(0).buffer, derive)),
+                y32: to_input,
+                pre: Some((tape.pre(0).buffer, Pre::Derive)),
             };
             plan.push(half_mlp(gpu, &stages, &io));
             return LayerGradients {
                 dz,
-                first32,
                 to_input: to_input.is_some(),
             };
         }
-        self.layer_gradients_apart(plan, m, tape, d_last, (&dz, first32.as_ref()));
+        self.layer_gradients_apart(plan, m, tape, d_last, &dz);
         LayerGradients {
             dz,
-            first32,
             to_input: false,
         }
     }
 
     /// [`Self::layer_gradients`] a layer a dispatch (`half_train`), where the fused pass cannot
-    /// hold the MLP: into `dz`'s rows, layer 0's also into `first32` where given.
+    /// hold the MLP: into `dz`'s rows.
     fn layer_gradients_apart(
         &self,
         plan: &mut Vec<Dispatch>,
         m: &MlpAt,
         tape: &MlpTape,
         d_last: &wgpu::Buffer,
-        (dz, first32): (&HeldRows, Option<&wgpu::Buffer>),
+        dz: &HeldRows,
     ) {
         let (gpu, rows) = (&self.gpu, tape.rows);
         let last = m.layers.len() - 1;
@@ -279,7 +285,7 @@ impl Trainable<'_> {
             let out = HalfOut {
                 z: Some(&pre),
                 y16: Some(&dz.part(i - 1)),
-                y32: first32.filter(|_| i == 1).map(|d| d as &dyn Bind),
+                y32: None,
             };
             let g = (&dz.part(i) as &dyn Bind, pad16(layer.d_out));
             let t = &copies.transposed;
@@ -298,25 +304,35 @@ impl Trainable<'_> {
     /// Records `layers`' weight gradients over `rows` rows into `grads[at..at + len]`, the
     /// span their places (each layer's `w_at` and `b_at`) are counted from: xᵀ·dz (f16
     /// operands) per chunk of rows (`half_weight_grads`), then one column sum adds the chunks
-    /// in order over the whole span. What no layer's sums take there (a first layer's rows of
-    /// the light code, a bias left out, the gaps between tensors) it writes as zeros, for
-    /// `on_first` to overwrite after.
+    /// in order over the whole span, and a layer's sums per view (at most one layer's, placed
+    /// at `len`) into `d_views`. What no layer's sums take in the span (a first layer's rows
+    /// of the light code, a bias left out, the gaps between tensors) it writes as zeros, for
+    /// the light code's products to overwrite after.
     fn half_weight_gradients(
         &self,
         plan: &mut Vec<Dispatch>,
         layers: &[GradLayer],
         rows: usize,
         [at, len]: [usize; 2],
+        d_views: Option<&wgpu::Buffer>,
     ) {
+        let mut extra = 0;
         for l in layers {
             let [m, n] = l.shape;
             assert!(l.w_at + m * n <= len && l.b_at.is_none_or(|b| b + n <= len));
+            if let Some(v) = l.views {
+                assert!(
+                    v.at == len && extra == 0,
+                    "one layer's sums per view, past the span"
+                );
+                extra = v.count * n;
+            }
         }
         let [chunk, chunks] = row_chunks(rows.next_multiple_of(16), 16);
-        let sums = ChunkSums::new(self.gpu, [at, len], chunks);
-        let split = [chunk, chunks, len];
+        let sums = ChunkSums::new(self.gpu, [at, len, extra], chunks);
+        let split = [chunk, chunks, sums.stride];
         plan.extend(half_weight_grads(self.gpu, layers, rows, split, &sums.sums));
-        sums.record_total(self.gpu, plan, self.grads);
+        sums.record_total(self.gpu, plan, self.grads, d_views);
     }
 }
 
@@ -331,12 +347,12 @@ mod tests {
     /// same f16 values: two layers whose rows share an x buffer and a dz buffer (as a fused
     /// pass keeps them) in one dispatch, a third (with no bias) in buffers of its own in
     /// another, and one column sum over the span they lie in. Each weight's xᵀ·dz and each
-    /// bias's dz column sums land in their own places, across chunks of rows; what no sums
-    /// take in the span (the third bias, the gaps) is zero, and nothing outside it is
-    /// touched. The sums are f32 over f16 products, so they agree to f32's rounding, far below
+    /// bias's dz column sums land in their own places, across chunks of rows, and the first
+    /// layer's dz column sums per view in a buffer of their own; what no sums take in the
+    /// span (the third bias, the gaps) is zero, and nothing outside it is touched. The sums are f32 over f16 products, so they agree to f32's rounding, far below
     /// the 10⁻² an f16 step's gradients carry (where a bias a few percent off would hide).
     #[test]
-    fn an_mlps_weight_gradients_come_from_one_dispatch_with_their_biases() {
+    fn an_mlps_weight_gradients_come_from_one_dispatch_with_their_biases_and_view_sums() {
         if !GpuDevice::probe() || !GpuDevice::get().unwrap().half {
             return;
         }
@@ -404,9 +420,20 @@ mod tests {
                 dz,
                 w_at,
                 b_at: bias.then_some(b_at),
+                views: None,
             });
         }
         let [at, len] = [7, end];
+        // The first layer's sums per view too: 3 views, the rows' taking turns unevenly.
+        let (views, view_of) = (3, |r: usize| (r * r / 7 % 3) as u32);
+        let view = gpu.upload(&(0..rows).map(view_of).collect::<Vec<u32>>());
+        layers[0].views = Some(PerView {
+            view: &view,
+            count: views,
+            at: len,
+        });
+        let n0 = layers[0].shape[1];
+        let d_views = gpu.upload(&vec![-1.0f32; views * n0 + 7]);
         let grads = gpu.upload(&vec![-1.0f32; at + len + 7]);
         let trainable = Trainable {
             gpu: &gpu,
@@ -414,10 +441,11 @@ mod tests {
             grads: &grads,
         };
         let mut plan = Vec::new();
-        trainable.half_weight_gradients(&mut plan, &layers, rows, [at, len]);
+        trainable.half_weight_gradients(&mut plan, &layers, rows, [at, len], Some(&d_views));
         assert_eq!(plan.len(), 3, "two products and a column sum");
         gpu.submit(&plan);
-        let got = gpu.read(&grads, at + len + 7);
+        let mut got = gpu.read(&grads, at + len + 7);
+        got.extend(gpu.read(&d_views, views * n0 + 7));
         let mut want = vec![-1.0f64; at + len + 7];
         want[at..at + len].fill(0.0);
         for (l, layer) in layers.iter().enumerate() {
@@ -439,6 +467,19 @@ mod tests {
                 }
             }
         }
+        // Past the span, each view's sums, then the canaries left.
+        let [_, dz0] = &hosts[0];
+        for g in 0..views {
+            for j in 0..n0 {
+                let of_view = (0..rows).filter(|&r| view_of(r) == g as u32);
+                want.push(
+                    of_view
+                        .map(|r| f64::from(f16::from_bits(dz0[r * pad16(n0) + j])))
+                        .sum(),
+                );
+            }
+        }
+        want.extend([-1.0; 7]);
         for (e, (&g, &w)) in got.iter().zip(&want).enumerate() {
             let g = f64::from(g);
             assert!(

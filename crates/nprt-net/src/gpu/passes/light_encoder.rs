@@ -85,6 +85,6 @@ impl EncoderAt {
             }
             d = d_input;
         }
-        sums.record_total(gpu, plan, grads);
+        sums.record_total(gpu, plan, grads, None);
     }
 }

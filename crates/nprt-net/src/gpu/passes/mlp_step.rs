@@ -6,7 +6,7 @@ use crate::gpu::layers::mlp_tape::MlpTape;
 use crate::gpu::layers::network_layout::MlpAt;
 use crate::gpu::products::codes::{activation_code, BACKWARD};
 use crate::gpu::products::dense_products::DenseProducts;
-use crate::gpu::products::operands::{Bias, Operand, Output};
+use crate::gpu::products::operands::{Bias, Operand, Output, Tail};
 use nprt_gpu::{Bind, Dispatch, GpuDevice};
 
 /// A weight gradient's product is split into chunks of at least ROW_CHUNK rows, at most
@@ -25,8 +25,17 @@ pub(crate) fn row_chunks(rows: usize, align: usize) -> [usize; 2] {
     [chunk, rows.div_ceil(chunk)]
 }
 
-/// What takes a first layer's bias gradient, given the gradient at its pre-activation.
-pub type FirstLayerBias<'a> = &'a dyn Fn(&mut Vec<Dispatch>, &wgpu::Buffer);
+/// A first layer whose bias is a row per view (the light code's share, `Bias::Group`): the
+/// sums of the gradient at its pre-activation over each view's rows (`views` × its width, into
+/// `d_views`) make its bias's gradient, and `then` records what else follows from them (the
+/// code's rows of the weight, the code's gradient).
+pub struct ViewSums<'a> {
+    /// Each batch row's view.
+    pub view: &'a wgpu::Buffer,
+    pub views: usize,
+    pub d_views: &'a wgpu::Buffer,
+    pub then: &'a dyn Fn(&mut Vec<Dispatch>),
+}
 
 /// What an MLP's training records against: the device, the flat parameters it reads and the
 /// gradients it writes (a design's trainer's, or the radiance cache's).
@@ -40,9 +49,8 @@ impl Trainable<'_> {
     /// Records the backward pass of `m` from the gradient `d_last` at its output: every
     /// layer's weight and bias gradient into `grads`, and the gradient at its input into
     /// `d_input` where given. `input` is what the first layer read: the buffer, its first
-    /// weight row and its values per row. `on_first`, where given, takes the first layer's
-    /// bias gradient (it also receives the light code's share), given the gradient at that
-    /// layer's pre-activation.
+    /// weight row and its values per row. With `view_sums` the first layer's bias is a row per
+    /// view, whose gradient comes from the sums per view.
     #[allow(clippy::too_many_arguments)]
     pub fn mlp_backward(
         &self,
@@ -52,10 +60,10 @@ impl Trainable<'_> {
         input: (&wgpu::Buffer, usize, usize),
         d_last: &wgpu::Buffer,
         d_input: Option<&wgpu::Buffer>,
-        on_first: Option<FirstLayerBias>,
+        view_sums: Option<&ViewSums>,
     ) {
         if !m.half.is_empty() {
-            return self.half_mlp_backward(plan, m, tape, d_last, d_input, on_first);
+            return self.half_mlp_backward(plan, m, tape, d_last, d_input, view_sums);
         }
         let rows = tape.rows;
         let scratch = [0, 1].map(|_| self.gpu.buffer(rows * m.widest()));
@@ -73,12 +81,13 @@ impl Trainable<'_> {
                 }
             };
             let weights = layer.weight.offset + own_row * layer.d_out;
-            // The bias's gradient (unless `on_first` takes it) rides on the weight's product as
-            // a row of ones in A where that product's last tile has a row to spare; otherwise
-            // the extra row would cost a row of tiles, and a column sum is cheaper.
-            let first_bias = on_first.filter(|_| i == 0);
+            // The bias's gradient (unless it comes from the sums per view) rides on the
+            // weight's product as a row of ones in A where that product's last tile has a row
+            // to spare; otherwise the extra row would cost a row of tiles, and a column sum is
+            // cheaper.
+            let per_view = view_sums.filter(|_| i == 0);
             let spare_row = !count.is_multiple_of(GEMM_TILE as usize);
-            let folded = first_bias.is_none() && spare_row;
+            let folded = per_view.is_none() && spare_row;
             self.sum_over_rows(
                 plan,
                 [count, layer.d_out, rows],
@@ -87,16 +96,16 @@ impl Trainable<'_> {
                 weights,
                 folded.then_some(layer.bias.offset),
             );
-            match first_bias {
-                Some(f) => f(plan, dz),
-                None if !folded => self.gpu.column_sum(
-                    plan,
-                    dz,
-                    rows,
-                    layer.d_out,
-                    None,
-                    Output::to(self.grads, layer.bias.offset, layer.d_out),
-                ),
+            let bias = Output::to(self.grads, layer.bias.offset, layer.d_out);
+            match per_view {
+                Some(v) => {
+                    let to = Output::to(v.d_views, 0, layer.d_out);
+                    let views = Some((v.view, v.views));
+                    (self.gpu).column_sum(plan, dz, rows, layer.d_out, views, to);
+                    (self.gpu).column_sum(plan, v.d_views, v.views, layer.d_out, None, bias);
+                    (v.then)(plan);
+                }
+                None if !folded => self.gpu.column_sum(plan, dz, rows, layer.d_out, None, bias),
                 None => {}
             }
             // The gradient at the layer's input; below a hidden layer, times its activation's
@@ -155,7 +164,11 @@ impl Trainable<'_> {
         if let Some(at) = bias {
             a.ones_row = Some(m);
             rows_of_c = m + 1;
-            out.tail = Some([m * n, at]);
+            out.tail = Some(Tail {
+                at: m * n,
+                buffer: self.grads,
+                offset: at,
+            });
         }
         let partial = self.gpu.buffer(chunks * rows_of_c * n);
         plan.push(

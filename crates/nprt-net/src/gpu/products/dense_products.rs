@@ -69,7 +69,9 @@ impl DenseProducts for GpuDevice {
     ) {
         let (group_of, count) = groups.unwrap_or((&self.empty, 1));
         if rows <= COLUMN_CHUNK {
-            let [tail_at, tail_off] = out.tail.unwrap_or([0, 0]);
+            let (tail_at, tail, tail_off) = out
+                .tail
+                .map_or((0, &self.spare, 0), |t| (t.at, t.buffer, t.offset));
             let params = [
                 rows,
                 n,
@@ -83,7 +85,7 @@ impl DenseProducts for GpuDevice {
             plan.push(self.prepare(
                 &COLUMN_SUM,
                 &params.map(|v| v as u32),
-                &[x, group_of, out.buffer],
+                &[x, group_of, out.buffer, tail],
                 groups_for(count * n),
             ));
             return;
@@ -94,7 +96,7 @@ impl DenseProducts for GpuDevice {
         plan.push(self.prepare(
             &COLUMN_SUM,
             &params.map(|v| v as u32),
-            &[x, group_of, &partial],
+            &[x, group_of, &partial, &self.spare],
             groups_for(chunks * count * n),
         ));
         self.column_sum(plan, &partial, chunks, count * n, None, out);

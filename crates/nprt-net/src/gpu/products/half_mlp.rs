@@ -90,11 +90,6 @@ pub enum Pre {
     Keep,
     /// Reads them for the activations' derivatives (a backward pass).
     Derive,
-    /// [`Pre::Derive`], and the last hidden layer's output, f32, then replaces the
-    /// pre-activation it was derived at, which nothing reads again: a backward pass that goes
-    /// on to the first layer's input leaves the gradient at the first layer's pre-activation
-    /// there.
-    DeriveInPlace,
 }
 
 /// The dispatch of `layers` over `io`'s rows (`half_mlp.wgsl`). The layers must [`fits`].
@@ -108,11 +103,7 @@ pub fn half_mlp(gpu: &GpuDevice, layers: &[FusedLayer], io: &FusedIo) -> Dispatc
     let mut params = vec![io.rows, layers.len(), x_f32, io.x_cols];
     params.extend([io.out16, io.y32.is_some(), io.kept_input.is_some()].map(usize::from));
     params.extend([
-        match io.pre {
-            Some((_, Pre::Keep)) => 1,
-            Some((_, Pre::DeriveInPlace)) => 2,
-            _ => 0,
-        },
+        usize::from(matches!(io.pre, Some((_, Pre::Keep)))),
         io.kept_input.unwrap_or(0),
         bias0_mode,
         bias0_at,
@@ -493,10 +484,9 @@ mod tests {
     /// transposed weights) against the host: the gradient at the output kept as held f16
     /// rows, each layer's gradient at its pre-activation (times ReLU's derivative at the
     /// pre-activations the forward pass kept) as held f16 rows, the first layer's as f32 rows
-    /// too, each within 1% of its largest value; nothing written outside its place. Then
-    /// again on to the first layer's input (one more stage, linear): the input's gradient as
-    /// f32 rows, the first layer's f32 gradient in place of its pre-activation, which alone
-    /// changes.
+    /// too, each within 1% of its largest value; nothing written outside its place, and the
+    /// pre-activations unchanged. Then again on to the first layer's input (one more stage,
+    /// linear): the input's gradient as f32 rows in place of the first layer's.
     #[test]
     fn a_backward_pass_keeps_every_layers_gradient() {
         if !GpuDevice::probe() || !GpuDevice::get().unwrap().half {
@@ -570,21 +560,9 @@ mod tests {
                 out16: !to_input,
                 kept_input: Some(out_at),
                 y32: Some(&y32),
-                pre: Some((
-                    &pre,
-                    if to_input {
-                        Pre::DeriveInPlace
-                    } else {
-                        Pre::Derive
-                    },
-                )),
+                pre: Some((&pre, Pre::Derive)),
             };
             gpu.submit([&half_mlp(&gpu, &stages, &io)]);
-            let pre_got = gpu.read(&pre, pre_values.len());
-            let first32 = match to_input {
-                true => pre_got[pre_at[0]..][..rows * 172].to_vec(),
-                false => gpu.read(&y32, rows * 172),
-            };
             let mut errors = vec![
                 (
                     "output's",
@@ -607,11 +585,11 @@ mod tests {
                         &padded(&round(&g0), rows, 172),
                     ),
                 ),
-                ("layer 0's f32", relative(&first32, &g0)),
             ];
-            if to_input {
-                errors.push(("input's", relative(&gpu.read(&y32, rows * 64), &d_input)));
-            }
+            errors.push(match to_input {
+                true => ("input's", relative(&gpu.read(&y32, rows * 64), &d_input)),
+                false => ("layer 0's f32", relative(&gpu.read(&y32, rows * 172), &g0)),
+            });
             eprintln!("to the input {to_input}: gradients within {errors:?} of each one's largest");
             for (what, error) in errors {
                 assert!(
@@ -634,11 +612,10 @@ mod tests {
                     .all(|e| half::f16::from_bits(bits[e]).to_f32() == canary),
                 "an f16 value written outside its place"
             );
-            // Only layer 0's pre-activation, and only when the pass goes on to the input.
-            let replaced = |e: usize| to_input && (pre_at[0]..pre_at[0] + rows * 172).contains(&e);
-            assert!(
-                (0..pre_values.len()).all(|e| replaced(e) || pre_got[e] == pre_values[e]),
-                "to the input {to_input}: a pre-activation changed"
+            assert_eq!(
+                gpu.read(&pre, pre_values.len()),
+                pre_values,
+                "to the input {to_input}: the pre-activations changed"
             );
         }
     }

@@ -63,14 +63,22 @@ impl<'a> Bias<'a> {
 }
 
 /// A product's output: `rows` values apart from `offset` of `buffer`, written or added to.
-/// For a column sum, `tail` (`[at, offset]`, `at` > 0) sends the sums from index `at` on to
-/// `offset` of the same buffer instead.
+/// For a column sum, `tail` sends the sums from its index on elsewhere.
 pub struct Output<'a> {
     pub buffer: &'a wgpu::Buffer,
     pub offset: usize,
     pub stride: usize,
     pub accumulate: bool,
-    pub tail: Option<[usize; 2]>,
+    pub tail: Option<Tail<'a>>,
+}
+
+/// A column sum's sums from index `at` (> 0) on, sent to `offset` of `buffer` (which may be
+/// the output's own).
+#[derive(Clone, Copy)]
+pub struct Tail<'a> {
+    pub at: usize,
+    pub buffer: &'a wgpu::Buffer,
+    pub offset: usize,
 }
 
 impl<'a> Output<'a> {

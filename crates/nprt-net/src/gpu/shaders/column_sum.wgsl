@@ -15,8 +15,9 @@ struct ColumnSum {
     out_off: u32,
     // Rows per chunk; 0: all rows in one.
     chunk: u32,
-    // Sums from index tail_at on go to out from tail_off instead (0: none): a weight's
-    // gradient summed over chunks with its bias's on an extra row, each to its own place.
+    // Sums from index tail_at on go to tail_out from tail_off instead (0: none): a weight's
+    // gradient summed over chunks with its bias's on an extra row, each to its own place, or
+    // an MLP's with its first layer's sums per view.
     tail_at: u32,
     tail_off: u32,
 }
@@ -25,6 +26,7 @@ struct ColumnSum {
 @group(0) @binding(1) var<storage, read> x: array<f32>;
 @group(0) @binding(2) var<storage, read> group_of: array<u32>;
 @group(0) @binding(3) var<storage, read_write> out: array<f32>;
+@group(0) @binding(4) var<storage, read_write> tail_out: array<f32>;
 
 @compute @workgroup_size(64)
 fn main(@builtin(global_invocation_id) id: vec3<u32>, @builtin(num_workgroups) groups: vec3<u32>) {
@@ -44,10 +46,15 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>, @builtin(num_workgroups) g
             s += x[i * p.n + j];
         }
     }
-    var at = p.out_off + o;
     if (p.tail_at > 0u && o >= p.tail_at) {
-        at = p.tail_off + (o - p.tail_at);
+        let at = p.tail_off + (o - p.tail_at);
+        if (p.accumulate == 1u) {
+            s += tail_out[at];
+        }
+        tail_out[at] = s;
+        return;
     }
+    let at = p.out_off + o;
     if (p.accumulate == 1u) {
         s += out[at];
     }

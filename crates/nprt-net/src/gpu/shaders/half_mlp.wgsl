@@ -25,9 +25,7 @@ struct HalfMlp {
     // each hidden layer's output, as f16 rows from its at.z of y16.
     keep: u32,
     // 1 (a training step's forward pass): each hidden layer's pre-activation is kept, f32 rows
-    // of n from its at.w of z, which a backward pass's derivatives read there; 2 (a backward
-    // pass on to the first layer's input): the last hidden layer's output, f32, replaces the
-    // pre-activation it was derived at (the gradient at the first layer's pre-activation).
+    // of n from its at.w of z, which a backward pass's derivatives read there.
     keep_z: u32,
     in_at: u32,
     // The first layer's bias: 0 none; 1 bias0[bias0_at + j]; 2 bias0[group_of[i] · n + j] (the
@@ -128,9 +126,6 @@ fn finish(r: u32, j: u32, sum: f32) {
             v = select(0.0, v, z[at_z] > 0.0);
         } else if (s.w == 4u) {
             v *= OMEGA_0 * cos(OMEGA_0 * z[at_z]);
-        }
-        if (p.keep_z == 2u && layer + 2u == p.layers) {
-            z[at_z] = v;
         }
     }
     let h = f16(clamp(v, -F16_MAX, F16_MAX));

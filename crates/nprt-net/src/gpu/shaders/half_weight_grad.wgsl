@@ -1,15 +1,17 @@
 // `half_weight_sums`' product without tensor cores, for adapters without cooperative matrices
 // (the tests' software Vulkan): a thread per 4 × 4 sums of a chunk, so that each value it loads
 // serves four products (a thread a sum loaded two values a product). The bias's row reads x as
-// ones: dz's column sums, in the same order as `dz_sum`. A chunk's threads run every layer's
+// ones, a view's row as ones on that view's rows and zeros elsewhere: dz's column sums, in the
+// same order as `dz_sum`. A chunk's threads run every layer's
 // sums, the layers' one after another (`work`).
 
-// x's value in row start xr, column i: the bias's row (i = m) reads ones, past it zeros.
-fn x_at(xr: u32, i: u32) -> f32 {
+// x's value in row r (starting at xr), column i: past the weight's rows, ones where the sum
+// row counts row r (`counts`), zeros past the last.
+fn x_at(r: u32, xr: u32, i: u32) -> f32 {
     if (i < l.m) {
         return f32(x[xr + i]);
     }
-    return select(0.0, 1.0, i == l.m);
+    return select(0.0, 1.0, i < l.m + l.bias + l.views && counts(r, i));
 }
 
 @compute @workgroup_size(64)
@@ -33,10 +35,10 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>, @builtin(num_workgroups) g
         let xr = l.x_at + r * l.k_pad;
         let d = l.dz_at + r * l.n_pad + j0;
         let b = vec4(f32(dz[d]), f32(dz[d + 1u]), f32(dz[d + 2u]), f32(dz[d + 3u]));
-        sums[0] += x_at(xr, i0) * b;
-        sums[1] += x_at(xr, i0 + 1u) * b;
-        sums[2] += x_at(xr, i0 + 2u) * b;
-        sums[3] += x_at(xr, i0 + 3u) * b;
+        sums[0] += x_at(r, xr, i0) * b;
+        sums[1] += x_at(r, xr, i0 + 1u) * b;
+        sums[2] += x_at(r, xr, i0 + 2u) * b;
+        sums[3] += x_at(r, xr, i0 + 3u) * b;
     }
     for (var c = 0u; c < 4u; c++) {
         for (var q = 0u; q < 4u; q++) {

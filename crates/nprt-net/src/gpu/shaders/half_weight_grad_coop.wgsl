@@ -7,7 +7,8 @@
 // others' spare workgroups return at once); tiles past x's or dz's padded columns read the
 // last tile again and are not written (`finish` keeps to m × n). A tile leaves through
 // `coop_drain`. With a bias, one more row of the layer's blocks (past k_pad's) sums dz's
-// columns instead, two threads a column over half the chunk's rows each.
+// columns instead, two threads a column over half the chunk's rows each, and with view sums a
+// row more per view.
 
 @compute @workgroup_size(128)
 fn main(@builtin(workgroup_id) group: vec3<u32>, @builtin(local_invocation_index) t: u32) {
@@ -22,10 +23,12 @@ fn main(@builtin(workgroup_id) group: vec3<u32>, @builtin(local_invocation_index
     let block_i = group.x / blocks_n;
     let block_j = group.x % blocks_n;
     let blocks_k = (shape.z + 255u) / 256u;
-    if (block_i >= blocks_k + p.work[group.y].y) {
+    let work = p.work[group.y];
+    if (block_i >= blocks_k + work.y + work.z) {
         return;
     }
     if (block_i >= blocks_k) {
+        let i = l.m + block_i - blocks_k;
         let j = block_j * 64u + t % 64u;
         let r0 = group.z * p.chunk;
         let r1 = min(p.rows, r0 + p.chunk);
@@ -33,15 +36,15 @@ fn main(@builtin(workgroup_id) group: vec3<u32>, @builtin(local_invocation_index
         var sum = 0.0;
         if (j < l.n) {
             if (t < 64u) {
-                sum = dz_sum(j, r0, mid);
+                sum = dz_sum(i, j, r0, mid);
             } else {
-                sum = dz_sum(j, mid, r1);
+                sum = dz_sum(i, j, mid, r1);
             }
         }
         staged[t] = sum;
         workgroupBarrier();
         if (t < 64u) {
-            finish(l.m, j, staged[t] + staged[t + 64u]);
+            finish(i, j, staged[t] + staged[t + 64u]);
         }
         return;
     }

@@ -9,6 +9,7 @@ use crate::gpu::layers::light_basis::{BasisAt, BasisFunctions};
 use crate::gpu::layers::mlp_tape::MlpTape;
 use crate::gpu::layers::network_forward::{FirstLayer, ForwardTargets};
 use crate::gpu::layers::network_layout::{LightAt, TrackAt};
+use crate::gpu::passes::mlp_step::ViewSums;
 use crate::gpu::products::codes::loss_code;
 use crate::gpu::products::dense_products::DenseProducts;
 use crate::gpu::products::half_layers::Held;
@@ -281,32 +282,11 @@ impl GpuTrainer {
             .map(|_| gpu.buffer(b.rows * TRANSPORT_CODE));
         let d_input = d_s.as_ref().or(tape.dx.as_ref());
         let input = tape.transfer.as_ref().map_or(&tape.x, |tr| &tr.output);
-        // Each view's sum of the first layer's pre-activation gradients: its bias's, its code
-        // rows' and the code's gradients all follow from it. A linear track's first layer has
-        // its bias alone.
-        let on_first = |plan: &mut Vec<Dispatch>, dz: &wgpu::Buffer| {
-            if t.coefficients.is_some() {
-                let to = Output::to(&self.grads, first.bias.offset, first.d_out);
-                self.gpu.column_sum(plan, dz, b.rows, first.d_out, None, to);
-                return;
-            }
-            let d_views = gpu.buffer(b.views * first.d_out);
-            self.gpu.column_sum(
-                plan,
-                dz,
-                b.rows,
-                first.d_out,
-                Some((&b.view, b.views)),
-                Output::to(&d_views, 0, first.d_out),
-            );
-            self.gpu.column_sum(
-                plan,
-                &d_views,
-                b.views,
-                first.d_out,
-                None,
-                Output::to(&self.grads, first.bias.offset, first.d_out),
-            );
+        // The code's rows of the first shading weight and the code's gradient, from each
+        // view's sums of the gradient at that layer's pre-activation (which also make its
+        // bias's). A linear track's first layer has a bias of its own instead.
+        let d_views = gpu.buffer(b.views * first.d_out);
+        let from_views = |plan: &mut Vec<Dispatch>| {
             plan.push(self.gpu.product(
                 [CODE_SIZE, first.d_out, b.views],
                 Operand::transposed(&b.codes, 0, CODE_SIZE),
@@ -329,6 +309,12 @@ impl GpuTrainer {
                 None,
             ));
         };
+        let view_sums = ViewSums {
+            view: &b.view,
+            views: b.views,
+            d_views: &d_views,
+            then: &from_views,
+        };
         self.trainable().mlp_backward(
             plan,
             &t.shading,
@@ -336,7 +322,7 @@ impl GpuTrainer {
             (input, own_row, t.own_width()),
             &tape.d_out,
             d_input,
-            Some(&on_first),
+            t.coefficients.is_none().then_some(&view_sums),
         );
         if let (Some(m), Some(tr), Some(d_s)) = (&t.transfer, &tape.transfer, &d_s) {
             self.trainable().mlp_backward(
