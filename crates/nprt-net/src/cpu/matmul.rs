@@ -1,5 +1,5 @@
-//! Row-major f32 matrix products through the `gemm` crate, with either operand read transposed
-//! through its strides instead of copied.
+//! Row-major f32 matrix products through the `gemm` family's f32 kernels (`gemm-f32`), with
+//! either operand read transposed through its strides instead of copied.
 
 /// A row-major matrix view: `rows × cols` values, row `r` starting at `r · stride`.
 #[derive(Clone, Copy)]
@@ -67,29 +67,39 @@ pub fn matmul(
         }
         return;
     }
-    // SAFETY: the asserts above keep every index gemm forms from these shapes and strides
-    // inside the three slices, and `dst` is borrowed mutably so it aliases neither operand.
+    // The kernels prefer a column-major destination, so a row-major one is computed as its
+    // transpose, Cᵀ = Bᵀ·Aᵀ (what the `gemm` crate's front end does before the same call).
+    let (m, n, dst_cs, dst_rs, lhs, [lhs_cs, lhs_rs], rhs, [rhs_cs, rhs_rs]) = if dst_stride > 1 {
+        let (a, b) = (a.data.as_ptr(), b.data.as_ptr());
+        (n, m, dst_stride as isize, 1, b, [b_rs, b_cs], a, [a_rs, a_cs])
+    } else {
+        let (a, b) = (a.data.as_ptr(), b.data.as_ptr());
+        (m, n, 1, dst_stride as isize, a, [a_cs, a_rs], b, [b_cs, b_rs])
+    };
+    // SAFETY: the asserts above keep every index the kernel forms from these shapes and
+    // strides inside the three slices, and `dst` is borrowed mutably so it aliases neither
+    // operand.
     unsafe {
-        gemm::gemm(
+        gemm_f32::gemm::f32::get_gemm_fn()(
             m,
             n,
             k,
             dst.as_mut_ptr(),
-            1,
-            dst_stride as isize,
+            dst_cs,
+            dst_rs,
             accumulate,
-            a.data.as_ptr(),
-            a_cs,
-            a_rs,
-            b.data.as_ptr(),
-            b_cs,
-            b_rs,
+            lhs,
+            lhs_cs,
+            lhs_rs,
+            rhs,
+            rhs_cs,
+            rhs_rs,
             1.0,
             1.0,
             false,
             false,
             false,
-            gemm::Parallelism::None,
+            gemm_common::Parallelism::None,
         );
     }
 }
