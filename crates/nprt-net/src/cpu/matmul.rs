@@ -69,12 +69,12 @@ pub fn matmul(
     }
     // The kernels prefer a column-major destination, so a row-major one is computed as its
     // transpose, Cᵀ = Bᵀ·Aᵀ (what the `gemm` crate's front end does before the same call).
-    let (m, n, dst_cs, dst_rs, lhs, [lhs_cs, lhs_rs], rhs, [rhs_cs, rhs_rs]) = if dst_stride > 1 {
-        let (a, b) = (a.data.as_ptr(), b.data.as_ptr());
-        (n, m, dst_stride as isize, 1, b, [b_rs, b_cs], a, [a_rs, a_cs])
-    } else {
-        let (a, b) = (a.data.as_ptr(), b.data.as_ptr());
-        (m, n, 1, dst_stride as isize, a, [a_cs, a_rs], b, [b_cs, b_rs])
+    // Each operand as (data, column stride, row stride).
+    let (a, b) = ((a.data.as_ptr(), a_cs, a_rs), (b.data.as_ptr(), b_cs, b_rs));
+    let stride = dst_stride as isize;
+    let (m, n, [dst_cs, dst_rs], lhs, rhs) = match dst_stride > 1 {
+        true => (n, m, [stride, 1], (b.0, b.2, b.1), (a.0, a.2, a.1)),
+        false => (m, n, [1, stride], a, b),
     };
     // SAFETY: the asserts above keep every index the kernel forms from these shapes and
     // strides inside the three slices, and `dst` is borrowed mutably so it aliases neither
@@ -88,12 +88,12 @@ pub fn matmul(
             dst_cs,
             dst_rs,
             accumulate,
-            lhs,
-            lhs_cs,
-            lhs_rs,
-            rhs,
-            rhs_cs,
-            rhs_rs,
+            lhs.0,
+            lhs.1,
+            lhs.2,
+            rhs.0,
+            rhs.1,
+            rhs.2,
             1.0,
             1.0,
             false,
