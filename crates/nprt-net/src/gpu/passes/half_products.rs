@@ -53,13 +53,12 @@ pub(crate) struct GradLayer<'a> {
     pub views: Option<PerView<'a>>,
 }
 
-/// A weight-gradient pass's sums per view: each batch row's view, the views' number, and
-/// where their sums go in a chunk's block, past the parameters' span (`n` a view).
+/// A weight-gradient pass's sums per view: each batch row's view and the views' number. They
+/// end a chunk's block, past the parameters' span (`n` a view).
 #[derive(Clone, Copy)]
 pub(crate) struct PerView<'a> {
     pub view: &'a wgpu::Buffer,
     pub count: usize,
-    pub at: usize,
 }
 
 /// The dispatches of `layers`' weight gradients, xᵀ·dz over `rows` rows cut into chunks of
@@ -96,7 +95,8 @@ fn half_weight_grads(
                     l.views.is_none() || l.b_at.is_some(),
                     "view sums with a bias"
                 );
-                let [views, g_at] = l.views.map_or([0, 0], |v| [v.count, v.at]);
+                let views = l.views.map_or(0, |v| v.count);
+                let g_at = stride - views * n;
                 shape[i] = [m, n, k_pad, n_pad];
                 let [x_at, dz_at] = [&l.x, &l.dz].map(|rows| 2 * rows.span.offset);
                 at[i] = [x_at, dz_at, l.w_at, l.b_at.unwrap_or(0)];
@@ -165,7 +165,6 @@ impl Trainable<'_> {
                 views: view_sums.filter(|_| i == 0).map(|v| PerView {
                     view: v.view,
                     count: v.views,
-                    at: len,
                 }),
             })
             .collect();
@@ -304,10 +303,10 @@ impl Trainable<'_> {
     /// Records `layers`' weight gradients over `rows` rows into `grads[at..at + len]`, the
     /// span their places (each layer's `w_at` and `b_at`) are counted from: xᵀ·dz (f16
     /// operands) per chunk of rows (`half_weight_grads`), then one column sum adds the chunks
-    /// in order over the whole span, and a layer's sums per view (at most one layer's, placed
-    /// at `len`) into `d_views`. What no layer's sums take in the span (a first layer's rows
-    /// of the light code, a bias left out, the gaps between tensors) it writes as zeros, for
-    /// the light code's products to overwrite after.
+    /// in order over the whole span, and a layer's sums per view (at most one layer's, past
+    /// the span in a chunk's block) into `d_views`. What no layer's sums take in the span (a
+    /// first layer's rows of the light code, a bias left out, the gaps between tensors) it
+    /// writes as zeros, for the light code's products to overwrite after.
     fn half_weight_gradients(
         &self,
         plan: &mut Vec<Dispatch>,
@@ -321,10 +320,7 @@ impl Trainable<'_> {
             let [m, n] = l.shape;
             assert!(l.w_at + m * n <= len && l.b_at.is_none_or(|b| b + n <= len));
             if let Some(v) = l.views {
-                assert!(
-                    v.at == len && extra == 0,
-                    "one layer's sums per view, past the span"
-                );
+                assert_eq!(extra, 0, "one layer's sums per view");
                 extra = v.count * n;
             }
         }
@@ -349,8 +345,9 @@ mod tests {
     /// another, and one column sum over the span they lie in. Each weight's xᵀ·dz and each
     /// bias's dz column sums land in their own places, across chunks of rows, and the first
     /// layer's dz column sums per view in a buffer of their own; what no sums take in the
-    /// span (the third bias, the gaps) is zero, and nothing outside it is touched. The sums are f32 over f16 products, so they agree to f32's rounding, far below
-    /// the 10⁻² an f16 step's gradients carry (where a bias a few percent off would hide).
+    /// span (the third bias, the gaps) is zero, and nothing outside it is touched. The sums
+    /// are f32 over f16 products, so they agree to f32's rounding, far below the 10⁻² an f16
+    /// step's gradients carry (where a bias a few percent off would hide).
     #[test]
     fn an_mlps_weight_gradients_come_from_one_dispatch_with_their_biases_and_view_sums() {
         if !GpuDevice::probe() || !GpuDevice::get().unwrap().half {
@@ -430,7 +427,6 @@ mod tests {
         layers[0].views = Some(PerView {
             view: &view,
             count: views,
-            at: len,
         });
         let n0 = layers[0].shape[1];
         let d_views = gpu.upload(&vec![-1.0f32; views * n0 + 7]);

@@ -9,10 +9,11 @@ enable f16;
 // at once. With a bias, the layer also sums dz's columns over the chunk, its bias's gradient
 // (from b_at), so that it costs no dispatches of its own (a column sum over the batch's rows
 // took three); with view sums too, dz's columns over each view's rows of the chunk (a row per
-// view from g_at, past the parameters' span: a first shading layer's, whose bias is a row per
-// view, the light code's share). What both of its products share: the parameters, the buffers, a work item's
-// layer, the bias's sums and where a sum goes. The product is `half_weight_grad_coop` (tensor
-// cores) where the adapter has cooperative matrices and `half_weight_grad` elsewhere.
+// view from g_at, ending the block past the parameters' span: a first shading layer's, whose
+// bias is a row per view, the light code's share). What both of its products share: the
+// parameters, the buffers, a work item's layer, the bias's sums and where a sum goes. The
+// product is `half_weight_grad_coop` (tensor cores) where the adapter has cooperative matrices
+// and `half_weight_grad` elsewhere.
 
 struct HalfWeightGrad {
     // The batch's rows padded to a multiple of 16 (x and dz hold at least these).
