@@ -6,11 +6,11 @@ use std::ops::ControlFlow;
 
 use glam::{Vec2, Vec3};
 use nprt_scene::{BsdfParams, Camera, EnvMap, Scene};
-use rand::RngExt;
 use rand_pcg::Pcg64Mcg;
 
 use crate::accel::Hit;
 use crate::bsdf::Bsdf;
+use crate::sampler::Sampler;
 use crate::shading_frame::Frame3;
 use crate::trace_scene::TraceScene;
 
@@ -192,12 +192,12 @@ impl CameraRay {
 /// until it leaves the scene (`Some`) or ends on a surface (absorbed, Russian roulette from
 /// `rr_depth`, `max_depth` reached, or `at_surface` breaking: `None`). The one walk behind
 /// every integrator.
-pub(crate) fn walk(
+pub(crate) fn walk<S: Sampler>(
     ts: &TraceScene,
     ray: &CameraRay,
     s: &PathSettings,
-    rng: &mut Pcg64Mcg,
-    mut at_surface: impl FnMut(&Vertex, &mut Pcg64Mcg) -> ControlFlow<()>,
+    rng: &mut S,
+    mut at_surface: impl FnMut(&Vertex, &mut S) -> ControlFlow<()>,
 ) -> Option<Escape> {
     let (mut beta, mut pdf, mut depth, mut delta) = (Vec3::ONE, 0.0f32, 0u32, false);
     // Product of the relative indices crossed: Russian roulette judges the throughput as if
@@ -239,9 +239,11 @@ pub(crate) fn walk(
         if at_surface(&v, rng).is_break() {
             return None;
         }
-        let bs = v
-            .bsdf
-            .sample(wo, Vec2::new(rng.random(), rng.random()), rng.random())?;
+        let bs = v.bsdf.sample(
+            wo,
+            Vec2::new(rng.next_f32(), rng.next_f32()),
+            rng.next_f32(),
+        )?;
         dir = frame.to_world(bs.wi);
         let origin = offset_origin(v.sp.p, v.sp.ng, dir);
         beta *= bs.weight;
@@ -251,7 +253,7 @@ pub(crate) fn walk(
         depth += 1;
         if depth >= s.rr_depth {
             let q = (beta.max_element() * eta * eta).min(0.95);
-            if rng.random::<f32>() >= q {
+            if rng.next_f32() >= q {
                 return None;
             }
             beta /= q;
@@ -267,7 +269,7 @@ pub fn trace_path(
     env: &EnvMap,
     ray: &CameraRay,
     s: &PathSettings,
-    rng: &mut Pcg64Mcg,
+    rng: &mut impl Sampler,
 ) -> PathRadiance {
     let mut out = PathRadiance::default();
     if s.max_depth == 0 {
@@ -293,11 +295,17 @@ pub fn trace_path(
 
 /// Next-event estimation at `v`: a light sample towards the environment, weighted by MIS
 /// against BSDF sampling (nothing at a vertex with no smooth lobe).
-pub(crate) fn next_event(ts: &TraceScene, env: &EnvMap, v: &Vertex, rng: &mut Pcg64Mcg) -> Vec3 {
+pub(crate) fn next_event(
+    ts: &TraceScene,
+    env: &EnvMap,
+    v: &Vertex,
+    rng: &mut impl Sampler,
+) -> Vec3 {
     if !v.bsdf.is_smooth() {
         return Vec3::ZERO;
     }
-    let (wi_world, le, light_pdf) = env.sample(Vec3::new(rng.random(), rng.random(), rng.random()));
+    let u = Vec3::new(rng.next_f32(), rng.next_f32(), rng.next_f32());
+    let (wi_world, le, light_pdf) = env.sample(u);
     if light_pdf <= 0.0 {
         return Vec3::ZERO;
     }

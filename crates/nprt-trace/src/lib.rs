@@ -43,6 +43,7 @@ mod microfacet;
 mod pixel_rng;
 mod reference;
 mod render;
+pub mod sampler;
 mod shading_frame;
 mod trace_scene;
 mod tracer;

@@ -10,6 +10,7 @@ use crate::frame::{Frame, GBuffer, GSample};
 use crate::gbuffer_pass::gsample;
 use crate::integrator::{trace_path, CameraRay, PathRadiance, PathSettings};
 use crate::pixel_rng::pixel_rng;
+use crate::sampler::StratifiedSampler;
 use crate::trace_scene::TraceScene;
 
 /// Where a pixel's samples go through the film.
@@ -125,8 +126,10 @@ fn pixel(
 
 /// Direct light alone: the map seen directly and light that reached the first surface straight
 /// from it, `spp` samples per pixel through the pixel centre (matching the G-buffer). What a
-/// model that leaves direct light to the tracer adds at run time: the same image as [`render`]
-/// with `max_depth` 2 and [`PixelFilter::Centre`] under the same seed, without the G-buffer.
+/// model that leaves direct light to the tracer adds at run time: the image [`render`] makes
+/// with `max_depth` 2 and [`PixelFilter::Centre`], in the mean, with each pixel's samples
+/// stratified over their light and BSDF samples ([`StratifiedSampler`]): less noise for the
+/// same rays (docs/model.md, "The recommended recipe").
 pub fn render_direct(
     ts: &TraceScene,
     camera: &Camera,
@@ -142,10 +145,13 @@ pub fn render_direct(
     (0..w * camera.height as usize)
         .into_par_iter()
         .map(|i| {
-            let mut rng = pixel_rng(seed, i as u64);
+            let mut sampler = StratifiedSampler::new(pixel_rng(seed, i as u64), spp);
             let ray = CameraRay::centre(ts, camera, i % w, i / w);
             let sum: Vec3 = (0..spp)
-                .map(|_| trace_path(ts, env, &ray, &ps, &mut rng).total)
+                .map(|s| {
+                    sampler.start(s);
+                    trace_path(ts, env, &ray, &ps, &mut sampler).total
+                })
                 .sum();
             sum / spp.max(1) as f32
         })

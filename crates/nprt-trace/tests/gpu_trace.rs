@@ -80,6 +80,7 @@ fn full_paths(scene: &Scene, size: [u32; 2], spp: u32, jitter: bool) {
         rr_depth: scene.rr_depth,
         first_path: 0,
         jitter,
+        stratified: false,
     };
     assert_unbiased(scene, &map, size, paths, |ts, camera, seed| {
         let settings = RenderSettings {

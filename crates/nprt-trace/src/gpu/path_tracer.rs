@@ -47,6 +47,9 @@ pub struct GpuPaths {
     /// Over the pixel (a reference's box filter) rather than through its centre (the
     /// G-buffer's, and traced direct light's, convention).
     pub jitter: bool,
+    /// The first dimensions of a pixel's `spp` paths stratified, as the CPU's traced direct
+    /// light (nprt-trace's `StratifiedSampler`); independent numbers otherwise.
+    pub stratified: bool,
 }
 
 impl GpuPaths {
@@ -60,6 +63,7 @@ impl GpuPaths {
             rr_depth: u32::MAX,
             first_path: 0,
             jitter: false,
+            stratified: true,
         }
     }
 }
@@ -109,7 +113,7 @@ pub fn record_paths(
             u32::from(paths.jitter),
             triangles,
             u32::from(out.direct.is_some()),
-            0,
+            u32::from(paths.stratified),
             0,
         ];
         params.extend(camera_words(camera));
@@ -172,6 +176,7 @@ impl RasterGBuffer {
             rr_depth: settings.rr_depth,
             first_path: 0,
             jitter: settings.filter == PixelFilter::Box,
+            stratified: false,
         };
         let gbuffer = self.render(camera)?;
         let (radiance, direct) = self.trace_with_direct(camera, map, &paths)?;

@@ -4,8 +4,8 @@
 // pixel, `spp` paths through the pixel centre (or jittered over the pixel), their sum over
 // `total_spp` written to or added onto `rgb` (a long estimate is split over dispatches), and
 // with `keep_direct` their direct part (the map seen directly, and light that reached the
-// first surface straight from it, as PathRadiance::direct) onto `direct_rgb` alike. Its random numbers are its own (PCG), so frames agree with the CPU's
-// within noise, not sample for sample. After camera_ray.wgsl, lerp.wgsl, map_lookup.wgsl,
+// first surface straight from it, as PathRadiance::direct) onto `direct_rgb` alike. Its random numbers are its own (PCG; the traced direct light's stratified
+// as the CPU's), so frames agree with the CPU's within noise, not sample for sample. After camera_ray.wgsl, lerp.wgsl, map_lookup.wgsl,
 // map_sampling.wgsl, surface.wgsl, bsdf.wgsl and bvh.wgsl.
 
 struct Params {
@@ -27,7 +27,8 @@ struct Params {
     jitter: u32,
     triangle_count: u32,
     keep_direct: u32,
-    _pad1: u32,
+    // 1: the first dimensions of a pixel's `total_spp` paths stratified (traced direct light).
+    stratified: u32,
     _pad2: u32,
     x_axis: vec4<f32>,
     y_axis: vec4<f32>,
@@ -76,6 +77,74 @@ fn next_uniform(state: ptr<function, u32>) -> f32 {
     return f32(((w >> 22u) ^ w) >> 8u) * (1.0 / 16777216.0);
 }
 
+// Where a path's uniform numbers come from (nprt-trace's sampler.rs): the PCG stream `state`,
+// and, where `count` is not 0 (the traced direct light), the first STRATIFIED_DIMENSIONS
+// dimensions of a pixel's `count` paths Latin hypercube sampled: path `sample` takes stratum
+// permute(sample, count, dimension_key(key, d)) of dimension d, jittered by the stream.
+const STRATIFIED_DIMENSIONS: u32 = 6u;
+
+struct Draws {
+    state: u32,
+    sample: u32,
+    count: u32,
+    key: u32,
+    dimension: u32,
+}
+
+// sampler.rs's `dimension_key`.
+fn dimension_key(key: u32, d: u32) -> u32 {
+    return pcg_hash(key ^ (d * 0x9e3779b9u));
+}
+
+// sampler.rs's `permute`: Kensler's hashed permutation of 0..l, by cycle walking.
+fn permute(i_in: u32, l_in: u32, p: u32) -> u32 {
+    let l = max(l_in, 1u);
+    var w = l - 1u;
+    w |= w >> 1u;
+    w |= w >> 2u;
+    w |= w >> 4u;
+    w |= w >> 8u;
+    w |= w >> 16u;
+    var i = i_in;
+    loop {
+        i ^= p;
+        i *= 0xe170893du;
+        i ^= p >> 16u;
+        i ^= (i & w) >> 4u;
+        i ^= p >> 8u;
+        i *= 0x0929eb3fu;
+        i ^= p >> 23u;
+        i ^= (i & w) >> 1u;
+        i *= 1u | (p >> 27u);
+        i *= 0x6935fa69u;
+        i ^= (i & w) >> 11u;
+        i *= 0x74dcb303u;
+        i ^= (i & w) >> 2u;
+        i *= 0x9e501cc3u;
+        i ^= (i & w) >> 2u;
+        i *= 0xc860a3dfu;
+        i &= w;
+        i ^= i >> 5u;
+        if i < l {
+            break;
+        }
+    }
+    return (i + p % l) % l;
+}
+
+fn draw(d: ptr<function, Draws>) -> f32 {
+    var state = (*d).state;
+    let jitter = next_uniform(&state);
+    (*d).state = state;
+    let dim = (*d).dimension;
+    (*d).dimension = dim + 1u;
+    if (*d).count == 0u || dim >= STRATIFIED_DIMENSIONS {
+        return jitter;
+    }
+    let stratum = permute((*d).sample, (*d).count, dimension_key((*d).key, dim));
+    return min((f32(stratum) + jitter) / f32((*d).count), 0.99999994);
+}
+
 fn power_heuristic(a: f32, b: f32) -> f32 {
     let a2 = a * a;
     let b2 = b * b;
@@ -105,7 +174,7 @@ fn scene_hit(origin: vec3<f32>, dir: vec3<f32>, first_hit: bool) -> Hit {
 }
 
 // The radiance one path carries into the camera along `dir` from `origin`.
-fn trace_path(origin_in: vec3<f32>, dir_in: vec3<f32>, state: ptr<function, u32>) -> PathOut {
+fn trace_path(origin_in: vec3<f32>, dir_in: vec3<f32>, draws: ptr<function, Draws>) -> PathOut {
     let size = vec2<u32>(params.map_width, params.map_height);
     let table_size = vec2<u32>(params.map_width, params.map_height - 1u);
     let to_local = mat3x3<f32>(params.to_local_x.xyz, params.to_local_y.xyz, params.to_local_z.xyz);
@@ -145,7 +214,7 @@ fn trace_path(origin_in: vec3<f32>, dir_in: vec3<f32>, state: ptr<function, u32>
             break;
         }
         if is_smooth(b) {
-            let u = vec3<f32>(next_uniform(state), next_uniform(state), next_uniform(state));
+            let u = vec3<f32>(draw(draws), draw(draws), draw(draws));
             let ls = map_sample(u, to_world, size, table_size);
             if ls.pdf > 0.0 {
                 let wi = ls.dir * local;
@@ -159,8 +228,8 @@ fn trace_path(origin_in: vec3<f32>, dir_in: vec3<f32>, state: ptr<function, u32>
                 }
             }
         }
-        let u = vec2<f32>(next_uniform(state), next_uniform(state));
-        let bs = bsdf_sample(b, wo, u, next_uniform(state));
+        let u = vec2<f32>(draw(draws), draw(draws));
+        let bs = bsdf_sample(b, wo, u, draw(draws));
         if !bs.ok {
             break;
         }
@@ -173,7 +242,7 @@ fn trace_path(origin_in: vec3<f32>, dir_in: vec3<f32>, state: ptr<function, u32>
         depth++;
         if depth >= params.rr_depth {
             let q = min(max_element(beta) * eta * eta, 0.95);
-            if next_uniform(state) >= q {
+            if draw(draws) >= q {
                 break;
             }
             beta /= q;
@@ -200,7 +269,10 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
             film = vec2<f32>(id.xy) + vec2<f32>(next_uniform(&state), next_uniform(&state));
         }
         let dir = camera_ray_at(film, size, params.x_axis.xyz, params.y_axis.xyz, params.z_axis.xyz, params.tangents.xy);
-        let path = trace_path(params.origin.xyz, dir, &state);
+        let key = pcg_hash(params.seed ^ pcg_hash(i ^ 0x5bd1e995u));
+        let count = select(0u, params.total_spp, params.stratified == 1u);
+        var draws = Draws(state, params.first_path + s, count, key, 0u);
+        let path = trace_path(params.origin.xyz, dir, &draws);
         sum += path.total;
         direct += path.direct;
     }
