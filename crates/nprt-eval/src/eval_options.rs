@@ -32,6 +32,9 @@ pub struct EvalOptions {
     pub temporal_res: u32,
     /// Frames the warmed radiance caches render before the path's first (0: cold ones only).
     pub nrc_warmup: usize,
+    /// Also score each part of a traced design's image with the other part the reference's
+    /// (`oracles`): where its error lives.
+    pub oracles: bool,
     pub progress: bool,
 }
 
@@ -100,6 +103,7 @@ impl Default for EvalOptions {
             temporal_frames: 12,
             temporal_res: 64,
             nrc_warmup: 8,
+            oracles: false,
             progress: true,
         }
     }

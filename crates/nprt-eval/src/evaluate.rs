@@ -22,6 +22,7 @@ use crate::eval_options::EvalOptions;
 use crate::method::{Family, MethodResult};
 use crate::metrics::Metrics;
 use crate::networks::{load_networks, run_networks, Net};
+use crate::oracles::run_oracles;
 use crate::path_tracing::{equal_time_spp, run_denoised, run_path_tracing, Traced};
 use crate::sh_prt::run_sh_prt;
 use crate::shown_view::ShownView;
@@ -92,9 +93,14 @@ pub fn evaluate(o: &EvalOptions, engine: Engine) -> Result<Evaluation> {
         Err(_) => 0,
     };
     let tiers = equal_time_tiers(&nets);
-    // Per view: each network (and denoised traced design), path tracing at 5 spp and at each
-    // tier's equal time, SH PRT.
-    let total_steps = (views.len() * (nets.len() + denoised_nets + 2 + tiers.len())) as u64;
+    let oracle_nets = match o.oracles {
+        true => nets.iter().filter(|(n, _)| n.traces_direct()).count(),
+        false => 0,
+    };
+    // Per view: each network (and denoised traced design, and its oracles), path tracing at 5
+    // spp and at each tier's equal time, SH PRT.
+    let steps = nets.len() + denoised_nets + oracle_nets + 2 + tiers.len();
+    let total_steps = (views.len() * steps) as u64;
     let mut bench = TestBench {
         views: &views,
         maps: &maps,
@@ -111,6 +117,17 @@ pub fn evaluate(o: &EvalOptions, engine: Engine) -> Result<Evaluation> {
     let stop = nprt_io::interrupt::check;
     let mut results = run_networks(&mut bench, &nets, oidn.as_ref().ok().copied())?;
     stop()?;
+    let mut oracles = Vec::new();
+    if o.oracles {
+        for (net, name) in &nets {
+            oracles.extend(run_oracles(
+                &mut bench,
+                net,
+                name,
+                oidn.as_ref().ok().copied(),
+            )?);
+        }
+    }
     let pt5 = run_path_tracing(&mut bench, "pt-5spp", 5, 0x5eed_0005);
     let equal_time = run_equal_time(&mut bench, &tiers, &pt5, &mut results);
     let equal_time_spp = equal_time.iter().map(|(n, _)| *n).max().unwrap_or(5);
@@ -130,6 +147,7 @@ pub fn evaluate(o: &EvalOptions, engine: Engine) -> Result<Evaluation> {
     results.push(pt5.result);
     results.extend(equal_time.into_iter().map(|(_, t)| t.result));
     results.extend(baselines);
+    results.extend(oracles);
 
     let timings = time_table(
         o.timing_res,

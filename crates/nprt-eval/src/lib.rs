@@ -24,6 +24,7 @@ mod method;
 pub mod metrics;
 mod networks;
 pub mod nrc;
+mod oracles;
 mod path_tracing;
 mod report;
 pub mod sh;

@@ -22,6 +22,9 @@ pub enum Family {
     Denoised,
     /// Per-pixel spherical-harmonics PRT in a fixed view.
     ShPrt,
+    /// A measurement, not a method: part of a traced design's image with the rest taken from
+    /// the reference (`nprt eval --oracles`).
+    Oracle,
 }
 
 /// Bins of the error analysis (directness and specularity in [0, 1]).

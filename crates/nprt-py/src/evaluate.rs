@@ -54,6 +54,7 @@ pub fn evaluate<'py>(
         temporal_res: temporal_res.unwrap_or(d.temporal_res),
         nrc_warmup: nrc_warmup.unwrap_or(d.nrc_warmup),
         progress,
+        ..d
     };
     let engine = engine(device)?;
     interruptible(py, || {

@@ -61,6 +61,12 @@ pub struct EvalArgs {
     /// only).
     #[arg(long, default_value_t = d().nrc_warmup)]
     nrc_warmup: usize,
+    /// Also score where each traced model's error lives: its network's indirect light with
+    /// the reference's direct light, and its traced direct light (denoised where OIDN is
+    /// installed) with the reference's indirect light, as rows of their own (measurements: no
+    /// time, no equal-time peer).
+    #[arg(long)]
+    oracles: bool,
     #[command(flatten)]
     device: DeviceArg,
 }
@@ -87,6 +93,7 @@ impl From<EvalArgs> for EvalJob {
                 temporal_frames: a.temporal_frames,
                 temporal_res: a.temporal_res,
                 nrc_warmup: a.nrc_warmup,
+                oracles: a.oracles,
                 progress: true,
             },
             out: a.out,
