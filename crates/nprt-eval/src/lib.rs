@@ -41,7 +41,7 @@ pub use method::{Family, MethodResult, BINS};
 pub use metrics::Metrics;
 pub use networks::row_name;
 pub use report::{
-    crop_image, markdown_to_html, mean_and_se, mean_and_se_text, plot_validation, table6,
-    write_report, VALIDATION_PLOT,
+    auto_exposure, crop_image, markdown_to_html, mean_and_se, mean_and_se_text, plot_validation,
+    table6, write_report, VALIDATION_PLOT,
 };
 pub use timing::Timing;

@@ -47,5 +47,5 @@ pub use limits::{available_memory, check_threads, ensure_memory, thread_limit};
 pub use lock_file::{lock_folder, open_lock_file};
 pub use plot::plot_lines;
 pub use png::{srgb8, to_image, write_png};
-pub use progress::progress_bar;
+pub use progress::{progress_bar, staged, StagedBar};
 pub use srgb::{linear_to_srgb, srgb_to_linear};

@@ -63,6 +63,7 @@ pub use model::direct_light::DirectLight;
 pub use model::folder::{load_model, read_model_file, ModelFile};
 pub use model::layer_table::{layer_table, ModelSummary};
 pub use network::activation::{Activation, OMEGA_0};
+pub use network::design::recipe::{Asked, Recipe, RECIPE};
 pub use network::design::{Design, TRANSPORT_CODE};
 pub use network::encoder::{LightEncoder, LightInput, Texels};
 pub use network::light_basis::{BasisChoice, LightBasis};

@@ -6,7 +6,7 @@ use std::path::{Path, PathBuf};
 use anyhow::{bail, Result};
 use nprt_data::{CameraChoice, GenerateOptions};
 use nprt_net::training::snapshot::Snapshot;
-use nprt_net::{BasisChoice, Calibration, Design, DirectLight, Engine, ModelConfig, RunLength};
+use nprt_net::{Calibration, Design, DirectLight, Engine, ModelConfig, RunLength, RECIPE};
 
 use crate::budget::{Budget, DEMO, TINY};
 use crate::orderings::ablation_configs;
@@ -42,23 +42,18 @@ pub struct Experiment {
 }
 
 /// The design beyond the paper that `nprt paper` and `nprt demo` set beside D/S in Table 6:
-/// the linear design on spherical harmonics to band 2, its direct light traced, the best
-/// measured under held-out real maps (docs/model.md, "The linear design, measured").
+/// the recommended recipe's (`nprt_net::RECIPE`: the linear design on spherical harmonics to
+/// band 2, its direct light traced; docs/model.md, "The recommended recipe").
 pub fn beyond_the_paper() -> ModelConfig {
-    ModelConfig {
-        direct: DirectLight::Traced,
-        basis: Some(BasisChoice::Sh { band: 2 }),
-        ..ModelConfig::new(Design::Linear, None)
-    }
+    RECIPE.config()
 }
 
-/// How a design's saved output is calibrated: the design beyond the paper has its level set from
-/// its training targets (`nprt train --calibrate level`), measured under held-out maps to lift
-/// its level from 0.85 to 0.99 on KITCHEN and from 0.97 to 1.00 on builtin:room, lowering L1
-/// and dSSIM (KITCHEN's MRSE rose 7%; docs/model.md); the paper's designs keep their raw output.
+/// How a design's saved output is calibrated: the recipe's model as the recipe says (its level
+/// set from its training targets, `nprt train --calibrate level`); the paper's designs keep
+/// their raw output.
 pub fn calibration(config: &ModelConfig) -> Calibration {
-    if *config == beyond_the_paper() {
-        Calibration::Level
+    if *config == RECIPE.config() {
+        RECIPE.calibration
     } else {
         Calibration::None
     }

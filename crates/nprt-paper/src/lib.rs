@@ -6,7 +6,9 @@
 //! it. It calls the stages' libraries and must not hold their logic: tracing, training,
 //! metrics and baselines stay in nprt-data, nprt-net and nprt-eval.
 
+pub mod bake;
 pub mod budget;
+mod claim;
 mod experiment;
 mod growth_report;
 pub mod orderings;

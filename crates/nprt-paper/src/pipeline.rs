@@ -4,10 +4,11 @@
 
 use std::path::{Path, PathBuf};
 
-use anyhow::{bail, Context, Result};
+use anyhow::{Context, Result};
 use nprt_eval::{Evaluation, MethodResult};
 use serde_json::json;
 
+use crate::claim::Claim;
 use crate::experiment::Experiment;
 use crate::orderings::ablation_configs;
 use crate::paper_report::write_paper_report;
@@ -78,7 +79,7 @@ impl Experiment {
             deep_shading: Some(deep),
             ..stages::eval_options(self, &data, &dirs)
         };
-        let (evaluation, worked) = stages::evaluation(self, &opts, &report)?;
+        let (evaluation, worked) = stages::evaluation(self.engine, &opts, &report)?;
         log.end(worked)?;
 
         let (ablation, paper) = match self.paper_tables {
@@ -146,8 +147,7 @@ impl Experiment {
 
     /// What the output folder is for, recorded by its first run once its settings hold: a
     /// later run with another scene, lighting, budget, training time or seed is refused rather
-    /// than mixed into it. None where the folder is this experiment's already; the record to
-    /// write otherwise.
+    /// than mixed into it.
     fn claim(&self) -> Result<Option<Claim>> {
         let mut what = json!({
             "scene": self.scene,
@@ -162,31 +162,6 @@ impl Experiment {
         if let Some(m) = self.training_minutes {
             what["training_minutes"] = json!(m);
         }
-        let file = self.out.join("experiment.json");
-        if let Ok(bytes) = std::fs::read(&file) {
-            let before = crate::readback::experiment_record(&bytes, &file)?;
-            if before != what {
-                bail!(
-                    "'{}' holds another experiment ({}); this one is {}: give another output folder, or remove it to start again",
-                    self.out.display(),
-                    before,
-                    what
-                );
-            }
-            return Ok(None);
-        }
-        Ok(Some(Claim { file, what }))
-    }
-}
-
-/// An experiment's record, to write into its folder.
-struct Claim {
-    file: PathBuf,
-    what: serde_json::Value,
-}
-
-impl Claim {
-    fn write(&self) -> Result<()> {
-        nprt_io::write_file(&self.file, serde_json::to_vec_pretty(&self.what)?)
+        Claim::check(&self.out, "experiment.json", "experiment", what)
     }
 }

@@ -10,7 +10,7 @@ use nprt_eval::{evaluate, score_networks, write_report, EvalOptions, Evaluation,
 use nprt_net::deep_shading::{self, DeepShadingOptions};
 use nprt_net::model::folder::{CONFIG_FILE, WEIGHTS_FILE};
 use nprt_net::training::training_set::TrainingSet;
-use nprt_net::{ModelConfig, TrainOptions, TrainSummary};
+use nprt_net::{Engine, ModelConfig, TrainOptions, TrainSummary, RECIPE};
 use nprt_render::oidn::Oidn;
 use nprt_render::{RenderJob, RenderOptions};
 
@@ -40,6 +40,10 @@ pub fn train_model(x: &Experiment, data: &Path, config: &ModelConfig, out: &Path
     let set = TrainingSet::load(data, config, true, |why| eprintln!("{why}"))?;
     let mut opts = TrainOptions::default().with_run(config.design, x.training(), None);
     opts.calibration = calibration(config);
+    // The recipe's model on the dataset's transfer vectors, where it has them.
+    if *config == RECIPE.config() {
+        opts.targets = RECIPE.targets(config, set.manifest.settings.transfer);
+    }
     // The paper's four designs keep their models as training grows (`--snapshots`).
     if x.snapshot_configs().contains(config) {
         opts.schedule.snapshots = x.snapshots.clone();
@@ -93,8 +97,8 @@ pub fn eval_options(x: &Experiment, data: &Path, models: &[PathBuf]) -> EvalOpti
 /// where its key holds the inputs and its outputs as this run wrote them (results.json and
 /// the pictures): a report rewritten by hand (`nprt eval --out` into the same folder) or with
 /// pictures gone is made again.
-pub fn evaluation(x: &Experiment, opts: &EvalOptions, report: &Path) -> Result<(Evaluation, bool)> {
-    let inputs = inputs_key(x, opts)?;
+pub fn evaluation(engine: Engine, opts: &EvalOptions, report: &Path) -> Result<(Evaluation, bool)> {
+    let inputs = inputs_key(engine, opts)?;
     let key_file = report.join("evaluation.key");
     let results = report.join("results.json");
     let kept = read_key(&key_file);
@@ -110,7 +114,7 @@ pub fn evaluation(x: &Experiment, opts: &EvalOptions, report: &Path) -> Result<(
             Err(e) => eprintln!("evaluating again: {e:#}"),
         }
     }
-    let e = evaluate(opts, x.engine)?;
+    let e = evaluate(opts, engine)?;
     let (md, _) = write_report(&e, report)?;
     let key = format!("{inputs}\n{}", outputs_key(report));
     nprt_io::write_file(&key_file, &key)?;
@@ -125,7 +129,7 @@ pub fn ablation(
     opts: &EvalOptions,
     file: &Path,
 ) -> Result<(Vec<MethodResult>, bool)> {
-    let key = inputs_key(x, opts)?;
+    let key = inputs_key(x.engine, opts)?;
     if let Ok(a) = read(file).and_then(|bytes| readback::ablation(&bytes, file)) {
         if a.key == key {
             return Ok((a.rows, false));
@@ -154,7 +158,7 @@ pub fn snapshots(x: &Experiment, data: &Path, file: &Path) -> Result<(Vec<Growth
             continue;
         }
         let opts = eval_options(x, data, &dirs);
-        let key = inputs_key(x, &opts)?;
+        let key = inputs_key(x.engine, &opts)?;
         if let Some(p) = kept.iter().find(|p| p.key == key) {
             points.push(p.clone());
             continue;
@@ -203,8 +207,6 @@ pub fn relight(x: &Experiment, data: &Path, model: &Path, frames: &Path) -> Resu
             lighting: held_out.join(","),
             frames: count,
             resolution: [side; 2],
-            // The traced light denoised where OIDN is installed: the cleaner frames.
-            denoise_direct: Oidn::open().is_ok(),
             ..RenderOptions::default()
         },
         x.engine,
@@ -221,7 +223,7 @@ pub fn relight(x: &Experiment, data: &Path, model: &Path, frames: &Path) -> Resu
 
 /// A key of everything an evaluation reads: the dataset's manifest, each model's files, the
 /// options, the engine and whether OIDN is there.
-fn inputs_key(x: &Experiment, opts: &EvalOptions) -> Result<String> {
+fn inputs_key(engine: Engine, opts: &EvalOptions) -> Result<String> {
     let mut h = blake3::Hasher::new();
     h.update(&read(&opts.data.join("manifest.json"))?);
     for dir in opts.models.iter().chain(&opts.deep_shading) {
@@ -233,7 +235,7 @@ fn inputs_key(x: &Experiment, opts: &EvalOptions) -> Result<String> {
             }
         }
     }
-    h.update(format!("{opts:?} {} {}", x.engine.name(), Oidn::open().is_ok()).as_bytes());
+    h.update(format!("{opts:?} {} {}", engine.name(), Oidn::open().is_ok()).as_bytes());
     Ok(h.finalize().to_hex().to_string())
 }
 

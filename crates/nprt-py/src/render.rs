@@ -3,7 +3,7 @@
 
 use std::path::PathBuf;
 
-use nprt_render::{RenderJob, RenderOptions};
+use nprt_render::{Denoise, RenderJob, RenderOptions};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
@@ -20,7 +20,7 @@ use crate::interruptible::interruptible;
 #[pyo3(signature = (
     model, out, *, scene = None, camera_path = None, camera_volume = None, lighting = None,
     spin = None, frames = None, res = None, fps = None, exposure = None, exr = false,
-    direct_spp = None, denoise_direct = false, precision = None, device = "cpu"
+    direct_spp = None, denoise_direct = None, precision = None, device = "cpu"
 ))]
 #[allow(clippy::too_many_arguments)]
 pub fn render<'py>(
@@ -38,7 +38,7 @@ pub fn render<'py>(
     exposure: Option<f32>,
     exr: bool,
     direct_spp: Option<u32>,
-    denoise_direct: bool,
+    denoise_direct: Option<&Bound<'py, PyAny>>,
     precision: Option<&str>,
     device: &str,
 ) -> PyResult<Bound<'py, PyDict>> {
@@ -59,7 +59,7 @@ pub fn render<'py>(
         exposure: finite_or_none(exposure, "exposure")?.unwrap_or(d.exposure),
         exr,
         direct_spp: direct_spp.unwrap_or(d.direct_spp),
-        denoise_direct,
+        denoise_direct: denoise_choice(denoise_direct)?.unwrap_or(d.denoise_direct),
         precision: precision.map(parse).transpose()?.unwrap_or(d.precision),
     };
     let engine = engine(device)?;
@@ -74,4 +74,22 @@ pub fn render<'py>(
     summary.set_item("direct_ms", m.direct_ms)?;
     summary.set_item("total_ms", m.total_ms())?;
     Ok(summary)
+}
+
+/// `denoise_direct`: True ("on"), False ("off") or one of "auto", "on", "off"; None takes the
+/// default (auto: OIDN where installed).
+fn denoise_choice(value: Option<&Bound<'_, PyAny>>) -> PyResult<Option<Denoise>> {
+    let Some(v) = value else {
+        return Ok(None);
+    };
+    if let Ok(on) = v.extract::<bool>() {
+        return Ok(Some(if on { Denoise::On } else { Denoise::Off }));
+    }
+    match v.extract::<String>() {
+        Ok(name) => parse(&name).map(Some),
+        Err(_) => Err(crate::error::input_error(format!(
+            "denoise_direct: expected True, False, 'auto', 'on' or 'off', not {}",
+            v.get_type().name()?
+        ))),
+    }
 }

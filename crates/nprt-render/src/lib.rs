@@ -24,6 +24,7 @@
 //! ```
 
 mod animation;
+mod denoise;
 mod example_view;
 mod frame_bench;
 mod frame_stages;
@@ -40,6 +41,7 @@ mod sequence;
 pub mod view;
 
 pub use animation::{write_animation, Animation};
+pub use denoise::Denoise;
 pub use example_view::ExampleView;
 pub use frame_bench::{bench_frame, FrameBenchOptions, FrameBenchRow};
 pub use frame_stages::FrameRadiance;

@@ -22,10 +22,11 @@ use crate::frame_timings::FrameTimings;
 use crate::oidn::Oidn;
 use crate::Precision;
 
-/// Samples per pixel of the traced direct light when none is asked for: on the demo, D/S with
-/// traced direct light beats equal-time path tracing in every metric from 4 spp, by a margin
-/// that grows with the count; 16 takes most of it (docs/model.md#traced-direct-light).
-pub const DEFAULT_DIRECT_SPP: u32 = 16;
+/// Samples per pixel of the traced direct light when none is asked for: the recommended
+/// recipe's (on the demo, D/S with traced direct light beats equal-time path tracing in every
+/// metric from 4 spp, by a margin that grows with the count; 16 takes most of it:
+/// docs/model.md#traced-direct-light).
+pub const DEFAULT_DIRECT_SPP: u32 = nprt_net::RECIPE.direct_spp;
 
 /// A trained model ready to shade G-buffers.
 pub struct Relighter {
@@ -125,6 +126,23 @@ impl Relighter {
     /// Where [`Self::path_trace`] and traced direct light run, for reports.
     pub fn paths_on(&self) -> &'static str {
         self.stages.paths_on()
+    }
+
+    /// What runs, in one line for each command to print: "linear design on sh:2 (siren),
+    /// direct light traced (16 spp, denoised by OIDN), level calibrated".
+    pub fn describe(&self, sampling: &DirectSampling) -> String {
+        let config = &self.file.config;
+        let design = config.describe();
+        let direct = match (self.traces_direct(), sampling.denoiser.is_some()) {
+            (false, _) => String::new(),
+            (true, true) => format!(" ({} spp, denoised by OIDN)", sampling.spp),
+            (true, false) => format!(" ({} spp, not denoised)", sampling.spp),
+        };
+        let level = match self.file.level_gain {
+            Some(_) => ", level calibrated",
+            None => "",
+        };
+        format!("{design}{direct}{level}")
     }
 
     /// Whether the model leaves direct light to the tracer ([`Self::complete`] traces it).

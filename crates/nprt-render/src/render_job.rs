@@ -4,15 +4,15 @@
 
 use std::path::PathBuf;
 
-use anyhow::{bail, Context, Result};
+use anyhow::{bail, Result};
 use nprt_net::Engine;
 use nprt_scene::Scene;
 use nprt_trace::TraceScene;
 
 use crate::oidn::Oidn;
 use crate::{
-    render_sequence, CameraPath, FrameReport, LightingSchedule, Precision, Relighter, Sequence,
-    SequenceSummary, DEFAULT_DIRECT_SPP,
+    render_sequence, CameraPath, Denoise, DirectSampling, FrameReport, LightingSchedule, Precision,
+    Relighter, Sequence, SequenceSummary, DEFAULT_DIRECT_SPP,
 };
 
 /// Lighting when none is given: maps outside the built-in training set (`builtin` maps).
@@ -42,8 +42,8 @@ pub struct RenderOptions {
     pub exr: bool,
     /// Samples per pixel of the direct light of a model that traces it.
     pub direct_spp: u32,
-    /// Denoise that light with Open Image Denoise.
-    pub denoise_direct: bool,
+    /// Whether that light is denoised with Open Image Denoise.
+    pub denoise_direct: Denoise,
     /// The networks' arithmetic (f16: GPU kernels only).
     pub precision: Precision,
 }
@@ -64,7 +64,7 @@ impl Default for RenderOptions {
             exposure: 0.0,
             exr: false,
             direct_spp: DEFAULT_DIRECT_SPP,
-            denoise_direct: false,
+            denoise_direct: Denoise::default(),
             precision: Precision::F32,
         }
     }
@@ -117,16 +117,7 @@ impl RenderJob {
             )?,
         };
         let lighting = LightingSchedule::parse(&opts.lighting, opts.spin_deg)?;
-        let denoiser = match (opts.denoise_direct, model.traces_direct()) {
-            (false, _) => None,
-            (true, false) => bail!(
-                "--denoise-direct: model '{}' does not trace direct light (train it with --direct traced)",
-                opts.model.display()
-            ),
-            (true, true) => {
-                Some(Oidn::open().context("--denoise-direct needs Open Image Denoise")?)
-            }
-        };
+        let denoiser = (opts.denoise_direct).denoiser(&model, &opts.model.display().to_string())?;
         Ok(RenderJob {
             opts: opts.clone(),
             model,
@@ -135,6 +126,15 @@ impl RenderJob {
             path,
             lighting,
             denoiser,
+        })
+    }
+
+    /// How the model's frames are made, in one line ([`Relighter::describe`]).
+    pub fn describe(&self) -> String {
+        self.model.describe(&DirectSampling {
+            spp: self.opts.direct_spp,
+            seed: 0,
+            denoiser: self.denoiser,
         })
     }
 

@@ -3,9 +3,9 @@
 use std::path::PathBuf;
 
 use anyhow::Result;
-use nprt_data::dataset::Jitter;
+use nprt_data::dataset::{Jitter, TransferBasis};
 use nprt_data::{generate, CameraChoice, GenerateOptions};
-use nprt_net::{Compute, Engine};
+use nprt_net::{Compute, Engine, RECIPE};
 
 use crate::flags::{parse_shard, parse_vec3, print_warnings, Resolution};
 
@@ -69,9 +69,10 @@ pub struct GenerateArgs {
     /// as many BSDF-sampled paths per pixel as its radiance: a target that holds every
     /// lighting at once, which `nprt train --arch linear --basis sh:L' --targets transfer`
     /// (L' ≤ L) learns. Adds about three quarters to the training views' time; CPU tracer only
-    /// (docs/dataset.md).
-    #[arg(long)]
-    transfer: Option<nprt_data::dataset::TransferBasis>,
+    /// (docs/dataset.md). `none` records none. [default: what the recommended recipe trains
+    /// on (`nprt train` without --arch) on the CPU tracer, none on the GPU's]
+    #[arg(long, value_parser = parse_transfer)]
+    transfer: Option<TransferArg>,
     /// Seed of every random choice (cameras, split, rotations, pixels).
     #[arg(long, default_value_t = d().seed)]
     seed: u64,
@@ -126,6 +127,7 @@ impl TryFrom<GenerateArgs> for GenerateOptions {
     type Error = anyhow::Error;
 
     fn try_from(a: GenerateArgs) -> Result<Self> {
+        let device = a.device.engine()?.tracer();
         let shard = match a.shard {
             Some(shard) => shard,
             None => nprt_data::shard_from_env()?.unwrap_or((0, 1)),
@@ -146,7 +148,10 @@ impl TryFrom<GenerateArgs> for GenerateOptions {
                 tint: a.jitter_tint,
             },
             mix_maps: a.mix_maps,
-            transfer: a.transfer,
+            transfer: match a.transfer {
+                Some(TransferArg(t)) => t,
+                None => RECIPE.dataset_transfer_on(device),
+            },
             test_maps: a.test_maps,
             mix_builtin: a.mix_builtin,
             camera: CameraChoice {
@@ -158,9 +163,23 @@ impl TryFrom<GenerateArgs> for GenerateOptions {
                 fov_deg: a.fov,
             },
             shard,
-            device: a.device.engine()?.tracer(),
+            device,
             progress: true,
         })
+    }
+}
+
+/// `--transfer`'s value: a basis, or `none`.
+#[derive(Clone, Copy)]
+struct TransferArg(Option<TransferBasis>);
+
+fn parse_transfer(s: &str) -> Result<TransferArg, String> {
+    match s {
+        "none" => Ok(TransferArg(None)),
+        _ => s
+            .parse()
+            .map(|t| TransferArg(Some(t)))
+            .map_err(|e: anyhow::Error| format!("{e}, or none")),
     }
 }
 
@@ -169,8 +188,12 @@ pub fn run(opts: &GenerateOptions) -> Result<()> {
     let summary = generate(opts, |p| {
         print_warnings(&p.warnings);
         let s = &p.manifest.settings;
+        let transfer = match s.transfer {
+            Some(t) => format!("; transfer vectors {t} (what `nprt train` learns without --arch)"),
+            None => String::new(),
+        };
         println!(
-            "dataset {}: {} train views ({}×{}, {} spp) under {} maps, {} test views ({}×{}, {} spp) under {} held-out maps; shard {}/{}; traced on the {}",
+            "dataset {}: {} train views ({}×{}, {} spp) under {} maps, {} test views ({}×{}, {} spp) under {} held-out maps; shard {}/{}; traced on the {}{transfer}",
             opts.out.display(), s.train_views, s.train_resolution[0], s.train_resolution[1], s.spp, s.train_maps.len(),
             s.test_views, s.test_resolution[0], s.test_resolution[1], opts.test_spp, s.test_maps.len(), opts.shard.0, opts.shard.1,
             Engine::from(opts.device).name()

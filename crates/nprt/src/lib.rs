@@ -7,6 +7,7 @@
 use anyhow::{Context, Result};
 use clap::{Parser, Subcommand};
 
+mod bake;
 mod bench;
 mod dataset;
 mod demo;
@@ -39,6 +40,11 @@ struct Cli {
 
 #[derive(Subcommand)]
 enum Command {
+    /// A scene and its lightings to a relit model in one resumable command: the dataset, the
+    /// recommended recipe trained (a first relit frame in preview.png after its first minute),
+    /// and a check against path tracing of equal cost on held-out views, under one progress
+    /// bar; prints the model's errors and the commands that use it.
+    Bake(bake::BakeArgs),
     /// Reproduce the paper's Tables 1-6 on a scene at a budget (tiny, small, medium, paper):
     /// one dataset, the four designs and Table 2's SIREN/ReLU ablation, Deep Shading, every
     /// baseline, then paper.md/paper.html with the paper's figures beside nprt's and each
@@ -144,6 +150,7 @@ fn run(cli: Cli) -> Result<()> {
             .context("cannot set up worker threads")?;
     }
     match cli.command {
+        Command::Bake(a) => bake::command(a),
         Command::Reference(a) => reference::run(a),
         Command::Demo(a) => demo::run(a),
         Command::Paper(a) => paper::command(a),

@@ -59,9 +59,11 @@ pub struct RenderArgs {
     #[arg(long, default_value_t = d().direct_spp)]
     direct_spp: u32,
     /// Denoise that direct light with Open Image Denoise (scripts/oidn.sh installs it) before
-    /// adding it: far less noise for a few ms per frame (docs/model.md#traced-direct-light).
-    #[arg(long)]
-    denoise_direct: bool,
+    /// adding it, far less noise for a few ms per frame (docs/model.md#traced-direct-light):
+    /// auto (where OIDN is installed), on (an error without it; the flag alone means on) or
+    /// off.
+    #[arg(long, default_value_t = d().denoise_direct, num_args = 0..=1, default_missing_value = "on")]
+    denoise_direct: nprt_render::Denoise,
     /// The networks' arithmetic: f32, or f16 (weights and activations in f16, sums in f32, on
     /// tensor cores where the adapter has them; the GPU kernels only: --device gpu or wgpu).
     #[arg(long, default_value_t = d().precision)]
@@ -102,9 +104,9 @@ pub fn run(opts: &RenderOptions, engine: Engine) -> Result<()> {
     let job = RenderJob::prepare(opts, engine)?;
     let [w, h] = opts.resolution;
     println!(
-        "nprt render: {} ({}, networks on the {}, G-buffer {}) on {}, {} frames at {w}×{h}, lighting {}",
+        "nprt render: {} ({}; networks on the {}, G-buffer {}) on {}, {} frames at {w}×{h}, lighting {}",
         opts.model.display(),
-        job.model.file.config.label(),
+        job.describe(),
         job.model.networks_on(),
         job.model.gbuffer_on(),
         job.scene_spec,

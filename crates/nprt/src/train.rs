@@ -6,9 +6,9 @@ use anyhow::{Context, Result};
 use nprt_net::network::encoder::check_input_width;
 use nprt_net::training::training_set::{TrainingSet, ViewSamples};
 use nprt_net::{
-    Activation, BasisChoice, Calibration, Design, DirectLight, Engine, Gather, Loss, MapNorm,
-    ModelConfig, PositionEncoding, Precision, Targets, TrainOptions, DEFAULT_ENCODER_WIDTH,
-    DEFAULT_MAP_NORM,
+    Activation, Asked, BasisChoice, Calibration, Design, DirectLight, Engine, Gather, Loss,
+    MapNorm, ModelConfig, PositionEncoding, Precision, Targets, TrainOptions,
+    DEFAULT_ENCODER_WIDTH, DEFAULT_MAP_NORM,
 };
 
 use crate::flags::{design_names, parse_snapshots, DeviceArg, RunArgs, Snapshots};
@@ -25,9 +25,13 @@ pub struct TrainArgs {
     /// `nprt dataset pack`), so the folder must be writable then.
     #[arg(long)]
     data: PathBuf,
-    /// Transport design (docs/model.md; the paper's four are its Table 1).
+    /// Transport design (docs/model.md; the paper's four are its Table 1), trained with its
+    /// own defaults (the paper's, for the paper's designs). Without it: the recommended recipe,
+    /// nprt's measured best (the linear design on sh:2, its direct light traced, trained on
+    /// the dataset's transfer vectors where it has them, its level calibrated; docs/model.md),
+    /// whose choices the flags below still change one by one.
     #[arg(long, value_parser = design_names())]
-    arch: Design,
+    arch: Option<Design>,
     /// siren or relu for the layers that read the pixel inputs (default: the paper's choice).
     #[arg(long)]
     activation: Option<Activation>,
@@ -73,17 +77,18 @@ pub struct TrainArgs {
     /// pixel's transfer vector as `nprt generate --transfer sh:L` recorded it, by the mean
     /// squared error of its coefficients: one target for every lighting at once, whose
     /// minimiser on noisy vectors is their mean; --loss then does not apply). On either engine;
-    /// docs/model.md.
-    #[arg(long, default_value_t = d().targets)]
-    targets: Targets,
+    /// docs/model.md. [default: radiance with --arch; without it, the recipe's: transfer where
+    /// the dataset holds vectors of the model's basis, else radiance]
+    #[arg(long)]
+    targets: Option<Targets>,
     /// none (the network's output as it is, the paper) or level (each channel of the saved
     /// model's radiance multiplied by the training targets' mean over its own, measured on
     /// training pixels whenever the model is saved, and again when a finished run is asked
     /// with another choice: log-L1 settles on a median, darker than the mean. It gets the level
     /// right but costs L1 where the darkness is light the network cannot place, as in the demo;
-    /// docs/model.md).
-    #[arg(long, default_value_t = d().calibration)]
-    calibrate: Calibration,
+    /// docs/model.md). [default: none with --arch; level for the recipe]
+    #[arg(long)]
+    calibrate: Option<Calibration>,
     /// Test-view pixels (held-out lighting) used for the validation loss after each epoch.
     #[arg(long, default_value_t = d().val_samples)]
     val_samples: usize,
@@ -98,9 +103,10 @@ pub struct TrainArgs {
     /// learned (the paper: the network predicts all the radiance) or traced (the network
     /// learns the indirect light only, the reference minus its direct part, and `nprt render`
     /// and `nprt eval` trace the direct light at run time with --direct-spp samples per pixel,
-    /// its cost counted in the model's time; docs/model.md).
-    #[arg(long, default_value_t = DirectLight::default())]
-    direct: DirectLight,
+    /// its cost counted in the model's time; docs/model.md). [default: learned with --arch;
+    /// traced for the recipe]
+    #[arg(long)]
+    direct: Option<DirectLight>,
     /// How the transport network sees the position: none (the paper: x, y, z only) or hash-grid
     /// (a multiresolution hash grid on the scene's box, 8 levels from 4 to 64 cells a side,
     /// 2^13 × 2 learned values each, 0.5 MB per track, whose interpolated values join the
@@ -110,7 +116,7 @@ pub struct TrainArgs {
     /// The linear design's light basis (--arch linear only): sh:L, real spherical harmonics of
     /// bands 0 to L ((L+1)² functions per colour channel, fixed), or learned:K, K functions
     /// trained with the network, started from the harmonics that fit (docs/model.md). Default
-    /// sh:4, SH PRT 25's lighting.
+    /// sh:4 (SH PRT 25's lighting) with --arch linear; sh:2 for the recipe.
     #[arg(long)]
     basis: Option<BasisChoice>,
     /// Minutes between checkpoints within an epoch. An epoch's end writes one once these
@@ -147,21 +153,29 @@ pub struct TrainJob {
     pub config: ModelConfig,
     pub opts: TrainOptions,
     pub out: PathBuf,
+    /// What was asked: the targets follow from it and the dataset (`opts.targets` is set from
+    /// them once the dataset is loaded).
+    pub asked: Asked,
 }
 
 impl TryFrom<TrainArgs> for TrainJob {
     type Error = anyhow::Error;
     fn try_from(a: TrainArgs) -> Result<Self> {
         check_input_width(a.encoder_width)?;
+        let asked = Asked {
+            design: a.arch,
+            activation: a.activation,
+            direct: a.direct,
+            basis: a.basis,
+            calibration: a.calibrate,
+            targets: a.targets,
+        };
         let config = ModelConfig {
             encoder_width: a.encoder_width,
             map_norm: a.map_norm,
-            direct: a.direct,
             encoding: a.encoding,
-            basis: a.basis.or(ModelConfig::new(a.arch, None).basis),
-            ..ModelConfig::new(a.arch, a.activation)
+            ..asked.config()?
         };
-        config.check()?;
         let opts = TrainOptions {
             schedule: nprt_net::Schedule {
                 seed: a.seed,
@@ -174,18 +188,19 @@ impl TryFrom<TrainArgs> for TrainJob {
             views_per_batch: a.views_per_batch,
             val_samples: a.val_samples,
             loss: a.loss,
-            calibration: a.calibrate,
-            targets: a.targets,
+            calibration: asked.calibration(),
             gather: a.gather,
             precision: a.precision,
+            ..d()
         }
-        .with_run(a.arch, a.run.into(), a.lr);
+        .with_run(config.design, a.run.into(), a.lr);
         opts.check().context("bad training options")?;
         Ok(TrainJob {
             data: a.data,
             config,
             opts,
             out: a.out,
+            asked,
         })
     }
 }
@@ -202,7 +217,15 @@ pub fn run(job: &TrainJob, engine: Engine) -> Result<()> {
         eprintln!("{why}")
     })?;
     print_dataset(&job.data, &set, t0.elapsed().as_secs_f64());
-    let (s, file) = nprt_net::train(&set, &job.config, &job.opts, &job.out, engine, &|_| true)?;
+    let opts = TrainOptions {
+        targets: (job.asked).targets(&job.config, set.manifest.settings.transfer),
+        ..job.opts.clone()
+    };
+    println!(
+        "{}",
+        training_line(&job.config, &opts, job.asked.recipe().is_some())
+    );
+    let (s, file) = nprt_net::train(&set, &job.config, &opts, &job.out, engine, &|_| true)?;
     if let Some(e) = s.resumed_from_epoch {
         println!("resumed from epoch {e:.2}");
     }
@@ -237,6 +260,27 @@ pub fn run(job: &TrainJob, engine: Engine) -> Result<()> {
         job.out.display()
     );
     Ok(())
+}
+
+/// What a run trains, in one line: "training the recommended recipe: linear design on sh:2,
+/// direct light traced, on transfer vectors, level calibrated".
+fn training_line(config: &ModelConfig, opts: &TrainOptions, recipe: bool) -> String {
+    let what = match recipe {
+        true => "the recommended recipe: ".to_string(),
+        false => String::new(),
+    };
+    let calibrated = match opts.calibration {
+        Calibration::Level => ", level calibrated",
+        Calibration::None => "",
+    };
+    format!(
+        "training {what}{}, on {}{calibrated}",
+        config.describe(),
+        match opts.targets {
+            Targets::Radiance => "radiance",
+            Targets::Transfer => "transfer vectors",
+        }
+    )
 }
 
 fn print_dataset(dir: &Path, set: &TrainingSet, seconds: f64) {

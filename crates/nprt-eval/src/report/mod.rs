@@ -14,7 +14,8 @@ mod table6;
 mod temporal_section;
 
 pub use html::markdown_to_html;
-use pictures::{auto_exposure, crop, crop_window, heat_map, save, with_background, HEAT_MAX, ZOOM};
+pub use pictures::auto_exposure;
+use pictures::{crop, crop_window, heat_map, save, with_background, HEAT_MAX, ZOOM};
 pub use table6::{mean_and_se, mean_and_se_text, table6};
 
 use crate::evaluate::Evaluation;

@@ -18,7 +18,7 @@ pub(super) const ZOOM: usize = 3;
 
 /// Exposure (stops) putting the 90th percentile of the foreground's luminance in `reference`
 /// at 0.7.
-pub(super) fn auto_exposure(reference: &[Vec3], mask: &[f32]) -> f32 {
+pub fn auto_exposure(reference: &[Vec3], mask: &[f32]) -> f32 {
     let mut l: Vec<f32> = (0..mask.len())
         .filter(|&i| mask[i] > 0.5)
         .map(|i| luminance(reference[i]))

@@ -116,6 +116,23 @@ impl ModelConfig {
         format!("{}{basis}{activation}{grid}{direct}", self.design.name())
     }
 
+    /// What the model is, for the one line each command prints of what it runs: "linear
+    /// design on sh:2 (siren), direct light traced".
+    pub fn describe(&self) -> String {
+        let basis = match self.design.is_linear() {
+            true => format!(" on {}", self.light_basis()),
+            false => String::new(),
+        };
+        let grid = match self.encoding {
+            PositionEncoding::None => "",
+            PositionEncoding::HashGrid => ", hash grid",
+        };
+        format!(
+            "{} design{basis} ({}{grid}), direct light {}",
+            self.design, self.activation, self.direct
+        )
+    }
+
     /// What the weights file records of the network that wrote it: the design and the
     /// activation, which both change what the same weights compute (an edit of model.json's
     /// activation went undetected).
@@ -169,5 +186,9 @@ mod tests {
         assert!(json.contains(r#""encoding":"hash-grid""#), "{json}");
         assert_eq!(serde_json::from_str::<ModelConfig>(&json).unwrap(), grid);
         assert_eq!(grid.label(), "dsep+grid+direct");
+        assert_eq!(
+            grid.describe(),
+            "dsep design (siren, hash grid), direct light traced"
+        );
     }
 }

@@ -43,7 +43,7 @@ pub(crate) fn dir(out: &Path) -> PathBuf {
 }
 
 /// Whether `out` holds a checkpoint (the state file is written last).
-pub(crate) fn exists(out: &Path) -> bool {
+pub fn exists(out: &Path) -> bool {
     dir(out).join(STATE_FILE).exists()
 }
 

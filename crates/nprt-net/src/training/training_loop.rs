@@ -236,7 +236,7 @@ fn start<O: Objective>(
     let s = &saved.state;
     let at =
         s.epoch as f64 + s.batch as f64 / objective.steps(schedule.seed, s.epoch).max(1) as f64;
-    if schedule.progress {
+    if schedule.progress && !nprt_io::staged() {
         eprintln!("resuming '{}' from epoch {at:.2}", out.display());
     }
     Ok((saved, Some(at)))
@@ -553,7 +553,7 @@ impl<'s, O: Objective> Run<'s, O> {
             val: Some(val),
         });
         (self.row_sum, self.row_n) = (0.0, 0);
-        if self.schedule.progress {
+        if self.schedule.progress && !nprt_io::staged() {
             // Also when the bar is hidden (output not a terminal), so logs show progress.
             let train = self.ck.history.iter().rev().find_map(|r| r.train);
             self.bar.suspend(|| {

@@ -77,6 +77,7 @@ impl FrameStages for DeviceStages {
             rr_depth: settings.rr_depth,
             first_path: 0,
             jitter: matches!(settings.filter, PixelFilter::Box),
+            stratified: false,
         };
         self.raster(ts)?.trace(camera, map, &paths)
     }

@@ -8,6 +8,7 @@ mod baseline;
 mod dsep;
 mod linear;
 mod prt;
+pub mod recipe;
 
 use crate::choice::named_choice;
 use crate::network::activation::Activation;
