@@ -77,6 +77,9 @@ class Model:
     def info(self) -> Dict[str, Any]:
         """Its settings and training record (model.json)."""
     @property
+    def description(self) -> str:
+        """What runs: design, basis, direct light, calibration."""
+    @property
     def device(self) -> str: ...
     def render(
         self,
@@ -89,8 +92,11 @@ class Model:
         rotation: float = 0.0,
         direct_spp: int = 16,
         seed: int = 0,
+        denoise_direct: Union[None, bool, str] = None,
     ) -> Image:
-        """A relit frame of ``scene`` under ``envmap`` turned by ``rotation`` degrees."""
+        """A relit frame of ``scene`` under ``envmap`` turned by ``rotation`` degrees (a traced
+        model's direct light denoised as ``denoise_direct`` says; None: where OIDN is
+        installed)."""
 
 def load_scene(spec: PathLike) -> Scene:
     """builtin:room, or a Mitsuba .xml, glTF, .ply or .obj file."""
@@ -145,12 +151,13 @@ def generate(
     transfer: Optional[str] = None,
 ) -> Dict[str, Any]:
     """`nprt generate`; None takes its default (``transfer``: ``"sh:L"`` records each
-    training pixel's transfer vector on SH bands 0..L)."""
+    training pixel's transfer vector on SH bands 0..L, ``"none"`` none; by default the
+    recommended recipe's, ``"sh:2"``, on the CPU tracer)."""
 
 def train(
     data: PathLike,
-    arch: str,
-    out: PathLike,
+    arch: Optional[str] = None,
+    out: Optional[PathLike] = None,
     *,
     minutes: Optional[float] = None,
     epochs: Optional[int] = None,
@@ -166,11 +173,17 @@ def train(
     basis: Optional[str] = None,
     snapshots: Optional[str] = None,
     targets: Optional[str] = None,
+    direct: Optional[str] = None,
+    calibrate: Optional[str] = None,
 ) -> Dict[str, Any]:
-    """`nprt train`; None takes its default (``basis``: the linear design's ``"sh:L"`` or
+    """`nprt train` into ``out`` (required); ``arch`` None trains the recommended recipe (the
+    linear design on ``"sh:2"``, its direct light traced, on the dataset's transfer vectors
+    where it has them, its level calibrated), a design's name that design with its own
+    defaults. None takes the default (``basis``: the linear design's ``"sh:L"`` or
     ``"learned:K"``; ``snapshots``: points such as ``"1m,2m,4m"`` at which the model is kept
     in ``out``/snapshots/POINT; ``targets``: ``"radiance"`` or ``"transfer"``, the vectors
-    ``generate(transfer=...)`` recorded). ``callback`` gets each epoch's row of the loss
+    ``generate(transfer=...)`` recorded; ``direct``: ``"learned"`` or ``"traced"``;
+    ``calibrate``: ``"none"`` or ``"level"``). ``callback`` gets each epoch's row of the loss
     curves; returning a false value other than None (False, 0, numpy's False_), or Ctrl-C,
     ends the run there, saved, and the same call resumes it."""
 
@@ -212,6 +225,28 @@ def paper(
     and ``orderings`` (table, statement, verdict). ``snapshots`` (``"1m,2m,4m"``) judges the
     orderings as training grows; ``training_minutes`` trains every network that long instead
     of the budget's."""
+
+def bake(
+    scene: SceneLike,
+    envmaps: PathLike,
+    out: PathLike,
+    *,
+    quality: str = "draft",
+    minutes: Optional[float] = None,
+    epochs: Optional[int] = None,
+    camera_volume: Optional[PathLike] = None,
+    test_maps: Optional[int] = None,
+    seed: int = 0,
+    device: str = "cpu",
+    progress: bool = True,
+) -> Dict[str, Any]:
+    """`nprt bake`: ``scene`` under ``envmaps`` (a folder of maps, or "builtin") to a relit
+    model in ``out`` at ``quality`` ("draft", "good", "best"; "tiny" for tests), resumable:
+    the dataset, the recommended recipe trained, a check against path tracing of equal cost
+    on held-out views. Returns ``model``, ``comparison``, ``preview``, ``report`` (paths),
+    ``description``, ``views``, ``held_out_maps``, ``model_errors`` and
+    ``path_tracing_errors`` (``name``, ``l1``, ``rmse``, ``dssim``, ``ms_per_view``,
+    ``level``) and ``seconds``."""
 
 def train_deep_shading(
     data: PathLike,
@@ -267,11 +302,12 @@ def render(
     exposure: Optional[float] = None,
     exr: bool = False,
     direct_spp: Optional[int] = None,
-    denoise_direct: bool = False,
+    denoise_direct: Union[None, bool, str] = None,
     precision: Optional[str] = None,
     device: str = "cpu",
 ) -> Dict[str, Any]:
-    """`nprt render`: a camera path relit into frames and an animation."""
+    """`nprt render`: a camera path relit into frames and an animation (``denoise_direct``:
+    True, False, "auto", "on" or "off"; None: auto, OIDN where installed)."""
 
 def write_image(path: PathLike, image: npt.ArrayLike, exposure: float = 0.0) -> None:
     """Writes an (H, W, 3) image of linear radiance as .exr (exact), .hdr or .png (sRGB of the

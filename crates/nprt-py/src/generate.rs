@@ -3,8 +3,9 @@
 
 use std::path::PathBuf;
 
-use nprt_data::dataset::Jitter;
+use nprt_data::dataset::{Jitter, TransferBasis};
 use nprt_data::{CameraChoice, GenerateOptions};
+use nprt_net::RECIPE;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
@@ -59,6 +60,7 @@ pub fn generate<'py>(
 ) -> PyResult<Bound<'py, PyDict>> {
     let (fin, fin3) = (argument::finite_or_none, finite_vec3);
     let d = GenerateOptions::default();
+    let device = choice::engine(device)?.tracer();
     let opts = GenerateOptions {
         scene: crate::scene::scene_spec(scene, "scene")?,
         envmaps: argument::text(
@@ -79,9 +81,11 @@ pub fn generate<'py>(
             tint: fin(jitter_tint, "jitter_tint")?.unwrap_or(d.jitter.tint),
         },
         mix_maps: mix_maps.unwrap_or(d.mix_maps),
-        transfer: (transfer.map(str::parse).transpose())
-            .map_err(|e: anyhow::Error| crate::error::input_error(format!("transfer: {e}")))?
-            .or(d.transfer),
+        transfer: match transfer {
+            Some(t) => TransferBasis::parse_choice(t)
+                .map_err(|e| crate::error::input_error(format!("transfer: {e:#}")))?,
+            None => RECIPE.dataset_transfer_on(device),
+        },
         test_maps: test_maps.or(d.test_maps),
         mix_builtin: fin(mix_builtin, "mix_builtin")?.or(d.mix_builtin),
         camera: CameraChoice {
@@ -93,7 +97,7 @@ pub fn generate<'py>(
             fov_deg: fin(fov, "fov")?,
         },
         shard: shard.unwrap_or(d.shard),
-        device: choice::engine(device)?.tracer(),
+        device,
         progress,
     };
     let mut warnings = Vec::new();

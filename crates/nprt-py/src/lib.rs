@@ -6,6 +6,7 @@
 
 mod argument;
 mod arrays;
+mod bake;
 mod choice;
 mod dataset;
 mod error;
@@ -47,6 +48,7 @@ fn _nprt(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(export::export, m)?)?;
     m.add_function(wrap_pyfunction!(model_info::model_info, m)?)?;
     m.add_function(wrap_pyfunction!(paper::paper, m)?)?;
+    m.add_function(wrap_pyfunction!(bake::bake, m)?)?;
     m.add_function(wrap_pyfunction!(render::render, m)?)?;
     m.add_function(wrap_pyfunction!(evaluate::evaluate, m)?)?;
     m.add_function(wrap_pyfunction!(image::write_image, m)?)?;

@@ -3,7 +3,9 @@
 
 use std::path::PathBuf;
 
-use nprt_render::{DirectSampling, FrameCache, Relighter};
+use nprt_render::{Denoise, DirectSampling, FrameCache, Relighter, DEFAULT_DIRECT_SPP};
+
+use crate::render::denoise_choice;
 use numpy::{AllowTypeChange, PyArray3, PyArrayLike2};
 use pyo3::exceptions::PyUserWarning;
 use pyo3::prelude::*;
@@ -65,6 +67,21 @@ impl Model {
         arrays::json_file(py, &self.dir.join("model.json"))
     }
 
+    /// What runs, in one line: the design, its basis and where its direct light comes from
+    /// ("linear design on sh:2 (siren), direct light traced (16 spp, denoised by OIDN), level
+    /// calibrated"), at `render`'s defaults.
+    #[getter]
+    fn description(&self) -> PyResult<String> {
+        let denoiser = Denoise::default()
+            .denoiser(&self.relighter, &self.dir)
+            .or_py()?;
+        Ok(self.relighter.describe(&DirectSampling {
+            spp: DEFAULT_DIRECT_SPP,
+            seed: 0,
+            denoiser,
+        }))
+    }
+
     /// Where the networks run: "cpu", or the GPU adapter.
     #[getter]
     fn device(&self) -> String {
@@ -74,13 +91,18 @@ impl Model {
     /// A frame of `scene` under `envmap` turned by `rotation` degrees about +Y, through
     /// `camera` (4 × 4 camera-to-world, horizontal field of view `fov`): the G-buffer, the
     /// networks, and the background (or, for a model trained with `--direct traced`, direct
-    /// light traced with `direct_spp` paths per pixel from `seed`). An (H, W, 3) float32 array
-    /// of linear radiance. The GIL is released while it renders.
+    /// light traced with `direct_spp` paths per pixel from `seed`, denoised as `denoise_direct`
+    /// says: True, False, "auto", "on" or "off"; None, auto: where OIDN is installed). An
+    /// (H, W, 3) float32 array of linear radiance. The GIL is released while it renders.
     ///
     /// `scene` and `envmap` may be loaded objects or what names them (a `str` or a
     /// `pathlib.Path`). A scene other than the one the model was trained on (by its hash)
     /// renders with a warning (`UserWarning`): the networks know their own scene only.
-    #[pyo3(signature = (scene, envmap, camera, width, height, fov = 60.0, rotation = 0.0, direct_spp = 16, seed = 0))]
+    #[pyo3(signature = (
+        scene, envmap, camera, width, height, fov = 60.0, rotation = 0.0,
+        direct_spp = DEFAULT_DIRECT_SPP,
+        seed = 0, denoise_direct = None
+    ))]
     #[allow(clippy::too_many_arguments)]
     fn render<'py>(
         &self,
@@ -94,6 +116,7 @@ impl Model {
         rotation: f32,
         direct_spp: u32,
         seed: u64,
+        denoise_direct: Option<&Bound<'py, PyAny>>,
     ) -> PyResult<Bound<'py, PyArray3<f32>>> {
         let (width, height) = arrays::frame_size(width, height)?;
         let camera = arrays::camera(camera, fov, width, height).or_py()?;
@@ -102,10 +125,11 @@ impl Model {
         let envmap = envmap_arg(envmap, "envmap")?;
         let scene = scene.get();
         self.warn_if_foreign(py, scene)?;
+        let denoise = denoise_choice(denoise_direct)?.unwrap_or_default();
         let sampling = DirectSampling {
             spp: direct_spp,
             seed,
-            denoiser: None,
+            denoiser: denoise.denoiser(&self.relighter, &self.dir).or_py()?,
         };
         let map = &envmap.get().map;
         let (rgb, _) = py

@@ -78,7 +78,7 @@ pub fn render<'py>(
 
 /// `denoise_direct`: True ("on"), False ("off") or one of "auto", "on", "off"; None takes the
 /// default (auto: OIDN where installed).
-fn denoise_choice(value: Option<&Bound<'_, PyAny>>) -> PyResult<Option<Denoise>> {
+pub fn denoise_choice(value: Option<&Bound<'_, PyAny>>) -> PyResult<Option<Denoise>> {
     let Some(v) = value else {
         return Ok(None);
     };

@@ -9,7 +9,7 @@ use nprt_net::deep_shading::{self, DeepShadingOptions};
 use nprt_net::training::loss_curves::LossRow;
 use nprt_net::training::snapshot::Snapshot;
 use nprt_net::training::training_set::TrainingSet;
-use nprt_net::{ModelConfig, RunLength, TrainOptions, TrainSummary};
+use nprt_net::{Asked, RunLength, TrainOptions, TrainSummary};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
@@ -17,7 +17,8 @@ use crate::argument::finite_or_none;
 use crate::choice::{engine, parse};
 use crate::error::OrPy;
 
-/// Trains `arch` (one of `nprt.DESIGNS`) on the dataset `data` into the model
+/// Trains `arch` (one of `nprt.DESIGNS`, with its own defaults; None: the recommended recipe,
+/// nprt's measured best, as `nprt train` without `--arch`) on the dataset `data` into the model
 /// folder `out` (a run already there with the same settings is resumed, and a larger `epochs`
 /// or `minutes` continues a finished one), on `device`, for `minutes` of training time and/or
 /// `epochs` passes (without either: 20 epochs). `None` takes `nprt train`'s default. Returns
@@ -29,7 +30,9 @@ use crate::error::OrPy;
 /// --snapshots`).
 ///
 /// `basis` is the linear design's light basis, `"sh:L"` or `"learned:K"` (`nprt train
-/// --basis`; only for `arch="linear"`).
+/// --basis`; only for the linear design); `direct` ("learned" or "traced"), `calibrate`
+/// ("none" or "level") and `targets` ("radiance" or "transfer") are `nprt train`'s flags of
+/// those names, each None for the recipe's choice or the named design's default.
 ///
 /// `callback`, where given, is called at each epoch's end with that epoch's row of the loss
 /// curves (`step`, `epoch`, `samples`, `seconds`, `train_loss`, `val_loss`); returning a false
@@ -40,16 +43,17 @@ use crate::error::OrPy;
 /// released while it trains.
 #[pyfunction]
 #[pyo3(signature = (
-    data, arch, out, *, minutes = None, epochs = None, activation = None, device = "cpu",
-    precision = None, batch_size = None, lr = None, schedule = None, seed = None,
-    progress = true, callback = None, basis = None, snapshots = None, targets = None
+    data, arch = None, out = None, *, minutes = None, epochs = None, activation = None,
+    device = "cpu", precision = None, batch_size = None, lr = None, schedule = None, seed = None,
+    progress = true, callback = None, basis = None, snapshots = None, targets = None,
+    direct = None, calibrate = None
 ))]
 #[allow(clippy::too_many_arguments)]
 pub fn train<'py>(
     py: Python<'py>,
     data: PathBuf,
-    arch: &str,
-    out: PathBuf,
+    arch: Option<&str>,
+    out: Option<PathBuf>,
     minutes: Option<f64>,
     epochs: Option<usize>,
     activation: Option<&str>,
@@ -64,11 +68,20 @@ pub fn train<'py>(
     basis: Option<&str>,
     snapshots: Option<&str>,
     targets: Option<&str>,
+    direct: Option<&str>,
+    calibrate: Option<&str>,
 ) -> PyResult<Bound<'py, PyDict>> {
-    let design = parse(arch)?;
-    let mut config = ModelConfig::new(design, activation.map(parse).transpose()?);
-    config.basis = basis.map(parse).transpose()?.or(config.basis);
-    config.check().or_py()?;
+    let out =
+        out.ok_or_else(|| crate::error::input_error("out: give the model folder to write"))?;
+    let asked = Asked {
+        design: arch.map(parse).transpose()?,
+        activation: activation.map(parse).transpose()?,
+        direct: direct.map(parse).transpose()?,
+        basis: basis.map(parse).transpose()?,
+        calibration: calibrate.map(parse).transpose()?,
+        targets: targets.map(parse).transpose()?,
+    };
+    let config = asked.config().or_py()?;
     let d = TrainOptions::default();
     let (minutes, lr) = (
         finite_or_none(minutes, "minutes")?,
@@ -90,16 +103,20 @@ pub fn train<'py>(
         },
         batch_size: batch_size.unwrap_or(d.batch_size),
         precision: precision.map(parse).transpose()?.unwrap_or(d.precision),
-        targets: targets.map(parse).transpose()?.unwrap_or(d.targets),
+        calibration: asked.calibration(),
         ..d
     }
-    .with_run(design, run, lr);
+    .with_run(config.design, run, lr);
     let engine = engine(device)?;
     let watch = EpochWatch::new(callback);
     let (summary, _) = py
         .detach(|| {
             opts.check()?;
             let set = TrainingSet::load(&data, &config, progress, |why| eprintln!("{why}"))?;
+            let opts = TrainOptions {
+                targets: asked.targets(&config, set.manifest.settings.transfer),
+                ..opts
+            };
             nprt_net::train(&set, &config, &opts, &out, engine, &|r| watch.hear(r))
         })
         .or_py()?;

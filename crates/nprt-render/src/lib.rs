@@ -41,7 +41,7 @@ mod sequence;
 pub mod view;
 
 pub use animation::{write_animation, Animation};
-pub use denoise::Denoise;
+pub use denoise::{Denoise, DenoiseCheck, DENOISE_CHECK_FILE};
 pub use example_view::ExampleView;
 pub use frame_bench::{bench_frame, FrameBenchOptions, FrameBenchRow};
 pub use frame_stages::FrameRadiance;

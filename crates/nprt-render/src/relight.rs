@@ -131,18 +131,11 @@ impl Relighter {
     /// What runs, in one line for each command to print: "linear design on sh:2 (siren),
     /// direct light traced (16 spp, denoised by OIDN), level calibrated".
     pub fn describe(&self, sampling: &DirectSampling) -> String {
-        let config = &self.file.config;
-        let design = config.describe();
-        let direct = match (self.traces_direct(), sampling.denoiser.is_some()) {
-            (false, _) => String::new(),
-            (true, true) => format!(" ({} spp, denoised by OIDN)", sampling.spp),
-            (true, false) => format!(" ({} spp, not denoised)", sampling.spp),
+        let denoised = match sampling.denoiser {
+            Some(_) => "denoised by OIDN",
+            None => "not denoised",
         };
-        let level = match self.file.level_gain {
-            Some(_) => ", level calibrated",
-            None => "",
-        };
-        format!("{design}{direct}{level}")
+        (self.file).describe(&format!("{} spp, {denoised}", sampling.spp))
     }
 
     /// Whether the model leaves direct light to the tracer ([`Self::complete`] traces it).

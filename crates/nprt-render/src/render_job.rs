@@ -117,7 +117,7 @@ impl RenderJob {
             )?,
         };
         let lighting = LightingSchedule::parse(&opts.lighting, opts.spin_deg)?;
-        let denoiser = (opts.denoise_direct).denoiser(&model, &opts.model.display().to_string())?;
+        let denoiser = (opts.denoise_direct).denoiser(&model, &opts.model)?;
         Ok(RenderJob {
             opts: opts.clone(),
             model,

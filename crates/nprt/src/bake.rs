@@ -105,6 +105,17 @@ fn print_summary(bake: &Bake, b: &Baked) {
             ahead(m.dssim, pt.mean.dssim),
         );
     }
+    if let Some(c) = &b.check {
+        let which = match c.denoise {
+            true => "denoised by OIDN, which measured better than raw",
+            false => "raw, which measured better than denoised by OIDN",
+        };
+        println!(
+            "  its traced direct light {which} (L1 / RMSE / dSSIM raw {:.4} / {:.4} / {:.4}, denoised {:.4} / {:.4} / {:.4}; kept as model/{})",
+            c.raw[0], c.raw[1], c.raw[2], c.denoised[0], c.denoised[1], c.denoised[2],
+            nprt_render::DENOISE_CHECK_FILE
+        );
+    }
     let [r, g, bl] = b.model_row.level;
     println!("  level R / G / B {r:.3} / {g:.3} / {bl:.3} (the reference's is 1)");
     println!(

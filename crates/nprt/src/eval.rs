@@ -108,6 +108,14 @@ pub fn command(a: EvalArgs) -> Result<()> {
 
 /// Runs the evaluation and writes the report; prints where it is and the headline figures.
 pub fn run(job: &EvalJob, engine: Engine) -> Result<Evaluation> {
+    let direct = format!(
+        "{} spp; denoised by OIDN in its '+ OIDN' row where OIDN is installed",
+        job.opts.direct_spp
+    );
+    for dir in &job.opts.models {
+        let file = nprt_net::read_model_file(dir)?;
+        println!("model '{}': {}", dir.display(), file.describe(&direct));
+    }
     let e = evaluate(&job.opts, engine)?;
     let (md, html) = write_report(&e, &job.out)?;
     println!(

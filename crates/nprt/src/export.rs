@@ -41,9 +41,11 @@ pub fn run(a: ExportArgs) -> Result<()> {
         map: a.example_map,
     };
     let done = nprt_render::gpu::export_model(&a.model, &a.out, &view)?;
+    let file = nprt_net::read_model_file(&a.model)?;
     println!(
-        "nprt export: {} → {}: {} files, {} weights ({:.2} MB)",
+        "nprt export: {} ({}) → {}: {} files, {} weights ({:.2} MB)",
         a.model.display(),
+        file.describe("left to the engine's renderer, docs/export.md"),
         a.out.display(),
         done.files.len(),
         done.weights,

@@ -174,13 +174,9 @@ impl TryFrom<GenerateArgs> for GenerateOptions {
 struct TransferArg(Option<TransferBasis>);
 
 fn parse_transfer(s: &str) -> Result<TransferArg, String> {
-    match s {
-        "none" => Ok(TransferArg(None)),
-        _ => s
-            .parse()
-            .map(|t| TransferArg(Some(t)))
-            .map_err(|e: anyhow::Error| format!("{e}, or none")),
-    }
+    TransferBasis::parse_choice(s)
+        .map(TransferArg)
+        .map_err(|e| format!("{e:#}"))
 }
 
 /// Renders the dataset, printing its plan and what was rendered.

@@ -91,8 +91,8 @@ enum Command {
     /// A window that relights trained models as you go: orbit (drag), dolly (wheel) and fly
     /// (WASDQE) the camera, turn the map (right-drag), switch maps (M) and models (Tab), a
     /// progressive path-traced reference of the view (R), the networks in f16 or f32 on the GPU
-    /// kernels (F), per-stage timings on screen, and screenshots (P). Needs the `gpu` feature
-    /// and a display (Xvfb will do).
+    /// kernels (F), traced direct light denoised or not (O), per-stage timings on screen, and
+    /// screenshots (P). Needs the `gpu` feature and a display (Xvfb will do).
     View(view::ViewArgs),
 }
 

@@ -32,6 +32,11 @@ pub struct ViewArgs {
     /// Samples per pixel of the direct light, for models trained with `--direct traced`.
     #[arg(long, default_value_t = 4)]
     direct_spp: u32,
+    /// Denoise that light with Open Image Denoise (O toggles it): auto (where OIDN is
+    /// installed), on (an error without it; the flag alone means on) or off. A denoised frame
+    /// is finished on the host.
+    #[arg(long, default_value_t = nprt_render::Denoise::default(), num_args = 0..=1, default_missing_value = "on")]
+    denoise_direct: nprt_render::Denoise,
     /// Exposure in stops (+ and - change it).
     #[arg(long, value_parser = crate::flags::finite_f32, default_value_t = 0.0, allow_hyphen_values = true)]
     exposure: f32,
@@ -74,6 +79,7 @@ pub fn run(a: ViewArgs) -> Result<()> {
         resolution: a.res.0,
         engine: a.device.engine()?,
         direct_spp: a.direct_spp,
+        denoise_direct: a.denoise_direct,
         exposure: a.exposure,
         spin_deg: a.spin,
         screenshot_dir: a.screenshot_dir,

@@ -32,7 +32,7 @@ fn eval_fails(dir: &std::path::Path, extra: &[&str], needles: &[&str]) {
 #[test]
 fn evaluation_counts_and_sizes_are_bounded_before_any_work() {
     let dir = fresh_dir("bounds-eval");
-    tiny_room_model(&dir, "baseline", &[]);
+    tiny_room_model(&dir, &["--arch", "baseline"]);
     let huge = u64::MAX.to_string();
     for (flags, needle) in [
         (&["--temporal-frames", &huge][..], "--temporal-frames"),
@@ -101,7 +101,7 @@ fn rayon_num_threads_is_held_to_the_threads_bound() {
 #[test]
 fn a_checkpoint_with_an_impossible_training_time_is_refused() {
     let dir = fresh_dir("bounds-seconds");
-    let model = tiny_room_model(&dir, "baseline", &[]);
+    let model = tiny_room_model(&dir, &["--arch", "baseline"]);
     let state = model.join("checkpoint/state.json");
     let text = std::fs::read_to_string(&state).unwrap();
     let mut json: serde_json::Value = serde_json::from_str(&text).unwrap();
@@ -144,7 +144,7 @@ fn a_frame_beyond_the_gpus_texture_size_is_refused() {
         return;
     }
     let dir = fresh_dir("bounds-texture");
-    let model = tiny_room_model(&dir, "baseline", &[]);
+    let model = tiny_room_model(&dir, &["--arch", "baseline"]);
     let (d, m) = (dir.join("data"), model.to_str().unwrap());
     let out = dir.join("wide");
     let o = out.to_str().unwrap();
@@ -200,7 +200,7 @@ fn a_frame_beyond_the_gpus_texture_size_is_refused() {
 #[test]
 fn a_manifest_camera_volume_is_checked_as_generate_checks_it() {
     let dir = fresh_dir("bounds-volume");
-    tiny_room_model(&dir, "baseline", &[]);
+    tiny_room_model(&dir, &["--arch", "baseline"]);
     let manifest = dir.join("data/manifest.json");
     let kept = std::fs::read_to_string(&manifest).unwrap();
     let json: serde_json::Value = serde_json::from_str(&kept).unwrap();
@@ -234,7 +234,7 @@ fn weights_of_an_implausible_magnitude_are_refused_on_load() {
     use nprt_net::model::folder::{load_model, save_model};
     use nprt_net::Parameters;
     let dir = fresh_dir("bounds-weights");
-    let model = tiny_room_model(&dir, "baseline", &[]);
+    let model = tiny_room_model(&dir, &["--arch", "baseline"]);
     let (file, mut net) = load_model(&model).unwrap();
     let mut first = true;
     net.visit_mut("", &mut |_, _, values| {
@@ -383,7 +383,7 @@ fn a_model_is_not_written_into_its_dataset() {
 #[test]
 fn a_report_over_one_view_and_one_frame_pair_shows_no_nan_or_infinity() {
     let dir = fresh_dir("bounds-one-view");
-    let model = tiny_room_model(&dir, "baseline", &[]);
+    let model = tiny_room_model(&dir, &["--arch", "baseline"]);
     let (data, out) = (dir.join("data"), dir.join("report"));
     #[rustfmt::skip]
     common::ok(&[

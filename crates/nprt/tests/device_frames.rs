@@ -121,23 +121,32 @@ fn frames_on_the_gpu_match_the_cpus_with_their_background() {
     }
 }
 
-/// A D/S model that traces its direct light: on the device the frame is the networks' plus
-/// direct light traced there, in one submission; it agrees with the CPU's frame (the CPU
-/// tracer's light) within the noise two CPU frames of different seeds show.
+/// Models that trace their direct light, D/S and the recommended recipe's (the linear design
+/// on sh:2): on the device the frame is the networks' plus direct light traced there, in one
+/// submission; it agrees with the CPU's frame (the CPU tracer's light) within the noise two
+/// CPU frames of different seeds show. The recipe's denoised on the host.
 #[test]
 fn traced_direct_light_stays_on_the_gpu_and_matches_the_cpus_within_noise() {
     if !common::wgpu_runs() {
         return;
     }
-    let scene = scene();
-    let ts = TraceScene::new(&scene);
-    let camera = camera();
-    let map = nprt_scene::open_envmap("builtin:sky:30:50").unwrap();
-    let config = ModelConfig {
+    let dsep = ModelConfig {
         encoder_width: 64,
         direct: DirectLight::Traced,
         ..ModelConfig::new(Design::Dsep, None)
     };
+    for config in [dsep, nprt_net::RECIPE.config()] {
+        traced_frames_agree(config);
+    }
+}
+
+fn traced_frames_agree(config: ModelConfig) {
+    let scene = scene();
+    let ts = TraceScene::new(&scene);
+    let camera = camera();
+    let map = nprt_scene::open_envmap("builtin:sky:30:50").unwrap();
+    let label = config.label();
+    let recipe = config == nprt_net::RECIPE.config();
     let (cpu, gpu) = relighters(config, &scene);
     let frame = |r: &Relighter, seed| {
         let sampling = DirectSampling {
@@ -163,11 +172,14 @@ fn traced_direct_light_stays_on_the_gpu_and_matches_the_cpus_within_noise() {
         block_rms(&cpu1, &got, width),
     );
     eprintln!(
-        "block rms CPU vs CPU {noise:.4}, GPU vs CPU {error:.4} (G-buffer {:.1} ms, networks {:.1} ms, direct light {:.1} ms)",
+        "{label}: block rms CPU vs CPU {noise:.4}, GPU vs CPU {error:.4} (G-buffer {:.1} ms, networks {:.1} ms, direct light {:.1} ms)",
         t.gbuffer_ms, t.network_ms, t.direct_ms
     );
     assert!(t.direct_ms > 0.0, "the traced light timed apart");
-    assert!(error <= 1.5 * noise && noise < 0.05);
+    assert!(error <= 1.5 * noise && noise < 0.05, "{label}");
+    if !recipe {
+        return;
+    }
 
     // Denoised, the light traced on the device goes through OIDN on the host: a few paths per
     // pixel come out closer to the converged frame than without it.
@@ -240,7 +252,7 @@ fn half_precision_frames_of_a_trained_model_follow_f32() {
         return;
     }
     let dir = common::fresh_dir("half-frames");
-    let model = common::tiny_room_model(&dir, "dsep", &["--encoding", "hash-grid"]);
+    let model = common::tiny_room_model(&dir, &["--arch", "dsep", "--encoding", "hash-grid"]);
     let m = model.to_str().unwrap();
     let frames = |precision: &str| {
         let out = dir.join(precision);

@@ -28,7 +28,7 @@ const KERNELS: [&str; 5] = [
 #[test]
 fn export_writes_kernels_weights_and_a_worked_example_that_webgpu_runs() {
     let dir = fresh_dir("export");
-    let model = tiny_room_model(&dir, "dsep", &["--encoding", "hash-grid"]);
+    let model = tiny_room_model(&dir, &["--arch", "dsep", "--encoding", "hash-grid"]);
     let m = model.to_str().unwrap();
     let out = dir.join("export");
     let printed = ok(&[
@@ -137,19 +137,33 @@ fn export_writes_kernels_weights_and_a_worked_example_that_webgpu_runs() {
 /// The linear design exports too: its basis (the functions and the texels' solid angles)
 /// instead of an encoder, a code of 3K values, tracks whose shading networks read no code, and
 /// a worked example whose page (`light_project`, then the dot products in `combine`) makes
-/// the CPU engine's image.
+/// the CPU engine's image. The model is the recommended recipe's (`nprt train` without
+/// `--arch`): the linear design on sh:2, its direct light traced (left to the engine), its
+/// level calibrated (the gain folded into the page's scale).
 #[test]
-fn a_linear_model_exports_and_its_page_matches_the_cpu_engine() {
+fn the_recipes_linear_model_exports_and_its_page_matches_the_cpu_engine() {
     let dir = fresh_dir("export-linear");
     // ReLU shading networks: with SIREN ones (the default) SwiftShader's sin of their large
     // arguments puts the page 9.1e-5 of the brightest value off the CPU's (6.1e-7 with ReLU),
     // which would hide a wrong layout no better than the bound does.
-    let model = tiny_room_model(&dir, "linear", &["--basis", "sh:2", "--activation", "relu"]);
+    let model = tiny_room_model(&dir, &["--activation", "relu"]);
     let out = dir.join("export");
     #[rustfmt::skip]
-    ok(&["export", model.to_str().unwrap(), "--out", out.to_str().unwrap(), "--example-res", "48x36"]);
+    let said = ok(&["export", model.to_str().unwrap(), "--out", out.to_str().unwrap(), "--example-res", "48x36"]);
+    assert!(
+        said.contains(
+            "(linear design on sh:2 (relu), direct light traced (left to the engine's renderer"
+        ),
+        "{said}"
+    );
     let manifest: Value =
         serde_json::from_slice(&std::fs::read(out.join("export.json")).unwrap()).unwrap();
+    assert_eq!(manifest["model"]["direct"], "traced", "{manifest}");
+    let gain = manifest["model"]["output_gain"].as_array().unwrap();
+    assert!(
+        gain.iter().any(|g| g.as_f64() != Some(1.0)),
+        "a calibrated model's gain: {gain:?}"
+    );
     assert!(manifest["encoder"].is_null(), "{manifest}");
     assert_eq!(manifest["basis"]["choice"], "sh:2");
     assert_eq!(manifest["code_size"], 27);

@@ -790,3 +790,47 @@ fn a_paused_run_is_continued_by_the_same_command() {
     );
     std::fs::remove_dir_all(&out).ok();
 }
+
+/// Without `--arch`, the recommended recipe (nprt_net::RECIPE) with its own settings, said in
+/// one line; with it, the named design with the paper's.
+#[test]
+fn without_arch_it_trains_the_recommended_recipe_and_says_so() {
+    let dir = fresh_dir("recipe");
+    let model = dir.join("recipe");
+    let mut args = train_args(&model, "linear", &["--epochs", "1"]);
+    let arch = args.iter().position(|a| *a == "--arch").unwrap();
+    args.drain(arch..arch + 2);
+    let out = ok(&args);
+    let manifest = std::fs::read_to_string(dataset().join("manifest.json")).unwrap();
+    let targets = match manifest.contains(r#""transfer": "sh:"#) {
+        true => "transfer vectors",
+        false => "radiance",
+    };
+    let line = format!(
+        "training the recommended recipe: linear design on sh:2 (siren), direct light traced, \
+         on {targets}, level calibrated"
+    );
+    assert!(out.contains(&line), "no '{line}' in:\n{out}");
+    let config = std::fs::read_to_string(model.join("model.json")).unwrap();
+    for needle in [
+        r#""design": "linear""#,
+        r#""basis": "sh:2""#,
+        r#""direct": "traced""#,
+        r#""level_gain""#,
+    ] {
+        assert!(config.contains(needle), "no {needle} in {config}");
+    }
+    // A design named keeps its own defaults: the paper's D/S learns all its light, raw.
+    let dsep = dir.join("dsep");
+    let out = train(&dsep, "dsep", &["--epochs", "1"]);
+    assert!(
+        out.contains("training dsep design (siren), direct light learned, on radiance\n"),
+        "{out}"
+    );
+    let config = std::fs::read_to_string(dsep.join("model.json")).unwrap();
+    assert!(
+        !config.contains("level_gain") && !config.contains(r#""direct""#),
+        "{config}"
+    );
+    std::fs::remove_dir_all(&dir).unwrap();
+}

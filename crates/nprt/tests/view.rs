@@ -63,8 +63,8 @@ fn display() -> Option<Display> {
     }
 }
 
-/// Runs `nprt view` on `display`, expecting success.
-fn view(display: &Display, args: &[&str]) {
+/// Runs `nprt view` on `display`, expecting success; returns what it printed.
+fn view(display: &Display, args: &[&str]) -> String {
     let out = Command::new(env!("CARGO_BIN_EXE_nprt"))
         .arg("view")
         .args(args)
@@ -76,13 +76,69 @@ fn view(display: &Display, args: &[&str]) {
         "nprt view {args:?}: {}",
         String::from_utf8_lossy(&out.stderr)
     );
+    String::from_utf8_lossy(&out.stdout).into_owned()
+}
+
+/// The recommended recipe's model (`nprt train` without `--arch`): the viewer says what runs,
+/// its direct light traced and, where OIDN is installed, denoised by default (`--denoise-direct
+/// off`, or the O key, leaves it raw): the denoised frame is the smoother.
+#[test]
+fn a_recipe_model_is_shown_with_its_traced_light_denoised_and_says_what_runs() {
+    let Some(display) = display() else { return };
+    let dir = fresh_dir("view-recipe");
+    let model = tiny_room_model(&dir, &[]);
+    let m = model.to_str().unwrap();
+    let oidn = nprt_render::oidn::Oidn::open().is_ok();
+    assert!(
+        oidn || std::env::var_os("NPRT_REQUIRE_OIDN").is_none(),
+        "OIDN is required"
+    );
+    let shot = |denoise: &str| {
+        let shot = dir.join(format!("recipe-{denoise}.png"));
+        #[rustfmt::skip]
+        let said = view(&display, &[m, "--res", "96x72", "--frames", "2", "--no-overlay",
+            "--denoise-direct", denoise, "--screenshot", shot.to_str().unwrap()]);
+        (said, image::open(&shot).unwrap().to_rgb8())
+    };
+    let (said, denoised) = shot("auto");
+    let how = if oidn {
+        "denoised by OIDN"
+    } else {
+        "not denoised"
+    };
+    let line = format!(
+        "linear design on sh:2 (siren), direct light traced (4 spp, {how}), level calibrated"
+    );
+    assert!(said.contains(&line), "no '{line}' in:\n{said}");
+    let (said, raw) = shot("off");
+    assert!(
+        said.contains("direct light traced (4 spp, not denoised)"),
+        "{said}"
+    );
+    if oidn {
+        // Differences between horizontal neighbours: the traced light's noise.
+        let grain = |img: &image::RgbImage| {
+            let mut sum = 0u64;
+            for (x, y, p) in img.enumerate_pixels().filter(|(x, _, _)| *x > 0) {
+                let q = img.get_pixel(x - 1, y);
+                sum += (p.0.iter().zip(q.0))
+                    .map(|(a, b)| u64::from(a.abs_diff(b)))
+                    .sum::<u64>();
+            }
+            sum
+        };
+        let (smooth, noisy) = (grain(&denoised), grain(&raw));
+        eprintln!("neighbour differences: denoised {smooth}, raw {noisy}");
+        assert!(smooth * 10 < noisy * 8, "denoised {smooth}, raw {noisy}");
+    }
+    std::fs::remove_dir_all(&dir).unwrap();
 }
 
 #[test]
 fn the_viewer_opens_a_window_and_shows_what_render_makes() {
     let Some(display) = display() else { return };
     let dir = fresh_dir("view");
-    let model = tiny_room_model(&dir, "prt", &[]);
+    let model = tiny_room_model(&dir, &["--arch", "prt"]);
     let m = model.to_str().unwrap();
 
     // With the overlay: text over the frame, in the top-left corner.

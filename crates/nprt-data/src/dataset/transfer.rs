@@ -26,6 +26,15 @@ pub struct TransferBasis {
 }
 
 impl TransferBasis {
+    /// `sh:L`, or `none` (no vectors): what `nprt generate --transfer` and Python's
+    /// `generate(transfer=…)` take.
+    pub fn parse_choice(s: &str) -> Result<Option<TransferBasis>> {
+        match s {
+            "none" => Ok(None),
+            _ => s.parse().map(Some).context("or none, for no vectors"),
+        }
+    }
+
     /// Coefficients per colour channel, (L + 1)².
     pub fn coefficients(self) -> usize {
         ((self.band + 1) * (self.band + 1)) as usize

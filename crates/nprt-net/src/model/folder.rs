@@ -15,6 +15,7 @@ pub use nprt_data::dataset::check_bounds;
 
 use crate::init::Init;
 use crate::model::config::ModelConfig;
+use crate::model::direct_light::DirectLight;
 use crate::network::encoder::check_input_width;
 use crate::network::nprt_net::NprtNet;
 use crate::parameters::Parameters;
@@ -73,6 +74,21 @@ impl ModelFile {
             training: serde_json::Value::Null,
             level_gain: None,
         }
+    }
+
+    /// What the model is, in one line, `direct` said of a traced direct light (how it is
+    /// traced; nothing for a model that learns it): "linear design on sh:2 (siren), direct
+    /// light traced (16 spp, denoised by OIDN), level calibrated".
+    pub fn describe(&self, direct: &str) -> String {
+        let direct = match self.config.direct {
+            DirectLight::Traced if !direct.is_empty() => format!(" ({direct})"),
+            _ => String::new(),
+        };
+        let level = match self.level_gain {
+            Some(_) => ", level calibrated",
+            None => "",
+        };
+        format!("{}{direct}{level}", self.config.describe())
     }
 
     /// The gain on each channel of the network's radiance (1 without calibration).

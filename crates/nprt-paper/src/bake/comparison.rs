@@ -36,7 +36,7 @@ pub fn write_comparison(model: &Path, data: &Path, engine: Engine, out: &Path) -
     let sampling = DirectSampling {
         spp: DEFAULT_DIRECT_SPP,
         seed: record.seed,
-        denoiser: Denoise::default().denoiser(&r, &model.display().to_string())?,
+        denoiser: Denoise::default().denoiser(&r, model)?,
     };
     let placed = map.rotated_y(record.rotation_deg);
     r.complete(&ts, &view.camera, &placed, &g, sampling, &mut rgb)?;

@@ -17,7 +17,7 @@ use nprt_data::{generate, CameraChoice, GenerateOptions};
 use nprt_eval::{row_name, EvalOptions, Evaluation, MethodResult};
 use nprt_net::training::training_set::TrainingSet;
 use nprt_net::{Engine, ModelConfig, RunLength, TrainOptions, RECIPE};
-use nprt_render::CameraPath;
+use nprt_render::{CameraPath, Denoise, DenoiseCheck};
 use nprt_trace::{render, PixelFilter, RenderSettings, TraceScene};
 use serde_json::json;
 
@@ -61,12 +61,16 @@ pub struct Baked {
     pub report: PathBuf,
     /// The model as run time runs it, in words.
     pub description: String,
-    /// The model's row in the check (its traced light denoised where OIDN is installed), and
-    /// path tracing of its cost (denoised alike).
+    /// The model's row in the check as run time makes its frames (its traced light denoised
+    /// where that measured better and OIDN is installed), and path tracing of its cost
+    /// (denoised where OIDN is installed).
     pub model_row: MethodResult,
     pub path_tracing: Option<MethodResult>,
     /// Held-out views checked.
     pub views: usize,
+    /// Its traced light raw and denoised in the check, and which measured better (None
+    /// without OIDN).
+    pub check: Option<DenoiseCheck>,
     /// The maps of those views (at most three), as the dataset records them.
     pub held_out_maps: Vec<String>,
     /// Wall-clock seconds of this call.
@@ -192,23 +196,29 @@ impl Bake {
             ..EvalOptions::default()
         };
         let (evaluation, _) = stages::evaluation(self.engine, &opts, &report)?;
+        let check = denoise_check(&model, &evaluation, &config)?;
+        if let Some(c) = &check {
+            c.write(&model)?;
+        }
         let comparison = self.out.join("comparison.png");
         write_comparison(&model, &data, self.engine, &comparison)?;
         bar.begin(STAGES.len());
         drop(bar);
         let r = nprt_render::Relighter::load(&model, self.engine)?;
+        let denoiser = Denoise::default().denoiser(&r, &model)?;
         let description = r.describe(&nprt_render::DirectSampling {
             spp: nprt_render::DEFAULT_DIRECT_SPP,
             seed: 0,
-            denoiser: nprt_render::Denoise::default().denoiser(&r, "")?,
+            denoiser,
         });
-        let (model_row, path_tracing) = rows(&evaluation, &config)?;
+        let (model_row, path_tracing) = rows(&evaluation, &config, denoiser.is_some())?;
         let manifest = nprt_data::dataset::load_manifest(&data)?;
         let held_out_maps = (manifest.settings.test_maps.iter().take(3))
             .map(|&k| manifest.settings.envmaps[k].spec.clone())
             .collect();
         Ok(Baked {
             held_out_maps,
+            check,
             model,
             comparison,
             preview,
@@ -283,7 +293,10 @@ impl Bake {
         if first {
             opts.schedule.pause_after = Some(sizes.preview_minutes);
         }
-        let (s, _) = nprt_net::train(&set, config, &opts, &model, self.engine, &|_| true)?;
+        // A stop asked for from Python (Ctrl-C) ends the training at an epoch's end, saved.
+        let go_on = |_: &_| !nprt_io::interrupt::requested();
+        let (s, _) = nprt_net::train(&set, config, &opts, &model, self.engine, &go_on)?;
+        nprt_io::interrupt::check()?;
         if first {
             write_comparison(&model, data, self.engine, preview)?;
             say(&format!(
@@ -294,9 +307,9 @@ impl Bake {
         }
         if s.paused {
             opts.schedule.pause_after = None;
-            nprt_net::train(&set, config, &opts, &model, self.engine, &|_| true)?;
+            nprt_net::train(&set, config, &opts, &model, self.engine, &go_on)?;
         }
-        Ok(())
+        nprt_io::interrupt::check()
     }
 
     /// Seconds each stage is expected to take: the dataset's paths at the rate of a small
@@ -358,14 +371,40 @@ impl Bake {
     }
 }
 
-/// The model's best row in the check (its traced light denoised, where OIDN made that row)
-/// and the path tracing of its cost it is held to.
-fn rows(e: &Evaluation, config: &ModelConfig) -> Result<(MethodResult, Option<MethodResult>)> {
-    let name = row_name(config);
-    let denoised = format!("{name} + OIDN");
-    let row = (e.method(&denoised).or_else(|| e.method(&name)))
+/// The model's row in the check as run time makes its frames (`denoised` or raw), and the
+/// path tracing of its cost it is held to, denoised where OIDN made that row: the stronger of
+/// the two.
+fn rows(
+    e: &Evaluation,
+    config: &ModelConfig,
+    denoised: bool,
+) -> Result<(MethodResult, Option<MethodResult>)> {
+    let raw = row_name(config);
+    let name = match denoised {
+        true => format!("{raw} + OIDN"),
+        false => raw.clone(),
+    };
+    let row = (e.method(&name).or_else(|| e.method(&raw)))
         .with_context(|| format!("the check has no row '{name}'"))?
         .clone();
-    let peer = row.equal_time.as_deref().and_then(|n| e.method(n)).cloned();
+    let peer = (e.method(&raw).and_then(|m| m.equal_time.clone()))
+        .map(|pt| pt.trim_end_matches(" + OIDN").to_string())
+        .and_then(|pt| e.method(&format!("{pt} + OIDN")).or_else(|| e.method(&pt)))
+        .cloned();
     Ok((row, peer))
+}
+
+/// Whether the model's traced light measured better denoised or raw in the check (None where
+/// OIDN made no denoised row): kept beside the model for `Denoise::Auto`.
+fn denoise_check(
+    model: &Path,
+    e: &Evaluation,
+    config: &ModelConfig,
+) -> Result<Option<DenoiseCheck>> {
+    let raw = row_name(config);
+    let (Some(r), Some(d)) = (e.method(&raw), e.method(&format!("{raw} + OIDN"))) else {
+        return Ok(None);
+    };
+    let errors = |m: &MethodResult| [m.mean.l1, m.mean.rmse, m.mean.dssim];
+    DenoiseCheck::measured(model, e.test_views, errors(r), errors(d)).map(Some)
 }

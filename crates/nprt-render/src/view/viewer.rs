@@ -23,8 +23,10 @@ use super::overlay::draw_lines;
 use super::presenter::{Presenter, Shown, OVERLAY_ROWS};
 use crate::frame_stages::FrameRadiance;
 use crate::frame_timings::FrameTimings;
+use crate::oidn::Oidn;
 use crate::relight::{DirectSampling, FrameCache, Relighter};
 use crate::CameraPath;
+use crate::Denoise;
 use crate::Precision;
 
 /// What `nprt view` shows and how.
@@ -42,6 +44,8 @@ pub struct ViewerOptions {
     pub engine: Engine,
     /// Samples per pixel of traced direct light, for models that trace it.
     pub direct_spp: u32,
+    /// Whether that light is denoised (O toggles it where OIDN is installed).
+    pub denoise_direct: Denoise,
     /// Exposure in stops.
     pub exposure: f32,
     /// Degrees the map turns each frame (0: still until moved).
@@ -94,6 +98,10 @@ struct Viewer<'a> {
     rotation: f32,
     exposure: f32,
     reference: Option<Reference>,
+    /// The denoiser of traced direct light, where one is installed and asked for, and whether
+    /// it is on (the O key).
+    oidn: Option<&'static Oidn>,
+    denoise: bool,
     /// What the current model kept of the last frame: its camera's G-buffer and network
     /// inputs, and the code of its lighting (map and rotation).
     cache: FrameCache<(usize, u32)>,
@@ -185,6 +193,23 @@ impl<'a> Viewer<'a> {
             spp: 0,
             pass_ms: 0.0,
         });
+        // Resolved for every model, so that `on` without OIDN, or for a model that traces no
+        // light, is refused before the window opens.
+        let mut oidn = None;
+        for (m, dir) in models.iter().zip(&opts.models) {
+            oidn = oidn.or(opts.denoise_direct.denoiser(m, dir)?);
+        }
+        if opts.denoise_direct == Denoise::Auto && oidn.is_none() {
+            oidn = Oidn::open().ok();
+        }
+        for (m, dir) in models.iter().zip(&opts.models) {
+            let sampling = DirectSampling {
+                spp: opts.direct_spp,
+                seed: 0,
+                denoiser: oidn.filter(|_| m.traces_direct()),
+            };
+            println!("nprt view: '{}': {}", dir.display(), m.describe(&sampling));
+        }
         Ok(Viewer {
             ts: TraceScene::new(scene),
             scene,
@@ -196,6 +221,8 @@ impl<'a> Viewer<'a> {
             rotation: 0.0,
             exposure: opts.exposure,
             reference,
+            denoise: oidn.is_some(),
+            oidn,
             cache: FrameCache::default(),
             timings: FrameTimings::default(),
             frames: 0,
@@ -247,7 +274,7 @@ impl<'a> Viewer<'a> {
         let sampling = DirectSampling {
             spp: self.opts.direct_spp,
             seed: self.frames as u64,
-            denoiser: None,
+            denoiser: self.oidn.filter(|_| self.denoise),
         };
         let key = (self.map, self.rotation.to_bits());
         let lit = (map, self.rotation, key);
@@ -289,13 +316,24 @@ impl<'a> Viewer<'a> {
                     t.network_ms, t.direct_ms
                 ));
                 lines.push(format!("total {:.1} ms", t.total_ms()));
+                if model.traces_direct() {
+                    let denoised = match (self.oidn, self.denoise) {
+                        (None, _) => "not denoised (no OIDN)",
+                        (Some(_), true) => "denoised by OIDN (O: off)",
+                        (Some(_), false) => "not denoised (O: on)",
+                    };
+                    lines.push(format!(
+                        "direct light {} spp, {denoised}",
+                        self.opts.direct_spp
+                    ));
+                }
                 lines.push(format!("networks on the {}", model.networks_on()));
                 lines.push(format!("G-buffer {}", model.gbuffer_on()));
             }
         }
         lines.push(format!("{:.1} fps, shown by {adapter}", self.fps));
         lines.push("drag orbit, right-drag map, wheel dolly".into());
-        lines.push("WASDQE fly, Tab model, M map, R reference, F f16".into());
+        lines.push("WASDQE fly, Tab model, M map, R reference, F f16, O denoise".into());
         lines.push("+/- exposure, P screenshot, H hide, Esc quit".into());
         if !self.message.is_empty() {
             lines.push(self.message.clone());
@@ -404,6 +442,11 @@ impl<'a> Viewer<'a> {
                     }
                 }
                 "h" => self.overlay = !self.overlay,
+                "o" => {
+                    // The next frame is made again: a denoised one takes the host's path.
+                    self.denoise = !self.denoise && self.oidn.is_some();
+                    self.cache = FrameCache::default();
+                }
                 "+" | "=" => self.exposure += 0.5,
                 "-" => self.exposure -= 0.5,
                 "w" => self.camera.fly(1.0, 0.0, 0.0),
