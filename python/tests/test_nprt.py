@@ -214,6 +214,47 @@ def test_the_linear_design_takes_its_basis_and_no_other_design_does(dataset, tmp
     assert nprt.Model(tmp_path / "m").info["basis"] == "sh:2"
 
 
+def test_without_arch_train_makes_the_recommended_recipe(dataset, tmp_path):
+    run = nprt.train(dataset, out=tmp_path / "r", epochs=1, progress=False)
+    assert np.isfinite(run["validation_loss"]), run
+    model = nprt.Model(tmp_path / "r")
+    info = model.info
+    assert (info["design"], info["basis"], info["direct"]) == ("linear", "sh:2", "traced"), info
+    assert info["level_gain"] is not None, info
+    assert model.description.startswith("linear design on sh:2 (siren), direct light traced (16 spp"), model.description
+    assert model.description.endswith("level calibrated"), model.description
+    # The recipe with one choice changed, and the out folder required.
+    nprt.train(dataset, out=tmp_path / "l", epochs=1, direct="learned", progress=False)
+    assert "direct" not in nprt.Model(tmp_path / "l").info
+    with pytest.raises(nprt.InputError, match="out"):
+        nprt.train(dataset, epochs=1, progress=False)
+
+
+def test_bake_makes_a_checked_model_in_one_call(tmp_path):
+    baked = nprt.bake("builtin:room", "builtin", tmp_path / "run", quality="tiny", epochs=3,
+                      progress=False)
+    assert baked["description"].startswith("linear design on sh:2"), baked
+    assert baked["views"] == 2 and len(baked["held_out_maps"]) >= 1, baked
+    for key in ("model_errors", "path_tracing_errors"):
+        errors = baked[key]
+        assert all(np.isfinite(errors[k]) and errors[k] >= 0 for k in ("l1", "rmse", "dssim")), errors
+        assert len(errors["level"]) == 3, errors
+    for key in ("comparison", "preview", "report"):
+        assert pathlib.Path(baked[key]).is_file(), baked[key]
+    frame = nprt.Model(baked["model"]).render("builtin:room", "builtin:sky", nprt.look_at(
+        (0.3, 1.5, 2.7), (-0.2, 0.8, -1.2)), 16, 12, 60.0, denoise_direct=False)
+    assert frame.shape == (12, 16, 3) and frame.mean() > 0
+    # Run again: found done, the same model.
+    again = nprt.bake("builtin:room", "builtin", tmp_path / "run", quality="tiny", epochs=3,
+                      progress=False)
+    assert again["model_errors"] == baked["model_errors"], (again, baked)
+    with pytest.raises(ValueError, match="draft, good or best"):
+        nprt.bake("builtin:room", "builtin", tmp_path / "x", quality="fine")
+    with pytest.raises(ValueError, match="denoise_direct"):
+        nprt.Model(baked["model"]).render("builtin:room", "builtin:sky", nprt.look_at(
+            (0.3, 1.5, 2.7), (-0.2, 0.8, -1.2)), 16, 12, 60.0, denoise_direct=3)
+
+
 def test_the_compiled_module_is_one_abi3_build():
     # One wheel for CPython 3.9 and later: the extension is built against the stable ABI.
     assert nprt._nprt.__file__.endswith(".abi3.so"), nprt._nprt.__file__

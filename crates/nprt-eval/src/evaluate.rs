@@ -88,18 +88,9 @@ pub fn evaluate(o: &EvalOptions, engine: Engine) -> Result<Evaluation> {
         .iter()
         .map(ShownView::of)
         .collect();
-    let denoised_nets = match &oidn {
-        Ok(_) => nets.iter().filter(|(n, _)| n.traces_direct()).count(),
-        Err(_) => 0,
-    };
+    let oidn_ok = oidn.as_ref().ok().copied();
     let tiers = equal_time_tiers(&nets);
-    let oracle_nets = match o.oracles {
-        true => nets.iter().filter(|(n, _)| n.traces_direct()).count(),
-        false => 0,
-    };
-    // Per view: each network (and denoised traced design, and its oracles), path tracing at 5
-    // spp and at each tier's equal time, SH PRT.
-    let steps = nets.len() + denoised_nets + oracle_nets + 2 + tiers.len();
+    let steps = steps_per_view(o, &nets, oidn_ok.is_some(), tiers.len());
     let total_steps = (views.len() * steps) as u64;
     let mut bench = TestBench {
         views: &views,
@@ -115,19 +106,12 @@ pub fn evaluate(o: &EvalOptions, engine: Engine) -> Result<Evaluation> {
     // A stop requested (nprt_io::interrupt) ends it between stages, before any result; the
     // traced stages skip their remaining pixels meanwhile.
     let stop = nprt_io::interrupt::check;
-    let mut results = run_networks(&mut bench, &nets, oidn.as_ref().ok().copied())?;
+    let mut results = run_networks(&mut bench, &nets, oidn_ok)?;
     stop()?;
-    let mut oracles = Vec::new();
-    if o.oracles {
-        for (net, name) in &nets {
-            oracles.extend(run_oracles(
-                &mut bench,
-                net,
-                name,
-                oidn.as_ref().ok().copied(),
-            )?);
-        }
-    }
+    let oracles = match o.oracles {
+        true => run_oracles(&mut bench, &nets, oidn_ok)?,
+        false => Vec::new(),
+    };
     let pt5 = run_path_tracing(&mut bench, "pt-5spp", 5, 0x5eed_0005);
     let equal_time = run_equal_time(&mut bench, &tiers, &pt5, &mut results);
     let equal_time_spp = equal_time.iter().map(|(n, _)| *n).max().unwrap_or(5);
@@ -139,7 +123,6 @@ pub fn evaluate(o: &EvalOptions, engine: Engine) -> Result<Evaluation> {
     }
     baselines.extend(run_sh_prt(&mut bench, o.sh_spp));
     bench.bar.finish_and_clear();
-    let oidn_ok = oidn.as_ref().ok().copied();
     let (traced, with) = ((&pt5, equal_time.as_slice()), (nets.as_slice(), engine));
     let what = (&ts, &manifest);
     let (temporal, temporal_note) = temporal_run(o, what, &maps, with, traced, oidn_ok)?;
@@ -186,6 +169,14 @@ pub fn evaluate(o: &EvalOptions, engine: Engine) -> Result<Evaluation> {
         temporal,
         temporal_note,
     })
+}
+
+/// Progress-bar steps per test view: each network (and each traced design denoised, where
+/// OIDN is, and its oracles, where asked), path tracing at 5 spp and at each of `tiers` equal
+/// times, SH PRT.
+fn steps_per_view(o: &EvalOptions, nets: &[(Net, String)], oidn: bool, tiers: usize) -> usize {
+    let traced = nets.iter().filter(|(n, _)| n.traces_direct()).count();
+    nets.len() + traced * (usize::from(oidn) + usize::from(o.oracles)) + 2 + tiers
 }
 
 /// What an evaluation reads: the dataset's manifest, its scene, the test views evaluated with

@@ -23,9 +23,22 @@ use crate::method::{Family, MethodResult};
 use crate::networks::Net;
 use crate::test_bench::TestBench;
 
-/// The two oracle rows of `net` (named `name`) over every test view; none for a network that
-/// learns all its light.
+/// The two oracle rows of each network of `nets` that traces its direct light, over every test
+/// view.
 pub fn run_oracles(
+    bench: &mut TestBench,
+    nets: &[(Net, String)],
+    oidn: Option<&'static Oidn>,
+) -> Result<Vec<MethodResult>> {
+    let mut rows = Vec::new();
+    for (net, name) in nets {
+        rows.extend(oracles_of(bench, net, name, oidn)?);
+    }
+    Ok(rows)
+}
+
+/// The two oracle rows of `net` (named `name`); none for a network that learns all its light.
+fn oracles_of(
     bench: &mut TestBench,
     net: &Net,
     name: &str,

@@ -3,8 +3,9 @@
 //! evaluation against every baseline, a relit camera path) at a budget stated once, resuming
 //! whatever a killed run left, and the report that sets the paper's Tables 1-6 beside its own
 //! figures and judges the orderings it states. `nprt demo` and `nprt paper` are two presets of
-//! it. It calls the stages' libraries and must not hold their logic: tracing, training,
-//! metrics and baselines stay in nprt-data, nprt-net and nprt-eval.
+//! it; `bake` is its shortest path, a scene to a model of the recommended recipe checked against
+//! path tracing (`nprt bake`). It calls the stages' libraries and must not hold their logic:
+//! tracing, training, metrics and baselines stay in nprt-data, nprt-net and nprt-eval.
 
 pub mod bake;
 pub mod budget;

@@ -45,11 +45,7 @@ pub fn bake<'py>(
     progress: bool,
 ) -> PyResult<Bound<'py, PyDict>> {
     let scene = crate::scene::scene_spec(scene, "scene")?;
-    let envmaps = crate::argument::text(
-        envmaps,
-        "envmaps",
-        "a folder of maps (a str or an os.PathLike) or \"builtin\"",
-    )?;
+    let envmaps = crate::scene::envmaps_spec(envmaps)?;
     let quality: Quality = quality
         .parse()
         .map_err(|e: anyhow::Error| crate::error::input_error(format!("quality: {e}")))?;

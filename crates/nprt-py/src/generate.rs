@@ -63,11 +63,7 @@ pub fn generate<'py>(
     let device = choice::engine(device)?.tracer();
     let opts = GenerateOptions {
         scene: crate::scene::scene_spec(scene, "scene")?,
-        envmaps: argument::text(
-            envmaps,
-            "envmaps",
-            "a folder of maps (a str or an os.PathLike) or \"builtin\"",
-        )?,
+        envmaps: crate::scene::envmaps_spec(envmaps)?,
         out,
         train_views: train_views.unwrap_or(d.train_views),
         test_views: test_views.unwrap_or(d.test_views),

@@ -39,11 +39,7 @@ pub fn paper<'py>(
     training_minutes: Option<f64>,
 ) -> PyResult<Bound<'py, PyDict>> {
     let scene = crate::scene::scene_spec(scene, "scene")?;
-    let envmaps = crate::argument::text(
-        envmaps,
-        "envmaps",
-        "a folder of maps (a str or an os.PathLike) or \"builtin\"",
-    )?;
+    let envmaps = crate::scene::envmaps_spec(envmaps)?;
     let budget: Budget = budget
         .parse()
         .map_err(|e: anyhow::Error| crate::error::input_error(e.to_string()))?;

@@ -312,6 +312,16 @@ pub fn scene_spec(obj: &Bound<'_, PyAny>, arg: &str) -> PyResult<String> {
     }
 }
 
+/// The lightings of a dataset `obj` names: a folder of maps (a str or an os.PathLike), or
+/// "builtin" (`generate`'s, `paper`'s and `bake`'s `envmaps`).
+pub fn envmaps_spec(obj: &Bound<'_, PyAny>) -> PyResult<String> {
+    argument::text(
+        obj,
+        "envmaps",
+        "a folder of maps (a str or an os.PathLike) or \"builtin\"",
+    )
+}
+
 /// The map `obj` is or names, opened where it is named.
 pub fn envmap_arg<'py>(obj: &Bound<'py, PyAny>, arg: &str) -> PyResult<Bound<'py, EnvMap>> {
     if let Ok(m) = obj.cast::<EnvMap>() {

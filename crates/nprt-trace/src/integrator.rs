@@ -258,7 +258,14 @@ pub(crate) fn walk<S: Sampler>(
             }
             beta /= q;
         }
-        next = ts.accel.intersect(origin, dir, f32::INFINITY);
+        // Where the next vertex would end the path (max_depth), only whether the ray leaves
+        // matters: an any-hit query, cheaper than the closest hit (traced direct light's every
+        // BSDF sample is such a ray).
+        next = match depth + 1 >= s.max_depth {
+            true if ts.accel.occluded(origin, dir, f32::INFINITY) => return None,
+            true => None,
+            false => ts.accel.intersect(origin, dir, f32::INFINITY),
+        };
     }
 }
 

@@ -11,7 +11,7 @@
 
 mod common;
 
-use common::block_rms;
+use common::trimmed_block_rms;
 use glam::Vec3;
 use nprt_net::model::folder::ModelFile;
 use nprt_net::{Compute, Design, DirectLight, Engine, Init, ModelConfig};
@@ -166,10 +166,13 @@ fn traced_frames_agree(config: ModelConfig) {
         .unwrap()
     };
     let ((cpu1, _), (cpu2, _), (got, t)) = (frame(&cpu, 1), frame(&cpu, 2), frame(&gpu, 3));
+    // Trimmed of the 2% of blocks that differ most: with each pixel's samples stratified the
+    // noise is mostly the sun's rare paths off the glossy ball, and the plain rms of 192 blocks
+    // swung from 0.0074 to 0.0143 between pairs of frames that agree at 2,048 spp.
     let width = camera.width as usize;
     let (noise, error) = (
-        block_rms(&cpu1, &cpu2, width),
-        block_rms(&cpu1, &got, width),
+        trimmed_block_rms(&cpu1, &cpu2, width),
+        trimmed_block_rms(&cpu1, &got, width),
     );
     eprintln!(
         "{label}: block rms CPU vs CPU {noise:.4}, GPU vs CPU {error:.4} (G-buffer {:.1} ms, networks {:.1} ms, direct light {:.1} ms)",

@@ -1,6 +1,7 @@
 //! Training: the training set in memory, batches, the learning-rate schedule, the one training
 //! loop with checkpoints and exact resume, each engine's steps as the loop takes them, the
-//! Neural PRT objective run through it, validation, calibration and loss curves, and the
+//! Neural PRT objective run through it, validation, calibration and loss curves, the
+//! recommended recipe (a design with every choice of its training and run time), and the
 //! radiance cache's online training.
 
 pub mod batch;
@@ -14,6 +15,7 @@ pub mod kernel_steps;
 pub mod loss_curves;
 pub mod lr_schedule;
 pub mod nprt_objective;
+pub mod recipe;
 pub mod run_length;
 pub mod schedule;
 pub mod snapshot;

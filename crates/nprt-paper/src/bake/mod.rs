@@ -147,20 +147,7 @@ impl Bake {
                 bar.println(line)
             }
         };
-        say(&format!(
-            "baking {} under {} maps at {} quality: {} training views of {}², {} held-out views; \
-             training {}",
-            self.scene,
-            self.envmaps,
-            self.quality,
-            sizes.train_views,
-            sizes.train_res,
-            sizes.test_views,
-            match self.epochs {
-                Some(e) => format!("{e} epochs"),
-                None => format!("{} minutes", self.minutes.unwrap_or(sizes.minutes)),
-            }
-        ));
+        say(&self.plan(&sizes));
         let data = self.data_dir();
         bar.begin(0);
         let s = generate(&generate_opts, |p| {
@@ -179,14 +166,48 @@ impl Bake {
             s.skipped
         ));
         bar.begin(1);
-        let model = self.model_dir();
-        let preview = self.out.join("preview.png");
         let config = RECIPE.config();
+        let preview = self.out.join("preview.png");
         self.train(&data, &config, &sizes, &preview, &say)?;
         bar.begin(2);
-        let report = self.out.join("report");
+        let (evaluation, check) = self.check(&data, &config, &sizes)?;
+        bar.begin(STAGES.len());
+        drop(bar);
+        let mut baked = self.baked(&evaluation, &config, check)?;
+        baked.seconds = start.elapsed().as_secs_f64();
+        Ok(baked)
+    }
+
+    /// What the bake will do, in one line.
+    fn plan(&self, sizes: &Sizes) -> String {
+        let training = match self.epochs {
+            Some(e) => format!("{e} epochs"),
+            None => format!("{} minutes", self.minutes.unwrap_or(sizes.minutes)),
+        };
+        format!(
+            "baking {} under {} maps at {} quality: {} training views of {}², {} held-out views; \
+             training {training}",
+            self.scene,
+            self.envmaps,
+            self.quality,
+            sizes.train_views,
+            sizes.train_res,
+            sizes.test_views,
+        )
+    }
+
+    /// The check: the model against every baseline on the held-out views (cached by its
+    /// inputs), whether its traced light measured better denoised (kept beside it), and its
+    /// frame beside a reference (comparison.png).
+    fn check(
+        &self,
+        data: &Path,
+        config: &ModelConfig,
+        sizes: &Sizes,
+    ) -> Result<(Evaluation, Option<DenoiseCheck>)> {
+        let model = self.model_dir();
         let opts = EvalOptions {
-            data: data.clone(),
+            data: data.to_path_buf(),
             models: vec![model.clone()],
             sh_spp: sizes.sh_spp,
             timing_res: sizes.test_res,
@@ -195,15 +216,25 @@ impl Bake {
             progress: self.progress,
             ..EvalOptions::default()
         };
+        let report = self.out.join("report");
         let (evaluation, _) = stages::evaluation(self.engine, &opts, &report)?;
-        let check = denoise_check(&model, &evaluation, &config)?;
+        let check = denoise_check(&model, &evaluation, config)?;
         if let Some(c) = &check {
             c.write(&model)?;
         }
         let comparison = self.out.join("comparison.png");
-        write_comparison(&model, &data, self.engine, &comparison)?;
-        bar.begin(STAGES.len());
-        drop(bar);
+        write_comparison(&model, data, self.engine, &comparison)?;
+        Ok((evaluation, check))
+    }
+
+    /// What the bake made, its model as run time makes its frames.
+    fn baked(
+        &self,
+        evaluation: &Evaluation,
+        config: &ModelConfig,
+        check: Option<DenoiseCheck>,
+    ) -> Result<Baked> {
+        let model = self.model_dir();
         let r = nprt_render::Relighter::load(&model, self.engine)?;
         let denoiser = Denoise::default().denoiser(&r, &model)?;
         let description = r.describe(&nprt_render::DirectSampling {
@@ -211,8 +242,8 @@ impl Bake {
             seed: 0,
             denoiser,
         });
-        let (model_row, path_tracing) = rows(&evaluation, &config, denoiser.is_some())?;
-        let manifest = nprt_data::dataset::load_manifest(&data)?;
+        let (model_row, path_tracing) = rows(evaluation, config, denoiser.is_some())?;
+        let manifest = nprt_data::dataset::load_manifest(&self.data_dir())?;
         let held_out_maps = (manifest.settings.test_maps.iter().take(3))
             .map(|&k| manifest.settings.envmaps[k].spec.clone())
             .collect();
@@ -220,14 +251,14 @@ impl Bake {
             held_out_maps,
             check,
             model,
-            comparison,
-            preview,
-            report: report.join("report.html"),
+            comparison: self.out.join("comparison.png"),
+            preview: self.out.join("preview.png"),
+            report: self.out.join("report").join("report.html"),
             description,
             model_row,
             path_tracing,
             views: evaluation.test_views,
-            seconds: start.elapsed().as_secs_f64(),
+            seconds: 0.0,
         })
     }
 

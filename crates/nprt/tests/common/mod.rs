@@ -6,7 +6,7 @@
 mod frame_noise;
 #[path = "../../../nprt-trace/tests/common/shared_data.rs"]
 mod shared_data;
-pub use frame_noise::block_rms;
+pub use frame_noise::{block_rms, trimmed_block_rms};
 pub use shared_data::{repo, shared};
 
 use std::path::{Path, PathBuf};

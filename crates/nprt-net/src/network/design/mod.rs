@@ -8,7 +8,6 @@ mod baseline;
 mod dsep;
 mod linear;
 mod prt;
-pub mod recipe;
 
 use crate::choice::named_choice;
 use crate::network::activation::Activation;

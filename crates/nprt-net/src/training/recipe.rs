@@ -1,7 +1,8 @@
-//! The recommended recipe: nprt's measured best relighting, stated once. `nprt train` trains it
-//! when no `--arch` is given, `nprt generate` records the dataset it needs without expert flags,
-//! `nprt bake` runs it end to end, and run time (render, view, eval, export) traces and denoises
-//! its direct light as the model records it. The paper's designs stay one flag away (`--arch`),
+//! The recommended recipe: nprt's measured best relighting, stated once (a design, from
+//! `network::design`, with every choice of its dataset, training and run time). `nprt train`
+//! trains it when no `--arch` is given, `nprt generate` records the dataset it needs without
+//! expert flags, `nprt bake` runs it end to end, and run time (render, view, eval, export)
+//! traces and denoises its direct light as the model records it. The paper's designs stay one flag away (`--arch`),
 //! with the paper's own settings. docs/model.md ("The recommended recipe") has the measurements
 //! that chose each part.
 
