@@ -177,6 +177,7 @@ def test_verify_pack_export_render_and_deep_shading(dataset, model, tmp_path):
     film = nprt.render(model, tmp_path / "film", frames=3, res=(16, 12))
     pngs = sorted(pathlib.Path(film["frames_dir"]).glob("*.png"))
     assert len(pngs) == 3 and os.path.exists(film["animation"]) and film["total_ms"] > 0
+    assert film["description"] == "dsep design (siren), direct light learned", film
     rows = []
     run = nprt.train_deep_shading(dataset, tmp_path / "ds", epochs=1, callback=rows.append,
                                   progress=False)

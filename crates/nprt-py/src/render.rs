@@ -13,8 +13,9 @@ use crate::interruptible::interruptible;
 
 /// Relights a camera path of the model in `model` under a lighting schedule into `out` (PNG
 /// frames, or EXR with `exr`, and an MP4 or GIF), as `nprt render`; keywords are its flags,
-/// `None` its default. Returns `frames_dir`, `animation` and the mean per-frame milliseconds
-/// (`gbuffer_ms`, `encoder_ms`, `network_ms`, `direct_ms`, `total_ms`). The GIL is released
+/// `None` its default. Returns `description` (what runs, in one line), `frames_dir`,
+/// `animation` and the mean per-frame milliseconds (`gbuffer_ms`, `encoder_ms`, `network_ms`,
+/// `direct_ms`, `total_ms`). The GIL is released
 /// while it renders; Ctrl-C stops it after the frame under way (`nprt.Interrupted`).
 #[pyfunction]
 #[pyo3(signature = (
@@ -63,9 +64,13 @@ pub fn render<'py>(
         precision: precision.map(parse).transpose()?.unwrap_or(d.precision),
     };
     let engine = engine(device)?;
-    let done = interruptible(py, || RenderJob::prepare(&opts, engine)?.run(|_| {}))?;
+    let (done, description) = interruptible(py, || {
+        let job = RenderJob::prepare(&opts, engine)?;
+        Ok((job.run(|_| {})?, job.describe()))
+    })?;
     let m = done.mean;
     let summary = PyDict::new(py);
+    summary.set_item("description", description)?;
     summary.set_item("frames_dir", done.frames_dir)?;
     summary.set_item("animation", done.animation.path().to_path_buf())?;
     summary.set_item("gbuffer_ms", m.gbuffer_ms)?;
