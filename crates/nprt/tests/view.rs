@@ -31,8 +31,11 @@ fn display() -> Option<Display> {
     if let Ok(name) = std::env::var("DISPLAY") {
         return Some(Display { name, server: None });
     }
-    // A display number of this process's own, so that parallel runs do not collide.
-    let name = format!(":{}", 100 + std::process::id() % 800);
+    // A display number of this test's own: parallel runs, and this binary's tests run on
+    // threads at once, must not collide (one's Xvfb killed under the other).
+    static NEXT: std::sync::atomic::AtomicU32 = std::sync::atomic::AtomicU32::new(0);
+    let test = NEXT.fetch_add(1, std::sync::atomic::Ordering::Relaxed) % 4;
+    let name = format!(":{}", 100 + (std::process::id() % 800) * 4 + test);
     match Command::new("Xvfb")
         .args([&name, "-screen", "0", "640x480x24", "-nolisten", "tcp"])
         .stdout(Stdio::null())
