@@ -24,8 +24,9 @@
 #       $OUT (default .visit/out): summary.md, visit.log, model.tar.xz and the test views
 #       (testviews.tar.part-*, 15 MiB each), 8 files at most.
 #   bench/kitchen-visit.sh land DIR [--cpu-model MODEL]
-#       here, on what a visit brought back in DIR: the model replaces pretrained/kitchen-dsep/
-#       model, the row joins visits.csv, and `nprt eval` (CPU; OIDN where scripts/oidn.sh put it)
+#       here, on what a visit brought back in DIR: checked whole (`nprt model land`: it loads,
+#       its checkpoint holds a validation loss, it continues the last visit), the model replaces
+#       pretrained/kitchen-dsep/model as one folder, the row joins visits.csv, and `nprt eval` (CPU; OIDN where scripts/oidn.sh put it)
 #       scores it on the visit's test views against their references, beside equal-time path
 #       tracing with and without OIDN and D/S trained on the CPU: MODEL, by default
 #       pretrained/kitchen-dsep/cpu-f32 (15 CPU-minutes in f32 on the visit's flags, traced on
@@ -209,7 +210,8 @@ land() {
   fi
   [ -f "$from/model.tar.xz" ] || die "'$from' holds no model.tar.xz (did the visit train?)"
   local nprt=${VISIT_NPRT:-target/release/nprt} work=target/kitchen-visit
-  [ -x "$nprt" ] || cargo build --release -p nprt
+  # Built whenever it is not given: an older binary lacks `nprt model land`.
+  [ -n "${VISIT_NPRT:-}" ] || cargo build -q --release -p nprt
   link_shared
   rm -rf "$work" && mkdir -p "$work"
   tar -xJf "$from/model.tar.xz" -C "$work"
@@ -220,20 +222,12 @@ land() {
   if [ -s "$pretrained/dataset.sha256" ] && [ "$(cat "$pretrained/dataset.sha256")" != "$hash" ]; then
     die "the visit's dataset ($hash) is not the run's ($(cat "$pretrained/dataset.sha256"))"
   fi
-  echo "$hash" >"$pretrained/dataset.sha256"
-  rm -rf "$pretrained/model.new" && cp -a "$work/model" "$pretrained/model.new"
-  rm -rf "$pretrained/model" && mv "$pretrained/model.new" "$pretrained/model"
-  # GPU-minutes done, samples seen and the last validation loss, from the checkpoint.
+  # Checked whole before anything of the run changes (nprt model land: the model loads, its
+  # checkpoint holds a validation loss, it continues the last visit), then landed as one folder.
   local row
-  row=$(python3 - "$pretrained/model/checkpoint/state.json" <<'EOF'
-import json, sys
-s = json.load(open(sys.argv[1]))
-val = next((r["val"] for r in reversed(s["history"]) if r.get("val") is not None), None)
-print(f'{s["seconds"] / 60:.2f},{s["samples"]},{s["epoch"]},{val:.5f}')
-EOF
-)
-  [ -f "$pretrained/visits.csv" ] || echo "landed,gpu_minutes,samples,epochs,val_loss" >"$pretrained/visits.csv"
-  echo "$(date -u +%Y-%m-%dT%H:%MZ),$row" >>"$pretrained/visits.csv"
+  row=$("$nprt" model land "$work/model" --into "$pretrained" --landed "$(date -u +%Y-%m-%dT%H:%MZ)") ||
+    die "the visit's model was not landed; $pretrained is as it was"
+  echo "$hash" >"$pretrained/dataset.sha256.new" && mv "$pretrained/dataset.sha256.new" "$pretrained/dataset.sha256"
   log "model landed in $pretrained/model ($row); evaluating on the CPU"
   local models=$pretrained/model
   [ -z "$cpu_model" ] || models=$models,$cpu_model

@@ -34,7 +34,7 @@ impl CameraChoice {
             (Some(min), Some(max), Some(look), None) => CameraVolume {
                 min,
                 max,
-                look: look.normalize_or_zero(),
+                look: CameraVolume::direction(look),
                 spread_deg: HAND_SPREAD_DEG,
                 fov_deg: HAND_FOV_DEG,
             },

@@ -128,25 +128,40 @@ fn check_sizes(opts: &GenerateOptions, builtin_share: f32) -> Result<()> {
     Ok(())
 }
 
+impl GenerateOptions {
+    /// The share of views lit by built-in maps: `--mix-builtin`, else none under `builtin`
+    /// alone and the default mix beside a folder of maps.
+    fn builtin_share(&self) -> f32 {
+        match (self.envmaps.as_str(), self.mix_builtin) {
+            (_, Some(share)) => share,
+            ("builtin", None) => 0.0,
+            (_, None) => lighting::DEFAULT_MIX_BUILTIN,
+        }
+    }
+
+    /// The maps and each view's lighting: refuses maps that cannot be listed and held-out
+    /// maps that cannot be held out, before any work (a caller that makes folders of its own
+    /// asks first).
+    pub fn lighting(&self) -> Result<(Vec<String>, dataset::MapAssignment)> {
+        lighting::choose(
+            &self.envmaps,
+            self.train_views,
+            self.test_views,
+            self.test_maps,
+            self.builtin_share(),
+            self.seed,
+        )
+    }
+}
+
 /// Plans the dataset (nothing is written before the plan holds), calls `planned` with it, then
 /// renders this shard's missing views.
 pub fn generate(opts: &GenerateOptions, planned: impl FnOnce(Planned)) -> Result<Summary> {
-    let share = match (opts.envmaps.as_str(), opts.mix_builtin) {
-        (_, Some(share)) => share,
-        ("builtin", None) => 0.0,
-        (_, None) => lighting::DEFAULT_MIX_BUILTIN,
-    };
-    check_sizes(opts, share)?;
+    check_sizes(opts, opts.builtin_share())?;
+    dataset::check_not_model_folder(&opts.out)?;
     let scene = load_scene(&opts.scene, &dataset::relit())?;
     let volume = opts.camera.resolve(&scene, &opts.scene)?;
-    let (specs, assignment) = lighting::choose(
-        &opts.envmaps,
-        opts.train_views,
-        opts.test_views,
-        opts.test_maps,
-        share,
-        opts.seed,
-    )?;
+    let (specs, assignment) = opts.lighting()?;
     let maps = lighting::load_all(&specs)?;
     let warnings = scene
         .warnings

@@ -55,6 +55,8 @@ pub fn choose(
     }
     let mut specs = specs_in_dir(Path::new(envmaps))?;
     let test_maps = test_maps.unwrap_or_else(|| default_test_count(specs.len()));
+    // Whether the folder can hold them out, asked now: the split itself is drawn when planning.
+    split(specs.len(), test_maps, seed)?;
     specs.extend(builtin_per_view(
         mixed_views(seed, train_views, builtin_share) as u64,
         0,

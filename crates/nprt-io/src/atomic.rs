@@ -98,6 +98,44 @@ pub fn write_atomically(path: &Path, write: impl FnOnce(&Path) -> Result<()>) ->
         .with_context(|| format!("cannot move '{}' into place", path.display()))
 }
 
+/// Lands the folder `path` whole: `fill` writes its files into a temporary folder beside it,
+/// which is then renamed into place (replacing a folder there, as a re-run of a killed one
+/// does), so that a reader finds all of it or none. Temporaries of `path` left by killed runs
+/// are removed first: the caller holds `path`'s parent for its run (a training run's lock).
+pub fn write_folder(path: &Path, fill: impl FnOnce(&Path) -> Result<()>) -> Result<()> {
+    let dir = create_parent_dir(path)?;
+    let name = path
+        .file_name()
+        .with_context(|| format!("output folder '{}' has no name", path.display()))?;
+    let claimed = name.to_string_lossy().into_owned();
+    for (stale, target) in leftover_temporaries(dir)? {
+        if target == claimed {
+            remove_path(&stale)?;
+        }
+    }
+    let tmp = dir.join(temporary_name(name));
+    std::fs::create_dir(&tmp)
+        .with_context(|| format!("cannot create folder '{}'", tmp.display()))?;
+    if let Err(e) = fill(&tmp) {
+        let _ = std::fs::remove_dir_all(&tmp);
+        return Err(e.context(format!("cannot write '{}'", path.display())));
+    }
+    if std::fs::symlink_metadata(path).is_ok() {
+        remove_path(path)?;
+    }
+    std::fs::rename(&tmp, path)
+        .with_context(|| format!("cannot move '{}' into place", path.display()))
+}
+
+/// Removes a file or a folder with what it holds.
+fn remove_path(path: &Path) -> Result<()> {
+    let removed = match std::fs::symlink_metadata(path)?.is_dir() {
+        true => std::fs::remove_dir_all(path),
+        false => std::fs::remove_file(path),
+    };
+    removed.with_context(|| format!("cannot remove '{}'", path.display()))
+}
+
 const TMP_SUFFIX: &str = ".tmp";
 /// The most bytes a file name may have (Linux, macOS and Windows alike).
 const NAME_MAX: usize = 255;
@@ -159,8 +197,7 @@ pub fn remove_temporaries(dir: &Path, ours: impl Fn(&Path) -> bool) -> Result<us
     let mut removed = 0;
     for (tmp, target) in leftover_temporaries(dir)? {
         if ours(&dir.join(target)) {
-            std::fs::remove_file(&tmp)
-                .with_context(|| format!("cannot remove '{}'", tmp.display()))?;
+            remove_path(&tmp)?;
             removed += 1;
         }
     }
@@ -191,6 +228,31 @@ mod tests {
         let d = std::env::temp_dir().join(format!("nprt-io-{name}-{}", std::process::id()));
         let _ = std::fs::remove_dir_all(&d);
         d
+    }
+
+    #[test]
+    fn a_folder_lands_whole_or_not_at_all() {
+        let d = dir("folder");
+        let path = d.join("snap");
+        // A killed run's temporary and a broken folder from a build that wrote in place.
+        std::fs::create_dir_all(d.join(".snap.1.tmp")).unwrap();
+        std::fs::create_dir_all(&path).unwrap();
+        std::fs::write(path.join("weights"), b"old").unwrap();
+        let err = write_folder(&path, |tmp| {
+            std::fs::write(tmp.join("weights"), b"new")?;
+            bail!("killed before the config")
+        });
+        assert!(err.is_err());
+        assert_eq!(std::fs::read(path.join("weights")).unwrap(), b"old");
+        write_folder(&path, |tmp| {
+            std::fs::write(tmp.join("weights"), b"new")?;
+            Ok(std::fs::write(tmp.join("config"), b"c")?)
+        })
+        .unwrap();
+        assert_eq!(std::fs::read(path.join("weights")).unwrap(), b"new");
+        assert!(path.join("config").is_file());
+        assert_eq!(leftover_temporaries(&d).unwrap(), vec![]);
+        std::fs::remove_dir_all(&d).unwrap();
     }
 
     #[test]

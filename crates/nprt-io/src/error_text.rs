@@ -1,4 +1,5 @@
-//! An error as nprt says it, to a terminal or to Python: the message and its causes, each once.
+//! An error as nprt says it, to a terminal or to Python: the message and its causes, each once;
+//! and a number as an error says it.
 
 /// `e` and its causes joined by colons, each said once: some libraries' messages (exr's,
 /// image's) and some of nprt's own already end with their cause's, which `{:#}` would repeat
@@ -15,9 +16,29 @@ pub fn describe_error(e: &anyhow::Error) -> String {
     text
 }
 
+/// `v` as written plainly where that is short, else in scientific notation: a refused 1e-300
+/// is said as such, not as 300 digits.
+pub fn short_number<T>(v: T) -> String
+where
+    T: Copy + Into<f64> + std::fmt::Display + std::fmt::LowerExp,
+{
+    let x: f64 = v.into();
+    match x == 0.0 || (1e-4..1e7).contains(&x.abs()) || !x.is_finite() {
+        true => format!("{v}"),
+        false => format!("{v:e}"),
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn numbers_are_said_plainly_or_in_scientific_notation() {
+        let said = [0.0, -1.0, 0.5, 1e30, 1e-300, f64::NAN, 123456.0].map(short_number);
+        assert_eq!(said, ["0", "-1", "0.5", "1e30", "1e-300", "NaN", "123456"]);
+        assert_eq!(short_number(1e30f32), "1e30");
+    }
 
     #[test]
     fn a_cause_its_message_already_ends_with_is_said_once() {

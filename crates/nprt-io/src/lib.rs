@@ -35,10 +35,10 @@ mod srgb;
 
 pub use atomic::{
     check_writable, create_parent_dir, leftover_temporaries, output_target, remove_temporaries,
-    write_atomically, write_file,
+    write_atomically, write_file, write_folder,
 };
 pub use bus_error::name_on_bus_error;
-pub use error_text::describe_error;
+pub use error_text::{describe_error, short_number};
 pub use image_read::{linear_rgb, read_linear_rgb, LinearImage};
 pub use image_write::write_linear_rgb;
 pub use indicatif::ProgressBar;

@@ -80,7 +80,7 @@ pub use training::checkpoint::RunState;
 pub use training::lr_schedule::LrSchedule;
 pub use training::nprt_objective::train;
 pub use training::recipe::{Asked, Recipe, RECIPE};
-pub use training::run_length::RunLength;
+pub use training::run_length::{check_minutes, RunLength, MAX_MINUTES, MIN_MINUTES};
 pub use training::schedule::Schedule;
 pub use training::train_options::{recipe_rate, Gather, Targets, TrainOptions};
 pub use training::training_loop::{Objective, TrainSummary, Watch};

@@ -173,13 +173,10 @@ impl Experiment {
 
     /// Refuses, before any work, paths that are not UTF-8 (the experiment writes them into its
     /// records, the report and `nprt generate`'s flags, which would hold another path) and a
-    /// training time that is not a positive number of minutes, naming the flag.
+    /// training time outside [`nprt_net::check_minutes`]'s range, naming the flag.
     pub fn check_settings(&self) -> Result<()> {
-        if let Some(m) = self
-            .training_minutes
-            .filter(|m| !(m.is_finite() && *m > 0.0))
-        {
-            bail!("--training-minutes {m} is not a positive number of minutes");
+        if let Some(m) = self.training_minutes {
+            nprt_net::check_minutes(m, "--training-minutes").map_err(anyhow::Error::msg)?;
         }
         let paths = [
             ("--out", Some(&self.out)),
@@ -255,7 +252,7 @@ mod tests {
         x.training_minutes = Some(16.0);
         assert_eq!(x.training(), RunLength::minutes(16.0));
         assert_eq!(x.deep_shading_training(), RunLength::minutes(16.0));
-        for bad in [0.0, -1.0, f64::NAN, f64::INFINITY] {
+        for bad in [0.0, -1.0, f64::NAN, f64::INFINITY, 1e-320, 1e300] {
             x.training_minutes = Some(bad);
             let err = x.check_settings().unwrap_err().to_string();
             assert!(err.contains("--training-minutes"), "{err}");

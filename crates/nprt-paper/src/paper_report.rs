@@ -75,10 +75,15 @@ fn header(md: &mut String, x: &Experiment, e: &Evaluation) -> Result<()> {
         x.envmaps,
         b.wall_time,
         match x.training_minutes {
-            Some(_) => format!(
-                " with its own training ({} a network); this run trains longer \
+            Some(m) => format!(
+                " with its own training ({} a network); this run trains {} \
                  (--training-minutes)",
-                describe_run(b.training)
+                describe_run(b.training),
+                match b.training.minutes {
+                    Some(own) if own == m => "as long",
+                    Some(own) if own > m => "shorter",
+                    _ => "longer",
+                }
             ),
             None => String::new(),
         },
@@ -128,7 +133,7 @@ pub fn report_tables(e: &Evaluation, ablation: &[MethodResult], kitchen: bool) -
 fn describe_run(r: nprt_net::RunLength) -> String {
     match (r.epochs, r.minutes) {
         (Some(e), _) => format!("{e} epochs"),
-        (None, Some(m)) => format!("{m} minutes"),
+        (None, Some(m)) => format!("{} minutes", nprt_io::short_number(m)),
         (None, None) => "the default schedule".into(),
     }
 }

@@ -12,6 +12,7 @@ use serde::{Deserialize, Serialize};
 
 use crate::oidn::Oidn;
 use crate::relight::Relighter;
+use nprt_net::model::folder::weights_hash;
 
 /// auto (OIDN where it is installed, unless the model's check says raw), on (OIDN, or an error
 /// saying how to install it) or off.
@@ -115,7 +116,7 @@ impl DenoiseCheck {
 
     /// The check kept in `dir`, where it is one of the weights there now.
     pub fn read(dir: &Path) -> Option<DenoiseCheck> {
-        let bytes = std::fs::read(dir.join(DENOISE_CHECK_FILE)).ok()?;
+        let bytes = nprt_io::read_input(&dir.join(DENOISE_CHECK_FILE)).ok()?;
         let check: DenoiseCheck = serde_json::from_slice(&bytes).ok()?;
         (weights_hash(dir).ok()? == check.weights).then_some(check)
     }
@@ -126,11 +127,4 @@ impl DenoiseCheck {
             serde_json::to_vec_pretty(self)?,
         )
     }
-}
-
-fn weights_hash(dir: &Path) -> Result<String> {
-    let path = dir.join(nprt_net::model::folder::WEIGHTS_FILE);
-    let bytes =
-        std::fs::read(&path).with_context(|| format!("cannot read '{}'", path.display()))?;
-    Ok(blake3::hash(&bytes).to_hex().to_string())
 }

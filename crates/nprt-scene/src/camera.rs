@@ -62,7 +62,7 @@ impl CameraVolume {
         let v = CameraVolume {
             min: Vec3::from(f.min),
             max: Vec3::from(f.max),
-            look: Vec3::from(f.look).normalize_or_zero(),
+            look: CameraVolume::direction(Vec3::from(f.look)),
             spread_deg: f.spread_deg,
             fov_deg: f.fov_deg,
         };
@@ -70,6 +70,13 @@ impl CameraVolume {
             bail!("camera volume '{}': {p}", path.display());
         }
         Ok(v)
+    }
+
+    /// `look` as a unit direction, normalised in double precision: a finite direction of any
+    /// size is one (its length overflowed f32 at [10³⁸; 3]); zero or not finite stays zero,
+    /// which [`problem`](Self::problem) refuses.
+    pub fn direction(look: Vec3) -> Vec3 {
+        look.as_dvec3().normalize_or_zero().as_vec3()
     }
 
     /// What makes this volume unusable, if anything: the rule each field breaks. The one check
@@ -195,6 +202,28 @@ mod tests {
 
     /// A camera looking straight up or down along its up vector (a camera path keyframe with
     /// its target above it) still has an orthonormal frame and finite rays.
+    /// A finite direction of any size is a direction: [10³⁸; 3]'s length overflowed f32 and
+    /// it was refused as "must be a non-zero direction".
+    #[test]
+    fn a_look_direction_of_any_finite_size_is_normalised() {
+        for look in [
+            Vec3::splat(1e38),
+            Vec3::splat(-3e38),
+            Vec3::new(1e-40, 0.0, 0.0),
+        ] {
+            let d = CameraVolume::direction(look);
+            assert!((d.length() - 1.0).abs() < 1e-6, "{look} → {d}");
+            assert!(d.dot(look.signum()) > 0.0, "{look} → {d}");
+        }
+        for look in [
+            Vec3::ZERO,
+            Vec3::new(f32::NAN, 1.0, 0.0),
+            Vec3::new(f32::INFINITY, 0.0, 0.0),
+        ] {
+            assert_eq!(CameraVolume::direction(look), Vec3::ZERO, "{look}");
+        }
+    }
+
     #[test]
     fn looking_along_up_gives_a_finite_frame() {
         for target in [Vec3::new(0.0, 2.0, 1.0), Vec3::new(0.0, -3.0, 1.0)] {

@@ -1,4 +1,5 @@
-//! `nprt model info`: a design's layer table and parameter counts, or a trained model's.
+//! `nprt model info`: a design's layer table and parameter counts, or a trained model's; `nprt
+//! model land`: a visit's model landed in a long run's folder.
 
 use std::path::PathBuf;
 
@@ -12,6 +13,23 @@ pub enum ModelCommand {
     /// Print the layer table and parameter counts of a design (transport counts exclude the
     /// encoder, as the paper's Table 1).
     Info(ModelInfoArgs),
+    /// Land a model folder a visit trained (bench/kitchen-visit.sh land) in a long run's folder:
+    /// checked whole first (it loads, its checkpoint holds a validation loss, it continues the
+    /// run's last visit), then RUN/model replaced as one folder and its row added to
+    /// RUN/visits.csv, which is printed. Nothing in RUN changes when a check fails.
+    Land(LandArgs),
+}
+
+#[derive(clap::Args)]
+pub struct LandArgs {
+    /// The model folder the visit brought back.
+    model: PathBuf,
+    /// The run's folder (pretrained/kitchen-dsep): its model/ and visits.csv.
+    #[arg(long)]
+    into: PathBuf,
+    /// When the visit landed, UTC as YYYY-MM-DDTHH:MMZ (`date -u +%Y-%m-%dT%H:%MZ`).
+    #[arg(long)]
+    landed: String,
 }
 
 #[derive(clap::Args)]
@@ -38,6 +56,14 @@ pub struct ModelInfoArgs {
 pub fn run(c: ModelCommand) -> Result<()> {
     match c {
         ModelCommand::Info(a) => info(a),
+        ModelCommand::Land(a) => {
+            let v = nprt_net::training::visits::land(&a.model, &a.into, &a.landed)?;
+            println!(
+                "{},{:.2},{},{},{:.5}",
+                v.landed, v.gpu_minutes, v.samples, v.epochs, v.val_loss
+            );
+            Ok(())
+        }
     }
 }
 

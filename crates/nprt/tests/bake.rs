@@ -130,7 +130,11 @@ fn a_scene_without_a_camera_volume_is_refused_with_the_flag_to_give_before_any_w
     );
     assert!(!out.exists(), "a refused bake made its folder");
     for (flag, value, needle) in [
-        ("--minutes", "0", "not a positive number of minutes"),
+        (
+            "--minutes",
+            "0",
+            "--minutes 0 is not a number of minutes from 0.001",
+        ),
         ("--quality", "fine", "choose draft, good or best"),
     ] {
         let o = common::nprt(&[

@@ -1,7 +1,7 @@
-//! Hostile input, round three (issue 65): counts and sizes beyond the machine refused before
-//! any work, by the flag (or variable) that asked for them, never a panic, an abort or a run
-//! without end; numbers a run wrote read back as input; frames the GPU cannot rasterise refused
-//! as such.
+//! Hostile input, rounds three and four (issues 65 and 80): counts and sizes beyond the machine
+//! refused before any work, by the flag (or variable) that asked for them, never a panic, an
+//! abort or a run without end; numbers a run wrote read back as input; frames the GPU cannot
+//! rasterise refused as such; a model folder cut between its two files refused, not rendered.
 
 mod common;
 
@@ -125,7 +125,7 @@ fn a_checkpoint_with_an_impossible_training_time_is_refused() {
         let err = String::from_utf8_lossy(&o.stderr);
         assert!(!o.status.success(), "{err}");
         assert!(
-            err.contains("which no run has") || err.contains("malformed"),
+            err.contains("it says the run has trained") || err.contains("malformed"),
             "{err}"
         );
         assert!(!err.contains("panicked"), "{err}");
@@ -401,5 +401,79 @@ fn a_report_over_one_view_and_one_frame_pair_shows_no_nan_or_infinity() {
     }
     assert!(md.contains("1 test view"), "{md}");
     assert!(md.contains("no spread"), "{md}");
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+/// A model folder's numbers are checked where it is read, by every command: a level gain no
+/// calibration makes (10³⁰, 0, −1: rendered, exported and evaluated with exit 0) is refused
+/// naming the channel and the range; weights written without their model.json (a save cut
+/// between the two) are refused as incomplete; `generate --out` refuses the model folder.
+#[test]
+fn a_model_folder_s_gain_and_wholeness_are_checked_where_it_is_read() {
+    use nprt_net::model::folder::{load_model, save_weights, WEIGHTS_FILE};
+    use nprt_net::Parameters;
+    let dir = fresh_dir("bounds-gain");
+    let model = tiny_room_model(&dir, &["--arch", "baseline"]);
+    let m = model.to_str().unwrap();
+    let config = model.join("model.json");
+    let kept = std::fs::read_to_string(&config).unwrap();
+    let json: serde_json::Value = serde_json::from_str(&kept).unwrap();
+    assert!(json["weights_blake3"].is_string(), "{json}");
+    let frames = dir.join("frames");
+    let commands: [Vec<&str>; 3] = [
+        vec!["render", "--model", m, "--out", frames.to_str().unwrap()],
+        vec!["export", m, "--out", frames.to_str().unwrap()],
+        vec!["model", "info", "--model", m],
+    ];
+    for (gain, said) in [
+        (
+            serde_json::json!([1e30, 1.0, 1.0]),
+            "level_gain's R is 1e30",
+        ),
+        (serde_json::json!([1.0, 0.0, 1.0]), "level_gain's G is 0,"),
+        (serde_json::json!([1.0, 1.0, -1.0]), "level_gain's B is -1,"),
+    ] {
+        let mut edited = json.clone();
+        edited["level_gain"] = gain;
+        std::fs::write(&config, edited.to_string()).unwrap();
+        for args in &commands {
+            fails(args, &[said, "outside the 0.001 to 1000"]);
+        }
+        eval_fails(&dir, &[], &[said]);
+    }
+    std::fs::write(&config, &kept).unwrap();
+    // The weights of a later save, without the model.json that names them.
+    let (file, mut net) = load_model(&model).unwrap();
+    net.visit_mut("", &mut |_, _, values| values[0] += 0.25);
+    save_weights(&model.join(WEIGHTS_FILE), &net, &file.config.weights_tag()).unwrap();
+    for args in &commands[..2] {
+        fails(args, &["is incomplete", "run the training again"]);
+    }
+    let o = nprt(&[
+        "generate",
+        "--scene",
+        "builtin:room",
+        "--envmaps",
+        "builtin",
+        "--out",
+        m,
+        "--train-views",
+        "2",
+        "--test-views",
+        "1",
+        "--train-res",
+        "8",
+        "--test-res",
+        "8",
+        "--spp",
+        "1",
+    ]);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(1), "{err}");
+    assert!(
+        err.contains("is a model folder (it holds model.json)"),
+        "{err}"
+    );
+    assert!(!model.join("manifest.json").exists() && !model.join("views").exists());
     std::fs::remove_dir_all(&dir).ok();
 }

@@ -116,3 +116,117 @@ fn a_visit_whose_tensor_core_kernels_fail_trains_on_the_plain_ones() {
         std::fs::remove_dir_all(dir).unwrap();
     }
 }
+
+/// Copies the model folder `from` to `to` (files and checkpoint/).
+fn copy_model(from: &Path, to: &Path) {
+    std::fs::create_dir_all(to.join("checkpoint")).unwrap();
+    for sub in ["", "checkpoint"] {
+        for e in std::fs::read_dir(from.join(sub)).unwrap().flatten() {
+            if e.file_type().unwrap().is_file() {
+                std::fs::copy(e.path(), to.join(sub).join(e.file_name())).unwrap();
+            }
+        }
+    }
+}
+
+/// What the run folder holds, to show a refused landing changed nothing.
+fn run_bytes(run: &Path) -> Vec<Vec<u8>> {
+    [
+        "visits.csv",
+        "model/weights.safetensors",
+        "model/model.json",
+    ]
+    .iter()
+    .map(|f| std::fs::read(run.join(f)).unwrap())
+    .collect()
+}
+
+/// `nprt model land` (the script's landing) checks a visit's model whole before the run's
+/// folder changes: a model without its checkpoint, with a NaN weight, with a training time of
+/// NaN, without a validation loss, or behind the last visit is refused naming why, and the
+/// run's model and visits.csv stay as they were; a good one lands with its row.
+#[test]
+fn a_visit_s_model_lands_whole_or_changes_nothing() {
+    let dir = fresh_dir("visit-land");
+    let model = common::tiny_room_model(&dir, &["--arch", "baseline"]);
+    let run = dir.join("run");
+    let land = |m: &Path| {
+        common::nprt(&[
+            "model",
+            "land",
+            m.to_str().unwrap(),
+            "--into",
+            run.to_str().unwrap(),
+            "--landed",
+            "2026-11-29T12:00Z",
+        ])
+    };
+    let o = land(&model);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let row = String::from_utf8_lossy(&o.stdout).trim().to_string();
+    assert!(row.starts_with("2026-11-29T12:00Z,"), "{row}");
+    let table = std::fs::read_to_string(run.join("visits.csv")).unwrap();
+    assert_eq!(table.lines().count(), 2, "{table}");
+    assert!(run.join("model/checkpoint/state.json").is_file());
+    let before = run_bytes(&run);
+
+    let state = |m: &Path| m.join("checkpoint/state.json");
+    let edited = |name: &str, edit: &dyn Fn(&Path)| {
+        let m = dir.join(name);
+        copy_model(&model, &m);
+        edit(&m);
+        m
+    };
+    let no_checkpoint = edited("no-ck", &|m| {
+        std::fs::remove_dir_all(m.join("checkpoint")).unwrap()
+    });
+    let nan_weight = edited("nan", &|m| {
+        let path = m.join("weights.safetensors");
+        let mut bytes = std::fs::read(&path).unwrap();
+        let n = bytes.len();
+        bytes[n - 4..].copy_from_slice(&f32::NAN.to_le_bytes());
+        std::fs::write(&path, bytes).unwrap();
+    });
+    let nan_seconds = edited("nan-seconds", &|m| {
+        let text = std::fs::read_to_string(state(m)).unwrap();
+        let mut json: serde_json::Value = serde_json::from_str(&text).unwrap();
+        json["seconds"] = serde_json::json!("S");
+        std::fs::write(state(m), json.to_string().replace("\"S\"", "NaN")).unwrap();
+    });
+    let no_val = edited("no-val", &|m| {
+        let text = std::fs::read_to_string(state(m)).unwrap();
+        let mut json: serde_json::Value = serde_json::from_str(&text).unwrap();
+        for row in json["history"].as_array_mut().unwrap() {
+            row["val"] = serde_json::Value::Null;
+        }
+        std::fs::write(state(m), json.to_string()).unwrap();
+    });
+    // The run's last visit has seen more than this model.
+    let behind = dir.join("behind-run");
+    std::fs::create_dir_all(&behind).unwrap();
+    for (m, why) in [
+        (&no_checkpoint, "holds no checkpoint/"),
+        (&nan_weight, "tensor"),
+        (&nan_seconds, "malformed"),
+        (&no_val, "holds no validation loss"),
+    ] {
+        let o = land(m);
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(o.status.code(), Some(1), "{why}: {err}");
+        assert!(err.contains(why), "{why}: {err}");
+        assert_eq!(run_bytes(&run), before, "{why}");
+    }
+    let table = format!(
+        "{}\n2026-11-29T12:05Z,99,999999999,9,0.01\n",
+        table.trim_end()
+    );
+    std::fs::write(run.join("visits.csv"), &table).unwrap();
+    let o = land(&model);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(err.contains("does not continue the run"), "{err}");
+    assert_eq!(
+        std::fs::read_to_string(run.join("visits.csv")).unwrap(),
+        table
+    );
+    std::fs::remove_dir_all(&dir).unwrap();
+}

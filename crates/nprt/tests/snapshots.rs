@@ -36,7 +36,7 @@ fn snapshots_are_the_models_of_their_points() {
     train(
         &data,
         &three,
-        &["--epochs", "3", "--snapshots", "1,2,0.0001m"],
+        &["--epochs", "3", "--snapshots", "2,0.001m,1"],
     );
     for (point, epochs) in [("1", "1"), ("2", "2")] {
         let alone = dir.join(format!("alone{point}"));
@@ -45,7 +45,7 @@ fn snapshots_are_the_models_of_their_points() {
         assert!(weights(&kept) == weights(&alone), "snapshot {point}");
         ok(&["model", "info", "--model", kept.to_str().unwrap()]);
     }
-    assert!(three.join("snapshots/0.0001m/model.json").is_file());
+    assert!(three.join("snapshots/0.001m/model.json").is_file());
     assert!(
         !three.join("snapshots/1/checkpoint").exists(),
         "no optimiser state"
@@ -57,7 +57,32 @@ fn snapshots_are_the_models_of_their_points() {
     assert!(err.contains("snapshot 1: the run passed it"), "{err}");
     assert!(!parts.join("snapshots/1").exists());
     assert!(weights(&parts.join("snapshots/3")) == weights(&parts));
-    for bad in ["0m", "1,1", "1.5", "soon"] {
+    // A point left broken (its weights without model.json, as a build that wrote in place left
+    // it when killed between the two) and a killed run's temporary: the point is taken again.
+    let broken = dir.join("broken");
+    train(&data, &broken, &["--epochs", "1"]);
+    std::fs::create_dir_all(broken.join("snapshots/.2.999.tmp")).unwrap();
+    std::fs::create_dir_all(broken.join("snapshots/2")).unwrap();
+    std::fs::copy(
+        broken.join("weights.safetensors"),
+        broken.join("snapshots/2/weights.safetensors"),
+    )
+    .unwrap();
+    train(&data, &broken, &["--epochs", "3", "--snapshots", "2"]);
+    ok(&[
+        "model",
+        "info",
+        "--model",
+        broken.join("snapshots/2").to_str().unwrap(),
+    ]);
+    assert!(weights(&broken.join("snapshots/2")) == weights(&dir.join("alone2")));
+    let left: Vec<_> = std::fs::read_dir(broken.join("snapshots"))
+        .unwrap()
+        .flatten()
+        .map(|e| e.file_name())
+        .collect();
+    assert_eq!(left, ["2"]);
+    for bad in ["0m", "1,1", "1.5", "soon", "1e-300m", "2,1,2"] {
         let o = nprt(&[
             "train",
             "--data",

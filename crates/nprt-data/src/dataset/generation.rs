@@ -18,6 +18,7 @@ use super::view_file::{check_view, write_view, ViewImage};
 /// dataset either began is resumed (and trained on) with the other, its manifest naming the
 /// first.
 pub fn prepare(dir: &Path, manifest: &Manifest) -> Result<()> {
+    check_not_model_folder(dir)?;
     std::fs::create_dir_all(dir.join("views"))
         .with_context(|| format!("cannot create dataset folder '{}'", dir.display()))?;
     if dir.join(MANIFEST).exists() {
@@ -40,6 +41,28 @@ pub fn prepare(dir: &Path, manifest: &Manifest) -> Result<()> {
     }
     let text = serde_json::to_string_pretty(manifest)?;
     nprt_io::write_file(&dir.join(MANIFEST), &text)
+}
+
+/// What a training run writes into its model folder (nprt-net's and Deep Shading's config,
+/// weights and checkpoint; nprt-net's tests hold the names to its own).
+pub const MODEL_FOLDER_ENTRIES: [&str; 4] = [
+    "model.json",
+    "deep-shading.json",
+    "weights.safetensors",
+    "checkpoint",
+];
+
+/// Refuses a dataset folder that holds a model, as `nprt train` refuses a model folder that
+/// holds a dataset: views written beside a model left a folder neither command could use.
+pub fn check_not_model_folder(dir: &Path) -> Result<()> {
+    if let Some(entry) = MODEL_FOLDER_ENTRIES.iter().find(|e| dir.join(e).exists()) {
+        bail!(
+            "'{}' is a model folder (it holds {entry}); a dataset goes into a folder of its own \
+             (--out)",
+            dir.display()
+        );
+    }
+    Ok(())
 }
 
 /// Salt of the second half's random streams of a view rendered in halves.

@@ -112,7 +112,7 @@ impl From<&VolumeRecord> for CameraVolume {
             min: v.min.into(),
             max: v.max.into(),
             // A zero direction stays zero, for `CameraVolume::problem` to refuse.
-            look: Vec3::from(v.look).normalize_or_zero(),
+            look: CameraVolume::direction(Vec3::from(v.look)),
             spread_deg: v.spread_deg,
             fov_deg: v.fov_deg,
         }

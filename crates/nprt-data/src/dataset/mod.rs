@@ -15,7 +15,9 @@ mod verify;
 mod view_file;
 mod view_parts;
 
-pub use generation::{prepare, render_view, run, Summary};
+pub use generation::{
+    check_not_model_folder, prepare, render_view, run, Summary, MODEL_FOLDER_ENTRIES,
+};
 pub use manifest::{
     check_bounds, load_manifest, load_manifest_hashed, Jitter, Manifest, MapRecord, MixTerm,
     Settings, ViewRecord, VolumeRecord, FORMAT_VERSION, MANIFEST,

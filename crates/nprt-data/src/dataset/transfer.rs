@@ -125,6 +125,12 @@ pub struct Transfer {
 const PARTS: [&str; 2] = ["transfer", "transfer_direct"];
 const RGB: [&str; 3] = ["R", "G", "B"];
 
+/// The largest transfer value a view may hold: half of f16's largest (65,504), so that the
+/// pack's f16 holds it and the difference of two (a pixel's indirect part) too. Real transfer
+/// stays within tens (the basis functions' size times 4π); a value past f16's range was packed
+/// as infinity and training blamed its learning rate.
+pub const MAX_TRANSFER: f32 = 32_752.0;
+
 impl Transfer {
     /// The view file's channels: one per part, coefficient and colour.
     pub fn channels(&self) -> Vec<(String, Vec<f32>)> {
@@ -142,7 +148,7 @@ impl Transfer {
     }
 
     /// The transfer of `pixels` pixels from a view file's channels, refusing a missing channel
-    /// or a value that is not finite.
+    /// or a value that is not finite or beyond ±[`MAX_TRANSFER`].
     pub fn from_channels(
         basis: TransferBasis,
         pixels: usize,
@@ -160,8 +166,12 @@ impl Transfer {
                     if v.len() != pixels {
                         bail!("channel '{channel}' holds {} values, not {pixels}", v.len());
                     }
-                    if let Some(p) = v.iter().position(|x| !x.is_finite()) {
-                        bail!("channel '{channel}' is {} at pixel {p}", v[p]);
+                    if let Some(p) = v.iter().position(|x| !(x.abs() <= MAX_TRANSFER)) {
+                        bail!(
+                            "channel '{channel}' is {:e} at pixel {p}, beyond the ±{MAX_TRANSFER} \
+                             a transfer value may hold (it is packed as f16)",
+                            v[p]
+                        );
                     }
                     for (p, x) in v.iter().enumerate() {
                         values[p * 3 * k + 3 * j + c] = *x;
@@ -220,12 +230,23 @@ mod tests {
         missing.remove("transfer_direct.2.B");
         let err = Transfer::from_channels(basis, 2, &missing).unwrap_err();
         assert!(err.to_string().contains("transfer_direct.2.B"), "{err}");
-        let mut nan = channels;
-        nan.get_mut("transfer.0.R").unwrap()[1] = f32::NAN;
-        let err = Transfer::from_channels(basis, 2, &nan).unwrap_err();
-        assert!(
-            err.to_string().contains("transfer.0.R' is NaN at pixel 1"),
-            "{err}"
-        );
+        for (bad, said) in [(f32::NAN, "NaN"), (6e4, "6e4"), (-1e30, "-1e30")] {
+            let mut damaged = channels.clone();
+            damaged.get_mut("transfer.0.R").unwrap()[1] = bad;
+            let err = Transfer::from_channels(basis, 2, &damaged).unwrap_err();
+            assert!(
+                err.to_string().contains(&format!(
+                    "transfer.0.R' is {said} at pixel 1, beyond the ±32752"
+                )),
+                "{err}"
+            );
+        }
+        let mut largest = channels;
+        largest.get_mut("transfer_direct.0.R").unwrap()[0] = -MAX_TRANSFER;
+        largest.get_mut("transfer.0.R").unwrap()[0] = MAX_TRANSFER;
+        let t = Transfer::from_channels(basis, 2, &largest).unwrap();
+        // The largest indirect part, a difference, fits f16 (65,504).
+        assert_eq!(t.pixel(0, true).next(), Some(2.0 * MAX_TRANSFER));
+        assert!(half::f16::from_f32(2.0 * MAX_TRANSFER).is_finite());
     }
 }

@@ -54,7 +54,17 @@ pub struct ModelFile {
     /// level (`nprt train --calibrate level`, training::calibration); absent: as the network says.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub level_gain: Option<[f32; 3]>,
+    /// BLAKE3 of the weights file this config was saved with: `model.json` is written last, so
+    /// a folder whose weights are not these was cut between its two writes (absent in older
+    /// files: not checked).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub weights_blake3: Option<String>,
 }
+
+/// The widest range of a calibrated level gain: calibration measures a few tenths either side
+/// of 1 (D/S 1.3-1.6); a gain beyond it would mean a network off by a factor of a thousand,
+/// and a file holding one (1e30, 0, −1) rendered, exported and evaluated with exit 0.
+pub const LEVEL_GAIN_RANGE: std::ops::RangeInclusive<f32> = 1e-3..=1e3;
 
 impl ModelFile {
     /// The file of an untrained network `net` built from `config`, for a scene with these
@@ -73,6 +83,7 @@ impl ModelFile {
             encoder_params: net.total_params() - transport_params,
             training: serde_json::Value::Null,
             level_gain: None,
+            weights_blake3: None,
         }
     }
 
@@ -97,16 +108,29 @@ impl ModelFile {
     }
 }
 
-/// Writes `model.json` and the weights of `net` into `dir`, each file atomically.
+/// Writes the weights of `net` and then `model.json`, naming their hash, into `dir`, each file
+/// atomically: the config is the marker that the folder is whole ([`load_model`] checks it).
 pub fn save_model(dir: &Path, file: &ModelFile, net: &NprtNet) -> Result<()> {
-    save_weights(&dir.join(WEIGHTS_FILE), net, &file.config.weights_tag())?;
-    let json = serde_json::to_vec_pretty(file)?;
+    let hash = save_weights(&dir.join(WEIGHTS_FILE), net, &file.config.weights_tag())?;
+    let file = ModelFile {
+        weights_blake3: Some(hash),
+        ..file.clone()
+    };
+    let json = serde_json::to_vec_pretty(&file)?;
     nprt_io::write_file(&dir.join(CONFIG_FILE), &json)
 }
 
+/// The BLAKE3 of a model folder's weights file, as `model.json` records it.
+pub fn weights_hash(dir: &Path) -> Result<String> {
+    let path = dir.join(WEIGHTS_FILE);
+    let bytes = nprt_io::read_input(&path)
+        .with_context(|| format!("cannot read weights '{}'", path.display()))?;
+    Ok(blake3::hash(&bytes).to_hex().to_string())
+}
+
 /// Weights as safetensors, tagged with the network that produced them (`design:activation`,
-/// [`ModelConfig::weights_tag`], or another network kind's name).
-pub fn save_weights<M: Parameters>(path: &Path, net: &M, tag: &str) -> Result<()> {
+/// [`ModelConfig::weights_tag`], or another network kind's name). Returns the file's BLAKE3.
+pub fn save_weights<M: Parameters>(path: &Path, net: &M, tag: &str) -> Result<String> {
     let mut tensors = Vec::new();
     let mut non_finite = None;
     net.visit("", &mut |name, shape, values| {
@@ -138,7 +162,8 @@ pub fn save_weights<M: Parameters>(path: &Path, net: &M, tag: &str) -> Result<()
     let metadata = HashMap::from([("nprt_design".to_string(), tag.to_string())]);
     let bytes = safetensors::serialize(views, Some(metadata))
         .map_err(|e| anyhow::anyhow!("cannot serialise weights: {e}"))?;
-    nprt_io::write_file(path, &bytes)
+    nprt_io::write_file(path, &bytes)?;
+    Ok(blake3::hash(&bytes).to_hex().to_string())
 }
 
 /// The first tensor of a safetensors file that holds a value no trained network has (not
@@ -158,7 +183,8 @@ fn implausible_tensor(tensors: &SafeTensors) -> Option<(String, f32)> {
 }
 
 /// Loads weights saved by [`save_weights`] into `net`, which must be of the same design.
-pub fn load_weights<M: Parameters>(path: &Path, net: &mut M, tag: &str) -> Result<()> {
+/// Returns the file's BLAKE3.
+pub fn load_weights<M: Parameters>(path: &Path, net: &mut M, tag: &str) -> Result<String> {
     let bytes = nprt_io::read_input(path)
         .with_context(|| format!("cannot read weights '{}'", path.display()))?;
     let saved_design = read_design_tag(&bytes)
@@ -217,7 +243,7 @@ pub fn load_weights<M: Parameters>(path: &Path, net: &mut M, tag: &str) -> Resul
                 .unwrap_or_default()
         );
     }
-    Ok(())
+    Ok(blake3::hash(&bytes).to_hex().to_string())
 }
 
 /// The `nprt_design` entry of a safetensors header.
@@ -232,15 +258,37 @@ fn read_design_tag(bytes: &[u8]) -> Result<String> {
         .context("no nprt_design tag in its metadata")
 }
 
-/// Reads a model folder's config, refusing other formats and versions, and sizes no network
-/// can have (an edited encoder_width would allocate without bound).
+/// Reads a model folder's config, refusing other formats and versions, sizes no network can
+/// have (an edited encoder_width would allocate without bound) or this machine cannot hold, and
+/// a level gain no calibration makes: every reader of a model folder comes through here.
 pub fn read_model_file(dir: &Path) -> Result<ModelFile> {
     let file: ModelFile = read_config(dir, CONFIG_FILE, MODEL_FORMAT, MODEL_VERSION, "model")?;
     check_input_width(file.config.encoder_width)
         .and_then(|()| file.config.check())
         .and_then(|()| check_bounds(&file.bounds))
+        .and_then(|()| check_level_gain(file.level_gain))
+        .and_then(|()| file.config.ensure_memory(1, "its network"))
         .with_context(|| format!("model '{}'", dir.display()))?;
     Ok(file)
+}
+
+/// Refuses a level gain outside [`LEVEL_GAIN_RANGE`] (NaN included), naming the channel.
+fn check_level_gain(gain: Option<[f32; 3]>) -> Result<()> {
+    let channels = gain
+        .iter()
+        .flat_map(|g| ["R", "G", "B"].into_iter().zip(*g));
+    for (channel, g) in channels {
+        if !LEVEL_GAIN_RANGE.contains(&g) {
+            bail!(
+                "its level_gain's {channel} is {}, outside the {} to {} a calibration \
+                 measures; the file is damaged (remove level_gain to render uncalibrated)",
+                nprt_io::short_number(g),
+                LEVEL_GAIN_RANGE.start(),
+                LEVEL_GAIN_RANGE.end()
+            );
+        }
+    }
+    Ok(())
 }
 
 /// Reads the versioned JSON config `file_name` of a folder of `kind` ("model", "Deep Shading
@@ -279,10 +327,35 @@ pub fn read_config<T: DeserializeOwned>(
 pub fn load_model(dir: &Path) -> Result<(ModelFile, NprtNet)> {
     let file = read_model_file(dir)?;
     let mut net = file.config.build(&mut Init::new(0));
-    load_weights(
+    let hash = load_weights(
         &dir.join(WEIGHTS_FILE),
         &mut net,
         &file.config.weights_tag(),
     )?;
+    let counts = [
+        net.transport_params(),
+        net.total_params() - net.transport_params(),
+    ];
+    if [file.transport_params, file.encoder_params] != counts {
+        bail!(
+            "model '{}': its {CONFIG_FILE} counts {} transport and {} encoder parameters, its \
+             network has {} and {}; the file is damaged",
+            dir.display(),
+            file.transport_params,
+            file.encoder_params,
+            counts[0],
+            counts[1]
+        );
+    }
+    if let Some(saved) = file.weights_blake3.as_ref().filter(|s| **s != hash) {
+        bail!(
+            "model '{}' is incomplete: its {WEIGHTS_FILE} (BLAKE3 {}…) is not the one {CONFIG_FILE} \
+             was saved with ({}…), as when a save is cut between its two files; run the training \
+             again to save it whole",
+            dir.display(),
+            &hash[..12],
+            &saved[..saved.len().min(12)]
+        );
+    }
     Ok((file, net))
 }

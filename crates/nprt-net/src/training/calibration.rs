@@ -10,6 +10,7 @@
 //! targets is unbiased, so no converged reference is needed, and no held-out view is seen.
 
 use crate::choice::named_choice;
+use crate::model::folder::LEVEL_GAIN_RANGE;
 use crate::network::nprt_net::NprtNet;
 use crate::training::batch::Batch;
 use crate::training::training_set::ViewSamples;
@@ -36,7 +37,8 @@ pub const LEVEL_SAMPLES: usize = 65_536;
 /// Per channel, the sum of the targets over the sum of `net`'s predictions on a fixed, evenly
 /// strided subset of at most `max_samples` of `views`' pixels, each pixel relative to its map's
 /// scale so that every lighting counts alike. 1 for a channel whose targets or predictions hold
-/// no light: a degenerate dataset keeps the network's output.
+/// no light, or whose gain would leave [`LEVEL_GAIN_RANGE`] (a network a thousandfold off is
+/// not one a gain corrects): a degenerate dataset keeps the network's output.
 pub fn level_gain(
     net: &NprtNet,
     views: &[ViewSamples],
@@ -56,11 +58,10 @@ pub fn level_gain(
     }
     views.iter().for_each(|v| v.release());
     std::array::from_fn(|k| {
-        let gain = target[k] / predicted[k];
-        if gain.is_finite() && gain > 0.0 {
-            gain as f32
-        } else {
-            1.0
+        let gain = (target[k] / predicted[k]) as f32;
+        match LEVEL_GAIN_RANGE.contains(&gain) {
+            true => gain,
+            false => 1.0,
         }
     })
 }

@@ -60,17 +60,58 @@ pub(crate) fn read(out: &Path) -> Result<Option<Checkpoint>> {
             path.display()
         )
     })?;
-    // Read back as input: a training time that is negative or not finite would let a run
-    // train past its budget (or never start).
-    let seconds = ck.state.seconds;
-    if !(seconds.is_finite() && seconds >= 0.0) {
+    if let Some(problem) = problem(&ck) {
         bail!(
-            "checkpoint '{}' says the run has trained {seconds} s, which no run has; delete \
-             the folder to start over",
+            "checkpoint '{}' is damaged: {problem}; delete the model folder to start over",
             path.display()
         );
     }
     Ok(Some(ck))
+}
+
+/// What no run writes into its state file, if `ck` holds it: the one check of a checkpoint,
+/// made as it is read. A training time negative or not finite let a run train past its budget
+/// (or never start); an epoch or batch beyond the steps (every epoch and batch is a step, every
+/// step at least one sample: an epoch of 10⁹ after a few steps replayed a billion epochs'
+/// shuffles before the first step); a history row no run writes; file names that are not this
+/// folder's own (a name with a path in it would be read from elsewhere).
+fn problem(ck: &Checkpoint) -> Option<String> {
+    let s = &ck.state;
+    if !(s.seconds.is_finite() && s.seconds >= 0.0) {
+        return Some(format!(
+            "it says the run has trained {} s",
+            nprt_io::short_number(s.seconds)
+        ));
+    }
+    if s.epoch as u64 > s.step || s.batch as u64 > s.step || s.samples < s.step {
+        return Some(format!(
+            "it says {} epochs, batch {}, {} steps and {} samples",
+            s.epoch, s.batch, s.step, s.samples
+        ));
+    }
+    if let Some((i, p)) =
+        (ck.history.iter().enumerate()).find_map(|(i, r)| r.problem().map(|p| (i, p)))
+    {
+        return Some(format!("its history's row {}: {p}", i + 1));
+    }
+    let own = |name: &str, ok: bool| {
+        (!ok || name.contains(['/', '\\']) || name.starts_with('.'))
+            .then(|| format!("it names '{name}', not a file of its own folder"))
+    };
+    own(
+        &ck.weights,
+        ck.weights.starts_with("weights-") && ck.weights.ends_with(".safetensors"),
+    )
+    .or_else(|| own(&ck.optimizer, is_state_file(&ck.optimizer)))
+}
+
+/// Where a run stands and its last validation loss, as its checkpoint in the model folder
+/// `out` says (checked as every reader of a checkpoint checks it); none without a checkpoint.
+pub fn progress(out: &Path) -> Result<Option<(RunState, Option<f64>)>> {
+    Ok(read(out)?.map(|ck| {
+        let val = ck.history.iter().rev().find_map(|r| r.val);
+        (ck.state, val)
+    }))
 }
 
 /// Loads the checkpoint's weights into `net`.
@@ -80,7 +121,7 @@ pub(crate) fn restore_weights<M: Parameters>(
     net: &mut M,
     tag: &str,
 ) -> Result<()> {
-    load_weights(&dir(out).join(&ck.weights), net, tag)
+    load_weights(&dir(out).join(&ck.weights), net, tag).map(drop)
 }
 
 /// Loads the checkpoint's optimiser state into `steps`.
@@ -126,6 +167,23 @@ mod tests {
     use super::*;
     use rand::{RngExt, SeedableRng};
 
+    /// `nprt generate` refuses a model folder by these names, stated in nprt-data.
+    #[test]
+    fn the_dataset_s_list_of_model_entries_names_every_file_a_run_writes() {
+        let written = [
+            DIR,
+            crate::model::folder::CONFIG_FILE,
+            crate::model::folder::WEIGHTS_FILE,
+            crate::deep_shading::CONFIG_FILE,
+        ];
+        for name in written {
+            assert!(
+                nprt_data::dataset::MODEL_FOLDER_ENTRIES.contains(&name),
+                "{name}"
+            );
+        }
+    }
+
     /// A resumed run carries its history on, so every loss must come back bit for bit (the
     /// default JSON float parser is off by an ulp on some values, such as the first below).
     #[test]
@@ -151,8 +209,8 @@ mod tests {
             run: serde_json::json!({ "lr": values[0] }),
             state: RunState::default(),
             history: history.clone(),
-            weights: "w".into(),
-            optimizer: "o".into(),
+            weights: "weights-000000000.safetensors".into(),
+            optimizer: state_file(0),
         };
         let out = std::env::temp_dir().join(format!("nprt-ck-{}", std::process::id()));
         std::fs::create_dir_all(dir(&out)).unwrap();

@@ -4,6 +4,7 @@ use std::path::Path;
 
 use anyhow::{Context, Result};
 use nprt_io::plot_lines;
+
 use serde::{Deserialize, Serialize};
 
 /// One row of a run's loss history.
@@ -19,6 +20,27 @@ pub struct LossRow {
     pub train: Option<f64>,
     /// Validation loss (at epoch ends).
     pub val: Option<f64>,
+}
+
+impl LossRow {
+    /// What no run writes, if the row holds it: an epoch or a time that is negative or not
+    /// finite, a loss that is negative or not finite (a diverged run stops before recording
+    /// one). The one check of a row, wherever one is read (loss.csv, a checkpoint's history).
+    pub fn problem(&self) -> Option<String> {
+        let fields = [
+            ("epoch", Some(self.epoch)),
+            ("seconds", Some(self.seconds)),
+            ("train loss", self.train),
+            ("validation loss", self.val),
+        ];
+        fields.into_iter().find_map(|(name, v)| match v {
+            Some(v) if !(v.is_finite() && v >= 0.0) => Some(format!(
+                "its {name} is {}, not a finite number ≥ 0",
+                nprt_io::short_number(v)
+            )),
+            _ => None,
+        })
+    }
 }
 
 /// One loss.csv row: `step,epoch,samples,seconds,train_loss,val_loss`, empty cells where a
@@ -49,7 +71,8 @@ pub fn write_csv(path: &Path, rows: &[LossRow]) -> Result<()> {
 }
 
 /// Rows of a loss.csv written by [`write_csv`]; none when the file does not exist. A row that
-/// does not parse is an error naming the file and the row.
+/// does not parse, or holds what no run writes ([`LossRow::problem`]), is an error naming the
+/// file and the row.
 pub fn read_csv(path: &Path) -> Result<Vec<LossRow>> {
     if !path.exists() {
         return Ok(vec![]);
@@ -62,14 +85,18 @@ pub fn read_csv(path: &Path) -> Result<Vec<LossRow>> {
             let row = row.with_context(|| {
                 format!("'{}': row {} is not a loss row", path.display(), i + 1)
             })?;
-            Ok(LossRow {
+            let row = LossRow {
                 step: row.step,
                 epoch: row.epoch,
                 samples: row.samples,
                 seconds: row.seconds,
                 train: row.train_loss,
                 val: row.val_loss,
-            })
+            };
+            if let Some(p) = row.problem() {
+                anyhow::bail!("'{}': row {}: {p}", path.display(), i + 1);
+            }
+            Ok(row)
         })
         .collect()
 }

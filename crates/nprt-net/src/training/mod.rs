@@ -1,8 +1,8 @@
 //! Training: the training set in memory, batches, the learning-rate schedule, the one training
 //! loop with checkpoints and exact resume, each engine's steps as the loop takes them, the
 //! Neural PRT objective run through it, validation, calibration and loss curves, the
-//! recommended recipe (a design with every choice of its training and run time), and the
-//! radiance cache's online training.
+//! recommended recipe (a design with every choice of its training and run time), the radiance
+//! cache's online training, and a long run's visits landed into its folder.
 
 pub mod batch;
 pub mod cache_trainer;
@@ -23,3 +23,4 @@ pub mod train_options;
 pub mod training_loop;
 pub mod training_set;
 pub mod validation;
+pub mod visits;

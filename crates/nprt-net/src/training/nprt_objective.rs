@@ -202,6 +202,7 @@ impl Objective for PixelObjective<'_> {
             }),
             level_gain: (self.opts.calibration == Calibration::Level)
                 .then(|| level_gain(net, &self.set.train, LEVEL_SAMPLES, self.opts.batch_size)),
+            weights_blake3: None,
         };
         save_model(out, &file, net)?;
         *self.saved.lock().unwrap_or_else(|e| e.into_inner()) = Some(file);

@@ -5,6 +5,7 @@ use anyhow::{bail, Result};
 use serde::{Deserialize, Serialize};
 
 use crate::training::lr_schedule::LrSchedule;
+use crate::training::run_length::check_minutes;
 use crate::training::snapshot::Snapshot;
 
 /// The loop's own settings, shared by every network.
@@ -71,14 +72,10 @@ impl Schedule {
             );
         }
         if let Some(m) = self.minutes {
-            if !(m > 0.0 && m.is_finite()) {
-                bail!("the time budget must be a positive number of minutes, got {m}");
-            }
+            check_minutes(m, "the time budget (--minutes)").map_err(anyhow::Error::msg)?;
         }
         if let Some(m) = self.pause_after {
-            if !(m > 0.0 && m.is_finite()) {
-                bail!("the pause must come after a positive number of minutes, got {m}");
-            }
+            check_minutes(m, "the pause (--pause-after)").map_err(anyhow::Error::msg)?;
         }
         Ok(())
     }

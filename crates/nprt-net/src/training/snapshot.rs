@@ -7,6 +7,9 @@ use std::fmt;
 use std::path::{Path, PathBuf};
 use std::str::FromStr;
 
+use crate::model::folder::{CONFIG_FILE, WEIGHTS_FILE};
+use crate::training::run_length::check_minutes;
+
 /// The folder of a model folder that holds its snapshots.
 pub const SNAPSHOTS: &str = "snapshots";
 
@@ -34,28 +37,39 @@ impl Snapshot {
         }
     }
 
-    /// Whether its model files are in `out` already (kept by an earlier part of the run).
+    /// Whether its model files are in `out` already (kept by an earlier part of the run): its
+    /// folder lands whole ([`SnapshotPlan::take`]), and one of a build that wrote the files in
+    /// place holds both (a kill between them left the weights alone).
     pub fn taken(&self, out: &Path) -> bool {
-        self.dir(out)
-            .join(crate::model::folder::WEIGHTS_FILE)
-            .is_file()
+        let dir = self.dir(out);
+        [WEIGHTS_FILE, CONFIG_FILE]
+            .iter()
+            .all(|f| dir.join(f).is_file())
     }
 
     /// `LIST` as `--snapshots` takes it: comma-separated points, `Nm` minutes or `N` epochs,
-    /// at most [`MAX_SNAPSHOTS`], each once.
+    /// at most [`MAX_SNAPSHOTS`], each once; in the order a run reaches them (minutes, then
+    /// epochs, each ascending), whatever the order given, so that what is judged over them is
+    /// the same for `2,1` as for `1,2`.
     pub fn parse_list(list: &str) -> Result<Vec<Snapshot>, String> {
-        let points = list
+        let mut points = list
             .split(',')
             .map(|p| p.trim().parse())
             .collect::<Result<Vec<Snapshot>, String>>()?;
+        points.sort_by(|a, b| match (a, b) {
+            (Snapshot::Minutes(x), Snapshot::Minutes(y)) => x.total_cmp(y),
+            (Snapshot::Epochs(x), Snapshot::Epochs(y)) => x.cmp(y),
+            (Snapshot::Minutes(_), Snapshot::Epochs(_)) => std::cmp::Ordering::Less,
+            (Snapshot::Epochs(_), Snapshot::Minutes(_)) => std::cmp::Ordering::Greater,
+        });
         if points.len() > MAX_SNAPSHOTS {
             return Err(format!(
                 "{} snapshots; a run keeps at most {MAX_SNAPSHOTS}",
                 points.len()
             ));
         }
-        if let Some((i, p)) = (points.iter().enumerate()).find(|(i, p)| points[..*i].contains(p)) {
-            return Err(format!("snapshot '{p}' is given twice (point {})", i + 1));
+        if let Some(p) = points.windows(2).find(|w| w[0] == w[1]) {
+            return Err(format!("snapshot '{}' is given twice", p[0]));
         }
         Ok(points)
     }
@@ -92,7 +106,8 @@ impl SnapshotPlan {
     }
 
     /// Keeps the model at every point reached: `save` writes the model's files into the
-    /// folder it is given.
+    /// folder it is given, a temporary one renamed into place once both are written, so that a
+    /// kill leaves a point whole or not taken (and a re-run takes it).
     pub fn take(
         &mut self,
         out: &Path,
@@ -101,10 +116,7 @@ impl SnapshotPlan {
         mut save: impl FnMut(&Path) -> anyhow::Result<()>,
     ) -> anyhow::Result<()> {
         for p in self.pending.iter().filter(|p| p.reached(seconds, epochs)) {
-            let dir = p.dir(out);
-            std::fs::create_dir_all(&dir)
-                .map_err(|e| anyhow::anyhow!("cannot create '{}': {e}", dir.display()))?;
-            save(&dir)?;
+            nprt_io::write_folder(&p.dir(out), &mut save)?;
         }
         self.pending.retain(|p| !p.reached(seconds, epochs));
         Ok(())
@@ -123,7 +135,9 @@ impl FromStr for Snapshot {
         };
         match s.strip_suffix('m') {
             Some(m) => match m.parse::<f64>() {
-                Ok(m) if m > 0.0 && m <= 1e6 => Ok(Snapshot::Minutes(m)),
+                Ok(m) => check_minutes(m, "snapshot")
+                    .map(|()| Snapshot::Minutes(m))
+                    .map_err(|e| format!("'{s}': {e}")),
                 _ => Err(refused()),
             },
             None => match s.parse::<usize>() {
@@ -150,24 +164,27 @@ mod tests {
 
     #[test]
     fn points_parse_label_and_refuse_what_no_run_reaches() {
-        let list = Snapshot::parse_list("1m, 0.5m,16m,10").unwrap();
+        let list = Snapshot::parse_list("10, 1m,2, 0.5m,16m").unwrap();
         assert_eq!(
             list,
             [
-                Snapshot::Minutes(1.0),
                 Snapshot::Minutes(0.5),
+                Snapshot::Minutes(1.0),
                 Snapshot::Minutes(16.0),
+                Snapshot::Epochs(2),
                 Snapshot::Epochs(10)
             ]
         );
         let labels: Vec<String> = list.iter().map(|p| p.to_string()).collect();
-        assert_eq!(labels, ["1m", "0.5m", "16m", "10"]);
+        assert_eq!(labels, ["0.5m", "1m", "16m", "2", "10"]);
+        assert_eq!(Snapshot::parse_list("2,1"), Snapshot::parse_list("1,2"));
         // Each label parses back to its point.
         assert!(list
             .iter()
             .all(|p| p.to_string().parse::<Snapshot>() == Ok(*p)));
         for bad in [
-            "0m", "-1m", "nanm", "infm", "0", "1.5", "m", "4min", "1m,1m", "",
+            "0m", "-1m", "nanm", "infm", "0", "1.5", "m", "4min", "1m,1m", "", "1e-300m", "1e-4m",
+            "2e6m", "2,1,2",
         ] {
             assert!(Snapshot::parse_list(bad).is_err(), "{bad}");
         }

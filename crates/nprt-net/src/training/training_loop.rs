@@ -645,20 +645,6 @@ fn resume<O: Objective>(
             out.display()
         );
     }
-    // Every epoch and every batch is a step, and every step at least one sample: a state that
-    // says otherwise was edited or damaged (an epoch of 10⁹ after a few steps replayed a
-    // billion epochs' shuffles before the first step).
-    let s = &saved.state;
-    if s.epoch as u64 > s.step || s.batch as u64 > s.step || s.samples < s.step {
-        bail!(
-            "checkpoint '{}' is damaged: it says {} epochs, batch {}, {} steps and {} samples; delete the model folder to start over",
-            checkpoint::dir(out).join("state.json").display(),
-            s.epoch,
-            s.batch,
-            s.step,
-            s.samples
-        );
-    }
     checkpoint::restore_weights(out, saved, net, &objective.tag())
 }
 

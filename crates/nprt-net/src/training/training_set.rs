@@ -11,7 +11,7 @@ use nprt_scene::envmap::EnvMap;
 use rayon::prelude::*;
 
 use crate::encoding::features::{sample_features, FEATURES};
-use crate::model::config::ModelConfig;
+use crate::model::config::{ModelConfig, TRAINING_COPIES};
 use crate::network::encoder::LightInput;
 use crate::network::light_basis::BasisChoice;
 
@@ -96,6 +96,7 @@ impl TrainingSet {
         on_pack: impl Fn(&str),
     ) -> Result<Self> {
         let (manifest, dataset_hash) = load_manifest_hashed(dir)?;
+        config.ensure_memory(TRAINING_COPIES, "training the network")?;
         let width = config.encoder_width as u128;
         nprt_io::ensure_memory(
             manifest.views.len() as u128 * (width * width / 2 * 3 * 4),

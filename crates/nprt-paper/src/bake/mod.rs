@@ -107,11 +107,11 @@ impl Bake {
         self.out.join("dataset")
     }
 
-    /// Refuses, before any work, a training length that is not a positive number and paths
+    /// Refuses, before any work, a training length outside [`nprt_net::check_minutes`]'s range and paths
     /// that are not UTF-8 (the bake prints them as commands to run), naming the flag.
     fn check_settings(&self) -> Result<()> {
-        if let Some(m) = self.minutes.filter(|m| !(m.is_finite() && *m > 0.0)) {
-            bail!("--minutes {m} is not a positive number of minutes");
+        if let Some(m) = self.minutes {
+            nprt_net::check_minutes(m, "--minutes").map_err(anyhow::Error::msg)?;
         }
         if self.epochs == Some(0) {
             bail!("--epochs must be at least 1");
@@ -129,16 +129,20 @@ impl Bake {
     pub fn run(&self) -> Result<Baked> {
         let start = Instant::now();
         self.check_settings()?;
-        // The scene and its camera volume first: a scene without one is refused before any
-        // folder is made, with the flag to give.
+        // The scene and its camera volume, then the maps, first: a scene without a volume, maps
+        // that cannot be listed or held out are refused before any folder is made.
         let scene = nprt_scene::load_scene(&self.scene, &nprt_data::dataset::relit())?;
         let volume = self.camera.resolve(&scene, &self.scene)?;
         let sizes = self.quality.sizes_for(scene.bounds(), &volume);
+        let generate_opts = self.generate_options(&sizes);
+        generate_opts.lighting()?;
+        if self.out.exists() && !self.out.is_dir() {
+            bail!("--out '{}' is not a folder", self.out.display());
+        }
         std::fs::create_dir_all(&self.out)
             .with_context(|| format!("cannot create '{}'", self.out.display()))?;
         let _lock = nprt_io::lock_folder(&self.out, "bake folder", "--out")?;
         let claim = self.claim(&sizes)?;
-        let generate_opts = self.generate_options(&sizes);
         let estimates = self.estimates(&scene, &volume, &sizes, &generate_opts);
         let stages: Vec<(&str, f64)> = STAGES.into_iter().zip(estimates).collect();
         let bar = nprt_io::StagedBar::new(self.progress, &stages);
