@@ -55,9 +55,10 @@ class Dataset:
     def split(self, split: str) -> List[int]:
         """The indices of the views of ``split`` ("train" or "test")."""
     def view(self, index: int) -> Dict[str, Any]:
-        """radiance, direct, position, normal, view, kd, ks (H, W, 3); alpha, mask (H, W);
-        half for a test view rendered in halves; index, split and lighting (map, rotation_deg,
-        gain, mix)."""
+        """View ``index`` (negative from the end): radiance, direct, position, normal, view, kd,
+        ks (H, W, 3); alpha, mask (H, W); half for a test view rendered in halves; transfer and
+        transfer_direct (H, W, K, 3) for a training view of a dataset with transfer vectors;
+        index, split and lighting (map, rotation_deg, gain, mix)."""
     @overload
     def __getitem__(self, key: int) -> Dict[str, Any]: ...
     @overload
@@ -189,7 +190,7 @@ def train(
 
 def evaluate(
     data: PathLike,
-    models: Sequence[PathLike],
+    models: Union[PathLike, Sequence[PathLike]],
     out: PathLike,
     *,
     deep_shading: Optional[PathLike] = None,
@@ -202,6 +203,7 @@ def evaluate(
     temporal_frames: Optional[int] = None,
     temporal_res: Optional[int] = None,
     nrc_warmup: Optional[int] = None,
+    oracles: bool = False,
     device: str = "cpu",
     progress: bool = True,
 ) -> Dict[str, Any]:

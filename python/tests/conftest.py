@@ -31,5 +31,5 @@ def dataset(tmp_path_factory):
 def model(dataset, tmp_path_factory):
     out = tmp_path_factory.mktemp("model")
     run = nprt.train(dataset, "dsep", out, epochs=2, progress=False)
-    assert run["epochs"] == pytest.approx(2.0) and np.isfinite(run["validation_loss"])
+    assert run["epochs"] == pytest.approx(2.0) and np.isfinite(run["val_loss"])
     return out

@@ -78,7 +78,7 @@ def test_dataset_as_numpy(dataset):
     assert "half" not in ds.view(0)
     with pytest.raises(IndexError):
         ds.view(8)
-    with pytest.raises(ValueError, match="'train' or 'test', not 'tset'"):
+    with pytest.raises(ValueError, match="split='tset': must be 'train' or 'test'"):
         ds.split("tset")
 
 
@@ -181,7 +181,7 @@ def test_verify_pack_export_render_and_deep_shading(dataset, model, tmp_path):
     rows = []
     run = nprt.train_deep_shading(dataset, tmp_path / "ds", epochs=1, callback=rows.append,
                                   progress=False)
-    assert run["unet_params"] > 0 and len(rows) == 1 and np.isfinite(run["validation_loss"])
+    assert run["unet_params"] > 0 and len(rows) == 1 and np.isfinite(run["val_loss"])
 
 
 def test_model_info_gives_the_layer_table_and_the_papers_counts(model):
@@ -211,13 +211,13 @@ def test_the_linear_design_takes_its_basis_and_no_other_design_does(dataset, tmp
     with pytest.raises(ValueError, match="sh:L"):
         nprt.train(dataset, "linear", tmp_path / "m", epochs=1, basis="sh:99", progress=False)
     run = nprt.train(dataset, "linear", tmp_path / "m", epochs=1, basis="sh:2", progress=False)
-    assert np.isfinite(run["validation_loss"]), run
+    assert np.isfinite(run["val_loss"]), run
     assert nprt.Model(tmp_path / "m").info["basis"] == "sh:2"
 
 
 def test_without_arch_train_makes_the_recommended_recipe(dataset, tmp_path):
     run = nprt.train(dataset, out=tmp_path / "r", epochs=1, progress=False)
-    assert np.isfinite(run["validation_loss"]), run
+    assert np.isfinite(run["val_loss"]), run
     model = nprt.Model(tmp_path / "r")
     info = model.info
     assert (info["design"], info["basis"], info["direct"]) == ("linear", "sh:2", "traced"), info

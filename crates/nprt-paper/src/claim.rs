@@ -22,19 +22,25 @@ impl Claim {
         what: serde_json::Value,
     ) -> Result<Option<Claim>> {
         let file = out.join(name);
-        if let Ok(bytes) = std::fs::read(&file) {
-            let before = crate::readback::experiment_record(&bytes, &file)?;
-            if before != what {
-                bail!(
-                    "'{}' holds another {kind} ({}); this one is {}: give another output folder, or remove it to start again",
-                    out.display(),
-                    before,
-                    what
-                );
-            }
-            return Ok(None);
+        if std::fs::symlink_metadata(&file).is_err() {
+            return Ok(Some(Claim { file, what }));
         }
-        Ok(Some(Claim { file, what }))
+        // Read as every input is: a FIFO there is refused, not waited on.
+        let bytes = nprt_io::read_input(&file)?;
+        let before = crate::readback::experiment_record(&bytes, &file)?;
+        if before != what {
+            let said = before.to_string();
+            let said = match said.chars().count() > 400 {
+                true => format!("a record of {} characters", said.len()),
+                false => said,
+            };
+            bail!(
+                "'{}' holds another {kind} ({said}); this one is {what}: give another output \
+                 folder, or remove it to start again",
+                out.display(),
+            );
+        }
+        Ok(None)
     }
 
     pub fn write(&self) -> Result<()> {

@@ -2,10 +2,9 @@
 //! matrices (Mitsuba's convention: columns left, up, forward, origin) with a horizontal field
 //! of view, and JSON values as Python objects.
 
-use anyhow::{bail, Result};
 use glam::{Mat4, Vec3};
 use nprt_scene::{Camera, FovAxis};
-use numpy::{AllowTypeChange, IntoPyArray, PyArray2, PyArray3, PyArrayLike2};
+use numpy::{IntoPyArray, PyArray2, PyArray3};
 use pyo3::prelude::*;
 
 /// `rgb` (`width × height` pixels, row by row) as an (H, W, 3) float32 array.
@@ -33,6 +32,20 @@ pub fn plane<'py>(
         .into_pyarray(py)
 }
 
+/// Per pixel, `k` coefficients of each colour channel (pixel-major, then coefficient, then
+/// channel) as an (H, W, K, 3) float32 array.
+pub fn coefficients<'py>(
+    py: Python<'py>,
+    values: &[f32],
+    width: usize,
+    height: usize,
+    k: usize,
+) -> Bound<'py, numpy::PyArray4<f32>> {
+    numpy::ndarray::Array4::from_shape_vec((height, width, k, 3), values.to_vec())
+        .expect("K × 3 values a pixel")
+        .into_pyarray(py)
+}
+
 /// A camera as Python gets it: (4 × 4 camera-to-world matrix, horizontal field of view in
 /// degrees, (width, height)).
 pub type CameraOut<'py> = (Bound<'py, PyArray2<f64>>, f32, (u32, u32));
@@ -46,43 +59,31 @@ pub fn matrix<'py>(py: Python<'py>, m: Mat4) -> Bound<'py, PyArray2<f64>> {
         .into_pyarray(py)
 }
 
-/// `width` × `height` as a frame's size, each named where it is not a positive pixel count
-/// (Python's integers have no bound; a negative one would otherwise be an OverflowError that
-/// names no argument).
-pub fn frame_size(width: i64, height: i64) -> PyResult<(u32, u32)> {
-    let side = |v: i64, arg: &str| {
-        u32::try_from(v).ok().filter(|&v| v > 0).ok_or_else(|| {
-            crate::error::input_error(format!(
-                "{arg} must be a pixel count from 1 to {}, got {v}",
-                u32::MAX
-            ))
-        })
-    };
+/// `width` × `height` as a frame's size, each a pixel count (named where it is not).
+pub fn frame_size(width: &Bound<'_, PyAny>, height: &Bound<'_, PyAny>) -> PyResult<(u32, u32)> {
+    let side = |v, arg| crate::argument::whole(v, arg, 1..=u32::MAX);
     Ok((side(width, "width")?, side(height, "height")?))
 }
 
-/// A camera from a 4 × 4 camera-to-world matrix (rows first), a horizontal field of view and
-/// a resolution; an error naming what is wrong (shape, non-finite entries, a frame that is not
-/// a rotation and a translation, sizes).
+/// A camera from `camera`, a 4 × 4 camera-to-world matrix (rows first: a numpy array or nested
+/// lists), a horizontal field of view `fov` (degrees, `None`: 60) and a resolution; an
+/// InputError naming the argument and what is wrong (shape, entries that are not finite
+/// numbers, a frame that is not a rotation and a translation, sizes).
 pub fn camera(
-    to_world: PyArrayLike2<f32, AllowTypeChange>,
-    fov_deg: f32,
+    camera: &Bound<'_, PyAny>,
+    fov: Option<&Bound<'_, PyAny>>,
     width: u32,
     height: u32,
-) -> Result<Camera> {
-    let m = to_world.as_array();
-    if m.shape() != [4, 4] {
-        bail!(
-            "a camera is a 4 × 4 camera-to-world matrix, got shape {:?}",
-            m.shape()
-        );
-    }
-    let mut rows = [[0.0f32; 4]; 4];
-    for ((i, j), &v) in m.indexed_iter() {
-        if !v.is_finite() {
-            bail!("the camera matrix holds a non-finite entry at ({i}, {j})");
-        }
-        rows[i][j] = v;
+) -> PyResult<Camera> {
+    use crate::argument::refused;
+    let rows = matrix4(camera)?;
+    let fov_deg = crate::argument::number_or_none(fov, "fov", 0.0..=180.0)?.unwrap_or(60.0);
+    if !(fov_deg > 0.0 && fov_deg < 180.0) {
+        return Err(refused(
+            fov.expect("a given fov"),
+            "fov",
+            "must be between 0 and 180 degrees (exclusive)",
+        ));
     }
     let to_world = Mat4::from_cols_array_2d(&rows).transpose();
     let axes = [
@@ -91,22 +92,66 @@ pub fn camera(
         to_world.z_axis.truncate(),
     ];
     if axes.iter().any(|a| (a.length() - 1.0).abs() > 1e-3) || rows[3] != [0.0, 0.0, 0.0, 1.0] {
-        bail!("the camera matrix must rotate and translate only (unit axes, last row 0 0 0 1)");
+        return Err(refused(
+            camera,
+            "camera",
+            "must rotate and translate only (unit axes, last row 0 0 0 1)",
+        ));
     }
-    if !(fov_deg > 0.0 && fov_deg < 180.0) {
-        bail!("the field of view must be between 0 and 180 degrees, got {fov_deg}");
-    }
-    if width == 0 || height == 0 {
-        bail!("a frame needs at least one pixel, got {width}×{height}");
-    }
-    nprt_trace::Frame::check_size(width, height, "the frame")?;
+    nprt_trace::Frame::check_size(width, height, "the frame")
+        .map_err(|e| crate::error::input_error(format!("width={width}, height={height}: {e:#}")))?;
     Ok(Camera {
         to_world,
-        fov_deg,
+        fov_deg: fov_deg as f32,
         fov_axis: FovAxis::X,
         width,
         height,
     })
+}
+
+/// `obj` as a 4 × 4 matrix of finite numbers, rows first.
+fn matrix4(obj: &Bound<'_, PyAny>) -> PyResult<[[f32; 4]; 4]> {
+    use crate::argument::refused;
+    let py = obj.py();
+    let rule = "must be a 4 × 4 camera-to-world matrix of finite numbers";
+    let array = py
+        .import("numpy")?
+        .call_method1("asarray", (obj,))
+        .map_err(|_| refused(obj, "camera", rule))?;
+    let kind: String = array.getattr("dtype")?.getattr("kind")?.extract()?;
+    let shape: Vec<usize> = array.getattr("shape")?.extract()?;
+    if !matches!(kind.as_str(), "i" | "u" | "f") {
+        return Err(refused(
+            obj,
+            "camera",
+            format!("{rule}, not of numpy kind '{kind}'"),
+        ));
+    }
+    if shape != [4, 4] {
+        return Err(refused(
+            obj,
+            "camera",
+            format!("{rule}, not of shape {shape:?}"),
+        ));
+    }
+    let values: Vec<Vec<f64>> = array
+        .call_method1("astype", ("float64",))?
+        .call_method0("tolist")?
+        .extract()?;
+    let mut rows = [[0.0f32; 4]; 4];
+    for (i, row) in values.iter().enumerate() {
+        for (j, &v) in row.iter().enumerate() {
+            if !v.is_finite() {
+                return Err(refused(
+                    obj,
+                    "camera",
+                    format!("{rule}: entry ({i}, {j}) is {v}"),
+                ));
+            }
+            rows[i][j] = v as f32;
+        }
+    }
+    Ok(rows)
 }
 
 /// A JSON value as the Python object `json.loads` makes of it.

@@ -1,22 +1,21 @@
 //! `nprt.bake`: `nprt bake` from Python, its sizes `nprt_paper::bake::Quality`'s.
 
-use std::path::PathBuf;
-
 use nprt_data::CameraChoice;
 use nprt_eval::MethodResult;
 use nprt_paper::bake::{Bake, Quality};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
-use crate::argument::finite_or_none;
-use crate::choice::engine;
+use crate::argument;
+use crate::choice::engine_arg;
 use crate::interruptible::interruptible;
 
 /// Bakes `scene` under `envmaps` (a folder of maps, or "builtin") into a relit model in `out`
 /// at `quality` ("draft", "good" or "best"; "tiny" for tests), as `nprt bake`: the dataset,
 /// the recommended recipe trained (`minutes`, or `epochs` for a run reproducible bit for bit),
 /// and a check against path tracing of equal cost on held-out views; a run already in `out` is
-/// resumed. Returns a dict: `model`, `comparison`, `preview` and `report` (paths),
+/// resumed. `camera_volume` is a camera-volume file for a scene without one, `test_maps` the
+/// maps held out of training, `seed` the dataset's, `device` and `progress` as for `train`. Returns a dict: `model`, `comparison`, `preview` and `report` (paths),
 /// `description` (the model as run time runs it), `views` (held-out views checked),
 /// `held_out_maps`, `model_errors` and `path_tracing_errors` (each `name`, `l1`, `rmse`,
 /// `dssim`, `ms_per_view`, `level`: per channel, 1 is the reference's), `denoised` (whether its
@@ -26,40 +25,49 @@ use crate::interruptible::interruptible;
 /// the same call resumes it.
 #[pyfunction]
 #[pyo3(signature = (
-    scene, envmaps, out, *, quality = "draft", minutes = None, epochs = None,
-    camera_volume = None, test_maps = None, seed = 0, device = "cpu", progress = true
-))]
+    scene, envmaps, out, *, quality = None, minutes = None, epochs = None,
+    camera_volume = None, test_maps = None, seed = None, device = None, progress = None
+), text_signature = "(scene, envmaps, out, *, quality='draft', minutes=None, epochs=None, \
+    camera_volume=None, test_maps=None, seed=0, device='cpu', progress=True)")]
 #[allow(clippy::too_many_arguments)]
 pub fn bake<'py>(
     py: Python<'py>,
     scene: &Bound<'py, PyAny>,
     envmaps: &Bound<'py, PyAny>,
-    out: PathBuf,
-    quality: &str,
-    minutes: Option<f64>,
-    epochs: Option<usize>,
-    camera_volume: Option<PathBuf>,
-    test_maps: Option<usize>,
-    seed: u64,
-    device: &str,
-    progress: bool,
+    out: &Bound<'py, PyAny>,
+    quality: Option<&Bound<'py, PyAny>>,
+    minutes: Option<&Bound<'py, PyAny>>,
+    epochs: Option<&Bound<'py, PyAny>>,
+    camera_volume: Option<&Bound<'py, PyAny>>,
+    test_maps: Option<&Bound<'py, PyAny>>,
+    seed: Option<&Bound<'py, PyAny>>,
+    device: Option<&Bound<'py, PyAny>>,
+    progress: Option<&Bound<'py, PyAny>>,
 ) -> PyResult<Bound<'py, PyDict>> {
     let scene = crate::scene::scene_spec(scene, "scene")?;
     let envmaps = crate::scene::envmaps_spec(envmaps)?;
-    let quality: Quality = quality
-        .parse()
-        .map_err(|e: anyhow::Error| crate::error::input_error(format!("quality: {e}")))?;
+    let out = argument::path(out, "out")?;
+    let quality = argument::text_or_none(quality, "quality", "a str")?;
+    let quality: Quality =
+        quality
+            .as_deref()
+            .unwrap_or("draft")
+            .parse()
+            .map_err(|e: anyhow::Error| {
+                crate::error::input_error(format!("quality={:?}: {e}", quality.unwrap_or_default()))
+            })?;
+    let range = nprt_net::MIN_MINUTES..=nprt_net::MAX_MINUTES;
     let bake = Bake {
-        minutes: finite_or_none(minutes, "minutes")?,
-        epochs,
+        minutes: argument::number_or_none(minutes, "minutes", range)?,
+        epochs: argument::whole_or_none(epochs, "epochs", 1..=usize::MAX)?,
         camera: CameraChoice {
-            file: camera_volume,
+            file: argument::path_or_none(camera_volume, "camera_volume")?,
             ..CameraChoice::default()
         },
-        test_maps,
-        seed,
-        progress,
-        ..Bake::new(&scene, &envmaps, &out, quality, engine(device)?)
+        test_maps: argument::whole_or_none(test_maps, "test_maps", 1..=usize::MAX)?,
+        seed: argument::whole_or_none(seed, "seed", 0..=u64::MAX)?.unwrap_or(0),
+        progress: argument::flag_or(progress, "progress", true)?,
+        ..Bake::new(&scene, &envmaps, &out, quality, engine_arg(device)?)
     };
     let b = interruptible(py, || bake.run())?;
     let d = PyDict::new(py);

@@ -4,7 +4,7 @@
 use std::str::FromStr;
 
 use nprt_net::{Compute, Engine};
-use pyo3::PyResult;
+use pyo3::prelude::*;
 
 use crate::error::OrPy;
 
@@ -13,8 +13,27 @@ pub fn parse<T: FromStr<Err = String>>(name: &str) -> PyResult<T> {
     name.parse().map_err(crate::error::input_error)
 }
 
+/// The choice `obj` names (a str), for the argument `arg`; `None` where it is `None`.
+pub fn named<T: FromStr<Err = String>>(
+    obj: Option<&Bound<'_, PyAny>>,
+    arg: &str,
+) -> PyResult<Option<T>> {
+    crate::argument::text_or_none(obj, arg, "a str")?
+        .map(|name| {
+            name.parse()
+                .map_err(|e: String| crate::error::input_error(format!("{arg}={name:?}: {e}")))
+        })
+        .transpose()
+}
+
 /// The engine `device` ("cpu", "gpu", "wgpu" or "auto") names, resolved as `--device` is; an
 /// NprtError where the device does not open.
 pub fn engine(device: &str) -> PyResult<Engine> {
     parse::<Compute>(device)?.engine().or_py()
+}
+
+/// [`engine`] of the `device` argument as Python passes it (a str; "cpu" where it is `None`).
+pub fn engine_arg(device: Option<&Bound<'_, PyAny>>) -> PyResult<Engine> {
+    let device = crate::argument::text_or_none(device, "device", "a str: cpu, gpu, wgpu or auto")?;
+    engine(device.as_deref().unwrap_or("cpu"))
 }

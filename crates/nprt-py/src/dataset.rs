@@ -9,10 +9,11 @@ use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList, PySlice};
 
 use crate::arrays::{self, CameraOut};
-use crate::choice::parse;
+use crate::choice::named;
 use crate::error::OrPy;
 
-/// A dataset `nprt generate` wrote (docs/dataset.md), checked as every command checks it.
+/// The dataset `nprt generate` wrote in the folder `path` (docs/dataset.md), checked as every
+/// command checks it.
 #[pyclass(frozen, module = "nprt")]
 pub struct Dataset {
     dir: PathBuf,
@@ -43,56 +44,7 @@ impl Dataset {
         arrays::json(py, &value)
     }
 
-    fn record(&self, index: usize) -> PyResult<&nprt_data::dataset::ViewRecord> {
-        self.manifest.views.get(index).ok_or_else(|| {
-            PyIndexError::new_err(format!(
-                "view {index} of a dataset of {}",
-                self.manifest.views.len()
-            ))
-        })
-    }
-}
-
-#[pymethods]
-impl Dataset {
-    #[new]
-    fn new(py: Python<'_>, path: PathBuf) -> PyResult<Self> {
-        let manifest = py.detach(|| load_manifest(&path)).or_py()?;
-        Ok(Dataset {
-            dir: path,
-            manifest,
-        })
-    }
-
-    /// Views in all (training views first, then test views).
-    fn __len__(&self) -> usize {
-        self.manifest.views.len()
-    }
-
-    /// The manifest (settings, scene bounds, one record per view) as a dict.
-    #[getter]
-    fn manifest<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
-        let value = serde_json::to_value(&self.manifest).expect("a manifest serialises");
-        arrays::json(py, &value)
-    }
-
-    /// The indices of the views of `split` ("train" or "test"; another name is a ValueError).
-    fn split(&self, split: &str) -> PyResult<Vec<usize>> {
-        if !["train", "test"].contains(&split) {
-            return Err(crate::error::input_error(format!(
-                "split must be 'train' or 'test', not '{split}'"
-            )));
-        }
-        Ok((self.manifest.views.iter().enumerate())
-            .filter(|(_, v)| v.split == split)
-            .map(|(i, _)| i)
-            .collect())
-    }
-
-    /// View `index`'s images, each an (H, W, 3) or (H, W) float32 array: `radiance`, `direct`,
-    /// `position`, `normal`, `view`, `kd`, `ks`, `alpha`, `mask`, and for a test view rendered
-    /// in halves `half` (the first half's radiance); with its `index`, `split` and `lighting`
-    /// (`map`, `rotation_deg`, `gain`, and `mix`: the maps added to it).
+    /// View `index`'s images and record as [`Dataset::view_py`] gives them.
     fn view<'py>(&self, py: Python<'py>, index: usize) -> PyResult<Bound<'py, PyDict>> {
         let v = self.record(index)?;
         let parts = self.manifest.settings.parts(v);
@@ -117,10 +69,98 @@ impl Dataset {
         if let Some(half) = &image.half {
             out.set_item("half", arrays::image(py, half, w, h))?;
         }
+        if let Some(t) = &image.transfer {
+            let k = t.basis.coefficients();
+            out.set_item("transfer", arrays::coefficients(py, &t.all, w, h, k))?;
+            out.set_item(
+                "transfer_direct",
+                arrays::coefficients(py, &t.direct, w, h, k),
+            )?;
+        }
         out.set_item("lighting", self.lighting(py, v)?)?;
         out.set_item("index", index)?;
         out.set_item("split", &v.split)?;
         Ok(out)
+    }
+
+    /// The view `obj` names for [`Dataset::view_py`] and [`Dataset::camera`]: a whole number
+    /// (an InputError otherwise), negative from the end; one past either end is an IndexError,
+    /// as a sequence's.
+    fn index_arg(&self, obj: &Bound<'_, PyAny>) -> PyResult<usize> {
+        let len = self.manifest.views.len() as i128;
+        let i: i128 = crate::argument::whole(obj, "index", i128::MIN..=i128::MAX)?;
+        if !(-len..len).contains(&i) {
+            return Err(PyIndexError::new_err(format!(
+                "index={i}: a dataset of {len} views has views 0 to {} (or -{len} to -1)",
+                len - 1
+            )));
+        }
+        Ok(if i < 0 { i + len } else { i } as usize)
+    }
+
+    fn record(&self, index: usize) -> PyResult<&nprt_data::dataset::ViewRecord> {
+        self.manifest.views.get(index).ok_or_else(|| {
+            PyIndexError::new_err(format!(
+                "view {index} of a dataset of {}",
+                self.manifest.views.len()
+            ))
+        })
+    }
+}
+
+#[pymethods]
+impl Dataset {
+    #[new]
+    fn new(py: Python<'_>, path: &Bound<'_, PyAny>) -> PyResult<Self> {
+        let path = crate::argument::path(path, "path")?;
+        let manifest = py.detach(|| load_manifest(&path)).or_py()?;
+        Ok(Dataset {
+            dir: path,
+            manifest,
+        })
+    }
+
+    /// Views in all (training views first, then test views).
+    fn __len__(&self) -> usize {
+        self.manifest.views.len()
+    }
+
+    /// The manifest (settings, scene bounds, one record per view) as a dict.
+    #[getter]
+    fn manifest<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        let value = serde_json::to_value(&self.manifest).expect("a manifest serialises");
+        arrays::json(py, &value)
+    }
+
+    /// The indices of the views of `split` ("train" or "test"; another name is a ValueError).
+    fn split(&self, split: &Bound<'_, PyAny>) -> PyResult<Vec<usize>> {
+        let rule = "must be 'train' or 'test'";
+        let name = crate::argument::text(split, "split", "a str: 'train' or 'test'")?;
+        if !["train", "test"].contains(&name.as_str()) {
+            return Err(crate::argument::refused(split, "split", rule));
+        }
+        let split = name.as_str();
+        Ok((self.manifest.views.iter().enumerate())
+            .filter(|(_, v)| v.split == split)
+            .map(|(i, _)| i)
+            .collect())
+    }
+
+    /// View `index`'s images (negative counts from the end), each an (H, W, 3) or (H, W)
+    /// float32 array: `radiance`, `direct`, `position`, `normal`, `view`, `kd`, `ks`, `alpha`,
+    /// `mask`, and for a test view rendered in halves `half` (the first half's radiance); for a
+    /// training view of a dataset made with `transfer="sh:L"`, `transfer` and
+    /// `transfer_direct`, (H, W, K, 3) arrays of its K = (L+1)² coefficients per colour
+    /// channel (all light and its direct part); with its `index`, `split` and `lighting`
+    /// (`map`, `rotation_deg`, `gain`, and `mix`: the maps added to it).
+    #[pyo3(name = "view")]
+    fn view_py<'py>(
+        &self,
+        py: Python<'py>,
+        index: &Bound<'py, PyAny>,
+    ) -> PyResult<Bound<'py, PyDict>> {
+        let index = self.index_arg(index)?;
+        self.view(py, index)
     }
 
     /// View `key` as [`Dataset::view`] gives it (negative indices count from the end), or a
@@ -158,10 +198,10 @@ impl Dataset {
         }
     }
 
-    /// View `index`'s camera: (4 × 4 camera-to-world matrix, horizontal field of view in
+    /// View `index`'s camera (negative counts from the end): (4 × 4 camera-to-world matrix, horizontal field of view in
     /// degrees, (width, height)).
-    fn camera<'py>(&self, py: Python<'py>, index: usize) -> PyResult<CameraOut<'py>> {
-        let v = self.record(index)?;
+    fn camera<'py>(&self, py: Python<'py>, index: &Bound<'py, PyAny>) -> PyResult<CameraOut<'py>> {
+        let v = self.record(self.index_arg(index)?)?;
         let c = v.camera();
         Ok((
             arrays::matrix(py, c.to_world),
@@ -188,16 +228,17 @@ impl Dataset {
     }
 
     /// Packs the dataset for training (`direct` "learned" or "traced", as `nprt train
-    /// --direct`), or checks the pack already there, as `nprt dataset pack`; returns its path,
-    /// its records and its bytes.
-    #[pyo3(signature = (direct = "learned", progress = true))]
+    /// --direct`), or checks the pack already there, as `nprt dataset pack` (with a progress
+    /// bar unless `progress` is False); returns its path, its records and its bytes.
+    #[pyo3(signature = (direct = None, progress = None), text_signature = "(direct='learned', progress=True)")]
     fn pack<'py>(
         &self,
         py: Python<'py>,
-        direct: &str,
-        progress: bool,
+        direct: Option<&Bound<'py, PyAny>>,
+        progress: Option<&Bound<'py, PyAny>>,
     ) -> PyResult<Bound<'py, PyDict>> {
-        let direct: nprt_net::DirectLight = parse(direct)?;
+        let direct: nprt_net::DirectLight = named(direct, "direct")?.unwrap_or_default();
+        let progress = crate::argument::flag_or(progress, "progress", true)?;
         let target = direct.packed_target();
         let (path, records, bytes) = py
             .detach(|| {
@@ -208,7 +249,11 @@ impl Dataset {
                     &hash,
                     target,
                     progress,
-                    |why| eprintln!("{why}"),
+                    |why| {
+                        if progress {
+                            eprintln!("{why}")
+                        }
+                    },
                 )?;
                 anyhow::Ok((
                     PackedDataset::path(&self.dir, target),

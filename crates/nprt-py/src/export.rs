@@ -6,27 +6,32 @@ use nprt_render::ExampleView;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
+use crate::argument;
 use crate::error::OrPy;
 
 /// Writes the model in `model` as shaders and weights for engines into `out` (the kernels as
 /// WGSL, GLSL and HLSL, weights.bin, export.json, and a WebGPU page relighting a view of
-/// `example_res` (width, height) under `example_map`), as `nprt export`; returns the files
+/// `example_res` (width, height, or one number for a square) under `example_map`, a map file
+/// or a `builtin:` map), as `nprt export`; returns the files
 /// written, the weights and, where the page could not be made, why.
 #[pyfunction]
 #[pyo3(signature = (model, out, *, example_res = None, example_map = None))]
 pub fn export<'py>(
     py: Python<'py>,
-    model: PathBuf,
-    out: PathBuf,
-    example_res: Option<(u32, u32)>,
-    example_map: Option<String>,
+    model: &Bound<'py, PyAny>,
+    out: &Bound<'py, PyAny>,
+    example_res: Option<&Bound<'py, PyAny>>,
+    example_map: Option<&Bound<'py, PyAny>>,
 ) -> PyResult<Bound<'py, PyDict>> {
+    let (model, out) = (argument::path(model, "model")?, argument::path(out, "out")?);
     let d = ExampleView::default();
-    let (width, height) = example_res.unwrap_or((d.width, d.height));
+    let (width, height) =
+        argument::size_or_none(example_res, "example_res")?.unwrap_or((d.width, d.height));
     let view = ExampleView {
         width,
         height,
-        map: example_map.unwrap_or(d.map),
+        map: argument::text_or_none(example_map, "example_map", "a str or an os.PathLike")?
+            .unwrap_or(d.map),
     };
     let done = py.detach(|| written(&model, &out, &view)).or_py()?;
     let summary = PyDict::new(py);

@@ -1,8 +1,6 @@
 //! `nprt.generate`: `nprt generate` from Python, every flag a keyword whose default is
 //! `GenerateOptions::default()`'s.
 
-use std::path::PathBuf;
-
 use nprt_data::dataset::{Jitter, TransferBasis};
 use nprt_data::{CameraChoice, GenerateOptions};
 use nprt_net::RECIPE;
@@ -18,7 +16,15 @@ use crate::interruptible::interruptible;
 /// where one with the same settings is there) and
 /// returns what was rendered: `rendered`, `skipped` (already complete), `seconds`,
 /// `msamples_per_s` and `warnings`. Keywords are `nprt generate`'s flags; `None` takes its
-/// default (`nprt generate --help`). `device` traces on "cpu" or the GPU ("gpu", "wgpu",
+/// default (`nprt generate --help`): `train_views` and `test_views` (views of each split),
+/// `train_res` and `test_res` (their size: one number for a square, or (width, height)), `spp`
+/// and `test_spp` (paths per pixel of each), `seed`, `jitter_exposure` and `jitter_tint` (each
+/// view's random gain on its map), `test_maps` (maps held out for the test views),
+/// `mix_builtin` (the share of training views lit by built-in maps), `mix_maps` (maps added to
+/// each training view's), `shard` ((k, n): the k-th of n parts), the camera volume as a
+/// `camera_volume` file or `volume_min`, `volume_max` and `look` (three numbers each) with
+/// `spread` and `fov` (degrees), `transfer` ("sh:L" records transfer vectors to band L,
+/// "none" none) and `progress` (a bar on stderr). `device` traces on "cpu" or the GPU ("gpu", "wgpu",
 /// "auto"). The GIL is released while it renders; Ctrl-C stops it after the view under way
 /// (`nprt.Interrupted`), and the same call resumes it.
 #[pyfunction]
@@ -27,74 +33,85 @@ use crate::interruptible::interruptible;
     test_res = None, spp = None, test_spp = None, seed = None, jitter_exposure = None,
     jitter_tint = None, test_maps = None, mix_builtin = None, shard = None, camera_volume = None,
     volume_min = None, volume_max = None, look = None, spread = None, fov = None,
-    device = "cpu", progress = true, mix_maps = None, transfer = None
-))]
+    device = None, progress = None, mix_maps = None, transfer = None
+), text_signature = "(scene, envmaps, out, *, train_views=None, test_views=None, train_res=None, \
+    test_res=None, spp=None, test_spp=None, seed=None, jitter_exposure=None, jitter_tint=None, \
+    test_maps=None, mix_builtin=None, shard=None, camera_volume=None, volume_min=None, \
+    volume_max=None, look=None, spread=None, fov=None, device='cpu', progress=True, \
+    mix_maps=None, transfer=None)")]
 #[allow(clippy::too_many_arguments)]
 pub fn generate<'py>(
     py: Python<'py>,
     scene: &Bound<'py, PyAny>,
     envmaps: &Bound<'py, PyAny>,
-    out: PathBuf,
-    train_views: Option<u64>,
-    test_views: Option<u64>,
-    train_res: Option<(u32, u32)>,
-    test_res: Option<(u32, u32)>,
-    spp: Option<u32>,
-    test_spp: Option<u32>,
-    seed: Option<u64>,
-    jitter_exposure: Option<f32>,
-    jitter_tint: Option<f32>,
-    test_maps: Option<usize>,
-    mix_builtin: Option<f32>,
-    shard: Option<(u64, u64)>,
-    camera_volume: Option<PathBuf>,
-    volume_min: Option<[f32; 3]>,
-    volume_max: Option<[f32; 3]>,
-    look: Option<[f32; 3]>,
-    spread: Option<f32>,
-    fov: Option<f32>,
-    device: &str,
-    progress: bool,
-    mix_maps: Option<u32>,
-    transfer: Option<&str>,
+    out: &Bound<'py, PyAny>,
+    train_views: Option<&Bound<'py, PyAny>>,
+    test_views: Option<&Bound<'py, PyAny>>,
+    train_res: Option<&Bound<'py, PyAny>>,
+    test_res: Option<&Bound<'py, PyAny>>,
+    spp: Option<&Bound<'py, PyAny>>,
+    test_spp: Option<&Bound<'py, PyAny>>,
+    seed: Option<&Bound<'py, PyAny>>,
+    jitter_exposure: Option<&Bound<'py, PyAny>>,
+    jitter_tint: Option<&Bound<'py, PyAny>>,
+    test_maps: Option<&Bound<'py, PyAny>>,
+    mix_builtin: Option<&Bound<'py, PyAny>>,
+    shard: Option<&Bound<'py, PyAny>>,
+    camera_volume: Option<&Bound<'py, PyAny>>,
+    volume_min: Option<&Bound<'py, PyAny>>,
+    volume_max: Option<&Bound<'py, PyAny>>,
+    look: Option<&Bound<'py, PyAny>>,
+    spread: Option<&Bound<'py, PyAny>>,
+    fov: Option<&Bound<'py, PyAny>>,
+    device: Option<&Bound<'py, PyAny>>,
+    progress: Option<&Bound<'py, PyAny>>,
+    mix_maps: Option<&Bound<'py, PyAny>>,
+    transfer: Option<&Bound<'py, PyAny>>,
 ) -> PyResult<Bound<'py, PyDict>> {
-    let (fin, fin3) = (argument::finite_or_none, finite_vec3);
+    use argument::{number_or_none as num, size_or_none, vec3_or_none, whole_or_none as whole};
     let d = GenerateOptions::default();
-    let device = choice::engine(device)?.tracer();
+    let device = choice::engine_arg(device)?.tracer();
+    let f32_of = |v: Option<f64>| v.map(|v| v as f32);
     let opts = GenerateOptions {
         scene: crate::scene::scene_spec(scene, "scene")?,
         envmaps: crate::scene::envmaps_spec(envmaps)?,
-        out,
-        train_views: train_views.unwrap_or(d.train_views),
-        test_views: test_views.unwrap_or(d.test_views),
-        train_resolution: train_res.map_or(d.train_resolution, |(w, h)| [w, h]),
-        test_resolution: test_res.map_or(d.test_resolution, |(w, h)| [w, h]),
-        spp: spp.unwrap_or(d.spp),
-        test_spp: test_spp.unwrap_or(d.test_spp),
-        seed: seed.unwrap_or(d.seed),
+        out: argument::path(out, "out")?,
+        train_views: whole(train_views, "train_views", 1..=u64::MAX)?.unwrap_or(d.train_views),
+        test_views: whole(test_views, "test_views", 1..=u64::MAX)?.unwrap_or(d.test_views),
+        train_resolution: size_or_none(train_res, "train_res")?
+            .map_or(d.train_resolution, |(w, h)| [w, h]),
+        test_resolution: size_or_none(test_res, "test_res")?
+            .map_or(d.test_resolution, |(w, h)| [w, h]),
+        spp: whole(spp, "spp", 1..=u32::MAX)?.unwrap_or(d.spp),
+        test_spp: whole(test_spp, "test_spp", 1..=u32::MAX)?.unwrap_or(d.test_spp),
+        seed: whole(seed, "seed", 0..=u64::MAX)?.unwrap_or(d.seed),
         jitter: Jitter {
-            exposure: fin(jitter_exposure, "jitter_exposure")?.unwrap_or(d.jitter.exposure),
-            tint: fin(jitter_tint, "jitter_tint")?.unwrap_or(d.jitter.tint),
+            exposure: f32_of(num(jitter_exposure, "jitter_exposure", 0.0..=f64::MAX)?)
+                .unwrap_or(d.jitter.exposure),
+            tint: f32_of(num(jitter_tint, "jitter_tint", 0.0..=f64::MAX)?).unwrap_or(d.jitter.tint),
         },
-        mix_maps: mix_maps.unwrap_or(d.mix_maps),
-        transfer: match transfer {
-            Some(t) => TransferBasis::parse_choice(t)
-                .map_err(|e| crate::error::input_error(format!("transfer: {e:#}")))?,
+        mix_maps: whole(mix_maps, "mix_maps", 0..=u32::MAX)?.unwrap_or(d.mix_maps),
+        transfer: match argument::text_or_none(transfer, "transfer", "a str: sh:L or none")? {
+            Some(t) => TransferBasis::parse_choice(&t)
+                .map_err(|e| crate::error::input_error(format!("transfer={t:?}: {e:#}")))?,
             None => RECIPE.dataset_transfer_on(device),
         },
-        test_maps: test_maps.or(d.test_maps),
-        mix_builtin: fin(mix_builtin, "mix_builtin")?.or(d.mix_builtin),
+        test_maps: whole(test_maps, "test_maps", 1..=usize::MAX)?.or(d.test_maps),
+        mix_builtin: f32_of(num(mix_builtin, "mix_builtin", 0.0..=1.0)?).or(d.mix_builtin),
         camera: CameraChoice {
-            file: camera_volume,
-            min: fin3(volume_min, "volume_min")?,
-            max: fin3(volume_max, "volume_max")?,
-            look: fin3(look, "look")?,
-            spread_deg: fin(spread, "spread")?,
-            fov_deg: fin(fov, "fov")?,
+            file: argument::path_or_none(camera_volume, "camera_volume")?,
+            min: vec3_or_none(volume_min, "volume_min")?.map(Into::into),
+            max: vec3_or_none(volume_max, "volume_max")?.map(Into::into),
+            look: vec3_or_none(look, "look")?.map(Into::into),
+            spread_deg: f32_of(num(spread, "spread", 0.0..=90.0)?),
+            fov_deg: f32_of(num(fov, "fov", 0.0..=180.0)?),
         },
-        shard: shard.unwrap_or(d.shard),
+        shard: match shard.filter(|s| !s.is_none()) {
+            Some(s) => argument::shard(s, "shard")?,
+            None => d.shard,
+        },
         device,
-        progress,
+        progress: argument::flag_or(progress, "progress", true)?,
     };
     let mut warnings = Vec::new();
     let summary = interruptible(py, || nprt_data::generate(&opts, |p| warnings = p.warnings))?;
@@ -109,14 +126,4 @@ pub fn generate<'py>(
     )?;
     out.set_item("warnings", warnings)?;
     Ok(out)
-}
-
-/// An optional point or direction, each coordinate finite (named `arg` otherwise).
-fn finite_vec3(v: Option<[f32; 3]>, arg: &str) -> PyResult<Option<glam::Vec3>> {
-    match v {
-        Some(v) if !v.iter().all(|c| c.is_finite()) => Err(crate::error::input_error(format!(
-            "{arg} must be three finite numbers, got {v:?}"
-        ))),
-        v => Ok(v.map(Into::into)),
-    }
 }

@@ -1,39 +1,30 @@
 //! Images to and from files, as numpy arrays: `nprt.write_image` and `nprt.read_image` (the
 //! library's one writer and one reader of linear RGB).
 
-use numpy::{AllowTypeChange, PyArray3, PyArrayLike3};
+use numpy::PyArray3;
 use pyo3::prelude::*;
 
 use crate::argument;
 use crate::arrays;
-use crate::error::{input_error, OrPy};
+use crate::error::OrPy;
 
 /// Writes `image`, an (H, W, 3) array of linear radiance, to `path` (a `str` or a
 /// `pathlib.Path`) in the format its extension names: .exr (float32, exact), .hdr (Radiance)
 /// or .png (8-bit sRGB of the radiance scaled by 2**`exposure`). Written whole or not at all;
 /// NaN or infinity is refused, naming the pixel.
 #[pyfunction]
-#[pyo3(signature = (path, image, exposure = 0.0))]
+#[pyo3(signature = (path, image, exposure = None), text_signature = "(path, image, exposure=0.0)")]
 pub fn write_image(
     py: Python<'_>,
     path: &Bound<'_, PyAny>,
-    image: PyArrayLike3<f32, AllowTypeChange>,
-    exposure: f32,
+    image: &Bound<'_, PyAny>,
+    exposure: Option<&Bound<'_, PyAny>>,
 ) -> PyResult<()> {
     let path = argument::path(path, "path")?;
-    let exposure = argument::finite(exposure, "exposure")?;
-    let a = image.as_array();
-    let (h, w, c) = a.dim();
-    if c != 3 {
-        return Err(input_error(format!(
-            "image must be an (H, W, 3) array, got shape ({h}, {w}, {c})"
-        )));
-    }
-    let rgb: Vec<glam::Vec3> = a
-        .rows()
-        .into_iter()
-        .map(|p| glam::Vec3::new(p[0], p[1], p[2]))
-        .collect();
+    let exposure =
+        argument::number_or_none(exposure, "exposure", argument::FINITE)?.unwrap_or(0.0) as f32;
+    let (array, h, w) = argument::rgb_array(image, "image", "an (H, W, 3) array")?;
+    let rgb = argument::rgb_texels(&array, "image")?;
     py.detach(|| nprt_io::write_linear_rgb(&path, &rgb, w, h, exposure))
         .or_py()
 }

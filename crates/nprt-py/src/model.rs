@@ -6,20 +6,23 @@ use std::path::PathBuf;
 use nprt_render::{Denoise, DirectSampling, FrameCache, Relighter, DEFAULT_DIRECT_SPP};
 
 use crate::render::denoise_choice;
-use numpy::{AllowTypeChange, PyArray3, PyArrayLike2};
+use numpy::PyArray3;
 use pyo3::exceptions::PyUserWarning;
 use pyo3::prelude::*;
 
 use crate::argument;
 use crate::arrays;
-use crate::choice::engine;
+use crate::choice::engine_arg;
 use crate::error::OrPy;
 use crate::scene::{envmap_arg, scene_arg, Scene};
 
-/// A model folder `nprt train` wrote, ready to relight frames on `device`.
+/// The model folder `path` that `nprt train` wrote, ready to relight frames on `device` ("cpu",
+/// "gpu", "wgpu" or "auto").
 #[pyclass(frozen, module = "nprt")]
 pub struct Model {
     dir: PathBuf,
+    /// The device it was asked for, as given ("cpu", "gpu", …): what a pickled copy opens.
+    asked: String,
     relighter: Relighter,
 }
 
@@ -51,12 +54,20 @@ impl Model {
 #[pymethods]
 impl Model {
     #[new]
-    #[pyo3(signature = (path, device = "cpu"))]
-    fn new(py: Python<'_>, path: PathBuf, device: &str) -> PyResult<Self> {
-        let engine = engine(device)?;
+    #[pyo3(signature = (path, device = None), text_signature = "(path, device='cpu')")]
+    fn new(
+        py: Python<'_>,
+        path: &Bound<'_, PyAny>,
+        device: Option<&Bound<'_, PyAny>>,
+    ) -> PyResult<Self> {
+        let path = argument::path(path, "path")?;
+        let asked = argument::text_or_none(device, "device", "a str: cpu, gpu, wgpu or auto")?
+            .unwrap_or_else(|| "cpu".into());
+        let engine = engine_arg(device)?;
         let relighter = py.detach(|| Relighter::load(&path, engine)).or_py()?;
         Ok(Model {
             dir: path,
+            asked,
             relighter,
         })
     }
@@ -89,7 +100,7 @@ impl Model {
     }
 
     /// A frame of `scene` under `envmap` turned by `rotation` degrees about +Y, through
-    /// `camera` (4 × 4 camera-to-world, horizontal field of view `fov`): the G-buffer, the
+    /// `camera` (4 × 4 camera-to-world, horizontal field of view `fov`) at `width` × `height`: the G-buffer, the
     /// networks, and the background (or, for a model trained with `--direct traced`, direct
     /// light traced with `direct_spp` paths per pixel from `seed`, denoised as `denoise_direct`
     /// says: True, False, "auto", "on" or "off"; None, auto: where OIDN is installed). An
@@ -99,28 +110,32 @@ impl Model {
     /// `pathlib.Path`). A scene other than the one the model was trained on (by its hash)
     /// renders with a warning (`UserWarning`): the networks know their own scene only.
     #[pyo3(signature = (
-        scene, envmap, camera, width, height, fov = 60.0, rotation = 0.0,
-        direct_spp = DEFAULT_DIRECT_SPP,
-        seed = 0, denoise_direct = None
-    ))]
+        scene, envmap, camera, width, height, fov = None, rotation = None, direct_spp = None,
+        seed = None, denoise_direct = None
+    ), text_signature = "(scene, envmap, camera, width, height, fov=60.0, rotation=0.0, \
+        direct_spp=16, seed=0, denoise_direct=None)")]
     #[allow(clippy::too_many_arguments)]
     fn render<'py>(
         &self,
         py: Python<'py>,
         scene: &Bound<'py, PyAny>,
         envmap: &Bound<'py, PyAny>,
-        camera: PyArrayLike2<f32, AllowTypeChange>,
-        width: i64,
-        height: i64,
-        fov: f32,
-        rotation: f32,
-        direct_spp: u32,
-        seed: u64,
+        camera: &Bound<'py, PyAny>,
+        width: &Bound<'py, PyAny>,
+        height: &Bound<'py, PyAny>,
+        fov: Option<&Bound<'py, PyAny>>,
+        rotation: Option<&Bound<'py, PyAny>>,
+        direct_spp: Option<&Bound<'py, PyAny>>,
+        seed: Option<&Bound<'py, PyAny>>,
         denoise_direct: Option<&Bound<'py, PyAny>>,
     ) -> PyResult<Bound<'py, PyArray3<f32>>> {
         let (width, height) = arrays::frame_size(width, height)?;
-        let camera = arrays::camera(camera, fov, width, height).or_py()?;
-        let rotation = argument::finite(rotation, "rotation")?;
+        let camera = arrays::camera(camera, fov, width, height)?;
+        let rotation =
+            argument::number_or_none(rotation, "rotation", argument::FINITE)?.unwrap_or(0.0) as f32;
+        let direct_spp = argument::whole_or_none(direct_spp, "direct_spp", 0..=u32::MAX)?
+            .unwrap_or(DEFAULT_DIRECT_SPP);
+        let seed = argument::whole_or_none(seed, "seed", 0..=u64::MAX)?.unwrap_or(0);
         let scene = scene_arg(scene, "scene")?;
         let envmap = envmap_arg(envmap, "envmap")?;
         let scene = scene.get();
@@ -141,6 +156,12 @@ impl Model {
             })
             .or_py()?;
         Ok(arrays::image(py, &rgb, width as usize, height as usize))
+    }
+
+    /// Pickled by its folder and device (a worker process loads it again).
+    fn __reduce__<'py>(&self, py: Python<'py>) -> PyResult<(Bound<'py, PyAny>, (PathBuf, String))> {
+        let class = py.import("nprt")?.getattr("Model")?;
+        Ok((class, (self.dir.clone(), self.asked.clone())))
     }
 
     fn __repr__(&self) -> String {

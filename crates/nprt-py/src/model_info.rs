@@ -1,12 +1,11 @@
 //! `nprt.model_info`: `nprt model info` from Python, a design's or a trained model's layer
 //! table and parameter counts as a dict (nprt-net's `ModelSummary`).
 
-use std::path::PathBuf;
-
 use nprt_net::{ModelSummary, DEFAULT_ENCODER_WIDTH};
 use pyo3::prelude::*;
 
-use crate::choice::parse;
+use crate::argument;
+use crate::choice::named;
 use crate::error::OrPy;
 
 /// The layer table and parameter counts of the trained model in `model`, or of the design
@@ -19,12 +18,17 @@ use crate::error::OrPy;
 #[pyo3(signature = (model = None, *, arch = None, activation = None, encoder_width = None, encoding = None))]
 pub fn model_info<'py>(
     py: Python<'py>,
-    model: Option<PathBuf>,
-    arch: Option<&str>,
-    activation: Option<&str>,
-    encoder_width: Option<usize>,
-    encoding: Option<&str>,
+    model: Option<&Bound<'py, PyAny>>,
+    arch: Option<&Bound<'py, PyAny>>,
+    activation: Option<&Bound<'py, PyAny>>,
+    encoder_width: Option<&Bound<'py, PyAny>>,
+    encoding: Option<&Bound<'py, PyAny>>,
 ) -> PyResult<Bound<'py, PyAny>> {
+    let model = argument::path_or_none(model, "model")?;
+    let arch: Option<nprt_net::Design> = named(arch, "arch")?;
+    let activation = named(activation, "activation")?;
+    let encoding = named(encoding, "encoding")?;
+    let encoder_width = argument::whole_or_none(encoder_width, "encoder_width", 1..=usize::MAX)?;
     let (summary, file) = match (model, arch) {
         (Some(dir), None) => {
             let (file, summary) = py.detach(|| ModelSummary::of_model(&dir)).or_py()?;
@@ -32,17 +36,22 @@ pub fn model_info<'py>(
         }
         (None, Some(arch)) => {
             let summary = ModelSummary::of_design(
-                parse(arch)?,
-                activation.map(parse).transpose()?,
+                arch,
+                activation,
                 encoder_width.unwrap_or(DEFAULT_ENCODER_WIDTH),
-                encoding.map(parse).transpose()?.unwrap_or_default(),
+                encoding.unwrap_or_default(),
             )
             .or_py()?;
             (summary, None)
         }
-        _ => {
+        (Some(_), Some(_)) => {
             return Err(crate::error::input_error(
                 "give a model folder or arch=, not both",
+            ))
+        }
+        (None, None) => {
+            return Err(crate::error::input_error(
+                "give a model folder (model=) or a design (arch=)",
             ))
         }
     };

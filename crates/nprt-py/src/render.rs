@@ -1,69 +1,76 @@
 //! `nprt.render`: `nprt render` from Python (a camera path relit under a lighting schedule,
 //! written as frames and an animation), its defaults `RenderOptions::default()`'s.
 
-use std::path::PathBuf;
-
 use nprt_render::{Denoise, RenderJob, RenderOptions};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
-use crate::argument::finite_or_none;
-use crate::choice::{engine, parse};
+use crate::argument;
+use crate::choice::{engine_arg, named};
 use crate::interruptible::interruptible;
 
 /// Relights a camera path of the model in `model` under a lighting schedule into `out` (PNG
 /// frames, or EXR with `exr`, and an MP4 or GIF), as `nprt render`; keywords are its flags,
-/// `None` its default. Returns `description` (what runs, in one line), `frames_dir`,
+/// `None` its default: `scene` (another scene than the model's), the path as a `camera_path`
+/// file or orbiting a `camera_volume` (`spin` degrees over the path), `lighting` (a map or a
+/// lighting schedule), `frames`, `res` ((width, height) or one number), `fps`, `exposure`
+/// (stops), `direct_spp` and `denoise_direct` (a traced direct light's paths per pixel and
+/// denoising: True, False, "auto", "on" or "off"), `precision` ("f32" or "f16") and `device`. Returns `description` (what runs, in one line), `frames_dir`,
 /// `animation` and the mean per-frame milliseconds (`gbuffer_ms`, `encoder_ms`, `network_ms`,
 /// `direct_ms`, `total_ms`). The GIL is released
 /// while it renders; Ctrl-C stops it after the frame under way (`nprt.Interrupted`).
 #[pyfunction]
 #[pyo3(signature = (
     model, out, *, scene = None, camera_path = None, camera_volume = None, lighting = None,
-    spin = None, frames = None, res = None, fps = None, exposure = None, exr = false,
-    direct_spp = None, denoise_direct = None, precision = None, device = "cpu"
-))]
+    spin = None, frames = None, res = None, fps = None, exposure = None, exr = None,
+    direct_spp = None, denoise_direct = None, precision = None, device = None
+), text_signature = "(model, out, *, scene=None, camera_path=None, camera_volume=None, \
+    lighting=None, spin=None, frames=None, res=None, fps=None, exposure=None, exr=False, \
+    direct_spp=None, denoise_direct=None, precision=None, device='cpu')")]
 #[allow(clippy::too_many_arguments)]
 pub fn render<'py>(
     py: Python<'py>,
-    model: PathBuf,
-    out: PathBuf,
+    model: &Bound<'py, PyAny>,
+    out: &Bound<'py, PyAny>,
     scene: Option<&Bound<'py, PyAny>>,
-    camera_path: Option<PathBuf>,
-    camera_volume: Option<PathBuf>,
-    lighting: Option<String>,
-    spin: Option<f32>,
-    frames: Option<usize>,
-    res: Option<(u32, u32)>,
-    fps: Option<u32>,
-    exposure: Option<f32>,
-    exr: bool,
-    direct_spp: Option<u32>,
+    camera_path: Option<&Bound<'py, PyAny>>,
+    camera_volume: Option<&Bound<'py, PyAny>>,
+    lighting: Option<&Bound<'py, PyAny>>,
+    spin: Option<&Bound<'py, PyAny>>,
+    frames: Option<&Bound<'py, PyAny>>,
+    res: Option<&Bound<'py, PyAny>>,
+    fps: Option<&Bound<'py, PyAny>>,
+    exposure: Option<&Bound<'py, PyAny>>,
+    exr: Option<&Bound<'py, PyAny>>,
+    direct_spp: Option<&Bound<'py, PyAny>>,
     denoise_direct: Option<&Bound<'py, PyAny>>,
-    precision: Option<&str>,
-    device: &str,
+    precision: Option<&Bound<'py, PyAny>>,
+    device: Option<&Bound<'py, PyAny>>,
 ) -> PyResult<Bound<'py, PyDict>> {
+    use argument::{number_or_none as num, whole_or_none as whole};
     let d = RenderOptions::default();
     let opts = RenderOptions {
-        model,
-        out,
+        model: argument::path(model, "model")?,
+        out: argument::path(out, "out")?,
         scene: scene
+            .filter(|s| !s.is_none())
             .map(|s| crate::scene::scene_spec(s, "scene"))
             .transpose()?,
-        camera_path,
-        camera_volume,
-        lighting: lighting.unwrap_or(d.lighting),
-        spin_deg: finite_or_none(spin, "spin")?.unwrap_or(d.spin_deg),
-        frames: frames.unwrap_or(d.frames),
-        resolution: res.map_or(d.resolution, |(w, h)| [w, h]),
-        fps: fps.unwrap_or(d.fps),
-        exposure: finite_or_none(exposure, "exposure")?.unwrap_or(d.exposure),
-        exr,
-        direct_spp: direct_spp.unwrap_or(d.direct_spp),
+        camera_path: argument::path_or_none(camera_path, "camera_path")?,
+        camera_volume: argument::path_or_none(camera_volume, "camera_volume")?,
+        lighting: argument::text_or_none(lighting, "lighting", "a str or an os.PathLike")?
+            .unwrap_or(d.lighting),
+        spin_deg: num(spin, "spin", argument::FINITE)?.map_or(d.spin_deg, |v| v as f32),
+        frames: whole(frames, "frames", 1..=usize::MAX)?.unwrap_or(d.frames),
+        resolution: argument::size_or_none(res, "res")?.map_or(d.resolution, |(w, h)| [w, h]),
+        fps: whole(fps, "fps", 1..=1000)?.unwrap_or(d.fps),
+        exposure: num(exposure, "exposure", argument::FINITE)?.map_or(d.exposure, |v| v as f32),
+        exr: argument::flag_or(exr, "exr", false)?,
+        direct_spp: whole(direct_spp, "direct_spp", 0..=u32::MAX)?.unwrap_or(d.direct_spp),
         denoise_direct: denoise_choice(denoise_direct)?.unwrap_or(d.denoise_direct),
-        precision: precision.map(parse).transpose()?.unwrap_or(d.precision),
+        precision: named(precision, "precision")?.unwrap_or(d.precision),
     };
-    let engine = engine(device)?;
+    let engine = engine_arg(device)?;
     let (done, description) = interruptible(py, || {
         let job = RenderJob::prepare(&opts, engine)?;
         Ok((job.run(|_| {})?, job.describe()))
@@ -84,17 +91,18 @@ pub fn render<'py>(
 /// `denoise_direct`: True ("on"), False ("off") or one of "auto", "on", "off"; None takes the
 /// default (auto: OIDN where installed).
 pub fn denoise_choice(value: Option<&Bound<'_, PyAny>>) -> PyResult<Option<Denoise>> {
-    let Some(v) = value else {
+    let Some(v) = value.filter(|v| !v.is_none()) else {
         return Ok(None);
     };
-    if let Ok(on) = v.extract::<bool>() {
+    if let Ok(on) = argument::flag(v, "denoise_direct") {
         return Ok(Some(if on { Denoise::On } else { Denoise::Off }));
     }
     match v.extract::<String>() {
-        Ok(name) => parse(&name).map(Some),
-        Err(_) => Err(crate::error::input_error(format!(
-            "denoise_direct: expected True, False, 'auto', 'on' or 'off', not {}",
-            v.get_type().name()?
-        ))),
+        Ok(_) => named(Some(v), "denoise_direct"),
+        Err(_) => Err(argument::refused(
+            v,
+            "denoise_direct",
+            "must be True, False, 'auto', 'on' or 'off'",
+        )),
     }
 }

@@ -5,7 +5,7 @@ use std::sync::{Arc, OnceLock};
 
 use nprt_scene::SceneOptions;
 use nprt_trace::{render, PixelFilter, RenderSettings, TraceScene};
-use numpy::{AllowTypeChange, PyArray2, PyArray3, PyArrayLike2, PyArrayLike3};
+use numpy::{PyArray2, PyArray3};
 use pyo3::prelude::*;
 
 use crate::argument;
@@ -86,6 +86,14 @@ impl Scene {
         self.scene.envmap.clone().map(|map| EnvMap { map })
     }
 
+    /// Pickled by what it was loaded from (a worker process loads it again).
+    fn __reduce__<'py>(&self, py: Python<'py>) -> PyResult<(Bound<'py, PyAny>, (String,))> {
+        Ok((
+            py.import("nprt")?.getattr("load_scene")?,
+            (self.spec.clone(),),
+        ))
+    }
+
     fn __repr__(&self) -> String {
         format!(
             "nprt.Scene('{}', {} triangles)",
@@ -95,8 +103,8 @@ impl Scene {
     }
 }
 
-/// Loads a scene: `builtin:room`, or a Mitsuba .xml, glTF (.gltf/.glb), .ply or .obj file
-/// (a `str` or a `pathlib.Path`).
+/// Loads the scene `spec` names: `builtin:room`, or a Mitsuba .xml, glTF (.gltf/.glb), .ply or
+/// .obj file (a `str` or a `pathlib.Path`).
 #[pyfunction]
 pub fn load_scene(py: Python<'_>, spec: &Bound<'_, PyAny>) -> PyResult<Scene> {
     load(
@@ -118,7 +126,9 @@ pub fn load(py: Python<'_>, spec: &str) -> PyResult<Scene> {
     })
 }
 
-/// A lat-long environment map (Mitsuba 3's mapping), 2:1, linear RGB radiance.
+/// A lat-long environment map (Mitsuba 3's mapping), 2:1, linear RGB radiance: made from
+/// `texels`, an (H, 2H, 3) array of real numbers, called `name` (negative texels are clamped to
+/// 0, and a map black everywhere, with a `UserWarning`), or opened with `nprt.open_envmap`.
 #[pyclass(frozen, module = "nprt")]
 pub struct EnvMap {
     pub map: nprt_scene::EnvMap,
@@ -126,40 +136,32 @@ pub struct EnvMap {
 
 #[pymethods]
 impl EnvMap {
-    /// A map from an (H, 2H, 3) array of linear radiance (negative values are clamped to 0).
+    /// A map from `texels`, an (H, 2H, 3) array of linear radiance (real numbers; negative
+    /// values are clamped to 0 with a warning, as is a map black everywhere), called `name`.
     #[new]
-    #[pyo3(signature = (texels, name = "array"))]
-    fn new(texels: &Bound<'_, PyAny>, name: &str) -> PyResult<Self> {
-        let kind = texels.get_type().name()?;
-        // A view stays a view (a broadcast array is not copied); nested lists become an array.
-        let array = (texels.py().import("numpy")?)
-            .call_method1("asarray", (texels,))
-            .map_err(|e| input_error(format!("texels: not an array of numbers ({e})")))?;
-        let shape = || -> PyResult<Vec<usize>> { array.getattr("shape")?.extract() };
-        let Ok(&[h, w, c]) = shape().as_deref() else {
-            return Err(input_error(format!(
-                "texels: an environment map is an (H, 2H, 3) array of numbers, not {kind}{}",
-                shape().map_or(String::new(), |s| format!(" of shape {s:?}"))
-            )));
-        };
-        if c != 3 {
-            return Err(input_error(format!(
-                "texels: an environment map is an (H, 2H, 3) array, got shape ({h}, {w}, {c})"
-            )));
-        }
+    #[pyo3(signature = (texels, name = None), text_signature = "(texels, name='array')")]
+    fn new(texels: &Bound<'_, PyAny>, name: Option<&Bound<'_, PyAny>>) -> PyResult<Self> {
+        let py = texels.py();
+        let name = argument::text_or_none(name, "name", "a str")?.unwrap_or("array".into());
+        let (array, h, w) = argument::rgb_array(texels, "texels", "an (H, 2H, 3) array")?;
         // Before any copy: a broadcast view of a huge shape costs nothing until copied.
-        nprt_scene::EnvMap::check_size(w, h, name).or_py()?;
-        let texels: PyArrayLike3<f32, AllowTypeChange> = (array.extract())
-            .map_err(|e| input_error(format!("texels: not an array of numbers ({e})")))?;
-        let texels = texels
-            .as_array()
-            .iter()
-            .copied()
-            .collect::<Vec<f32>>()
-            .chunks_exact(3)
-            .map(glam::Vec3::from_slice)
-            .collect();
-        let map = nprt_scene::EnvMap::from_texels(name, w, h, texels).or_py()?;
+        nprt_scene::EnvMap::check_size(w, h, &name)
+            .map_err(|e| argument::refused(texels, "texels", format!("{e:#}")))?;
+        let texels_rgb = argument::rgb_texels(&array, "texels")?;
+        let map = nprt_scene::EnvMap::from_texels(&name, w, h, texels_rgb)
+            .map_err(|e| argument::refused(texels, "texels", format!("{e:#}")))?;
+        let warn = |message: String| {
+            PyErr::warn(
+                py,
+                &py.get_type::<pyo3::exceptions::PyUserWarning>(),
+                &std::ffi::CString::new(message)?,
+                1,
+            )
+        };
+        // What the map changed (negative texels clamped) or says (black everywhere).
+        for w in map.warnings() {
+            warn(w)?;
+        }
         Ok(EnvMap { map })
     }
 
@@ -168,10 +170,36 @@ impl EnvMap {
         arrays::image(py, self.map.texels(), self.map.width(), self.map.height())
     }
 
+    /// `numpy.asarray(map)`: its texels (as `to_array`), in `dtype` where one is asked.
+    #[pyo3(signature = (dtype = None, copy = None))]
+    fn __array__<'py>(
+        &self,
+        py: Python<'py>,
+        dtype: Option<&Bound<'py, PyAny>>,
+        copy: Option<bool>,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        let _ = copy; // a new array every call: a copy either way
+        let texels = self.to_array(py).into_any();
+        match dtype.filter(|d| !d.is_none()) {
+            Some(d) => texels.call_method1("astype", (d,)),
+            None => Ok(texels),
+        }
+    }
+
+    /// Pickled by its texels and name.
+    fn __reduce__<'py>(
+        &self,
+        py: Python<'py>,
+    ) -> PyResult<(Bound<'py, PyAny>, (Bound<'py, PyArray3<f32>>, String))> {
+        let class = py.import("nprt")?.getattr("EnvMap")?;
+        Ok((class, (self.to_array(py), self.map.name().to_string())))
+    }
+
     /// The same map turned by `degrees` about +Y (Mitsuba's `<rotate y="1" angle=.../>`).
-    fn rotated(&self, degrees: f32) -> PyResult<EnvMap> {
+    fn rotated(&self, degrees: &Bound<'_, PyAny>) -> PyResult<EnvMap> {
+        let degrees = argument::number(degrees, "degrees", argument::FINITE)? as f32;
         Ok(EnvMap {
-            map: self.map.rotated_y(argument::finite(degrees, "degrees")?),
+            map: self.map.rotated_y(degrees),
         })
     }
 
@@ -199,20 +227,16 @@ impl EnvMap {
 /// The 4 × 4 camera-to-world matrix of a camera at `origin` looking at `target` with `up`
 /// upwards (Mitsuba's `lookat`: columns left, up, forward, origin).
 #[pyfunction]
-#[pyo3(signature = (origin, target, up = [0.0, 1.0, 0.0]), text_signature = "(origin, target, up=(0.0, 1.0, 0.0))")]
+#[pyo3(signature = (origin, target, up = None), text_signature = "(origin, target, up=(0.0, 1.0, 0.0))")]
 pub fn look_at<'py>(
     py: Python<'py>,
-    origin: [f32; 3],
-    target: [f32; 3],
-    up: [f32; 3],
+    origin: &Bound<'py, PyAny>,
+    target: &Bound<'py, PyAny>,
+    up: Option<&Bound<'py, PyAny>>,
 ) -> PyResult<Bound<'py, PyArray2<f64>>> {
-    for (arg, v) in [("origin", origin), ("target", target), ("up", up)] {
-        if !v.iter().all(|c| c.is_finite()) {
-            return Err(input_error(format!(
-                "{arg} must be three finite numbers, got {v:?}"
-            )));
-        }
-    }
+    let origin = argument::vec3(origin, "origin")?;
+    let target = argument::vec3(target, "target")?;
+    let up = argument::vec3_or_none(up, "up")?.unwrap_or([0.0, 1.0, 0.0]);
     let (o, t, u): (glam::Vec3, glam::Vec3, glam::Vec3) = (origin.into(), target.into(), up.into());
     if o == t {
         return Err(input_error(
@@ -230,7 +254,7 @@ pub fn look_at<'py>(
     ))
 }
 
-/// Opens an environment map: an .exr/.hdr file (a `str` or a `pathlib.Path`),
+/// Opens the environment map `spec` names: an .exr/.hdr file (a `str` or a `pathlib.Path`),
 /// `builtin:sky[:ELEV[:AZIM[:TURB]]]` or `builtin:indoor[:SEED]`.
 #[pyfunction]
 pub fn open_envmap(py: Python<'_>, spec: &Bound<'_, PyAny>) -> PyResult<EnvMap> {
@@ -247,30 +271,34 @@ pub fn open(py: Python<'_>, spec: &str) -> PyResult<EnvMap> {
 }
 
 /// A path-traced frame of `scene` under `envmap` through `camera` (4 × 4 camera-to-world,
-/// horizontal field of view `fov`), `spp` paths per pixel over the pixel (box filter), as
+/// horizontal field of view `fov`) at `width` × `height` pixels, `spp` paths per pixel over the
+/// pixel (box filter) from `seed`, each at most `max_depth` bounces (None: the scene's), as
 /// `nprt reference` renders: an (H, W, 3) float32 array of linear radiance. `scene` and
 /// `envmap` may be loaded objects or what names them (a `str` or a `pathlib.Path`). Ctrl-C
 /// stops it within a moment (`nprt.Interrupted`).
 #[pyfunction]
-#[pyo3(signature = (scene, envmap, camera, width, height, fov = 60.0, spp = 64, seed = 0, max_depth = None))]
+#[pyo3(
+    signature = (scene, envmap, camera, width, height, fov = None, spp = None, seed = None, max_depth = None),
+    text_signature = "(scene, envmap, camera, width, height, fov=60.0, spp=64, seed=0, max_depth=None)"
+)]
 #[allow(clippy::too_many_arguments)]
 pub fn reference<'py>(
     py: Python<'py>,
     scene: &Bound<'py, PyAny>,
     envmap: &Bound<'py, PyAny>,
-    camera: PyArrayLike2<f32, AllowTypeChange>,
-    width: i64,
-    height: i64,
-    fov: f32,
-    spp: u32,
-    seed: u64,
-    max_depth: Option<u32>,
+    camera: &Bound<'py, PyAny>,
+    width: &Bound<'py, PyAny>,
+    height: &Bound<'py, PyAny>,
+    fov: Option<&Bound<'py, PyAny>>,
+    spp: Option<&Bound<'py, PyAny>>,
+    seed: Option<&Bound<'py, PyAny>>,
+    max_depth: Option<&Bound<'py, PyAny>>,
 ) -> PyResult<Bound<'py, PyArray3<f32>>> {
     let (width, height) = arrays::frame_size(width, height)?;
-    let camera = arrays::camera(camera, fov, width, height).or_py()?;
-    if spp == 0 {
-        return Err(input_error("spp (samples per pixel) must be at least 1"));
-    }
+    let camera = arrays::camera(camera, fov, width, height)?;
+    let spp = argument::whole_or_none(spp, "spp", 1..=u32::MAX)?.unwrap_or(64);
+    let seed = argument::whole_or_none(seed, "seed", 0..=u64::MAX)?.unwrap_or(0);
+    let max_depth = argument::whole_or_none(max_depth, "max_depth", 0..=u32::MAX)?;
     let scene = scene_arg(scene, "scene")?;
     let envmap = envmap_arg(envmap, "envmap")?;
     let scene = scene.get();

@@ -1,8 +1,6 @@
 //! `nprt.train`: `nprt train` from Python, its defaults the library's (`TrainOptions`,
 //! `ModelConfig`).
 
-use std::path::PathBuf;
-
 use std::sync::Mutex;
 
 use nprt_net::deep_shading::{self, DeepShadingOptions};
@@ -13,16 +11,19 @@ use nprt_net::{Asked, RunLength, TrainOptions, TrainSummary};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
-use crate::argument::finite_or_none;
-use crate::choice::{engine, parse};
+use crate::argument;
+use crate::choice::{engine_arg, named};
 use crate::error::OrPy;
 
 /// Trains `arch` (one of `nprt.DESIGNS`, with its own defaults; None: the recommended recipe,
 /// nprt's measured best, as `nprt train` without `--arch`) on the dataset `data` into the model
 /// folder `out` (a run already there with the same settings is resumed, and a larger `epochs`
 /// or `minutes` continues a finished one), on `device`, for `minutes` of training time and/or
-/// `epochs` passes (without either: 20 epochs). `None` takes `nprt train`'s default. Returns
-/// the run: `epochs`, `steps`, `samples_per_s`, `train_loss`, `validation_loss`, `seconds`,
+/// `epochs` passes (without either: 20 epochs), from `seed`, with a progress bar unless
+/// `progress` is False. `None` takes `nprt train`'s default, as for `activation` ("siren" or
+/// "relu"), `precision` ("f32" or "f16"), `batch_size`, `lr` (the learning rate) and
+/// `schedule` (the learning rate's: "paper" or "cosine"). Returns
+/// the run: `epochs`, `steps`, `samples_per_s`, `train_loss`, `val_loss`, `seconds`,
 /// `steps_on` and `resumed_from_epoch`; the loss curves are in `out`/loss.csv.
 ///
 /// `snapshots` keeps the model at points of the run (`"1m,2m,4m"`: minutes of training time
@@ -44,75 +45,84 @@ use crate::error::OrPy;
 #[pyfunction]
 #[pyo3(signature = (
     data, arch = None, out = None, *, minutes = None, epochs = None, activation = None,
-    device = "cpu", precision = None, batch_size = None, lr = None, schedule = None, seed = None,
-    progress = true, callback = None, basis = None, snapshots = None, targets = None,
+    device = None, precision = None, batch_size = None, lr = None, schedule = None, seed = None,
+    progress = None, callback = None, basis = None, snapshots = None, targets = None,
     direct = None, calibrate = None
-))]
+), text_signature = "(data, arch=None, out=None, *, minutes=None, epochs=None, activation=None, \
+    device='cpu', precision=None, batch_size=None, lr=None, schedule=None, seed=None, \
+    progress=True, callback=None, basis=None, snapshots=None, targets=None, direct=None, \
+    calibrate=None)")]
 #[allow(clippy::too_many_arguments)]
 pub fn train<'py>(
     py: Python<'py>,
-    data: PathBuf,
-    arch: Option<&str>,
-    out: Option<PathBuf>,
-    minutes: Option<f64>,
-    epochs: Option<usize>,
-    activation: Option<&str>,
-    device: &str,
-    precision: Option<&str>,
-    batch_size: Option<usize>,
-    lr: Option<f64>,
-    schedule: Option<&str>,
-    seed: Option<u64>,
-    progress: bool,
-    callback: Option<Py<PyAny>>,
-    basis: Option<&str>,
-    snapshots: Option<&str>,
-    targets: Option<&str>,
-    direct: Option<&str>,
-    calibrate: Option<&str>,
+    data: &Bound<'py, PyAny>,
+    arch: Option<&Bound<'py, PyAny>>,
+    out: Option<&Bound<'py, PyAny>>,
+    minutes: Option<&Bound<'py, PyAny>>,
+    epochs: Option<&Bound<'py, PyAny>>,
+    activation: Option<&Bound<'py, PyAny>>,
+    device: Option<&Bound<'py, PyAny>>,
+    precision: Option<&Bound<'py, PyAny>>,
+    batch_size: Option<&Bound<'py, PyAny>>,
+    lr: Option<&Bound<'py, PyAny>>,
+    schedule: Option<&Bound<'py, PyAny>>,
+    seed: Option<&Bound<'py, PyAny>>,
+    progress: Option<&Bound<'py, PyAny>>,
+    callback: Option<Bound<'py, PyAny>>,
+    basis: Option<&Bound<'py, PyAny>>,
+    snapshots: Option<&Bound<'py, PyAny>>,
+    targets: Option<&Bound<'py, PyAny>>,
+    direct: Option<&Bound<'py, PyAny>>,
+    calibrate: Option<&Bound<'py, PyAny>>,
 ) -> PyResult<Bound<'py, PyDict>> {
-    let out =
-        out.ok_or_else(|| crate::error::input_error("out: give the model folder to write"))?;
+    let data = argument::path(data, "data")?;
+    let out = argument::path_or_none(out, "out")?
+        .ok_or_else(|| crate::error::input_error("out=None: give the model folder to write"))?;
+    let callback = argument::callable_or_none(callback, "callback")?;
+    let progress = argument::flag_or(progress, "progress", true)?;
     let asked = Asked {
-        design: arch.map(parse).transpose()?,
-        activation: activation.map(parse).transpose()?,
-        direct: direct.map(parse).transpose()?,
-        basis: basis.map(parse).transpose()?,
-        calibration: calibrate.map(parse).transpose()?,
-        targets: targets.map(parse).transpose()?,
+        design: named(arch, "arch")?,
+        activation: named(activation, "activation")?,
+        direct: named(direct, "direct")?,
+        basis: named(basis, "basis")?,
+        calibration: named(calibrate, "calibrate")?,
+        targets: named(targets, "targets")?,
     };
     let config = asked.config().or_py()?;
     let d = TrainOptions::default();
-    let (minutes, lr) = (
-        finite_or_none(minutes, "minutes")?,
-        finite_or_none(lr, "lr")?,
-    );
     let run = RunLength {
-        epochs,
-        minutes,
-        lr_schedule: schedule.map(parse).transpose()?,
+        epochs: argument::whole_or_none(epochs, "epochs", 1..=usize::MAX)?,
+        minutes: minutes_or_none(minutes, "minutes")?,
+        lr_schedule: named(schedule, "schedule")?,
     };
+    let lr = argument::number_or_none(lr, "lr", f64::MIN_POSITIVE..=f64::MAX)?;
+    let snapshots = argument::text_or_none(snapshots, "snapshots", "a str such as \"1m,2m,4m\"")?;
     let opts = TrainOptions {
         schedule: nprt_net::Schedule {
-            seed: seed.unwrap_or(d.schedule.seed),
+            seed: argument::whole_or_none(seed, "seed", 0..=u64::MAX)?.unwrap_or(d.schedule.seed),
             progress,
-            snapshots: (snapshots.map(Snapshot::parse_list).transpose())
-                .map_err(|e| crate::error::input_error(format!("snapshots: {e}")))?
+            snapshots: (snapshots.as_deref().map(Snapshot::parse_list).transpose())
+                .map_err(|e| crate::error::input_error(format!("snapshots={snapshots:?}: {e}")))?
                 .unwrap_or_default(),
             ..d.schedule
         },
-        batch_size: batch_size.unwrap_or(d.batch_size),
-        precision: precision.map(parse).transpose()?.unwrap_or(d.precision),
+        batch_size: argument::whole_or_none(batch_size, "batch_size", 1..=usize::MAX)?
+            .unwrap_or(d.batch_size),
+        precision: named(precision, "precision")?.unwrap_or(d.precision),
         calibration: asked.calibration(),
         ..d
     }
     .with_run(config.design, run, lr);
-    let engine = engine(device)?;
+    let engine = engine_arg(device)?;
     let watch = EpochWatch::new(callback);
     let (summary, _) = py
         .detach(|| {
             opts.check()?;
-            let set = TrainingSet::load(&data, &config, progress, |why| eprintln!("{why}"))?;
+            let set = TrainingSet::load(&data, &config, progress, |why| {
+                if progress {
+                    eprintln!("{why}")
+                }
+            })?;
             let opts = TrainOptions {
                 targets: asked.targets(&config, set.manifest.settings.transfer),
                 ..opts
@@ -125,49 +135,56 @@ pub fn train<'py>(
     Ok(s)
 }
 
+/// Minutes of training time, as `nprt train --minutes` takes them ([`nprt_net::check_minutes`]).
+fn minutes_or_none(obj: Option<&Bound<'_, PyAny>>, arg: &str) -> PyResult<Option<f64>> {
+    let range = nprt_net::MIN_MINUTES..=nprt_net::MAX_MINUTES;
+    argument::number_or_none(obj, arg, range)
+}
+
 /// Trains the Deep Shading baseline (Nalbach et al. 2017, a U-Net on G-buffer images) on
 /// `data` into `out`, on `device` as for [`train`], as `nprt train-deep-shading`; `minutes`, `epochs`,
-/// `schedule` and `callback` as for [`train`]. Returns what [`train`] returns, and
-/// `unet_params` and `encoder_params`.
+/// `schedule`, `lr`, `seed`, `progress` and `callback` as for [`train`]; `batch_views` views
+/// per batch. Returns what [`train`] returns, and `unet_params` and `encoder_params`.
 #[pyfunction]
 #[pyo3(signature = (
     data, out, *, minutes = None, epochs = None, schedule = None, lr = None, seed = None,
-    batch_views = None, device = "cpu", progress = true, callback = None
-))]
+    batch_views = None, device = None, progress = None, callback = None
+), text_signature = "(data, out, *, minutes=None, epochs=None, schedule=None, lr=None, \
+    seed=None, batch_views=None, device='cpu', progress=True, callback=None)")]
 #[allow(clippy::too_many_arguments)]
 pub fn train_deep_shading<'py>(
     py: Python<'py>,
-    data: PathBuf,
-    out: PathBuf,
-    minutes: Option<f64>,
-    epochs: Option<usize>,
-    schedule: Option<&str>,
-    lr: Option<f64>,
-    seed: Option<u64>,
-    batch_views: Option<usize>,
-    device: &str,
-    progress: bool,
-    callback: Option<Py<PyAny>>,
+    data: &Bound<'py, PyAny>,
+    out: &Bound<'py, PyAny>,
+    minutes: Option<&Bound<'py, PyAny>>,
+    epochs: Option<&Bound<'py, PyAny>>,
+    schedule: Option<&Bound<'py, PyAny>>,
+    lr: Option<&Bound<'py, PyAny>>,
+    seed: Option<&Bound<'py, PyAny>>,
+    batch_views: Option<&Bound<'py, PyAny>>,
+    device: Option<&Bound<'py, PyAny>>,
+    progress: Option<&Bound<'py, PyAny>>,
+    callback: Option<Bound<'py, PyAny>>,
 ) -> PyResult<Bound<'py, PyDict>> {
-    let engine = engine(device)?;
+    let (data, out) = (argument::path(data, "data")?, argument::path(out, "out")?);
+    let callback = argument::callable_or_none(callback, "callback")?;
+    let engine = engine_arg(device)?;
     let d = DeepShadingOptions::default();
-    let (minutes, lr) = (
-        finite_or_none(minutes, "minutes")?,
-        finite_or_none(lr, "lr")?,
-    );
+    let lr = argument::number_or_none(lr, "lr", f64::MIN_POSITIVE..=f64::MAX)?;
     let run = RunLength {
-        epochs,
-        minutes,
-        lr_schedule: schedule.map(parse).transpose()?,
+        epochs: argument::whole_or_none(epochs, "epochs", 1..=usize::MAX)?,
+        minutes: minutes_or_none(minutes, "minutes")?,
+        lr_schedule: named(schedule, "schedule")?,
     };
     let opts = DeepShadingOptions {
         schedule: run.apply(nprt_net::Schedule {
             learning_rate: lr.unwrap_or(d.schedule.learning_rate),
-            seed: seed.unwrap_or(d.schedule.seed),
-            progress,
+            seed: argument::whole_or_none(seed, "seed", 0..=u64::MAX)?.unwrap_or(d.schedule.seed),
+            progress: argument::flag_or(progress, "progress", true)?,
             ..d.schedule
         }),
-        batch_views: batch_views.unwrap_or(d.batch_views),
+        batch_views: argument::whole_or_none(batch_views, "batch_views", 1..=usize::MAX)?
+            .unwrap_or(d.batch_views),
         ..d
     };
     let watch = EpochWatch::new(callback);
@@ -236,7 +253,7 @@ fn summary_dict<'py>(py: Python<'py>, summary: &TrainSummary) -> PyResult<Bound<
         summary.samples as f64 / summary.seconds.max(1e-9),
     )?;
     s.set_item("train_loss", summary.final_train)?;
-    s.set_item("validation_loss", summary.final_val)?;
+    s.set_item("val_loss", summary.final_val)?;
     s.set_item("steps_on", summary.steps_on.as_str())?;
     s.set_item("resumed_from_epoch", summary.resumed_from_epoch)?;
     Ok(s)

@@ -216,6 +216,24 @@ fn a_visit_s_model_lands_whole_or_changes_nothing() {
         assert!(err.contains(why), "{why}: {err}");
         assert_eq!(run_bytes(&run), before, "{why}");
     }
+    // Into the model's own folder (it was copied into itself until the names grew too long), or
+    // into a file.
+    let file = run.join("visits.csv");
+    for (into, why) in [(&model, "is the model folder"), (&file, "is not a folder")] {
+        let o = common::nprt(&[
+            "model",
+            "land",
+            model.to_str().unwrap(),
+            "--into",
+            into.to_str().unwrap(),
+            "--landed",
+            "2026-11-29T12:00Z",
+        ]);
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert!(err.contains(why), "{why}: {err}");
+        assert_eq!(run_bytes(&run), before, "{why}");
+    }
+    assert!(!model.join("model").exists());
     let table = format!(
         "{}\n2026-11-29T12:05Z,99,999999999,9,0.01\n",
         table.trim_end()

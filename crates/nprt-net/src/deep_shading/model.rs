@@ -2,7 +2,7 @@
 
 use std::path::Path;
 
-use anyhow::{Context, Result};
+use anyhow::{bail, Context, Result};
 use glam::Vec3;
 use nprt_scene::EnvMap;
 use nprt_trace::GBuffer;
@@ -12,7 +12,7 @@ use super::options::DeepShadingOptions;
 use super::unet::feature_image;
 use crate::engine::Engine;
 use crate::init::Init;
-use crate::model::folder::{check_bounds, load_weights, read_config, WEIGHTS_FILE};
+use crate::model::folder::{check_bounds, check_whole, load_weights, read_config, WEIGHTS_FILE};
 use crate::network::encoder::{check_input_width, LightInput};
 use crate::network::unet::DeepShading;
 use crate::shading::UnetShading;
@@ -35,6 +35,10 @@ pub struct DeepShadingFile {
     pub options: DeepShadingOptions,
     pub epochs_done: usize,
     pub seconds: f64,
+    /// BLAKE3 of the weights file this config was saved with (as a model folder's `model.json`
+    /// names it: [`check_whole`]); absent in older files.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub weights_blake3: Option<String>,
 }
 
 /// A trained Deep Shading network, ready to shade.
@@ -50,6 +54,13 @@ pub fn read_file(dir: &Path) -> Result<DeepShadingFile> {
     check_input_width(file.encoder_width)
         .and_then(|()| check_bounds(&file.bounds))
         .with_context(|| format!("Deep Shading model '{}'", dir.display()))?;
+    if !(file.seconds.is_finite() && file.seconds >= 0.0) {
+        bail!(
+            "Deep Shading model '{}' says it trained {} s; the file is damaged",
+            dir.display(),
+            nprt_io::short_number(file.seconds)
+        );
+    }
     Ok(file)
 }
 
@@ -58,7 +69,20 @@ impl DeepShadingModel {
     pub fn load(dir: &Path, engine: Engine) -> Result<Self> {
         let file = read_file(dir)?;
         let mut net = DeepShading::new(&mut Init::new(0), file.encoder_width);
-        load_weights(&dir.join(WEIGHTS_FILE), &mut net, TAG)?;
+        let hash = load_weights(&dir.join(WEIGHTS_FILE), &mut net, TAG)?;
+        let counts = [net.unet_params(), crate::Parameters::num_params(&net.light)];
+        if [file.unet_params, file.encoder_params] != counts {
+            bail!(
+                "Deep Shading model '{}': its {CONFIG_FILE} counts {} U-Net and {} encoder \
+                 parameters, its network has {} and {}; the file is damaged",
+                dir.display(),
+                file.unet_params,
+                file.encoder_params,
+                counts[0],
+                counts[1]
+            );
+        }
+        check_whole(dir, CONFIG_FILE, file.weights_blake3.as_deref(), &hash)?;
         Ok(DeepShadingModel {
             file,
             net: engine.unet(net)?,

@@ -117,8 +117,9 @@ impl Objective for UnetObjective {
         schedule: &Schedule,
         state: &RunState,
     ) -> Result<()> {
-        save_weights(&out.join(WEIGHTS_FILE), net, TAG)?;
+        let hash = save_weights(&out.join(WEIGHTS_FILE), net, TAG)?;
         let mut file = self.file.clone();
+        file.weights_blake3 = Some(hash);
         file.options.schedule = schedule.clone();
         file.unet_params = net.unet_params();
         file.encoder_params = net.light.num_params();
@@ -181,6 +182,7 @@ pub fn train(
         options: opts.clone(),
         epochs_done: 0,
         seconds: 0.0,
+        weights_blake3: None,
     };
     let objective = UnetObjective {
         train,

@@ -201,6 +201,36 @@ impl ModelConfig {
 mod tests {
     use super::*;
 
+    /// A network's memory is bounded before it is built: a learned:1024 basis at width 1024 is
+    /// 537 M floats (it held 12.8 GB in training and aborted under a memory limit).
+    #[test]
+    fn a_network_beyond_memory_is_refused_naming_its_basis_and_width() {
+        let mut config = ModelConfig::new(Design::Linear, None);
+        config.encoder_width = 1024;
+        config.basis = Some("learned:1024".parse().unwrap());
+        assert!(config.floats_bound() >= 1024 * 1024 * 512);
+        let err = config
+            .ensure_memory(1 << 40, "training the network")
+            .unwrap_err()
+            .to_string();
+        assert!(
+            err.contains("training the network (basis learned:1024 at encoder width 1024)"),
+            "{err}"
+        );
+        // The bound holds every design's network at the default width.
+        for design in Design::ALL {
+            let config = ModelConfig::new(design, None);
+            let net = config.build(&mut Init::new(0));
+            assert!(
+                net.total_params() as u128 <= config.floats_bound(),
+                "{design}"
+            );
+        }
+        ModelConfig::new(Design::Dsep, None)
+            .ensure_memory(1, "a network")
+            .unwrap();
+    }
+
     #[test]
     fn older_configs_read_as_the_paper_s_and_learned_ones_keep_their_old_form() {
         let old = r#"{"design": "dsep", "activation": "siren", "encoder_width": 128}"#;

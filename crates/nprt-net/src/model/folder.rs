@@ -323,6 +323,23 @@ pub fn read_config<T: DeserializeOwned>(
     serde_json::from_value(value).with_context(|| format!("'{}' is malformed", path.display()))
 }
 
+/// Refuses a model folder whose weights (BLAKE3 `hash`) are not the ones its config
+/// `config_file` was saved with (`saved`; none in files from before it was recorded): the
+/// config is written last, so the folder was cut between its two writes, or edited.
+pub fn check_whole(dir: &Path, config_file: &str, saved: Option<&str>, hash: &str) -> Result<()> {
+    if let Some(saved) = saved.filter(|s| *s != hash) {
+        bail!(
+            "model '{}' is incomplete: its {WEIGHTS_FILE} (BLAKE3 {}…) is not the one {config_file} \
+             was saved with ({}…), as when a save is cut between its two files; run the training \
+             again to save it whole",
+            dir.display(),
+            &hash[..12],
+            saved.get(..12).unwrap_or(saved)
+        );
+    }
+    Ok(())
+}
+
 /// Loads a trained model folder.
 pub fn load_model(dir: &Path) -> Result<(ModelFile, NprtNet)> {
     let file = read_model_file(dir)?;
@@ -347,15 +364,6 @@ pub fn load_model(dir: &Path) -> Result<(ModelFile, NprtNet)> {
             counts[1]
         );
     }
-    if let Some(saved) = file.weights_blake3.as_ref().filter(|s| **s != hash) {
-        bail!(
-            "model '{}' is incomplete: its {WEIGHTS_FILE} (BLAKE3 {}…) is not the one {CONFIG_FILE} \
-             was saved with ({}…), as when a save is cut between its two files; run the training \
-             again to save it whole",
-            dir.display(),
-            &hash[..12],
-            &saved[..saved.len().min(12)]
-        );
-    }
+    check_whole(dir, CONFIG_FILE, file.weights_blake3.as_deref(), &hash)?;
     Ok((file, net))
 }

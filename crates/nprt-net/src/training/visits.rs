@@ -157,6 +157,20 @@ fn write_visits(path: &Path, rows: &[Visit]) -> Result<()> {
 /// on from the last visit), then replaces `run/model` with it as one folder renamed into place
 /// and adds its row to `run/visits.csv`. Nothing in `run` changes when a check fails.
 pub fn land(model: &Path, run: &Path, landed: &str) -> Result<Visit> {
+    if run.exists() && !run.is_dir() {
+        bail!("--into '{}' is not a folder", run.display());
+    }
+    // A run folder in the model's would be copied into itself.
+    if let (Ok(m), Ok(r)) = (model.canonicalize(), run.canonicalize()) {
+        if r.starts_with(&m) {
+            bail!(
+                "--into '{}' is the model folder '{}' or inside it; land the model in the run's \
+                 own folder",
+                run.display(),
+                model.display()
+            );
+        }
+    }
     load_model(model).context("the visit's model does not load")?;
     let visit = Visit::of_model(model, landed)?;
     let table = run.join(VISITS_FILE);
