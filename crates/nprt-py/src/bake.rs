@@ -7,7 +7,7 @@ use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
 use crate::argument;
-use crate::choice::engine_arg;
+use crate::choice::{engine_arg, named_or};
 use crate::interruptible::interruptible;
 
 /// Bakes `scene` under `envmaps` (a folder of maps, or "builtin") into a relit model in `out`
@@ -47,15 +47,7 @@ pub fn bake<'py>(
     let scene = crate::scene::scene_spec(scene, "scene")?;
     let envmaps = crate::scene::envmaps_spec(envmaps)?;
     let out = argument::path(out, "out")?;
-    let quality = argument::text_or_none(quality, "quality", "a str")?;
-    let quality: Quality =
-        quality
-            .as_deref()
-            .unwrap_or("draft")
-            .parse()
-            .map_err(|e: anyhow::Error| {
-                crate::error::input_error(format!("quality={:?}: {e}", quality.unwrap_or_default()))
-            })?;
+    let quality: Quality = named_or(quality, "quality", "draft")?;
     let range = nprt_net::MIN_MINUTES..=nprt_net::MAX_MINUTES;
     let bake = Bake {
         minutes: argument::number_or_none(minutes, "minutes", range)?,

@@ -14,16 +14,31 @@ pub fn parse<T: FromStr<Err = String>>(name: &str) -> PyResult<T> {
 }
 
 /// The choice `obj` names (a str), for the argument `arg`; `None` where it is `None`.
-pub fn named<T: FromStr<Err = String>>(
-    obj: Option<&Bound<'_, PyAny>>,
-    arg: &str,
-) -> PyResult<Option<T>> {
+pub fn named<T>(obj: Option<&Bound<'_, PyAny>>, arg: &str) -> PyResult<Option<T>>
+where
+    T: FromStr,
+    T::Err: std::fmt::Display,
+{
     crate::argument::text_or_none(obj, arg, "a str")?
         .map(|name| {
             name.parse()
-                .map_err(|e: String| crate::error::input_error(format!("{arg}={name:?}: {e}")))
+                .map_err(|e| crate::error::input_error(format!("{arg}={name:?}: {e:#}")))
         })
         .transpose()
+}
+
+/// [`named`], the choice `default` names where `obj` is `None`.
+pub fn named_or<T>(obj: Option<&Bound<'_, PyAny>>, arg: &str, default: &str) -> PyResult<T>
+where
+    T: FromStr,
+    T::Err: std::fmt::Display,
+{
+    match named(obj, arg)? {
+        Some(t) => Ok(t),
+        None => default
+            .parse()
+            .map_err(|e| crate::error::input_error(format!("{arg}={default:?}: {e:#}"))),
+    }
 }
 
 /// The engine `device` ("cpu", "gpu", "wgpu" or "auto") names, resolved as `--device` is; an

@@ -64,7 +64,6 @@ pub fn evaluate<'py>(
         nrc_warmup: whole(nrc_warmup, "nrc_warmup", 0..=usize::MAX)?.unwrap_or(d.nrc_warmup),
         oracles: argument::flag_or(oracles, "oracles", d.oracles)?,
         progress: argument::flag_or(progress, "progress", true)?,
-        ..d
     };
     let engine = engine_arg(device)?;
     interruptible(py, || {

@@ -14,7 +14,7 @@ use crate::argument;
 use crate::arrays;
 use crate::choice::engine_arg;
 use crate::error::OrPy;
-use crate::scene::{envmap_arg, scene_arg, Scene};
+use crate::scene::{envmap_arg, scene_arg, Reduced, Scene};
 
 /// The model folder `path` that `nprt train` wrote, ready to relight frames on `device` ("cpu",
 /// "gpu", "wgpu" or "auto").
@@ -159,7 +159,7 @@ impl Model {
     }
 
     /// Pickled by its folder and device (a worker process loads it again).
-    fn __reduce__<'py>(&self, py: Python<'py>) -> PyResult<(Bound<'py, PyAny>, (PathBuf, String))> {
+    fn __reduce__<'py>(&self, py: Python<'py>) -> PyResult<Reduced<'py, (PathBuf, String)>> {
         let class = py.import("nprt")?.getattr("Model")?;
         Ok((class, (self.dir.clone(), self.asked.clone())))
     }

@@ -8,7 +8,7 @@ use pyo3::types::PyDict;
 
 use crate::argument;
 use crate::arrays;
-use crate::choice::engine_arg;
+use crate::choice::{engine_arg, named_or};
 use crate::error::OrPy;
 
 /// Runs the paper's tables on `scene` under `envmaps` at `budget` ("tiny", "small", "medium",
@@ -42,15 +42,7 @@ pub fn paper<'py>(
     let scene = crate::scene::scene_spec(scene, "scene")?;
     let envmaps = crate::scene::envmaps_spec(envmaps)?;
     let out = argument::path(out, "out")?;
-    let budget = argument::text_or_none(budget, "budget", "a str")?;
-    let budget: Budget =
-        budget
-            .as_deref()
-            .unwrap_or("small")
-            .parse()
-            .map_err(|e: anyhow::Error| {
-                crate::error::input_error(format!("budget={:?}: {e}", budget.unwrap_or_default()))
-            })?;
+    let budget: Budget = named_or(budget, "budget", "small")?;
     let snapshots = argument::text_or_none(snapshots, "snapshots", "a str such as \"1m,2m,4m\"")?;
     let range = nprt_net::MIN_MINUTES..=nprt_net::MAX_MINUTES;
     let x = Experiment {

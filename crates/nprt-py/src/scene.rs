@@ -87,7 +87,7 @@ impl Scene {
     }
 
     /// Pickled by what it was loaded from (a worker process loads it again).
-    fn __reduce__<'py>(&self, py: Python<'py>) -> PyResult<(Bound<'py, PyAny>, (String,))> {
+    fn __reduce__<'py>(&self, py: Python<'py>) -> PyResult<Reduced<'py, (String,)>> {
         Ok((
             py.import("nprt")?.getattr("load_scene")?,
             (self.spec.clone(),),
@@ -125,6 +125,9 @@ pub fn load(py: Python<'_>, spec: &str) -> PyResult<Scene> {
         hash: OnceLock::new(),
     })
 }
+
+/// What `__reduce__` gives pickle: a callable and its arguments.
+pub type Reduced<'py, A> = (Bound<'py, PyAny>, A);
 
 /// A lat-long environment map (Mitsuba 3's mapping), 2:1, linear RGB radiance: made from
 /// `texels`, an (H, 2H, 3) array of real numbers, called `name` (negative texels are clamped to
@@ -190,7 +193,7 @@ impl EnvMap {
     fn __reduce__<'py>(
         &self,
         py: Python<'py>,
-    ) -> PyResult<(Bound<'py, PyAny>, (Bound<'py, PyArray3<f32>>, String))> {
+    ) -> PyResult<Reduced<'py, (Bound<'py, PyArray3<f32>>, String)>> {
         let class = py.import("nprt")?.getattr("EnvMap")?;
         Ok((class, (self.to_array(py), self.map.name().to_string())))
     }

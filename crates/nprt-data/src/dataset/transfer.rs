@@ -166,7 +166,7 @@ impl Transfer {
                     if v.len() != pixels {
                         bail!("channel '{channel}' holds {} values, not {pixels}", v.len());
                     }
-                    if let Some(p) = v.iter().position(|x| !(x.abs() <= MAX_TRANSFER)) {
+                    if let Some(p) = v.iter().position(|x| x.is_nan() || x.abs() > MAX_TRANSFER) {
                         bail!(
                             "channel '{channel}' is {:e} at pixel {p}, beyond the ±{MAX_TRANSFER} \
                              a transfer value may hold (it is packed as f16)",

@@ -14,6 +14,7 @@ pub mod host_steps;
 pub mod kernel_steps;
 pub mod loss_curves;
 pub mod lr_schedule;
+pub mod minutes;
 pub mod nprt_objective;
 pub mod recipe;
 pub mod run_length;

@@ -5,7 +5,7 @@ use anyhow::{bail, Result};
 use serde::{Deserialize, Serialize};
 
 use crate::training::lr_schedule::LrSchedule;
-use crate::training::run_length::check_minutes;
+use crate::training::minutes::check_minutes;
 use crate::training::snapshot::Snapshot;
 
 /// The loop's own settings, shared by every network.

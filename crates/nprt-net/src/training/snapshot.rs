@@ -8,7 +8,7 @@ use std::path::{Path, PathBuf};
 use std::str::FromStr;
 
 use crate::model::folder::{CONFIG_FILE, WEIGHTS_FILE};
-use crate::training::run_length::check_minutes;
+use crate::training::minutes::check_minutes;
 
 /// The folder of a model folder that holds its snapshots.
 pub const SNAPSHOTS: &str = "snapshots";

@@ -13,7 +13,7 @@ use serde::{Deserialize, Serialize};
 
 use crate::model::folder::load_model;
 use crate::training::checkpoint;
-use crate::training::run_length::MAX_MINUTES;
+use crate::training::minutes::MAX_MINUTES;
 
 /// The run's table of visits, beside its model folder.
 pub const VISITS_FILE: &str = "visits.csv";
