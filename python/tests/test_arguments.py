@@ -3,6 +3,7 @@ nprt's InputError (a ValueError) naming the keyword, the value and the rule, nev
 layer's TypeError or OverflowError; keywords in messages, docstrings that name every keyword."""
 
 import inspect
+import re
 
 import numpy as np
 import pytest
@@ -15,7 +16,7 @@ NOT_NUMBER = [float("nan"), float("inf"), "1.5", True, 1j, [1.0]]
 
 
 def _refused(call, arg):
-    with pytest.raises(nprt.InputError, match=f"^{arg}=") as raised:
+    with pytest.raises(nprt.InputError, match=f"^{re.escape(arg)}=") as raised:
         call()
     assert isinstance(raised.value, ValueError)
     return str(raised.value)
@@ -189,3 +190,38 @@ def test_scenes_maps_and_models_pickle_by_their_source_and_maps_are_arrays(room,
     camera, fov, _ = room.camera()
     np.testing.assert_array_equal(m.render(room, sky, camera, 8, 6, fov),
                                   nprt.Model(model).render(room, sky, camera, 8, 6, fov))
+
+
+def test_the_network_runs_on_a_dataset_view_s_arrays(dataset, model, room):
+    m, ds = nprt.Model(model), nprt.Dataset(dataset)
+    view = ds.view(ds.split("test")[0])
+    sky = nprt.open_envmap(view["lighting"]["map"]).rotated(view["lighting"]["rotation_deg"])
+    radiance = m(view, sky)
+    assert radiance.shape == view["radiance"].shape and radiance.dtype == np.float32
+    background = view["mask"] == 0
+    assert (radiance[background] == 0).all() and np.isfinite(radiance).all()
+    # The frame render makes of the same view: the same networks on its own G-buffer.
+    camera, fov, (w, h) = ds.camera(view["index"])
+    frame = m.render(room, sky, camera, w, h, fov)
+    both = (view["mask"] > 0) & (np.abs(frame - radiance).max(axis=2) < 1e9)
+    assert np.median(np.abs(frame[both] - radiance[both])) < 1e-3 * max(frame[both].mean(), 1e-6)
+    _refused(lambda: m({"position": view["position"]}, sky), "gbuffer")
+    with pytest.raises(nprt.InputError, match=r"gbuffer\['kd'\] is 2 × 32 pixels"):
+        m({**view, "kd": view["kd"][:2]}, sky)
+    _refused(lambda: m({**view, "alpha": view["kd"]}, sky), "gbuffer['alpha']")
+    weights = m.weights()
+    info = nprt.model_info(model)
+    assert sum(w.size for w in weights.values()) == info["total_params"]
+    assert all(w.dtype == np.float32 for w in weights.values())
+    code = m.light_code(sky)
+    assert code["code"].shape == (64,) and code["scale"].shape == (3,)
+
+
+def test_render_without_out_returns_the_frames(model, tmp_path):
+    import glob
+    import tempfile
+
+    done = nprt.render(model, frames=2, res=(16, 12))
+    assert done["frames"].shape == (2, 12, 16, 3) and done["frames"].dtype == np.float32
+    assert "frames_dir" not in done and np.isfinite(done["frames"]).all()
+    assert not glob.glob(f"{tempfile.gettempdir()}/nprt-render-*")

@@ -56,3 +56,17 @@ def test_the_python_quick_starts_run_as_written(tmp_path):
             os.chdir(cwd)
         frame = scope["frame"]
         assert frame.ndim == 3 and frame.shape[2] == 3 and frame.mean() > 0
+
+
+def test_the_notebook_example_runs_as_written(tmp_path, capsys):
+    # docs/python.md: the network on a dataset view's arrays, and the view's transfer vectors.
+    code = blocks("docs/python.md", "python", "In a notebook, the network")[0]
+    cwd = os.getcwd()
+    os.chdir(tmp_path)
+    try:
+        exec(compile(code, "notebook example", "exec"), {})
+    finally:
+        os.chdir(cwd)
+    printed = capsys.readouterr().out.splitlines()
+    assert float(printed[0]) >= 0 and printed[1] == "(32, 32, 4, 3)", printed
+    assert printed[2].startswith("(64,)"), printed

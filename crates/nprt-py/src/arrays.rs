@@ -154,6 +154,84 @@ fn matrix4(obj: &Bound<'_, PyAny>) -> PyResult<[[f32; 4]; 4]> {
     Ok(rows)
 }
 
+/// A G-buffer from a dict of the dataset's channels (`position`, `normal`, `view`, `kd`, `ks`:
+/// (H, W, 3); `alpha`, `mask`: (H, W)), all of one size; and that size (W, H). Each refused
+/// naming its key.
+pub fn gbuffer(obj: &Bound<'_, PyAny>) -> PyResult<(nprt_trace::GBuffer, usize, usize)> {
+    use crate::argument::refused;
+    let rule = "must be a dict of G-buffer channels (a Dataset view is one)";
+    if !obj.is_instance_of::<pyo3::types::PyDict>() {
+        return Err(refused(obj, "gbuffer", rule));
+    }
+    let item = |key: &str| {
+        obj.get_item(key)
+            .map_err(|_| refused(obj, "gbuffer", format!("{rule}: it has no '{key}'")))
+    };
+    let mut size = None;
+    let mut same = |key: &str, h: usize, w: usize| match size.replace((h, w)) {
+        Some(s) if s != (h, w) => Err(crate::error::input_error(format!(
+            "gbuffer['{key}'] is {h} × {w} pixels, the channels before it {} × {}",
+            s.0, s.1
+        ))),
+        _ => Ok(()),
+    };
+    let mut rgb = |key: &str| -> PyResult<Vec<Vec3>> {
+        let arg = format!("gbuffer['{key}']");
+        let (array, h, w) = crate::argument::rgb_array(&item(key)?, &arg, "an (H, W, 3) array")?;
+        same(key, h, w)?;
+        crate::argument::rgb_texels(&array, &arg)
+    };
+    let (position, normal, view, kd, ks) = (
+        rgb("position")?,
+        rgb("normal")?,
+        rgb("view")?,
+        rgb("kd")?,
+        rgb("ks")?,
+    );
+    let mut plane = |key: &str| -> PyResult<Vec<f32>> {
+        let arg = format!("gbuffer['{key}']");
+        let value = item(key)?;
+        let array = (obj.py().import("numpy")?)
+            .call_method1("asarray", (&value, "float32"))
+            .map_err(|_| refused(&value, &arg, "must be an (H, W) array of real numbers"))?;
+        let shape: Vec<usize> = array.getattr("shape")?.extract()?;
+        let &[h, w] = shape.as_slice() else {
+            return Err(refused(
+                &value,
+                &arg,
+                format!("must be an (H, W) array, not of shape {shape:?}"),
+            ));
+        };
+        same(key, h, w)?;
+        Ok(array
+            .call_method0("ravel")?
+            .call_method0("tolist")?
+            .extract()?)
+    };
+    let (alpha, mask) = (plane("alpha")?, plane("mask")?);
+    let (h, w) = size.expect("channels were read");
+    let g = nprt_trace::GBuffer {
+        position,
+        normal,
+        view,
+        kd,
+        ks,
+        alpha,
+        mask,
+    };
+    if let Some(i) = (0..w * h).find(|&i| {
+        let v = [g.position[i], g.normal[i], g.view[i], g.kd[i], g.ks[i]];
+        !(v.iter().all(|c| c.is_finite()) && g.alpha[i].is_finite() && g.mask[i].is_finite())
+    }) {
+        return Err(crate::error::input_error(format!(
+            "gbuffer: pixel ({}, {}) holds a value that is not finite",
+            i % w,
+            i / w
+        )));
+    }
+    Ok((g, w, h))
+}
+
 /// A JSON value as the Python object `json.loads` makes of it.
 pub fn json<'py>(py: Python<'py>, value: &serde_json::Value) -> PyResult<Bound<'py, PyAny>> {
     let text = serde_json::to_string(value).expect("JSON values serialise");

@@ -6,9 +6,11 @@ use std::path::PathBuf;
 use nprt_render::{Denoise, DirectSampling, FrameCache, Relighter, DEFAULT_DIRECT_SPP};
 
 use crate::render::denoise_choice;
-use numpy::PyArray3;
+use nprt_net::Parameters;
+use numpy::{IntoPyArray, PyArray3};
 use pyo3::exceptions::PyUserWarning;
 use pyo3::prelude::*;
+use pyo3::types::PyDict;
 
 use crate::argument;
 use crate::arrays;
@@ -156,6 +158,88 @@ impl Model {
             })
             .or_py()?;
         Ok(arrays::image(py, &rgb, width as usize, height as usize))
+    }
+
+    /// The network's radiance at the G-buffer `gbuffer` under `envmap` turned by `rotation`
+    /// degrees about +Y: `gbuffer` is a dict of the dataset's own channels (`position`, `normal`,
+    /// `view`, `kd`, `ks` as (H, W, 3) arrays, `alpha` and `mask` as (H, W); a `Dataset` view is
+    /// one), and the result an (H, W, 3) float32 array, zero where `mask` is 0. What the networks
+    /// predict, calibrated: for a model that traces its direct light, its indirect light only
+    /// (`render` adds the traced direct light).
+    #[pyo3(signature = (gbuffer, envmap, rotation = None))]
+    fn __call__<'py>(
+        &self,
+        py: Python<'py>,
+        gbuffer: &Bound<'py, PyAny>,
+        envmap: &Bound<'py, PyAny>,
+        rotation: Option<&Bound<'py, PyAny>>,
+    ) -> PyResult<Bound<'py, PyArray3<f32>>> {
+        let (g, w, h) = arrays::gbuffer(gbuffer)?;
+        let rotation =
+            argument::number_or_none(rotation, "rotation", argument::FINITE)?.unwrap_or(0.0) as f32;
+        let envmap = envmap_arg(envmap, "envmap")?;
+        let map = &envmap.get().map;
+        let rgb = py.detach(|| {
+            let light = self.relighter.light_code(map, rotation);
+            self.relighter.shade(&g, &light)
+        });
+        Ok(arrays::image(py, &rgb, w, h))
+    }
+
+    /// The network's weights as a dict of float32 arrays by tensor name (as the weights file
+    /// names them), each of its own shape.
+    fn weights<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        let (_, net) = py.detach(|| nprt_net::load_model(&self.dir)).or_py()?;
+        let out = PyDict::new(py);
+        let mut failed = None;
+        net.visit("", &mut |name, shape, values| {
+            let array = numpy::ndarray::ArrayD::from_shape_vec(shape.to_vec(), values.to_vec())
+                .expect("a tensor of its shape");
+            if let Err(e) = out.set_item(name, array.into_pyarray(py)) {
+                failed.get_or_insert(e);
+            }
+        });
+        failed.map_or(Ok(out), Err)
+    }
+
+    /// The light code of `envmap` turned by `rotation` degrees about +Y, as the shading networks
+    /// read it: a dict with `code` (the encoder's 64 values, or for the linear design the map's
+    /// projection on its basis, (K, 3): coefficient k of each colour channel) and `scale` (what
+    /// each channel of the map was divided by first; the radiance is multiplied by it again).
+    #[pyo3(signature = (envmap, rotation = None), text_signature = "($self, envmap, rotation=0.0)")]
+    fn light_code<'py>(
+        &self,
+        py: Python<'py>,
+        envmap: &Bound<'py, PyAny>,
+        rotation: Option<&Bound<'py, PyAny>>,
+    ) -> PyResult<Bound<'py, PyDict>> {
+        let rotation =
+            argument::number_or_none(rotation, "rotation", argument::FINITE)?.unwrap_or(0.0) as f32;
+        let envmap = envmap_arg(envmap, "envmap")?;
+        let map = &envmap.get().map;
+        let (code, scale, linear) = py
+            .detach(|| {
+                let (file, net) = nprt_net::load_model(&self.dir)?;
+                let input = file.config.light_input(map, rotation);
+                let code = net
+                    .light
+                    .forward(&input.pixels, input.width)
+                    .codes()
+                    .to_vec();
+                anyhow::Ok((code, input.scale, file.config.design.is_linear()))
+            })
+            .or_py()?;
+        let out = PyDict::new(py);
+        let code = match linear {
+            true => numpy::ndarray::Array2::from_shape_vec((code.len() / 3, 3), code)
+                .expect("3 values a coefficient")
+                .into_pyarray(py)
+                .into_any(),
+            false => code.into_pyarray(py).into_any(),
+        };
+        out.set_item("code", code)?;
+        out.set_item("scale", scale.to_vec().into_pyarray(py))?;
+        Ok(out)
     }
 
     /// Pickled by its folder and device (a worker process loads it again).
