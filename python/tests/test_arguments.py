@@ -225,3 +225,13 @@ def test_render_without_out_returns_the_frames(model, tmp_path):
     assert done["frames"].shape == (2, 12, 16, 3) and done["frames"].dtype == np.float32
     assert "frames_dir" not in done and np.isfinite(done["frames"]).all()
     assert not glob.glob(f"{tempfile.gettempdir()}/nprt-render-*")
+
+
+def test_messages_name_keywords_not_flags(dataset, tmp_path):
+    texts = []
+    for kwargs in [dict(arch="dsep", targets="transfer"), dict(arch="dsep", basis="sh:2")]:
+        with pytest.raises(nprt.NprtError) as raised:
+            nprt.train(dataset, out=tmp_path / "m", epochs=1, progress=False, **kwargs)
+        texts.append(str(raised.value))
+    assert not any("--" in t for t in texts), texts
+    assert "targets=" in texts[0] and "basis sh:2" in texts[1], texts
