@@ -136,6 +136,12 @@ fn a_scene_without_a_camera_volume_is_refused_with_the_flag_to_give_before_any_w
             "--minutes 0 is not a number of minutes from 0.001",
         ),
         ("--quality", "fine", "choose draft, good or best"),
+        // Maps that cannot be held out: refused before the folder is made, not after.
+        (
+            "--test-maps",
+            "3",
+            "--test-maps applies to a folder of maps",
+        ),
     ] {
         let o = common::nprt(&[
             "bake",
@@ -151,4 +157,16 @@ fn a_scene_without_a_camera_volume_is_refused_with_the_flag_to_give_before_any_w
         assert!(!o.status.success() && err.contains(needle), "{flag}: {err}");
     }
     assert!(!out.exists(), "a refused bake made its folder");
+    let o = common::nprt(&[
+        "bake",
+        "builtin:room",
+        "--envmaps",
+        "builtin",
+        "--out",
+        "/dev/null",
+        "--quality",
+        "tiny",
+    ]);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(err.contains("--out '/dev/null' is not a folder"), "{err}");
 }

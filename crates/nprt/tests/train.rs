@@ -786,7 +786,7 @@ fn a_paused_run_is_continued_by_the_same_command() {
             "baseline",
             &["--minutes", "0.1", "--pause-after", "0"],
         ),
-        &["pause", "positive number of minutes"],
+        &["the pause (--pause-after) 0 is not a number of minutes from 0.001"],
     );
     std::fs::remove_dir_all(&out).ok();
 }
