@@ -109,12 +109,27 @@ pub fn size(obj: &Bound<'_, PyAny>, arg: &str) -> PyResult<(u32, u32)> {
     if let Ok(n) = whole(obj, arg, 1..=MAX_SIDE) {
         return Ok((n, n));
     }
+    whole_pair(obj, arg, 1..=MAX_SIDE, &rule)
+}
+
+/// Two whole numbers within `range` (a list, a tuple or an array of two); anything else is
+/// `obj` refused as breaking `rule`.
+fn whole_pair<T>(
+    obj: &Bound<'_, PyAny>,
+    arg: &str,
+    range: RangeInclusive<T>,
+    rule: &str,
+) -> PyResult<(T, T)>
+where
+    T: Copy + Display + TryFrom<i128>,
+    i128: TryFrom<T>,
+{
     let items = sequence(obj)
         .filter(|v| v.len() == 2)
-        .ok_or_else(|| refused(obj, arg, &rule))?;
-    let side =
-        |o: &Bound<'_, PyAny>| whole(o, arg, 1..=MAX_SIDE).map_err(|_| refused(obj, arg, &rule));
-    Ok((side(&items[0])?, side(&items[1])?))
+        .ok_or_else(|| refused(obj, arg, rule))?;
+    let one =
+        |o: &Bound<'_, PyAny>| whole(o, arg, range.clone()).map_err(|_| refused(obj, arg, rule));
+    Ok((one(&items[0])?, one(&items[1])?))
 }
 
 /// [`size`] of an argument that may be `None`.
@@ -155,12 +170,7 @@ pub fn vec3_or_none(obj: Option<&Bound<'_, PyAny>>, arg: &str) -> PyResult<Optio
 /// A shard `(k, n)`: the k-th of n, 0 ≤ k < n.
 pub fn shard(obj: &Bound<'_, PyAny>, arg: &str) -> PyResult<(u64, u64)> {
     let rule = "must be (k, n), two whole numbers with 0 <= k < n";
-    let items = sequence(obj)
-        .filter(|v| v.len() == 2)
-        .ok_or_else(|| refused(obj, arg, rule))?;
-    let part =
-        |o: &Bound<'_, PyAny>| whole(o, arg, 0..=u64::MAX).map_err(|_| refused(obj, arg, rule));
-    match (part(&items[0])?, part(&items[1])?) {
+    match whole_pair(obj, arg, 0..=u64::MAX, rule)? {
         (k, n) if k < n => Ok((k, n)),
         _ => Err(refused(obj, arg, rule)),
     }
@@ -250,21 +260,24 @@ pub fn path(obj: &Bound<'_, PyAny>, arg: &str) -> PyResult<PathBuf> {
     text(obj, arg, "a str or an os.PathLike").map(PathBuf::from)
 }
 
-/// An (H, W, 3) array of real numbers (a numpy array, or what `numpy.asarray` makes one of:
-/// nested lists), as numpy holds it, and its (H, W); refused naming `arg` when it is not:
-/// complex values (whose imaginary part a float conversion drops), text, objects or bools, or
-/// another shape. Nothing is copied: a broadcast view of a huge shape costs nothing until its
-/// size is checked.
-pub fn rgb_array<'py>(
+/// numpy's kinds of real numbers (signed, unsigned, floating point); with "b", bools too.
+pub const REAL: &str = "iuf";
+
+/// `obj` as numpy holds it (`numpy.asarray`: nested lists become an array; nothing is copied),
+/// and its shape; refused naming `arg` (as `shape_rule` of real numbers) where its values are
+/// not of numpy's `kinds`: complex values (whose imaginary part a float conversion drops), text
+/// or objects, and bools unless `kinds` has "b".
+pub fn real_array<'py>(
     obj: &Bound<'py, PyAny>,
     arg: &str,
     shape_rule: &str,
-) -> PyResult<(Bound<'py, PyAny>, usize, usize)> {
+    kinds: &str,
+) -> PyResult<(Bound<'py, PyAny>, Vec<usize>)> {
     let array = (obj.py().import("numpy")?)
         .call_method1("asarray", (obj,))
         .map_err(|_| refused(obj, arg, format!("must be {shape_rule} of real numbers")))?;
     let kind: String = array.getattr("dtype")?.getattr("kind")?.extract()?;
-    if !matches!(kind.as_str(), "i" | "u" | "f") {
+    if !kinds.contains(kind.as_str()) {
         let what = match kind.as_str() {
             "c" => "complex numbers",
             "b" => "bools",
@@ -276,7 +289,19 @@ pub fn rgb_array<'py>(
             format!("must be {shape_rule} of real numbers, not of {what}"),
         ));
     }
-    let shape: Vec<usize> = array.getattr("shape")?.extract()?;
+    let shape = array.getattr("shape")?.extract()?;
+    Ok((array, shape))
+}
+
+/// An (H, W, 3) array of real numbers ([`real_array`]), and its (H, W); refused naming `arg`
+/// when it is not. Nothing is copied: a broadcast view of a huge shape costs nothing until its
+/// size is checked.
+pub fn rgb_array<'py>(
+    obj: &Bound<'py, PyAny>,
+    arg: &str,
+    shape_rule: &str,
+) -> PyResult<(Bound<'py, PyAny>, usize, usize)> {
+    let (array, shape) = real_array(obj, arg, shape_rule, REAL)?;
     match shape.as_slice() {
         &[h, w, 3] => Ok((array, h, w)),
         _ => Err(refused(

@@ -111,22 +111,9 @@ pub fn camera(
 
 /// `obj` as a 4 × 4 matrix of finite numbers, rows first.
 fn matrix4(obj: &Bound<'_, PyAny>) -> PyResult<[[f32; 4]; 4]> {
-    use crate::argument::refused;
-    let py = obj.py();
+    use crate::argument::{real_array, refused, REAL};
     let rule = "must be a 4 × 4 camera-to-world matrix of finite numbers";
-    let array = py
-        .import("numpy")?
-        .call_method1("asarray", (obj,))
-        .map_err(|_| refused(obj, "camera", rule))?;
-    let kind: String = array.getattr("dtype")?.getattr("kind")?.extract()?;
-    let shape: Vec<usize> = array.getattr("shape")?.extract()?;
-    if !matches!(kind.as_str(), "i" | "u" | "f") {
-        return Err(refused(
-            obj,
-            "camera",
-            format!("{rule}, not of numpy kind '{kind}'"),
-        ));
-    }
+    let (array, shape) = real_array(obj, "camera", "a 4 × 4 camera-to-world matrix", REAL)?;
     if shape != [4, 4] {
         return Err(refused(
             obj,
@@ -191,10 +178,8 @@ pub fn gbuffer(obj: &Bound<'_, PyAny>) -> PyResult<(nprt_trace::GBuffer, usize, 
     let mut plane = |key: &str| -> PyResult<Vec<f32>> {
         let arg = format!("gbuffer['{key}']");
         let value = item(key)?;
-        let array = (obj.py().import("numpy")?)
-            .call_method1("asarray", (&value, "float32"))
-            .map_err(|_| refused(&value, &arg, "must be an (H, W) array of real numbers"))?;
-        let shape: Vec<usize> = array.getattr("shape")?.extract()?;
+        // A mask of bools (`view["mask"] > 0`) is one too.
+        let (array, shape) = crate::argument::real_array(&value, &arg, "an (H, W) array", "biuf")?;
         let &[h, w] = shape.as_slice() else {
             return Err(refused(
                 &value,
@@ -203,10 +188,11 @@ pub fn gbuffer(obj: &Bound<'_, PyAny>) -> PyResult<(nprt_trace::GBuffer, usize, 
             ));
         };
         same(key, h, w)?;
-        Ok(array
+        array
+            .call_method1("astype", ("float32",))?
             .call_method0("ravel")?
             .call_method0("tolist")?
-            .extract()?)
+            .extract()
     };
     let (alpha, mask) = (plane("alpha")?, plane("mask")?);
     let (h, w) = size.expect("channels were read");

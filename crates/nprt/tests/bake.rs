@@ -157,16 +157,7 @@ fn a_scene_without_a_camera_volume_is_refused_with_the_flag_to_give_before_any_w
         assert!(!o.status.success() && err.contains(needle), "{flag}: {err}");
     }
     assert!(!out.exists(), "a refused bake made its folder");
-    let o = common::nprt(&[
-        "bake",
-        "builtin:room",
-        "--envmaps",
-        "builtin",
-        "--out",
-        "/dev/null",
-        "--quality",
-        "tiny",
-    ]);
+    let o = common::nprt(&bake_args("/dev/null", &[]));
     let err = String::from_utf8_lossy(&o.stderr);
     assert!(err.contains("--out '/dev/null' is not a folder"), "{err}");
 }

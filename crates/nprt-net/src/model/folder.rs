@@ -125,7 +125,12 @@ pub fn weights_hash(dir: &Path) -> Result<String> {
     let path = dir.join(WEIGHTS_FILE);
     let bytes = nprt_io::read_input(&path)
         .with_context(|| format!("cannot read weights '{}'", path.display()))?;
-    Ok(blake3::hash(&bytes).to_hex().to_string())
+    Ok(hex_hash(&bytes))
+}
+
+/// A weights file's bytes as `weights_blake3` records them: BLAKE3, in hex.
+fn hex_hash(bytes: &[u8]) -> String {
+    blake3::hash(bytes).to_hex().to_string()
 }
 
 /// Weights as safetensors, tagged with the network that produced them (`design:activation`,
@@ -163,7 +168,7 @@ pub fn save_weights<M: Parameters>(path: &Path, net: &M, tag: &str) -> Result<St
     let bytes = safetensors::serialize(views, Some(metadata))
         .map_err(|e| anyhow::anyhow!("cannot serialise weights: {e}"))?;
     nprt_io::write_file(path, &bytes)?;
-    Ok(blake3::hash(&bytes).to_hex().to_string())
+    Ok(hex_hash(&bytes))
 }
 
 /// The first tensor of a safetensors file that holds a value no trained network has (not
@@ -243,7 +248,7 @@ pub fn load_weights<M: Parameters>(path: &Path, net: &mut M, tag: &str) -> Resul
                 .unwrap_or_default()
         );
     }
-    Ok(blake3::hash(&bytes).to_hex().to_string())
+    Ok(hex_hash(&bytes))
 }
 
 /// The `nprt_design` entry of a safetensors header.
