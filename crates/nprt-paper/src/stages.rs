@@ -48,7 +48,14 @@ pub fn train_model(x: &Experiment, data: &Path, config: &ModelConfig, out: &Path
     if x.snapshot_configs().contains(config) {
         opts.schedule.snapshots = x.snapshots.clone();
     }
-    let (s, _) = nprt_net::train(&set, config, &opts, out, x.engine, &|_| true)?;
+    let (s, _) = nprt_net::train(
+        &set,
+        config,
+        &opts,
+        out,
+        x.engine,
+        nprt_net::Watch::default(),
+    )?;
     report_training(&config.label(), &s, out);
     Ok(s.split.steps > 0.0)
 }
@@ -60,7 +67,7 @@ pub fn train_deep_shading(x: &Experiment, data: &Path, out: &Path) -> Result<boo
         schedule: x.deep_shading_training().apply(defaults.schedule.clone()),
         ..defaults
     };
-    let (s, _) = deep_shading::train(data, &opts, x.engine, out, &|_| true)?;
+    let (s, _) = deep_shading::train(data, &opts, x.engine, out, nprt_net::Watch::default())?;
     report_training("deep-shading", &s, out);
     Ok(s.split.steps > 0.0)
 }

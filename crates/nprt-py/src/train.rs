@@ -7,7 +7,7 @@ use nprt_net::deep_shading::{self, DeepShadingOptions};
 use nprt_net::training::loss_curves::LossRow;
 use nprt_net::training::snapshot::Snapshot;
 use nprt_net::training::training_set::TrainingSet;
-use nprt_net::{Asked, RunLength, TrainOptions, TrainSummary};
+use nprt_net::{Asked, RunLength, TrainOptions, TrainSummary, Watch};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
@@ -127,7 +127,14 @@ pub fn train<'py>(
                 targets: asked.targets(&config, set.manifest.settings.transfer),
                 ..opts
             };
-            nprt_net::train(&set, &config, &opts, &out, engine, &|r| watch.hear(r))
+            nprt_net::train(
+                &set,
+                &config,
+                &opts,
+                &out,
+                engine,
+                Watch::epochs(&|r| watch.hear(r)),
+            )
         })
         .or_py()?;
     watch.finish()?;
@@ -189,7 +196,15 @@ pub fn train_deep_shading<'py>(
     };
     let watch = EpochWatch::new(callback);
     let (summary, file) = py
-        .detach(|| deep_shading::train(&data, &opts, engine, &out, &|r| watch.hear(r)))
+        .detach(|| {
+            deep_shading::train(
+                &data,
+                &opts,
+                engine,
+                &out,
+                Watch::epochs(&|r| watch.hear(r)),
+            )
+        })
         .or_py()?;
     watch.finish()?;
     let s = summary_dict(py, &summary)?;

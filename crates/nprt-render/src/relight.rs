@@ -101,6 +101,17 @@ impl Relighter {
         })
     }
 
+    /// Takes `file`'s settings and `net`'s weights (a run's newer model) on `engine`, in the
+    /// precision the networks ran in; the G-buffer and traced light stay as they are. Frames
+    /// made after use them, with a new [`FrameCache`].
+    pub fn set_weights(&mut self, file: ModelFile, net: NprtNet, engine: Engine) -> Result<()> {
+        let precision = self.precision();
+        self.shading = engine.network(&file, net)?;
+        self.shading.set_precision(precision)?;
+        self.file = file;
+        Ok(())
+    }
+
     /// Runs the networks in `precision`; f16 needs the GPU kernels (`--device gpu`) and an
     /// adapter with f16 in shaders. Frames made after use it, with a new [`FrameCache`].
     pub fn set_precision(&mut self, precision: Precision) -> Result<()> {

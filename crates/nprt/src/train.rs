@@ -225,7 +225,14 @@ pub fn run(job: &TrainJob, engine: Engine) -> Result<()> {
         "{}",
         training_line(&job.config, &opts, job.asked.recipe().is_some())
     );
-    let (s, file) = nprt_net::train(&set, &job.config, &opts, &job.out, engine, &|_| true)?;
+    let (s, file) = nprt_net::train(
+        &set,
+        &job.config,
+        &opts,
+        &job.out,
+        engine,
+        nprt_net::Watch::default(),
+    )?;
     if let Some(e) = s.resumed_from_epoch {
         println!("resumed from epoch {e:.2}");
     }

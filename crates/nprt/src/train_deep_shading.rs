@@ -86,7 +86,13 @@ pub fn command(a: DeepShadingArgs) -> Result<()> {
 
 /// Trains and prints what the run did.
 pub fn run(job: &DeepShadingJob) -> Result<()> {
-    let (s, f) = deep_shading::train(&job.data, &job.opts, job.engine, &job.out, &|_| true)?;
+    let (s, f) = deep_shading::train(
+        &job.data,
+        &job.opts,
+        job.engine,
+        &job.out,
+        nprt_net::Watch::default(),
+    )?;
     if let Some(e) = s.resumed_from_epoch {
         println!("resumed from epoch {e:.2}");
     }

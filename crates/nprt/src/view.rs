@@ -4,13 +4,44 @@ use std::path::PathBuf;
 
 use anyhow::Result;
 
-use crate::flags::{DeviceArg, Resolution};
+use crate::flags::{design_names, DeviceArg, Resolution};
+
+/// The lightings M switches among when neither `--maps` nor a dataset gives them.
+const DEFAULT_MAPS: [&str; 5] = [
+    "builtin:sky:30:250:3",
+    "builtin:sky:60:90:2",
+    "builtin:sky:12:200:6",
+    "builtin:indoor:9",
+    "builtin:indoor:3",
+];
 
 #[derive(clap::Args)]
 pub struct ViewArgs {
     /// Trained model folders of one scene (from `nprt train`); Tab switches among them.
-    #[arg(required = true)]
+    #[arg(required_unless_present = "train", conflicts_with = "train")]
     models: Vec<PathBuf>,
+    /// Train a model on this dataset folder (from `nprt generate`) while the window shows it:
+    /// the window opens at once on the dataset's scene, in its camera volume, under its maps
+    /// (held-out ones first); the view relights with the newest weights every 2 seconds of
+    /// training. Space pauses and resumes training, K saves, X lengthens the run; closing the
+    /// window saves the model (resumable). Without --arch: the recommended recipe.
+    #[arg(long, value_name = "DATA")]
+    train: Option<PathBuf>,
+    /// With --train: the model folder (a run there continues) [default: DATA-model beside the
+    /// dataset].
+    #[arg(long, requires = "train", value_name = "MODEL")]
+    out: Option<PathBuf>,
+    /// With --train: minutes of training, 0.001 to 1,000,000 [default: the model folder's own
+    /// run's, else 10].
+    #[arg(long, requires = "train", value_parser = crate::flags::finite_f64)]
+    minutes: Option<f64>,
+    /// With --train: the transport design, with its own defaults (as `nprt train --arch`)
+    /// [default: the recommended recipe].
+    #[arg(long, requires = "train", value_parser = design_names())]
+    arch: Option<nprt_net::Design>,
+    /// With --train: the minutes the X key adds to the run.
+    #[arg(long, requires = "train", value_parser = crate::flags::finite_f64, default_value_t = 5.0)]
+    extend_minutes: f64,
     /// Scene (default: the one the models were trained on); must be that scene.
     #[arg(long)]
     scene: Option<String>,
@@ -19,12 +50,9 @@ pub struct ViewArgs {
     #[arg(long)]
     camera_volume: Option<PathBuf>,
     /// Lightings M switches among, comma-separated: .exr/.hdr maps (e.g. a dataset's held-out
-    /// maps) or built-in specs.
-    #[arg(
-        long,
-        value_delimiter = ',',
-        default_value = "builtin:sky:30:250:3,builtin:sky:60:90:2,builtin:sky:12:200:6,builtin:indoor:9,builtin:indoor:3"
-    )]
+    /// maps) or built-in specs [default: with --train, the dataset's maps; else
+    /// builtin:sky:30:250:3,builtin:sky:60:90:2,builtin:sky:12:200:6,builtin:indoor:9,builtin:indoor:3].
+    #[arg(long, value_delimiter = ',')]
     maps: Vec<String>,
     /// Window size, N or WxH.
     #[arg(long, default_value = "384x288")]
@@ -58,6 +86,11 @@ pub struct ViewArgs {
     /// With --frames: write the last frame, overlay included, to this PNG.
     #[arg(long, requires = "frames")]
     screenshot: Option<PathBuf>,
+    /// Keys pressed at given times, comma-separated SECONDS:KEY, the seconds since the first
+    /// frame and the key a character, or space, tab, escape or f12: e.g.
+    /// 2:space,5:k,6:space,9:escape (for scripts and tests).
+    #[arg(long, value_delimiter = ',', value_parser = parse_key)]
+    keys: Vec<(f64, String)>,
     /// The networks' arithmetic: f32, or f16 (weights and activations in f16, sums in f32, on
     /// tensor cores where the adapter has them).
     #[arg(long, default_value = "f32")]
@@ -66,16 +99,72 @@ pub struct ViewArgs {
     device: DeviceArg,
 }
 
+/// A scripted key: SECONDS:KEY.
+fn parse_key(s: &str) -> Result<(f64, String), String> {
+    let (at, key) = s
+        .split_once(':')
+        .ok_or_else(|| format!("'{s}' is not SECONDS:KEY"))?;
+    let at: f64 = (at.parse().ok())
+        .filter(|t: &f64| (0.0..=1e6).contains(t))
+        .ok_or_else(|| format!("'{at}' in '{s}' is not a time in seconds, 0 to 1,000,000"))?;
+    let named = ["space", "tab", "escape", "esc", "f12"].contains(&key);
+    if !named && key.chars().count() != 1 {
+        return Err(format!(
+            "'{key}' in '{s}' is not a key: one character, or space, tab, escape or f12"
+        ));
+    }
+    Ok((at, key.to_string()))
+}
+
+/// The run `--train` asks for: the recipe, or `--arch`'s design with its own defaults.
+#[cfg(feature = "gpu")]
+fn training(a: &ViewArgs) -> Result<Option<nprt_render::view::TrainingJob>> {
+    let Some(data) = &a.train else {
+        return Ok(None);
+    };
+    let asked = nprt_net::Asked {
+        design: a.arch,
+        ..Default::default()
+    };
+    let config = asked.config()?;
+    nprt_net::check_minutes(a.extend_minutes, "--extend-minutes").map_err(anyhow::Error::msg)?;
+    let minutes = a.minutes.unwrap_or(nprt_render::view::DEFAULT_MINUTES);
+    let opts = nprt_net::TrainOptions {
+        calibration: asked.calibration(),
+        ..Default::default()
+    }
+    .with_run(config.design, nprt_net::RunLength::minutes(minutes), None);
+    let out = a.out.clone().unwrap_or_else(|| {
+        let mut name = data.file_name().unwrap_or_default().to_os_string();
+        name.push("-model");
+        data.with_file_name(name)
+    });
+    Ok(Some(nprt_render::view::TrainingJob {
+        data: data.clone(),
+        out,
+        config,
+        opts,
+        asked,
+        minutes: a.minutes,
+        engine: a.device.engine()?,
+    }))
+}
+
 #[cfg(feature = "gpu")]
 pub fn run(a: ViewArgs) -> Result<()> {
     if let Some(path) = &a.screenshot {
         nprt_io::check_writable(path)?;
     }
+    let training = training(&a)?;
+    let maps = match (a.maps.is_empty(), &training) {
+        (true, None) => DEFAULT_MAPS.map(String::from).to_vec(),
+        _ => a.maps,
+    };
     nprt_render::view::run_viewer(nprt_render::view::ViewerOptions {
         models: a.models,
         scene: a.scene,
         camera_volume: a.camera_volume,
-        maps: a.maps,
+        maps,
         resolution: a.res.0,
         engine: a.device.engine()?,
         direct_spp: a.direct_spp,
@@ -88,6 +177,9 @@ pub fn run(a: ViewArgs) -> Result<()> {
         reference: a.reference,
         hide_overlay: a.no_overlay,
         precision: a.precision,
+        training,
+        extend_minutes: a.extend_minutes,
+        keys: a.keys,
     })
 }
 

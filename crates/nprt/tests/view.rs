@@ -283,3 +283,149 @@ fn the_viewer_opens_a_window_and_shows_what_render_makes() {
     }
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+/// The number after `what` in `said`'s line that holds it (e.g. "paused at step 12").
+fn number_after(said: &str, what: &str) -> f64 {
+    let at = said
+        .find(what)
+        .unwrap_or_else(|| panic!("no '{what}' in:\n{said}"))
+        + what.len();
+    let digits: String = said[at..]
+        .trim_start()
+        .chars()
+        .take_while(|c| c.is_ascii_digit() || *c == '.')
+        .collect();
+    digits
+        .parse()
+        .unwrap_or_else(|_| panic!("no number after '{what}' in:\n{said}"))
+}
+
+/// `nprt view --train`: the window shows the run's newest model as it trains; Space pauses
+/// the run (its step counter stops, a save then writes that step), X lengthens it, and closing
+/// the window saves it: the model renders, and `nprt train` of the lengthened run resumes it.
+/// The later frame is closer to the path-traced reference (R, brought on while the run is
+/// paused) than the earlier, and the split view (V) shows the model left of a white divider
+/// and the reference right of it.
+#[test]
+fn the_viewer_trains_a_model_as_it_shows_it_and_saves_it_on_close() {
+    let Some(display) = display() else { return };
+    let dir = fresh_dir("view-train");
+    let data = dir.join("data");
+    common::room_dataset(&data, [24, 2], 32, 4);
+    let (model, shots) = (dir.join("model"), dir.join("shots"));
+    std::fs::create_dir_all(&shots).unwrap();
+    let (d, m) = (data.to_str().unwrap(), model.to_str().unwrap());
+    // Shots: 0 early, 1 late (after about 24 s of training: fewer, on 2 cores, and the
+    // frames are not yet clearly better), 2 the reference, 3 the split view.
+    #[rustfmt::skip]
+    let keys = "2.5:p,3:space,5:k,6:space,7:x,27:p,27.2:space,27.3:r,33:p,33.2:r,33.3:v,34:p,34.5:escape";
+    #[rustfmt::skip]
+    let said = view(&display, &["--train", d, "--out", m, "--device", "cpu", "--minutes", "0.5",
+        "--extend-minutes", "0.1", "--res", "64x48", "--no-overlay",
+        "--screenshot-dir", shots.to_str().unwrap(), "--keys", keys]);
+    let paused = number_after(&said, "training paused at step");
+    let saved = number_after(&said, "' at step");
+    let resumed = number_after(&said, "training resumed at step");
+    assert!(
+        paused == saved && saved == resumed && paused > 0.0,
+        "{said}"
+    );
+    let trained = number_after(&said, "trained");
+    assert!(
+        trained > resumed,
+        "training went on after the pause:\n{said}"
+    );
+    let shot = |i: u32| {
+        image::open(shots.join(format!("nprt-view-{i:04}.png")))
+            .unwrap()
+            .to_rgb8()
+    };
+    let (early, late, reference, split) = (shot(0), shot(1), shot(2), shot(3));
+    let l1 = |a: &image::RgbImage| {
+        let pairs = a.as_raw().iter().zip(reference.as_raw());
+        pairs
+            .map(|(&x, &y)| (x as f64 - y as f64).abs())
+            .sum::<f64>()
+            / a.as_raw().len() as f64
+    };
+    assert!(
+        early.as_raw().iter().any(|&v| v > 0),
+        "the early frame shows a model"
+    );
+    let (l1_early, l1_late) = (l1(&early), l1(&late));
+    assert!(
+        l1_late < 0.9 * l1_early,
+        "L1 {l1_early} then {l1_late}:\n{said}"
+    );
+    assert!(
+        said.contains("nprt-view-0003.png (L1"),
+        "the split's L1 said:\n{said}"
+    );
+    assert!(
+        (0..48).all(|y| split.get_pixel(32, y).0 == [255; 3]),
+        "no divider"
+    );
+    assert_ne!(split.get_pixel(10, 24), split.get_pixel(54, 24));
+
+    let frames = dir.join("frames");
+    #[rustfmt::skip]
+    let rendered = ok(&["render", "--model", m, "--out", frames.to_str().unwrap(),
+        "--frames", "1", "--res", "32x24", "--device", "cpu"]);
+    assert!(
+        rendered.contains("networks on the CPU engine"),
+        "{rendered}"
+    );
+    // X made the run 0.6 minutes long (0.5 + 0.1): `nprt train` of that length continues it.
+    let resumed = ok(&[
+        "train",
+        "--data",
+        d,
+        "--out",
+        m,
+        "--minutes",
+        "0.6",
+        "--device",
+        "cpu",
+    ]);
+    assert!(resumed.contains("resumed from epoch"), "{resumed}");
+}
+
+/// `nprt view --train` refuses, before any window opens, what it cannot train: a folder that
+/// is no dataset, a model folder that is the dataset itself, a time out of range and a
+/// scripted key that is none.
+#[test]
+fn the_viewer_refuses_a_run_it_cannot_train_before_opening_a_window() {
+    let dir = fresh_dir("view-train-refusals");
+    let data = dir.join("data");
+    common::room_dataset(&data, [2, 1], 8, 1);
+    let (d, nothing) = (data.to_str().unwrap(), dir.join("nothing"));
+    common::fails(
+        &["view", "--train", nothing.to_str().unwrap()],
+        &["--train '", "nothing"],
+    );
+    common::fails(
+        &["view", "--train", d, "--out", d],
+        &["is a dataset folder"],
+    );
+    common::fails(&["view", "--train", d, "--minutes", "0"], &["--minutes"]);
+    common::fails(
+        &["view", "--train", d, "--extend-minutes", "0"],
+        &["--extend-minutes"],
+    );
+    // What the flags' parser refuses is a usage error (exit 2).
+    let usage = |args: &[&str], needles: &[&str]| {
+        let o = common::nprt(args);
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(o.status.code(), Some(2), "{args:?}: {err}");
+        assert!(needles.iter().all(|n| err.contains(n)), "{args:?}: {err}");
+    };
+    usage(
+        &["view", "--train", d, "--keys", "1:ab"],
+        &["'ab'", "is not a key"],
+    );
+    usage(
+        &["view", "--train", d, "--keys", "x:p"],
+        &["'x'", "not a time"],
+    );
+    usage(&["view", "m", "--train", d], &["cannot be used with"]);
+}

@@ -92,6 +92,19 @@ pub struct VolumeRecord {
     pub fov_deg: f32,
 }
 
+impl VolumeRecord {
+    /// The camera volume this record states.
+    pub fn volume(&self) -> CameraVolume {
+        CameraVolume {
+            min: self.min.into(),
+            max: self.max.into(),
+            look: self.look.into(),
+            spread_deg: self.spread_deg,
+            fov_deg: self.fov_deg,
+        }
+    }
+}
+
 impl From<&CameraVolume> for VolumeRecord {
     /// The volume a dataset's cameras are placed in, for its manifest.
     fn from(v: &CameraVolume) -> Self {

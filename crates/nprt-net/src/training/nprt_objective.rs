@@ -27,6 +27,7 @@ use crate::training::calibration::{level_gain, Calibration, LEVEL_SAMPLES};
 use crate::training::checkpoint::RunState;
 use crate::training::epoch_plan::{group_batches, EpochPlan};
 use crate::training::host_steps::HostSteps;
+use crate::training::live::LiveRun;
 use crate::training::schedule::Schedule;
 use crate::training::train_options::{Gather, Targets, TrainOptions};
 use crate::training::training_loop::{self, Objective, Steps, TrainSummary, Watch};
@@ -175,12 +176,26 @@ impl Objective for PixelObjective<'_> {
         schedule: &Schedule,
         state: &RunState,
     ) -> Result<()> {
+        let file = self.model_file(net, schedule, state);
+        save_model(out, &file, net)?;
+        *self.saved.lock().unwrap_or_else(|e| e.into_inner()) = Some(file);
+        Ok(())
+    }
+
+    fn publish(&self, net: &NprtNet, schedule: &Schedule, state: &RunState, live: &LiveRun) {
+        live.publish(self.model_file(net, schedule, state), net.clone());
+    }
+}
+
+impl PixelObjective<'_> {
+    /// The model file of `net` as it stands, `state` into `schedule`.
+    fn model_file(&self, net: &NprtNet, schedule: &Schedule, state: &RunState) -> ModelFile {
         let transport_params = net.transport_params();
         let options = TrainOptions {
             schedule: schedule.clone(),
             ..self.opts.clone()
         };
-        let file = ModelFile {
+        ModelFile {
             format: MODEL_FORMAT.into(),
             version: MODEL_VERSION,
             config: self.config.clone(),
@@ -203,10 +218,7 @@ impl Objective for PixelObjective<'_> {
             level_gain: (self.opts.calibration == Calibration::Level)
                 .then(|| level_gain(net, &self.set.train, LEVEL_SAMPLES, self.opts.batch_size)),
             weights_blake3: None,
-        };
-        save_model(out, &file, net)?;
-        *self.saved.lock().unwrap_or_else(|e| e.into_inner()) = Some(file);
-        Ok(())
+        }
     }
 }
 

@@ -330,7 +330,14 @@ impl Bake {
         }
         // A stop asked for from Python (Ctrl-C) ends the training at an epoch's end, saved.
         let go_on = |_: &_| !nprt_io::interrupt::requested();
-        let (s, _) = nprt_net::train(&set, config, &opts, &model, self.engine, &go_on)?;
+        let (s, _) = nprt_net::train(
+            &set,
+            config,
+            &opts,
+            &model,
+            self.engine,
+            nprt_net::Watch::epochs(&go_on),
+        )?;
         nprt_io::interrupt::check()?;
         if first {
             write_comparison(&model, data, self.engine, preview)?;
@@ -342,7 +349,14 @@ impl Bake {
         }
         if s.paused {
             opts.schedule.pause_after = None;
-            nprt_net::train(&set, config, &opts, &model, self.engine, &go_on)?;
+            nprt_net::train(
+                &set,
+                config,
+                &opts,
+                &model,
+                self.engine,
+                nprt_net::Watch::epochs(&go_on),
+            )?;
         }
         nprt_io::interrupt::check()
     }

@@ -8,9 +8,17 @@
 //! Owns the window, input and presentation; it must not own rendering: every pixel comes from
 //! the relighter or the tracer.
 
+mod compare;
+mod live_training;
 mod orbit_camera;
 mod overlay;
 mod presenter;
 mod viewer;
+mod viewer_keys;
+mod viewer_overlay;
+mod viewer_state;
+mod viewer_training;
 
-pub use viewer::{run_viewer, ViewerOptions};
+pub use live_training::{TrainingJob, DEFAULT_MINUTES};
+pub use viewer::run_viewer;
+pub use viewer_state::ViewerOptions;

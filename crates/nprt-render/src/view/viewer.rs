@@ -2,138 +2,81 @@
 //! frame a change makes again (a lighting change under a still camera reruns the encoder and
 //! the shading networks only).
 
-use std::path::PathBuf;
 use std::sync::Arc;
 use std::time::Instant;
 
 use anyhow::{anyhow, bail, Context, Result};
 use glam::Vec3;
-use nprt_net::Engine;
-use nprt_scene::{EnvMap, Scene};
+use nprt_scene::Scene;
 use nprt_trace::{PixelFilter, RenderSettings, TraceScene};
 use winit::application::ApplicationHandler;
 use winit::dpi::PhysicalSize;
-use winit::event::{ElementState, MouseButton, MouseScrollDelta, WindowEvent};
-use winit::event_loop::{ActiveEventLoop, EventLoop};
-use winit::keyboard::{Key, NamedKey};
+use winit::event::{ElementState, MouseButton, MouseScrollDelta, StartCause, WindowEvent};
+use winit::event_loop::{ActiveEventLoop, ControlFlow, EventLoop};
 use winit::window::{Window, WindowId};
 
+use super::compare::{compose, l1, Compare, ERROR_SPP};
+use super::live_training::Training;
 use super::orbit_camera::OrbitCamera;
-use super::overlay::draw_lines;
-use super::presenter::{Presenter, Shown, OVERLAY_ROWS};
+use super::presenter::{Presenter, Shown};
+use super::viewer_keys::scripted_key;
+use super::viewer_state::{Reference, Said, Viewer, ViewerOptions};
+use super::viewer_training::{dataset_maps, finish_training};
 use crate::frame_stages::FrameRadiance;
 use crate::frame_timings::FrameTimings;
 use crate::oidn::Oidn;
 use crate::relight::{DirectSampling, FrameCache, Relighter};
 use crate::CameraPath;
 use crate::Denoise;
-use crate::Precision;
-
-/// What `nprt view` shows and how.
-pub struct ViewerOptions {
-    /// Model folders of one scene; Tab switches among them.
-    pub models: Vec<PathBuf>,
-    /// The scene (default: the first model's).
-    pub scene: Option<String>,
-    /// A camera volume's JSON file to start the camera in (default: the scene's sidecar).
-    pub camera_volume: Option<PathBuf>,
-    /// Lightings (map files or built-in specs); M switches among them.
-    pub maps: Vec<String>,
-    pub resolution: [u32; 2],
-    /// Where the networks run.
-    pub engine: Engine,
-    /// Samples per pixel of traced direct light, for models that trace it.
-    pub direct_spp: u32,
-    /// Whether that light is denoised (O toggles it where OIDN is installed).
-    pub denoise_direct: Denoise,
-    /// Exposure in stops.
-    pub exposure: f32,
-    /// Degrees the map turns each frame (0: still until moved).
-    pub spin_deg: f32,
-    /// Folder of the screenshots the P key takes.
-    pub screenshot_dir: PathBuf,
-    /// Close after this many frames, writing `screenshot` of the last (scripts and tests).
-    pub frames: Option<usize>,
-    pub screenshot: Option<PathBuf>,
-    /// Start in path-tracing mode (the R key).
-    pub reference: bool,
-    /// Start with the overlay hidden (the H key).
-    pub hide_overlay: bool,
-    /// The networks' arithmetic.
-    pub precision: Precision,
-}
 
 /// Opens the window and runs until it is closed (or `frames` are drawn).
-pub fn run_viewer(opts: ViewerOptions) -> Result<()> {
-    let (models, scene) = load(&opts)?;
-    let mut viewer = Viewer::new(opts, models, &scene)?;
+pub fn run_viewer(mut opts: ViewerOptions) -> Result<()> {
+    let training = opts.training.take().map(Training::start).transpose()?;
+    let (models, scene) = load(&opts, training.as_ref())?;
+    let mut viewer = Viewer::new(opts, models, &scene, training)?;
     let event_loop = EventLoop::new().map_err(|e| {
         anyhow!("nprt view needs a display ({e}); on a machine without one, run it under Xvfb (scripts/xvfb.sh installs it)")
-    })?;
-    event_loop
-        .run_app(&mut viewer)
-        .context("the window's event loop")?;
+    });
+    let shown = event_loop.and_then(|l| l.run_app(&mut viewer).context("the window's event loop"));
+    if let Some(opened) = viewer.opened {
+        let seconds = opened.elapsed().as_secs_f64();
+        let n = viewer.frames;
+        println!(
+            "nprt view: {n} frames in {seconds:.1} s ({:.1} a second)",
+            n as f64 / seconds.max(1e-9)
+        );
+    }
+    // The run is saved, however the window ended.
+    let trained = viewer.training.take().map(finish_training).transpose();
+    shown?;
+    trained?;
     match viewer.failed.take() {
         Some(e) => Err(e),
         None => Ok(()),
     }
 }
 
-/// Progressive path tracing of the current view: the running sum and its samples per pixel.
-struct Reference {
-    sum: Vec<Vec3>,
-    spp: u32,
-    pass_ms: f64,
-}
-
-struct Viewer<'a> {
-    opts: ViewerOptions,
-    scene: &'a Scene,
-    ts: TraceScene<'a>,
-    models: Vec<Relighter>,
-    maps: Vec<(String, EnvMap)>,
-    camera: OrbitCamera,
-    model: usize,
-    map: usize,
-    rotation: f32,
-    exposure: f32,
-    reference: Option<Reference>,
-    /// The denoiser of traced direct light, where one is installed and asked for, and whether
-    /// it is on (the O key).
-    oidn: Option<&'static Oidn>,
-    denoise: bool,
-    /// What the current model kept of the last frame: its camera's G-buffer and network
-    /// inputs, and the code of its lighting (map and rotation).
-    cache: FrameCache<(usize, u32)>,
-    timings: FrameTimings,
-    frames: usize,
-    fps: f64,
-    last_frame: Option<Instant>,
-    drag: Option<(MouseButton, f64, f64)>,
-    cursor: (f64, f64),
-    /// The last frame drawn and its overlay (RGBA8 over the frame's top rows; empty when
-    /// hidden), for screenshots.
-    shown: Option<FrameRadiance>,
-    overlay_rgba: Vec<u8>,
-    overlay: bool,
-    message: String,
-    window: Option<Arc<Window>>,
-    presenter: Option<Presenter>,
-    failed: Option<anyhow::Error>,
-}
-
-/// The models and their scene, checked to be one scene.
-fn load(opts: &ViewerOptions) -> Result<(Vec<Relighter>, Scene)> {
-    if opts.models.is_empty() {
-        bail!("nprt view: give at least one model folder");
-    }
-    if opts.maps.is_empty() {
-        bail!("nprt view: give at least one map");
-    }
+/// The models and their scene, checked to be one scene (a run's: its dataset's).
+fn load(opts: &ViewerOptions, training: Option<&Training>) -> Result<(Vec<Relighter>, Scene)> {
     let [w, h] = opts.resolution;
     opts.engine
         .tracer()
         .check_frame(w, h, &format!("a {w}×{h} window"))?;
+    if let Some(t) = training {
+        let s = &t.manifest.settings;
+        let spec = opts.scene.as_deref().unwrap_or(&s.scene);
+        let what = "the dataset was made of";
+        return Ok((
+            Vec::new(),
+            nprt_data::dataset::load_checked_scene(spec, &s.scene_hash, what)?,
+        ));
+    }
+    if opts.models.is_empty() {
+        bail!("nprt view: give at least one model folder, or --train DATA");
+    }
+    if opts.maps.is_empty() {
+        bail!("nprt view: give at least one map");
+    }
     let models = opts
         .models
         .iter()
@@ -170,29 +113,30 @@ fn load(opts: &ViewerOptions) -> Result<(Vec<Relighter>, Scene)> {
 }
 
 impl<'a> Viewer<'a> {
-    fn new(opts: ViewerOptions, models: Vec<Relighter>, scene: &'a Scene) -> Result<Self> {
-        let spec = opts
-            .scene
-            .clone()
-            .unwrap_or_else(|| models[0].file.scene.clone());
-        let path = CameraPath::through_volume_of(
-            opts.camera_volume.as_deref(),
-            scene,
-            &spec,
-            "give --camera-volume to start the camera in",
-        )?;
+    pub(super) fn new(
+        opts: ViewerOptions,
+        models: Vec<Relighter>,
+        scene: &'a Scene,
+        training: Option<Training>,
+    ) -> Result<Self> {
+        let path = match (&training, &opts.camera_volume) {
+            (Some(t), None) => {
+                CameraPath::through_volume(&t.manifest.settings.camera_volume.volume())
+            }
+            _ => {
+                let spec = (opts.scene.clone()).unwrap_or_else(|| models[0].file.scene.clone());
+                let hint = "give --camera-volume to start the camera in";
+                CameraPath::through_volume_of(opts.camera_volume.as_deref(), scene, &spec, hint)?
+            }
+        };
         let k = &path.keyframes[0];
         let camera = OrbitCamera::new(k.position.into(), k.target.into(), k.fov_x_deg);
-        let maps = opts
-            .maps
-            .iter()
-            .map(|m| Ok((m.clone(), nprt_scene::open_envmap(m)?)))
-            .collect::<Result<Vec<_>>>()?;
-        let reference = opts.reference.then(|| Reference {
-            sum: Vec::new(),
-            spp: 0,
-            pass_ms: 0.0,
-        });
+        let maps = match &training {
+            Some(t) if opts.maps.is_empty() => dataset_maps(&t.manifest)?,
+            _ => (opts.maps.iter())
+                .map(|m| Ok((m.clone(), nprt_scene::open_envmap(m)?)))
+                .collect::<Result<Vec<_>>>()?,
+        };
         // Resolved for every model, so that `on` without OIDN, or for a model that traces no
         // light, is refused before the window opens.
         let mut oidn = None;
@@ -220,7 +164,22 @@ impl<'a> Viewer<'a> {
             map: 0,
             rotation: 0.0,
             exposure: opts.exposure,
-            reference,
+            reference: Reference::default(),
+            show_reference: opts.reference,
+            compare: Compare::Off,
+            divider: 0.5,
+            l1: None,
+            stale: true,
+            model_rgb: None,
+            worked: None,
+            training,
+            said: Said::default(),
+            keys: {
+                let mut keys = opts.keys.clone();
+                keys.sort_by(|a, b| a.0.total_cmp(&b.0));
+                keys.into()
+            },
+            opened: None,
             denoise: oidn.is_some(),
             oidn,
             cache: FrameCache::default(),
@@ -229,6 +188,7 @@ impl<'a> Viewer<'a> {
             fps: 0.0,
             last_frame: None,
             drag: None,
+            on_divider: false,
             cursor: (0.0, 0.0),
             shown: None,
             overlay_rgba: Vec::new(),
@@ -242,35 +202,55 @@ impl<'a> Viewer<'a> {
     }
 
     /// The frame's linear radiance: the model's relighting (left on the device where the GPU
-    /// kernels made it there), or the reference's running mean.
-    fn radiance(&mut self) -> Result<FrameRadiance> {
+    /// kernels made it there), the reference's running mean, or the two compared.
+    pub(super) fn radiance(&mut self) -> Result<FrameRadiance> {
+        let paced = self.pacing();
+        if !paced {
+            self.take_newest_model()?;
+        }
+        self.say_training();
         let [w, h] = self.opts.resolution;
+        if self.models.is_empty() {
+            return Ok(FrameRadiance::Host(vec![Vec3::ZERO; (w * h) as usize]));
+        }
+        let still = !std::mem::replace(&mut self.stale, false);
+        if still && paced {
+            if let Some(shown) = self.shown.take() {
+                return Ok(shown);
+            }
+        }
+        let clock = Instant::now();
+        let shown = self.made(still)?;
+        self.worked = Some((Instant::now(), clock.elapsed().as_secs_f64()));
+        Ok(shown)
+    }
+
+    /// [`Self::radiance`] made: the reference's next pass, or the model's frame (made again
+    /// unless the view is `still`) alone or compared.
+    fn made(&mut self, still: bool) -> Result<FrameRadiance> {
+        let [w, h] = self.opts.resolution;
+        if self.show_reference {
+            return Ok(FrameRadiance::Host(self.reference_pass()?));
+        }
+        // A still view's model frame is kept: as shown, or as compared last.
+        match (still, self.compare) {
+            (true, Compare::Off) => {
+                if let Some(shown) = self.shown.take() {
+                    return Ok(shown);
+                }
+                if let Some(model) = self.model_rgb.take() {
+                    return Ok(FrameRadiance::Host(model));
+                }
+            }
+            (true, _) => {
+                if let Some(model) = self.model_rgb.take() {
+                    return self.compared(model);
+                }
+            }
+            (false, _) => self.model_rgb = None,
+        }
         let camera = self.camera.camera(w, h);
         let map = &self.maps[self.map].1;
-        if let Some(r) = &mut self.reference {
-            let clock = Instant::now();
-            let pass = self.models[self.model].path_trace(
-                &self.ts,
-                &camera,
-                &map.rotated_y(self.rotation),
-                &RenderSettings {
-                    spp: 1,
-                    max_depth: self.scene.max_depth,
-                    rr_depth: self.scene.rr_depth,
-                    seed: r.spp as u64,
-                    filter: PixelFilter::Box,
-                    progress: false,
-                },
-            )?;
-            r.pass_ms = clock.elapsed().as_secs_f64() * 1e3;
-            if r.sum.len() != pass.len() {
-                r.sum = vec![Vec3::ZERO; pass.len()];
-            }
-            r.sum.iter_mut().zip(&pass).for_each(|(s, p)| *s += *p);
-            r.spp += 1;
-            let k = 1.0 / r.spp as f32;
-            return Ok(FrameRadiance::Host(r.sum.iter().map(|s| *s * k).collect()));
-        }
         let sampling = DirectSampling {
             spp: self.opts.direct_spp,
             seed: self.frames as u64,
@@ -282,66 +262,60 @@ impl<'a> Viewer<'a> {
         let (shown, t) =
             model.frame_shown(&mut self.cache, &self.ts, &camera, lit, sampling, true)?;
         self.timings = t;
-        Ok(shown)
+        if self.compare == Compare::Off {
+            self.l1 = None;
+            return Ok(shown);
+        }
+        self.compared(shown.into_host())
     }
 
-    /// What the overlay says.
-    fn overlay(&self, adapter: &str) -> Vec<String> {
-        let model = &self.models[self.model];
-        let mut lines = vec![
-            format!(
-                "{} [{}/{}]  exposure {:+.1}",
-                model.file.config.label(),
-                self.model + 1,
-                self.models.len(),
-                self.exposure
-            ),
-            format!("{} at {:.0} deg", self.maps[self.map].0, self.rotation),
-        ];
-        match &self.reference {
-            Some(r) => lines.push(format!(
-                "path-traced reference {}: {} spp, {:.0} ms per pass",
-                model.paths_on(),
-                r.spp,
-                r.pass_ms
-            )),
-            None => {
-                let t = &self.timings;
-                lines.push(format!(
-                    "G-buffer {:.1}  encoder {:.1} ms",
-                    t.gbuffer_ms, t.encoder_ms
-                ));
-                lines.push(format!(
-                    "networks {:.1}  direct {:.1} ms",
-                    t.network_ms, t.direct_ms
-                ));
-                lines.push(format!("total {:.1} ms", t.total_ms()));
-                if model.traces_direct() {
-                    let denoised = match (self.oidn, self.denoise) {
-                        (None, _) => "not denoised (no OIDN)",
-                        (Some(_), true) => "denoised by OIDN (O: off)",
-                        (Some(_), false) => "not denoised (O: on)",
-                    };
-                    lines.push(format!(
-                        "direct light {} spp, {denoised}",
-                        self.opts.direct_spp
-                    ));
-                }
-                lines.push(format!("networks on the {}", model.networks_on()));
-                lines.push(format!("G-buffer {}", model.gbuffer_on()));
-            }
-        }
-        lines.push(format!("{:.1} fps, shown by {adapter}", self.fps));
-        lines.push("drag orbit, right-drag map, wheel dolly".into());
-        lines.push("WASDQE fly, Tab model, M map, R reference, F f16, O denoise".into());
-        lines.push("+/- exposure, P screenshot, H hide, Esc quit".into());
-        if !self.message.is_empty() {
-            lines.push(self.message.clone());
-        }
-        lines
+    /// The model's frame `model` compared with the reference, one more sample into it.
+    pub(super) fn compared(&mut self, model: Vec<Vec3>) -> Result<FrameRadiance> {
+        let w = self.opts.resolution[0];
+        let reference = self.reference_pass()?;
+        self.l1 = Some(l1(&model, &reference));
+        // The error of a reference this noisy would mostly be its noise: the split until then.
+        let mode = match self.compare {
+            Compare::Error if self.reference.spp < ERROR_SPP => Compare::Split,
+            mode => mode,
+        };
+        let (width, divider, exposure) = (w as usize, self.divider, self.exposure);
+        let composed = compose(mode, &model, &reference, width, divider, exposure);
+        self.model_rgb = Some(model);
+        Ok(FrameRadiance::Host(composed))
     }
 
-    fn redraw(&mut self) -> Result<()> {
+    /// One more path-traced sample per pixel of the view; the reference's running mean.
+    pub(super) fn reference_pass(&mut self) -> Result<Vec<Vec3>> {
+        let [w, h] = self.opts.resolution;
+        let camera = self.camera.camera(w, h);
+        let map = &self.maps[self.map].1;
+        let r = &mut self.reference;
+        let clock = Instant::now();
+        let pass = self.models[self.model].path_trace(
+            &self.ts,
+            &camera,
+            &map.rotated_y(self.rotation),
+            &RenderSettings {
+                spp: 1,
+                max_depth: self.scene.max_depth,
+                rr_depth: self.scene.rr_depth,
+                seed: r.spp as u64,
+                filter: PixelFilter::Box,
+                progress: false,
+            },
+        )?;
+        r.pass_ms = clock.elapsed().as_secs_f64() * 1e3;
+        if r.sum.len() != pass.len() {
+            r.sum = vec![Vec3::ZERO; pass.len()];
+        }
+        r.sum.iter_mut().zip(&pass).for_each(|(s, p)| *s += *p);
+        r.spp += 1;
+        let k = 1.0 / r.spp as f32;
+        Ok(r.sum.iter().map(|s| *s * k).collect())
+    }
+
+    pub(super) fn redraw(&mut self) -> Result<()> {
         let rgb = self.radiance()?;
         let now = Instant::now();
         if let Some(last) = self.last_frame {
@@ -353,14 +327,9 @@ impl<'a> Viewer<'a> {
             };
         }
         self.last_frame = Some(now);
-        let [w, h] = self.opts.resolution;
         self.overlay_rgba.clear();
         if self.overlay {
-            let adapter = &self.presenter.as_ref().expect("a window is open").adapter;
-            let lines = self.overlay(adapter);
-            let rows = h.min(OVERLAY_ROWS) as usize;
-            self.overlay_rgba.resize(4 * w as usize * rows, 0);
-            draw_lines(&mut self.overlay_rgba, w as usize, &lines, 1);
+            self.draw_overlay();
         }
         let shown = Shown {
             frame: &rgb,
@@ -370,12 +339,15 @@ impl<'a> Viewer<'a> {
         self.presenter.as_mut().expect("open").present(&shown)?;
         self.shown = Some(rgb);
         self.frames += 1;
-        self.rotation = (self.rotation + self.opts.spin_deg).rem_euclid(360.0);
+        if self.opts.spin_deg != 0.0 {
+            self.rotation = (self.rotation + self.opts.spin_deg).rem_euclid(360.0);
+            self.moved();
+        }
         Ok(())
     }
 
     /// Writes the frame on screen, overlay included, as a PNG.
-    fn screenshot(&self, path: &std::path::Path) -> Result<()> {
+    pub(super) fn screenshot(&self, path: &std::path::Path) -> Result<()> {
         let [w, h] = self.opts.resolution;
         let frame = self.shown.as_ref().context("no frame drawn yet")?;
         let shown = Shown {
@@ -394,91 +366,33 @@ impl<'a> Viewer<'a> {
     }
 
     /// Whether frames keep coming without input: a spinning map or a reference converging.
-    fn animating(&self) -> bool {
-        self.opts.spin_deg != 0.0 || self.reference.is_some() || self.opts.frames.is_some()
+    pub(super) fn animating(&self) -> bool {
+        self.opts.spin_deg != 0.0
+            || self.show_reference
+            || self.compare != Compare::Off
+            || self.training.is_some()
+            || self.opts.frames.is_some()
+    }
+
+    /// Whether the next frame only shows the last again, with the run's figures.
+    pub(super) fn idling(&self) -> bool {
+        let still = !self.show_reference && self.compare == Compare::Off;
+        self.training.is_some()
+            && !self.stale
+            && (still || self.pacing())
+            && self.opts.frames.is_none()
     }
 
     /// The view changed: the reference starts again.
-    fn moved(&mut self) {
-        if let Some(r) = &mut self.reference {
-            r.sum.clear();
-            r.spp = 0;
-        }
+    pub(super) fn moved(&mut self) {
+        self.reference = Reference::default();
+        self.stale = true;
         if let Some(w) = &self.window {
             w.request_redraw();
         }
     }
 
-    fn key(&mut self, key: &Key, el: &ActiveEventLoop) -> Result<()> {
-        match key {
-            Key::Named(NamedKey::Escape) => el.exit(),
-            Key::Named(NamedKey::Tab) => {
-                self.model = (self.model + 1) % self.models.len();
-                self.cache = FrameCache::default();
-            }
-            Key::Named(NamedKey::F12) => self.take_screenshot()?,
-            Key::Character(c) => match c.to_lowercase().as_str() {
-                "m" => self.map = (self.map + 1) % self.maps.len(),
-                "r" => {
-                    self.reference = match self.reference {
-                        Some(_) => None,
-                        None => Some(Reference {
-                            sum: Vec::new(),
-                            spp: 0,
-                            pass_ms: 0.0,
-                        }),
-                    }
-                }
-                "p" => self.take_screenshot()?,
-                "f" => {
-                    // f16 ⇄ f32 on the GPU kernels; a model on the CPU stays f32.
-                    let model = &mut self.models[self.model];
-                    let other = match model.precision() {
-                        Precision::F32 => Precision::F16,
-                        Precision::F16 => Precision::F32,
-                    };
-                    if model.set_precision(other).is_ok() {
-                        self.cache = FrameCache::default();
-                    }
-                }
-                "h" => self.overlay = !self.overlay,
-                "o" => {
-                    // The next frame is made again: a denoised one takes the host's path.
-                    self.denoise = !self.denoise && self.oidn.is_some();
-                    self.cache = FrameCache::default();
-                }
-                "+" | "=" => self.exposure += 0.5,
-                "-" => self.exposure -= 0.5,
-                "w" => self.camera.fly(1.0, 0.0, 0.0),
-                "s" => self.camera.fly(-1.0, 0.0, 0.0),
-                "d" => self.camera.fly(0.0, 1.0, 0.0),
-                "a" => self.camera.fly(0.0, -1.0, 0.0),
-                "e" => self.camera.fly(0.0, 0.0, 1.0),
-                "q" => self.camera.fly(0.0, 0.0, -1.0),
-                _ => return Ok(()),
-            },
-            _ => return Ok(()),
-        }
-        self.moved();
-        Ok(())
-    }
-
-    fn take_screenshot(&mut self) -> Result<()> {
-        let path = (0..)
-            .map(|i| {
-                self.opts
-                    .screenshot_dir
-                    .join(format!("nprt-view-{i:04}.png"))
-            })
-            .find(|p| !p.exists())
-            .expect("a free name");
-        self.screenshot(&path)?;
-        self.message = format!("wrote {}", path.display());
-        println!("{}", self.message);
-        Ok(())
-    }
-
-    fn handle(&mut self, el: &ActiveEventLoop, event: WindowEvent) -> Result<()> {
+    pub(super) fn handle(&mut self, el: &ActiveEventLoop, event: WindowEvent) -> Result<()> {
         match event {
             WindowEvent::CloseRequested => el.exit(),
             WindowEvent::Resized(size) => {
@@ -487,6 +401,12 @@ impl<'a> Viewer<'a> {
                 }
             }
             WindowEvent::RedrawRequested => {
+                let opened = *self.opened.get_or_insert_with(Instant::now);
+                let now = opened.elapsed().as_secs_f64();
+                while self.keys.front().is_some_and(|(t, _)| *t <= now) {
+                    let (_, key) = self.keys.pop_front().expect("a key");
+                    self.key(&scripted_key(&key), el)?;
+                }
                 self.redraw()?;
                 if let Some(n) = self.opts.frames {
                     if self.frames >= n {
@@ -498,7 +418,13 @@ impl<'a> Viewer<'a> {
                         return Ok(());
                     }
                 }
-                if self.animating() {
+                if self.idling() {
+                    // Only the run's figures change: redrawn about seven times a second, so that the
+                    // window leaves the cores to the training.
+                    let next = Instant::now() + std::time::Duration::from_millis(150);
+                    el.set_control_flow(ControlFlow::WaitUntil(next));
+                } else if self.animating() {
+                    el.set_control_flow(ControlFlow::Wait);
                     self.window.as_ref().expect("open").request_redraw();
                 }
             }
@@ -511,6 +437,15 @@ impl<'a> Viewer<'a> {
                     self.cursor.0,
                     self.cursor.1,
                 ));
+                let column = self.divider as f64 * self.opts.resolution[0] as f64;
+                self.on_divider = self.compare != Compare::Off
+                    && button == MouseButton::Left
+                    && (self.cursor.0 - column).abs() <= 6.0;
+            }
+            WindowEvent::CursorMoved { position, .. } if self.drag.is_some() && self.on_divider => {
+                self.cursor = (position.x, position.y);
+                let width = self.opts.resolution[0] as f64;
+                self.move_divider((position.x / width) as f32);
             }
             WindowEvent::CursorMoved { position, .. } => {
                 self.cursor = (position.x, position.y);
@@ -566,6 +501,12 @@ impl ApplicationHandler for Viewer<'_> {
                 self.failed = Some(e);
                 el.exit();
             }
+        }
+    }
+
+    fn new_events(&mut self, _: &ActiveEventLoop, cause: StartCause) {
+        if let (StartCause::ResumeTimeReached { .. }, Some(w)) = (cause, &self.window) {
+            w.request_redraw();
         }
     }
 
