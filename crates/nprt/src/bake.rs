@@ -46,6 +46,15 @@ pub struct BakeArgs {
     /// Seed of every random choice (cameras, lightings, samples, initial weights).
     #[arg(long, default_value_t = 0)]
     seed: u64,
+    /// Train in a window (`nprt view --train`'s, keys and all), watching the model learn beside
+    /// the path-traced reference; the bake goes on to its check once the run's minutes are
+    /// trained and the window is closed. Closed earlier, the bake stops with the model saved
+    /// (the same command continues it). Needs the `gpu` feature.
+    #[arg(long, conflicts_with = "epochs")]
+    view: bool,
+    /// With --view: keys pressed at given times, as `nprt view --keys` (scripts and tests).
+    #[arg(long, requires = "view", value_delimiter = ',', value_parser = crate::view::parse_key)]
+    keys: Vec<(f64, String)>,
     #[command(flatten)]
     device: DeviceArg,
 }
@@ -64,6 +73,10 @@ pub fn command(a: BakeArgs) -> Result<()> {
         },
         test_maps: a.test_maps,
         seed: a.seed,
+        view: a
+            .view
+            .then(|| crate::view::training_window(a.keys))
+            .transpose()?,
         ..Bake::new(&a.scene, &a.envmaps, &a.out, a.quality, a.device.engine()?)
     };
     let baked = bake.run()?;

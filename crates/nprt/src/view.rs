@@ -7,6 +7,7 @@ use anyhow::Result;
 use crate::flags::{design_names, DeviceArg, Resolution};
 
 /// The lightings M switches among when neither `--maps` nor a dataset gives them.
+#[cfg(feature = "gpu")]
 const DEFAULT_MAPS: [&str; 5] = [
     "builtin:sky:30:250:3",
     "builtin:sky:60:90:2",
@@ -100,7 +101,7 @@ pub struct ViewArgs {
 }
 
 /// A scripted key: SECONDS:KEY.
-fn parse_key(s: &str) -> Result<(f64, String), String> {
+pub fn parse_key(s: &str) -> Result<(f64, String), String> {
     let (at, key) = s
         .split_once(':')
         .ok_or_else(|| format!("'{s}' is not SECONDS:KEY"))?;
@@ -181,6 +182,36 @@ pub fn run(a: ViewArgs) -> Result<()> {
         extend_minutes: a.extend_minutes,
         keys: a.keys,
     })
+}
+
+/// `nprt bake --view`'s window: the bake's run trained as `nprt view --train` trains it,
+/// `keys` pressed as `--keys` presses them.
+#[cfg(feature = "gpu")]
+pub fn training_window(keys: Vec<(f64, String)>) -> Result<nprt_paper::bake::TrainingWindow> {
+    Ok(nprt_paper::bake::TrainingWindow(std::sync::Arc::new(
+        move |r: &nprt_paper::bake::WindowedRun| {
+            let job = nprt_render::view::TrainingJob {
+                data: r.data.to_path_buf(),
+                out: r.model.to_path_buf(),
+                config: r.config.clone(),
+                opts: r.opts.clone(),
+                asked: nprt_net::Asked::default(),
+                minutes: r.opts.schedule.minutes,
+                engine: r.engine,
+            };
+            let mut opts = nprt_render::view::ViewerOptions::training(job);
+            opts.keys = keys.clone();
+            nprt_render::view::run_viewer(opts)
+        },
+    )))
+}
+
+#[cfg(not(feature = "gpu"))]
+pub fn training_window(_: Vec<(f64, String)>) -> Result<nprt_paper::bake::TrainingWindow> {
+    anyhow::bail!(
+        "nprt bake --view: this nprt was built without the window; rebuild it with \
+         `cargo build --release --features gpu` (docs/building.md)"
+    )
 }
 
 #[cfg(not(feature = "gpu"))]

@@ -429,3 +429,49 @@ fn the_viewer_refuses_a_run_it_cannot_train_before_opening_a_window() {
     );
     usage(&["view", "m", "--train", d], &["cannot be used with"]);
 }
+
+/// `nprt bake --view` trains the bake's run in the window: closed before the run's minutes,
+/// the bake stops with the model saved and says how to continue; the same bake without the
+/// window continues the run and checks the model.
+#[test]
+fn a_bake_trained_in_the_window_stops_when_closed_early_and_continues_without_it() {
+    let Some(display) = display() else { return };
+    let dir = fresh_dir("bake-view");
+    let out = dir.join("run");
+    let bake = |window: &[&str]| {
+        Command::new(env!("CARGO_BIN_EXE_nprt"))
+            .args([
+                "bake",
+                "builtin:room",
+                "--envmaps",
+                "builtin",
+                "--quality",
+                "tiny",
+            ])
+            .args(["--minutes", "0.25", "--device", "cpu"])
+            .args(window)
+            .arg("--out")
+            .arg(&out)
+            .env("DISPLAY", &display.name)
+            .output()
+            .unwrap()
+    };
+    let early = bake(&["--view", "--keys", "0.1:escape"]);
+    let err = String::from_utf8_lossy(&early.stderr);
+    assert_eq!(early.status.code(), Some(1), "{err}");
+    assert!(
+        err.contains("the window closed after") && err.contains("--minutes 0.25"),
+        "{err}"
+    );
+    assert!(out.join("model/model.json").is_file(), "the model is saved");
+    let done = bake(&[]);
+    let said = String::from_utf8_lossy(&done.stdout);
+    let err = String::from_utf8_lossy(&done.stderr);
+    assert!(done.status.success(), "{err}");
+    assert!(
+        (said.clone() + err.clone()).contains("training resumes where a run before stopped"),
+        "{said}{err}"
+    );
+    assert!(said.contains("checked on 2 held-out views"), "{said}");
+    assert!(out.join("preview.png").is_file() && out.join("comparison.png").is_file());
+}

@@ -10,6 +10,7 @@ mod comparison;
 pub mod quality;
 
 use std::path::{Path, PathBuf};
+use std::sync::Arc;
 use std::time::Instant;
 
 use anyhow::{bail, Context, Result};
@@ -48,6 +49,29 @@ pub struct Bake {
     pub seed: u64,
     pub engine: Engine,
     pub progress: bool,
+    /// Trains in a window instead of headless (`nprt bake --view`), for minutes only.
+    pub view: Option<TrainingWindow>,
+}
+
+/// A bake's training as a window runs it (`nprt bake --view`, which passes `nprt view
+/// --train`'s): the window returns when it is closed, the run saved.
+pub struct WindowedRun<'a> {
+    pub data: &'a Path,
+    pub model: &'a Path,
+    pub config: &'a ModelConfig,
+    pub opts: &'a TrainOptions,
+    pub engine: Engine,
+}
+
+/// What trains a bake's run in a window; this crate opens none itself (the window is
+/// nprt-render's, behind its `view` feature).
+#[derive(Clone)]
+pub struct TrainingWindow(pub Arc<dyn Fn(&WindowedRun) -> Result<()> + Send + Sync>);
+
+impl std::fmt::Debug for TrainingWindow {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str("TrainingWindow")
+    }
 }
 
 /// What a bake made, and how its model did against path tracing.
@@ -96,6 +120,7 @@ impl Bake {
             seed: 0,
             engine,
             progress: true,
+            view: None,
         }
     }
 
@@ -115,6 +140,9 @@ impl Bake {
         }
         if self.epochs == Some(0) {
             bail!("--epochs must be at least 1");
+        }
+        if self.view.is_some() && self.epochs.is_some() {
+            bail!("--view trains for minutes: drop --epochs");
         }
         if self.out.to_str().is_none() {
             bail!(
@@ -180,6 +208,32 @@ impl Bake {
         let mut baked = self.baked(&evaluation, &config, check)?;
         baked.seconds = start.elapsed().as_secs_f64();
         Ok(baked)
+    }
+
+    /// After the window closed: the bake goes on to its check only with the run done; the
+    /// preview is the trained model's frame.
+    fn windowed_run_ended(&self, data: &Path, preview: &Path, say: &dyn Fn(&str)) -> Result<()> {
+        let model = self.model_dir();
+        let file = nprt_net::read_model_file(&model)
+            .context("the window closed before the run saved a model; run the bake again")?;
+        let done = file.training["seconds"].as_f64().unwrap_or(0.0);
+        let minutes = file.training["options"]["minutes"].as_f64().unwrap_or(0.0);
+        if done < minutes * 60.0 {
+            bail!(
+                "the window closed after {:.2} of the run's {minutes} minutes of training; the \
+                 model is saved: the same `nprt bake` (with --minutes {minutes}, --view or not) \
+                 continues it, then checks it",
+                done / 60.0
+            );
+        }
+        if !preview.is_file() {
+            write_comparison(&model, data, self.engine, preview)?;
+            say(&format!(
+                "preview: '{}' (the trained model beside the path-traced reference)",
+                preview.display()
+            ));
+        }
+        Ok(())
     }
 
     /// What the bake will do, in one line.
@@ -300,7 +354,7 @@ impl Bake {
         preview: &Path,
         say: &dyn Fn(&str),
     ) -> Result<()> {
-        let set = TrainingSet::load(data, config, self.progress, |why| say(why))?;
+        let manifest = nprt_data::dataset::load_manifest(data)?;
         let run = match self.epochs {
             Some(e) => RunLength::epochs(e),
             None => RunLength::minutes(self.minutes.unwrap_or(sizes.minutes)),
@@ -308,7 +362,7 @@ impl Bake {
         let defaults = TrainOptions::default();
         let mut opts = TrainOptions {
             calibration: RECIPE.calibration,
-            targets: RECIPE.targets(config, set.manifest.settings.transfer),
+            targets: RECIPE.targets(config, manifest.settings.transfer),
             schedule: nprt_net::Schedule {
                 seed: self.seed,
                 progress: self.progress,
@@ -318,6 +372,18 @@ impl Bake {
         }
         .with_run(config.design, run, None);
         let model = self.model_dir();
+        if let Some(window) = &self.view {
+            let run = WindowedRun {
+                data,
+                model: &model,
+                config,
+                opts: &opts,
+                engine: self.engine,
+            };
+            (window.0)(&run)?;
+            return self.windowed_run_ended(data, preview, say);
+        }
+        let set = TrainingSet::load(data, config, self.progress, |why| say(why))?;
         if nprt_net::training::checkpoint::exists(&model) {
             say(&format!(
                 "training resumes where a run before stopped ('{}')",
@@ -330,14 +396,11 @@ impl Bake {
         }
         // A stop asked for from Python (Ctrl-C) ends the training at an epoch's end, saved.
         let go_on = |_: &_| !nprt_io::interrupt::requested();
-        let (s, _) = nprt_net::train(
-            &set,
-            config,
-            &opts,
-            &model,
-            self.engine,
-            nprt_net::Watch::epochs(&go_on),
-        )?;
+        let train = |opts: &TrainOptions| {
+            let watch = nprt_net::Watch::epochs(&go_on);
+            nprt_net::train(&set, config, opts, &model, self.engine, watch)
+        };
+        let (s, _) = train(&opts)?;
         nprt_io::interrupt::check()?;
         if first {
             write_comparison(&model, data, self.engine, preview)?;
@@ -349,14 +412,7 @@ impl Bake {
         }
         if s.paused {
             opts.schedule.pause_after = None;
-            nprt_net::train(
-                &set,
-                config,
-                &opts,
-                &model,
-                self.engine,
-                nprt_net::Watch::epochs(&go_on),
-            )?;
+            train(&opts)?;
         }
         nprt_io::interrupt::check()
     }

@@ -68,6 +68,34 @@ pub struct ViewerOptions {
     pub keys: Vec<(f64, String)>,
 }
 
+impl ViewerOptions {
+    /// A window on `job`'s run, with `nprt view`'s defaults: 384×288, the dataset's maps, 4
+    /// traced samples a pixel denoised where OIDN is installed, X adding 5 minutes.
+    pub fn training(job: TrainingJob) -> Self {
+        ViewerOptions {
+            models: Vec::new(),
+            scene: None,
+            camera_volume: None,
+            maps: Vec::new(),
+            resolution: [384, 288],
+            engine: job.engine,
+            direct_spp: 4,
+            denoise_direct: Denoise::default(),
+            exposure: 0.0,
+            spin_deg: 0.0,
+            screenshot_dir: PathBuf::from("."),
+            frames: None,
+            screenshot: None,
+            reference: false,
+            hide_overlay: false,
+            precision: Precision::F32,
+            training: Some(job),
+            extend_minutes: 5.0,
+            keys: Vec::new(),
+        }
+    }
+}
+
 /// Progressive path tracing of the current view: the running sum and its samples per pixel.
 #[derive(Default)]
 pub(super) struct Reference {
