@@ -22,6 +22,10 @@ impl Viewer<'_> {
             (" ", Some(t)) => {
                 t.toggle_pause();
             }
+            // An ended run was saved at its end; only a running one has a step to save at.
+            ("k", Some(_)) if self.said.ended => {
+                self.message = "the run has ended and is saved (X trains it longer)".into();
+            }
             ("k", Some(t)) => {
                 t.save();
                 self.message = "saving …".into();
