@@ -191,8 +191,7 @@ pub fn snapshots(x: &Experiment, data: &Path, file: &Path) -> Result<(Vec<Growth
 /// The training time a model folder's model.json records, seconds.
 fn training_seconds(model: &Path) -> Result<f64> {
     let file = nprt_net::model::folder::read_model_file(model)?;
-    (file.training["seconds"].as_f64())
-        .filter(|s| s.is_finite() && *s >= 0.0)
+    (file.trained_seconds())
         .with_context(|| format!("'{}' records no training time", model.display()))
 }
 

@@ -102,6 +102,18 @@ impl ModelFile {
         format!("{}{direct}{level}", self.config.describe())
     }
 
+    /// Seconds of training the model records (None where it records none, or one that is
+    /// negative or not finite).
+    pub fn trained_seconds(&self) -> Option<f64> {
+        (self.training["seconds"].as_f64()).filter(|s| s.is_finite() && *s >= 0.0)
+    }
+
+    /// The time budget, minutes, of the run that saved the model (None for a run bounded by
+    /// epochs): a run resumes only under the same.
+    pub fn run_minutes(&self) -> Option<f64> {
+        self.training["options"]["minutes"].as_f64()
+    }
+
     /// The gain on each channel of the network's radiance (1 without calibration).
     pub fn output_gain(&self) -> [f32; 3] {
         self.level_gain.unwrap_or([1.0; 3])

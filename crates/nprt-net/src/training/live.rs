@@ -25,15 +25,11 @@ pub struct LiveStatus {
     pub seconds: f64,
     /// The run's time budget, seconds (None: bounded by epochs).
     pub budget: Option<f64>,
-    /// Epochs done, fractional.
-    pub epoch: f64,
     /// The training loss's running mean.
     pub train_loss: f64,
     /// The loss table's rows so far (training rows, and validation at epochs' ends).
     pub rows: Vec<LossRow>,
     pub paused: bool,
-    /// The run has ended (its time spent, stopped, or failed).
-    pub ended: bool,
     /// The step of the last save asked for, once written.
     pub saved_at: Option<u64>,
 }
@@ -159,13 +155,6 @@ impl LiveRun {
         }
         start.elapsed().as_secs_f64()
     }
-
-    /// The run's side: it has ended.
-    pub fn end(&self) {
-        let mut s = self.lock();
-        s.status.ended = true;
-        s.status.paused = false;
-    }
 }
 
 #[cfg(test)]
@@ -202,8 +191,8 @@ mod tests {
         assert!(!live.pausing() && live.stopping());
         let waited = live.wait_paused(Duration::from_secs(5));
         assert!(waited < 1.0, "a stopped run does not wait: {waited}");
-        live.end();
-        assert!(live.status().ended && !live.status().paused);
+        live.report(|_| {});
+        assert!(!live.status().paused, "a stopped run is not paused");
     }
 
     #[test]

@@ -38,8 +38,6 @@ pub(crate) struct Run<'s, O: Objective> {
     /// The model folder.
     pub(super) out: &'s Path,
     pub(super) ck: Checkpoint,
-    /// Seconds of training the run may take, when it has a time budget.
-    pub(super) budget: Option<f64>,
     pub(super) total_batches: usize,
     pub(super) done_batches: usize,
     /// Steps queued on a device whose loss is not back yet (counted in the learning rate's
@@ -98,7 +96,6 @@ impl<'s, O: Objective> Run<'s, O> {
             objective,
             schedule: schedule.clone(),
             out,
-            budget,
             total_batches,
             done_batches,
             queued: 0,
@@ -125,6 +122,11 @@ impl<'s, O: Objective> Run<'s, O> {
         }
     }
 
+    /// Seconds of training the run may take, when it has a time budget.
+    pub(super) fn budget(&self) -> Option<f64> {
+        self.schedule.budget_secs()
+    }
+
     /// Whether the run's time budget is spent, or this call's pause has come.
     pub(super) fn out_of_time(&self) -> bool {
         self.budget_spent() || self.pausing()
@@ -132,7 +134,7 @@ impl<'s, O: Objective> Run<'s, O> {
 
     /// Whether the run's time budget, if it has one, is spent.
     pub(super) fn budget_spent(&self) -> bool {
-        self.budget.is_some_and(|b| self.ck.state.seconds >= b)
+        self.budget().is_some_and(|b| self.ck.state.seconds >= b)
     }
 
     /// Whether this call has trained its `pause_after`.
@@ -148,7 +150,7 @@ impl<'s, O: Objective> Run<'s, O> {
 
     /// The learning rate of the next step.
     pub(super) fn learning_rate(&self) -> f64 {
-        let progress = match self.budget {
+        let progress = match self.budget() {
             Some(b) => self.ck.state.seconds / b,
             None => (self.done_batches + self.queued) as f64 / self.total_batches.max(1) as f64,
         };
@@ -323,7 +325,7 @@ impl<'s, O: Objective> Run<'s, O> {
             });
             (self.row_sum, self.row_n) = (0.0, 0);
         }
-        match self.budget {
+        match self.schedule.budget_secs() {
             Some(_) => self.bar.set_position(s.seconds as u64),
             None => self.bar.inc(1),
         }

@@ -34,7 +34,7 @@ impl<O: Objective> Run<'_, O> {
         let (epoch, total, row_every) = at;
         let mut published = false;
         loop {
-            let asks = self.report(live, total);
+            let asks = self.report(live);
             if asks.extend_minutes > 0.0 {
                 self.extend(asks.extend_minutes);
             }
@@ -61,16 +61,14 @@ impl<O: Objective> Run<'_, O> {
         }
     }
 
-    /// Tells a live run's watcher where the run stands (`total` batches in its epoch); returns
-    /// what the watcher asked.
-    pub(super) fn report(&self, live: &LiveRun, total: usize) -> Asks {
+    /// Tells a live run's watcher where the run stands; returns what the watcher asked.
+    pub(super) fn report(&self, live: &LiveRun) -> Asks {
         let (state, history) = (self.ck.state, &self.ck.history);
         live.report(|s| {
             s.step = state.step;
             s.samples = state.samples;
             s.seconds = state.seconds;
-            s.epoch = state.epoch as f64 + state.batch as f64 / total.max(1) as f64;
-            s.budget = self.budget;
+            s.budget = self.budget();
             s.train_loss = self.guard.ema;
             s.rows
                 .extend_from_slice(history.get(s.rows.len()..).unwrap_or_default());
@@ -88,12 +86,11 @@ impl<O: Objective> Run<'_, O> {
     /// the key its checkpoint resumes under with it: `nprt train --minutes` of the new length
     /// (the sum, as the watcher adds it) continues it.
     pub(super) fn extend(&mut self, minutes: f64) {
-        if let Some(before) = self.schedule.minutes.filter(|_| self.budget.is_some()) {
+        if let Some(before) = self.schedule.minutes {
             self.schedule.minutes = Some(before + minutes);
-            self.budget = self.schedule.budget_secs();
             self.ck.run = run_key(self.objective, &self.schedule);
-            self.bar
-                .set_length(self.budget.unwrap_or(0.0).ceil() as u64);
+            let budget = self.budget().expect("a run of minutes has a budget");
+            self.bar.set_length(budget.ceil() as u64);
         }
     }
 }

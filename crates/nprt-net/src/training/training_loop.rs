@@ -85,13 +85,17 @@ impl<'a> Watch<'a> {
     }
 }
 
-/// Tells a live run's watcher that the run ended, however it ended.
-struct Ends<'a>(Option<&'a LiveRun>);
-
-impl Drop for Ends<'_> {
-    fn drop(&mut self) {
-        self.0.inspect(|l| l.end());
+/// Refuses a model folder `out` that is a dataset's: a model goes into a folder of its own.
+pub fn check_model_folder(out: &Path) -> Result<()> {
+    if out.join(nprt_data::dataset::MANIFEST).exists() {
+        bail!(
+            "'{}' is a dataset folder (it holds {}); a model goes into a folder of its own \
+             (--out)",
+            out.display(),
+            nprt_data::dataset::MANIFEST
+        );
     }
+    Ok(())
 }
 
 /// Trains (or resumes training of) `objective`'s network in the model folder `out`, telling
@@ -103,15 +107,7 @@ pub fn train<O: Objective>(
     watch: Watch,
 ) -> Result<TrainSummary> {
     schedule.check()?;
-    let _ends = Ends(watch.live);
-    if out.join(nprt_data::dataset::MANIFEST).exists() {
-        bail!(
-            "'{}' is a dataset folder (it holds {}); a model goes into a folder of its own \
-             (--out)",
-            out.display(),
-            nprt_data::dataset::MANIFEST
-        );
-    }
+    check_model_folder(out)?;
     let mut net = objective.build(&mut Init::new(schedule.seed));
     std::fs::create_dir_all(checkpoint::dir(out))
         .with_context(|| format!("cannot create model folder '{}'", out.display()))?;
@@ -162,7 +158,7 @@ pub fn train<O: Objective>(
         objective.save_model(out, &net, &run.schedule, &run.ck.state)?;
     }
     if let Some(live) = watch.live {
-        run.report(live, 1);
+        run.report(live);
         run.publish(live, &net);
     }
     Ok(run.summary(resumed_from_epoch))

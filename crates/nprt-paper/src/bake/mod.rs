@@ -216,8 +216,8 @@ impl Bake {
         let model = self.model_dir();
         let file = nprt_net::read_model_file(&model)
             .context("the window closed before the run saved a model; run the bake again")?;
-        let done = file.training["seconds"].as_f64().unwrap_or(0.0);
-        let minutes = file.training["options"]["minutes"].as_f64().unwrap_or(0.0);
+        let done = file.trained_seconds().unwrap_or(0.0);
+        let minutes = file.run_minutes().unwrap_or(0.0);
         if done < minutes * 60.0 {
             bail!(
                 "the window closed after {:.2} of the run's {minutes} minutes of training; the \

@@ -10,6 +10,7 @@ use std::thread::JoinHandle;
 use anyhow::{anyhow, bail, Context, Result};
 use nprt_data::dataset::{load_manifest, Manifest};
 use nprt_net::training::live::{LiveRun, LiveStatus};
+use nprt_net::training::training_loop::check_model_folder;
 use nprt_net::training::training_set::TrainingSet;
 use nprt_net::{
     read_model_file, Asked, Engine, ModelConfig, ModelFile, NprtNet, RunLength, TrainOptions,
@@ -57,9 +58,11 @@ impl Training {
     pub fn start(mut job: TrainingJob) -> Result<Self> {
         let manifest = load_manifest(&job.data)
             .with_context(|| format!("--train '{}'", job.data.display()))?;
-        if job.out.join(nprt_data::dataset::MANIFEST).exists() || job.out.is_file() {
+        // Refused before the window opens, not on the run's thread.
+        check_model_folder(&job.out)?;
+        if job.out.is_file() {
             bail!(
-                "--out '{}' is a dataset folder or a file; a model goes into a folder of its own",
+                "--out '{}' is a file; a model goes into a folder",
                 job.out.display()
             );
         }
@@ -100,8 +103,7 @@ impl Training {
             job.engine,
         );
         self.thread = Some(std::thread::spawn(move || {
-            let set = TrainingSet::load(&data, &config, false, |why| eprintln!("{why}"));
-            let set = set.inspect_err(|_| live.end())?;
+            let set = TrainingSet::load(&data, &config, false, |why| eprintln!("{why}"))?;
             let opts = TrainOptions {
                 targets: asked.targets(&config, set.manifest.settings.transfer),
                 ..opts
@@ -195,6 +197,5 @@ impl Training {
 
 /// The length (minutes) the run in model folder `out` was saved with, if it holds one.
 fn recorded_minutes(out: &std::path::Path) -> Option<f64> {
-    let file = read_model_file(out).ok()?;
-    file.training["options"]["minutes"].as_f64()
+    read_model_file(out).ok()?.run_minutes()
 }

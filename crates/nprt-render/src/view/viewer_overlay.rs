@@ -2,6 +2,8 @@
 //! trained beside the frames with its loss curves, the comparison with path tracing and its
 //! error scale, and the keys.
 
+use nprt_net::training::live::LiveStatus;
+
 use super::compare::{Compare, ERROR_SPP};
 use super::live_training::Training;
 use super::overlay::{draw_curves, draw_lines, draw_scale, Area};
@@ -10,11 +12,11 @@ use super::viewer_state::Viewer;
 use crate::relight::Relighter;
 
 impl Viewer<'_> {
-    /// What the overlay says.
-    pub(super) fn overlay(&self, adapter: &str) -> Vec<String> {
+    /// What the overlay says (`status`: where the run trained beside the frames stands).
+    pub(super) fn overlay(&self, adapter: &str, status: Option<&LiveStatus>) -> Vec<String> {
         let mut lines = Vec::new();
-        if let Some(t) = &self.training {
-            lines.extend(training_lines(t, self.models.is_empty()));
+        if let (Some(t), Some(s)) = (&self.training, status) {
+            lines.extend(training_lines(t, s, self.models.is_empty()));
         }
         let Some(model) = self.models.get(self.model) else {
             lines.push(format!("{:.1} fps, shown by {adapter}", self.fps));
@@ -99,7 +101,8 @@ impl Viewer<'_> {
     pub(super) fn draw_overlay(&mut self) {
         let [w, h] = self.opts.resolution;
         let adapter = &self.presenter.as_ref().expect("a window is open").adapter;
-        let lines = self.overlay(adapter);
+        let status = self.training.as_ref().map(Training::status);
+        let lines = self.overlay(adapter, status.as_ref());
         let rows = h.min(OVERLAY_ROWS) as usize;
         let width = w as usize;
         self.overlay_rgba.resize(4 * width * rows, 0);
@@ -113,8 +116,8 @@ impl Viewer<'_> {
             height,
         };
         let mut top = 4;
-        if let Some(t) = &self.training {
-            let (train, val) = loss_curves(&t.status().rows);
+        if let Some(s) = &status {
+            let (train, val) = loss_curves(&s.rows);
             let curves = [(&train[..], [220, 220, 220]), (&val[..], [255, 160, 40])];
             draw_curves(&mut self.overlay_rgba, width, area(top, side / 2), &curves);
             top += side / 2 + 4;
@@ -135,9 +138,8 @@ impl Viewer<'_> {
     }
 }
 
-/// The overlay's lines on a run trained beside the frames.
-fn training_lines(t: &Training, waiting: bool) -> Vec<String> {
-    let s = t.status();
+/// The overlay's lines on the run `t` trained beside the frames, standing at `s`.
+fn training_lines(t: &Training, s: &LiveStatus, waiting: bool) -> Vec<String> {
     let budget = s.budget.unwrap_or(t.minutes() * 60.0);
     let mut lines = vec![format!(
         "training: step {}, {:.0} K samples/s, {:.0} of {:.0} s ({:.0} s left){}",
