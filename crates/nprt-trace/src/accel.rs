@@ -1,5 +1,5 @@
 //! Ray-triangle intersection over the whole scene with obvhs's compressed wide BVH (chosen over
-//! the `bvh` crate by `cargo bench -p nprt-trace --bench bvh`).
+//! the `bvh` crate by `cargo bench --manifest-path bench/bvh/Cargo.toml`).
 
 use std::time::Duration;
 

@@ -1,17 +1,21 @@
-//! `nprt paper --budget tiny` end to end on builtin:room: every table of the paper in one
-//! report with finite figures and the paper's columns, a repeated run resumed from its caches,
-//! and a folder of another experiment refused.
+//! `nprt paper --budget tiny` end to end on builtin:room: its dataset rendered from the flags
+//! it prints, every table of the paper in one report with finite figures and the paper's
+//! columns, a repeated run resumed from its caches, the orderings judged at snapshots of the
+//! training, and a folder of another experiment refused.
 
 mod common;
 
 use common::{fails, fresh_dir, nprt, ok};
 
+/// One tiny run serves every check of a finished experiment (a paper run costs a quarter of a
+/// minute of the suite's time): its dataset rendered from the flags it prints (the cluster
+/// route), its tables, and what its re-runs resume or redo.
 #[test]
 fn the_tiny_budget_writes_every_table_and_resumes() {
     let dir = fresh_dir("paper");
     let out = dir.to_str().unwrap();
     let args = ["paper", "--budget", "tiny", "--out", out, "--device", "cpu"];
-    let stdout = ok(&args);
+    let stdout = run_from_printed_flags(&args);
     assert!(stdout.contains("the paper's orderings here: "), "{stdout}");
     let report = dir.join("report");
     let md = std::fs::read_to_string(report.join("paper.md")).unwrap();
@@ -197,25 +201,23 @@ fn the_tiny_budget_writes_every_table_and_resumes() {
     );
 }
 
-#[test]
-fn a_dataset_rendered_from_the_printed_flags_is_the_one_a_run_needs() {
-    // The cluster route: `nprt generate` with the flags `--generate-flags` prints (as
-    // scripts/slurm-generate runs it), then `nprt paper` finds every view done.
-    let dir = fresh_dir("paper-flags");
-    let out = dir.to_str().unwrap();
-    let args = ["paper", "--budget", "tiny", "--out", out, "--device", "cpu"];
-    let flags = ok(&[&args[..], &["--generate-flags"]].concat());
+/// The cluster route: `nprt generate` with the flags `--generate-flags` prints (as
+/// scripts/slurm-generate runs it), then the `nprt paper` of `args` finds every view done.
+/// What that run printed.
+fn run_from_printed_flags(args: &[&str]) -> String {
+    let flags = ok(&[args, &["--generate-flags"]].concat());
     let flags: Vec<&str> = flags.split_whitespace().collect();
     assert!(
         flags.contains(&"--train-views") && flags.contains(&"24"),
         "{flags:?}"
     );
     ok(&[&["generate"], &flags[..]].concat());
-    let run = ok(&args);
+    let run = ok(args);
     assert!(
         run.contains("0 views rendered") && run.contains("28 already complete"),
         "{run}"
     );
+    run
 }
 
 /// A run refused before its dataset exists claims nothing (the corrected command is not

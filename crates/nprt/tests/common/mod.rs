@@ -126,8 +126,14 @@ pub fn tiny_frame(device: &str) -> Output {
 }
 
 /// Whether `--device wgpu` runs here (a Vulkan driver, e.g. the software one scripts/vulkan.sh
-/// installs). Where NPRT_REQUIRE_VULKAN is set (scripts/test sets it) it must.
+/// installs). Where NPRT_REQUIRE_VULKAN is set (scripts/test sets it) it must. Asked once per
+/// test binary: each asking starts the device and compiles its kernels.
 pub fn wgpu_runs() -> bool {
+    static RUNS: std::sync::OnceLock<bool> = std::sync::OnceLock::new();
+    *RUNS.get_or_init(wgpu_runs_once)
+}
+
+fn wgpu_runs_once() -> bool {
     let o = tiny_frame("wgpu");
     let err = String::from_utf8_lossy(&o.stderr);
     if o.status.success() {

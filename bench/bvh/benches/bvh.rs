@@ -2,7 +2,7 @@
 //! `Accel`) against `bvh` (binary SAH BVH, via its traversal iterator), on the built-in room
 //! with incoherent closest-hit rays, the path tracer's workload; and their build times.
 //!
-//! cargo bench -p nprt-trace --bench bvh
+//! cargo bench --manifest-path bench/bvh/Cargo.toml
 
 use criterion::{criterion_group, criterion_main, Criterion, Throughput};
 use glam::Vec3;
