@@ -7,9 +7,9 @@ mod common;
 
 use common::{fails, fresh_dir, nprt, ok};
 
-/// One tiny run serves every check of a finished experiment (a paper run costs a quarter of a
-/// minute of the suite's time): its dataset rendered from the flags it prints (the cluster
-/// route), its tables, and what its re-runs resume or redo.
+/// One tiny run serves every check of a finished experiment (each run trains and evaluates the
+/// whole experiment again): its dataset rendered from the flags it prints (the cluster route),
+/// its tables, and what its re-runs resume or redo.
 #[test]
 fn the_tiny_budget_writes_every_table_and_resumes() {
     let dir = fresh_dir("paper");
