@@ -72,13 +72,7 @@ impl Net {
     ) -> Result<Shaded> {
         match self {
             Net::Nprt(r, _) => {
-                let t = Instant::now();
-                let code = r.light_code(map, rotation);
-                r.settle()?;
-                let encoder_ms = ms(t);
-                let t = Instant::now();
-                let mut rgb = r.shade(g, &code);
-                let network_ms = ms(t);
+                let (mut rgb, shaded) = r.shade(g, (map, rotation))?;
                 let t = Instant::now();
                 if r.traces_direct() {
                     let placed = map.rotated_y(rotation);
@@ -86,8 +80,8 @@ impl Net {
                 }
                 Ok(Shaded {
                     rgb,
-                    encoder_ms,
-                    network_ms,
+                    encoder_ms: shaded.encoder_ms,
+                    network_ms: shaded.network_ms,
                     direct_ms: ms(t),
                 })
             }

@@ -63,8 +63,7 @@ fn oracles_of(
         bench.bar.set_message(format!("{name}, oracles"));
         let g = render_gbuffer(bench.ts, &v.camera);
         let map = bench.map(v);
-        let code = r.light_code(map, v.record.rotation_deg);
-        let mut rgb = r.shade(&g, &code);
+        let (mut rgb, _) = r.shade(&g, (map, v.record.rotation_deg))?;
         for (c, d) in rgb.iter_mut().zip(&v.direct) {
             *c += *d;
         }

@@ -158,10 +158,9 @@ impl TimedFrame<'_> {
             }
         }
         if r.file.config.design.has_transfer() {
-            let px = r.pixels(g);
-            let code = r.light_code(map, 0.0);
+            let still = r.still(g, map, 0.0);
             let relight_ms = median_of_runs(|| {
-                r.relight(&px, &code);
+                still.relight();
             });
             rows.push(row(
                 format!(

@@ -9,14 +9,12 @@ use anyhow::{bail, Result};
 use nprt_trace::TraceDevice;
 
 use crate::choice::named_choice;
-use crate::cpu::{CpuShading, HostCacheSteps};
-use crate::model::folder::ModelFile;
-use crate::network::nprt_net::NprtNet;
+use crate::cpu::HostCacheSteps;
 use crate::network::radiance_cache::{RadianceCache, ADAM_BETAS};
 use crate::network::unet::DeepShading;
 use crate::optimiser::{Adam, CacheSteps};
 use crate::parameters::Parameters;
-use crate::shading::{Shading, UnetShading};
+use crate::shading::UnetShading;
 
 /// `--device`: the CPU, a GPU (hardware adapters only), any wgpu adapter (software ones
 /// included), or a GPU when one is present.
@@ -117,26 +115,6 @@ impl From<TraceDevice> for Engine {
 impl Engine {
     pub fn is_gpu(self) -> bool {
         self == Engine::Gpu
-    }
-
-    /// The trained network `net` (with `file`'s settings: its encoder's input and its gain) on
-    /// this engine: the one place a frame's networks choose between the CPU engine and the GPU
-    /// kernels.
-    pub fn network(self, file: &ModelFile, net: NprtNet) -> Result<Box<dyn Shading>> {
-        let (width, norm, gain) = (
-            file.config.encoder_width,
-            file.config.map_norm,
-            file.output_gain(),
-        );
-        match self {
-            Engine::Cpu => Ok(Box::new(CpuShading::new(net, gain, width, norm))),
-            #[cfg(feature = "gpu")]
-            Engine::Gpu => Ok(Box::new(crate::gpu::GpuNetwork::new(
-                &net, gain, width, norm,
-            )?)),
-            #[cfg(not(feature = "gpu"))]
-            Engine::Gpu => bail!("--device gpu: {WITHOUT_KERNELS}"),
-        }
     }
 
     /// The trained Deep Shading U-Net `net` on this engine (one view at a time on the GPU).

@@ -73,7 +73,7 @@ pub use network::track::Track;
 pub use network::track_kind::TrackKind;
 pub use parameters::Parameters;
 pub use precision::Precision;
-pub use shading::{LightCode, PixelRows, Shading, UnetShading};
+pub use shading::{CpuEngine, NetworkEngine, Shading, UnetShading};
 pub use training::batch::Batch;
 pub use training::calibration::{level_gain, Calibration, LEVEL_SAMPLES};
 pub use training::checkpoint::RunState;

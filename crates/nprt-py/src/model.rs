@@ -179,10 +179,9 @@ impl Model {
             argument::number_or_none(rotation, "rotation", argument::FINITE)?.unwrap_or(0.0) as f32;
         let envmap = envmap_arg(envmap, "envmap")?;
         let map = &envmap.get().map;
-        let rgb = py.detach(|| {
-            let light = self.relighter.light_code(map, rotation);
-            self.relighter.shade(&g, &light)
-        });
+        let (rgb, _) = py
+            .detach(|| self.relighter.shade(&g, (map, rotation)))
+            .or_py()?;
         Ok(arrays::image(py, &rgb, w, h))
     }
 

@@ -8,8 +8,9 @@ use nprt_net::{Design, DirectLight, Engine, Init, ModelConfig};
 use nprt_scene::{load_scene, SceneOptions};
 use nprt_trace::TraceScene;
 
+use crate::frame_stages::DirectSampling;
 use crate::frame_timings::FrameTimings;
-use crate::relight::{DirectSampling, FrameCache, Relighter};
+use crate::relight::{FrameCache, Relighter};
 use crate::{CameraPath, Precision};
 
 /// What to time.

@@ -1,15 +1,20 @@
 //! A frame's stages besides the networks, on the device the networks run on: the G-buffer,
 //! traced light (direct light for models that leave it to the tracer, and whole paths), and,
 //! where the G-buffer can stay on the device, the frame made there from G-buffer to background.
-//! The CPU's ([`HostStages`]: nprt-trace's tracer) and the GPU's (`gpu::DeviceStages`:
-//! rasterised G-buffers and the tracer's kernels) implement one trait, chosen once by
-//! [`frame_stages`] beside the networks' engine.
+//! The CPU's ([`HostStages`]: nprt-trace's tracer, beside any engine's networks) and the GPU's
+//! (`gpu::DeviceStages`: rasterised G-buffers and the tracer's kernels, beside the GPU
+//! kernels' networks) implement one trait for the networks they run beside, which the types
+//! hold them to: pixels they keep, and light codes they are given, are that network's.
 
+use std::convert::Infallible;
+
+use crate::oidn::Oidn;
 use anyhow::Result;
-use glam::Vec3;
-use nprt_net::{Engine, LightCode, PixelRows, Shading};
+use glam::{Vec2, Vec3};
+use nprt_net::Shading;
 use nprt_scene::{Camera, EnvMap};
 use nprt_trace::{render, render_direct, render_gbuffer, GBuffer, RenderSettings, TraceScene};
+use rayon::prelude::*;
 
 /// A frame's radiance, 3 f32 a pixel in pixel order: on the host, or left on the device by
 /// the GPU kernels (`Relighter::frame_shown`).
@@ -39,14 +44,32 @@ impl FrameRadiance {
 
 /// A camera's pixels whose G-buffer stayed on the device, as [`FrameStages::kept_pixels`]
 /// made them: a row per pixel, and the milliseconds of the G-buffer and of the networks.
-pub struct KeptPixels {
-    pub rows: PixelRows,
+pub struct KeptPixels<R> {
+    pub rows: R,
     pub gbuffer_ms: f64,
     pub network_ms: f64,
 }
 
+/// How a frame's direct light is traced, for a model that leaves it to the tracer.
+#[derive(Clone, Copy)]
+pub struct DirectSampling {
+    /// Samples per pixel, each a shadow ray towards the importance-sampled map and a BSDF
+    /// sample combined by MIS.
+    pub spp: u32,
+    pub seed: u64,
+    /// Denoises the traced light (with the G-buffer as auxiliaries) before it is added.
+    pub denoiser: Option<&'static Oidn>,
+}
+
 /// The traced direct light of a frame: samples per pixel and seed.
 pub type DirectRays = (u32, u64);
+
+/// A camera's pixels as an engine holds them: the foreground's rows on the networks, or every
+/// pixel of a G-buffer the stages kept on the device.
+pub enum Rows<R, K> {
+    Networks(R),
+    Kept(K),
+}
 
 /// Where a frame's stages other than the networks run.
 pub trait FrameStages: Send + Sync {
@@ -72,16 +95,29 @@ pub trait FrameStages: Send + Sync {
         settings: &RenderSettings,
     ) -> Result<Vec<Vec3>>;
 
+    /// Where the G-buffer is made, for reports.
+    fn gbuffer_on(&self) -> &'static str;
+
+    /// Where traced light runs, for reports.
+    fn paths_on(&self) -> &'static str;
+}
+
+/// The stages beside the networks `N`, where a G-buffer can stay on the device and the frame
+/// be finished there.
+pub trait KeptStages<N: Shading>: FrameStages {
+    /// A camera's pixels with their G-buffer kept on the device ([`Self::kept_pixels`]).
+    type Kept: Send + Sync;
+
     /// `camera`'s pixels with the G-buffer left on the device and run through `shading`'s
     /// light-independent part there (positions normalised by `bounds`); None where G-buffers
     /// are made on the host.
     fn kept_pixels(
         &self,
-        shading: &dyn Shading,
+        shading: &N,
         ts: &TraceScene,
         camera: &Camera,
         bounds: &[[f32; 3]; 2],
-    ) -> Result<Option<KeptPixels>>;
+    ) -> Result<Option<KeptPixels<Self::Kept>>>;
 
     /// The finished frame of [`Self::kept_pixels`]' rows under `light`, with `map` (as placed
     /// in the world) behind or, with `direct`, that light traced over every pixel; left on the
@@ -89,10 +125,10 @@ pub trait FrameStages: Send + Sync {
     #[allow(clippy::too_many_arguments)]
     fn kept_frame(
         &self,
-        shading: &dyn Shading,
+        shading: &N,
         ts: &TraceScene,
-        rows: &PixelRows,
-        light: &LightCode,
+        rows: &Self::Kept,
+        light: &N::Code,
         map: &EnvMap,
         direct: Option<DirectRays>,
         keep: bool,
@@ -104,27 +140,10 @@ pub trait FrameStages: Send + Sync {
     #[cfg(feature = "gpu")]
     fn profile(
         &self,
-        shading: &dyn Shading,
-        rows: &PixelRows,
-        light: &LightCode,
+        shading: &N,
+        rows: Rows<&N::Rows, &Self::Kept>,
+        light: &N::Code,
     ) -> Result<Vec<nprt_gpu::KernelTime>>;
-
-    /// Where the G-buffer is made, for reports.
-    fn gbuffer_on(&self) -> &'static str;
-
-    /// Where traced light runs, for reports.
-    fn paths_on(&self) -> &'static str;
-}
-
-/// The stages beside the networks on `engine`.
-pub fn frame_stages(engine: Engine) -> Result<Box<dyn FrameStages>> {
-    match engine {
-        Engine::Cpu => Ok(Box::new(HostStages)),
-        #[cfg(feature = "gpu")]
-        Engine::Gpu => Ok(Box::new(crate::gpu::DeviceStages::default())),
-        #[cfg(not(feature = "gpu"))]
-        Engine::Gpu => anyhow::bail!("this nprt-render was built without its GPU kernels"),
-    }
 }
 
 /// The stages on the CPU: nprt-trace's tracer, every G-buffer on the host.
@@ -155,39 +174,6 @@ impl FrameStages for HostStages {
         Ok(render(ts, camera, map, settings).radiance)
     }
 
-    fn kept_pixels(
-        &self,
-        _: &dyn Shading,
-        _: &TraceScene,
-        _: &Camera,
-        _: &[[f32; 3]; 2],
-    ) -> Result<Option<KeptPixels>> {
-        Ok(None)
-    }
-
-    fn kept_frame(
-        &self,
-        _: &dyn Shading,
-        _: &TraceScene,
-        _: &PixelRows,
-        _: &LightCode,
-        _: &EnvMap,
-        _: Option<DirectRays>,
-        _: bool,
-    ) -> Result<(FrameRadiance, f64)> {
-        unreachable!("the CPU's stages keep no pixels on a device")
-    }
-
-    #[cfg(feature = "gpu")]
-    fn profile(
-        &self,
-        _: &dyn Shading,
-        _: &PixelRows,
-        _: &LightCode,
-    ) -> Result<Vec<nprt_gpu::KernelTime>> {
-        anyhow::bail!("kernel times are measured on the GPU kernels only (--device gpu)")
-    }
-
     fn gbuffer_on(&self) -> &'static str {
         "traced on the CPU"
     }
@@ -195,4 +181,52 @@ impl FrameStages for HostStages {
     fn paths_on(&self) -> &'static str {
         "on the CPU"
     }
+}
+
+impl<N: Shading> KeptStages<N> for HostStages {
+    type Kept = Infallible;
+
+    fn kept_pixels(
+        &self,
+        _: &N,
+        _: &TraceScene,
+        _: &Camera,
+        _: &[[f32; 3]; 2],
+    ) -> Result<Option<KeptPixels<Infallible>>> {
+        Ok(None)
+    }
+
+    fn kept_frame(
+        &self,
+        _: &N,
+        _: &TraceScene,
+        rows: &Infallible,
+        _: &N::Code,
+        _: &EnvMap,
+        _: Option<DirectRays>,
+        _: bool,
+    ) -> Result<(FrameRadiance, f64)> {
+        match *rows {}
+    }
+
+    #[cfg(feature = "gpu")]
+    fn profile(
+        &self,
+        _: &N,
+        _: Rows<&N::Rows, &Infallible>,
+        _: &N::Code,
+    ) -> Result<Vec<nprt_gpu::KernelTime>> {
+        anyhow::bail!("kernel times are measured on the GPU kernels only (--device gpu)")
+    }
+}
+
+/// Fills background pixels (mask 0) with the map seen through the pixel centre.
+pub fn background(camera: &Camera, map: &EnvMap, mask: &[f32], rgb: &mut [Vec3]) {
+    let w = camera.width as usize;
+    rgb.par_iter_mut().enumerate().for_each(|(i, c)| {
+        if mask[i] <= 0.5 {
+            let (_, d) = camera.ray(Vec2::new((i % w) as f32 + 0.5, (i / w) as f32 + 0.5));
+            *c = map.eval(d);
+        }
+    });
 }

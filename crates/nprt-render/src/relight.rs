@@ -1,25 +1,25 @@
 //! The run-time network: light code once per lighting change, transport on foreground pixels,
 //! for a still camera the light-independent part (the transfer networks' ŝ) kept between
 //! lighting changes, and for models that leave direct light to the tracer, that light traced.
-//! The networks run on an engine's [`Shading`], the other stages on its [`FrameStages`]; this
-//! file holds what a frame does with them, whichever the engine.
+//! A [`Relighter`] resolves the `--device` engine once into that engine's networks and frame
+//! stages ([`OnEngine`], whose types keep each engine's light codes and pixels to it); this
+//! file holds the model's side of a frame and picks the engine, `on_engine.rs` what a frame
+//! does on it.
 
 use std::path::Path;
 use std::time::Instant;
 
 use anyhow::Result;
-use glam::{Vec2, Vec3};
+use glam::Vec3;
 use nprt_net::{
-    gbuffer_features, load_model, DirectLight, Engine, LightCode, ModelFile, NprtNet, PixelRows,
-    Shading, FEATURES,
+    load_model, CpuEngine, DirectLight, Engine, ModelFile, NetworkEngine, NprtNet, Shading,
 };
 use nprt_scene::{Camera, EnvMap};
 use nprt_trace::{GBuffer, RenderSettings, TraceScene};
-use rayon::prelude::*;
 
-use crate::frame_stages::{frame_stages, FrameRadiance, FrameStages, KeptPixels};
+use crate::frame_stages::{DirectSampling, FrameRadiance, FrameStages, HostStages};
 use crate::frame_timings::FrameTimings;
-use crate::oidn::Oidn;
+use crate::on_engine::{Kept, OnEngine};
 use crate::Precision;
 
 /// Samples per pixel of the traced direct light when none is asked for: the recommended
@@ -28,59 +28,85 @@ use crate::Precision;
 /// docs/model.md#traced-direct-light).
 pub const DEFAULT_DIRECT_SPP: u32 = nprt_net::RECIPE.direct_spp;
 
+/// The CPU engine's networks beside the CPU tracer.
+type CpuFrames = OnEngine<<CpuEngine as NetworkEngine>::Network, HostStages>;
+
+/// The GPU kernels' networks beside the rasterised G-buffer and the tracer's kernels.
+#[cfg(feature = "gpu")]
+type GpuFrames =
+    OnEngine<<nprt_net::gpu::GpuKernels as NetworkEngine>::Network, crate::gpu::DeviceStages>;
+
+/// The engine a model's frames run on, resolved once (the GPU's boxed: its kernels' state is
+/// most of the size).
+enum Engines {
+    Cpu(CpuFrames),
+    #[cfg(feature = "gpu")]
+    Gpu(Box<GpuFrames>),
+}
+
+/// Runs `$body` with `$e` bound to the engine's [`OnEngine`], whichever it is.
+macro_rules! on_engine {
+    ($engines:expr, $e:ident => $body:expr) => {
+        match $engines {
+            Engines::Cpu($e) => $body,
+            #[cfg(feature = "gpu")]
+            Engines::Gpu($e) => $body,
+        }
+    };
+}
+
 /// A trained model ready to shade G-buffers.
 pub struct Relighter {
     pub file: ModelFile,
-    /// The networks, on the engine the model was loaded for.
-    shading: Box<dyn Shading>,
-    /// The G-buffer and traced light, beside them.
-    stages: Box<dyn FrameStages>,
-}
-
-/// A G-buffer's foreground pixels as the networks hold them, with what of the networks does
-/// not depend on the lighting: all a still camera needs to relight.
-pub struct Pixels {
-    count: usize,
-    foreground: Vec<usize>,
-    rows: PixelRows,
-    /// Whether the G-buffer stayed on the device ([`FrameStages::kept_pixels`]): every pixel
-    /// then has a row, and the frame is finished there.
-    kept: bool,
-}
-
-/// How a frame's direct light is traced, for a model that leaves it to the tracer.
-#[derive(Clone, Copy)]
-pub struct DirectSampling {
-    /// Samples per pixel, each a shadow ray towards the importance-sampled map and a BSDF
-    /// sample combined by MIS.
-    pub spp: u32,
-    pub seed: u64,
-    /// Denoises the traced light (with the G-buffer as auxiliaries) before it is added.
-    pub denoiser: Option<&'static Oidn>,
+    /// The networks and the frame's other stages, on the engine the model was loaded for.
+    engine: Engines,
 }
 
 /// What consecutive frames keep: the last camera's G-buffer and network inputs (with the
-/// light-independent networks' outputs), and the last lighting's code under its key `K`.
+/// light-independent networks' outputs), and the last lighting's code under its key `K`, in
+/// the types of the engine that made them (a cache from another engine holds nothing a frame
+/// can use, and is replaced).
 pub struct FrameCache<K> {
-    still: Option<(Camera, GBuffer, Pixels)>,
-    light: Option<(K, LightCode)>,
+    kept: EngineCache<K>,
+}
+
+enum EngineCache<K> {
+    Empty,
+    Cpu(Kept<<CpuEngine as NetworkEngine>::Network, HostStages, K>),
+    #[cfg(feature = "gpu")]
+    Gpu(Kept<<nprt_net::gpu::GpuKernels as NetworkEngine>::Network, crate::gpu::DeviceStages, K>),
 }
 
 impl<K> FrameCache<K> {
     /// Foreground pixels of the kept G-buffer (none before a frame).
     pub fn foreground(&self) -> usize {
-        self.still
-            .as_ref()
-            .map_or(0, |(_, _, px)| px.foreground.len())
+        match &self.kept {
+            EngineCache::Empty => 0,
+            EngineCache::Cpu(kept) => kept.foreground(),
+            #[cfg(feature = "gpu")]
+            EngineCache::Gpu(kept) => kept.foreground(),
+        }
     }
 }
 
 impl<K> Default for FrameCache<K> {
     fn default() -> Self {
         FrameCache {
-            still: None,
-            light: None,
+            kept: EngineCache::Empty,
         }
+    }
+}
+
+/// A G-buffer's pixels and a lighting made ready by a model's networks: relighting runs only
+/// what depends on the lighting ([`Relighter::still`]).
+pub struct Still<'a> {
+    relight: Box<dyn Fn() -> Vec<Vec3> + 'a>,
+}
+
+impl Still<'_> {
+    /// Radiance of every pixel; background pixels are zero.
+    pub fn relight(&self) -> Vec<Vec3> {
+        (self.relight)()
     }
 }
 
@@ -92,22 +118,36 @@ impl Relighter {
     }
 
     /// A model with `file`'s settings and the weights of `net` (on the host), to run on
-    /// `engine`.
+    /// `engine`: the one place a frame's networks and stages choose between the CPU engine and
+    /// the GPU kernels.
     pub fn new(file: ModelFile, net: NprtNet, engine: Engine) -> Result<Self> {
-        Ok(Relighter {
-            shading: engine.network(&file, net)?,
-            stages: frame_stages(engine)?,
-            file,
-        })
+        let engine = match engine {
+            Engine::Cpu => Engines::Cpu(OnEngine {
+                net: CpuEngine::network(&file, net)?,
+                stages: HostStages,
+            }),
+            #[cfg(feature = "gpu")]
+            Engine::Gpu => Engines::Gpu(Box::new(OnEngine {
+                net: nprt_net::gpu::GpuKernels::network(&file, net)?,
+                stages: crate::gpu::DeviceStages::default(),
+            })),
+            #[cfg(not(feature = "gpu"))]
+            Engine::Gpu => anyhow::bail!("this nprt-render was built without its GPU kernels"),
+        };
+        Ok(Relighter { file, engine })
     }
 
-    /// Takes `file`'s settings and `net`'s weights (a run's newer model) on `engine`, in the
-    /// precision the networks ran in; the G-buffer and traced light stay as they are. Frames
-    /// made after use them, with a new [`FrameCache`].
-    pub fn set_weights(&mut self, file: ModelFile, net: NprtNet, engine: Engine) -> Result<()> {
+    /// Takes `file`'s settings and `net`'s weights (a run's newer model), in the precision the
+    /// networks ran in, on the engine they ran on; the G-buffer and traced light stay as they
+    /// are. Frames made after use them, with a new [`FrameCache`].
+    pub fn set_weights(&mut self, file: ModelFile, net: NprtNet) -> Result<()> {
         let precision = self.precision();
-        self.shading = engine.network(&file, net)?;
-        self.shading.set_precision(precision)?;
+        match &mut self.engine {
+            Engines::Cpu(e) => e.net = CpuEngine::network(&file, net)?,
+            #[cfg(feature = "gpu")]
+            Engines::Gpu(e) => e.net = nprt_net::gpu::GpuKernels::network(&file, net)?,
+        }
+        self.set_precision(precision)?;
         self.file = file;
         Ok(())
     }
@@ -115,28 +155,28 @@ impl Relighter {
     /// Runs the networks in `precision`; f16 needs the GPU kernels (`--device gpu`) and an
     /// adapter with f16 in shaders. Frames made after use it, with a new [`FrameCache`].
     pub fn set_precision(&mut self, precision: Precision) -> Result<()> {
-        self.shading.set_precision(precision)
+        on_engine!(&mut self.engine, e => e.net.set_precision(precision))
     }
 
     /// The precision the networks run in.
     pub fn precision(&self) -> Precision {
-        self.shading.precision()
+        on_engine!(&self.engine, e => e.net.precision())
     }
 
     /// Where the networks run, for reports: "CPU engine" or "GPU kernels on ADAPTER".
     pub fn networks_on(&self) -> String {
-        self.shading.describe()
+        on_engine!(&self.engine, e => e.net.describe())
     }
 
     /// Where the G-buffer is made, for reports: rasterised beside the GPU kernels, or the CPU
     /// tracer's primary rays.
     pub fn gbuffer_on(&self) -> &'static str {
-        self.stages.gbuffer_on()
+        on_engine!(&self.engine, e => e.stages.gbuffer_on())
     }
 
     /// Where [`Self::path_trace`] and traced direct light run, for reports.
     pub fn paths_on(&self) -> &'static str {
-        self.stages.paths_on()
+        on_engine!(&self.engine, e => e.stages.paths_on())
     }
 
     /// What runs, in one line for each command to print: "linear design on sh:2 (siren),
@@ -168,18 +208,8 @@ impl Relighter {
         sampling: DirectSampling,
         rgb: &mut [Vec3],
     ) -> Result<()> {
-        if !self.traces_direct() {
-            background(camera, map, &g.mask, rgb);
-            return Ok(());
-        }
-        let rays = (sampling.spp, sampling.seed);
-        let mut direct = self.stages.traced_direct(ts, camera, map, rays)?;
-        if let Some(oidn) = sampling.denoiser {
-            let (w, h) = (camera.width as usize, camera.height as usize);
-            direct = oidn.denoise_frame(&direct, g, w, h)?;
-        }
-        rgb.par_iter_mut().zip(direct).for_each(|(c, d)| *c += d);
-        Ok(())
+        let file = &self.file;
+        on_engine!(&self.engine, e => e.complete(file, ts, camera, map, g, sampling, rgb))
     }
 
     /// One frame through `camera` under `map` turned by `rotation_deg` (the lighting `key`
@@ -210,105 +240,39 @@ impl Relighter {
         cache: &mut FrameCache<K>,
         ts: &TraceScene,
         camera: &Camera,
-        (map, rotation_deg, key): (&EnvMap, f32, K),
+        lit: (&EnvMap, f32, K),
         sampling: DirectSampling,
         keep: bool,
     ) -> Result<(FrameRadiance, FrameTimings)> {
-        let ms = |t: Instant| t.elapsed().as_secs_f64() * 1e3;
-        let mut t = FrameTimings::default();
-        let moved = !matches!(&cache.still, Some((c, _, _)) if c == camera);
-        let code = match cache.light.take() {
-            Some((k, code)) if k == key => code,
-            _ => {
-                let clock = Instant::now();
-                let code = self.light_code(map, rotation_deg);
-                // On the GPU kernels the code is only queued: before a new viewpoint's stages,
-                // which wait for the queue one by one, it is waited for, so that the G-buffer
-                // is not charged with it. A lighting change alone does not wait.
-                if moved {
-                    self.settle()?;
-                }
-                t.encoder_ms = ms(clock);
-                code
+        let file = &self.file;
+        let kept = std::mem::replace(&mut cache.kept, EngineCache::Empty);
+        match &self.engine {
+            Engines::Cpu(e) => {
+                let mut kept = match kept {
+                    EngineCache::Cpu(kept) => kept,
+                    _ => Kept::default(),
+                };
+                let shown = e.frame_shown(file, &mut kept, ts, camera, lit, sampling, keep);
+                cache.kept = EngineCache::Cpu(kept);
+                shown
             }
-        };
-        let (g, px) = match cache.still.take() {
-            Some((c, g, px)) if c == *camera => (g, px),
-            _ => match self.kept_pixels(ts, camera, &sampling, &mut t)? {
-                Some(px) => (GBuffer::default(), px),
-                None => {
-                    let clock = Instant::now();
-                    let g = self.gbuffer(ts, camera)?;
-                    t.gbuffer_ms = ms(clock);
-                    let clock = Instant::now();
-                    let px = self.pixels(&g);
-                    t.network_ms = ms(clock);
-                    (g, px)
-                }
-            },
-        };
-        let placed = map.rotated_y(rotation_deg);
-        let clock = Instant::now();
-        let shown = if px.kept {
-            let direct = self
-                .traces_direct()
-                .then_some((sampling.spp, sampling.seed));
-            let shading = &*self.shading;
-            let (shown, direct_ms) =
-                (self.stages).kept_frame(shading, ts, &px.rows, &code, &placed, direct, keep)?;
-            t.network_ms += ms(clock) - direct_ms;
-            t.direct_ms = direct_ms;
-            shown
-        } else {
-            let mut rgb = self.relight(&px, &code);
-            t.network_ms += ms(clock);
-            let clock = Instant::now();
-            self.complete(ts, camera, &placed, &g, sampling, &mut rgb)?;
-            t.direct_ms = ms(clock);
-            FrameRadiance::Host(rgb)
-        };
-        cache.light = Some((key, code));
-        cache.still = Some((camera.clone(), g, px));
-        Ok((shown, t))
-    }
-
-    /// A camera's pixels with the G-buffer left on the device, where the stages can and the
-    /// frame needs nothing on the host (traced light to denoise: OIDN runs on the host); the
-    /// G-buffer's and the networks' times into `t`.
-    fn kept_pixels(
-        &self,
-        ts: &TraceScene,
-        camera: &Camera,
-        sampling: &DirectSampling,
-        t: &mut FrameTimings,
-    ) -> Result<Option<Pixels>> {
-        if self.traces_direct() && sampling.denoiser.is_some() {
-            return Ok(None);
+            #[cfg(feature = "gpu")]
+            Engines::Gpu(e) => {
+                let mut kept = match kept {
+                    EngineCache::Gpu(kept) => kept,
+                    _ => Kept::default(),
+                };
+                let shown = e.frame_shown(file, &mut kept, ts, camera, lit, sampling, keep);
+                cache.kept = EngineCache::Gpu(kept);
+                shown
+            }
         }
-        let bounds = &self.file.bounds;
-        let kept = (self.stages).kept_pixels(&*self.shading, ts, camera, bounds)?;
-        let Some(KeptPixels {
-            rows,
-            gbuffer_ms,
-            network_ms,
-        }) = kept
-        else {
-            return Ok(None);
-        };
-        (t.gbuffer_ms, t.network_ms) = (gbuffer_ms, network_ms);
-        let count = (camera.width * camera.height) as usize;
-        Ok(Some(Pixels {
-            count,
-            foreground: (0..count).collect(),
-            rows,
-            kept: true,
-        }))
     }
 
     /// The G-buffer of `camera`'s pixel centres: rasterised on the GPU beside the kernels (the
     /// scene uploaded at its first frame), traced otherwise.
     pub fn gbuffer(&self, ts: &TraceScene, camera: &Camera) -> Result<GBuffer> {
-        self.stages.gbuffer(ts, camera)
+        on_engine!(&self.engine, e => e.stages.gbuffer(ts, camera))
     }
 
     /// One pass of path tracing of `camera`'s view under `map` (as placed in the world), as
@@ -320,7 +284,7 @@ impl Relighter {
         map: &EnvMap,
         settings: &RenderSettings,
     ) -> Result<Vec<Vec3>> {
-        self.stages.path_trace(ts, camera, map, settings)
+        on_engine!(&self.engine, e => e.stages.path_trace(ts, camera, map, settings))
     }
 
     /// The GPU time of each kernel of a lighting change of the pixels `cache` keeps, under the
@@ -331,86 +295,60 @@ impl Relighter {
         &self,
         cache: &FrameCache<K>,
     ) -> Result<Option<Vec<nprt_gpu::KernelTime>>> {
-        let (Some((_, _, px)), Some((_, light))) = (&cache.still, &cache.light) else {
-            return Ok(None);
-        };
-        if self.shading.host_waits().is_none() {
-            return Ok(None);
+        match (&self.engine, &cache.kept) {
+            (Engines::Gpu(e), EngineCache::Gpu(kept)) => e.profile_relight(kept),
+            _ => Ok(None),
         }
-        (self.stages)
-            .profile(&*self.shading, &px.rows, light)
-            .map(Some)
-    }
-
-    /// Encodes `map` rotated by `rotation_deg` about +Y: on the GPU kernels, queued there and
-    /// left on the device.
-    pub fn light_code(&self, map: &EnvMap, rotation_deg: f32) -> LightCode {
-        self.shading.light_code(map, rotation_deg)
     }
 
     /// How many times the host has waited for the GPU kernels' queue so far (None off them):
     /// `nprt bench frame` counts a lighting change's.
     pub fn host_waits(&self) -> Option<u64> {
-        self.shading.host_waits()
+        on_engine!(&self.engine, e => e.net.host_waits())
     }
 
-    /// Waits for the work the GPU kernels queued (a light code: [`Self::light_code`] does not
-    /// wait), so that a stage timed after is not charged with it; nothing to wait for
-    /// elsewhere.
-    pub fn settle(&self) -> Result<()> {
-        self.shading.settle()
+    /// Radiance of every pixel of `g` under `map` turned by `rotation_deg`, background pixels
+    /// zero (see [`background`]), with the encoder's time (its queue waited for) and the
+    /// networks'.
+    pub fn shade(
+        &self,
+        g: &GBuffer,
+        (map, rotation_deg): (&EnvMap, f32),
+    ) -> Result<(Vec<Vec3>, FrameTimings)> {
+        let ms = |t: Instant| t.elapsed().as_secs_f64() * 1e3;
+        let bounds = &self.file.bounds;
+        on_engine!(&self.engine, e => {
+            let clock = Instant::now();
+            let code = Shading::light_code(&e.net, map, rotation_deg);
+            e.net.settle()?;
+            let encoder_ms = ms(clock);
+            let clock = Instant::now();
+            let rgb = e.relight(&e.foreground(bounds, g), &code);
+            let t = FrameTimings {
+                encoder_ms,
+                network_ms: ms(clock),
+                ..FrameTimings::default()
+            };
+            Ok((rgb, t))
+        })
     }
 
-    /// Radiance of every pixel of `g` under `light`; background pixels are zero (see
-    /// [`background`]).
-    pub fn shade(&self, g: &GBuffer, light: &LightCode) -> Vec<Vec3> {
-        self.relight(&self.pixels(g), light)
-    }
-
-    /// The network inputs of `g`'s foreground pixels run through what of the networks does
-    /// not depend on the lighting, so that [`Self::relight`] under each further lighting runs
+    /// `g`'s foreground pixels through what of the networks does not depend on the lighting,
+    /// and the light code of `map` turned by `rotation_deg`: each [`Still::relight`] then runs
     /// only the shading networks.
-    pub fn pixels(&self, g: &GBuffer) -> Pixels {
-        let foreground: Vec<usize> = (0..g.mask.len()).filter(|&i| g.mask[i] > 0.5).collect();
-        let mut features = vec![0.0; foreground.len() * FEATURES];
-        features
-            .par_chunks_mut(FEATURES)
-            .zip(&foreground)
-            .for_each(|(f, &i)| f.copy_from_slice(&gbuffer_features(&self.file.bounds, g, i)));
-        Pixels {
-            count: g.mask.len(),
-            foreground,
-            rows: self.shading.pixels(&features),
-            kept: false,
-        }
+    pub fn still<'a>(&'a self, g: &GBuffer, map: &EnvMap, rotation_deg: f32) -> Still<'a> {
+        let bounds = &self.file.bounds;
+        let relight: Box<dyn Fn() -> Vec<Vec3> + 'a> = on_engine!(&self.engine, e => {
+            let (px, code) = (e.foreground(bounds, g), Shading::light_code(&e.net, map, rotation_deg));
+            Box::new(move || e.relight(&px, &code))
+        });
+        Still { relight }
     }
 
     /// Floating-point operations of the dense layers per foreground pixel, for a frame from a
     /// new viewpoint or (`transfer_known`) a lighting change under a still camera; None off the
     /// CPU engine.
     pub fn flops_per_pixel(&self, transfer_known: bool) -> Option<f64> {
-        self.shading.flops_per_pixel(transfer_known)
+        on_engine!(&self.engine, e => e.net.flops_per_pixel(transfer_known))
     }
-
-    /// Radiance of every pixel under `light`; background pixels are zero.
-    pub fn relight(&self, px: &Pixels, light: &LightCode) -> Vec<Vec3> {
-        assert!(!px.kept, "pixels kept on the device are finished there");
-        let rgb = self.shading.radiance(&px.rows, light);
-        let mut out = vec![Vec3::ZERO; px.count];
-        for (k, &i) in px.foreground.iter().enumerate() {
-            out[i] = Vec3::from_slice(&rgb[3 * k..3 * k + 3]);
-        }
-        out
-    }
-}
-
-/// Fills background pixels (mask 0) with the map seen through the pixel centre.
-pub fn background(camera: &Camera, map: &EnvMap, mask: &[f32], rgb: &mut [Vec3]) {
-    let w = camera.width as usize;
-    rgb.par_iter_mut().enumerate().for_each(|(i, c)| {
-        if mask[i] <= 0.5 {
-            let (_, d) = camera.ray(Vec2::new((i % w) as f32 + 0.5, (i / w) as f32 + 0.5));
-            *c = map.eval(d);
-        }
-    });
 }

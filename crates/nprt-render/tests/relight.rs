@@ -76,7 +76,7 @@ fn a_model_that_traces_direct_light_adds_it_to_every_pixel() {
         denoiser: None,
     };
     let frame = |r: &Relighter| {
-        let mut rgb = r.shade(&g, &r.light_code(&map, 0.0));
+        let mut rgb = r.shade(&g, (&map, 0.0)).unwrap().0;
         let network = rgb.clone();
         r.complete(&ts, &camera, &map, &g, sampling, &mut rgb)
             .unwrap();
@@ -114,7 +114,7 @@ fn a_calibrated_model_multiplies_each_channel_of_the_network_by_its_gain() {
     let map = nprt_scene::open_envmap("builtin:sky").unwrap();
     let g = render_gbuffer(&ts, &camera);
     let gain = Vec3::new(2.0, 1.0, 0.5);
-    let shade = |r: &Relighter| r.shade(&g, &r.light_code(&map, 30.0));
+    let shade = |r: &Relighter| r.shade(&g, (&map, 30.0)).unwrap().0;
     let plain = shade(&relighter(DirectLight::Traced));
     let scaled = shade(&calibrated(DirectLight::Traced, Some(gain.to_array())));
     let mut lit = 0;
@@ -145,8 +145,7 @@ fn denoised_direct_light_is_closer_to_the_converged_one() {
     let map = nprt_scene::open_envmap("builtin:sky").unwrap();
     let g = render_gbuffer(&ts, &camera);
     let traced = relighter(DirectLight::Traced);
-    let code = traced.light_code(&map, 0.0);
-    let network = traced.shade(&g, &code);
+    let network = traced.shade(&g, (&map, 0.0)).unwrap().0;
     // The direct light each way: the frame less what the network added.
     let direct = |denoiser| {
         let mut rgb = network.clone();

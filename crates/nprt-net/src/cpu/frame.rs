@@ -1,8 +1,6 @@
 //! A trained network's frames on the CPU engine ([`Shading`]): the light model on the host's
 //! map input, each track's ŝ kept per camera, and the shading networks per lighting.
 
-use std::any::Any;
-
 use anyhow::{bail, Result};
 use nprt_scene::EnvMap;
 
@@ -11,7 +9,7 @@ use crate::encoding::map_norm::MapNorm;
 use crate::network::encoder::LightInput;
 use crate::network::nprt_net::NprtNet;
 use crate::precision::Precision;
-use crate::shading::{foreign, LightCode, PixelRows, Shading};
+use crate::shading::Shading;
 
 /// A model's networks on the CPU engine.
 pub struct CpuShading {
@@ -24,13 +22,13 @@ pub struct CpuShading {
 }
 
 /// A lighting on the host: the code ê and what the map's channels were divided by.
-struct HostCode {
+pub struct HostCode {
     code: Vec<f32>,
     divisor: [f32; 3],
 }
 
 /// A camera's pixels on the host: their inputs and each track's ŝ.
-struct HostRows {
+pub struct HostRows {
     features: Vec<f32>,
     transfer: TransferCodes,
 }
@@ -47,10 +45,13 @@ impl CpuShading {
 }
 
 impl Shading for CpuShading {
-    fn light_code(&self, map: &EnvMap, rotation_deg: f32) -> LightCode {
+    type Code = HostCode;
+    type Rows = HostRows;
+
+    fn light_code(&self, map: &EnvMap, rotation_deg: f32) -> HostCode {
         let (width, norm, texels) = (self.encoder_width, self.map_norm, self.net.light.texels());
         let input = LightInput::with_texels(map, rotation_deg, width, norm, texels);
-        LightCode::new(HostCode {
+        HostCode {
             code: self
                 .net
                 .light
@@ -58,21 +59,17 @@ impl Shading for CpuShading {
                 .codes()
                 .to_vec(),
             divisor: input.scale,
-        })
+        }
     }
 
-    fn pixels(&self, features: &[f32]) -> PixelRows {
-        PixelRows::new(HostRows {
+    fn pixels(&self, features: &[f32]) -> HostRows {
+        HostRows {
             transfer: self.net.transfer_codes(features),
             features: features.to_vec(),
-        })
+        }
     }
 
-    fn radiance(&self, px: &PixelRows, light: &LightCode) -> Vec<f32> {
-        let rows = px.get::<HostRows>().unwrap_or_else(|| foreign("pixels"));
-        let light = light
-            .get::<HostCode>()
-            .unwrap_or_else(|| foreign("a light code"));
+    fn radiance(&self, rows: &HostRows, light: &HostCode) -> Vec<f32> {
         // Each channel: the map's divisor times the model's gain.
         let scale = std::array::from_fn(|k| light.divisor[k] * self.gain[k]);
         (self.net).radiance(&rows.features, &light.code, scale, Some(&rows.transfer))
@@ -95,9 +92,5 @@ impl Shading for CpuShading {
 
     fn flops_per_pixel(&self, transfer_known: bool) -> Option<f64> {
         Some(self.net.flops_per_pixel(transfer_known))
-    }
-
-    fn as_any(&self) -> &dyn Any {
-        self
     }
 }

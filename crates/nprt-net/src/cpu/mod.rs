@@ -23,7 +23,7 @@ mod unet;
 
 use crate::loss::Loss;
 use crate::network::nprt_net::NprtNet;
-pub use frame::CpuShading;
+pub use frame::{CpuShading, HostCode, HostRows};
 pub use light_encoder::EncoderPass;
 pub use light_model::LightPass;
 pub use peak::{measured_peak, Peak};

@@ -9,7 +9,7 @@
 //! 3. `passes`: backward passes and Adam on the device;
 //! 4. `trainers` (each network's training step: [`GpuTrainer`], [`GpuUnet`], [`GpuCache`],
 //!    with [`DeviceDataset`]) and, beside them, `frame` (a trained network's frames:
-//!    [`GpuNetwork`], the GPU engine's [`crate::Shading`]).
+//!    [`GpuNetwork`], the GPU engine's [`crate::Shading`], made by [`GpuKernels`]).
 //!
 //! Layouts, designs and the hash grid stay defined where the CPU engine reads them
 //! (`network`, `encoding`). The public surface is the trainers, the device network and the
@@ -22,6 +22,6 @@ mod passes;
 mod products;
 mod trainers;
 
-pub use frame::{GpuLightCode, GpuLightInput, GpuNetwork, GpuPixels};
+pub use frame::{DeviceShading, GpuKernels, GpuLightCode, GpuLightInput, GpuNetwork, GpuPixels};
 pub use products::half_layers::{half_weight_bits, pad16};
 pub use trainers::{DeviceDataset, GpuCache, GpuTrainer, GpuUnet};

@@ -31,8 +31,7 @@ pub fn write_comparison(model: &Path, data: &Path, engine: Engine, out: &Path) -
     let r = Relighter::load(model, engine)?;
     let map = open_recorded_map(&manifest, record.map)?;
     let g = render_gbuffer(&ts, &view.camera);
-    let code = r.light_code(&map, record.rotation_deg);
-    let mut rgb = r.shade(&g, &code);
+    let (mut rgb, _) = r.shade(&g, (&map, record.rotation_deg))?;
     let sampling = DirectSampling {
         spp: DEFAULT_DIRECT_SPP,
         seed: record.seed,

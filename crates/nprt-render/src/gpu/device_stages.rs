@@ -1,4 +1,5 @@
-//! A frame's stages on the GPU, beside nprt-net's device network ([`GpuNetwork`]): the scene
+//! A frame's stages on the GPU, beside nprt-net's networks on the GPU kernels (a
+//! [`DeviceShading`]): the scene
 //! rasterised into a G-buffer that stays on the device, the networks' inputs made there, the
 //! background recorded into the networks' own compute pass, and traced light on the tracer's
 //! kernels, all on the process's one device.
@@ -6,17 +7,16 @@
 use std::sync::Arc;
 use std::time::Instant;
 
-use anyhow::{Context, Result};
+use anyhow::Result;
 use glam::Vec3;
 use nprt_gpu::{GpuDevice, KeptLast, KernelTime, PooledBuffer};
-use nprt_net::gpu::{GpuLightCode, GpuNetwork, GpuPixels};
-use nprt_net::{LightCode, PixelRows, Shading};
+use nprt_net::gpu::{DeviceShading, GpuLightCode, GpuPixels};
 use nprt_scene::{Camera, EnvMap};
 use nprt_trace::gpu::{record_paths, GpuPaths, PathTargets, RasterGBuffer};
 use nprt_trace::{GBuffer, PixelFilter, RenderSettings, TraceScene};
 
 use super::frame_background::{record_background, Background, Fill};
-use crate::frame_stages::{DirectRays, FrameRadiance, FrameStages, KeptPixels};
+use crate::frame_stages::{DirectRays, FrameRadiance, FrameStages, KeptPixels, KeptStages, Rows};
 
 /// The stages on the GPU: the scene of the last frame on the device (by its address: a model
 /// renders the one scene it was trained on).
@@ -26,16 +26,10 @@ pub struct DeviceStages {
 }
 
 /// Pixels of a G-buffer that stayed on the device: a row per pixel, its samples and camera.
-struct KeptGBuffer {
+pub struct KeptGBuffer {
     px: GpuPixels,
     samples: PooledBuffer,
     camera: Camera,
-}
-
-/// The device network `shading` is: the GPU stages run beside the GPU engine only.
-fn network(shading: &dyn Shading) -> &GpuNetwork {
-    (shading.as_any().downcast_ref::<GpuNetwork>())
-        .expect("the GPU's frame stages run beside the GPU kernels' networks")
 }
 
 impl DeviceStages {
@@ -82,16 +76,27 @@ impl FrameStages for DeviceStages {
         self.raster(ts)?.trace(camera, map, &paths)
     }
 
+    fn gbuffer_on(&self) -> &'static str {
+        "rasterised on the GPU"
+    }
+
+    fn paths_on(&self) -> &'static str {
+        "on the GPU"
+    }
+}
+
+impl<N: DeviceShading> KeptStages<N> for DeviceStages {
+    type Kept = KeptGBuffer;
+
     /// Rasterised, then every pixel's inputs and the light-independent networks, the queue
     /// waited for after each so that the stages can be told apart.
     fn kept_pixels(
         &self,
-        shading: &dyn Shading,
+        net: &N,
         ts: &TraceScene,
         camera: &Camera,
         bounds: &[[f32; 3]; 2],
-    ) -> Result<Option<KeptPixels>> {
-        let net = network(shading);
+    ) -> Result<Option<KeptPixels<KeptGBuffer>>> {
         let device = GpuDevice::get()?;
         let ms = |t: Instant| t.elapsed().as_secs_f64() * 1e3;
         let raster = self.raster(ts)?;
@@ -103,11 +108,11 @@ impl FrameStages for DeviceStages {
         let count = (camera.width * camera.height) as usize;
         let px = net.pixels_of_gbuffer(&samples, count, bounds);
         device.wait();
-        let rows = PixelRows::new(KeptGBuffer {
+        let rows = KeptGBuffer {
             px,
             samples,
             camera: camera.clone(),
-        });
+        };
         Ok(Some(KeptPixels {
             rows,
             gbuffer_ms,
@@ -119,21 +124,14 @@ impl FrameStages for DeviceStages {
     /// after it (timed alone); read back once, or left on the device.
     fn kept_frame(
         &self,
-        shading: &dyn Shading,
+        net: &N,
         ts: &TraceScene,
-        rows: &PixelRows,
-        light: &LightCode,
+        kept: &KeptGBuffer,
+        code: &GpuLightCode,
         map: &EnvMap,
         direct: Option<DirectRays>,
         keep: bool,
     ) -> Result<(FrameRadiance, f64)> {
-        let net = network(shading);
-        let kept = rows
-            .get::<KeptGBuffer>()
-            .context("pixels kept by the GPU's stages")?;
-        let code = light
-            .get::<GpuLightCode>()
-            .context("a light code on the GPU")?;
         let gpu = GpuDevice::get()?;
         let background = Background {
             samples: &kept.samples,
@@ -184,26 +182,14 @@ impl FrameStages for DeviceStages {
 
     fn profile(
         &self,
-        shading: &dyn Shading,
-        rows: &PixelRows,
-        light: &LightCode,
+        net: &N,
+        rows: Rows<&GpuPixels, &KeptGBuffer>,
+        code: &GpuLightCode,
     ) -> Result<Vec<KernelTime>> {
-        let net = network(shading);
-        let px = match rows.get::<KeptGBuffer>() {
-            Some(kept) => &kept.px,
-            None => rows.get::<GpuPixels>().context("pixels on the GPU")?,
+        let px = match rows {
+            Rows::Networks(px) => px,
+            Rows::Kept(kept) => &kept.px,
         };
-        let code = light
-            .get::<GpuLightCode>()
-            .context("a light code on the GPU")?;
         net.profile_relight(px, code)
-    }
-
-    fn gbuffer_on(&self) -> &'static str {
-        "rasterised on the GPU"
-    }
-
-    fn paths_on(&self) -> &'static str {
-        "on the GPU"
     }
 }

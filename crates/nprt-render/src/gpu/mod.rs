@@ -1,8 +1,8 @@
 //! The GPU frame path's own stages and the export: a frame's G-buffer rasterised by
 //! nprt-trace and left on the device, the background and traced direct light recorded beside
-//! nprt-net's device network (`nprt_net::gpu::GpuNetwork`, which runs the encoder and the
-//! transport networks), on nprt-gpu's device (Vulkan, Metal, DX12; Mesa's software Vulkan in
-//! the tests); and the export of the networks' shaders, translated to GLSL and HLSL, with the
+//! nprt-net's networks on the GPU kernels (a `nprt_net::gpu::DeviceShading`, which runs the
+//! encoder and the transport networks), on nprt-gpu's device (Vulkan, Metal, DX12; Mesa's
+//! software Vulkan in the tests); and the export of the networks' shaders, translated to GLSL and HLSL, with the
 //! weights for engines.
 //!
 //! Owns the frame's background shader (`shaders/`) and the order of a frame's stages on the

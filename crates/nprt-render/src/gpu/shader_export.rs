@@ -310,7 +310,7 @@ fn example(model_dir: &Path, file: &nprt_net::ModelFile, view: &ExampleView) -> 
     let g = render_gbuffer(&ts, &camera);
     let map = nprt_scene::open_envmap(&view.map)?;
     let relighter = Relighter::load(model_dir, nprt_net::Engine::Cpu)?;
-    let reference = relighter.shade(&g, &relighter.light_code(&map, 0.0));
+    let (reference, _) = relighter.shade(&g, (&map, 0.0))?;
     let config = &file.config;
     let input = config.light_input(&map, 0.0);
     let gain = file.output_gain();

@@ -22,10 +22,11 @@ use super::presenter::{Presenter, Shown};
 use super::viewer_keys::scripted_key;
 use super::viewer_state::{Reference, Said, Viewer, ViewerOptions};
 use super::viewer_training::{dataset_maps, finish_training};
+use crate::frame_stages::DirectSampling;
 use crate::frame_stages::FrameRadiance;
 use crate::frame_timings::FrameTimings;
 use crate::oidn::Oidn;
-use crate::relight::{DirectSampling, FrameCache, Relighter};
+use crate::relight::{FrameCache, Relighter};
 use crate::CameraPath;
 use crate::Denoise;
 

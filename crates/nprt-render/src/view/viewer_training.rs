@@ -33,7 +33,7 @@ impl Viewer<'_> {
         };
         if let Some((file, net)) = t.newest_model() {
             match self.models.first_mut() {
-                Some(m) => m.set_weights(file, net, self.opts.engine)?,
+                Some(m) => m.set_weights(file, net)?,
                 None => {
                     let mut m = Relighter::new(file, net, self.opts.engine)?;
                     m.set_precision(self.opts.precision)?;

@@ -5,7 +5,6 @@
 //! combination, dispatches prepared at the camera's first lighting and recorded again at each
 //! later one: a lighting change waits for the queue once, to read the frame back.
 
-use std::any::Any;
 use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::{Arc, Mutex, OnceLock};
 
@@ -14,22 +13,25 @@ use nprt_gpu::{groups_for, BufferPool, Dispatch, GpuDevice, KeptLast, KernelTime
 use nprt_scene::EnvMap;
 use nprt_trace::gpu::{GpuMap, SameTexels};
 
+use super::device_shading::DeviceShading;
 use super::encoder_run::GpuEncoder;
+use super::gpu_pixels::{GpuPixels, PixelChunk, Workspace};
 use super::light_code::GpuLightCode;
 use super::light_input::GpuLightInput;
 use crate::encoding::features::{position_frame, FEATURES};
 use crate::encoding::hash_grid;
 use crate::encoding::map_norm::MapNorm;
 use crate::gpu::kernels::{COMBINE, GBUFFER_FEATURES};
-use crate::gpu::layers::network_forward::{FirstLayer, ForwardTargets};
-use crate::gpu::layers::network_layout::{MlpAt, NetworkLayout};
+use crate::gpu::layers::network_forward::FirstLayer;
+use crate::gpu::layers::network_layout::NetworkLayout;
 use crate::gpu::layers::parameters::ParameterLayout;
 use crate::gpu::products::half_layers::{held_halves, HalfLayers, Held, HALF_ROW_BLOCK};
 use crate::gpu::products::operands::Bias;
+use crate::model::folder::ModelFile;
 use crate::network::encoder::Texels;
 use crate::network::nprt_net::NprtNet;
 use crate::precision::Precision;
-use crate::shading::{foreign, LightCode, PixelRows, Shading};
+use crate::shading::{NetworkEngine, Shading};
 
 /// Most rows per block of dispatches. Fewer blocks mean fewer dispatches to prepare and record
 /// (at 65,536 rows a 1920 × 1080 D/S frame was 32 blocks of a dozen dispatches each). A
@@ -71,85 +73,6 @@ pub struct GpuNetwork {
     encoder_width: usize,
     map_norm: MapNorm,
     texels: Texels,
-}
-
-/// The buffers a camera's pixels run their networks through, which the network keeps for the
-/// next camera: a new viewpoint then allocates only what it keeps (on an H200, allocating
-/// these afresh for every 512² frame cost more than its networks). Pixels share them: the
-/// queue runs one submission after another, and each writes them before reading.
-struct Workspace {
-    /// Rows they hold (the largest block).
-    rows: usize,
-    /// Ping-pong activations: f32 and, where the networks run in half precision, f16 (rows
-    /// padded to a multiple of 256 and columns to 16).
-    f32: [wgpu::Buffer; 2],
-    f16: Option<[wgpu::Buffer; 2]>,
-    /// Each track's shading outputs.
-    outputs: Vec<wgpu::Buffer>,
-}
-
-impl Workspace {
-    fn half(&self) -> bool {
-        self.f16.is_some()
-    }
-
-    /// Where `m`'s forward pass writes through this workspace: its hidden layers' outputs in
-    /// turn into the ping-pong activations (f16 in half precision, where the input made f16
-    /// takes the first), its last into `out`.
-    fn targets<'a>(&'a self, m: &MlpAt, out: Held<'a>) -> ForwardTargets<'a> {
-        let last = m.layers.len() - 1;
-        ForwardTargets::Frame {
-            outputs: (0..=last)
-                .map(|i| match (i == last, &self.f16) {
-                    (true, _) => out,
-                    (false, Some(f16)) => Held::F16(&f16[(i + 1) % 2]),
-                    (false, None) => Held::F32(&self.f32[(i + 1) % 2]),
-                })
-                .collect(),
-            input16: self.f16.as_ref().map(|f16| &f16[0]),
-        }
-    }
-
-    /// `buffer`'s rows as the networks run through this workspace hold them.
-    fn held<'a>(&self, buffer: &'a wgpu::Buffer) -> Held<'a> {
-        match self.half() {
-            true => Held::F16(buffer),
-            false => Held::F32(buffer),
-        }
-    }
-}
-
-/// A camera's foreground pixels on the device and what of the network does not depend on the
-/// lighting, with the buffers a lighting change reuses.
-pub struct GpuPixels {
-    /// Rows the networks run on: the foreground pixels, or every pixel of a G-buffer on the
-    /// device (see [`GpuNetwork::pixels_of_gbuffer`]).
-    pub rows: usize,
-    chunks: Vec<PixelChunk>,
-    work: Arc<Workspace>,
-    /// Radiance of every row, `rows × 3`.
-    rgb: PooledBuffer,
-    /// What a lighting change records (see [`GpuNetwork::radiance`]), prepared at the first.
-    relight: OnceLock<Vec<Dispatch>>,
-    /// The network that made these pixels, the one that may relight them.
-    network: u64,
-}
-
-impl GpuPixels {
-    /// Radiance of every row (`rows × 3` f32), as the last radiance left it.
-    pub fn rgb(&self) -> &wgpu::Buffer {
-        &self.rgb
-    }
-}
-
-struct PixelChunk {
-    first: usize,
-    rows: usize,
-    features: PooledBuffer,
-    /// Per track, what its shading network's first layer reads besides the light code: ŝ
-    /// (`rows × TRANSPORT_CODE`) or, for the baseline, the gathered inputs (`rows × width`);
-    /// in f16 where the networks run in half precision.
-    kept: Vec<PooledBuffer>,
 }
 
 impl GpuNetwork {
@@ -222,12 +145,6 @@ impl GpuNetwork {
         }
     }
 
-    /// The map texels this network's encoder inputs were last made from, which a renderer's
-    /// background and traced light share.
-    pub fn maps(&self) -> &GpuMap {
-        &self.map
-    }
-
     /// `map` under `rotation_deg` made into this model's encoder input on the device (see
     /// [`GpuLightInput`]), its texels kept for the frame's background too.
     pub fn light_input(
@@ -292,36 +209,6 @@ impl GpuNetwork {
         self.pixels_with(rows, |_, first, n| {
             let rows = &features[first * FEATURES..(first + n) * FEATURES];
             self.pool.hold(self.gpu.upload(rows))
-        })
-    }
-
-    /// [`Self::pixels`] of every pixel of a G-buffer on the device (`pixels` samples of
-    /// `RasterGBuffer::samples`), their inputs made there with the model's `bounds`; a
-    /// background pixel's row runs too, on zero inputs, and the frame's background replaces
-    /// it.
-    pub fn pixels_of_gbuffer(
-        &self,
-        samples: &wgpu::Buffer,
-        pixels: usize,
-        bounds: &[[f32; 3]; 2],
-    ) -> GpuPixels {
-        let (lo, extent) = position_frame(bounds);
-        self.pixels_with(pixels, |pass, first, n| {
-            let features = self.pool.take_pooled(&self.gpu, n * FEATURES);
-            let mut params = vec![n as u32, first as u32, 0, 0];
-            params.extend(
-                [lo.extend(0.0), extent.extend(0.0)]
-                    .iter()
-                    .flat_map(|v| v.to_array().map(f32::to_bits)),
-            );
-            self.gpu.dispatch(
-                pass,
-                &GBUFFER_FEATURES,
-                &params,
-                &[samples, &features],
-                groups_for(n),
-            );
-            features
         })
     }
 
@@ -502,22 +389,6 @@ impl GpuNetwork {
         list
     }
 
-    /// The GPU time of each kernel of a lighting change on `px` under `code` (the last map's
-    /// input and the encoder's at the last width, and what [`Self::radiance`] runs before the
-    /// background), each dispatch timed in a pass of its own: `nprt bench frame --profile`. An
-    /// error where the adapter has no timestamp queries.
-    pub fn profile_relight(&self, px: &GpuPixels, code: &GpuLightCode) -> Result<Vec<KernelTime>> {
-        let mut encoder = self.gpu.device.create_command_encoder(&Default::default());
-        self.use_light(&mut encoder, code);
-        self.gpu.queue.submit([encoder.finish()]);
-        let input = self.inputs.kept();
-        let run = self.encoder.kept();
-        let encoding = input.iter().flat_map(|i| i.dispatches());
-        let encoding = encoding.chain(run.iter().flat_map(|r| r.dispatches()));
-        let dispatches: Vec<&Dispatch> = encoding.chain(self.relight_dispatches(px)).collect();
-        self.gpu.profile(&dispatches)
-    }
-
     /// Records the copy of `code` (and its divisor) into the light slot the shading networks
     /// read.
     fn use_light(&self, encoder: &mut wgpu::CommandEncoder, code: &GpuLightCode) {
@@ -539,46 +410,22 @@ impl GpuNetwork {
         self.queue_radiance(px, code, &mut |_, _| {});
         self.gpu.read(&px.rgb, px.rows * 3)
     }
-
-    /// Queues [`Self::radiance`]'s work into [`GpuPixels::rgb`], nothing waited for or read
-    /// back, with `after` recorded into the same compute pass once the networks are done (a
-    /// renderer's background, given the pass and the radiance buffer).
-    pub fn queue_radiance(
-        &self,
-        px: &GpuPixels,
-        code: &GpuLightCode,
-        after: &mut dyn FnMut(&mut wgpu::ComputePass, &wgpu::Buffer),
-    ) {
-        let gpu = &*self.gpu;
-        let dispatches = self.relight_dispatches(px);
-        let mut encoder = gpu.device.create_command_encoder(&Default::default());
-        self.use_light(&mut encoder, code);
-        {
-            let mut pass = encoder.begin_compute_pass(&Default::default());
-            for d in dispatches {
-                d.record(&mut pass);
-            }
-            after(&mut pass, &px.rgb);
-        }
-        gpu.queue.submit([encoder.finish()]);
-    }
 }
 
 impl Shading for GpuNetwork {
-    fn light_code(&self, map: &EnvMap, rotation_deg: f32) -> LightCode {
-        LightCode::new(self.encode_map(map, rotation_deg, self.encoder_width, self.map_norm))
+    type Code = GpuLightCode;
+    type Rows = GpuPixels;
+
+    fn light_code(&self, map: &EnvMap, rotation_deg: f32) -> GpuLightCode {
+        self.encode_map(map, rotation_deg, self.encoder_width, self.map_norm)
     }
 
-    fn pixels(&self, features: &[f32]) -> PixelRows {
-        PixelRows::new(GpuNetwork::pixels(self, features))
+    fn pixels(&self, features: &[f32]) -> GpuPixels {
+        GpuNetwork::pixels(self, features)
     }
 
-    fn radiance(&self, px: &PixelRows, light: &LightCode) -> Vec<f32> {
-        let px = px.get::<GpuPixels>().unwrap_or_else(|| foreign("pixels"));
-        let code = light
-            .get::<GpuLightCode>()
-            .unwrap_or_else(|| foreign("a light code"));
-        GpuNetwork::radiance(self, px, code)
+    fn radiance(&self, px: &GpuPixels, light: &GpuLightCode) -> Vec<f32> {
+        GpuNetwork::radiance(self, px, light)
     }
 
     fn precision(&self) -> Precision {
@@ -611,9 +458,81 @@ impl Shading for GpuNetwork {
     fn host_waits(&self) -> Option<u64> {
         Some(self.gpu.host_waits())
     }
+}
 
-    fn as_any(&self) -> &dyn Any {
-        self
+impl DeviceShading for GpuNetwork {
+    fn maps(&self) -> &GpuMap {
+        &self.map
+    }
+
+    fn pixels_of_gbuffer(
+        &self,
+        samples: &wgpu::Buffer,
+        pixels: usize,
+        bounds: &[[f32; 3]; 2],
+    ) -> GpuPixels {
+        let (lo, extent) = position_frame(bounds);
+        self.pixels_with(pixels, |pass, first, n| {
+            let features = self.pool.take_pooled(&self.gpu, n * FEATURES);
+            let mut params = vec![n as u32, first as u32, 0, 0];
+            params.extend(
+                [lo.extend(0.0), extent.extend(0.0)]
+                    .iter()
+                    .flat_map(|v| v.to_array().map(f32::to_bits)),
+            );
+            self.gpu.dispatch(
+                pass,
+                &GBUFFER_FEATURES,
+                &params,
+                &[samples, &features],
+                groups_for(n),
+            );
+            features
+        })
+    }
+
+    fn profile_relight(&self, px: &GpuPixels, code: &GpuLightCode) -> Result<Vec<KernelTime>> {
+        let mut encoder = self.gpu.device.create_command_encoder(&Default::default());
+        self.use_light(&mut encoder, code);
+        self.gpu.queue.submit([encoder.finish()]);
+        let input = self.inputs.kept();
+        let run = self.encoder.kept();
+        let encoding = input.iter().flat_map(|i| i.dispatches());
+        let encoding = encoding.chain(run.iter().flat_map(|r| r.dispatches()));
+        let dispatches: Vec<&Dispatch> = encoding.chain(self.relight_dispatches(px)).collect();
+        self.gpu.profile(&dispatches)
+    }
+
+    fn queue_radiance(
+        &self,
+        px: &GpuPixels,
+        code: &GpuLightCode,
+        after: &mut dyn FnMut(&mut wgpu::ComputePass, &wgpu::Buffer),
+    ) {
+        let gpu = &*self.gpu;
+        let dispatches = self.relight_dispatches(px);
+        let mut encoder = gpu.device.create_command_encoder(&Default::default());
+        self.use_light(&mut encoder, code);
+        {
+            let mut pass = encoder.begin_compute_pass(&Default::default());
+            for d in dispatches {
+                d.record(&mut pass);
+            }
+            after(&mut pass, &px.rgb);
+        }
+        gpu.queue.submit([encoder.finish()]);
+    }
+}
+
+/// The GPU kernels: networks on the process's one wgpu device.
+pub struct GpuKernels;
+
+impl NetworkEngine for GpuKernels {
+    type Network = GpuNetwork;
+
+    fn network(file: &ModelFile, net: NprtNet) -> Result<GpuNetwork> {
+        let (width, norm) = (file.config.encoder_width, file.config.map_norm);
+        GpuNetwork::new(&net, file.output_gain(), width, norm)
     }
 }
 
