@@ -8,11 +8,10 @@ use nprt_scene::load_scene;
 use nprt_trace::{TraceDevice, TraceScene, Tracer};
 
 use crate::camera_choice::CameraChoice;
-use crate::dataset::{self, Jitter, Manifest, Request, Summary, TransferBasis};
+use crate::dataset::{self, Manifest, Request, Summary, TransferBasis, ViewSpec};
 use crate::lighting;
 
-/// What to render and where. `Default` is the recipe for a 2-core CPU (400 + 40 views at 128²,
-/// 64 spp, about 7 minutes on builtin:room); the paper used 3000 views at 256² and 200 at 400².
+/// What to render and where; `Default`'s views are [`ViewSpec`]'s.
 #[derive(Clone, Debug)]
 pub struct GenerateOptions {
     /// `builtin:room`, or a Mitsuba .xml / glTF / mesh file.
@@ -20,20 +19,7 @@ pub struct GenerateOptions {
     /// A folder of lat-long maps, or `builtin` (a fresh procedural lighting for every view).
     pub envmaps: String,
     pub out: PathBuf,
-    pub train_views: u64,
-    pub test_views: u64,
-    pub train_resolution: [u32; 2],
-    pub test_resolution: [u32; 2],
-    /// Samples per pixel of the training views, every one through the pixel centre.
-    pub spp: u32,
-    /// Samples per pixel of the test views, rendered as two halves (so even).
-    pub test_spp: u32,
-    /// Seed of every random choice: the same seed gives byte-identical views.
-    pub seed: u64,
-    /// Exposure and white-balance jitter of the training views' maps, in stops.
-    pub jitter: Jitter,
-    /// The most maps a training view's lighting mixes (1: one map a view).
-    pub mix_maps: u32,
+    pub views: ViewSpec,
     /// Record the training pixels' transfer vectors on this basis (CPU tracer only).
     pub transfer: Option<TransferBasis>,
     /// Maps of a folder held out for testing (default: a fifth, at least one).
@@ -56,18 +42,7 @@ impl Default for GenerateOptions {
             scene: "builtin:room".into(),
             envmaps: "builtin".into(),
             out: PathBuf::from("dataset"),
-            train_views: 400,
-            test_views: 40,
-            train_resolution: [128; 2],
-            test_resolution: [128; 2],
-            spp: 64,
-            test_spp: 1024,
-            seed: 0,
-            jitter: Jitter {
-                exposure: 1.0,
-                tint: 0.3,
-            },
-            mix_maps: 1,
+            views: ViewSpec::default(),
             transfer: None,
             test_maps: None,
             mix_builtin: None,
@@ -93,11 +68,11 @@ const BYTES_PER_BUILTIN_MAP: u128 = 1 << 20;
 /// Refuses view counts and resolutions this machine's memory cannot hold, before anything is
 /// allocated (`--train-views 1000000000000` grew until killed).
 fn check_sizes(opts: &GenerateOptions, builtin_share: f32) -> Result<()> {
-    let views = opts.train_views as u128 + opts.test_views as u128;
+    let views = opts.views.train_views as u128 + opts.views.test_views as u128;
     let own_maps = if opts.envmaps == "builtin" {
         views
     } else {
-        (opts.train_views as f64 * builtin_share.clamp(0.0, 1.0) as f64) as u128
+        (opts.views.train_views as f64 * builtin_share.clamp(0.0, 1.0) as f64) as u128
     };
     nprt_io::ensure_memory(
         views * BYTES_PER_VIEW + own_maps * BYTES_PER_BUILTIN_MAP,
@@ -111,7 +86,7 @@ fn check_sizes(opts: &GenerateOptions, builtin_share: f32) -> Result<()> {
             );
         }
         // A training view's transfer as traced (a vector per pixel) and as written.
-        let [w, h] = opts.train_resolution;
+        let [w, h] = opts.views.train_resolution;
         let floats = 2 * basis.floats() as u128;
         nprt_io::ensure_memory(
             w as u128 * h as u128 * floats * 4 * 3,
@@ -119,8 +94,8 @@ fn check_sizes(opts: &GenerateOptions, builtin_share: f32) -> Result<()> {
         )?;
     }
     for (split, [w, h]) in [
-        ("training", opts.train_resolution),
-        ("test", opts.test_resolution),
+        ("training", opts.views.train_resolution),
+        ("test", opts.views.test_resolution),
     ] {
         opts.device
             .check_frame(w, h, &format!("a {w}×{h} {split} view"))?;
@@ -145,11 +120,11 @@ impl GenerateOptions {
     pub fn lighting(&self) -> Result<(Vec<String>, dataset::MapAssignment)> {
         lighting::choose(
             &self.envmaps,
-            self.train_views,
-            self.test_views,
+            self.views.train_views,
+            self.views.test_views,
             self.test_maps,
             self.builtin_share(),
-            self.seed,
+            self.views.seed,
         )
     }
 }
@@ -177,15 +152,7 @@ pub fn generate(opts: &GenerateOptions, planned: impl FnOnce(Planned)) -> Result
         lighting: assignment,
         map_specs: specs,
         maps,
-        train_views: opts.train_views,
-        test_views: opts.test_views,
-        train_resolution: opts.train_resolution,
-        test_resolution: opts.test_resolution,
-        spp: opts.spp,
-        test_spp: opts.test_spp,
-        seed: opts.seed,
-        jitter: opts.jitter,
-        mix_maps: opts.mix_maps,
+        views: opts.views,
     };
     let ts = TraceScene::new(&scene);
     let mut manifest = dataset::plan(&request, &ts)?;

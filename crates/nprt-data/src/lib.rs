@@ -20,15 +20,17 @@
 //!     map_specs,
 //!     maps,
 //!     lighting: dataset::MapAssignment::Pool { test_maps: 1, builtin_share: 0.0 },
-//!     train_views: 2,
-//!     test_views: 1,
-//!     train_resolution: [8, 8],
-//!     test_resolution: [8, 8],
-//!     spp: 2,
-//!     test_spp: 4,
-//!     seed: 0,
-//!     jitter: dataset::Jitter::default(),
-//!     mix_maps: 1,
+//!     views: dataset::ViewSpec {
+//!         train_views: 2,
+//!         test_views: 1,
+//!         train_resolution: [8, 8],
+//!         test_resolution: [8, 8],
+//!         spp: 2,
+//!         test_spp: 4,
+//!         seed: 0,
+//!         jitter: dataset::Jitter::default(),
+//!         mix_maps: 1,
+//!     },
 //! };
 //! let manifest = dataset::plan(&request, &ts)?;
 //! let dir = std::env::temp_dir().join(format!("nprt-data-doc-{}", std::process::id()));
@@ -49,6 +51,6 @@ pub mod views;
 
 pub use camera_choice::CameraChoice;
 pub use cameras::{place_camera, PlacementError};
-pub use dataset::{Manifest, Request};
+pub use dataset::{Manifest, Request, ViewSpec};
 pub use generate::{generate, GenerateOptions, Planned};
 pub use shard::shard_from_env;

@@ -4,7 +4,7 @@
 use std::path::{Path, PathBuf};
 
 use anyhow::{bail, Result};
-use nprt_data::{CameraChoice, GenerateOptions};
+use nprt_data::{CameraChoice, GenerateOptions, ViewSpec};
 use nprt_net::training::snapshot::Snapshot;
 use nprt_net::{Calibration, Design, DirectLight, Engine, ModelConfig, RunLength, RECIPE};
 
@@ -144,13 +144,16 @@ impl Experiment {
             scene: self.scene.clone(),
             envmaps: self.envmaps.clone(),
             out: data.to_path_buf(),
-            train_views: b.train_views,
-            test_views: b.test_views,
-            train_resolution: [b.train_res; 2],
-            test_resolution: [b.test_res; 2],
-            spp: b.spp,
-            test_spp: b.test_spp,
-            seed: self.seed,
+            views: ViewSpec {
+                train_views: b.train_views,
+                test_views: b.test_views,
+                train_resolution: [b.train_res; 2],
+                test_resolution: [b.test_res; 2],
+                spp: b.spp,
+                test_spp: b.test_spp,
+                seed: self.seed,
+                ..ViewSpec::default()
+            },
             test_maps: self.test_maps,
             camera: self.camera.clone(),
             device: self.engine.tracer(),
@@ -204,13 +207,13 @@ impl Experiment {
             ("--scene", o.scene.clone()),
             ("--envmaps", o.envmaps.clone()),
             ("--out", o.out.display().to_string()),
-            ("--train-views", o.train_views.to_string()),
-            ("--test-views", o.test_views.to_string()),
-            ("--train-res", o.train_resolution[0].to_string()),
-            ("--test-res", o.test_resolution[0].to_string()),
-            ("--spp", o.spp.to_string()),
-            ("--test-spp", o.test_spp.to_string()),
-            ("--seed", o.seed.to_string()),
+            ("--train-views", o.views.train_views.to_string()),
+            ("--test-views", o.views.test_views.to_string()),
+            ("--train-res", o.views.train_resolution[0].to_string()),
+            ("--test-res", o.views.test_resolution[0].to_string()),
+            ("--spp", o.views.spp.to_string()),
+            ("--test-spp", o.views.test_spp.to_string()),
+            ("--seed", o.views.seed.to_string()),
         ]
         .into_iter()
         .flat_map(|(k, v)| [k.to_string(), v])

@@ -2,7 +2,7 @@
 //! `GenerateOptions::default()`'s.
 
 use nprt_data::dataset::{Jitter, TransferBasis};
-use nprt_data::{CameraChoice, GenerateOptions};
+use nprt_data::{CameraChoice, GenerateOptions, ViewSpec};
 use nprt_net::RECIPE;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
@@ -70,27 +70,31 @@ pub fn generate<'py>(
 ) -> PyResult<Bound<'py, PyDict>> {
     use argument::{number_or_none as num, size_or_none, vec3_or_none, whole_or_none as whole};
     let d = GenerateOptions::default();
+    let v = d.views;
     let device = choice::engine_arg(device)?.tracer();
     let f32_of = |v: Option<f64>| v.map(|v| v as f32);
     let opts = GenerateOptions {
         scene: crate::scene::scene_spec(scene, "scene")?,
         envmaps: crate::scene::envmaps_spec(envmaps)?,
         out: argument::path(out, "out")?,
-        train_views: whole(train_views, "train_views", 1..=u64::MAX)?.unwrap_or(d.train_views),
-        test_views: whole(test_views, "test_views", 1..=u64::MAX)?.unwrap_or(d.test_views),
-        train_resolution: size_or_none(train_res, "train_res")?
-            .map_or(d.train_resolution, |(w, h)| [w, h]),
-        test_resolution: size_or_none(test_res, "test_res")?
-            .map_or(d.test_resolution, |(w, h)| [w, h]),
-        spp: whole(spp, "spp", 1..=u32::MAX)?.unwrap_or(d.spp),
-        test_spp: whole(test_spp, "test_spp", 1..=u32::MAX)?.unwrap_or(d.test_spp),
-        seed: whole(seed, "seed", 0..=u64::MAX)?.unwrap_or(d.seed),
-        jitter: Jitter {
-            exposure: f32_of(num(jitter_exposure, "jitter_exposure", 0.0..=f64::MAX)?)
-                .unwrap_or(d.jitter.exposure),
-            tint: f32_of(num(jitter_tint, "jitter_tint", 0.0..=f64::MAX)?).unwrap_or(d.jitter.tint),
+        views: ViewSpec {
+            train_views: whole(train_views, "train_views", 1..=u64::MAX)?.unwrap_or(v.train_views),
+            test_views: whole(test_views, "test_views", 1..=u64::MAX)?.unwrap_or(v.test_views),
+            train_resolution: size_or_none(train_res, "train_res")?
+                .map_or(v.train_resolution, |(w, h)| [w, h]),
+            test_resolution: size_or_none(test_res, "test_res")?
+                .map_or(v.test_resolution, |(w, h)| [w, h]),
+            spp: whole(spp, "spp", 1..=u32::MAX)?.unwrap_or(v.spp),
+            test_spp: whole(test_spp, "test_spp", 1..=u32::MAX)?.unwrap_or(v.test_spp),
+            seed: whole(seed, "seed", 0..=u64::MAX)?.unwrap_or(v.seed),
+            jitter: Jitter {
+                exposure: f32_of(num(jitter_exposure, "jitter_exposure", 0.0..=f64::MAX)?)
+                    .unwrap_or(v.jitter.exposure),
+                tint: f32_of(num(jitter_tint, "jitter_tint", 0.0..=f64::MAX)?)
+                    .unwrap_or(v.jitter.tint),
+            },
+            mix_maps: whole(mix_maps, "mix_maps", 0..=u32::MAX)?.unwrap_or(v.mix_maps),
         },
-        mix_maps: whole(mix_maps, "mix_maps", 0..=u32::MAX)?.unwrap_or(d.mix_maps),
         transfer: match argument::text_or_none(transfer, "transfer", "a str: sh:L or none")? {
             Some(t) => TransferBasis::parse_choice(&t)
                 .map_err(|e| crate::error::input_error(format!("transfer={t:?}: {e:#}")))?,

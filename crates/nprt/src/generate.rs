@@ -4,14 +4,14 @@ use std::path::PathBuf;
 
 use anyhow::Result;
 use nprt_data::dataset::{Jitter, TransferBasis};
-use nprt_data::{generate, CameraChoice, GenerateOptions};
+use nprt_data::{generate, CameraChoice, GenerateOptions, ViewSpec};
 use nprt_net::{Compute, Engine, RECIPE};
 
 use crate::flags::{parse_shard, parse_vec3, print_warnings, Resolution};
 
 /// The defaults every flag shows, from the one place that states them.
-fn d() -> GenerateOptions {
-    GenerateOptions::default()
+fn d() -> ViewSpec {
+    GenerateOptions::default().views
 }
 
 #[derive(clap::Args)]
@@ -136,18 +136,20 @@ impl TryFrom<GenerateArgs> for GenerateOptions {
             scene: a.scene,
             envmaps: a.envmaps,
             out: a.out,
-            train_views: a.train_views,
-            test_views: a.test_views,
-            train_resolution: a.train_res.0,
-            test_resolution: a.test_res.0,
-            spp: a.spp,
-            test_spp: a.test_spp,
-            seed: a.seed,
-            jitter: Jitter {
-                exposure: a.jitter_exposure,
-                tint: a.jitter_tint,
+            views: ViewSpec {
+                train_views: a.train_views,
+                test_views: a.test_views,
+                train_resolution: a.train_res.0,
+                test_resolution: a.test_res.0,
+                spp: a.spp,
+                test_spp: a.test_spp,
+                seed: a.seed,
+                jitter: Jitter {
+                    exposure: a.jitter_exposure,
+                    tint: a.jitter_tint,
+                },
+                mix_maps: a.mix_maps,
             },
-            mix_maps: a.mix_maps,
             transfer: match a.transfer {
                 Some(TransferArg(t)) => t,
                 None => RECIPE.dataset_transfer_on(device),
@@ -191,7 +193,7 @@ pub fn run(opts: &GenerateOptions) -> Result<()> {
         println!(
             "dataset {}: {} train views ({}×{}, {} spp) under {} maps, {} test views ({}×{}, {} spp) under {} held-out maps; shard {}/{}; traced on the {}{transfer}",
             opts.out.display(), s.train_views, s.train_resolution[0], s.train_resolution[1], s.spp, s.train_maps.len(),
-            s.test_views, s.test_resolution[0], s.test_resolution[1], opts.test_spp, s.test_maps.len(), opts.shard.0, opts.shard.1,
+            s.test_views, s.test_resolution[0], s.test_resolution[1], opts.views.test_spp, s.test_maps.len(), opts.shard.0, opts.shard.1,
             Engine::from(opts.device).name()
         );
     })?;

@@ -217,7 +217,7 @@ fn remove_leftovers(dir: &Path, views: &[&ViewRecord]) -> Result<usize> {
 mod tests {
     use super::*;
     use crate::dataset::plan::room_request;
-    use crate::dataset::{plan, read_view, Request};
+    use crate::dataset::{plan, read_view, Request, ViewSpec};
     use nprt_scene::{load_scene, SceneOptions};
     use nprt_trace::{render, TraceScene};
 
@@ -236,10 +236,14 @@ mod tests {
     fn test_views_in_halves_hold_their_own_noise() {
         let scene = load_scene("builtin:room", &SceneOptions::default()).unwrap();
         let ts = TraceScene::new(&scene);
+        let base = room_request(&scene, ["builtin:indoor:1", "builtin:indoor:2"]);
         let request = Request {
-            test_resolution: [32, 32],
-            test_spp: 8,
-            ..room_request(&scene, ["builtin:indoor:1", "builtin:indoor:2"])
+            views: ViewSpec {
+                test_resolution: [32, 32],
+                test_spp: 8,
+                ..base.views
+            },
+            ..base
         };
         let manifest = plan(&request, &ts).unwrap();
         let dir = std::env::temp_dir().join(format!("nprt-halves-{}", std::process::id()));

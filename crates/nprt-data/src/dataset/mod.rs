@@ -14,6 +14,7 @@ mod transfer;
 mod verify;
 mod view_file;
 mod view_parts;
+mod view_spec;
 
 pub use generation::{
     check_not_model_folder, prepare, render_view, run, Summary, MODEL_FOLDER_ENTRIES,
@@ -31,3 +32,4 @@ pub use transfer::{Transfer, TransferBasis, MAX_TRANSFER_BAND};
 pub use verify::{verify, Report};
 pub use view_file::{check_view, read_view, write_view, ViewImage};
 pub use view_parts::ViewParts;
+pub use view_spec::ViewSpec;

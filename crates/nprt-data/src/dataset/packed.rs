@@ -576,7 +576,7 @@ mod tests {
     use super::*;
     use crate::dataset::packed_pixel::tests::angle;
     use crate::dataset::plan::room_request;
-    use crate::dataset::{plan, prepare, run, Request};
+    use crate::dataset::{plan, prepare, run, Request, ViewSpec};
     use nprt_scene::{load_scene, SceneOptions};
     use nprt_trace::{TraceScene, Tracer};
 
@@ -584,14 +584,18 @@ mod tests {
     fn room(name: &str) -> (PathBuf, Manifest, String) {
         let scene = load_scene("builtin:room", &SceneOptions::default()).unwrap();
         let ts = TraceScene::new(&scene);
+        let base = room_request(&scene, ["builtin:sky", "builtin:indoor:1"]);
         let request = Request {
-            train_views: 2,
-            train_resolution: [12, 10],
-            test_resolution: [16, 16],
-            spp: 4,
-            test_spp: 4,
-            seed: 3,
-            ..room_request(&scene, ["builtin:sky", "builtin:indoor:1"])
+            views: ViewSpec {
+                train_views: 2,
+                train_resolution: [12, 10],
+                test_resolution: [16, 16],
+                spp: 4,
+                test_spp: 4,
+                seed: 3,
+                ..base.views
+            },
+            ..base
         };
         let manifest = plan(&request, &ts).unwrap();
         let dir = std::env::temp_dir().join(format!("nprt-pack-{name}-{}", std::process::id()));

@@ -12,6 +12,7 @@ use super::manifest::{
     Jitter, Manifest, MapRecord, MixTerm, Settings, ViewRecord, VolumeRecord, FORMAT_VERSION,
 };
 use super::scene_identity::scene_hash;
+use super::view_spec::ViewSpec;
 use crate::cameras::place_camera;
 
 /// The most maps `--mix-maps` mixes into a training view's lighting.
@@ -28,19 +29,7 @@ pub struct Request<'a> {
     /// How views take their maps: from a pool split into training and held-out maps, or one
     /// map per view.
     pub lighting: MapAssignment,
-    pub train_views: u64,
-    pub test_views: u64,
-    pub train_resolution: [u32; 2],
-    pub test_resolution: [u32; 2],
-    pub spp: u32,
-    /// Samples per pixel of the test views: even, at least 2.
-    pub test_spp: u32,
-    pub seed: u64,
-    /// Exposure and white-balance changes of the training views' maps.
-    pub jitter: Jitter,
-    /// The most maps a training view's lighting mixes: its own and up to this many − 1 others
-    /// of the training maps, each rotated and scaled at random (1: one map a view).
-    pub mix_maps: u32,
+    pub views: ViewSpec,
 }
 
 /// How the views of a dataset take their maps.
@@ -60,13 +49,13 @@ pub enum MapAssignment {
 
 /// Builds the manifest: cameras, maps and rotations of every view, from the settings alone.
 pub fn plan(req: &Request, ts: &TraceScene) -> Result<Manifest> {
-    let views_total = (req.train_views + req.test_views) as usize;
+    let views_total = (req.views.train_views + req.views.test_views) as usize;
     let builtin_share = match req.lighting {
         MapAssignment::Pool { builtin_share, .. } => builtin_share,
         MapAssignment::PerView => 0.0,
     };
-    let own_map = |index: u64| crate::lighting::takes_builtin(req.seed, index, builtin_share);
-    let mixed = crate::lighting::mixed_views(req.seed, req.train_views, builtin_share);
+    let own_map = |index: u64| crate::lighting::takes_builtin(req.views.seed, index, builtin_share);
+    let mixed = crate::lighting::mixed_views(req.views.seed, req.views.train_views, builtin_share);
     // The maps the training views draw from, then each split's maps as recorded: the training
     // views' with the mixed views' own maps, which follow the pool's.
     let (train_pool, train_maps, test_maps) = match req.lighting {
@@ -77,7 +66,7 @@ pub fn plan(req: &Request, ts: &TraceScene) -> Result<Manifest> {
                     req.maps.len()
                 );
             };
-            let (train, test) = crate::lighting::split(folder, test_maps, req.seed)?;
+            let (train, test) = crate::lighting::split(folder, test_maps, req.views.seed)?;
             let recorded = train
                 .iter()
                 .copied()
@@ -90,19 +79,19 @@ pub fn plan(req: &Request, ts: &TraceScene) -> Result<Manifest> {
             req.maps.len()
         ),
         MapAssignment::PerView => {
-            let train: Vec<usize> = (0..req.train_views as usize).collect();
+            let train: Vec<usize> = (0..req.views.train_views as usize).collect();
             (
                 train.clone(),
                 train,
-                (req.train_views as usize..views_total).collect(),
+                (req.views.train_views as usize..views_total).collect(),
             )
         }
     };
-    check_jitter(&req.jitter)?;
-    if !(1..=MAX_MIX_MAPS).contains(&req.mix_maps) {
+    check_jitter(&req.views.jitter)?;
+    if !(1..=MAX_MIX_MAPS).contains(&req.views.mix_maps) {
         bail!(
             "mix_maps {}: a training view's lighting mixes 1 to {MAX_MIX_MAPS} maps",
-            req.mix_maps
+            req.views.mix_maps
         );
     }
     let envmaps = map_records(req)?;
@@ -114,17 +103,17 @@ pub fn plan(req: &Request, ts: &TraceScene) -> Result<Manifest> {
         envmaps,
         train_maps: train_maps.clone(),
         test_maps: test_maps.clone(),
-        train_views: req.train_views,
-        test_views: req.test_views,
-        train_resolution: req.train_resolution,
-        test_resolution: req.test_resolution,
-        spp: req.spp,
-        test_spp: Some(req.test_spp),
+        train_views: req.views.train_views,
+        test_views: req.views.test_views,
+        train_resolution: req.views.train_resolution,
+        test_resolution: req.views.test_resolution,
+        spp: req.views.spp,
+        test_spp: Some(req.views.test_spp),
         max_depth: req.scene.max_depth,
         rr_depth: req.scene.rr_depth,
-        seed: req.seed,
-        jitter: req.jitter,
-        mix_maps: req.mix_maps,
+        seed: req.views.seed,
+        jitter: req.views.jitter,
+        mix_maps: req.views.mix_maps,
         camera_volume: VolumeRecord::from(v),
         transfer: None,
         tracer: TraceDevice::Cpu,
@@ -170,27 +159,28 @@ fn plan_views(
     mixed: usize,
     own_map: impl Fn(u64) -> bool,
 ) -> Result<Vec<ViewRecord>> {
-    let mut views = Vec::with_capacity((req.train_views + req.test_views) as usize);
+    let mut views = Vec::with_capacity((req.views.train_views + req.views.test_views) as usize);
     let mut next_own = req.maps.len() - mixed;
     let brightest: Vec<glam::Vec3> = req
         .maps
         .iter()
         .map(|m| m.texels().iter().fold(glam::Vec3::ZERO, |a, t| a.max(*t)))
         .collect();
-    for index in 0..req.train_views + req.test_views {
-        let train = index < req.train_views;
+    for index in 0..req.views.train_views + req.views.test_views {
+        let train = index < req.views.train_views;
         let (split, local, maps, [w, h]) = if train {
-            ("train", index, train_pool, req.train_resolution)
+            ("train", index, train_pool, req.views.train_resolution)
         } else {
             (
                 "test",
-                index - req.train_views,
+                index - req.views.train_views,
                 test_maps,
-                req.test_resolution,
+                req.views.test_resolution,
             )
         };
         let mut rng = Pcg64Mcg::seed_from_u64(
-            req.seed
+            req.views
+                .seed
                 .wrapping_add(0x1f83_d9ab_fb41_bd6b)
                 .wrapping_mul(index + 1),
         );
@@ -206,20 +196,20 @@ fn plan_views(
         let rotation_deg = rng.random::<f32>() * 360.0;
         let seed = rng.random::<u64>();
         let gain = if train {
-            jittered_gain(&req.jitter, &mut rng)
+            jittered_gain(&req.views.jitter, &mut rng)
         } else {
             [1.0; 3]
         };
         // Drawn after everything else, so that datasets without mixing plan as before.
         let mix = match train {
-            true => mix_terms(req.mix_maps, train_pool, &mut rng),
+            true => mix_terms(req.views.mix_maps, train_pool, &mut rng),
             false => Vec::new(),
         };
         let lifted = (mix.iter()).fold(brightest[map] * glam::Vec3::from(gain), |sum, t| {
             sum + brightest[t.map] * t.gain
         });
         check_gain(lifted, &req.map_specs[map], gain, index)?;
-        let camera = place_camera(ts, &req.volume, req.seed, index, w, h)?;
+        let camera = place_camera(ts, &req.volume, req.views.seed, index, w, h)?;
         views.push(ViewRecord {
             index,
             split: split.into(),
@@ -306,15 +296,17 @@ pub(crate) fn room_request<'a>(scene: &'a Scene, map_specs: [&str; 2]) -> Reques
             test_maps: 1,
             builtin_share: 0.0,
         },
-        train_views: 1,
-        test_views: 1,
-        train_resolution: [8, 8],
-        test_resolution: [8, 8],
-        spp: 2,
-        test_spp: 2,
-        seed: 0,
-        jitter: Jitter::default(),
-        mix_maps: 1,
+        views: ViewSpec {
+            train_views: 1,
+            test_views: 1,
+            train_resolution: [8, 8],
+            test_resolution: [8, 8],
+            spp: 2,
+            test_spp: 2,
+            seed: 0,
+            jitter: Jitter::default(),
+            mix_maps: 1,
+        },
     }
 }
 
@@ -333,11 +325,17 @@ mod tests {
         let scene = load_scene("builtin:room", &SceneOptions::default()).unwrap();
         let ts = TraceScene::new(&scene);
         let bright = || EnvMap::constant(glam::Vec3::splat(0.9 * MAX_RADIANCE)).unwrap();
-        let req = |jitter| Request {
-            maps: vec![bright(), bright()],
-            train_views: 8,
-            jitter,
-            ..room_request(&scene, ["builtin:indoor:1", "builtin:indoor:2"])
+        let req = |jitter| {
+            let base = room_request(&scene, ["builtin:indoor:1", "builtin:indoor:2"]);
+            Request {
+                maps: vec![bright(), bright()],
+                views: ViewSpec {
+                    train_views: 8,
+                    jitter,
+                    ..base.views
+                },
+                ..base
+            }
         };
         assert!(plan(&req(Jitter::default()), &ts).is_ok());
         let err = plan(
@@ -380,15 +378,17 @@ mod tests {
                     test_maps: 1,
                     builtin_share,
                 },
-                train_views,
-                test_views: 6,
-                train_resolution: [4, 4],
-                test_resolution: [4, 4],
-                spp: 1,
-                test_spp: 2,
-                seed,
-                jitter: Jitter::default(),
-                mix_maps: 1,
+                views: ViewSpec {
+                    train_views,
+                    test_views: 6,
+                    train_resolution: [4, 4],
+                    test_resolution: [4, 4],
+                    spp: 1,
+                    test_spp: 2,
+                    seed,
+                    jitter: Jitter::default(),
+                    mix_maps: 1,
+                },
             };
             plan(&req, &ts)
         };
@@ -426,12 +426,18 @@ mod tests {
         let scene = load_scene("builtin:room", &SceneOptions::default()).unwrap();
         let ts = TraceScene::new(&scene);
         let specs: Vec<String> = (1..=4).map(|i| format!("builtin:indoor:{i}")).collect();
-        let req = |mix_maps| Request {
-            maps: load_all(&specs).unwrap(),
-            map_specs: specs.clone(),
-            train_views: 40,
-            mix_maps,
-            ..room_request(&scene, ["builtin:indoor:1", "builtin:indoor:2"])
+        let req = |mix_maps| {
+            let base = room_request(&scene, ["builtin:indoor:1", "builtin:indoor:2"]);
+            Request {
+                maps: load_all(&specs).unwrap(),
+                map_specs: specs.clone(),
+                views: ViewSpec {
+                    train_views: 40,
+                    mix_maps,
+                    ..base.views
+                },
+                ..base
+            }
         };
         let (one, three) = (plan(&req(1), &ts).unwrap(), plan(&req(3), &ts).unwrap());
         let counts: Vec<usize> = three.views.iter().map(|v| v.mix.len()).collect();

@@ -14,7 +14,7 @@ use std::sync::Arc;
 use std::time::Instant;
 
 use anyhow::{bail, Context, Result};
-use nprt_data::{generate, CameraChoice, GenerateOptions};
+use nprt_data::{generate, CameraChoice, GenerateOptions, ViewSpec};
 use nprt_eval::{row_name, EvalOptions, Evaluation, MethodResult};
 use nprt_net::training::training_set::TrainingSet;
 use nprt_net::{Engine, ModelConfig, RunLength, TrainOptions, RECIPE};
@@ -328,13 +328,16 @@ impl Bake {
             scene: self.scene.clone(),
             envmaps: self.envmaps.clone(),
             out: self.data_dir(),
-            train_views: sizes.train_views,
-            test_views: sizes.test_views,
-            train_resolution: [sizes.train_res; 2],
-            test_resolution: [sizes.test_res; 2],
-            spp: sizes.spp,
-            test_spp: sizes.test_spp,
-            seed: self.seed,
+            views: ViewSpec {
+                train_views: sizes.train_views,
+                test_views: sizes.test_views,
+                train_resolution: [sizes.train_res; 2],
+                test_resolution: [sizes.test_res; 2],
+                spp: sizes.spp,
+                test_spp: sizes.test_spp,
+                seed: self.seed,
+                ..ViewSpec::default()
+            },
             transfer: RECIPE.dataset_transfer_on(device),
             test_maps: self.test_maps,
             camera: self.camera.clone(),
