@@ -1,9 +1,8 @@
 //! What trains a network's weights: an engine's steps ([`EngineSteps`]: the batch's loss,
 //! gradients and an Adam update together, wherever the parameters live; [`CacheSteps`] for a
-//! radiance cache trained online), and Adam on the host
-//! ([`Adam`]), the update the CPU engine's steps take. The GPU kernels run the same update
-//! (shaders/adam.wgsl), and both keep Adam's state in one file format, so a checkpoint resumes
-//! on either engine.
+//! radiance cache trained online), and Adam on the host ([`Adam`]), the update the CPU
+//! engine's steps take. The GPU kernels run the same update (`gpu/shaders/optimiser/adam.wgsl`),
+//! and both keep Adam's state in one file format, so a checkpoint resumes on either engine.
 
 use std::collections::HashMap;
 use std::path::Path;

@@ -2,7 +2,7 @@
 //! Vulkan, Metal, DX12; Mesa's software Vulkan in the tests), computing what the CPU engine
 //! ([`crate::cpu`]) computes, which tests hold them to. In layers, each folder using only those
 //! before it (and nprt-gpu's runtime directly, never through this module):
-//! 0. [`kernels`]: the kernel list, each shader's WGSL (`shaders/`);
+//! 0. [`kernels`]: the kernel list, each shader's WGSL (`shaders/`, in folders by concept);
 //! 1. `products`: matrix products and their operands, in f32 and on f16 (tensor cores);
 //! 2. `layers`: where each tensor lies in the flat parameter buffer, and each layer's forward
 //!    pass recorded on it;

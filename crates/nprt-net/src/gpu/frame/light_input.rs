@@ -17,13 +17,17 @@ use nprt_trace::gpu::{matrix_words, GpuMap};
 pub static LIGHT_TEXELS: LazyLock<KernelSource> = LazyLock::new(|| {
     KernelSource::joined(
         "light_texels",
-        &[LERP, MAP_LOOKUP, include_str!("shaders/light_texels.wgsl")],
+        &[
+            LERP,
+            MAP_LOOKUP,
+            include_str!("../shaders/light/light_texels.wgsl"),
+        ],
     )
 });
 
 pub const LIGHT_NORMALISE: KernelSource = KernelSource {
     name: "light_normalise",
-    wgsl: include_str!("shaders/light_normalise.wgsl"),
+    wgsl: include_str!("../shaders/light/light_normalise.wgsl"),
 };
 
 /// A map made into the encoder's input on the device: `3 × width × width/2` values,

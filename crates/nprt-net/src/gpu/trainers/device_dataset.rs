@@ -1,7 +1,7 @@
 //! A training set held on the device: every record of its pack as it lies in the file (40 bytes
 //! a pixel, docs/dataset.md), and each training view's pre-processed map and scale, uploaded
 //! once, so that a step gathers its batch there from the sample picks alone
-//! (`shaders/gather_samples.wgsl`) instead of taking the batch's inputs from the host.
+//! (`shaders/encodings/gather_samples.wgsl`) instead of taking the batch's inputs from the host.
 
 use anyhow::{bail, Context, Result};
 use nprt_data::dataset::PACKED_PIXEL_BYTES;
@@ -19,7 +19,7 @@ const UPLOAD_RECORDS: usize = 1 << 20;
 
 const _: () = assert!(
     PACKED_PIXEL_BYTES == 40,
-    "shaders/gather_samples.wgsl reads a record as 10 words"
+    "shaders/encodings/gather_samples.wgsl reads a record as 10 words"
 );
 
 /// The pack's records from `first` on, in one storage buffer.
