@@ -4,8 +4,9 @@
 # ignores it; about 50 MiB, inside a 64 MiB transfer):
 #   nprt        the release binary with the GPU kernels (`--features gpu`), stripped;
 #   tests/      the GPU kernels' correctness tests (nprt-net's gpu_training, gpu_unet, gpu_cache,
-#               gpu_frame: f32 and the f16/tensor-core paths against the CPU engine; nprt_net,
-#               its library's own tests, among them each tensor-core kernel's against the host;
+#               gpu_frame: f32 and the f16/tensor-core paths against the CPU engine; nprt_net
+#               and nprt_engine, their libraries' own tests, among them each tensor-core
+#               kernel's against the host;
 #               nprt-trace's gpu_trace: the path tracer against the CPU's), stripped;
 #   cooperative_matrix  nprt-render's bench of the tensor-core products (frame and training
 #               shapes), stripped;
@@ -52,7 +53,7 @@ for line in sys.stdin:
 }
 log "building the GPU kernels' tests"
 for spec in nprt-net:gpu:gpu_training nprt-net:gpu:gpu_unet nprt-net:gpu:gpu_cache \
-  nprt-net:gpu:gpu_frame nprt-net:gpu:lib \
+  nprt-net:gpu:gpu_frame nprt-net:gpu:lib nprt-engine:gpu:lib \
   nprt-trace:gpu:gpu_trace; do
   IFS=: read -r package features test <<<"$spec"
   exe=$(test_binary test "$package" "$features" "$test")

@@ -86,7 +86,7 @@ prepare() {
   log "packing .visit/bundle.tar.xz"
   XZ_OPT=-T0 tar -cJhf .visit/bundle.tar.xz --transform 's,^\.gpu,gpu,' --transform 's,^\.visit/,,' \
     .gpu/nprt .gpu/commit .gpu/nprt.commit "${base[@]}" .gpu/lib .gpu/tests/gpu_training \
-    .gpu/tests/gpu_frame .gpu/tests/nprt_net .visit/kitchen .visit/envmaps
+    .gpu/tests/gpu_frame .gpu/tests/nprt_net .gpu/tests/nprt_engine .visit/kitchen .visit/envmaps
   du -h .visit/bundle.tar.xz
   log "ready: carry '.visit/bundle.tar.xz' and run 'bench/kitchen-visit.sh run' on the GPU machine"
 }

@@ -32,22 +32,20 @@
 //! ```
 
 pub mod bench;
-mod choice;
 pub mod cpu;
 pub mod deep_shading;
 pub mod encoding;
 mod engine;
 #[cfg(feature = "gpu")]
 pub mod gpu;
-pub mod init;
-pub mod loss;
 pub mod model;
 pub mod network;
-pub mod optimiser;
-pub mod parameters;
-mod precision;
 mod shading;
 pub mod training;
+
+// The engine below the networks (nprt-engine), under the paths the networks have always used.
+use nprt_engine::{choice, precision};
+pub use nprt_engine::{init, loss, optimiser, parameters};
 
 #[cfg(feature = "gpu")]
 pub use bench::throughput::profile_kernels;

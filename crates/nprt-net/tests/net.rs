@@ -461,3 +461,61 @@ fn weights_files_have_the_headers_models_were_written_with() {
     assert_eq!(golden.len(), Design::PAPER.len() + 1);
     std::fs::remove_dir_all(&dir).ok();
 }
+
+/// Every named choice of the networks and their training (`nprt_engine::named_choice!`), held
+/// to its names: parsed back, through serde as model.json writes them, and an unknown name
+/// answered with the accepted ones.
+mod choices {
+    use nprt_net::PositionEncoding;
+    use nprt_net::{
+        Activation, Calibration, Compute, Design, DirectLight, Loss, LrSchedule, MapNorm,
+    };
+
+    /// Every choice's name parses back and round-trips through serde (model.json).
+    fn round_trips<T>(all: &[T])
+    where
+        T: Copy + PartialEq + std::fmt::Debug + std::fmt::Display + std::str::FromStr,
+        T: serde::Serialize + serde::de::DeserializeOwned,
+        <T as std::str::FromStr>::Err: std::fmt::Debug,
+    {
+        for &c in all {
+            assert_eq!(c.to_string().parse::<T>().unwrap(), c);
+            let json = serde_json::to_string(&c).unwrap();
+            assert_eq!(json, format!("\"{c}\""));
+            assert_eq!(serde_json::from_str::<T>(&json).unwrap(), c);
+        }
+    }
+
+    #[test]
+    fn names_parse_and_unknown_ones_list_the_choices() {
+        round_trips(&Loss::ALL);
+        round_trips(&MapNorm::ALL);
+        round_trips(&DirectLight::ALL);
+        round_trips(&Calibration::ALL);
+        round_trips(&PositionEncoding::ALL);
+        round_trips(&Design::ALL);
+        round_trips(&Activation::ALL);
+        round_trips(&LrSchedule::ALL);
+        round_trips(&Compute::ALL);
+        let err = "mean".parse::<Calibration>().unwrap_err().to_string();
+        assert_eq!(err, "unknown calibration 'mean' (expected none or level)");
+        let err = "l2".parse::<Loss>().unwrap_err().to_string();
+        assert_eq!(err, "unknown loss 'l2' (expected log-l1 or rel-l2)");
+        let err = "max".parse::<MapNorm>().unwrap_err().to_string();
+        assert_eq!(
+            err,
+            "unknown map normalisation 'max' (expected mean or channel)"
+        );
+        // A list of three or more: commas, then "or" (the designs' names, whatever they are).
+        let err = serde_json::from_str::<Design>("\"mlp\"")
+            .unwrap_err()
+            .to_string();
+        let names = Design::ALL.map(Design::name);
+        let (last, rest) = names.split_last().unwrap();
+        let want = format!(
+            "unknown design 'mlp' (expected {} or {last})",
+            rest.join(", ")
+        );
+        assert!(rest.len() >= 2 && err.contains(&want), "{err}");
+    }
+}

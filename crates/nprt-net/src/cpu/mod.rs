@@ -6,20 +6,17 @@
 //!
 //! Tests hold it to f64 finite differences of its own forward pass (tests/net.rs).
 
-mod conv;
-mod dense;
 mod frame;
 mod light_encoder;
 mod light_model;
-mod matmul;
-mod peak;
-mod pool;
 pub(crate) mod radiance_cache;
-mod relu;
 mod samples;
-pub mod sincos;
 mod transport;
 mod unet;
+
+// The kernels these passes run, nprt-engine's.
+use nprt_engine::cpu::{accumulate, dense, matmul, pool, relu};
+pub use nprt_engine::cpu::{peak, sincos};
 
 use crate::loss::Loss;
 use crate::network::nprt_net::NprtNet;
@@ -50,9 +47,4 @@ pub fn gradients(net: &NprtNet, batch: &Samples, loss: Loss) -> (f64, NprtNet) {
 pub fn predict(net: &NprtNet, batch: &Samples) -> Vec<f32> {
     let pass = net.light.forward(batch.lights, batch.light_width);
     net.predict(batch, pass.codes())
-}
-
-/// `acc += x`, element by element: gradients summed over blocks, runs and maps.
-fn accumulate(acc: &mut [f32], x: &[f32]) {
-    acc.iter_mut().zip(x).for_each(|(a, v)| *a += v);
 }

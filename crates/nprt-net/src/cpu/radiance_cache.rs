@@ -10,8 +10,9 @@ use super::matmul::MatRef;
 use crate::encoding::hash_grid::{self, Corners};
 use crate::encoding::spherical_harmonics::basis;
 use crate::loss::Loss;
+use crate::network::radiance_cache::CacheSteps;
 use crate::network::radiance_cache::{CacheQuery, RadianceCache, INPUTS, SH_BANDS};
-use crate::optimiser::{Adam, CacheSteps};
+use crate::optimiser::Adam;
 use crate::parameters::Parameters;
 
 /// Rows a task reads or trains on at once.

@@ -3,7 +3,8 @@
 //! ([`crate::cpu`]) computes, which tests hold them to. In layers, each folder using only those
 //! before it (and nprt-gpu's runtime directly, never through this module):
 //! 0. [`kernels`]: the kernel list, each shader's WGSL (`shaders/`, in folders by concept);
-//! 1. `products`: matrix products and their operands, in f32 and on f16 (tensor cores);
+//! 1. `products`: matrix products and their operands, in f32 and on f16 (tensor cores),
+//!    nprt-engine's;
 //! 2. `layers`: where each tensor lies in the flat parameter buffer, and each layer's forward
 //!    pass recorded on it;
 //! 3. `passes`: backward passes and Adam on the device;
@@ -19,8 +20,10 @@ mod frame;
 pub mod kernels;
 mod layers;
 mod passes;
-mod products;
 mod trainers;
+
+// The matrix products, nprt-engine's, under the path the layers have always used.
+use nprt_engine::gpu::products;
 
 pub use frame::{DeviceShading, GpuKernels, GpuLightCode, GpuLightInput, GpuNetwork, GpuPixels};
 pub use products::half_layers::{half_weight_bits, pad16};

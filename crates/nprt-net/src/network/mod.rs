@@ -3,16 +3,15 @@
 //! Radiance Cache's network, each of them `crate::parameters` to the model file and the
 //! optimiser.
 
-pub mod activation;
-pub mod conv;
-pub mod dense;
 pub mod design;
 pub mod encoder;
 pub mod light_basis;
 pub mod light_model;
-pub mod mlp;
 pub mod nprt_net;
 pub mod radiance_cache;
 pub mod track;
 pub mod track_kind;
 pub mod unet;
+
+// The layers, nprt-engine's, under the paths the networks have always used.
+pub use nprt_engine::layers::{activation, conv, dense, mlp};

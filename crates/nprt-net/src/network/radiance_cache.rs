@@ -83,3 +83,13 @@ impl Parameters for RadianceCache {
         self.mlp.visit_mut(&child(prefix, "mlp"), f);
     }
 }
+
+/// A radiance cache trained online on an engine: its weights and Adam's state there.
+pub trait CacheSteps: Send {
+    /// The weights as they stand.
+    fn cache(&self) -> RadianceCache;
+    /// The radiance the cache holds for each query.
+    fn read(&mut self, queries: &[CacheQuery]) -> Vec<Vec3>;
+    /// One Adam step on the pairs at learning rate `lr`; returns their loss before it.
+    fn step(&mut self, queries: &[CacheQuery], targets: &[Vec3], lr: f64) -> f64;
+}

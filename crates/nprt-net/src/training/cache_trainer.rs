@@ -6,8 +6,7 @@ use anyhow::Result;
 use glam::Vec3;
 
 use crate::engine::Engine;
-use crate::network::radiance_cache::{CacheQuery, RadianceCache};
-use crate::optimiser::CacheSteps;
+use crate::network::radiance_cache::{CacheQuery, CacheSteps, RadianceCache};
 
 /// A cache trained online: its weights and Adam's state on an engine.
 pub struct CacheTrainer {

@@ -26,8 +26,8 @@ use crate::gpu::products::half_layers::Held;
 use crate::gpu::products::operands::{Bias, Output};
 use crate::gpu::trainers::plans::{submit, Pass, Plans};
 use crate::loss::Loss;
+use crate::network::radiance_cache::CacheSteps;
 use crate::network::radiance_cache::{CacheQuery, RadianceCache, INPUTS};
-use crate::optimiser::CacheSteps;
 use nprt_gpu::{groups_for, Dispatch, GpuDevice, Part, Span};
 
 /// Threads of `grid_backward` per chunk of rows: one per 64 slots of each level's table.

@@ -1,8 +1,8 @@
 //! The numbers the kernels take for the network's choices (activation, loss), as their
 //! parameter blocks document them; a track kind's is `TrackKind::code`.
 
+use crate::layers::activation::Activation;
 use crate::loss::Loss;
-use crate::network::activation::Activation;
 
 /// A hidden layer's activation in `gemm`: 1 ReLU, 2 SIREN (0 is the linear last layer).
 pub fn activation_code(a: Activation) -> u32 {

@@ -50,10 +50,7 @@ pub enum Bias<'a> {
 impl<'a> Bias<'a> {
     /// What a kernel's epilogue takes: its mode (0 none, 1 column, 2 group), its buffer, its
     /// offset there and the rows' groups (`gpu`'s empty buffer for what is unused).
-    pub(crate) fn binding(
-        self,
-        gpu: &'a GpuDevice,
-    ) -> (usize, &'a wgpu::Buffer, usize, &'a wgpu::Buffer) {
+    pub fn binding(self, gpu: &'a GpuDevice) -> (usize, &'a wgpu::Buffer, usize, &'a wgpu::Buffer) {
         match self {
             Bias::None => (0, &gpu.empty, 0, &gpu.empty),
             Bias::Column(buffer, offset) => (1, buffer, offset, &gpu.empty),

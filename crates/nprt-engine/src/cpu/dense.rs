@@ -6,9 +6,9 @@ use std::ops::Range;
 
 use super::matmul::{matmul, MatRef, Op};
 use super::sincos::{sin_scaled, sincos_scaled};
-use crate::network::activation::{Activation, OMEGA_0};
-use crate::network::dense::Dense;
-use crate::network::mlp::Mlp;
+use crate::layers::activation::{Activation, OMEGA_0};
+use crate::layers::dense::Dense;
+use crate::layers::mlp::Mlp;
 
 /// An input of layer 0 that rows share in groups (the light code: one per view), multiplied by
 /// its weight rows once per group instead of once per row.

@@ -11,6 +11,7 @@ pub struct MatRef<'a> {
 }
 
 impl<'a> MatRef<'a> {
+    #[inline]
     pub fn new(data: &'a [f32], rows: usize, cols: usize) -> Self {
         MatRef {
             data,

@@ -51,7 +51,7 @@ pub enum Held<'a> {
 
 /// f16 values a `d_in × d_out` weight takes as [`HalfWeight`] holds it: `d_in + 16` rows of
 /// `pad16(d_out)`.
-pub(crate) fn half_weight_halves(d_in: usize, d_out: usize) -> usize {
+pub fn half_weight_halves(d_in: usize, d_out: usize) -> usize {
     (d_in + 16) * pad16(d_out)
 }
 
@@ -186,7 +186,7 @@ fn half_dense(
 }
 
 /// Where a mixed-precision product's results go.
-pub(crate) struct HalfOut<'a> {
+pub struct HalfOut<'a> {
     /// The pre-activation: kept here by a forward product, read for the activation's
     /// derivative by a backward one.
     pub z: Option<&'a dyn Bind>,
@@ -199,7 +199,7 @@ pub(crate) struct HalfOut<'a> {
 /// The dispatch of `act(x·W + bias)` over `rows` rows of `x` (f16 rows of `k_pad` values)
 /// with `w` from its first row; `activation` 3 or 4 multiplies by ReLU's or SIREN's
 /// derivative at `out.z` instead (`half_train_layer.wgsl`).
-pub(crate) fn half_train_layer(
+pub fn half_train_layer(
     gpu: &GpuDevice,
     rows: usize,
     (x, k_pad): (&dyn Bind, usize),

@@ -4,7 +4,7 @@
 
 use super::accumulate;
 use super::matmul::{matmul, MatRef, Op};
-use crate::network::conv::Conv;
+use crate::layers::conv::Conv;
 
 /// The source column of output column `x` under horizontal tap `kx` of a 3×3 kernel, if inside
 /// the image.
@@ -69,7 +69,7 @@ impl Conv {
     }
 
     /// The convolution of `x` (c_in × h × w) plus the bias, c_out × h × w; `cols` is scratch.
-    pub(super) fn forward(&self, x: &[f32], h: usize, w: usize, cols: &mut Vec<f32>) -> Vec<f32> {
+    pub fn forward(&self, x: &[f32], h: usize, w: usize, cols: &mut Vec<f32>) -> Vec<f32> {
         let hw = h * w;
         let mut z = vec![0.0; self.c_out * hw];
         let k = self.c_in * self.k * self.k;
@@ -83,7 +83,7 @@ impl Conv {
 
     /// Given the gradient `d_z` at the output of [`Self::forward`] on `x`, sets `g`'s weight and
     /// bias gradients and, if asked, adds the gradient at `x` to `d_x`.
-    pub(super) fn backward(
+    pub fn backward(
         &self,
         x: &[f32],
         (h, w): (usize, usize),

@@ -5,8 +5,8 @@
 //! the codes the shaders read for activations and losses. The CPU engine's twin is
 //! `cpu/matmul.rs`. Uses only the kernel list and nprt-gpu's runtime.
 
-pub(crate) mod codes;
-pub(crate) mod dense_products;
-pub(crate) mod half_layers;
-pub(crate) mod half_mlp;
-pub(crate) mod operands;
+pub mod codes;
+pub mod dense_products;
+pub mod half_layers;
+pub mod half_mlp;
+pub mod operands;

@@ -1,17 +1,15 @@
 //! What trains a network's weights: an engine's steps ([`EngineSteps`]: the batch's loss,
-//! gradients and an Adam update together, wherever the parameters live; [`CacheSteps`] for a
-//! radiance cache trained online), and Adam on the host ([`Adam`]), the update the CPU
-//! engine's steps take. The GPU kernels run the same update (`gpu/shaders/optimiser/adam.wgsl`),
-//! and both keep Adam's state in one file format, so a checkpoint resumes on either engine.
+//! gradients and an Adam update together, wherever the parameters live), and Adam on the host
+//! ([`Adam`]), the update the CPU engine's steps take. nprt-net's GPU kernels run the same
+//! update (`shaders/optimiser/adam.wgsl`), and both keep Adam's state in one file format, so a
+//! checkpoint resumes on either engine.
 
 use std::collections::HashMap;
 use std::path::Path;
 
 use anyhow::{anyhow, bail, Context, Result};
-use glam::Vec3;
 use safetensors::{tensor::TensorView, Dtype, SafeTensors};
 
-use crate::network::radiance_cache::{CacheQuery, RadianceCache};
 use crate::parameters::Parameters;
 
 /// Adam's ε, on every engine.
@@ -45,16 +43,6 @@ pub trait EngineSteps<N, B> {
     fn load(&mut self, path: &Path) -> Result<()>;
     /// Where the steps run, for reports ("cpu", "GPU kernels on …").
     fn describe(&self) -> String;
-}
-
-/// A radiance cache trained online on an engine: its weights and Adam's state there.
-pub trait CacheSteps: Send {
-    /// The weights as they stand.
-    fn cache(&self) -> RadianceCache;
-    /// The radiance the cache holds for each query.
-    fn read(&mut self, queries: &[CacheQuery]) -> Vec<Vec3>;
-    /// One Adam step on the pairs at learning rate `lr`; returns their loss before it.
-    fn step(&mut self, queries: &[CacheQuery], targets: &[Vec3], lr: f64) -> f64;
 }
 
 /// Whether a checkpoint file is optimiser state (this nprt's or burn's, to clean up).
@@ -136,7 +124,7 @@ pub fn bias_corrections(t: u64) -> (f32, f32) {
 }
 
 /// [`bias_corrections`] under decay rates `[β1, β2]`.
-pub(crate) fn bias_corrections_for(t: u64, [beta1, beta2]: [f32; 2]) -> (f32, f32) {
+pub fn bias_corrections_for(t: u64, [beta1, beta2]: [f32; 2]) -> (f32, f32) {
     let t = t.min(i32::MAX as u64) as i32;
     let c2 = (1.0 - beta2.powi(t)).sqrt();
     (c2 / (1.0 - beta1.powi(t)), ADAM_EPSILON * c2)
@@ -204,7 +192,7 @@ pub fn load_state(path: &Path, params: usize) -> Result<([Vec<f32>; 2], u64)> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::network::dense::Dense;
+    use crate::layers::dense::Dense;
 
     fn layer(values: [f32; 3]) -> Dense {
         Dense {

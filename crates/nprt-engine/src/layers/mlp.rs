@@ -1,8 +1,8 @@
 //! A multilayer perceptron with SIREN or ReLU hidden layers and their initialisations.
 
 use crate::init::Init;
-use crate::network::activation::{Activation, OMEGA_0};
-use crate::network::dense::Dense;
+use crate::layers::activation::{Activation, OMEGA_0};
+use crate::layers::dense::Dense;
 use crate::parameters::{child, Parameters, Visit, VisitMut};
 
 /// A multilayer perceptron: every layer but the last is followed by the activation; the last
