@@ -37,6 +37,7 @@ mod path;
 mod relight;
 mod render_job;
 pub mod schedule;
+mod scripted_key;
 mod sequence;
 #[cfg(feature = "view")]
 pub mod view;
@@ -52,4 +53,5 @@ pub use path::CameraPath;
 pub use relight::{FrameCache, Relighter, Still, DEFAULT_DIRECT_SPP};
 pub use render_job::{RenderJob, RenderOptions, DEFAULT_LIGHTING};
 pub use schedule::LightingSchedule;
+pub use scripted_key::ScriptedKey;
 pub use sequence::{render_sequence, FrameReport, Sequence, SequenceSummary};

@@ -54,7 +54,7 @@ pub struct BakeArgs {
     view: bool,
     /// With --view: keys pressed at given times, as `nprt view --keys` (scripts and tests).
     #[arg(long, requires = "view", value_delimiter = ',', value_parser = crate::view::parse_key)]
-    keys: Vec<(f64, String)>,
+    keys: Vec<(f64, nprt_render::ScriptedKey)>,
     #[command(flatten)]
     device: DeviceArg,
 }

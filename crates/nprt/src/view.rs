@@ -3,6 +3,7 @@
 use std::path::PathBuf;
 
 use anyhow::Result;
+use nprt_render::ScriptedKey;
 
 use crate::flags::{design_names, DeviceArg, Resolution};
 
@@ -91,7 +92,7 @@ pub struct ViewArgs {
     /// frame and the key a character, or space, tab, escape or f12: e.g.
     /// 2:space,5:k,6:space,9:escape (for scripts and tests).
     #[arg(long, value_delimiter = ',', value_parser = parse_key)]
-    keys: Vec<(f64, String)>,
+    keys: Vec<(f64, ScriptedKey)>,
     /// The networks' arithmetic: f32, or f16 (weights and activations in f16, sums in f32, on
     /// tensor cores where the adapter has them).
     #[arg(long, default_value = "f32")]
@@ -101,20 +102,15 @@ pub struct ViewArgs {
 }
 
 /// A scripted key: SECONDS:KEY.
-pub fn parse_key(s: &str) -> Result<(f64, String), String> {
+pub fn parse_key(s: &str) -> Result<(f64, ScriptedKey), String> {
     let (at, key) = s
         .split_once(':')
         .ok_or_else(|| format!("'{s}' is not SECONDS:KEY"))?;
     let at: f64 = (at.parse().ok())
         .filter(|t: &f64| (0.0..=1e6).contains(t))
         .ok_or_else(|| format!("'{at}' in '{s}' is not a time in seconds, 0 to 1,000,000"))?;
-    let named = ["space", "tab", "escape", "esc", "f12"].contains(&key);
-    if !named && key.chars().count() != 1 {
-        return Err(format!(
-            "'{key}' in '{s}' is not a key: one character, or space, tab, escape or f12"
-        ));
-    }
-    Ok((at, key.to_string()))
+    let key = key.parse().map_err(|e| format!("{e} (in '{s}')"))?;
+    Ok((at, key))
 }
 
 /// The run `--train` asks for: the recipe, or `--arch`'s design with its own defaults.
@@ -187,7 +183,7 @@ pub fn run(a: ViewArgs) -> Result<()> {
 /// `nprt bake --view`'s window: the bake's run trained as `nprt view --train` trains it,
 /// `keys` pressed as `--keys` presses them.
 #[cfg(feature = "gpu")]
-pub fn training_window(keys: Vec<(f64, String)>) -> Result<nprt_paper::bake::TrainingWindow> {
+pub fn training_window(keys: Vec<(f64, ScriptedKey)>) -> Result<nprt_paper::bake::TrainingWindow> {
     Ok(nprt_paper::bake::TrainingWindow(std::sync::Arc::new(
         move |r: &nprt_paper::bake::WindowedRun| {
             let job = nprt_render::view::TrainingJob {
@@ -207,7 +203,7 @@ pub fn training_window(keys: Vec<(f64, String)>) -> Result<nprt_paper::bake::Tra
 }
 
 #[cfg(not(feature = "gpu"))]
-pub fn training_window(_: Vec<(f64, String)>) -> Result<nprt_paper::bake::TrainingWindow> {
+pub fn training_window(_: Vec<(f64, ScriptedKey)>) -> Result<nprt_paper::bake::TrainingWindow> {
     anyhow::bail!(
         "nprt bake --view: this nprt was built without the window; rebuild it with \
          `cargo build --release --features gpu` (docs/building.md)"

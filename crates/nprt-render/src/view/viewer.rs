@@ -406,7 +406,7 @@ impl<'a> Viewer<'a> {
                 let now = opened.elapsed().as_secs_f64();
                 while self.keys.front().is_some_and(|(t, _)| *t <= now) {
                     let (_, key) = self.keys.pop_front().expect("a key");
-                    self.key(&scripted_key(&key), el)?;
+                    self.key(&scripted_key(key), el)?;
                 }
                 self.redraw()?;
                 if let Some(n) = self.opts.frames {

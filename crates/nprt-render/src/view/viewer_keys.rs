@@ -6,7 +6,7 @@ use winit::keyboard::{Key, NamedKey, SmolStr};
 
 use super::viewer_state::Viewer;
 use crate::relight::FrameCache;
-use crate::Precision;
+use crate::{Precision, ScriptedKey};
 
 impl Viewer<'_> {
     /// Keys that leave the view as it is: the run's, the comparison's, screenshots and the
@@ -123,13 +123,13 @@ impl Viewer<'_> {
     }
 }
 
-/// The key a script names: a character, or space, tab, escape or f12.
-pub(super) fn scripted_key(name: &str) -> Key {
-    match name {
-        "space" => Key::Named(NamedKey::Space),
-        "tab" => Key::Named(NamedKey::Tab),
-        "escape" | "esc" => Key::Named(NamedKey::Escape),
-        "f12" => Key::Named(NamedKey::F12),
-        c => Key::Character(SmolStr::new(c)),
+/// The key a script presses, as the window would send it.
+pub(super) fn scripted_key(key: ScriptedKey) -> Key {
+    match key {
+        ScriptedKey::Space => Key::Named(NamedKey::Space),
+        ScriptedKey::Tab => Key::Named(NamedKey::Tab),
+        ScriptedKey::Escape => Key::Named(NamedKey::Escape),
+        ScriptedKey::F12 => Key::Named(NamedKey::F12),
+        ScriptedKey::Character(c) => Key::Character(SmolStr::new(c.to_string())),
     }
 }

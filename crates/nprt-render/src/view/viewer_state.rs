@@ -25,6 +25,7 @@ use crate::oidn::Oidn;
 use crate::relight::{FrameCache, Relighter};
 use crate::Denoise;
 use crate::Precision;
+use crate::ScriptedKey;
 
 /// What `nprt view` shows and how.
 pub struct ViewerOptions {
@@ -63,9 +64,9 @@ pub struct ViewerOptions {
     pub training: Option<TrainingJob>,
     /// Minutes the X key adds to the run.
     pub extend_minutes: f64,
-    /// Keys pressed at given times, as `(seconds since the first frame, key)`: a single
-    /// character, or space, tab, escape or f12 (scripts and tests).
-    pub keys: Vec<(f64, String)>,
+    /// Keys pressed at given times, as `(seconds since the first frame, key)` (scripts and
+    /// tests).
+    pub keys: Vec<(f64, ScriptedKey)>,
 }
 
 impl ViewerOptions {
@@ -133,7 +134,7 @@ pub(super) struct Viewer<'a> {
     /// The run trained beside the frames, and what the viewer last said of it.
     pub(super) training: Option<Training>,
     pub(super) said: Said,
-    pub(super) keys: VecDeque<(f64, String)>,
+    pub(super) keys: VecDeque<(f64, ScriptedKey)>,
     /// When the first frame was drawn.
     pub(super) opened: Option<Instant>,
     /// The denoiser of traced direct light, where one is installed and asked for, and whether
