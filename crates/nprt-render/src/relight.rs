@@ -28,13 +28,15 @@ use crate::Precision;
 /// docs/model.md#traced-direct-light).
 pub const DEFAULT_DIRECT_SPP: u32 = nprt_net::RECIPE.direct_spp;
 
-/// The CPU engine's networks beside the CPU tracer.
-type CpuFrames = OnEngine<<CpuEngine as NetworkEngine>::Network, HostStages>;
+/// The CPU engine's networks, beside the CPU tracer ([`HostStages`]).
+type CpuNet = <CpuEngine as NetworkEngine>::Network;
+type CpuFrames = OnEngine<CpuNet, HostStages>;
 
-/// The GPU kernels' networks beside the rasterised G-buffer and the tracer's kernels.
+/// The GPU kernels' networks, beside the rasterised G-buffer and the tracer's kernels.
 #[cfg(feature = "gpu")]
-type GpuFrames =
-    OnEngine<<nprt_net::gpu::GpuKernels as NetworkEngine>::Network, crate::gpu::DeviceStages>;
+type GpuNet = <nprt_net::gpu::GpuKernels as NetworkEngine>::Network;
+#[cfg(feature = "gpu")]
+type GpuFrames = OnEngine<GpuNet, crate::gpu::DeviceStages>;
 
 /// The engine a model's frames run on, resolved once (the GPU's boxed: its kernels' state is
 /// most of the size).
@@ -70,11 +72,12 @@ pub struct FrameCache<K> {
     kept: EngineCache<K>,
 }
 
+/// What the last frame kept, on the engine that made it.
 enum EngineCache<K> {
     Empty,
-    Cpu(Kept<<CpuEngine as NetworkEngine>::Network, HostStages, K>),
+    Cpu(Kept<CpuNet, HostStages, K>),
     #[cfg(feature = "gpu")]
-    Gpu(Kept<<nprt_net::gpu::GpuKernels as NetworkEngine>::Network, crate::gpu::DeviceStages, K>),
+    Gpu(Kept<GpuNet, crate::gpu::DeviceStages, K>),
 }
 
 impl<K> FrameCache<K> {
