@@ -1,6 +1,7 @@
 //! A frame's work on one engine, in that engine's types: its networks (a [`Shading`]) and the
-//! stages beside them (a [`FrameStages`] of that network), so that a light code or a camera's
-//! pixels one engine made are only ever handed back to it. [`crate::Relighter`] holds one of
+//! stages beside them (a [`KeptStages`] of that network: G-buffer, traced light, and what stays
+//! on the device), so that a light code or a camera's pixels one engine made are only ever
+//! handed back to it. [`crate::Relighter`] holds one of
 //! these, resolved once from the `--device` engine; this file holds what a frame does with it.
 
 use std::time::Instant;
