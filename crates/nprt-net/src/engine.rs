@@ -10,8 +10,7 @@ use nprt_trace::TraceDevice;
 
 use crate::choice::named_choice;
 use crate::cpu::HostCacheSteps;
-use crate::network::radiance_cache::CacheSteps;
-use crate::network::radiance_cache::{RadianceCache, ADAM_BETAS};
+use crate::network::radiance_cache::{CacheSteps, RadianceCache, ADAM_BETAS};
 use crate::network::unet::DeepShading;
 use crate::optimiser::Adam;
 use crate::parameters::Parameters;

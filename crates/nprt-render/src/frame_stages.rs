@@ -3,18 +3,20 @@
 //! where the G-buffer can stay on the device, the frame made there from G-buffer to background.
 //! The CPU's ([`HostStages`]: nprt-trace's tracer, beside any engine's networks) and the GPU's
 //! (`gpu::DeviceStages`: rasterised G-buffers and the tracer's kernels, beside the GPU
-//! kernels' networks) implement one trait for the networks they run beside, which the types
-//! hold them to: pixels they keep, and light codes they are given, are that network's.
+//! kernels' networks) implement [`FrameStages`], and [`KeptStages`] for the networks they run
+//! beside, which the types hold them to: pixels they keep, and light codes they are given, are
+//! that network's.
 
 use std::convert::Infallible;
 
-use crate::oidn::Oidn;
 use anyhow::Result;
 use glam::{Vec2, Vec3};
 use nprt_net::Shading;
 use nprt_scene::{Camera, EnvMap};
 use nprt_trace::{render, render_direct, render_gbuffer, GBuffer, RenderSettings, TraceScene};
 use rayon::prelude::*;
+
+use crate::oidn::Oidn;
 
 /// A frame's radiance, 3 f32 a pixel in pixel order: on the host, or left on the device by
 /// the GPU kernels (`Relighter::frame_shown`).
@@ -42,7 +44,7 @@ impl FrameRadiance {
     }
 }
 
-/// A camera's pixels whose G-buffer stayed on the device, as [`FrameStages::kept_pixels`]
+/// A camera's pixels whose G-buffer stayed on the device, as [`KeptStages::kept_pixels`]
 /// made them: a row per pixel, and the milliseconds of the G-buffer and of the networks.
 pub struct KeptPixels<R> {
     pub rows: R,

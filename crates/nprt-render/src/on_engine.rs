@@ -8,7 +8,7 @@ use std::time::Instant;
 
 use anyhow::Result;
 use glam::Vec3;
-use nprt_net::{gbuffer_features, DirectLight, ModelFile, Shading, FEATURES};
+use nprt_net::{gbuffer_features, ModelFile, Shading, FEATURES};
 use nprt_scene::{Camera, EnvMap};
 use nprt_trace::{GBuffer, TraceScene};
 use rayon::prelude::*;
@@ -79,7 +79,7 @@ impl<N: Shading, S: KeptStages<N>> OnEngine<N, S> {
         sampling: DirectSampling,
         rgb: &mut [Vec3],
     ) -> Result<()> {
-        if file.config.direct != DirectLight::Traced {
+        if file.config.direct.is_learned() {
             background(camera, map, &g.mask, rgb);
             return Ok(());
         }
@@ -142,8 +142,8 @@ impl<N: Shading, S: KeptStages<N>> OnEngine<N, S> {
         let clock = Instant::now();
         let shown = match &px {
             Rows::Kept(rows) => {
-                let direct = (file.config.direct == DirectLight::Traced)
-                    .then_some((sampling.spp, sampling.seed));
+                let direct =
+                    (!file.config.direct.is_learned()).then_some((sampling.spp, sampling.seed));
                 let (shown, direct_ms) =
                     (self.stages).kept_frame(&self.net, ts, rows, &code, &placed, direct, keep)?;
                 t.network_ms += ms(clock) - direct_ms;
@@ -175,7 +175,7 @@ impl<N: Shading, S: KeptStages<N>> OnEngine<N, S> {
         sampling: &DirectSampling,
         t: &mut FrameTimings,
     ) -> Result<Option<Pixels<N, S>>> {
-        if file.config.direct == DirectLight::Traced && sampling.denoiser.is_some() {
+        if !file.config.direct.is_learned() && sampling.denoiser.is_some() {
             return Ok(None);
         }
         let kept = (self.stages).kept_pixels(&self.net, ts, camera, &file.bounds)?;

@@ -11,9 +11,7 @@ use std::time::Instant;
 
 use anyhow::Result;
 use glam::Vec3;
-use nprt_net::{
-    load_model, CpuEngine, DirectLight, Engine, ModelFile, NetworkEngine, NprtNet, Shading,
-};
+use nprt_net::{load_model, CpuEngine, Engine, ModelFile, NetworkEngine, NprtNet, Shading};
 use nprt_scene::{Camera, EnvMap};
 use nprt_trace::{GBuffer, RenderSettings, TraceScene};
 
@@ -194,7 +192,7 @@ impl Relighter {
 
     /// Whether the model leaves direct light to the tracer ([`Self::complete`] traces it).
     pub fn traces_direct(&self) -> bool {
-        self.file.config.direct == DirectLight::Traced
+        !self.file.config.direct.is_learned()
     }
 
     /// Completes a frame the network shaded (`rgb`, background pixels zero) from G-buffer `g`

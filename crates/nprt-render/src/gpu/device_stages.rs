@@ -1,8 +1,7 @@
 //! A frame's stages on the GPU, beside nprt-net's networks on the GPU kernels (a
-//! [`DeviceShading`]): the scene
-//! rasterised into a G-buffer that stays on the device, the networks' inputs made there, the
-//! background recorded into the networks' own compute pass, and traced light on the tracer's
-//! kernels, all on the process's one device.
+//! [`DeviceShading`]): the scene rasterised into a G-buffer that stays on the device, the
+//! networks' inputs made there, the background recorded into the networks' own compute pass,
+//! and traced light on the tracer's kernels, all on the process's one device.
 
 use std::sync::Arc;
 use std::time::Instant;
