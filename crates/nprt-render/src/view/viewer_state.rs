@@ -163,11 +163,11 @@ pub(super) struct Viewer<'a> {
     pub(super) failed: Option<anyhow::Error>,
 }
 
-/// What the viewer has printed of its run: whether it was paused, and the step of its last
-/// save.
+/// What the viewer has printed of its run: the step it was paused at (None while it runs),
+/// and the step of its last save.
 #[derive(Default)]
 pub(super) struct Said {
-    pub(super) paused: bool,
+    pub(super) paused_at: Option<u64>,
     pub(super) saved_at: Option<u64>,
     pub(super) ended: bool,
 }

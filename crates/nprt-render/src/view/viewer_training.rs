@@ -19,7 +19,7 @@ impl Viewer<'_> {
     /// run trains, each piece of work is followed by four times as long without (input is
     /// served at once; a paused or ended run leaves the machine to the window).
     pub(super) fn pacing(&self) -> bool {
-        let running = self.training.is_some() && !self.said.paused && !self.said.ended;
+        let running = self.training.is_some() && self.said.paused_at.is_none() && !self.said.ended;
         let rest = |secs: f64| secs * (1.0 / WINDOW_SHARE - 1.0);
         running
             && !self.models.is_empty()
@@ -53,10 +53,17 @@ impl Viewer<'_> {
         };
         let status = t.status();
         let said = &mut self.said;
-        if status.paused != said.paused {
-            said.paused = status.paused;
-            let what = if status.paused { "paused" } else { "resumed" };
-            self.message = format!("training {what} at step {}", status.step);
+        if status.paused != said.paused_at.is_some() {
+            // A run resumes from the step it was paused at; the status, polled once a frame,
+            // may already count a step taken since.
+            let (what, step) = match said.paused_at.take() {
+                Some(at) => ("resumed", at),
+                None => {
+                    said.paused_at = Some(status.step);
+                    ("paused", status.step)
+                }
+            };
+            self.message = format!("training {what} at step {step}");
             println!("nprt view: {}", self.message);
         }
         if status.saved_at != said.saved_at {
