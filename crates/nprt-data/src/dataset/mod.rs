@@ -5,9 +5,11 @@
 
 mod generation;
 mod manifest;
+mod pack_format;
 mod packed;
 mod packed_pixel;
 mod packed_transfer;
+mod packing;
 mod plan;
 mod scene_identity;
 mod transfer;
@@ -23,9 +25,11 @@ pub use manifest::{
     check_bounds, load_manifest, load_manifest_hashed, Jitter, Manifest, MapRecord, MixTerm,
     Settings, ViewRecord, VolumeRecord, FORMAT_VERSION, MANIFEST,
 };
-pub use packed::{views_stamp, PackHeader, PackedDataset, PackedTarget, PACK_FORMAT, PACK_VERSION};
+pub use pack_format::{PackHeader, PackedTarget, PACK_FORMAT, PACK_VERSION};
+pub use packed::PackedDataset;
 pub use packed_pixel::{PackedPixel, PACKED_PIXEL_BYTES};
 pub use packed_transfer::{PackedTransfer, TransferSection};
+pub use packing::views_stamp;
 pub use plan::{plan, MapAssignment, Request, MAX_MIX_MAPS};
 pub use scene_identity::{load_checked_scene, relit, scene_hash, scene_source};
 pub use transfer::{Transfer, TransferBasis, MAX_TRANSFER_BAND};

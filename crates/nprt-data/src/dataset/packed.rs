@@ -7,95 +7,21 @@
 //! them after the records, one vector per record ([`super::packed_transfer`]).
 
 use std::fs::File;
-use std::io::{BufWriter, Seek, SeekFrom, Write};
 use std::path::{Path, PathBuf};
 
-use anyhow::{bail, ensure, Context, Result};
-use glam::Vec3;
+use anyhow::{ensure, Context, Result};
 use memmap2::{Mmap, UncheckedAdvice};
-use rayon::prelude::*;
-use serde::{Deserialize, Serialize};
 
-use super::manifest::{Manifest, ViewRecord};
+use super::manifest::Manifest;
+use super::pack_format::{
+    read_header, PackHeader, PackedTarget, PACK_FORMAT, PACK_VERSION, PRELUDE_BYTES,
+};
 use super::packed_pixel::{PackedPixel, PACKED_PIXEL_BYTES};
-use super::packed_transfer::{self, PackedTransfer, TransferSection};
-
-/// What a pack's radiance holds.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
-#[serde(rename_all = "lowercase")]
-pub enum PackedTarget {
-    /// The reference radiance.
-    Radiance,
-    /// The reference minus its direct part (never below zero), for models that trace the
-    /// direct light at run time.
-    Indirect,
-}
-
-impl PackedTarget {
-    pub fn name(self) -> &'static str {
-        match self {
-            PackedTarget::Radiance => "radiance",
-            PackedTarget::Indirect => "indirect",
-        }
-    }
-
-    /// The value learned for a pixel of `radiance` whose direct part is `direct`.
-    pub fn of(self, radiance: Vec3, direct: Vec3) -> Vec3 {
-        match self {
-            PackedTarget::Radiance => radiance,
-            PackedTarget::Indirect => (radiance - direct).max(Vec3::ZERO),
-        }
-    }
-}
-
-pub const PACK_FORMAT: &str = "nprt-packed-dataset";
-pub const PACK_VERSION: u32 = 1;
-const MAGIC: [u8; 8] = *b"NPRTPACK";
-/// The fixed part at the file's start; the records follow it, 64-byte aligned.
-const PRELUDE_BYTES: usize = 64;
-/// Views read and encoded at once while packing: enough to keep every core busy, few enough
-/// that their images stay well under a gigabyte at the paper's resolutions.
-const PACK_CHUNK: usize = 32;
+use super::packed_transfer::{self, TransferSection};
+use super::packing::{lock_packing, pack, views_stamp};
 
 /// Bytes hashed at once when a pack is opened.
 const HASH_PIECE: usize = 256 << 20;
-
-/// Where a pack sits in its file, written last at its start.
-#[repr(C)]
-#[derive(Clone, Copy, Debug, bytemuck::Pod, bytemuck::Zeroable)]
-struct Prelude {
-    magic: [u8; 8],
-    version: u32,
-    record_bytes: u32,
-    records_offset: u64,
-    records_len: u64,
-    header_offset: u64,
-    header_len: u64,
-    /// Bytes of transfer vectors between the records and the header (0: none).
-    transfer_len: u64,
-    reserved: u64,
-}
-
-/// The pack's description, JSON after the records.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-pub struct PackHeader {
-    pub format: String,
-    pub version: u32,
-    /// BLAKE3 of the manifest.json it was made from.
-    pub dataset_hash: String,
-    /// BLAKE3 over the view files' names, sizes and modification times.
-    pub views_stamp: String,
-    pub target: PackedTarget,
-    /// The scene bounds positions are stored within.
-    pub bounds: [[f32; 3]; 2],
-    /// Per manifest view, in its order: first record and record count.
-    pub views: Vec<[u64; 2]>,
-    /// BLAKE3 of the records.
-    pub records_hash: String,
-    /// The transfer vectors after the records, for a dataset made with `--transfer`.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub transfer: Option<PackedTransfer>,
-}
 
 /// A pack opened for reading.
 pub struct PackedDataset {
@@ -146,7 +72,7 @@ impl PackedDataset {
             return Ok(pack);
         }
         on_pack(&why);
-        pack(dir, manifest, dataset_hash, &stamp, target, progress)?;
+        pack(&path, dir, manifest, dataset_hash, &stamp, target, progress)?;
         drop(lock);
         current()
     }
@@ -356,195 +282,6 @@ impl PackedDataset {
         }
     }
 }
-
-/// Takes the dataset's packing lock, waiting while another process holds it.
-fn lock_packing(dir: &Path) -> Result<File> {
-    let path = dir.join(".packing.lock");
-    let file = nprt_io::open_lock_file(&path).with_context(|| {
-        format!(
-            "cannot pack the dataset in '{}' (training packs it beside manifest.json; make the folder writable, or copy the dataset where it is)",
-            dir.display()
-        )
-    })?;
-    file.lock()
-        .with_context(|| format!("cannot lock '{}'", path.display()))?;
-    Ok(file)
-}
-
-/// BLAKE3 over each view file's name, size and modification time: a view redone or replaced
-/// since packing changes it.
-pub fn views_stamp(dir: &Path, manifest: &Manifest) -> Result<String> {
-    let mut h = blake3::Hasher::new();
-    for v in &manifest.views {
-        let path = dir.join(&v.file);
-        let meta = std::fs::metadata(&path)
-            .with_context(|| format!("dataset view '{}' is missing", path.display()))?;
-        let modified = meta
-            .modified()
-            .ok()
-            .and_then(|t| t.duration_since(std::time::UNIX_EPOCH).ok())
-            .map_or(0, |d| d.as_nanos());
-        h.update(v.file.as_bytes());
-        h.update(&[0]);
-        h.update(&meta.len().to_le_bytes());
-        h.update(&modified.to_le_bytes());
-    }
-    Ok(h.finalize().to_hex().to_string())
-}
-
-/// Writes the pack of `target` for the dataset in `dir` (holding the packing lock).
-fn pack(
-    dir: &Path,
-    manifest: &Manifest,
-    dataset_hash: &str,
-    views_stamp: &str,
-    target: PackedTarget,
-    progress: bool,
-) -> Result<()> {
-    let path = PackedDataset::path(dir, target);
-    // Temporaries of a killed packing: ours, since the lock is held.
-    nprt_io::remove_temporaries(dir, |of| of == path)?;
-    nprt_io::write_atomically(&path, |tmp| {
-        let mut w = BufWriter::with_capacity(8 << 20, File::create(tmp)?);
-        w.write_all(&[0; PRELUDE_BYTES])?;
-        let bar = nprt_io::progress_bar(progress, manifest.views.len() as u64, "packing", "views");
-        let mut hasher = blake3::Hasher::new();
-        let mut views = Vec::with_capacity(manifest.views.len());
-        let mut next = 0u64;
-        let mut transfer = packed_transfer::Writer::new(dir, manifest)?;
-        for chunk in manifest
-            .views
-            .chunks(packed_transfer::views_at_once(manifest, PACK_CHUNK))
-        {
-            let records: Vec<(Vec<PackedPixel>, Vec<u16>)> = chunk
-                .par_iter()
-                .map(|v| view_records(dir, manifest, v, target, transfer.is_some()))
-                .collect::<Result<_>>()?;
-            for (r, t) in records {
-                let bytes: &[u8] = bytemuck::cast_slice(&r);
-                hasher.update(bytes);
-                w.write_all(bytes)?;
-                if let Some(transfer) = &mut transfer {
-                    transfer.add(&t, r.len())?;
-                }
-                views.push([next, r.len() as u64]);
-                next += r.len() as u64;
-                bar.inc(1);
-            }
-        }
-        bar.finish_and_clear();
-        let (transfer, transfer_len) = match transfer {
-            Some(t) => t.append_to(&mut w)?,
-            None => (None, 0),
-        };
-        let header = PackHeader {
-            format: PACK_FORMAT.into(),
-            version: PACK_VERSION,
-            dataset_hash: dataset_hash.into(),
-            views_stamp: views_stamp.into(),
-            target,
-            bounds: manifest.bounds,
-            views,
-            records_hash: hasher.finalize().to_hex().to_string(),
-            transfer,
-        };
-        let json = serde_json::to_vec(&header)?;
-        w.write_all(&json)?;
-        let mut file = w.into_inner().map_err(|e| e.into_error())?;
-        let records_len = next * PACKED_PIXEL_BYTES as u64;
-        let prelude = Prelude {
-            magic: MAGIC,
-            version: PACK_VERSION,
-            record_bytes: PACKED_PIXEL_BYTES as u32,
-            records_offset: PRELUDE_BYTES as u64,
-            records_len,
-            header_offset: PRELUDE_BYTES as u64 + records_len + transfer_len,
-            header_len: json.len() as u64,
-            transfer_len,
-            reserved: 0,
-        };
-        file.seek(SeekFrom::Start(0))?;
-        file.write_all(bytemuck::bytes_of(&prelude))?;
-        file.sync_all()?;
-        Ok(())
-    })
-}
-
-/// The records of one view's foreground pixels, refusing a position outside the scene bounds
-/// (it could not be stored), and (`transfer`) their transfer vectors as `target` has them
-/// (zero for a view without).
-fn view_records(
-    dir: &Path,
-    manifest: &Manifest,
-    view: &ViewRecord,
-    target: PackedTarget,
-    transfer: bool,
-) -> Result<(Vec<PackedPixel>, Vec<u16>)> {
-    let image = crate::views::load_view(dir, manifest, view)?;
-    let g = &image.gbuffer;
-    let [lo, hi] = manifest.bounds.map(Vec3::from);
-    let slack = (hi - lo).max_element() * 1e-4;
-    let mut records = Vec::with_capacity(image.foreground());
-    for i in (0..g.mask.len()).filter(|&i| g.mask[i] > 0.5) {
-        let s = g.sample(i);
-        if s.position.cmplt(lo - slack).any() || s.position.cmpgt(hi + slack).any() {
-            bail!(
-                "pixel ({}, {}) of '{}' lies at {} outside the scene bounds {lo}..{hi} in manifest.json",
-                i % image.width,
-                i / image.width,
-                dir.join(&view.file).display(),
-                s.position
-            );
-        }
-        let r = target.of(image.radiance[i], image.direct[i]);
-        records.push(PackedPixel::encode(&s, r, &manifest.bounds));
-    }
-    let vectors = match (transfer, manifest.settings.transfer) {
-        (true, Some(basis)) => {
-            packed_transfer::vectors(&image, basis, target == PackedTarget::Indirect)
-        }
-        _ => vec![],
-    };
-    Ok((records, vectors))
-}
-
-/// The header of a mapped pack, its records' and its transfer vectors' lengths in bytes, after
-/// checking that every part lies where the prelude says.
-fn read_header(bytes: &[u8]) -> Result<(PackHeader, usize, usize)> {
-    ensure!(bytes.len() >= PRELUDE_BYTES, "shorter than its prelude");
-    let p: Prelude = bytemuck::pod_read_unaligned(&bytes[..PRELUDE_BYTES]);
-    ensure!(
-        p.magic == MAGIC,
-        "not a packed dataset (no NPRTPACK signature)"
-    );
-    ensure!(
-        p.version == PACK_VERSION && p.record_bytes as usize == PACKED_PIXEL_BYTES,
-        "pack version {} with {}-byte records; this nprt reads version {PACK_VERSION}",
-        p.version,
-        p.record_bytes
-    );
-    let len = bytes.len() as u64;
-    let fits = |offset: u64, n: u64| offset.checked_add(n).is_some_and(|end| end <= len);
-    ensure!(
-        p.records_offset == PRELUDE_BYTES as u64
-            && p.records_len.is_multiple_of(PACKED_PIXEL_BYTES as u64)
-            && Some(p.header_offset)
-                == (p.records_offset + p.records_len).checked_add(p.transfer_len)
-            && fits(p.header_offset, p.header_len)
-            && p.header_offset + p.header_len == len,
-        "its parts do not fit its {len} bytes (truncated or not written to the end)"
-    );
-    let json = &bytes[p.header_offset as usize..(p.header_offset + p.header_len) as usize];
-    let header: PackHeader = serde_json::from_slice(json).context("its header is not valid")?;
-    ensure!(
-        header.format == PACK_FORMAT && header.version == PACK_VERSION,
-        "its header says format '{}' version {}",
-        header.format,
-        header.version
-    );
-    Ok((header, p.records_len as usize, p.transfer_len as usize))
-}
-
 /// Each view's records lie within the file, one after another, at most one per pixel.
 fn check_view_ranges(header: &PackHeader, manifest: &Manifest, records: usize) -> Result<()> {
     ensure!(
@@ -572,6 +309,8 @@ fn check_view_ranges(header: &PackHeader, manifest: &Manifest, records: usize) -
 #[cfg(test)]
 mod tests {
     use std::cell::RefCell;
+
+    use glam::Vec3;
 
     use super::*;
     use crate::dataset::packed_pixel::tests::angle;
@@ -706,17 +445,5 @@ mod tests {
             "{err:#}"
         );
         std::fs::remove_dir_all(&dir).unwrap();
-    }
-
-    #[test]
-    fn the_indirect_target_is_the_rest_of_the_radiance_never_negative() {
-        let radiance = Vec3::new(1.0, 2.0, 0.5);
-        // The last channel's direct part exceeds its total by a rounding error.
-        let direct = Vec3::new(0.25, 0.5, 0.5000001);
-        assert_eq!(PackedTarget::Radiance.of(radiance, direct), radiance);
-        assert_eq!(
-            PackedTarget::Indirect.of(radiance, direct),
-            Vec3::new(0.75, 1.5, 0.0)
-        );
     }
 }

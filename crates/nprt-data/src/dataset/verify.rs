@@ -5,7 +5,9 @@ use std::path::{Path, PathBuf};
 use anyhow::Result;
 
 use super::manifest::load_manifest_hashed;
-use super::packed::{views_stamp, PackedDataset, PackedTarget};
+use super::pack_format::PackedTarget;
+use super::packed::PackedDataset;
+use super::packing::views_stamp;
 use super::view_file::check_view;
 
 /// Completeness of a dataset folder.
