@@ -8,7 +8,7 @@ use std::sync::LazyLock;
 use nprt_gpu::{GpuDevice, KernelSource};
 use nprt_scene::{Camera, EnvMap};
 use nprt_trace::gpu::wgsl::{CAMERA_RAY, LERP, MAP_LOOKUP};
-use nprt_trace::gpu::{camera_words, matrix_words, GpuMap};
+use nprt_trace::gpu::{camera_words, map_frame_words, GpuMap};
 
 pub static FRAME_BACKGROUND: LazyLock<KernelSource> = LazyLock::new(|| {
     KernelSource::joined(
@@ -55,11 +55,9 @@ pub fn record_background(
         Fill::TracedDirect(map) => (map, 0),
     };
     let texels = maps.texels(gpu, map);
-    let size = [map.width() as u32, map.height() as u32];
-    let to_local = map.to_world().inverse();
-    let mut params = vec![camera.width, camera.height, size[0], size[1], fill, 0, 0, 0];
+    let mut params = vec![camera.width, camera.height, fill, 0];
     params.extend(camera_words(camera));
-    params.extend(matrix_words(to_local));
+    params.extend(map_frame_words(map));
     gpu.dispatch(
         pass,
         &FRAME_BACKGROUND,

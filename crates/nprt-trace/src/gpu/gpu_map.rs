@@ -26,12 +26,19 @@ impl PartialEq for SameTexels {
     }
 }
 
-/// A 3 × 3 matrix as map_lookup.wgsl's callers take it: its columns, each padded to a vec4,
-/// as u32 words of the parameter block (a map's world-to-local rotation).
+/// A 3 × 3 matrix as the kernels take it: its columns, each padded to a vec4, as u32 words of
+/// the parameter block.
 pub fn matrix_words(m: glam::Mat3) -> impl Iterator<Item = u32> {
     [m.x_axis, m.y_axis, m.z_axis]
         .into_iter()
         .flat_map(|c| c.extend(0.0).to_array().map(f32::to_bits))
+}
+
+/// `map` as it lies in the world, as map_lookup.wgsl's `MapFrame` holds it in a kernel's
+/// parameters: its world-to-local rotation, then its size.
+pub fn map_frame_words(map: &EnvMap) -> impl Iterator<Item = u32> {
+    let size = [map.width() as u32, map.height() as u32, 0, 0];
+    matrix_words(map.to_world().inverse()).chain(size)
 }
 
 impl GpuMap {

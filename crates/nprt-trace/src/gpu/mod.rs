@@ -14,7 +14,7 @@ mod gpu_scene;
 mod path_tracer;
 mod raster_gbuffer;
 
-pub use gpu_map::{matrix_words, GpuMap, SameTexels};
+pub use gpu_map::{map_frame_words, GpuMap, SameTexels};
 pub use gpu_scene::{GpuBvh, GpuScene};
 pub use path_tracer::{record_paths, GpuPaths, PathTargets, PATH_TRACE};
 pub use raster_gbuffer::{camera_words, RasterGBuffer, GBUFFER};

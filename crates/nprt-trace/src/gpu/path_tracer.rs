@@ -9,7 +9,7 @@ use nprt_scene::{Camera, EnvMap};
 
 use crate::{Frame, PixelFilter, RenderSettings};
 
-use super::gpu_map::{matrix_words, GpuMap};
+use super::gpu_map::{map_frame_words, matrix_words, GpuMap};
 use super::gpu_scene::GpuScene;
 use super::raster_gbuffer::{camera_words, RasterGBuffer};
 
@@ -101,8 +101,6 @@ pub fn record_paths(
         let mut params = vec![
             camera.width,
             camera.height,
-            map.width() as u32,
-            map.height() as u32,
             PATHS_PER_DISPATCH.min(paths.spp - first),
             paths.spp,
             seed,
@@ -115,9 +113,11 @@ pub fn record_paths(
             u32::from(out.direct.is_some()),
             u32::from(paths.stratified),
             0,
+            0,
+            0,
         ];
         params.extend(camera_words(camera));
-        params.extend(matrix_words(map.to_world().inverse()));
+        params.extend(map_frame_words(map));
         params.extend(matrix_words(map.to_world()));
         gpu.dispatch(
             pass,

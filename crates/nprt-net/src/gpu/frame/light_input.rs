@@ -12,7 +12,7 @@ use crate::network::encoder::{LightInput, Texels};
 use nprt_gpu::{groups_for, Dispatch, GpuDevice, KernelSource};
 use nprt_scene::EnvMap;
 use nprt_trace::gpu::wgsl::{LERP, MAP_LOOKUP};
-use nprt_trace::gpu::{matrix_words, GpuMap};
+use nprt_trace::gpu::{map_frame_words, GpuMap};
 
 pub static LIGHT_TEXELS: LazyLock<KernelSource> = LazyLock::new(|| {
     KernelSource::joined(
@@ -133,13 +133,10 @@ impl GpuLightInput {
 }
 
 /// `light_texels`' parameters for `map` under `rotation_deg`, into an input `width` wide: its
-/// size, the lookups per texel side (ss) and the map's world-to-local rotation.
+/// size, the lookups per texel side (ss) and the rotated map.
 fn texel_params(map: &EnvMap, rotation_deg: f32, width: usize) -> Vec<u32> {
     let ss = map.width().div_ceil(width).max(2);
-    let to_local = map.rotated_y(rotation_deg).to_world().inverse();
-    let mut params = [width, width / 2, ss, map.width(), map.height(), 0, 0, 0]
-        .map(|v| v as u32)
-        .to_vec();
-    params.extend(matrix_words(to_local));
+    let mut params = [width, width / 2, ss, 0].map(|v| v as u32).to_vec();
+    params.extend(map_frame_words(&map.rotated_y(rotation_deg)));
     params
 }

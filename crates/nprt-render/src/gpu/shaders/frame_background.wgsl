@@ -5,22 +5,15 @@
 struct Background {
     width: u32,
     height: u32,
-    map_width: u32,
-    map_height: u32,
     // 1: the map; 0: zero.
     fill: u32,
     _pad0: u32,
-    _pad1: u32,
-    _pad2: u32,
     x_axis: vec4<f32>,
     y_axis: vec4<f32>,
     z_axis: vec4<f32>,
     origin: vec4<f32>,
     tangents: vec4<f32>,
-    // World to the map's own frame (its rotation's inverse), as columns.
-    to_local_x: vec4<f32>,
-    to_local_y: vec4<f32>,
-    to_local_z: vec4<f32>,
+    map: MapFrame,
 }
 
 @group(0) @binding(0) var<uniform> p: Background;
@@ -40,9 +33,8 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
     var c = vec3<f32>(0.0);
     if p.fill == 1u {
         let size = vec2<u32>(p.width, p.height);
-        let to_local = mat3x3<f32>(p.to_local_x.xyz, p.to_local_y.xyz, p.to_local_z.xyz);
         let ray = camera_ray(id.xy, size, p.x_axis.xyz, p.y_axis.xyz, p.z_axis.xyz, p.tangents.xy);
-        c = map_radiance(ray, to_local, vec2<u32>(p.map_width, p.map_height));
+        c = map_radiance(ray, map_to_local(p.map), p.map.size.xy);
     }
     rgb[3u * i] = c.x;
     rgb[3u * i + 1u] = c.y;

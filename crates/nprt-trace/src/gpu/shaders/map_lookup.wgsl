@@ -5,6 +5,20 @@
 
 const PI: f32 = 3.14159265358979323846;
 
+// Where a map lies and how large it is, as every kernel that reads a map takes it in its
+// parameters (gpu_map.rs's map_frame_words): world to the map's own frame (its rotation's
+// inverse) as columns, then its width and height in texels.
+struct MapFrame {
+    to_local_x: vec4<f32>,
+    to_local_y: vec4<f32>,
+    to_local_z: vec4<f32>,
+    size: vec4<u32>,
+}
+
+fn map_to_local(m: MapFrame) -> mat3x3<f32> {
+    return mat3x3<f32>(m.to_local_x.xyz, m.to_local_y.xyz, m.to_local_z.xyz);
+}
+
 fn texel(x: u32, y: u32, width: u32) -> vec3<f32> {
     let k = 3u * (y * width + x % width);
     return vec3<f32>(texels[k], texels[k + 1u], texels[k + 2u]);

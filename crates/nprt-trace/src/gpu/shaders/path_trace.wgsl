@@ -11,8 +11,6 @@
 struct Params {
     width: u32,
     height: u32,
-    map_width: u32,
-    map_height: u32,
     // Paths per pixel in this dispatch, and in the whole estimate (the mean's divisor).
     spp: u32,
     total_spp: u32,
@@ -29,15 +27,16 @@ struct Params {
     keep_direct: u32,
     // 1: the first dimensions of a pixel's `total_spp` paths stratified (traced direct light).
     stratified: u32,
+    _pad0: u32,
+    _pad1: u32,
     _pad2: u32,
     x_axis: vec4<f32>,
     y_axis: vec4<f32>,
     z_axis: vec4<f32>,
     origin: vec4<f32>,
     tangents: vec4<f32>,
-    to_local_x: vec4<f32>,
-    to_local_y: vec4<f32>,
-    to_local_z: vec4<f32>,
+    map: MapFrame,
+    // The map's own frame to world (MapFrame's rotation's inverse), as columns.
     to_world_x: vec4<f32>,
     to_world_y: vec4<f32>,
     to_world_z: vec4<f32>,
@@ -175,9 +174,9 @@ fn scene_hit(origin: vec3<f32>, dir: vec3<f32>, first_hit: bool) -> Hit {
 
 // The radiance one path carries into the camera along `dir` from `origin`.
 fn trace_path(origin_in: vec3<f32>, dir_in: vec3<f32>, draws: ptr<function, Draws>) -> PathOut {
-    let size = vec2<u32>(params.map_width, params.map_height);
-    let table_size = vec2<u32>(params.map_width, params.map_height - 1u);
-    let to_local = mat3x3<f32>(params.to_local_x.xyz, params.to_local_y.xyz, params.to_local_z.xyz);
+    let size = params.map.size.xy;
+    let table_size = vec2<u32>(size.x, size.y - 1u);
+    let to_local = map_to_local(params.map);
     let to_world = mat3x3<f32>(params.to_world_x.xyz, params.to_world_y.xyz, params.to_world_z.xyz);
     var total = vec3<f32>(0.0);
     var direct = vec3<f32>(0.0);

@@ -7,15 +7,9 @@ struct LightTexels {
     height: u32,
     // Lookups per texel along each axis.
     ss: u32,
-    map_width: u32,
-    map_height: u32,
     _pad0: u32,
-    _pad1: u32,
-    _pad2: u32,
-    // World to the rotated map's own frame, as columns.
-    to_local_x: vec4<f32>,
-    to_local_y: vec4<f32>,
-    to_local_z: vec4<f32>,
+    // The rotated map.
+    map: MapFrame,
 }
 
 @group(0) @binding(0) var<uniform> p: LightTexels;
@@ -32,8 +26,8 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>, @builtin(num_workgroups) g
     let x = f32(i % p.width);
     let y = f32(i / p.width);
     let ss = f32(p.ss);
-    let to_local = mat3x3<f32>(p.to_local_x.xyz, p.to_local_y.xyz, p.to_local_z.xyz);
-    let size = vec2<u32>(p.map_width, p.map_height);
+    let to_local = map_to_local(p.map);
+    let size = p.map.size.xy;
     var c = vec3<f32>(0.0);
     for (var s = 0u; s < p.ss * p.ss; s++) {
         let sx = f32(s % p.ss);
