@@ -73,35 +73,16 @@ pub struct Evaluation {
 /// equal-time sample count), then path tracing, denoised path tracing and SH PRT.
 pub fn evaluate(o: &EvalOptions, engine: Engine) -> Result<Evaluation> {
     o.check(engine.tracer())?;
-    let Loaded {
-        manifest,
-        scene,
-        views,
-        maps,
-        nets,
-    } = Loaded::new(o, engine)?;
+    let l = Loaded::new(o, engine)?;
+    let (manifest, views, nets) = (&l.manifest, &l.views, &l.nets);
     let s = &manifest.settings;
-    let ts = TraceScene::new(&scene);
+    let ts = TraceScene::new(&l.scene);
     let oidn = Oidn::open();
     let denoiser = describe_denoiser(&oidn);
-    let shown = views[..o.shown_views.min(views.len())]
-        .iter()
-        .map(ShownView::of)
-        .collect();
     let oidn_ok = oidn.as_ref().ok().copied();
-    let tiers = equal_time_tiers(&nets);
-    let steps = steps_per_view(o, &nets, oidn_ok.is_some(), tiers.len());
-    let total_steps = (views.len() * steps) as u64;
-    let mut bench = TestBench {
-        views: &views,
-        maps: &maps,
-        ts: &ts,
-        settings: s,
-        seed: o.seed,
-        direct_spp: o.direct_spp,
-        shown,
-        bar: nprt_io::progress_bar(o.progress, total_steps, "evaluating", "steps"),
-    };
+    let tiers = equal_time_tiers(nets);
+    let steps = views.len() * steps_per_view(o, nets, oidn_ok.is_some(), tiers.len());
+    let mut bench = l.bench(&ts, o, o.shown_views, (steps, "evaluating", "steps"));
 
     // A stop requested (nprt_io::interrupt) ends it between stages, before any result; the
     // traced stages skip their remaining pixels meanwhile.
@@ -124,40 +105,31 @@ pub fn evaluate(o: &EvalOptions, engine: Engine) -> Result<Evaluation> {
     baselines.extend(run_sh_prt(&mut bench, o.sh_spp));
     bench.bar.finish_and_clear();
     let (traced, with) = ((&pt5, equal_time.as_slice()), (nets.as_slice(), engine));
-    let what = (&ts, &manifest);
-    let (temporal, temporal_note) = temporal_run(o, what, &maps, with, traced, oidn_ok)?;
+    let what = (&ts, manifest);
+    let (temporal, temporal_note) = temporal_run(o, what, &l.maps, with, traced, oidn_ok)?;
     stop()?;
     results.push(pt5.result);
     results.extend(equal_time.into_iter().map(|(_, t)| t.result));
     results.extend(baselines);
     results.extend(oracles);
 
-    let timings = time_table(
-        o.timing_res,
-        &ts,
-        &views[0].camera,
-        bench.map(&views[0]),
-        &nets,
-        &bench.path_tracer(5, o.seed),
-        DirectSampling {
-            spp: o.direct_spp,
-            seed: o.seed,
-            denoiser: oidn_ok,
-        },
-    )?;
+    let direct = DirectSampling {
+        spp: o.direct_spp,
+        seed: o.seed,
+        denoiser: oidn_ok,
+    };
+    let timings = time_table(&bench, o.timing_res, nets, direct)?;
     stop()?;
-    check_finite(&results, &views)?;
-    let fg = views.iter().map(|v| v.foreground()).sum();
-    let noise_floor = noise_floor(&views);
+    check_finite(&results, views)?;
     Ok(Evaluation {
         data: o.data.clone(),
         scene: s.scene.clone(),
         test_views: views.len(),
         resolution: [views[0].width, views[0].height],
-        foreground_pixels: fg,
+        foreground_pixels: views.iter().map(|v| v.foreground()).sum(),
         equal_time_spp,
         reference_spp: s.spp_of(&views[0].record),
-        noise_floor,
+        noise_floor: noise_floor(views),
         methods: results,
         timing_res: o.timing_res,
         timings,
@@ -209,6 +181,28 @@ impl Loaded {
             nets,
         })
     }
+
+    /// The test bench of these views and maps on `ts` (this scene's), its first `shown` views
+    /// kept for the report, its progress `steps` long, named `what`, counted in `unit`.
+    fn bench<'a>(
+        &'a self,
+        ts: &'a TraceScene<'a>,
+        o: &EvalOptions,
+        shown: usize,
+        (steps, what, unit): (usize, &str, &str),
+    ) -> TestBench<'a> {
+        let shown = &self.views[..shown.min(self.views.len())];
+        TestBench {
+            views: &self.views,
+            maps: &self.maps,
+            ts,
+            settings: &self.manifest.settings,
+            seed: o.seed,
+            direct_spp: o.direct_spp,
+            shown: shown.iter().map(ShownView::of).collect(),
+            bar: nprt_io::progress_bar(o.progress, steps as u64, what, unit),
+        }
+    }
 }
 
 /// The networks `o` names on the test views alone, without baselines, timings or the camera
@@ -217,21 +211,7 @@ pub fn score_networks(o: &EvalOptions, engine: Engine) -> Result<Vec<MethodResul
     let l = Loaded::new(o, engine)?;
     let (views, nets) = (&l.views, &l.nets);
     let ts = TraceScene::new(&l.scene);
-    let mut bench = TestBench {
-        views,
-        maps: &l.maps,
-        ts: &ts,
-        settings: &l.manifest.settings,
-        seed: o.seed,
-        direct_spp: o.direct_spp,
-        shown: Vec::new(),
-        bar: nprt_io::progress_bar(
-            o.progress,
-            (views.len() * nets.len()) as u64,
-            "scoring",
-            "views",
-        ),
-    };
+    let mut bench = l.bench(&ts, o, 0, (views.len() * nets.len(), "scoring", "views"));
     let results = run_networks(&mut bench, nets, None)?;
     bench.bar.finish_and_clear();
     check_finite(&results, views)?;

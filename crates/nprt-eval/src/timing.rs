@@ -7,11 +7,12 @@ use glam::Vec3;
 use nprt_net::median;
 use nprt_render::DirectSampling;
 use nprt_scene::{Camera, EnvMap};
-use nprt_trace::{render, render_gbuffer, GBuffer, RenderSettings, TraceScene};
+use nprt_trace::{render, render_gbuffer, GBuffer, TraceScene};
 use serde::{Deserialize, Serialize};
 
 use crate::networks::{Net, Shaded};
 use crate::stopwatch::ms;
+use crate::test_bench::TestBench;
 
 /// Rows of the timing table.
 #[derive(Clone, Debug, Serialize, Deserialize)]
@@ -23,20 +24,20 @@ pub struct Timing {
     pub gflops: Option<f64>,
 }
 
-/// The paper's Tables 3 and 4 on this machine: per-stage times of one frame at
-/// `timing_res`², the median of three runs each; for Neural PRT designs also a lighting change
-/// under a still camera, which runs only the shading networks, and the direct light of those
-/// that trace it as `direct` says, also denoised when it names a denoiser.
+/// The paper's Tables 3 and 4 on this machine: per-stage times of one frame of the bench's
+/// first test view at `timing_res`², the median of three runs each; for Neural PRT designs
+/// also a lighting change under a still camera, which runs only the shading networks, and the
+/// direct light of those that trace it as `direct` says, also denoised when it names a
+/// denoiser.
 pub fn time_table(
+    bench: &TestBench,
     timing_res: u32,
-    ts: &TraceScene,
-    camera: &Camera,
-    map: &EnvMap,
     nets: &[(Net, String)],
-    pt: &RenderSettings,
     direct: DirectSampling,
 ) -> Result<Vec<Timing>> {
-    let camera = camera.with_resolution(timing_res, timing_res);
+    let view = &bench.views[0];
+    let (ts, map, pt) = (bench.ts, bench.map(view), &bench.path_tracer(5, bench.seed));
+    let camera = view.camera.with_resolution(timing_res, timing_res);
     let mut g = GBuffer::default();
     let mut rows = vec![Timing {
         what: "G-buffer (primary rays)".into(),

@@ -1,6 +1,7 @@
 //! Line plots as PNG (loss curves, error against budget), drawn with an embedded font so
 //! that they look the same on machines without system fonts.
 
+use std::ops::Range;
 use std::path::Path;
 use std::sync::Once;
 
@@ -46,16 +47,9 @@ fn round_to_2_digits(v: f64) -> f64 {
     (v * scale).round() / scale
 }
 
-/// Named series as lines with markers on a log-scaled y axis, as a PNG.
-pub fn plot_lines(
-    path: &Path,
-    title: &str,
-    (x_desc, y_desc): (&str, &str),
-    series: &[(String, Vec<(f64, f64)>)],
-) -> Result<()> {
-    register_font();
-    let (w, h) = (800u32, 500u32);
-    let mut buf = vec![0u8; (w * h * 3) as usize];
+/// The axes of `series`: x from 0 (or the least x, where negative) to the largest; y, log
+/// scaled, from just below the least positive value to just above the largest; y's ticks.
+fn axes(series: &[(String, Vec<(f64, f64)>)]) -> (Range<f64>, Range<f64>, Vec<f64>) {
     let values = || {
         series
             .iter()
@@ -77,6 +71,20 @@ pub fn plot_lines(
     let ticks: Vec<f64> = (0..=5)
         .map(|i| round_to_2_digits(lo * (hi / lo).powf(i as f64 / 5.0)))
         .collect();
+    (x_min..x_max, lo..hi, ticks)
+}
+
+/// Named series as lines with markers on a log-scaled y axis, as a PNG.
+pub fn plot_lines(
+    path: &Path,
+    title: &str,
+    (x_desc, y_desc): (&str, &str),
+    series: &[(String, Vec<(f64, f64)>)],
+) -> Result<()> {
+    register_font();
+    let (w, h) = (800u32, 500u32);
+    let mut buf = vec![0u8; (w * h * 3) as usize];
+    let (x, y, ticks) = axes(series);
     {
         let root = BitMapBackend::with_buffer(&mut buf, (w, h)).into_drawing_area();
         let err = |e: DrawingAreaErrorKind<_>| anyhow!("cannot draw plot '{title}': {e:?}");
@@ -86,7 +94,7 @@ pub fn plot_lines(
             .margin(12)
             .x_label_area_size(40)
             .y_label_area_size(70)
-            .build_cartesian_2d(x_min..x_max, (lo..hi).log_scale().with_key_points(ticks))
+            .build_cartesian_2d(x, y.log_scale().with_key_points(ticks))
             .map_err(err)?;
         chart
             .configure_mesh()

@@ -52,25 +52,7 @@ impl Experiment {
         if let Some(claim) = claim {
             claim.write()?;
         }
-        let models = self.models();
-        for (i, config) in models.iter().enumerate() {
-            let name = format!("train {}", config.label());
-            log.begin(
-                &name,
-                &format!(
-                    "training model {} of {}: {}",
-                    i + 1,
-                    models.len(),
-                    config.label()
-                ),
-            );
-            let worked = stages::train_model(self, &data, config, &self.model_dir(config))?;
-            log.end(worked)?;
-        }
-        let deep = self.out.join("models").join("deep-shading");
-        log.begin("train deep-shading", "training the Deep Shading baseline");
-        let worked = stages::train_deep_shading(self, &data, &deep)?;
-        log.end(worked)?;
+        let deep = self.train_models(&mut log, &data)?;
 
         log.begin("evaluation", "evaluating against the baselines");
         let report = self.out.join("report");
@@ -112,6 +94,31 @@ impl Experiment {
             relit,
             seconds: log.elapsed(),
         })
+    }
+
+    /// The training stages: each design's model, then the Deep Shading baseline, whose
+    /// folder it returns.
+    fn train_models(&self, log: &mut StageLog, data: &Path) -> Result<PathBuf> {
+        let models = self.models();
+        for (i, config) in models.iter().enumerate() {
+            let name = format!("train {}", config.label());
+            log.begin(
+                &name,
+                &format!(
+                    "training model {} of {}: {}",
+                    i + 1,
+                    models.len(),
+                    config.label()
+                ),
+            );
+            let worked = stages::train_model(self, data, config, &self.model_dir(config))?;
+            log.end(worked)?;
+        }
+        let deep = self.out.join("models").join("deep-shading");
+        log.begin("train deep-shading", "training the Deep Shading baseline");
+        let worked = stages::train_deep_shading(self, data, &deep)?;
+        log.end(worked)?;
+        Ok(deep)
     }
 
     /// Table 2's ablation scored, the snapshots scored (`--snapshots`), and the paper's tables

@@ -1,7 +1,7 @@
 //! `nprt.generate`: `nprt generate` from Python, every flag a keyword whose default is
 //! `GenerateOptions::default()`'s.
 
-use nprt_data::dataset::{Jitter, TransferBasis};
+use nprt_data::dataset::{Jitter, Summary, TransferBasis};
 use nprt_data::{CameraChoice, GenerateOptions, ViewSpec};
 use nprt_net::RECIPE;
 use pyo3::prelude::*;
@@ -87,12 +87,7 @@ pub fn generate<'py>(
             spp: whole(spp, "spp", 1..=u32::MAX)?.unwrap_or(v.spp),
             test_spp: whole(test_spp, "test_spp", 1..=u32::MAX)?.unwrap_or(v.test_spp),
             seed: whole(seed, "seed", 0..=u64::MAX)?.unwrap_or(v.seed),
-            jitter: Jitter {
-                exposure: f32_of(num(jitter_exposure, "jitter_exposure", 0.0..=f64::MAX)?)
-                    .unwrap_or(v.jitter.exposure),
-                tint: f32_of(num(jitter_tint, "jitter_tint", 0.0..=f64::MAX)?)
-                    .unwrap_or(v.jitter.tint),
-            },
+            jitter: jitter([jitter_exposure, jitter_tint], v.jitter)?,
             mix_maps: whole(mix_maps, "mix_maps", 0..=u32::MAX)?.unwrap_or(v.mix_maps),
         },
         transfer: match argument::text_or_none(transfer, "transfer", "a str: sh:L or none")? {
@@ -119,6 +114,16 @@ pub fn generate<'py>(
     };
     let mut warnings = Vec::new();
     let summary = interruptible(py, || nprt_data::generate(&opts, |p| warnings = p.warnings))?;
+    summary_dict(py, summary, warnings)
+}
+
+/// What `generate` returns: the views rendered, skipped and redone, the time, the rate and the
+/// plan's warnings.
+fn summary_dict<'py>(
+    py: Python<'py>,
+    summary: Summary,
+    warnings: Vec<String>,
+) -> PyResult<Bound<'py, PyDict>> {
     let out = PyDict::new(py);
     out.set_item("rendered", summary.rendered)?;
     out.set_item("skipped", summary.skipped)?;
@@ -130,4 +135,17 @@ pub fn generate<'py>(
     )?;
     out.set_item("warnings", warnings)?;
     Ok(out)
+}
+
+/// The jitter of each view's map from `jitter_exposure` and `jitter_tint`, each `default`'s
+/// where None.
+fn jitter([exposure, tint]: [Option<&Bound<'_, PyAny>>; 2], default: Jitter) -> PyResult<Jitter> {
+    let of = |v: Option<&Bound<'_, PyAny>>, arg: &str, default: f32| -> PyResult<f32> {
+        let v = argument::number_or_none(v, arg, 0.0..=f64::MAX)?;
+        Ok(v.map_or(default, |v| v as f32))
+    };
+    Ok(Jitter {
+        exposure: of(exposure, "jitter_exposure", default.exposure)?,
+        tint: of(tint, "jitter_tint", default.tint)?,
+    })
 }

@@ -1,7 +1,7 @@
 //! `nprt.render`: `nprt render` from Python (a camera path relit under a lighting schedule,
 //! written as frames and an animation), its defaults `RenderOptions::default()`'s.
 
-use nprt_render::{Denoise, RenderJob, RenderOptions};
+use nprt_render::{Denoise, RenderJob, RenderOptions, SequenceSummary};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
@@ -93,12 +93,23 @@ pub fn render<'py>(
         let _ = std::fs::remove_dir_all(dir);
     }
     let (done, description, frames) = rendered?;
+    summary_dict(py, done, description, frames)
+}
+
+/// What `render` returns: the description, the frames (as an array, or where they were
+/// written) and the mean per-frame times.
+fn summary_dict(
+    py: Python<'_>,
+    done: SequenceSummary,
+    description: String,
+    frames: Option<(Vec<f32>, usize, usize)>,
+) -> PyResult<Bound<'_, PyDict>> {
     let m = done.mean;
     let summary = PyDict::new(py);
     summary.set_item("description", description)?;
     match frames {
         Some((rgb, w, h)) => {
-            let n = opts.frames;
+            let n = rgb.len() / (3 * w * h).max(1);
             let array = numpy::ndarray::Array4::from_shape_vec((n, h, w, 3), rgb)
                 .expect("frames of one size");
             summary.set_item("frames", numpy::IntoPyArray::into_pyarray(array, py))?;

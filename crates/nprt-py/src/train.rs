@@ -7,7 +7,7 @@ use nprt_net::deep_shading::{self, DeepShadingOptions};
 use nprt_net::training::loss_curves::LossRow;
 use nprt_net::training::snapshot::Snapshot;
 use nprt_net::training::training_set::TrainingSet;
-use nprt_net::{Asked, RunLength, TrainOptions, TrainSummary, Watch};
+use nprt_net::{Asked, Calibration, RunLength, TrainOptions, TrainSummary, Watch};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
@@ -89,30 +89,14 @@ pub fn train<'py>(
         targets: named(targets, "targets")?,
     };
     let config = asked.config().or_py()?;
-    let d = TrainOptions::default();
     let run = RunLength {
         epochs: argument::whole_or_none(epochs, "epochs", 1..=usize::MAX)?,
         minutes: minutes_or_none(minutes, "minutes")?,
         lr_schedule: named(schedule, "schedule")?,
     };
     let lr = argument::number_or_none(lr, "lr", f64::MIN_POSITIVE..=f64::MAX)?;
-    let snapshots = argument::text_or_none(snapshots, "snapshots", "a str such as \"1m,2m,4m\"")?;
-    let opts = TrainOptions {
-        schedule: nprt_net::Schedule {
-            seed: argument::whole_or_none(seed, "seed", 0..=u64::MAX)?.unwrap_or(d.schedule.seed),
-            progress,
-            snapshots: (snapshots.as_deref().map(Snapshot::parse_list).transpose())
-                .map_err(|e| crate::error::input_error(format!("snapshots={snapshots:?}: {e}")))?
-                .unwrap_or_default(),
-            ..d.schedule
-        },
-        batch_size: argument::whole_or_none(batch_size, "batch_size", 1..=usize::MAX)?
-            .unwrap_or(d.batch_size),
-        precision: named(precision, "precision")?.unwrap_or(d.precision),
-        calibration: asked.calibration(),
-        ..d
-    }
-    .with_run(config.design, run, lr);
+    let keywords = [seed, batch_size, precision, snapshots];
+    let opts = options(keywords, progress, asked.calibration())?.with_run(config.design, run, lr);
     let engine = engine_arg(device)?;
     let watch = EpochWatch::new(callback);
     let (summary, _) = py
@@ -140,6 +124,32 @@ pub fn train<'py>(
     watch.finish()?;
     let s = summary_dict(py, &summary)?;
     Ok(s)
+}
+
+/// The run's options from `train`'s keywords `seed`, `batch_size`, `precision` and
+/// `snapshots`, each the default where None.
+fn options(
+    [seed, batch_size, precision, snapshots]: [Option<&Bound<'_, PyAny>>; 4],
+    progress: bool,
+    calibration: Calibration,
+) -> PyResult<TrainOptions> {
+    let d = TrainOptions::default();
+    let snapshots = argument::text_or_none(snapshots, "snapshots", "a str such as \"1m,2m,4m\"")?;
+    Ok(TrainOptions {
+        schedule: nprt_net::Schedule {
+            seed: argument::whole_or_none(seed, "seed", 0..=u64::MAX)?.unwrap_or(d.schedule.seed),
+            progress,
+            snapshots: (snapshots.as_deref().map(Snapshot::parse_list).transpose())
+                .map_err(|e| crate::error::input_error(format!("snapshots={snapshots:?}: {e}")))?
+                .unwrap_or_default(),
+            ..d.schedule
+        },
+        batch_size: argument::whole_or_none(batch_size, "batch_size", 1..=usize::MAX)?
+            .unwrap_or(d.batch_size),
+        precision: named(precision, "precision")?.unwrap_or(d.precision),
+        calibration,
+        ..d
+    })
 }
 
 /// Minutes of training time, as `nprt train --minutes` takes them ([`nprt_net::check_minutes`]).

@@ -5,7 +5,7 @@
 use anyhow::Result;
 use nprt_net::model::folder::ModelFile;
 use nprt_net::{Design, DirectLight, Engine, Init, ModelConfig};
-use nprt_scene::{load_scene, SceneOptions};
+use nprt_scene::{load_scene, Camera, EnvMap, SceneOptions};
 use nprt_trace::TraceScene;
 
 use crate::frame_stages::DirectSampling;
@@ -81,7 +81,6 @@ pub fn bench_frame(
     let map = &nprt_scene::open_envmap(&opts.map)?;
     let (lo, hi) = scene.bounds();
     let ts = TraceScene::new(&scene);
-    let median = |v: Vec<f64>| nprt_net::median(v);
     let runs = opts
         .models
         .iter()
@@ -91,69 +90,80 @@ pub fn bench_frame(
         let (model, label) = untrained(design, direct, precision, bounds, engine)?;
         for &[w, h] in &opts.resolutions {
             let camera = path.camera(0.5, w, h);
-            let mut frames = Vec::new();
-            let mut relights = Vec::new();
-            let mut foreground = 0;
-            let mut relight_waits = None;
-            let mut shown = [Vec::new(), Vec::new()];
-            // The last frame's lighting change, timed kernel by kernel.
-            #[cfg(feature = "gpu")]
-            let mut profile = None;
-            for i in 0..=opts.repeats {
-                let rotation = 10.0 * i as f32;
-                let sampling = DirectSampling {
-                    spp: opts.direct_spp,
-                    seed: i as u64,
-                    denoiser: None,
-                };
-                // A new viewpoint under a new lighting: nothing kept from before.
-                let mut cache = FrameCache::default();
-                let (_, t) = model.frame(&mut cache, &ts, &camera, map, rotation, i, sampling)?;
-                // A lighting change under the still camera.
-                let turned = rotation + 5.0;
-                let waits = model.host_waits();
-                let (_, change) =
-                    model.frame(&mut cache, &ts, &camera, map, turned, i + 1, sampling)?;
-                relight_waits = waits.zip(model.host_waits()).map(|(a, b)| b - a);
-                foreground = cache.foreground();
-                // Both again, left on the device as the viewer leaves them (after the profile,
-                // which reads the kept lighting).
-                #[cfg(feature = "gpu")]
-                if opts.profile && i == opts.repeats {
-                    profile = model.profile_relight(&cache)?;
-                }
-                if waits.is_some() && i > 0 {
-                    let mut cache = FrameCache::default();
-                    for (k, turn) in [0.0, 5.0].into_iter().enumerate() {
-                        let lit = (map, rotation + turn, i + k);
-                        let (_, t) =
-                            model.frame_shown(&mut cache, &ts, &camera, lit, sampling, true)?;
-                        shown[k].push(t.total_ms());
-                    }
-                }
-                // The first frame is untimed: a GPU compiles and allocates on first use.
-                if i > 0 {
-                    frames.push(t);
-                    relights.push(change.encoder_ms + change.network_ms);
-                }
-            }
-            on_row(&FrameBenchRow {
-                label: label.clone(),
-                resolution: [w, h],
-                foreground,
-                frame: FrameTimings::median(&frames),
-                relight_ms: median(relights),
-                relight_waits,
-                shown_ms: (!shown[0].is_empty()).then(|| shown.map(median)),
-                networks_on: model.networks_on(),
-                gbuffer_on: model.gbuffer_on(),
-                paths_on: model.paths_on(),
-                #[cfg(feature = "gpu")]
-                profile,
-            });
+            on_row(&time_frames(&model, &label, (&ts, &camera, map), opts)?);
         }
     }
     Ok(())
+}
+
+/// `model`'s frames of `camera` on `ts` under `map`, timed as [`bench_frame`] times them: a
+/// new viewpoint and a lighting change under the still camera, `opts.repeats` times after an
+/// untimed first, and where the host waits for the device, both again left on it.
+fn time_frames(
+    model: &Relighter,
+    label: &str,
+    (ts, camera, map): (&TraceScene, &Camera, &EnvMap),
+    opts: &FrameBenchOptions,
+) -> Result<FrameBenchRow> {
+    let median = |v: Vec<f64>| nprt_net::median(v);
+    let mut frames = Vec::new();
+    let mut relights = Vec::new();
+    let mut foreground = 0;
+    let mut relight_waits = None;
+    let mut shown = [Vec::new(), Vec::new()];
+    // The last frame's lighting change, timed kernel by kernel.
+    #[cfg(feature = "gpu")]
+    let mut profile = None;
+    for i in 0..=opts.repeats {
+        let rotation = 10.0 * i as f32;
+        let sampling = DirectSampling {
+            spp: opts.direct_spp,
+            seed: i as u64,
+            denoiser: None,
+        };
+        // A new viewpoint under a new lighting: nothing kept from before.
+        let mut cache = FrameCache::default();
+        let (_, t) = model.frame(&mut cache, ts, camera, map, rotation, i, sampling)?;
+        // A lighting change under the still camera.
+        let turned = rotation + 5.0;
+        let waits = model.host_waits();
+        let (_, change) = model.frame(&mut cache, ts, camera, map, turned, i + 1, sampling)?;
+        relight_waits = waits.zip(model.host_waits()).map(|(a, b)| b - a);
+        foreground = cache.foreground();
+        // Both again, left on the device as the viewer leaves them (after the profile,
+        // which reads the kept lighting).
+        #[cfg(feature = "gpu")]
+        if opts.profile && i == opts.repeats {
+            profile = model.profile_relight(&cache)?;
+        }
+        if waits.is_some() && i > 0 {
+            let mut cache = FrameCache::default();
+            for (k, turn) in [0.0, 5.0].into_iter().enumerate() {
+                let lit = (map, rotation + turn, i + k);
+                let (_, t) = model.frame_shown(&mut cache, ts, camera, lit, sampling, true)?;
+                shown[k].push(t.total_ms());
+            }
+        }
+        // The first frame is untimed: a GPU compiles and allocates on first use.
+        if i > 0 {
+            frames.push(t);
+            relights.push(change.encoder_ms + change.network_ms);
+        }
+    }
+    Ok(FrameBenchRow {
+        label: label.to_string(),
+        resolution: [camera.width, camera.height],
+        foreground,
+        frame: FrameTimings::median(&frames),
+        relight_ms: median(relights),
+        relight_waits,
+        shown_ms: (!shown[0].is_empty()).then(|| shown.map(median)),
+        networks_on: model.networks_on(),
+        gbuffer_on: model.gbuffer_on(),
+        paths_on: model.paths_on(),
+        #[cfg(feature = "gpu")]
+        profile,
+    })
 }
 
 /// An untrained model of `design` (the cost does not depend on the weights) in `bounds`, on

@@ -177,28 +177,40 @@ fn frame(a: BenchFrameArgs) -> Result<()> {
         direct_spp: a.direct_spp,
         map: a.map,
     };
-    let mut header = true;
-    let mut networks_on = String::new();
-    nprt_render::bench_frame(&opts, engine, |r| {
-        if header {
+    let mut table = FrameTable::default();
+    nprt_render::bench_frame(&opts, engine, |r| table.print(&opts, r))
+}
+
+/// `bench frame`'s table, printed a row at a time as the rows come: what was measured and the
+/// columns before the first, the engine again where it changes (f16 rows after f32 ones).
+#[derive(Default)]
+struct FrameTable {
+    /// Whether the header has been printed.
+    headed: bool,
+    networks_on: String,
+}
+
+impl FrameTable {
+    fn print(&mut self, opts: &nprt_render::FrameBenchOptions, r: &nprt_render::FrameBenchRow) {
+        let first = !self.headed;
+        if first {
             println!(
-                "relit frames of {} under {}, median of {} (ms; direct light traced {}, {} host threads)",
-                opts.scene,
-                opts.map,
-                opts.repeats,
-                r.paths_on,
-                rayon::current_num_threads()
-            );
+            "relit frames of {} under {}, median of {} (ms; direct light traced {}, {} host threads)",
+            opts.scene,
+            opts.map,
+            opts.repeats,
+            r.paths_on,
+            rayon::current_num_threads()
+        );
         }
-        // Said again where it changes (f16 rows after f32 ones).
-        if r.networks_on != networks_on {
+        if r.networks_on != self.networks_on {
             println!(
                 "networks on the {}, G-buffer {}",
                 r.networks_on, r.gbuffer_on
             );
-            networks_on = r.networks_on.clone();
+            self.networks_on = r.networks_on.clone();
         }
-        if header {
+        if first {
             println!(
                 "{:<16} {:>10} {:>9} {:>9} {:>8} {:>9} {:>8} {:>9} {:>7} {:>11}",
                 "design",
@@ -212,7 +224,7 @@ fn frame(a: BenchFrameArgs) -> Result<()> {
                 "fps",
                 "relight ms"
             );
-            header = false;
+            self.headed = true;
         }
         let t = &r.frame;
         println!(
@@ -234,7 +246,7 @@ fn frame(a: BenchFrameArgs) -> Result<()> {
         if let Some([frame, change]) = r.shown_ms {
             println!(
                 "  left on the device, as nprt view shows it (not read back): a new viewpoint \
-                 {frame:.1} ms ({:.1} fps), a lighting change {change:.1} ms ({:.1} fps)",
+             {frame:.1} ms ({:.1} fps), a lighting change {change:.1} ms ({:.1} fps)",
                 1e3 / frame,
                 1e3 / change
             );
@@ -243,7 +255,7 @@ fn frame(a: BenchFrameArgs) -> Result<()> {
         if let Some(times) = &r.profile {
             print_kernel_times("a lighting change's kernels", times, r.relight_ms);
         }
-    })
+    }
 }
 
 fn infer(a: BenchInferArgs) -> Result<()> {
@@ -301,44 +313,7 @@ fn train(a: BenchTrainArgs) -> Result<()> {
     );
     for &arch in &a.designs.arch {
         let config = ModelConfig::new(arch, a.activation);
-        let measure = |precision| {
-            measure_throughput(
-                &config,
-                a.batch_size,
-                a.views,
-                a.steps,
-                a.warmup,
-                precision,
-                engine,
-            )
-        };
-        // Rounds alternate the peer and nprt, so that a drift in the machine's speed (identical
-        // runs here differ by up to 30%) reaches both alike; medians are compared.
-        // Per precision, nprt's rate in each round.
-        let mut ours: Vec<Vec<f64>> = vec![Vec::new(); a.precision.len()];
-        // Per variant, its rate in each round.
-        let mut variants: Vec<Vec<f64>> = vec![Vec::new(); a.peer_variants.len()];
-        for _ in 0..rounds {
-            if let Some((python, torch_device, script)) = &peer {
-                for (&variant, rates) in a.peer_variants.iter().zip(&mut variants) {
-                    rates.push(script.run(&PeerRun {
-                        python,
-                        design: arch,
-                        activation: a.activation,
-                        batch_size: a.batch_size,
-                        views: a.views,
-                        steps: a.steps,
-                        warmup: a.warmup,
-                        threads,
-                        torch_device,
-                        variant,
-                    })?);
-                }
-            }
-            for (&precision, rates) in a.precision.iter().zip(&mut ours) {
-                rates.push(measure(precision)?);
-            }
-        }
+        let (ours, variants) = timed_rounds(&a, &config, peer.as_ref(), engine)?;
         let best = fastest(&variants);
         let theirs = best.map_or(Vec::new(), |v| variants[v].clone());
         for (&precision, ours) in a.precision.iter().zip(ours) {
@@ -363,6 +338,44 @@ fn train(a: BenchTrainArgs) -> Result<()> {
         }
     }
     Ok(())
+}
+
+/// nprt's rate per precision and the peer's per variant, in each of the rounds `a` asks for,
+/// training `config`. Rounds alternate the peer and nprt, so that a drift in the machine's speed
+/// (identical runs here differ by up to 30%) reaches both alike; medians are compared.
+fn timed_rounds(
+    a: &BenchTrainArgs,
+    config: &ModelConfig,
+    peer: Option<&(&PathBuf, &'static str, PeerScript)>,
+    engine: Engine,
+) -> Result<(Vec<Vec<f64>>, Vec<Vec<f64>>)> {
+    let mut ours: Vec<Vec<f64>> = vec![Vec::new(); a.precision.len()];
+    let mut variants: Vec<Vec<f64>> = vec![Vec::new(); a.peer_variants.len()];
+    for _ in 0..a.rounds.max(1) {
+        if let Some((python, torch_device, script)) = peer {
+            for (&variant, rates) in a.peer_variants.iter().zip(&mut variants) {
+                rates.push(script.run(&PeerRun {
+                    python,
+                    design: config.design,
+                    activation: a.activation,
+                    batch_size: a.batch_size,
+                    views: a.views,
+                    steps: a.steps,
+                    warmup: a.warmup,
+                    threads: rayon::current_num_threads(),
+                    torch_device,
+                    variant,
+                })?);
+            }
+        }
+        for (&precision, rates) in a.precision.iter().zip(&mut ours) {
+            let (batch, views, steps) = (a.batch_size, a.views, a.steps);
+            rates.push(measure_throughput(
+                config, batch, views, steps, a.warmup, precision, engine,
+            )?);
+        }
+    }
+    Ok((ours, variants))
 }
 
 /// The fastest peer variant by its median rate, among those that ran.

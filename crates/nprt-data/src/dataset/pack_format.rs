@@ -1,7 +1,7 @@
 //! A pack's file (docs/dataset.md, "Packed datasets"): the fixed prelude at its start that says
 //! where each part lies, then the records, the transfer vectors and the JSON header that
 //! describes them; and what a pack's radiance holds ([`PackedTarget`]). Written by
-//! [`super::packing`], read by [`super::packed`].
+//! `packing.rs`, read by `packed.rs`.
 
 use anyhow::{ensure, Context, Result};
 use glam::Vec3;

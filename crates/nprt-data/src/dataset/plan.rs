@@ -49,44 +49,13 @@ pub enum MapAssignment {
 
 /// Builds the manifest: cameras, maps and rotations of every view, from the settings alone.
 pub fn plan(req: &Request, ts: &TraceScene) -> Result<Manifest> {
-    let views_total = (req.views.train_views + req.views.test_views) as usize;
     let builtin_share = match req.lighting {
         MapAssignment::Pool { builtin_share, .. } => builtin_share,
         MapAssignment::PerView => 0.0,
     };
     let own_map = |index: u64| crate::lighting::takes_builtin(req.views.seed, index, builtin_share);
     let mixed = crate::lighting::mixed_views(req.views.seed, req.views.train_views, builtin_share);
-    // The maps the training views draw from, then each split's maps as recorded: the training
-    // views' with the mixed views' own maps, which follow the pool's.
-    let (train_pool, train_maps, test_maps) = match req.lighting {
-        MapAssignment::Pool { test_maps, .. } => {
-            let Some(folder) = req.maps.len().checked_sub(mixed) else {
-                bail!(
-                    "{mixed} training views take a built-in lighting of their own, but only {} maps were given",
-                    req.maps.len()
-                );
-            };
-            let (train, test) = crate::lighting::split(folder, test_maps, req.views.seed)?;
-            let recorded = train
-                .iter()
-                .copied()
-                .chain(folder..req.maps.len())
-                .collect();
-            (train, recorded, test)
-        }
-        MapAssignment::PerView if req.maps.len() != views_total => bail!(
-            "one map per view needs {views_total} maps, got {}",
-            req.maps.len()
-        ),
-        MapAssignment::PerView => {
-            let train: Vec<usize> = (0..req.views.train_views as usize).collect();
-            (
-                train.clone(),
-                train,
-                (req.views.train_views as usize..views_total).collect(),
-            )
-        }
-    };
+    let (train_pool, train_maps, test_maps) = map_split(req, mixed)?;
     check_jitter(&req.views.jitter)?;
     if !(1..=MAX_MIX_MAPS).contains(&req.views.mix_maps) {
         bail!(
@@ -129,6 +98,41 @@ pub fn plan(req: &Request, ts: &TraceScene) -> Result<Manifest> {
         .check()
         .with_context(|| format!("cannot plan a dataset for scene '{}'", req.scene_spec))?;
     Ok(manifest)
+}
+
+/// The maps the training views draw from, then each split's maps as recorded: the training
+/// views' with the own maps of the `mixed` views, which follow the pool's; and the test views'.
+fn map_split(req: &Request, mixed: usize) -> Result<(Vec<usize>, Vec<usize>, Vec<usize>)> {
+    let views_total = (req.views.train_views + req.views.test_views) as usize;
+    Ok(match req.lighting {
+        MapAssignment::Pool { test_maps, .. } => {
+            let Some(folder) = req.maps.len().checked_sub(mixed) else {
+                bail!(
+                    "{mixed} training views take a built-in lighting of their own, but only {} maps were given",
+                    req.maps.len()
+                );
+            };
+            let (train, test) = crate::lighting::split(folder, test_maps, req.views.seed)?;
+            let recorded = train
+                .iter()
+                .copied()
+                .chain(folder..req.maps.len())
+                .collect();
+            (train, recorded, test)
+        }
+        MapAssignment::PerView if req.maps.len() != views_total => bail!(
+            "one map per view needs {views_total} maps, got {}",
+            req.maps.len()
+        ),
+        MapAssignment::PerView => {
+            let train: Vec<usize> = (0..req.views.train_views as usize).collect();
+            (
+                train.clone(),
+                train,
+                (req.views.train_views as usize..views_total).collect(),
+            )
+        }
+    })
 }
 
 /// What the manifest records of each map: its spec, a hash of its file and its size.

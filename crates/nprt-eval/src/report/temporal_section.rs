@@ -63,6 +63,26 @@ pub(super) fn temporal(md: &mut String, e: &Evaluation, dir: &Path) -> Result<()
             100.0 * n.settings.train_share
         )?;
     }
+    method_table(md, t)?;
+    l1_plot(md, t, dir)?;
+    writeln!(
+        md,
+        "Table 6's metrics along the path (× 10³, ± the standard error over the {} frames; \
+         consecutive frames are alike, so this spread understates the uncertainty):\n",
+        t.frames
+    )?;
+    super::table6::table6(
+        md,
+        t.methods
+            .iter()
+            .map(|m| (m.name.as_str(), m.per_frame.as_slice())),
+    )?;
+    strips(md, t, dir)
+}
+
+/// Per method, its temporal error beside its L1 error per frame: the mean, and on the frames
+/// before and at the lighting change.
+fn method_table(md: &mut String, t: &Temporal) -> Result<()> {
     let c = t.change_at;
     writeln!(
         md,
@@ -84,6 +104,11 @@ pub(super) fn temporal(md: &mut String, e: &Evaluation, dir: &Path) -> Result<()
             m.ms_per_frame
         )?;
     }
+    Ok(())
+}
+
+/// The L1 error per frame of every method, plotted into the report's images.
+fn l1_plot(md: &mut String, t: &Temporal, dir: &Path) -> Result<()> {
     let series: Vec<(String, Vec<(f64, f64)>)> = (t.methods.iter())
         .map(|m| {
             let points = m.per_frame_l1().into_iter().enumerate();
@@ -98,19 +123,7 @@ pub(super) fn temporal(md: &mut String, e: &Evaluation, dir: &Path) -> Result<()
         &series,
     )?;
     writeln!(md, "\n![L1 error per frame]({rel})\n")?;
-    writeln!(
-        md,
-        "Table 6's metrics along the path (× 10³, ± the standard error over the {} frames; \
-         consecutive frames are alike, so this spread understates the uncertainty):\n",
-        t.frames
-    )?;
-    super::table6::table6(
-        md,
-        t.methods
-            .iter()
-            .map(|m| (m.name.as_str(), m.per_frame.as_slice())),
-    )?;
-    strips(md, t, dir)
+    Ok(())
 }
 
 /// Per method, the frames around the lighting change side by side, and under them each pair's

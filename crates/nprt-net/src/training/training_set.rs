@@ -114,40 +114,7 @@ impl TrainingSet {
             progress,
             on_pack,
         )?);
-        // Views grouped by their map, each map open only while its views' inputs are made: a
-        // dataset with a fresh map per view held all of them at once, 3.4 GB at the paper's size.
-        let mut by_map: BTreeMap<usize, Vec<usize>> = BTreeMap::new();
-        for (i, v) in manifest.views.iter().enumerate() {
-            by_map.entry(v.map).or_default().push(i);
-        }
-        // Views that mix maps (`nprt generate --mix-maps`) need several at once: the training
-        // maps, a folder's few, are then all opened once.
-        let mixing = manifest.views.iter().any(|v| !v.mix.is_empty());
-        let all = mixing.then(|| open_recorded_maps(&manifest)).transpose()?;
-        let mut lights: Vec<(usize, LightInput)> = by_map
-            .into_par_iter()
-            .map(|(m, views)| -> Result<Vec<(usize, LightInput)>> {
-                let map = match all.as_ref().and_then(|maps| maps.get(m)) {
-                    Some(map) => map.clone(),
-                    None => open_recorded_map(&manifest, m)?,
-                };
-                views
-                    .into_par_iter()
-                    .map(|i| {
-                        let v = &manifest.views[i];
-                        let lighting = match &all {
-                            Some(maps) => v.lighting(maps)?,
-                            None => v.light(&map)?,
-                        };
-                        Ok((i, config.light_input(&lighting, 0.0)))
-                    })
-                    .collect()
-            })
-            .collect::<Result<Vec<_>>>()?
-            .into_iter()
-            .flatten()
-            .collect();
-        lights.sort_by_key(|(i, _)| *i);
+        let lights = light_inputs(&manifest, config)?;
         let (mut train, mut test) = (Vec::new(), Vec::new());
         for (i, light) in lights {
             let samples = ViewSamples::new(pack.clone(), i, light);
@@ -262,4 +229,43 @@ pub fn open_recorded_map(manifest: &Manifest, index: usize) -> Result<EnvMap> {
         );
     }
     nprt_scene::open_envmap(&rec.spec)
+}
+
+/// Each view's light input for `config`'s encoder, in view order. Views are grouped by their
+/// map, each map open only while its views' inputs are made: a dataset with a fresh map per
+/// view held all of them at once, 3.4 GB at the paper's size.
+fn light_inputs(manifest: &Manifest, config: &ModelConfig) -> Result<Vec<(usize, LightInput)>> {
+    let mut by_map: BTreeMap<usize, Vec<usize>> = BTreeMap::new();
+    for (i, v) in manifest.views.iter().enumerate() {
+        by_map.entry(v.map).or_default().push(i);
+    }
+    // Views that mix maps (`nprt generate --mix-maps`) need several at once: the training
+    // maps, a folder's few, are then all opened once.
+    let mixing = manifest.views.iter().any(|v| !v.mix.is_empty());
+    let all = mixing.then(|| open_recorded_maps(manifest)).transpose()?;
+    let mut lights: Vec<(usize, LightInput)> = by_map
+        .into_par_iter()
+        .map(|(m, views)| -> Result<Vec<(usize, LightInput)>> {
+            let map = match all.as_ref().and_then(|maps| maps.get(m)) {
+                Some(map) => map.clone(),
+                None => open_recorded_map(manifest, m)?,
+            };
+            views
+                .into_par_iter()
+                .map(|i| {
+                    let v = &manifest.views[i];
+                    let lighting = match &all {
+                        Some(maps) => v.lighting(maps)?,
+                        None => v.light(&map)?,
+                    };
+                    Ok((i, config.light_input(&lighting, 0.0)))
+                })
+                .collect()
+        })
+        .collect::<Result<Vec<_>>>()?
+        .into_iter()
+        .flatten()
+        .collect();
+    lights.sort_by_key(|(i, _)| *i);
+    Ok(lights)
 }

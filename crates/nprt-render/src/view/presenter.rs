@@ -101,35 +101,44 @@ pub struct Shown<'a> {
     pub overlay: &'a [u8],
 }
 
+/// `window`'s surface on `gpu`, configured to its size in the first format it offers.
+fn window_surface(
+    gpu: &GpuDevice,
+    window: &Arc<Window>,
+) -> Result<(wgpu::Surface<'static>, wgpu::SurfaceConfiguration)> {
+    let surface = gpu
+        .instance
+        .create_surface(window.clone())
+        .map_err(|e| anyhow!("cannot draw into the window: {e}"))?;
+    let caps = surface.get_capabilities(&gpu.wgpu_adapter);
+    let format = *caps.formats.first().ok_or_else(|| {
+        anyhow!(
+            "the GPU adapter {} cannot draw into this window (its surface offers no format)",
+            gpu.adapter
+        )
+    })?;
+    let window_size = window.inner_size();
+    let config = wgpu::SurfaceConfiguration {
+        usage: wgpu::TextureUsages::RENDER_ATTACHMENT,
+        format,
+        width: window_size.width.max(1),
+        height: window_size.height.max(1),
+        present_mode: wgpu::PresentMode::Fifo,
+        desired_maximum_frame_latency: 2,
+        alpha_mode: caps.alpha_modes[0],
+        view_formats: vec![],
+        color_space: wgpu::SurfaceColorSpace::Auto,
+    };
+    surface.configure(&gpu.device, &config);
+    Ok((surface, config))
+}
+
 impl Presenter {
     /// A presenter for `window` on the GPU kernels' device, whose frames are
     /// `width × height`.
     pub fn new(window: Arc<Window>, width: u32, height: u32) -> Result<Self> {
         let gpu = GpuDevice::get()?;
-        let surface = gpu
-            .instance
-            .create_surface(window.clone())
-            .map_err(|e| anyhow!("cannot draw into the window: {e}"))?;
-        let caps = surface.get_capabilities(&gpu.wgpu_adapter);
-        let format = *caps.formats.first().ok_or_else(|| {
-            anyhow!(
-                "the GPU adapter {} cannot draw into this window (its surface offers no format)",
-                gpu.adapter
-            )
-        })?;
-        let window_size = window.inner_size();
-        let config = wgpu::SurfaceConfiguration {
-            usage: wgpu::TextureUsages::RENDER_ATTACHMENT,
-            format,
-            width: window_size.width.max(1),
-            height: window_size.height.max(1),
-            present_mode: wgpu::PresentMode::Fifo,
-            desired_maximum_frame_latency: 2,
-            alpha_mode: caps.alpha_modes[0],
-            view_formats: vec![],
-            color_space: wgpu::SurfaceColorSpace::Auto,
-        };
-        surface.configure(&gpu.device, &config);
+        let (surface, config) = window_surface(&gpu, &window)?;
         let device = &gpu.device;
         let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
             label: Some("show"),
@@ -174,7 +183,7 @@ impl Presenter {
         });
         let info = gpu.wgpu_adapter.get_info();
         Ok(Presenter {
-            to_window: pipeline(format),
+            to_window: pipeline(config.format),
             to_image: pipeline(wgpu::TextureFormat::Rgba8Unorm),
             host_rgb: gpu.buffer(3 * (width * height) as usize),
             adapter: format!("{} ({:?})", info.name, info.backend),
@@ -259,6 +268,29 @@ impl Presenter {
             .collect()
     }
 
+    /// Uploads the overlay's rows (RGBA, the frame's width); returns how many.
+    fn upload_overlay(&self, overlay: &[u8]) -> u32 {
+        let w = self.size[0];
+        let overlay_rows = (overlay.len() / (4 * w as usize)) as u32;
+        if overlay_rows > 0 {
+            self.gpu.queue.write_texture(
+                self.overlay.as_image_copy(),
+                overlay,
+                wgpu::TexelCopyBufferLayout {
+                    offset: 0,
+                    bytes_per_row: Some(4 * w),
+                    rows_per_image: Some(overlay_rows),
+                },
+                wgpu::Extent3d {
+                    width: w,
+                    height: overlay_rows,
+                    depth_or_array_layers: 1,
+                },
+            );
+        }
+        overlay_rows
+    }
+
     /// Records `shown` drawn into `target` by `pipeline` (`srgb`: the target encodes itself).
     fn draw(
         &self,
@@ -277,23 +309,7 @@ impl Presenter {
             }
             FrameRadiance::Device { rgb, .. } => rgb,
         };
-        let overlay_rows = (shown.overlay.len() / (4 * w as usize)) as u32;
-        if overlay_rows > 0 {
-            gpu.queue.write_texture(
-                self.overlay.as_image_copy(),
-                shown.overlay,
-                wgpu::TexelCopyBufferLayout {
-                    offset: 0,
-                    bytes_per_row: Some(4 * w),
-                    rows_per_image: Some(overlay_rows),
-                },
-                wgpu::Extent3d {
-                    width: w,
-                    height: overlay_rows,
-                    depth_or_array_layers: 1,
-                },
-            );
-        }
+        let overlay_rows = self.upload_overlay(shown.overlay);
         let scale = shown.exposure.exp2().to_bits();
         let params = [w, h, overlay_rows, u32::from(srgb), scale, 0, 0, 0];
         let uniform = gpu

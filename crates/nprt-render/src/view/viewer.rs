@@ -113,6 +113,28 @@ fn load(opts: &ViewerOptions, training: Option<&Training>) -> Result<(Vec<Religh
     Ok((models, scene))
 }
 
+/// The denoiser of the traced direct light `opts` asks for, resolved for every model, so that
+/// `on` without OIDN, or for a model that traces no light, is refused before the window opens;
+/// each model is described as it will be shown.
+fn denoiser(opts: &ViewerOptions, models: &[Relighter]) -> Result<Option<&'static Oidn>> {
+    let mut oidn = None;
+    for (m, dir) in models.iter().zip(&opts.models) {
+        oidn = oidn.or(opts.denoise_direct.denoiser(m, dir)?);
+    }
+    if opts.denoise_direct == Denoise::Auto && oidn.is_none() {
+        oidn = Oidn::open().ok();
+    }
+    for (m, dir) in models.iter().zip(&opts.models) {
+        let sampling = DirectSampling {
+            spp: opts.direct_spp,
+            seed: 0,
+            denoiser: oidn.filter(|_| m.traces_direct()),
+        };
+        println!("nprt view: '{}': {}", dir.display(), m.describe(&sampling));
+    }
+    Ok(oidn)
+}
+
 impl<'a> Viewer<'a> {
     pub(super) fn new(
         opts: ViewerOptions,
@@ -138,23 +160,7 @@ impl<'a> Viewer<'a> {
                 .map(|m| Ok((m.clone(), nprt_scene::open_envmap(m)?)))
                 .collect::<Result<Vec<_>>>()?,
         };
-        // Resolved for every model, so that `on` without OIDN, or for a model that traces no
-        // light, is refused before the window opens.
-        let mut oidn = None;
-        for (m, dir) in models.iter().zip(&opts.models) {
-            oidn = oidn.or(opts.denoise_direct.denoiser(m, dir)?);
-        }
-        if opts.denoise_direct == Denoise::Auto && oidn.is_none() {
-            oidn = Oidn::open().ok();
-        }
-        for (m, dir) in models.iter().zip(&opts.models) {
-            let sampling = DirectSampling {
-                spp: opts.direct_spp,
-                seed: 0,
-                denoiser: oidn.filter(|_| m.traces_direct()),
-            };
-            println!("nprt view: '{}': {}", dir.display(), m.describe(&sampling));
-        }
+        let oidn = denoiser(&opts, &models)?;
         Ok(Viewer {
             ts: TraceScene::new(scene),
             scene,

@@ -158,26 +158,7 @@ impl<'a> Ctx<'a> {
                 let key = if self.legacy && self.prop(node, "reflectance").is_none() { "diffuse_reflectance" } else { "reflectance" };
                 (self.texture_prop(node, key, Vec3::splat(0.5))?, Texture::constant(0.0), Texture::constant(1.0))
             }
-            "conductor" | "roughconductor" => {
-                let alpha = if ty == "conductor" { MIN_ALPHA } else { self.microfacet_alpha(node, 0.1)? };
-                let ks = self.texture_prop(node, "specular_reflectance", Vec3::ONE)?;
-                let material = self.string_prop(node, "material")?;
-                let scattering = match (self.prop(node, "eta").is_some() || self.prop(node, "k").is_some(), material.as_deref()) {
-                    (false, None | Some("none")) => Scattering::FresnelFree,
-                    (true, None) => Scattering::Conductor {
-                        eta: self.colour_prop(node, "eta", Vec3::ZERO)?,
-                        k: self.colour_prop(node, "k", Vec3::ONE)?,
-                    },
-                    (true, Some(_)) => return self.fail(node, "give either a material or eta and k, not both"),
-                    (false, Some(named)) => match named_conductor(named) {
-                        Some((eta, k)) => Scattering::Conductor { eta, k },
-                        None => return self.fail(node, format!("unknown conductor material '{named}' (Mitsuba 3 names: {})", conductor_names().collect::<Vec<_>>().join(", "))),
-                    },
-                };
-                let mut m = Material::new(&name, Surface::Direct { kd: Texture::constant(0.0), ks, alpha: Texture::constant(alpha) }, false);
-                m.scattering = scattering;
-                return Ok(m);
-            }
+            "conductor" | "roughconductor" => return self.conductor(node, &name, ty),
             "dielectric" | "thindielectric" => {
                 let eta = self.relative_ior(node, 1.5046)?;
                 let mut m = Material::new(
@@ -193,21 +174,7 @@ impl<'a> Ctx<'a> {
                 m.scattering = Scattering::Dielectric { eta, thin: ty == "thindielectric" };
                 return Ok(m);
             }
-            "plastic" | "roughplastic" => {
-                let rough = ty == "roughplastic";
-                let alpha = if rough { self.microfacet_alpha(node, 0.1)? } else { MIN_ALPHA };
-                let kd = self.texture_prop(node, "diffuse_reflectance", Vec3::splat(0.5))?;
-                let ks = self.texture_prop(node, "specular_reflectance", Vec3::ONE)?;
-                let (d_mean, s_mean) = (kd.mean(), ks.mean());
-                let mut m = Material::new(&name, Surface::Direct { kd, ks, alpha: Texture::constant(alpha) }, false);
-                m.scattering = Scattering::Plastic {
-                    eta: self.relative_ior(node, 1.49)?,
-                    rough,
-                    nonlinear: self.bool_prop(node, "nonlinear", false)?,
-                    sampling_weight: if d_mean + s_mean > 0.0 { s_mean / (d_mean + s_mean) } else { 0.5 },
-                };
-                return Ok(m);
-            }
+            "plastic" | "roughplastic" => return self.plastic(node, &name, ty),
             "blendbsdf" => return self.blend(node, name),
             "bumpmap" => return self.bump_map(node, name),
             other => return self.fail(node, format!("unsupported BSDF plugin '{other}' (supported: diffuse, conductor, roughconductor, plastic, roughplastic, dielectric, thindielectric, twosided, mask, bumpmap, blendbsdf of diffuse + conductor)")),
@@ -217,6 +184,87 @@ impl<'a> Ctx<'a> {
             Surface::Direct { kd, ks, alpha },
             false,
         ))
+    }
+
+    /// Mitsuba 3's `conductor` and `roughconductor` (`ty`): Fresnel-free, or with eta and k
+    /// given or named by `material`.
+    fn conductor(&mut self, node: Node<'a, 'a>, name: &str, ty: &str) -> Result<Material> {
+        let alpha = if ty == "conductor" {
+            MIN_ALPHA
+        } else {
+            self.microfacet_alpha(node, 0.1)?
+        };
+        let ks = self.texture_prop(node, "specular_reflectance", Vec3::ONE)?;
+        let material = self.string_prop(node, "material")?;
+        let scattering = match (
+            self.prop(node, "eta").is_some() || self.prop(node, "k").is_some(),
+            material.as_deref(),
+        ) {
+            (false, None | Some("none")) => Scattering::FresnelFree,
+            (true, None) => Scattering::Conductor {
+                eta: self.colour_prop(node, "eta", Vec3::ZERO)?,
+                k: self.colour_prop(node, "k", Vec3::ONE)?,
+            },
+            (true, Some(_)) => {
+                return self.fail(node, "give either a material or eta and k, not both")
+            }
+            (false, Some(named)) => match named_conductor(named) {
+                Some((eta, k)) => Scattering::Conductor { eta, k },
+                None => {
+                    return self.fail(
+                        node,
+                        format!(
+                            "unknown conductor material '{named}' (Mitsuba 3 names: {})",
+                            conductor_names().collect::<Vec<_>>().join(", ")
+                        ),
+                    )
+                }
+            },
+        };
+        let mut m = Material::new(
+            name,
+            Surface::Direct {
+                kd: Texture::constant(0.0),
+                ks,
+                alpha: Texture::constant(alpha),
+            },
+            false,
+        );
+        m.scattering = scattering;
+        Ok(m)
+    }
+
+    /// Mitsuba 3's `plastic` and `roughplastic` (`ty`): a diffuse base under a dielectric coat.
+    fn plastic(&mut self, node: Node<'a, 'a>, name: &str, ty: &str) -> Result<Material> {
+        let rough = ty == "roughplastic";
+        let alpha = if rough {
+            self.microfacet_alpha(node, 0.1)?
+        } else {
+            MIN_ALPHA
+        };
+        let kd = self.texture_prop(node, "diffuse_reflectance", Vec3::splat(0.5))?;
+        let ks = self.texture_prop(node, "specular_reflectance", Vec3::ONE)?;
+        let (d_mean, s_mean) = (kd.mean(), ks.mean());
+        let mut m = Material::new(
+            name,
+            Surface::Direct {
+                kd,
+                ks,
+                alpha: Texture::constant(alpha),
+            },
+            false,
+        );
+        m.scattering = Scattering::Plastic {
+            eta: self.relative_ior(node, 1.49)?,
+            rough,
+            nonlinear: self.bool_prop(node, "nonlinear", false)?,
+            sampling_weight: if d_mean + s_mean > 0.0 {
+                s_mean / (d_mean + s_mean)
+            } else {
+                0.5
+            },
+        };
+        Ok(m)
     }
 
     /// Mitsuba 3's `bumpmap`: one nested texture (the height, whatever its name) and one BSDF.

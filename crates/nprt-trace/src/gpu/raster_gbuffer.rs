@@ -171,62 +171,11 @@ impl RasterGBuffer {
             Some(t) if t.size == size => t,
             _ => self.targets(size),
         };
-        let clip = self.clip(camera);
-        let view = gpu
-            .device
-            .create_buffer_init(&wgpu::util::BufferInitDescriptor {
-                label: Some("view"),
-                contents: bytemuck::cast_slice(&clip.to_cols_array()),
-                usage: wgpu::BufferUsages::UNIFORM,
-            });
-        let scene = &self.scene;
-        let group = gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("visibility"),
-            layout: &self.visibility.get_bind_group_layout(0),
-            entries: &[
-                view.as_entire_binding(),
-                scene.positions.as_entire_binding(),
-                scene.triangles.as_entire_binding(),
-            ]
-            .into_iter()
-            .enumerate()
-            .map(|(i, resource)| wgpu::BindGroupEntry {
-                binding: i as u32,
-                resource,
-            })
-            .collect::<Vec<_>>(),
-        });
         let visible = TextureBinding(targets.visible.create_view(&Default::default()));
         let samples = self.pooled(pixels * SAMPLE_FLOATS);
         let mut encoder = gpu.device.create_command_encoder(&Default::default());
-        {
-            let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
-                label: Some("visibility"),
-                color_attachments: &[Some(wgpu::RenderPassColorAttachment {
-                    view: &visible.0,
-                    depth_slice: None,
-                    resolve_target: None,
-                    ops: wgpu::Operations {
-                        load: wgpu::LoadOp::Clear(wgpu::Color::TRANSPARENT),
-                        store: wgpu::StoreOp::Store,
-                    },
-                })],
-                depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
-                    view: &targets.depth,
-                    depth_ops: Some(wgpu::Operations {
-                        load: wgpu::LoadOp::Clear(0.0),
-                        store: wgpu::StoreOp::Discard,
-                    }),
-                    stencil_ops: None,
-                }),
-                timestamp_writes: None,
-                occlusion_query_set: None,
-                multiview_mask: None,
-            });
-            pass.set_pipeline(&self.visibility);
-            pass.set_bind_group(0, &group, &[]);
-            pass.draw(0..3 * scene.triangle_count, 0..1);
-        }
+        self.record_visibility(&mut encoder, camera, &targets.depth, &visible);
+        let scene = &self.scene;
         {
             let mut pass = encoder.begin_compute_pass(&Default::default());
             let mut params = vec![camera.width, camera.height, 0, 0];
@@ -251,6 +200,68 @@ impl RasterGBuffer {
         gpu.queue.submit([encoder.finish()]);
         *kept = Some(targets);
         Ok(samples)
+    }
+
+    /// Records the visibility pass of `camera` into `visible` (each pixel's nearest
+    /// triangle), with the depth buffer `depth`.
+    fn record_visibility(
+        &self,
+        encoder: &mut wgpu::CommandEncoder,
+        camera: &Camera,
+        depth: &wgpu::TextureView,
+        visible: &TextureBinding,
+    ) {
+        let gpu = &*self.gpu;
+        let clip = self.clip(camera);
+        let view = gpu
+            .device
+            .create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                label: Some("view"),
+                contents: bytemuck::cast_slice(&clip.to_cols_array()),
+                usage: wgpu::BufferUsages::UNIFORM,
+            });
+        let group = gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("visibility"),
+            layout: &self.visibility.get_bind_group_layout(0),
+            entries: &[
+                view.as_entire_binding(),
+                self.scene.positions.as_entire_binding(),
+                self.scene.triangles.as_entire_binding(),
+            ]
+            .into_iter()
+            .enumerate()
+            .map(|(i, resource)| wgpu::BindGroupEntry {
+                binding: i as u32,
+                resource,
+            })
+            .collect::<Vec<_>>(),
+        });
+        let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+            label: Some("visibility"),
+            color_attachments: &[Some(wgpu::RenderPassColorAttachment {
+                view: &visible.0,
+                depth_slice: None,
+                resolve_target: None,
+                ops: wgpu::Operations {
+                    load: wgpu::LoadOp::Clear(wgpu::Color::TRANSPARENT),
+                    store: wgpu::StoreOp::Store,
+                },
+            })],
+            depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
+                view: depth,
+                depth_ops: Some(wgpu::Operations {
+                    load: wgpu::LoadOp::Clear(0.0),
+                    store: wgpu::StoreOp::Discard,
+                }),
+                stencil_ops: None,
+            }),
+            timestamp_writes: None,
+            occlusion_query_set: None,
+            multiview_mask: None,
+        });
+        pass.set_pipeline(&self.visibility);
+        pass.set_bind_group(0, &group, &[]);
+        pass.draw(0..3 * self.scene.triangle_count, 0..1);
     }
 
     /// World to clip for `camera`: a point's pixel is where `camera.ray` through it would

@@ -23,7 +23,7 @@ use crate::encoding::hash_grid;
 use crate::encoding::map_norm::MapNorm;
 use crate::gpu::kernels::{COMBINE, GBUFFER_FEATURES};
 use crate::gpu::layers::network_forward::FirstLayer;
-use crate::gpu::layers::network_layout::NetworkLayout;
+use crate::gpu::layers::network_layout::{NetworkLayout, TrackAt};
 use crate::gpu::layers::parameters::ParameterLayout;
 use crate::gpu::products::half_layers::{held_halves, HalfLayers, Held, HALF_ROW_BLOCK};
 use crate::gpu::products::operands::Bias;
@@ -232,7 +232,6 @@ impl GpuNetwork {
             .expect("a network has layers");
         let chunk = chunk_rows(gpu, widest);
         let work = self.workspace(rows.clamp(1, chunk), widest);
-        let half = work.half();
         let mut encoder = gpu.device.create_command_encoder(&Default::default());
         let mut chunks = Vec::new();
         {
@@ -240,43 +239,8 @@ impl GpuNetwork {
             for first in (0..rows).step_by(chunk) {
                 let n = chunk.min(rows - first);
                 let features = inputs(&mut pass, first, n);
-                let mut list = Vec::new();
-                let (params, resolutions) = (&self.params, &self.resolutions);
                 let kept = (self.net.tracks.iter())
-                    .map(|t| {
-                        let width = t.own_width();
-                        let floats = match half {
-                            true => held_halves(n, width).div_ceil(2),
-                            false => n * width,
-                        };
-                        let kept = self.pool.take_pooled(gpu, floats);
-                        let gathered = &work.f32[0];
-                        let x = match (&t.transfer, half) {
-                            (None, false) => &*kept,
-                            _ => gathered,
-                        };
-                        list.push(t.record_inputs(gpu, params, resolutions, [&features, x], n));
-                        match (&t.transfer, half) {
-                            (None, false) => {}
-                            (None, true) => {
-                                list.push(gpu.half_rows([n, width, width], gathered, &kept));
-                            }
-                            (Some(transfer), _) => {
-                                let first = FirstLayer {
-                                    own_row: 0,
-                                    count: t.width,
-                                    bias: Bias::Column(params, transfer.layers[0].bias.offset),
-                                };
-                                let to = work.targets(transfer, work.held(&kept));
-                                let x = Held::F32(gathered);
-                                transfer.record_forward(gpu, &mut list, params, x, n, first, &to);
-                            }
-                        }
-                        for d in list.drain(..) {
-                            d.record(&mut pass);
-                        }
-                        kept
-                    })
+                    .map(|t| self.kept_rows(&mut pass, t, &features, n, &work))
                     .collect();
                 chunks.push(PixelChunk {
                     first,
@@ -295,6 +259,54 @@ impl GpuNetwork {
             relight: OnceLock::new(),
             network: self.id,
         }
+    }
+
+    /// Records what track `t` keeps of `n` rows of `features` for every lighting: its
+    /// inputs, gathered (in f16 where the workspace is), or its transfer network's output ŝ.
+    fn kept_rows(
+        &self,
+        pass: &mut wgpu::ComputePass,
+        t: &TrackAt,
+        features: &PooledBuffer,
+        n: usize,
+        work: &Workspace,
+    ) -> PooledBuffer {
+        let gpu = &*self.gpu;
+        let (params, resolutions) = (&self.params, &self.resolutions);
+        let half = work.half();
+        let mut list = Vec::new();
+        let width = t.own_width();
+        let floats = match half {
+            true => held_halves(n, width).div_ceil(2),
+            false => n * width,
+        };
+        let kept = self.pool.take_pooled(gpu, floats);
+        let gathered = &work.f32[0];
+        let x = match (&t.transfer, half) {
+            (None, false) => &*kept,
+            _ => gathered,
+        };
+        list.push(t.record_inputs(gpu, params, resolutions, [features, x], n));
+        match (&t.transfer, half) {
+            (None, false) => {}
+            (None, true) => {
+                list.push(gpu.half_rows([n, width, width], gathered, &kept));
+            }
+            (Some(transfer), _) => {
+                let first = FirstLayer {
+                    own_row: 0,
+                    count: t.width,
+                    bias: Bias::Column(params, transfer.layers[0].bias.offset),
+                };
+                let to = work.targets(transfer, work.held(&kept));
+                let x = Held::F32(gathered);
+                transfer.record_forward(gpu, &mut list, params, x, n, first, &to);
+            }
+        }
+        for d in list {
+            d.record(pass);
+        }
+        kept
     }
 
     /// The workspace for blocks of `rows` rows of activations at most `widest` wide: the kept

@@ -2,6 +2,7 @@
 //! weights' summed over chunks of rows) from what its forward pass kept (`MlpTape`).
 
 use crate::gpu::kernels::GEMM_TILE;
+use crate::gpu::layers::layer_at::DenseAt;
 use crate::gpu::layers::mlp_tape::MlpTape;
 use crate::gpu::layers::network_layout::MlpAt;
 use crate::gpu::products::codes::{activation_code, BACKWARD};
@@ -96,17 +97,8 @@ impl Trainable<'_> {
                 weights,
                 folded.then_some(layer.bias.offset),
             );
-            let bias = Output::to(self.grads, layer.bias.offset, layer.d_out);
-            match per_view {
-                Some(v) => {
-                    let to = Output::to(v.d_views, 0, layer.d_out);
-                    let views = Some((v.view, v.views));
-                    (self.gpu).column_sum(plan, dz, rows, layer.d_out, views, to);
-                    (self.gpu).column_sum(plan, v.d_views, v.views, layer.d_out, None, bias);
-                    (v.then)(plan);
-                }
-                None if !folded => self.gpu.column_sum(plan, dz, rows, layer.d_out, None, bias),
-                None => {}
+            if !folded {
+                self.bias_gradient(plan, layer, (dz, rows), per_view);
             }
             // The gradient at the layer's input; below a hidden layer, times its activation's
             // derivative at the pre-activation there (`gemm`'s backward epilogue).
@@ -134,6 +126,28 @@ impl Trainable<'_> {
                 Output::to(dx, 0, count),
                 pre,
             ));
+        }
+    }
+
+    /// Records the gradient of `layer`'s bias from the gradient `dz` at its `rows` outputs:
+    /// their sum, or with `per_view` their sums per view, then those summed.
+    fn bias_gradient(
+        &self,
+        plan: &mut Vec<Dispatch>,
+        layer: &DenseAt,
+        (dz, rows): (&wgpu::Buffer, usize),
+        per_view: Option<&ViewSums>,
+    ) {
+        let bias = Output::to(self.grads, layer.bias.offset, layer.d_out);
+        match per_view {
+            Some(v) => {
+                let to = Output::to(v.d_views, 0, layer.d_out);
+                let views = Some((v.view, v.views));
+                (self.gpu).column_sum(plan, dz, rows, layer.d_out, views, to);
+                (self.gpu).column_sum(plan, v.d_views, v.views, layer.d_out, None, bias);
+                (v.then)(plan);
+            }
+            None => self.gpu.column_sum(plan, dz, rows, layer.d_out, None, bias),
         }
     }
 

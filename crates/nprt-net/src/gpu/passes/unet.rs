@@ -204,29 +204,7 @@ impl UnetAt {
             x = conv(plan, &mut tape, joined, images);
         }
         let y = conv(plan, &mut tape, x, images);
-        let loss_at = plan.len();
-        plan.push(gpu.prepare(
-            &UNET_LOSS,
-            &loss_params(images, loss, 0.0),
-            &[
-                &y,
-                &b.radiance,
-                &b.mask,
-                &b.scale,
-                &b.prediction,
-                &b.d_y,
-                &b.values,
-            ],
-            groups_for(images.values(3)),
-        ));
-        gpu.column_sum(
-            plan,
-            &b.values,
-            images.values(3),
-            1,
-            None,
-            Output::to(&b.loss, 0, 1),
-        );
+        let loss_at = record_loss(gpu, plan, &y, b, images, loss);
         (tape, loss_at)
     }
 
@@ -445,4 +423,41 @@ fn record_join(
         groups_for(full.values(c_in)),
     ));
     (joined, full)
+}
+
+/// Appends to `plan` the masked `loss` of the output `y` (`images` of 3 channels) against
+/// `b`'s radiance: the prediction into `b.prediction`, the gradient at `y` into `b.d_y`, the
+/// sum into `b.loss`. Returns the index in `plan` of the loss's dispatch.
+fn record_loss(
+    gpu: &GpuDevice,
+    plan: &mut Vec<Dispatch>,
+    y: &wgpu::Buffer,
+    b: &UnetBuffers,
+    images: Images,
+    loss: Loss,
+) -> usize {
+    let at = plan.len();
+    plan.push(gpu.prepare(
+        &UNET_LOSS,
+        &loss_params(images, loss, 0.0),
+        &[
+            y,
+            &b.radiance,
+            &b.mask,
+            &b.scale,
+            &b.prediction,
+            &b.d_y,
+            &b.values,
+        ],
+        groups_for(images.values(3)),
+    ));
+    gpu.column_sum(
+        plan,
+        &b.values,
+        images.values(3),
+        1,
+        None,
+        Output::to(&b.loss, 0, 1),
+    );
+    at
 }

@@ -233,25 +233,7 @@ impl GpuCache {
             Some(&dx),
             None,
         );
-        // The grid's gradient, per chunk of rows in a fixed order, then over the chunks.
-        let chunk = rows.div_ceil(64).max(256);
-        let chunks = rows.div_ceil(chunk);
-        let partial = gpu.buffer(chunks * self.grid.len);
-        dispatches.push(gpu.prepare(
-            &GRID_BACKWARD,
-            &[rows, 0, INPUTS, chunk].map(|v| v as u32),
-            &[&features, &self.resolutions, &dx, &partial],
-            groups_for(chunks * GRID_BACKWARD_THREADS),
-        ));
-        let d_table = Output::to(&self.grads, self.grid.offset, self.grid.len);
-        gpu.column_sum(
-            &mut dispatches,
-            &partial,
-            chunks,
-            self.grid.len,
-            None,
-            d_table,
-        );
+        self.record_grid_backward(&mut dispatches, &features, &dx, rows);
         CachePlan {
             rows,
             features,
@@ -263,6 +245,29 @@ impl GpuCache {
             dispatches,
             forward,
         }
+    }
+
+    /// Records the grid's gradient from the gradient `dx` at the inputs of `rows` queries of
+    /// `features`: per chunk of rows in a fixed order, then summed over the chunks.
+    fn record_grid_backward(
+        &self,
+        dispatches: &mut Vec<Dispatch>,
+        features: &wgpu::Buffer,
+        dx: &wgpu::Buffer,
+        rows: usize,
+    ) {
+        let gpu = &self.gpu;
+        let chunk = rows.div_ceil(64).max(256);
+        let chunks = rows.div_ceil(chunk);
+        let partial = gpu.buffer(chunks * self.grid.len);
+        dispatches.push(gpu.prepare(
+            &GRID_BACKWARD,
+            &[rows, 0, INPUTS, chunk].map(|v| v as u32),
+            &[features, &self.resolutions, dx, &partial],
+            groups_for(chunks * GRID_BACKWARD_THREADS),
+        ));
+        let d_table = Output::to(&self.grads, self.grid.offset, self.grid.len);
+        gpu.column_sum(dispatches, &partial, chunks, self.grid.len, None, d_table);
     }
 }
 
