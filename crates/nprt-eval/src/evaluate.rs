@@ -87,10 +87,10 @@ pub fn evaluate(o: &EvalOptions, engine: Engine) -> Result<Evaluation> {
     // A stop requested (nprt_io::interrupt) ends it between stages, before any result; the
     // traced stages skip their remaining pixels meanwhile.
     let stop = nprt_io::interrupt::check;
-    let mut results = run_networks(&mut bench, &nets, oidn_ok)?;
+    let mut results = run_networks(&mut bench, nets, oidn_ok)?;
     stop()?;
     let oracles = match o.oracles {
-        true => run_oracles(&mut bench, &nets, oidn_ok)?,
+        true => run_oracles(&mut bench, nets, oidn_ok)?,
         false => Vec::new(),
     };
     let pt5 = run_path_tracing(&mut bench, "pt-5spp", 5, 0x5eed_0005);

@@ -117,8 +117,8 @@ mod tests {
             "{:?}",
             c[1]
         );
-        for k in 2..9 {
-            assert!(c[k].abs().max_element() < 1e-2, "c{k} = {:?}", c[k]);
+        for (k, ck) in c.iter().enumerate().take(9).skip(2) {
+            assert!(ck.abs().max_element() < 1e-2, "c{k} = {ck:?}");
         }
         // Rotating the map about +Y turns x into z; the y-only part stays.
         let rotated = project(&map_from(|d| Vec3::splat(1.0 + d.x)).rotated_y(90.0), 2);

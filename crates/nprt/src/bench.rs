@@ -346,11 +346,11 @@ fn train(a: BenchTrainArgs) -> Result<()> {
 fn timed_rounds(
     a: &BenchTrainArgs,
     config: &ModelConfig,
-    peer: Option<&(&PathBuf, &'static str, PeerScript)>,
+    peer: Option<&Peer>,
     engine: Engine,
-) -> Result<(Vec<Vec<f64>>, Vec<Vec<f64>>)> {
-    let mut ours: Vec<Vec<f64>> = vec![Vec::new(); a.precision.len()];
-    let mut variants: Vec<Vec<f64>> = vec![Vec::new(); a.peer_variants.len()];
+) -> Result<(Vec<Rates>, Vec<Rates>)> {
+    let mut ours = vec![Vec::new(); a.precision.len()];
+    let mut variants = vec![Vec::new(); a.peer_variants.len()];
     for _ in 0..a.rounds.max(1) {
         if let Some((python, torch_device, script)) = peer {
             for (&variant, rates) in a.peer_variants.iter().zip(&mut variants) {
@@ -377,6 +377,12 @@ fn timed_rounds(
     }
     Ok((ours, variants))
 }
+
+/// Samples per second, one per round.
+type Rates = Vec<f64>;
+
+/// The PyTorch peer of a training bench: its Python, its torch device and its script.
+type Peer<'a> = (&'a PathBuf, &'static str, PeerScript);
 
 /// The fastest peer variant by its median rate, among those that ran.
 fn fastest(variants: &[Vec<f64>]) -> Option<usize> {
@@ -432,10 +438,7 @@ fn print_profile(_: &ModelConfig, _: &BenchTrainArgs, _: Precision, _: f64) -> R
 
 /// The PyTorch peer to compare with, if one was given: its Python, PyTorch's device name (CUDA
 /// for the GPU kernels) and the script written out.
-fn peer(
-    python: Option<&PathBuf>,
-    engine: Engine,
-) -> Result<Option<(&PathBuf, &'static str, PeerScript)>> {
+fn peer(python: Option<&PathBuf>, engine: Engine) -> Result<Option<Peer<'_>>> {
     let torch_device = match engine {
         Engine::Cpu => "cpu",
         Engine::Gpu => "cuda",

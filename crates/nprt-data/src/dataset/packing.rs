@@ -67,7 +67,7 @@ pub(super) fn pack(
 ) -> Result<()> {
     // Temporaries of a killed packing: ours, since the lock is held.
     nprt_io::remove_temporaries(dir, |of| of == path)?;
-    nprt_io::write_atomically(&path, |tmp| {
+    nprt_io::write_atomically(path, |tmp| {
         let mut w = BufWriter::with_capacity(8 << 20, File::create(tmp)?);
         w.write_all(&[0; PRELUDE_BYTES])?;
         let bar = nprt_io::progress_bar(progress, manifest.views.len() as u64, "packing", "views");

@@ -66,7 +66,10 @@ pub struct WindowedRun<'a> {
 /// What trains a bake's run in a window; this crate opens none itself (the window is
 /// nprt-render's, behind its `view` feature).
 #[derive(Clone)]
-pub struct TrainingWindow(pub Arc<dyn Fn(&WindowedRun) -> Result<()> + Send + Sync>);
+pub struct TrainingWindow(pub Arc<TrainsInWindow>);
+
+/// Trains a bake's run in a window, returning when the run ends or the window closes.
+pub type TrainsInWindow = dyn Fn(&WindowedRun) -> Result<()> + Send + Sync;
 
 impl std::fmt::Debug for TrainingWindow {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
