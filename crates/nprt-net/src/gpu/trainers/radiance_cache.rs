@@ -13,12 +13,13 @@ use glam::Vec3;
 use crate::cpu::radiance_cache::encode_rest;
 use crate::encoding::features::FEATURES;
 use crate::encoding::hash_grid;
-use crate::gpu::kernels::{GRID_BACKWARD, RADIANCE_LOSS, TRACK_INPUTS};
+use crate::gpu::kernels::{RADIANCE_LOSS, TRACK_INPUTS};
 use crate::gpu::layers::mlp_tape::MlpTape;
 use crate::gpu::layers::network_forward::{FirstLayer, ForwardTargets};
 use crate::gpu::layers::network_layout::{mlp_at, MlpAt};
 use crate::gpu::layers::parameters::ParameterLayout;
 use crate::gpu::passes::device_adam::DeviceAdam;
+use crate::gpu::passes::grid_backward::{record_grid_backward, GridRows};
 use crate::gpu::passes::mlp_step::Trainable;
 use crate::gpu::products::codes::loss_code;
 use crate::gpu::products::dense_products::DenseProducts;
@@ -30,8 +31,6 @@ use crate::network::radiance_cache::CacheSteps;
 use crate::network::radiance_cache::{CacheQuery, RadianceCache, INPUTS};
 use nprt_gpu::{groups_for, Dispatch, GpuDevice, Part, Span};
 
-/// Threads of `grid_backward` per chunk of rows: one per 64 slots of each level's table.
-const GRID_BACKWARD_THREADS: usize = hash_grid::LEVELS * hash_grid::TABLE_SIZE / 64;
 /// Rows a read records at once.
 const READ_ROWS: usize = 4096;
 
@@ -233,7 +232,14 @@ impl GpuCache {
             Some(&dx),
             None,
         );
-        self.record_grid_backward(&mut dispatches, &features, &dx, rows);
+        let at = GridRows {
+            features: &features,
+            rows,
+            count: 0,
+            width: INPUTS,
+        };
+        let buffers = [&self.resolutions, &dx, &self.grads];
+        record_grid_backward(gpu, &mut dispatches, at, buffers, self.grid);
         CachePlan {
             rows,
             features,
@@ -245,29 +251,6 @@ impl GpuCache {
             dispatches,
             forward,
         }
-    }
-
-    /// Records the grid's gradient from the gradient `dx` at the inputs of `rows` queries of
-    /// `features`: per chunk of rows in a fixed order, then summed over the chunks.
-    fn record_grid_backward(
-        &self,
-        dispatches: &mut Vec<Dispatch>,
-        features: &wgpu::Buffer,
-        dx: &wgpu::Buffer,
-        rows: usize,
-    ) {
-        let gpu = &self.gpu;
-        let chunk = rows.div_ceil(64).max(256);
-        let chunks = rows.div_ceil(chunk);
-        let partial = gpu.buffer(chunks * self.grid.len);
-        dispatches.push(gpu.prepare(
-            &GRID_BACKWARD,
-            &[rows, 0, INPUTS, chunk].map(|v| v as u32),
-            &[features, &self.resolutions, dx, &partial],
-            groups_for(chunks * GRID_BACKWARD_THREADS),
-        ));
-        let d_table = Output::to(&self.grads, self.grid.offset, self.grid.len);
-        gpu.column_sum(dispatches, &partial, chunks, self.grid.len, None, d_table);
     }
 }
 

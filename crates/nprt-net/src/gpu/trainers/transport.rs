@@ -3,12 +3,12 @@
 //! first shading layer's bias, the loss and its gradient at the tracks' outputs, and backward
 //! into every parameter, the grids' tables and the light codes.
 
-use crate::encoding::hash_grid;
-use crate::gpu::kernels::{COMBINE, GRID_BACKWARD, RADIANCE_LOSS, TRACK_GRADIENT, TRANSFER_LOSS};
+use crate::gpu::kernels::{COMBINE, RADIANCE_LOSS, TRACK_GRADIENT, TRANSFER_LOSS};
 use crate::gpu::layers::light_basis::{BasisAt, BasisFunctions};
 use crate::gpu::layers::mlp_tape::MlpTape;
 use crate::gpu::layers::network_forward::{FirstLayer, ForwardTargets};
 use crate::gpu::layers::network_layout::{LightAt, TrackAt};
+use crate::gpu::passes::grid_backward::{record_grid_backward, GridRows};
 use crate::gpu::passes::mlp_step::ViewSums;
 use crate::gpu::products::codes::loss_code;
 use crate::gpu::products::dense_products::DenseProducts;
@@ -19,12 +19,6 @@ use crate::loss::Loss;
 use crate::network::design::TRANSPORT_CODE;
 use crate::network::encoder::CODE_SIZE;
 use nprt_gpu::{groups_for, Dispatch};
-
-/// Threads of `grid_backward` per chunk of rows: one per 64 slots of each level's table.
-const GRID_BACKWARD_THREADS: usize = hash_grid::LEVELS * hash_grid::TABLE_SIZE / 64;
-/// Chunks of rows `grid_backward` cuts a batch into at most, each with its own copy of the
-/// tables (512 KiB): 32 MiB at most.
-const GRID_CHUNKS: usize = 64;
 
 /// One track's state over a batch.
 struct TrackTape {
@@ -349,19 +343,13 @@ impl GpuTrainer {
         let (Some(span), Some(dx)) = (t.grid, &tape.dx) else {
             return;
         };
-        let gpu = &self.gpu;
-        // At most GRID_CHUNKS copies of the tables, each summing at least 256 rows.
-        let chunk = b.rows.div_ceil(GRID_CHUNKS).max(256);
-        let chunks = b.rows.div_ceil(chunk);
-        let partial = gpu.buffer(chunks * span.len);
-        let params = [b.rows, t.count, t.width, chunk].map(|v| v as u32);
-        plan.push(gpu.prepare(
-            &GRID_BACKWARD,
-            &params,
-            &[&b.features, &self.resolutions, dx, &partial],
-            groups_for(chunks * GRID_BACKWARD_THREADS),
-        ));
-        let d_table = Output::to(&self.grads, span.offset, span.len);
-        gpu.column_sum(plan, &partial, chunks, span.len, None, d_table);
+        let at = GridRows {
+            features: &b.features,
+            rows: b.rows,
+            count: t.count,
+            width: t.width,
+        };
+        let buffers = [&self.resolutions, dx, &self.grads];
+        record_grid_backward(&self.gpu, plan, at, buffers, span);
     }
 }
