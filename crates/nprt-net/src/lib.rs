@@ -64,6 +64,7 @@ pub use network::activation::{Activation, OMEGA_0};
 pub use network::design::{Design, TRANSPORT_CODE};
 pub use network::encoder::{LightEncoder, LightInput, Texels};
 pub use network::light_basis::{BasisChoice, LightBasis};
+pub use network::light_entry::LightEntry;
 pub use network::light_model::LightModel;
 pub use network::mlp::Mlp;
 pub use network::nprt_net::NprtNet;

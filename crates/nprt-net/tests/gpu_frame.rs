@@ -333,7 +333,7 @@ fn a_new_viewpoint_reusing_the_last_ones_buffers_gets_its_own_radiance() {
 /// The linear design on the frame path: its light code (the map made into the basis' input and
 /// projected, all on the device) and its radiance agree with the CPU engine's, for the fixed
 /// basis and a learned one, and a frame under a·E₁ + b·E₂ is a·(the frame under E₁) +
-/// b·(under E₂) to rounding, as on the CPU engine.
+/// b·(under E₂) to rounding, as on the CPU engine; in half precision within 1% of the mean.
 #[test]
 fn the_linear_design_shades_as_on_the_cpu_engine() {
     if !GpuDevice::probe() {
@@ -391,5 +391,20 @@ fn the_linear_design_shades_as_on_the_cpu_engine() {
         let error = relative_difference(&both, &sum);
         eprintln!("linear {basis}: mixture {error:.2e}");
         assert!(error < 1e-5, "{basis}: a mixture's frame off by {error}");
+
+        // In half precision: the kept transfer coefficients made from f16 activations.
+        let mut half = GpuNetwork::new(&net, gain, 64, MapNorm::Channel).unwrap();
+        half.set_half(true).unwrap();
+        let code = half.encode_map(&sky, 30.0, 64, MapNorm::Channel);
+        let rgb = half.radiance(&half.pixels(&features), &code);
+        let error = mean_relative_difference(&rgb, &want);
+        eprintln!(
+            "linear {basis} ({}): mean error {error:.2e}",
+            half.precision_name()
+        );
+        assert!(
+            error < 1e-2,
+            "{basis}: half precision off by {error} of the mean"
+        );
     }
 }

@@ -370,7 +370,7 @@ fn cpu_engine_radiance_matches_the_reference() {
         let code = &code[..net.light.code_size()];
         let codes = [code.iter().map(|&c| c as f64).collect::<Vec<f64>>()];
         let want = Reference::new(&net).predict(&batch, Some(&codes));
-        let kept = net.transfer_codes(&features);
+        let kept = net.kept_rows(&features);
         for got in [
             net.radiance(&features, code, scale, None),
             net.radiance(&features, code, scale, Some(&kept)),

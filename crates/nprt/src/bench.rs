@@ -258,6 +258,15 @@ impl FrameTable {
     }
 }
 
+/// The design column's width in the benches' tables: the longest design name.
+fn design_column() -> usize {
+    Design::ALL
+        .iter()
+        .map(|d| d.name().len())
+        .max()
+        .unwrap_or(0)
+}
+
 fn infer(a: BenchInferArgs) -> Result<()> {
     let p = nprt_net::cpu::measured_peak(rayon::current_num_threads());
     println!(
@@ -269,15 +278,23 @@ fn infer(a: BenchInferArgs) -> Result<()> {
         r = a.resolution
     );
     println!(
-        "{:<10} {:>9} {:>8} {:>6} {:>11} {:>8} {:>6} {:>8}",
-        "design", "frame ms", "GFLOP/s", "peak", "relight ms", "GFLOP/s", "peak", "speed-up"
+        "{:<w$} {:>9} {:>8} {:>6} {:>11} {:>8} {:>6} {:>8}",
+        "design",
+        "frame ms",
+        "GFLOP/s",
+        "peak",
+        "relight ms",
+        "GFLOP/s",
+        "peak",
+        "speed-up",
+        w = design_column()
     );
     for &arch in &a.designs.arch {
         let config = ModelConfig::new(arch, None);
         let s = nprt_net::measure_inference(&config, a.resolution * a.resolution, a.repeats);
         let pct = |g: f64| format!("{:.0}%", 100.0 * g / p.gflops);
         println!(
-            "{:<10} {:>9.1} {:>8.1} {:>6} {:>11.1} {:>8.1} {:>6} {:>7.2}×",
+            "{:<w$} {:>9.1} {:>8.1} {:>6} {:>11.1} {:>8.1} {:>6} {:>7.2}×",
             arch.name(),
             s.frame_ms,
             s.frame_gflops,
@@ -285,7 +302,8 @@ fn infer(a: BenchInferArgs) -> Result<()> {
             s.relight_ms,
             s.relight_gflops,
             pct(s.relight_gflops),
-            s.frame_ms / s.relight_ms
+            s.frame_ms / s.relight_ms,
+            w = design_column()
         );
     }
     Ok(())
@@ -308,8 +326,15 @@ fn train(a: BenchTrainArgs) -> Result<()> {
     );
     let peer = peer(a.python.as_ref(), engine)?;
     println!(
-        "{:<10} {:<6} {:<4} {:>14} {:>17} {:>8} {:>15}  peer",
-        "design", "act", "prec", "nprt samples/s", "PyTorch samples/s", "ratio", "rounds' ratios"
+        "{:<w$} {:<6} {:<4} {:>14} {:>17} {:>8} {:>15}  peer",
+        "design",
+        "act",
+        "prec",
+        "nprt samples/s",
+        "PyTorch samples/s",
+        "ratio",
+        "rounds' ratios",
+        w = design_column()
     );
     for &arch in &a.designs.arch {
         let config = ModelConfig::new(arch, a.activation);
@@ -322,7 +347,7 @@ fn train(a: BenchTrainArgs) -> Result<()> {
             let theirs = (!theirs.is_empty()).then(|| median(theirs.clone()));
             let spread = ratio_range(&ratios);
             println!(
-                "{:<10} {:<6} {:<4} {:>14.0} {:>17} {:>8} {:>15}  {}",
+                "{:<w$} {:<6} {:<4} {:>14.0} {:>17} {:>8} {:>15}  {}",
                 arch.name(),
                 config.activation.name(),
                 precision.name(),
@@ -330,7 +355,8 @@ fn train(a: BenchTrainArgs) -> Result<()> {
                 theirs.map_or("-".into(), |t| format!("{t:.0}")),
                 theirs.map_or("-".into(), |t| format!("{:.2}×", ours / t)),
                 spread,
-                best.map_or("-".into(), |v| a.peer_variants[v].name())
+                best.map_or("-".into(), |v| a.peer_variants[v].name()),
+                w = design_column()
             );
             if a.profile {
                 print_profile(&config, &a, precision, 1e3 * a.batch_size as f64 / ours)?;

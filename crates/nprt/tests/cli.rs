@@ -422,6 +422,30 @@ fn bench_train_compares_with_the_fastest_peer_variant() {
     assert_eq!(row[7], "compile-bf16", "{out}");
 }
 
+/// `bench infer` times every design, a row each: the linear designs' light codes are their
+/// basis' projections (3K values), not the encoder's code (it panicked on them once).
+#[test]
+fn bench_infer_times_every_design() {
+    let designs = nprt_net::Design::ALL.map(|d| d.name());
+    let arch = designs.join(",");
+    let out = common::ok(&[
+        "bench",
+        "infer",
+        "--arch",
+        &arch,
+        "--resolution",
+        "8",
+        "--repeats",
+        "1",
+    ]);
+    let rows: Vec<&str> = (out.lines())
+        .filter_map(|l| l.split_whitespace().next())
+        .collect();
+    for name in designs {
+        assert!(rows.contains(&name), "no row of {name}: {out}");
+    }
+}
+
 #[test]
 fn bench_frame_times_every_stage_on_each_device() {
     let mut devices = vec!["cpu"];

@@ -10,7 +10,6 @@ use crate::engine::Engine;
 use crate::init::Init;
 use crate::loss::Loss;
 use crate::model::config::ModelConfig;
-use crate::network::encoder::CODE_SIZE;
 use crate::optimiser::Adam;
 use crate::parameters::Parameters;
 use crate::precision::Precision;
@@ -135,8 +134,9 @@ pub struct InferenceSpeed {
     pub pixels: usize,
     /// A frame from a new viewpoint: transfer and shading networks.
     pub frame_ms: f64,
-    /// A lighting change under a still camera: shading networks only (the transfer networks'
-    /// outputs kept); equal to `frame_ms` for the baseline, which has none.
+    /// A lighting change under a still camera: what runs from where the light enters on (the
+    /// shading networks after the kept ŝ, a linear design's dot products after its kept
+    /// transfer coefficients); equal to `frame_ms` for the baseline, which keeps nothing.
     pub relight_ms: f64,
     pub frame_gflops: f64,
     pub relight_gflops: f64,
@@ -152,7 +152,9 @@ pub fn measure_inference(config: &ModelConfig, pixels: usize, repeats: usize) ->
     let features: Vec<f32> = (0..pixels * FEATURES)
         .map(|_| rng.random::<f32>())
         .collect();
-    let code: Vec<f32> = (0..CODE_SIZE).map(|_| rng.random::<f32>() - 0.5).collect();
+    // The light model's code: the encoder's ê, or a linear design's projection on its basis.
+    let code_size = net.light.code_size();
+    let code: Vec<f32> = (0..code_size).map(|_| rng.random::<f32>() - 0.5).collect();
     let median_ms = |run: &dyn Fn()| {
         run();
         median(
@@ -165,7 +167,7 @@ pub fn measure_inference(config: &ModelConfig, pixels: usize, repeats: usize) ->
                 .collect(),
         )
     };
-    let kept = host.transfer_codes(&features);
+    let kept = host.kept_rows(&features);
     let frame_ms = median_ms(&|| {
         host.radiance(&features, &code, [1.0; 3], None);
     });

@@ -1,10 +1,11 @@
 //! A trained network's frames on the CPU engine ([`Shading`]): the light model on the host's
-//! map input, each track's ŝ kept per camera, and the shading networks per lighting.
+//! map input, what each track's networks make before the light enters kept per camera (ŝ, or a
+//! linear track's transfer coefficients), and the rest per lighting.
 
 use anyhow::{bail, Result};
 use nprt_scene::EnvMap;
 
-use super::transport::TransferCodes;
+use super::transport::KeptRows;
 use crate::encoding::map_norm::MapNorm;
 use crate::network::encoder::LightInput;
 use crate::network::nprt_net::NprtNet;
@@ -27,10 +28,10 @@ pub struct HostCode {
     divisor: [f32; 3],
 }
 
-/// A camera's pixels on the host: their inputs and each track's ŝ.
+/// A camera's pixels on the host: their inputs and what a lighting change leaves of each track.
 pub struct HostRows {
     features: Vec<f32>,
-    transfer: TransferCodes,
+    kept: KeptRows,
 }
 
 impl CpuShading {
@@ -64,7 +65,7 @@ impl Shading for CpuShading {
 
     fn pixels(&self, features: &[f32]) -> HostRows {
         HostRows {
-            transfer: self.net.transfer_codes(features),
+            kept: self.net.kept_rows(features),
             features: features.to_vec(),
         }
     }
@@ -72,7 +73,7 @@ impl Shading for CpuShading {
     fn radiance(&self, rows: &HostRows, light: &HostCode) -> Vec<f32> {
         // Each channel: the map's divisor times the model's gain.
         let scale = std::array::from_fn(|k| light.divisor[k] * self.gain[k]);
-        (self.net).radiance(&rows.features, &light.code, scale, Some(&rows.transfer))
+        (self.net).radiance(&rows.features, &light.code, scale, Some(&rows.kept))
     }
 
     fn precision(&self) -> Precision {

@@ -26,7 +26,7 @@ pub use light_model::LightPass;
 pub use peak::{measured_peak, Peak};
 pub use radiance_cache::HostCacheSteps;
 pub use samples::Samples;
-pub use transport::{TransferCodes, TransportGradients};
+pub use transport::{KeptRows, TransportGradients};
 pub use unet::UnetBatch;
 
 /// The batch's mean `loss` and every parameter's gradient (a network of `net`'s shapes).

@@ -1,7 +1,8 @@
 //! The transport tracks of a design on the CPU engine: forward, the training loss and backward
 //! for a whole batch, block by block on all cores, given the light codes the light model made;
-//! and the radiance of a frame's pixels for one light code. A linear track's shading outputs
-//! are transfer coefficients, each term's value their dot product with the light code.
+//! and the radiance of a frame's pixels for one light code, from what a still camera keeps of
+//! each track ([`KeptRows`]). A linear track's shading outputs are transfer coefficients, each
+//! term's value their dot product with the light code.
 
 use rayon::prelude::*;
 
@@ -14,12 +15,16 @@ use crate::encoding::hash_grid;
 use crate::loss::Loss;
 use crate::network::design::TRANSPORT_CODE;
 use crate::network::encoder::CODE_SIZE;
+use crate::network::light_entry::LightEntry;
 use crate::network::mlp::Mlp;
 use crate::network::nprt_net::NprtNet;
 use crate::network::track::Track;
 use crate::parameters::Parameters;
 
+mod kept_rows;
 mod transfer_vectors;
+
+pub use kept_rows::KeptRows;
 
 /// Rows per block: small enough that a block's activations stay in the caches, large enough
 /// for efficient matrix products.
@@ -38,12 +43,6 @@ pub struct TransportGradients {
     pub tracks: Vec<Track>,
     /// Gradient at each view's light code, `views × code size`.
     pub codes: Vec<f32>,
-}
-
-/// Each track's transfer output ŝ (`rows × TRANSPORT_CODE`, empty without a transfer network)
-/// for a set of rows, such as a still camera's pixels.
-pub struct TransferCodes {
-    tracks: Vec<Vec<f32>>,
 }
 
 /// A track's state over one block; its buffers are reused from block to block, and kept by
@@ -116,20 +115,11 @@ impl Track {
         self.kind.inputs().len() + self.grid.as_ref().map_or(0, |_| hash_grid::OUTPUTS)
     }
 
-    /// The shading network's first-layer weight rows that multiply ê: after ŝ, or first for
-    /// the baseline (whose input is [ê, inputs]).
-    fn code_rows(&self) -> std::ops::Range<usize> {
-        match self.transfer {
-            Some(_) => TRANSPORT_CODE..TRANSPORT_CODE + CODE_SIZE,
-            None => 0..CODE_SIZE,
-        }
-    }
-
     /// The light code as the shading network's first layer reads it; None for a linear
     /// track, whose shading network does not see it.
     fn shared<'a>(&self, light: Lighting<'a>) -> Option<SharedInput<'a>> {
-        self.coefficients.is_none().then(|| SharedInput {
-            weight_rows: self.code_rows(),
+        self.light.code_rows().map(|weight_rows| SharedInput {
+            weight_rows,
             values: light.codes,
             group: light.view,
         })
@@ -192,9 +182,9 @@ impl Track {
         }
     }
 
-    /// Forward over `n` rows of `features` under `light`. `known` holds the transfer
-    /// network's outputs ŝ for these rows when they are known already (they do not depend on
-    /// the lighting).
+    /// Forward over `n` rows of `features` under `light`. `known` holds what a still camera
+    /// keeps of these rows ([`Self::kept_width`]) when it is known already: ŝ, or Φ's outputs
+    /// (neither depends on the lighting).
     fn forward(
         &self,
         features: &[f32],
@@ -204,24 +194,29 @@ impl Track {
         pass: &mut TrackPass,
         purpose: Pass,
     ) {
-        let shared = self.shared(light);
-        let shared = shared.as_ref();
-        let x = self.inputs(features, &mut pass.x, n);
-        match (&self.transfer, known) {
-            (Some(_), Some(s)) => {
-                let s = MatRef::new(s, n, TRANSPORT_CODE);
-                self.shading.forward(s, shared, &mut pass.shading, purpose);
+        let out = match known {
+            Some(outputs) if self.light.after_networks() => outputs,
+            _ => {
+                let shared = self.shared(light);
+                let shared = shared.as_ref();
+                let x = self.inputs(features, &mut pass.x, n);
+                match (&self.transfer, known) {
+                    (Some(_), Some(s)) => {
+                        let s = MatRef::new(s, n, TRANSPORT_CODE);
+                        self.shading.forward(s, shared, &mut pass.shading, purpose);
+                    }
+                    (Some(ft), None) => {
+                        ft.forward(x, None, &mut pass.transfer, purpose);
+                        let s = MatRef::new(pass.transfer.output(), n, TRANSPORT_CODE);
+                        self.shading.forward(s, shared, &mut pass.shading, purpose);
+                    }
+                    (None, _) => self.shading.forward(x, shared, &mut pass.shading, purpose),
+                }
+                pass.shading.output()
             }
-            (Some(ft), None) => {
-                ft.forward(x, None, &mut pass.transfer, purpose);
-                let s = MatRef::new(pass.transfer.output(), n, TRANSPORT_CODE);
-                self.shading.forward(s, shared, &mut pass.shading, purpose);
-            }
-            (None, _) => self.shading.forward(x, shared, &mut pass.shading, purpose),
-        }
+        };
         pass.terms.clear();
-        let out = pass.shading.output();
-        let Some(k) = self.coefficients else {
+        let LightEntry::Combine { k } = self.light else {
             pass.terms.extend(out.iter().map(|o| o.exp()));
             return;
         };
@@ -239,17 +234,6 @@ impl Track {
                 }
             }
         }
-    }
-
-    /// ŝ of the rows of `features` into `out` (`rows × TRANSPORT_CODE`), for a track with a
-    /// transfer network.
-    fn transfer_code(&self, ft: &Mlp, features: &[f32], out: &mut [f32]) {
-        with_passes(1, |passes| {
-            let pass = &mut passes[0];
-            let x = self.inputs(features, &mut pass.x, features.len() / FEATURES);
-            ft.forward(x, None, &mut pass.transfer, Pass::Infer);
-            out.copy_from_slice(pass.transfer.output());
-        })
     }
 
     /// Radiance of row `r` before the map's scale.
@@ -276,7 +260,7 @@ impl Track {
             .d_out
             .chunks_exact_mut(outs)
             .zip(pass.terms.chunks_exact(per_row));
-        let Some(k) = self.coefficients else {
+        let LightEntry::Combine { k } = self.light else {
             for (r, (d, e)) in rows.enumerate() {
                 let f = &features[r * FEATURES..];
                 self.kind.output_gradients(f, e, &dr[r * 3..r * 3 + 3], d);
@@ -421,9 +405,9 @@ impl NprtNet {
         total
     }
 
-    /// Multiply-adds × 2 of the dense layers per pixel: all of them, or (`transfer_known`) only
-    /// those a lighting change runs again. The light code's share of each shading network's
-    /// first layer, made once per lighting, is not counted.
+    /// Multiply-adds × 2 per pixel of the dense layers and a linear track's dot products: all
+    /// of them, or (`transfer_known`) only those a lighting change runs again. The light code's
+    /// share of each shading network's first layer, made once per lighting, is not counted.
     pub fn flops_per_pixel(&self, transfer_known: bool) -> f64 {
         let dense = |s: &Mlp| -> f64 {
             s.layers
@@ -435,49 +419,35 @@ impl NprtNet {
             .iter()
             .map(|t| {
                 let transfer = t.transfer.as_ref().map_or(0.0, dense);
-                let code = match t.coefficients {
-                    None => 2.0 * (CODE_SIZE * t.shading.layers[0].d_out) as f64,
-                    // No code in the first layer; the dot products with it instead.
-                    Some(_) => -2.0 * t.shading.d_out() as f64,
-                };
-                dense(&t.shading) - code + if transfer_known { 0.0 } else { transfer }
+                let unlit = if transfer_known { 0.0 } else { transfer };
+                match t.light {
+                    LightEntry::FirstLayer { .. } => {
+                        let code = 2.0 * (CODE_SIZE * t.shading.layers[0].d_out) as f64;
+                        dense(&t.shading) - code + unlit
+                    }
+                    // The dot products with the code; a still camera keeps Φ's outputs.
+                    LightEntry::Combine { .. } => {
+                        let dots = 2.0 * t.shading.d_out() as f64;
+                        dots + if transfer_known {
+                            0.0
+                        } else {
+                            dense(&t.shading) + unlit
+                        }
+                    }
+                }
             })
             .sum()
     }
 
-    /// Each track's ŝ for the rows of `features`: the part of the network a lighting change
-    /// leaves as it is (empty for the baseline, whose every layer sees the light code).
-    pub fn transfer_codes(&self, features: &[f32]) -> TransferCodes {
-        let n = features.len() / FEATURES;
-        // Written in place: collected block by block, the codes of a 512² frame (67 MB a
-        // track) were copied as the vector grew, into freshly mapped pages each time.
-        let tracks = self
-            .tracks
-            .iter()
-            .map(|t| {
-                let Some(ft) = &t.transfer else {
-                    return Vec::new();
-                };
-                let mut codes = vec![0.0; n * TRANSPORT_CODE];
-                codes
-                    .par_chunks_mut(BLOCK * TRANSPORT_CODE)
-                    .zip(features.par_chunks(BLOCK * FEATURES))
-                    .for_each(|(out, f)| t.transfer_code(ft, f, out));
-                codes
-            })
-            .collect();
-        TransferCodes { tracks }
-    }
-
     /// Radiance (`n × 3`) of the rows of `features` lit by one light `code` of a map normalised
-    /// by `scale`. With `known`, made by [`Self::transfer_codes`] from the same features, the
-    /// transfer networks are not run again.
+    /// by `scale`. With `known`, made by [`Self::kept_rows`] from the same features, what it
+    /// keeps is not run again.
     pub fn radiance(
         &self,
         features: &[f32],
         code: &[f32],
         scale: [f32; 3],
-        known: Option<&TransferCodes>,
+        known: Option<&KeptRows>,
     ) -> Vec<f32> {
         assert_eq!(code.len(), self.light.code_size());
         self.shade(features, code, None, &|_| scale, known)
@@ -499,7 +469,7 @@ impl NprtNet {
         codes: &[f32],
         view: Option<&[u32]>,
         scale: &(dyn Fn(usize) -> [f32; 3] + Sync),
-        known: Option<&TransferCodes>,
+        known: Option<&KeptRows>,
     ) -> Vec<f32> {
         let n = features.len() / FEATURES;
         let mut out = vec![0.0; n * 3];
@@ -514,9 +484,10 @@ impl NprtNet {
                         view: view.map_or(&ONE_GROUP[..rows], |v| &v[b * BLOCK..][..rows]),
                     };
                     for (k, (t, pass)) in self.tracks.iter().zip(passes.iter_mut()).enumerate() {
-                        let s = known.filter(|_| t.transfer.is_some()).map(|c| {
-                            &c.tracks[k][b * BLOCK * TRANSPORT_CODE..][..rows * TRANSPORT_CODE]
-                        });
+                        let w = t.kept_width();
+                        let s = known
+                            .filter(|_| w > 0)
+                            .map(|c| &c.tracks[k][b * BLOCK * w..][..rows * w]);
                         t.forward(f, light, rows, s, pass, Pass::Infer);
                         for r in 0..rows {
                             let c = t.radiance(pass, f, r);

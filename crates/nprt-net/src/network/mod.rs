@@ -6,6 +6,7 @@
 pub mod design;
 pub mod encoder;
 pub mod light_basis;
+pub mod light_entry;
 pub mod light_model;
 pub mod nprt_net;
 pub mod radiance_cache;

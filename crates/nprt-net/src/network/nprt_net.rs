@@ -6,6 +6,7 @@ use crate::network::activation::Activation;
 use crate::network::design::Design;
 use crate::network::encoder::LightEncoder;
 use crate::network::light_basis::{BasisChoice, LightBasis};
+use crate::network::light_entry::LightEntry;
 use crate::network::light_model::LightModel;
 use crate::network::track::Track;
 use crate::parameters::{child, Parameters, Visit, VisitMut};
@@ -56,9 +57,9 @@ impl NprtNet {
                 .layers
                 .last_mut()
                 .expect("a network has layers");
-            match track.coefficients {
-                None => last.bias.iter_mut().for_each(|b| *b += log_level),
-                Some(k) => {
+            match track.light {
+                LightEntry::FirstLayer { .. } => last.bias.iter_mut().for_each(|b| *b += log_level),
+                LightEntry::Combine { k } => {
                     let constant = (4.0 * std::f32::consts::PI).sqrt();
                     let t0 = log_level.exp() / (tracks * constant * 0.5);
                     for term in last.bias.chunks_exact_mut(3 * k) {

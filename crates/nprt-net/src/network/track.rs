@@ -6,7 +6,7 @@ use crate::encoding::position_encoding::PositionEncoding;
 use crate::init::Init;
 use crate::network::activation::Activation;
 use crate::network::design::{Design, Layout, TRANSPORT_CODE};
-use crate::network::encoder::CODE_SIZE;
+use crate::network::light_entry::LightEntry;
 use crate::network::mlp::Mlp;
 use crate::network::track_kind::TrackKind;
 use crate::parameters::{child, Parameters, Visit, VisitMut};
@@ -22,9 +22,10 @@ pub struct Track {
     pub transfer: Option<Mlp>,
     pub shading: Mlp,
     pub kind: TrackKind,
-    /// K for the linear design: Φ's outputs are K transfer coefficients per term and channel,
-    /// at (term·K + k)·3 + channel, dotted with the light code. None: they are log-radiance.
-    pub coefficients: Option<usize>,
+    /// Where the light code enters: Φ's first layer (its outputs log-radiance), or the
+    /// combine, Φ's outputs K transfer coefficients per term and channel at (term·K + k)·3 +
+    /// channel, dotted with the code (the linear design).
+    pub light: LightEntry,
 }
 
 impl Track {
@@ -39,9 +40,12 @@ impl Track {
         coefficients: usize,
     ) -> Self {
         let n_in = kind.inputs().len() + encoding.extra_inputs();
-        let coefficients = design.is_linear().then_some(coefficients);
-        let outputs = kind.outputs() * coefficients.unwrap_or(1);
-        let code = if design.is_linear() { 0 } else { CODE_SIZE };
+        let light = match design.is_linear() {
+            true => LightEntry::Combine { k: coefficients },
+            false => LightEntry::first_layer(design.has_transfer()),
+        };
+        let outputs = kind.outputs() * light.coefficients().max(1);
+        let code = light.code_inputs();
         let grid = match encoding {
             PositionEncoding::None => None,
             PositionEncoding::HashGrid => Some(HashGrid::new(init)),
@@ -57,7 +61,7 @@ impl Track {
                     transfer: None,
                     shading: Mlp::new(init, &widths, activation),
                     kind,
-                    coefficients,
+                    light,
                 }
             }
             Layout::Transfer { width: w } => Track {
@@ -69,7 +73,7 @@ impl Track {
                     Activation::Relu,
                 ),
                 kind,
-                coefficients,
+                light,
             },
         }
     }

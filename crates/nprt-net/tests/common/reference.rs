@@ -6,7 +6,7 @@ use nprt_net::encoding::hash_grid::{self, LEVEL_FEATURES};
 use nprt_net::network::light_model::LightModel;
 use nprt_net::network::mlp::Mlp;
 use nprt_net::network::track_kind::Weight;
-use nprt_net::{Activation, Batch, Loss, NprtNet, Parameters, FEATURES, OMEGA_0};
+use nprt_net::{Activation, Batch, LightEntry, Loss, NprtNet, Parameters, FEATURES, OMEGA_0};
 
 /// A network's structure and its weights in f64, one vector per tensor in visiting order.
 pub struct Reference<'a> {
@@ -168,7 +168,7 @@ impl<'a> Reference<'a> {
                     x.extend(enc);
                 }
                 let outputs = match &track.transfer {
-                    Some(ft) if track.coefficients.is_some() => {
+                    Some(ft) if matches!(track.light, LightEntry::Combine { .. }) => {
                         let s = mlp(ft, &mut t, x);
                         mlp(&track.shading, &mut t, s)
                     }
@@ -189,9 +189,9 @@ impl<'a> Reference<'a> {
                             Weight::One => 1.0,
                             Weight::Albedo(at) => f[at + c] as f64,
                         };
-                        let term = match track.coefficients {
-                            None => outputs[3 * k + c].exp(),
-                            Some(n) => (0..n)
+                        let term = match track.light {
+                            LightEntry::FirstLayer { .. } => outputs[3 * k + c].exp(),
+                            LightEntry::Combine { k: n } => (0..n)
                                 .map(|j| outputs[(k * n + j) * 3 + c] * code[j * 3 + c])
                                 .sum(),
                         };

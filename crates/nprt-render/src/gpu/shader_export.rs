@@ -11,11 +11,8 @@ use std::path::{Path, PathBuf};
 use anyhow::{bail, Context, Result};
 use nprt_net::encoding::hash_grid;
 use nprt_net::network::dense::Dense;
-use nprt_net::network::encoder::CODE_SIZE;
 use nprt_net::network::mlp::Mlp;
-use nprt_net::{
-    gbuffer_features, load_model, LightEncoder, LightModel, NprtNet, FEATURES, TRANSPORT_CODE,
-};
+use nprt_net::{gbuffer_features, load_model, LightEncoder, LightModel, NprtNet, FEATURES};
 use nprt_trace::{render_gbuffer, TraceScene};
 use serde_json::{json, Value};
 
@@ -168,13 +165,9 @@ impl WeightFile {
                     // Which weight rows of the shading network's first layer multiply the light
                     // code: after ŝ, or first for the baseline's [ê, inputs]; none for a
                     // linear track, whose shading network reads ŝ alone.
-                    "code_rows": match (t.coefficients, &t.transfer) {
-                        (Some(_), _) => None,
-                        (None, Some(_)) => Some([TRANSPORT_CODE, TRANSPORT_CODE + CODE_SIZE]),
-                        (None, None) => Some([0, CODE_SIZE]),
-                    },
+                    "code_rows": t.light.code_rows().map(|rows| [rows.start, rows.end]),
                     // A linear track's K transfer coefficients per term and channel.
-                    "coefficients": t.coefficients,
+                    "coefficients": (t.light.after_networks()).then(|| t.light.coefficients()),
                 })
             })
             .collect()

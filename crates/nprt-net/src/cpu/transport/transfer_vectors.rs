@@ -6,6 +6,7 @@
 use super::{Lighting, TrackPass, TransportGradients, Upstream};
 use crate::cpu::samples::Samples;
 use crate::encoding::features::FEATURES;
+use crate::network::light_entry::LightEntry;
 use crate::network::nprt_net::NprtNet;
 use crate::network::track::Track;
 
@@ -56,8 +57,12 @@ impl Track {
     /// The coefficients per channel of a linear track (only a linear track has transfer
     /// vectors to learn: training checks it before the first step).
     fn linear(&self) -> usize {
-        self.coefficients
-            .expect("transfer vectors are learned by the linear design's tracks")
+        match self.light {
+            LightEntry::Combine { k } => k,
+            LightEntry::FirstLayer { .. } => {
+                panic!("transfer vectors are learned by the linear design's tracks")
+            }
+        }
     }
 }
 

@@ -261,8 +261,10 @@ impl GpuNetwork {
         }
     }
 
-    /// Records what track `t` keeps of `n` rows of `features` for every lighting: its
-    /// inputs, gathered (in f16 where the workspace is), or its transfer network's output ŝ.
+    /// Records what track `t` keeps of `n` rows of `features` for every lighting, everything
+    /// before the light enters: what its shading network reads (its inputs gathered, or its
+    /// transfer network's output ŝ; in f16 where the workspace is) or, where the light enters
+    /// at the combine, the shading network's outputs (f32).
     fn kept_rows(
         &self,
         pass: &mut wgpu::ComputePass,
@@ -303,6 +305,25 @@ impl GpuNetwork {
                 transfer.record_forward(gpu, &mut list, params, x, n, first, &to);
             }
         }
+        if t.light.after_networks() {
+            let out = self
+                .pool
+                .take_pooled(gpu, n * t.shading.layers.last().expect("layers").d_out);
+            let first = FirstLayer {
+                own_row: t.light.own_row(),
+                count: t.own_width(),
+                bias: Bias::Column(params, t.shading.layers[0].bias.offset),
+            };
+            let to = work.targets(&t.shading, Held::F32(&out));
+            let x = work.held(&kept);
+            (t.shading).record_forward(gpu, &mut list, params, x, n, first, &to);
+            for d in list {
+                d.record(pass);
+            }
+            // What the shading network read goes back to the pool: the pass reads it before
+            // any later dispatch can write it.
+            return out;
+        }
         for d in list {
             d.record(pass);
         }
@@ -331,8 +352,9 @@ impl GpuNetwork {
     }
 
     /// What a lighting change runs on `px`, prepared at its first: each track's shading
-    /// network with the light code's share folded into its first bias, then the combination
-    /// into radiance (times the map's divisor and the gain), all reading the light slot.
+    /// network with the light code's share folded into its first bias (none where the light
+    /// enters at the combine: its outputs are kept), then the combination into radiance (times
+    /// the map's divisor and the gain), all reading the light slot.
     fn relight_dispatches<'p>(&self, px: &'p GpuPixels) -> &'p [Dispatch] {
         assert_eq!(
             px.network, self.id,
@@ -352,7 +374,7 @@ impl GpuNetwork {
         let params = &self.params;
         // b' = b + ê·W[code rows]: the light slot's code through the first layer's code rows.
         for (t, bias) in self.net.tracks.iter().zip(&self.biases) {
-            if t.coefficients.is_none() {
+            if t.light.code_rows().is_some() {
                 list.push(t.record_code_share(gpu, params, &self.light, 1, bias));
             }
         }
@@ -361,15 +383,14 @@ impl GpuNetwork {
                 .zip(&chunk.kept)
                 .zip(self.biases.iter().zip(&px.work.outputs))
             {
+                if t.light.after_networks() {
+                    continue;
+                }
                 // [ŝ, ê] (ŝ's rows first), or the baseline's [ê, inputs].
-                let bias = match t.coefficients {
-                    None => Bias::Column(bias, 0),
-                    Some(_) => Bias::Column(params, t.shading.layers[0].bias.offset),
-                };
                 let first = FirstLayer {
-                    own_row: t.code_and_own_rows().1,
+                    own_row: t.light.own_row(),
                     count: t.own_width(),
-                    bias,
+                    bias: Bias::Column(bias, 0),
                 };
                 let to = px.work.targets(&t.shading, Held::F32(out));
                 let x = px.work.held(kept);
@@ -378,7 +399,11 @@ impl GpuNetwork {
             // The tracks' radiance summed into rgb one track per dispatch (any number of
             // tracks), the last multiplied by the map's divisor and the model's gain.
             let n = self.net.tracks.len();
-            for (k, (t, out)) in self.net.tracks.iter().zip(&px.work.outputs).enumerate() {
+            let outputs = (self.net.tracks.iter())
+                .zip(&px.work.outputs)
+                .zip(&chunk.kept);
+            for (k, ((t, out), kept)) in outputs.enumerate() {
+                let out = if t.light.after_networks() { kept } else { out };
                 let params = [
                     chunk.rows,
                     t.kind.code() as usize,
@@ -386,7 +411,7 @@ impl GpuNetwork {
                     usize::from(k + 1 == n),
                     chunk.first,
                     self.net.light.code_size(),
-                    t.coefficients.unwrap_or(0),
+                    t.light.coefficients(),
                     0,
                 ];
                 // One code for every row (code_stride 0): the views binding is not read.

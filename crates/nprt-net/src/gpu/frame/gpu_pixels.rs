@@ -21,7 +21,7 @@ pub(super) struct Workspace {
     /// padded to a multiple of 256 and columns to 16).
     pub(super) f32: [wgpu::Buffer; 2],
     pub(super) f16: Option<[wgpu::Buffer; 2]>,
-    /// Each track's shading outputs.
+    /// Each track's shading outputs (where a lighting change runs its shading network).
     pub(super) outputs: Vec<wgpu::Buffer>,
 }
 
@@ -83,8 +83,9 @@ pub(super) struct PixelChunk {
     pub(super) first: usize,
     pub(super) rows: usize,
     pub(super) features: PooledBuffer,
-    /// Per track, what its shading network's first layer reads besides the light code: ŝ
-    /// (`rows × TRANSPORT_CODE`) or, for the baseline, the gathered inputs (`rows × width`);
-    /// in f16 where the networks run in half precision.
+    /// Per track, what a lighting change leaves as it is: what its shading network's first
+    /// layer reads besides the light code, ŝ (`rows × TRANSPORT_CODE`) or, for the baseline,
+    /// the gathered inputs (`rows × width`), in f16 where the networks run in half precision;
+    /// or, where the light enters at the combine, the shading network's outputs (f32).
     pub(super) kept: Vec<PooledBuffer>,
 }

@@ -327,7 +327,9 @@ impl TrackAt {
         out: &wgpu::Buffer,
     ) -> Dispatch {
         let first = &self.shading.layers[0];
-        let (code_row, _) = self.code_and_own_rows();
+        let code_row = (self.light.code_rows())
+            .expect("a track whose shading network reads the light code")
+            .start;
         gpu.product(
             [lights, first.d_out, CODE_SIZE],
             Operand::plain(codes, 0, CODE_SIZE),

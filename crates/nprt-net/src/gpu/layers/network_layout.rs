@@ -11,6 +11,7 @@ use crate::gpu::products::half_layers::{half_weight_halves, pad16, HalfLayers, H
 use crate::network::activation::Activation;
 use crate::network::design::TRANSPORT_CODE;
 use crate::network::encoder::CODE_SIZE;
+use crate::network::light_entry::LightEntry;
 use crate::network::light_model::LightModel;
 use crate::network::mlp::Mlp;
 use crate::network::nprt_net::NprtNet;
@@ -116,9 +117,8 @@ impl LightAt {
 /// One track's networks on the device.
 pub struct TrackAt {
     pub kind: TrackKind,
-    /// The linear design's K transfer coefficients per term and channel (its shading network
-    /// reads ŝ alone and its terms are dot products with the code); None for the paper's.
-    pub coefficients: Option<usize>,
+    /// Where the light code enters (the track's, see [`LightEntry`]).
+    pub light: LightEntry,
     /// The feature indices the track reads, in its input order.
     pub index: wgpu::Buffer,
     pub count: usize,
@@ -130,16 +130,6 @@ pub struct TrackAt {
 }
 
 impl TrackAt {
-    /// The shading network's first weight row that multiplies the light code, and the first
-    /// that multiplies the per-row input: [ŝ, ê] after a transfer network, [ê, inputs] for the
-    /// baseline.
-    pub fn code_and_own_rows(&self) -> (usize, usize) {
-        match self.transfer {
-            Some(_) => (TRANSPORT_CODE, 0),
-            None => (0, CODE_SIZE),
-        }
-    }
-
     /// Width of the shading network's per-row input.
     pub fn own_width(&self) -> usize {
         match self.transfer {
@@ -176,7 +166,7 @@ impl NetworkLayout {
                 let transfer = t.transfer.as_ref().map(|s| mlp_at(s, &mut spans));
                 TrackAt {
                     kind: t.kind,
-                    coefficients: t.coefficients,
+                    light: t.light,
                     index: gpu.upload(&index),
                     count: index.len(),
                     width: index.len() + grid.map_or(0, |_| hash_grid::OUTPUTS),
@@ -198,8 +188,7 @@ impl NetworkLayout {
     /// multiplies, every other layer whole.
     pub fn hold_half(&mut self, gpu: &GpuDevice) {
         for t in &mut self.tracks {
-            let (_, own_row) = t.code_and_own_rows();
-            let own = [own_row, t.own_width()];
+            let own = [t.light.own_row(), t.own_width()];
             if let Some(m) = &mut t.transfer {
                 m.hold_half(gpu, [0, t.width]);
             }

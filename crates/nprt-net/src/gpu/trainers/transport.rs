@@ -84,7 +84,7 @@ impl GpuTrainer {
                 0,
                 0,
                 0,
-                t.coefficients.unwrap_or(0),
+                t.light.coefficients(),
                 code_size,
             ];
             plan.push(self.gpu.prepare(
@@ -170,11 +170,11 @@ impl GpuTrainer {
         );
         let d_row_codes = learned.then(|| self.gpu.buffer(b.rows * code_size));
         for (t, tape) in self.net.tracks.iter().zip(tapes) {
-            let d_rows = d_row_codes.as_ref().filter(|_| t.coefficients.is_some());
+            let d_rows = d_row_codes.as_ref().filter(|_| t.light.after_networks());
             let params = [
                 b.rows,
                 t.kind.code() as usize,
-                t.coefficients.unwrap_or(0),
+                t.light.coefficients(),
                 code_size,
                 usize::from(d_rows.is_some()),
                 usize::from(b.transfer.is_some()),
@@ -229,18 +229,18 @@ impl GpuTrainer {
         // shading network reads ŝ alone).
         let first = &t.shading.layers[0];
         let group_bias;
-        let bias = match t.coefficients {
-            None => {
+        let bias = match t.light.code_rows() {
+            Some(_) => {
                 group_bias = gpu.buffer(b.views * first.d_out);
                 plan.push(t.record_code_share(gpu, params, &b.codes, b.views, &group_bias));
                 Bias::Group(&group_bias, &b.view)
             }
-            Some(_) => Bias::Column(params, first.bias.offset),
+            None => Bias::Column(params, first.bias.offset),
         };
         let shading = MlpTape::new(&self.gpu, &t.shading, rows);
         let input = transfer.as_ref().map_or(&x, |tape| &tape.output);
         let first_layer = FirstLayer {
-            own_row: t.code_and_own_rows().1,
+            own_row: t.light.own_row(),
             count: t.own_width(),
             bias,
         };
@@ -266,7 +266,8 @@ impl GpuTrainer {
     ) {
         let gpu = &self.gpu;
         let first = &t.shading.layers[0];
-        let (code_row, own_row) = t.code_and_own_rows();
+        let own_row = t.light.own_row();
+        let code_row = t.light.code_rows().map_or(0, |rows| rows.start);
         let code_weights = first.weight.offset + code_row * first.d_out;
         // The shading network's input gradient: at ŝ, or at the baseline's inputs (needed only
         // to train its grid).
@@ -316,7 +317,7 @@ impl GpuTrainer {
             (input, own_row, t.own_width()),
             &tape.d_out,
             d_input,
-            t.coefficients.is_none().then_some(&view_sums),
+            t.light.code_rows().map(|_| &view_sums),
         );
         if let (Some(m), Some(tr), Some(d_s)) = (&t.transfer, &tape.transfer, &d_s) {
             self.trainable().mlp_backward(

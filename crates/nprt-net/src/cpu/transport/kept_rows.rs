@@ -1,0 +1,82 @@
+//! What a lighting change leaves as it is of a design's tracks on the CPU engine: for a still
+//! camera's rows, everything each track computes before the light enters (ŝ behind a transfer
+//! network, or a linear track's transfer coefficients), kept and read back by every lighting.
+
+use rayon::prelude::*;
+
+use super::{with_passes, BLOCK};
+use crate::cpu::dense::Pass;
+use crate::cpu::matmul::MatRef;
+use crate::encoding::features::FEATURES;
+use crate::network::design::TRANSPORT_CODE;
+use crate::network::nprt_net::NprtNet;
+use crate::network::track::Track;
+
+/// What a lighting change leaves as it is of each track, for a set of rows such as a still
+/// camera's pixels: everything before the light enters ([`Track::kept_width`] values a row).
+pub struct KeptRows {
+    pub(super) tracks: Vec<Vec<f32>>,
+}
+
+impl Track {
+    /// Values per row a still camera keeps of this track: Φ's outputs where the light enters
+    /// at the combine, ŝ where it enters Φ behind a transfer network, none where Φ reads the
+    /// inputs and the code together (the baseline).
+    pub fn kept_width(&self) -> usize {
+        match (self.light.after_networks(), &self.transfer) {
+            (true, _) => self.shading.d_out(),
+            (false, Some(_)) => TRANSPORT_CODE,
+            (false, None) => 0,
+        }
+    }
+
+    /// What a still camera keeps of the rows of `features`, into `out` (`rows ×`
+    /// [`Self::kept_width`]): the networks run up to where the light enters.
+    fn kept_block(&self, features: &[f32], out: &mut [f32]) {
+        with_passes(1, |passes| {
+            let pass = &mut passes[0];
+            let n = features.len() / FEATURES;
+            let x = self.inputs(features, &mut pass.x, n);
+            let s = match &self.transfer {
+                Some(ft) => {
+                    ft.forward(x, None, &mut pass.transfer, Pass::Infer);
+                    MatRef::new(pass.transfer.output(), n, TRANSPORT_CODE)
+                }
+                None => x,
+            };
+            if self.light.after_networks() {
+                self.shading
+                    .forward(s, None, &mut pass.shading, Pass::Infer);
+                out.copy_from_slice(pass.shading.output());
+            } else {
+                out.copy_from_slice(s.data);
+            }
+        })
+    }
+}
+
+impl NprtNet {
+    /// What a lighting change leaves as it is of each track for the rows of `features`: ŝ,
+    /// or a linear track's Φ outputs (nothing for the baseline, whose every layer sees the
+    /// light code).
+    pub fn kept_rows(&self, features: &[f32]) -> KeptRows {
+        let n = features.len() / FEATURES;
+        // Written in place: collected block by block, the codes of a 512² frame (67 MB a
+        // track) were copied as the vector grew, into freshly mapped pages each time.
+        let tracks = self
+            .tracks
+            .iter()
+            .map(|t| {
+                let width = t.kept_width();
+                let mut kept = vec![0.0; n * width];
+                if width > 0 {
+                    kept.par_chunks_mut(BLOCK * width)
+                        .zip(features.par_chunks(BLOCK * FEATURES))
+                        .for_each(|(out, f)| t.kept_block(f, out));
+                }
+                kept
+            })
+            .collect();
+        KeptRows { tracks }
+    }
+}
