@@ -160,32 +160,34 @@ async function main() {
   if (toCode) denseLayer(pass, toCode, x, 1, toCode.dIn, 0, toCode.bias, 0, code);
 
   // 2. What does not depend on the lighting (once per camera): each track's inputs and, where
-  // it has one, its transfer network's output ŝ.
-  const kept = tracks.map((t) => {
+  // it has one, its transfer network's output ŝ; for a linear track, whose shading network
+  // does not read the code, that network's outputs too (its transfer coefficients).
+  const kept = tracks.map((t, i) => {
     const inputs = t.transfer ? scratch[0] : room(rows * t.width);
     dispatch(pass, 'track_inputs', { rows, count: t.count, width: t.width, grid: t.grid ? 1 : 0 },
       [features, t.index, t.grid ?? empty, resolutions, inputs], groups('track_inputs', rows));
-    if (!t.transfer) return inputs;
-    const s = room(rows * t.transfer.layers.at(-1).dOut);
-    runMlp(pass, t.transfer, inputs, rows, { dIn: t.width, wRow: 0 }, scratch, s);
+    let s = inputs;
+    if (t.transfer) {
+      s = room(rows * t.transfer.layers.at(-1).dOut);
+      runMlp(pass, t.transfer, inputs, rows, { dIn: t.width, wRow: 0 }, scratch, s);
+    }
+    if (!t.codeRows) {
+      runMlp(pass, t.shading, s, rows, { dIn: t.shading.layers[0].dIn, wRow: 0 }, scratch, outputs[i]);
+    }
     return s;
   });
   pass.end();
   device.queue.submit([encoder.finish()]);
 
   // 3. Per lighting: the code's share of each shading network's first layer, the shading
-  // networks, and exp (or, for a linear track, the dot products of its transfer coefficients
-  // with the code), kd/ks and the map's scale (combine.wgsl).
+  // networks, and exp (or, for a linear track, the dot products of its kept transfer
+  // coefficients with the code), kd/ks and the map's scale (combine.wgsl).
   const relight = () => {
     const encoder = device.createCommandEncoder();
     const pass = encoder.beginComputePass();
     tracks.forEach((t, i) => {
       const first = t.shading.layers[0];
-      if (!t.codeRows) {
-        // A linear track's shading network reads ŝ alone.
-        runMlp(pass, t.shading, kept[i], rows, { dIn: first.dIn, wRow: 0 }, scratch, outputs[i]);
-        return;
-      }
+      if (!t.codeRows) return;
       const bias = room(first.dOut);
       // b' = b + ê·W[code rows]: the first layer's code rows over one row.
       denseLayer(pass, first, code, 1, codeSize, t.codeRows[0], first.bias, 0, bias);
