@@ -177,6 +177,9 @@ impl<'a> Reference<'a> {
                         s.extend_from_slice(code);
                         mlp(&track.shading, &mut t, s)
                     }
+                    None if matches!(track.light, LightEntry::Combine { .. }) => {
+                        mlp(&track.shading, &mut t, x)
+                    }
                     None => {
                         let mut input = code.clone();
                         input.extend(x);

@@ -1,4 +1,4 @@
-//! The transport designs: the paper's four (its Table 1) and the linear design beyond them. One file per
+//! The transport designs: the paper's four (its Table 1) and the linear designs beyond them. One file per
 //! design states everything that is its own ([`DesignSpec`]): its tracks, its networks' sizes,
 //! its default activation, the paper's parameter count and the measured learning rate; the
 //! networks, the engines and the training recipe read it from there.
@@ -7,6 +7,7 @@ mod albedo;
 mod baseline;
 mod dsep;
 mod linear;
+mod linear_direct;
 mod prt;
 
 use crate::choice::named_choice;
@@ -58,6 +59,9 @@ pub enum Design {
     /// Beyond the paper: D/S's tracks, each Φ(ŝ) a transfer matrix dotted with the map's
     /// projection on a basis; exact under any gain or mixture of maps.
     Linear,
+    /// Beyond the paper: the linear design with one MLP per track from the inputs to the
+    /// transfer matrix (no ŝ).
+    LinearDirect,
 }
 
 named_choice!(Design, "design", {
@@ -66,6 +70,7 @@ named_choice!(Design, "design", {
     Albedo => "albedo",
     Dsep => "dsep",
     Linear => "linear",
+    LinearDirect => "linear-direct",
 });
 
 impl Design {
@@ -80,6 +85,7 @@ impl Design {
             Design::Albedo => &albedo::SPEC,
             Design::Dsep => &dsep::SPEC,
             Design::Linear => &linear::SPEC,
+            Design::LinearDirect => &linear_direct::SPEC,
         }
     }
 
