@@ -4,7 +4,8 @@
 //! file, the named choices' parsing, and their CPU kernels (blocked matrix products through
 //! gemm, fused bias and activation passes, vectorised sin/cos, convolutions as products,
 //! pooling); with the `gpu` feature, the matrix products on the device (f32 and f16, on tensor
-//! cores where the adapter has them) and their WGSL. It must not know a design, a track, a
+//! cores where the adapter has them), the convolutions and pools with their adjoints, where a
+//! layer's tensors lie in a flat parameter buffer, and their WGSL. It must not know a design, a track, a
 //! light model, a dataset or a frame: nprt-net builds those on it.
 
 pub mod choice;

@@ -1,8 +1,9 @@
 //! The engine's kernels, by name: the matrix products (f32 with gemm's epilogues, and on f16
 //! operands with tensor cores and without: a dense layer, a whole MLP, a training step's
 //! forward, input-gradient and weight-gradient products, the weights' f16 copies), the chunks
-//! of a split product added, and Adam. Each is its file in `shaders/` (`products`,
-//! `optimiser`) after the shared files it names, by [`crate::kernel!`].
+//! of a split product added, convolutions and pools with their adjoints, and Adam. Each is its
+//! file in `shaders/` (`products`, `convolutions`, `optimiser`) after the shared files it
+//! names, by [`crate::kernel!`].
 
 use nprt_gpu::KernelSource;
 
@@ -55,3 +56,23 @@ pub const HALF_WEIGHT_GRAD_COOP: KernelSource = kernel!(
 
 /// Rows and columns of the tile a `gemm` workgroup computes.
 pub const GEMM_TILE: u32 = 128;
+
+/// Convolutional layers (nprt-net's U-Net and light encoder): convolutions, pools, the
+/// U-Net's decoder inputs and bottleneck offsets, and their adjoints.
+pub const CONV_FORWARD: KernelSource = kernel!(convolutions / "conv_forward");
+pub const MAX_POOL: KernelSource = kernel!(convolutions / "max_pool");
+pub const POOL_BACKWARD: KernelSource = kernel!(convolutions / "pool_backward");
+pub const UPSAMPLE_CONCAT: KernelSource =
+    kernel!(convolutions / "upsample_concat", convolutions / "upsample");
+pub const UPSAMPLE_BACKWARD: KernelSource = kernel!(
+    convolutions / "upsample_backward",
+    convolutions / "upsample"
+);
+pub const PLANE_OFFSET: KernelSource = kernel!(convolutions / "plane_offset");
+pub const OFFSET_BACKWARD: KernelSource = kernel!(convolutions / "offset_backward");
+/// A convolution's gradients: at its input (the light encoder's and the U-Net's), and of its
+/// weights and biases, per chunk of image rows.
+pub const CONV_INPUT_BACKWARD: KernelSource = kernel!(convolutions / "conv_input_backward");
+/// Threads `conv_input_backward` takes per input value: one per quarter of the channels.
+pub const CONV_INPUT_BACKWARD_THREADS: usize = 4;
+pub const CONV_WEIGHT_BACKWARD: KernelSource = kernel!(convolutions / "conv_weight_backward");

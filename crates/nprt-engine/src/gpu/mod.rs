@@ -2,10 +2,13 @@
 //! f32 (`products::dense_products`, gemm's epilogues) and on f16 operands
 //! (`products::half_layers`: the f16 weight layout, rows padded to 16, and the product on
 //! tensor cores where the adapter has them; `products::half_mlp`: a whole MLP's forward pass in
-//! one dispatch), with the codes the shaders read for activations and losses; and the kernel
-//! list with Adam's. The CPU's twin is `cpu/matmul.rs`.
+//! one dispatch), with the codes the shaders read for activations and losses; the layers
+//! that are not a design's own (`layers`: where a dense layer's or a convolution's tensors lie
+//! in a flat parameter buffer, convolutions and pooling with their adjoints, gradients summed
+//! over chunks of rows); and the kernel list with Adam's. The CPU's twin is `cpu/matmul.rs`.
 
 pub mod kernels;
+pub mod layers;
 pub mod products;
 
 pub use nprt_gpu::KernelSource;

@@ -1,11 +1,11 @@
 //! The networks' kernels, by name: the light encoder's blocks, the track inputs (with the hash
 //! grid's encoding), the combination into radiance, which the frame path dispatches too, the
 //! inputs made from a G-buffer on the device (the frame path's), the losses, the U-Net's
-//! layers, and the training step's own, its batch gathered from a dataset on the device among
-//! them; beside nprt-engine's (the matrix products and Adam), re-exported here. A kernel's
-//! source is its file in `shaders/`, in a folder by concept (`networks`: the tracks'
-//! combination; `encodings`: the inputs and the hash grid; `light`: the light models;
-//! `losses`; `convolutions`: the U-Net's and the light encoder's), after the shared files it
+//! loss, and the training step's own, its batch gathered from a dataset on the device among
+//! them; beside nprt-engine's (the matrix products, the convolutions and pools, and Adam),
+//! re-exported here. A kernel's source is its file in `shaders/`, in a folder by concept
+//! (`networks`: the tracks' combination; `encodings`: the inputs and the hash grid; `light`:
+//! the light models; `losses`), after the shared files it
 //! names (WGSL has no includes; [`nprt_engine::kernel!`]); those that read the track kinds
 //! begin with their table, generated from `TrackKind` at first use.
 
@@ -15,19 +15,13 @@ use crate::network::track_kind::kind_table_wgsl;
 use nprt_engine::kernel;
 use nprt_gpu::KernelSource;
 
-// The products' and Adam's kernels, nprt-engine's, beside these.
+// The products', the convolutions' and Adam's kernels, nprt-engine's, beside these.
 pub use nprt_engine::gpu::kernels::*;
 
 pub const ENCODER_BLOCK: KernelSource = kernel!(light / "encoder_block");
 /// Threads `encoder_block` takes per output value: one per slot of its pooling window.
 pub const ENCODER_BLOCK_THREADS: usize = 4;
 pub const ENCODER_POOL_BACKWARD: KernelSource = kernel!(light / "encoder_pool_backward");
-/// A convolution's gradients: at its input (the light encoder's and the U-Net's), and of its
-/// weights and biases, per chunk of image rows.
-pub const CONV_INPUT_BACKWARD: KernelSource = kernel!(convolutions / "conv_input_backward");
-/// Threads `conv_input_backward` takes per input value: one per quarter of the channels.
-pub const CONV_INPUT_BACKWARD_THREADS: usize = 4;
-pub const CONV_WEIGHT_BACKWARD: KernelSource = kernel!(convolutions / "conv_weight_backward");
 pub const TRACK_INPUTS: KernelSource = kernel!(encodings / "track_inputs", encodings / "hash_grid");
 pub const GRID_BACKWARD: KernelSource =
     kernel!(encodings / "grid_backward", encodings / "hash_grid");
@@ -57,19 +51,7 @@ pub const GATHER_SAMPLES: KernelSource =
 pub const GBUFFER_FEATURES: KernelSource =
     kernel!(encodings / "gbuffer_features", encodings / "pixel_features");
 
-/// The Deep Shading U-Net's layers (`unet_pass`): its convolutions, pools, decoder inputs,
-/// bottleneck offsets and loss, and their adjoints.
-pub const CONV_FORWARD: KernelSource = kernel!(convolutions / "conv_forward");
-pub const MAX_POOL: KernelSource = kernel!(convolutions / "max_pool");
-pub const POOL_BACKWARD: KernelSource = kernel!(convolutions / "pool_backward");
-pub const UPSAMPLE_CONCAT: KernelSource =
-    kernel!(convolutions / "upsample_concat", convolutions / "upsample");
-pub const UPSAMPLE_BACKWARD: KernelSource = kernel!(
-    convolutions / "upsample_backward",
-    convolutions / "upsample"
-);
-pub const PLANE_OFFSET: KernelSource = kernel!(convolutions / "plane_offset");
-pub const OFFSET_BACKWARD: KernelSource = kernel!(convolutions / "offset_backward");
+/// The Deep Shading U-Net's loss (its layers are nprt-engine's).
 pub const UNET_LOSS: KernelSource = kernel!(losses / "unet_loss", losses / "loss_element");
 
 /// `kernel` after the track kinds' table, made once per process (a kernel's source lives as

@@ -1,8 +1,8 @@
 //! Where a layer's tensors lie in a network's flat parameter buffers (`ParameterLayout`), and
 //! its shape: what every recorded dispatch addresses a layer by.
 
-use crate::network::conv::Conv;
-use crate::network::dense::Dense;
+use crate::layers::conv::Conv;
+use crate::layers::dense::Dense;
 use nprt_gpu::Span;
 
 /// One dense layer's place in the flat buffers.
