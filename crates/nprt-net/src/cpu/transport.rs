@@ -200,18 +200,12 @@ impl Track {
                 let shared = self.shared(light);
                 let shared = shared.as_ref();
                 let x = self.inputs(features, &mut pass.x, n);
-                match (&self.transfer, known) {
-                    (Some(_), Some(s)) => {
-                        let s = MatRef::new(s, n, TRANSPORT_CODE);
-                        self.shading.forward(s, shared, &mut pass.shading, purpose);
-                    }
-                    (Some(ft), None) => {
-                        ft.forward(x, None, &mut pass.transfer, purpose);
-                        let s = MatRef::new(pass.transfer.output(), n, TRANSPORT_CODE);
-                        self.shading.forward(s, shared, &mut pass.shading, purpose);
-                    }
-                    (None, _) => self.shading.forward(x, shared, &mut pass.shading, purpose),
-                }
+                // A known ŝ (only a track with a transfer network keeps one before Φ).
+                let s = match known {
+                    Some(s) => MatRef::new(s, n, TRANSPORT_CODE),
+                    None => self.shading_input(x, &mut pass.transfer, purpose),
+                };
+                self.shading.forward(s, shared, &mut pass.shading, purpose);
                 pass.shading.output()
             }
         };
@@ -233,6 +227,18 @@ impl Track {
                     *v = (0..k).map(|j| coeffs[j * 3 + c] * code[j * 3 + c]).sum();
                 }
             }
+        }
+    }
+
+    /// What Φ reads per row of the inputs `x`: ŝ, run through the transfer network on `tape`,
+    /// or `x` itself where there is none.
+    fn shading_input<'a>(&self, x: MatRef<'a>, tape: &'a mut Tape, purpose: Pass) -> MatRef<'a> {
+        match &self.transfer {
+            Some(ft) => {
+                ft.forward(x, None, tape, purpose);
+                MatRef::new(tape.output(), x.rows, TRANSPORT_CODE)
+            }
+            None => x,
         }
     }
 
@@ -427,12 +433,8 @@ impl NprtNet {
                     }
                     // The dot products with the code; a still camera keeps Φ's outputs.
                     LightEntry::Combine { .. } => {
-                        let dots = 2.0 * t.shading.d_out() as f64;
-                        dots + if transfer_known {
-                            0.0
-                        } else {
-                            dense(&t.shading) + unlit
-                        }
+                        let networks = dense(&t.shading) + transfer;
+                        2.0 * t.shading.d_out() as f64 + if transfer_known { 0.0 } else { networks }
                     }
                 }
             })

@@ -6,7 +6,6 @@ use rayon::prelude::*;
 
 use super::{with_passes, BLOCK};
 use crate::cpu::dense::Pass;
-use crate::cpu::matmul::MatRef;
 use crate::encoding::features::FEATURES;
 use crate::network::design::TRANSPORT_CODE;
 use crate::network::nprt_net::NprtNet;
@@ -37,13 +36,7 @@ impl Track {
             let pass = &mut passes[0];
             let n = features.len() / FEATURES;
             let x = self.inputs(features, &mut pass.x, n);
-            let s = match &self.transfer {
-                Some(ft) => {
-                    ft.forward(x, None, &mut pass.transfer, Pass::Infer);
-                    MatRef::new(pass.transfer.output(), n, TRANSPORT_CODE)
-                }
-                None => x,
-            };
+            let s = self.shading_input(x, &mut pass.transfer, Pass::Infer);
             if self.light.after_networks() {
                 self.shading
                     .forward(s, None, &mut pass.shading, Pass::Infer);

@@ -305,7 +305,8 @@ impl GpuNetwork {
                 transfer.record_forward(gpu, &mut list, params, x, n, first, &to);
             }
         }
-        if t.light.after_networks() {
+        // Where the light enters at the combine, Φ runs here too and its outputs are kept.
+        let outputs = t.light.after_networks().then(|| {
             let out = self
                 .pool
                 .take_pooled(gpu, n * t.shading.layers.last().expect("layers").d_out);
@@ -317,17 +318,14 @@ impl GpuNetwork {
             let to = work.targets(&t.shading, Held::F32(&out));
             let x = work.held(&kept);
             (t.shading).record_forward(gpu, &mut list, params, x, n, first, &to);
-            for d in list {
-                d.record(pass);
-            }
-            // What the shading network read goes back to the pool: the pass reads it before
-            // any later dispatch can write it.
-            return out;
-        }
+            out
+        });
         for d in list {
             d.record(pass);
         }
-        kept
+        // Then what Φ read goes back to the pool: the pass reads it before any later dispatch
+        // can write it.
+        outputs.unwrap_or(kept)
     }
 
     /// The workspace for blocks of `rows` rows of activations at most `widest` wide: the kept
