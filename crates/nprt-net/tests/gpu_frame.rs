@@ -123,7 +123,7 @@ fn three_tracks_shade_as_on_the_cpu_engine() {
         kind,
         Activation::Siren,
         PositionEncoding::None,
-        0,
+        Design::Dsep.entries(0)[0],
     );
     net.tracks.push(third);
     let (divisor, gain) = ([0.5, 3.0, 1.0], [4.0, 1.0, 0.5]);

@@ -124,7 +124,7 @@ fn three_tracks() -> NprtNet {
         kind,
         Activation::Siren,
         encoding,
-        0,
+        Design::Dsep.entries(0)[0],
     );
     net.tracks.push(third);
     net

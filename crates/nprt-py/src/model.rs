@@ -225,7 +225,7 @@ impl Model {
                     .forward(&input.pixels, input.width)
                     .codes()
                     .to_vec();
-                anyhow::Ok((code, input.scale, file.config.design.is_linear()))
+                anyhow::Ok((code, input.scale, file.config.design.reads_basis()))
             })
             .or_py()?;
         let out = PyDict::new(py);

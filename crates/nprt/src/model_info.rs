@@ -95,7 +95,7 @@ fn info(a: ModelInfoArgs) -> Result<()> {
 
 fn print_description(s: &ModelSummary) {
     let config = &s.config;
-    let light = match config.design.is_linear() {
+    let light = match config.design.reads_basis() {
         true => format!("light basis {} on a", config.light_basis()),
         false => "light encoder input".into(),
     };

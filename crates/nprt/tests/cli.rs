@@ -641,7 +641,9 @@ fn the_ab_script_times_two_builds_side_by_side() {
         "{table}{}",
         String::from_utf8_lossy(&out.stderr)
     );
-    let row = table.lines().find(|l| l.starts_with("| linear | f32 | 64 |"));
+    let row = table
+        .lines()
+        .find(|l| l.starts_with("| linear | f32 | 64 |"));
     let cells: Vec<&str> = row
         .expect("a row for linear")
         .split('|')
@@ -655,7 +657,9 @@ fn the_ab_script_times_two_builds_side_by_side() {
         "{table}"
     );
     // And a 32² frame's new viewpoint, in ms.
-    let row = table.lines().find(|l| l.starts_with("| linear | f32 | 32 |"));
+    let row = table
+        .lines()
+        .find(|l| l.starts_with("| linear | f32 | 32 |"));
     let cells: Vec<&str> = row
         .expect("a frame row")
         .split('|')

@@ -14,7 +14,6 @@ use crate::encoding::features::FEATURES;
 use crate::encoding::hash_grid;
 use crate::loss::Loss;
 use crate::network::design::TRANSPORT_CODE;
-use crate::network::encoder::CODE_SIZE;
 use crate::network::light_entry::LightEntry;
 use crate::network::mlp::Mlp;
 use crate::network::nprt_net::NprtNet;
@@ -295,7 +294,7 @@ impl Track {
 
     /// Backward of [`Self::forward`] from the gradient `upstream` at the radiance or the
     /// transfer vector: adds parameter gradients to `grads` and the gradient at each view's
-    /// light code to `d_codes` (`views × CODE_SIZE`).
+    /// light code to `d_codes` (`views ×` the code's size).
     fn backward(
         &self,
         pass: &mut TrackPass,
@@ -427,8 +426,8 @@ impl NprtNet {
                 let transfer = t.transfer.as_ref().map_or(0.0, dense);
                 let unlit = if transfer_known { 0.0 } else { transfer };
                 match t.light {
-                    LightEntry::FirstLayer { .. } => {
-                        let code = 2.0 * (CODE_SIZE * t.shading.layers[0].d_out) as f64;
+                    LightEntry::FirstLayer { code_size, .. } => {
+                        let code = 2.0 * (code_size * t.shading.layers[0].d_out) as f64;
                         dense(&t.shading) - code + unlit
                     }
                     // The dot products with the code; a still camera keeps Φ's outputs.
@@ -456,7 +455,7 @@ impl NprtNet {
     }
 
     /// Radiance (`n × 3`) of a batch mixing views: each row lit by its view's code among
-    /// `codes` (`views × CODE_SIZE`) and scaled by its map's scale.
+    /// `codes` (`views ×` the code's size) and scaled by its map's scale.
     pub fn predict(&self, batch: &Samples, codes: &[f32]) -> Vec<f32> {
         let view: Vec<u32> = batch.view.iter().map(|&v| v as u32).collect();
         let scale = |r: usize| std::array::from_fn(|i| batch.scale[3 * r + i]);

@@ -34,8 +34,8 @@ pub struct ModelConfig {
     /// does). Written only for a hash grid, for the same reason as `direct`.
     #[serde(default, skip_serializing_if = "PositionEncoding::is_none")]
     pub encoding: PositionEncoding,
-    /// The linear design's light basis (absent: [`BasisChoice::default`]); written only for
-    /// that design, which alone reads it.
+    /// The linear designs' light basis (absent: [`BasisChoice::default`]); written only for
+    /// them, which alone read it.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub basis: Option<BasisChoice>,
 }
@@ -61,16 +61,22 @@ impl ModelConfig {
             map_norm: DEFAULT_MAP_NORM,
             direct: DirectLight::Learned,
             encoding: PositionEncoding::None,
-            basis: design.is_linear().then(BasisChoice::default),
+            basis: design.reads_basis().then(BasisChoice::default),
         }
     }
 
     /// Refuses a basis given to a design that has none.
     pub fn check(&self) -> anyhow::Result<()> {
-        if let (Some(b), false) = (self.basis, self.design.is_linear()) {
+        if let (Some(b), false) = (self.basis, self.design.reads_basis()) {
+            let on_a_basis: Vec<&str> = (Design::ALL.into_iter())
+                .filter(|d| d.reads_basis())
+                .map(Design::name)
+                .collect();
             anyhow::bail!(
-                "light basis {b} given to design {}: only the linear design projects the lighting on a basis",
-                self.design
+                "light basis {b} given to design {}: only the linear designs ({}) project the \
+                 lighting on a basis",
+                self.design,
+                on_a_basis.join(", ")
             );
         }
         Ok(())
@@ -84,7 +90,7 @@ impl ModelConfig {
     /// How this model's light model takes a map's texels: as they are for the linear design's
     /// basis, through log(1 + x) for the encoder.
     pub fn texels(&self) -> Texels {
-        match self.design.is_linear() {
+        match self.design.reads_basis() {
             true => Texels::Linear,
             false => Texels::Log,
         }
@@ -113,7 +119,7 @@ impl ModelConfig {
             DirectLight::Learned => "",
             DirectLight::Traced => "+direct",
         };
-        let basis = match self.design.is_linear() {
+        let basis = match self.design.reads_basis() {
             true => format!("+{}", self.light_basis()),
             false => String::new(),
         };
@@ -123,7 +129,7 @@ impl ModelConfig {
     /// What the model is, for the one line each command prints of what it runs: "linear
     /// design on sh:2 (siren), direct light traced".
     pub fn describe(&self) -> String {
-        let basis = match self.design.is_linear() {
+        let basis = match self.design.reads_basis() {
             true => format!(" on {}", self.light_basis()),
             false => String::new(),
         };
@@ -141,7 +147,7 @@ impl ModelConfig {
     /// activation, which both change what the same weights compute (an edit of model.json's
     /// activation went undetected).
     pub fn weights_tag(&self) -> String {
-        match self.design.is_linear() {
+        match self.design.reads_basis() {
             true => format!("{}:{}:{}", self.design, self.activation, self.light_basis()),
             false => format!("{}:{}", self.design.name(), self.activation),
         }
@@ -153,7 +159,7 @@ impl ModelConfig {
     /// hash grid).
     pub fn floats_bound(&self) -> u128 {
         let w = self.encoder_width as u128;
-        let basis = match self.design.is_linear() {
+        let basis = match self.design.reads_basis() {
             true => self.light_basis().size() as u128 * w * w / 2,
             false => 0,
         };
@@ -165,7 +171,7 @@ impl ModelConfig {
     /// in the available memory, naming its size: `--basis learned:1024 --encoder-width 1024`
     /// took 12.8 GB and aborted under a memory limit.
     pub fn ensure_memory(&self, copies: u128, what: &str) -> anyhow::Result<()> {
-        let basis = match self.design.is_linear() {
+        let basis = match self.design.reads_basis() {
             true => format!(
                 " (basis {} at encoder width {})",
                 self.light_basis(),

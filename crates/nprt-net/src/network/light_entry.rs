@@ -6,16 +6,19 @@
 
 use std::ops::Range;
 
-use crate::network::encoder::CODE_SIZE;
-
 /// Where a track's shading network Φ meets the light code.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum LightEntry {
-    /// Φ's first layer reads the encoder's code ê beside its per-row input: ê multiplies its
-    /// weight rows from `code_row` (CODE_SIZE of them), the per-row input those from
-    /// `own_row`. A lighting folds ê's share into that layer's bias; a still camera keeps Φ's
-    /// per-row input (ŝ, or the baseline's inputs).
-    FirstLayer { code_row: usize, own_row: usize },
+    /// Φ's first layer reads the light code (the encoder's ê, or a basis projection) beside
+    /// its per-row input: the code's `code_size` values multiply its weight rows from
+    /// `code_row`, the per-row input those from `own_row`. A lighting folds the code's share
+    /// into that layer's bias; a still camera keeps Φ's per-row input (ŝ, or the baseline's
+    /// inputs).
+    FirstLayer {
+        code_row: usize,
+        own_row: usize,
+        code_size: usize,
+    },
     /// Φ reads its per-row input alone and outputs K transfer coefficients per term and
     /// channel, each term their dot product with the light code (a basis projection) at the
     /// combine: a still camera keeps Φ's outputs, and a lighting runs only the combine.
@@ -23,16 +26,19 @@ pub enum LightEntry {
 }
 
 impl LightEntry {
-    /// The paper's: ê after ŝ ([ŝ, ê]) behind a transfer network, else first ([ê, inputs]).
-    pub fn first_layer(after_transfer: bool) -> Self {
+    /// The paper's, for a code of `code_size` values: after ŝ ([ŝ, code]) behind a transfer
+    /// network, else first ([code, inputs]).
+    pub fn first_layer(after_transfer: bool, code_size: usize) -> Self {
         match after_transfer {
             true => LightEntry::FirstLayer {
                 code_row: crate::network::design::TRANSPORT_CODE,
                 own_row: 0,
+                code_size,
             },
             false => LightEntry::FirstLayer {
                 code_row: 0,
-                own_row: CODE_SIZE,
+                own_row: code_size,
+                code_size,
             },
         }
     }
@@ -41,7 +47,11 @@ impl LightEntry {
     /// not read it.
     pub fn code_rows(self) -> Option<Range<usize>> {
         match self {
-            LightEntry::FirstLayer { code_row, .. } => Some(code_row..code_row + CODE_SIZE),
+            LightEntry::FirstLayer {
+                code_row,
+                code_size,
+                ..
+            } => Some(code_row..code_row + code_size),
             LightEntry::Combine { .. } => None,
         }
     }
@@ -78,16 +88,17 @@ impl LightEntry {
 mod tests {
     use super::*;
     use crate::network::design::TRANSPORT_CODE;
+    use crate::network::encoder::CODE_SIZE;
 
     #[test]
     fn the_code_and_the_own_input_share_no_row() {
         // [ê, inputs] and [ŝ, ê]: the code's rows end where the inputs start, or start where ŝ ends.
-        let first = LightEntry::first_layer(false);
+        let first = LightEntry::first_layer(false, CODE_SIZE);
         assert_eq!(
             (first.code_rows(), first.own_row()),
             (Some(0..CODE_SIZE), CODE_SIZE)
         );
-        let after = LightEntry::first_layer(true);
+        let after = LightEntry::first_layer(true, CODE_SIZE);
         let rows = TRANSPORT_CODE..TRANSPORT_CODE + CODE_SIZE;
         assert_eq!((after.code_rows(), after.own_row()), (Some(rows), 0));
         let linear = LightEntry::Combine { k: 25 };

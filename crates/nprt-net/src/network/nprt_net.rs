@@ -28,12 +28,13 @@ impl NprtNet {
         encoding: PositionEncoding,
         basis: BasisChoice,
     ) -> Self {
-        let light = match design.is_linear() {
+        let light = match design.reads_basis() {
             true => LightModel::Basis(LightBasis::new(init, basis, encoder_width)),
             false => LightModel::Encoder(LightEncoder::new(init, encoder_width)),
         };
-        let tracks = (design.spec().tracks.iter())
-            .map(|&k| Track::new(init, design, k, activation, encoding, basis.size()))
+        let kinds = design.spec().tracks.iter();
+        let tracks = (kinds.zip(design.entries(basis.size())))
+            .map(|(&k, entry)| Track::new(init, design, k, activation, encoding, entry))
             .collect();
         NprtNet { light, tracks }
     }

@@ -29,21 +29,16 @@ pub struct Track {
 }
 
 impl Track {
-    /// A track of `design`; `coefficients` is the basis size K for the linear design and
-    /// ignored otherwise.
+    /// A track of `design` whose light code enters as `light` (one of [`Design::entries`]).
     pub fn new(
         init: &mut Init,
         design: Design,
         kind: TrackKind,
         activation: Activation,
         encoding: PositionEncoding,
-        coefficients: usize,
+        light: LightEntry,
     ) -> Self {
         let n_in = kind.inputs().len() + encoding.extra_inputs();
-        let light = match design.is_linear() {
-            true => LightEntry::Combine { k: coefficients },
-            false => LightEntry::first_layer(design.has_transfer()),
-        };
         let outputs = kind.outputs() * light.coefficients().max(1);
         let code = light.code_inputs();
         let grid = match encoding {

@@ -79,7 +79,11 @@ impl Recipe {
     /// What a model of `config` learns on a dataset whose transfer vectors are `recorded`: the
     /// vectors where the recipe takes them and they hold the model's basis, else radiance.
     pub fn targets(&self, config: &ModelConfig, recorded: Option<TransferBasis>) -> Targets {
-        let holds = match (config.design.is_linear(), config.light_basis(), recorded) {
+        let holds = match (
+            config.design.linear_in_light(),
+            config.light_basis(),
+            recorded,
+        ) {
             (true, BasisChoice::Sh { band }, Some(t)) => t.band as usize >= band,
             _ => false,
         };

@@ -143,11 +143,12 @@ impl TrainingSet {
     /// L at least the model's band).
     pub fn transfer(&self, config: &ModelConfig) -> Result<usize> {
         let scene = &self.manifest.settings.scene;
-        let band = match (config.design.is_linear(), config.light_basis()) {
+        let band = match (config.design.linear_in_light(), config.light_basis()) {
             (true, BasisChoice::Sh { band }) => band,
             _ => bail!(
                 "--targets transfer trains the linear design on an SH basis (--arch linear \
-                 --basis sh:L), whose coefficients the transfer vectors are; this is {}",
+                 --basis sh:L, or another design whose every track is linear in the lighting), \
+                 whose coefficients the transfer vectors are; this is {}",
                 config.label()
             ),
         };

@@ -13,11 +13,11 @@ use rand_pcg::Pcg64Mcg;
 use reference::Reference;
 
 /// Every design with the paper's inputs and each of its activations, then with a hash grid and
-/// its own activation; the linear design also with a learned basis.
+/// its own activation; the designs on a basis also with a learned one.
 pub fn variants() -> Vec<ModelConfig> {
     let mut all = Vec::new();
     for design in Design::ALL {
-        if design.is_linear() {
+        if design.reads_basis() {
             all.push(ModelConfig {
                 basis: Some(nprt_net::BasisChoice::Learned { size: 12 }),
                 ..ModelConfig::new(design, None)

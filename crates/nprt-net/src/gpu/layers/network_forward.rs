@@ -11,7 +11,6 @@ use crate::gpu::products::dense_products::DenseProducts;
 use crate::gpu::products::half_layers::{half_train_layer, pad16, HalfLayers, HalfOut, Held};
 use crate::gpu::products::half_mlp::{fits, half_mlp, FusedIo, FusedLayer, Pre};
 use crate::gpu::products::operands::{Bias, Operand, Output};
-use crate::network::encoder::CODE_SIZE;
 use nprt_gpu::{groups_for, Bind, Dispatch, GpuDevice, Part};
 
 /// How an MLP's first layer reads its input: from weight row `own_row`, `count` values per
@@ -327,12 +326,12 @@ impl TrackAt {
         out: &wgpu::Buffer,
     ) -> Dispatch {
         let first = &self.shading.layers[0];
-        let code_row = (self.light.code_rows())
-            .expect("a track whose shading network reads the light code")
-            .start;
+        let rows =
+            (self.light.code_rows()).expect("a track whose shading network reads the light code");
+        let (code_row, code_size) = (rows.start, rows.len());
         gpu.product(
-            [lights, first.d_out, CODE_SIZE],
-            Operand::plain(codes, 0, CODE_SIZE),
+            [lights, first.d_out, code_size],
+            Operand::plain(codes, 0, code_size),
             Operand::plain(
                 params,
                 first.weight.offset + code_row * first.d_out,

@@ -17,7 +17,6 @@ use crate::gpu::products::operands::{Bias, Operand, Output};
 use crate::gpu::trainers::gpu_trainer::{BatchBuffers, GpuTrainer, TransferBuffers};
 use crate::loss::Loss;
 use crate::network::design::TRANSPORT_CODE;
-use crate::network::encoder::CODE_SIZE;
 use nprt_gpu::{groups_for, Dispatch};
 
 /// One track's state over a batch.
@@ -268,6 +267,7 @@ impl GpuTrainer {
         let first = &t.shading.layers[0];
         let own_row = t.light.own_row();
         let code_row = t.light.code_rows().map_or(0, |rows| rows.start);
+        let code_size = t.light.code_inputs();
         let code_weights = first.weight.offset + code_row * first.d_out;
         // The shading network's input gradient: at ŝ, or at the baseline's inputs (needed only
         // to train its grid).
@@ -283,8 +283,8 @@ impl GpuTrainer {
         let d_views = gpu.buffer(b.views * first.d_out);
         let from_views = |plan: &mut Vec<Dispatch>| {
             plan.push(self.gpu.product(
-                [CODE_SIZE, first.d_out, b.views],
-                Operand::transposed(&b.codes, 0, CODE_SIZE),
+                [code_size, first.d_out, b.views],
+                Operand::transposed(&b.codes, 0, code_size),
                 Operand::plain(&d_views, 0, first.d_out),
                 Bias::None,
                 0,
@@ -292,14 +292,14 @@ impl GpuTrainer {
                 None,
             ));
             plan.push(self.gpu.product(
-                [b.views, CODE_SIZE, first.d_out],
+                [b.views, code_size, first.d_out],
                 Operand::plain(&d_views, 0, first.d_out),
                 Operand::transposed(&self.params, code_weights, first.d_out),
                 Bias::None,
                 0,
                 Output {
                     accumulate: true,
-                    ..Output::to(&b.d_codes, 0, CODE_SIZE)
+                    ..Output::to(&b.d_codes, 0, code_size)
                 },
                 None,
             ));

@@ -1,7 +1,7 @@
 //! The paper's albedo-factorised design: as PRT, but Φ outputs L^D and L^S and
 //! L = kd·L^D + ks·L^S.
 
-use super::{DesignSpec, Layout};
+use super::{DesignSpec, Layout, LightPlan};
 use crate::network::activation::Activation;
 use crate::network::track_kind::TrackKind;
 
@@ -12,5 +12,5 @@ pub const SPEC: DesignSpec = DesignSpec {
     default_activation: Activation::Siren,
     paper_params: 187_718,
     cosine_rate: 5e-4,
-    linear: false,
+    light: LightPlan::Encoder,
 };

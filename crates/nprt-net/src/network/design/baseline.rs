@@ -1,6 +1,6 @@
 //! The paper's baseline: one ReLU MLP on [ê, inputs], 83 → 256 ×4 → 3.
 
-use super::{DesignSpec, Layout};
+use super::{DesignSpec, Layout, LightPlan};
 use crate::network::activation::Activation;
 use crate::network::track_kind::TrackKind;
 
@@ -14,5 +14,5 @@ pub const SPEC: DesignSpec = DesignSpec {
     paper_params: 219_651,
     // Its deep ReLU stack collapses to a constant at 1e-3.
     cosine_rate: 3e-4,
-    linear: false,
+    light: LightPlan::Encoder,
 };

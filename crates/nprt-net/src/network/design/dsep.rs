@@ -2,7 +2,7 @@
 //! F_T^D(x, n, kd) and specular F_T^S(x, n, ks, ωo, ωr, α), each with its own Φ;
 //! L = kd·Φ^D + ks·Φ^S.
 
-use super::{DesignSpec, Layout};
+use super::{DesignSpec, Layout, LightPlan};
 use crate::network::activation::Activation;
 use crate::network::track_kind::TrackKind;
 
@@ -13,5 +13,5 @@ pub const SPEC: DesignSpec = DesignSpec {
     default_activation: Activation::Siren,
     paper_params: 194_226,
     cosine_rate: 5e-4,
-    linear: false,
+    light: LightPlan::Encoder,
 };

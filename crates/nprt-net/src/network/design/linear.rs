@@ -4,7 +4,7 @@
 //! enters only as its projection e = P·E on a basis of K functions (`LightBasis`), and
 //! L = kd·(T^D·e) + ks·(T^S·e). Exact under any gain or mixture of maps, as light transport is.
 
-use super::{DesignSpec, Layout};
+use super::{DesignSpec, Enters, Layout, LightPlan};
 use crate::network::activation::Activation;
 use crate::network::track_kind::TrackKind;
 
@@ -15,5 +15,5 @@ pub const SPEC: DesignSpec = DesignSpec {
     default_activation: Activation::Siren,
     paper_params: 0,
     cosine_rate: 5e-4,
-    linear: true,
+    light: LightPlan::Basis(&[Enters::Combine, Enters::Combine]),
 };

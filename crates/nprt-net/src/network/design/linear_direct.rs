@@ -7,7 +7,7 @@
 //! network and a shading network buys a linear design nothing at run time. Its one file beyond
 //! the design list is this one (docs/model.md counts them).
 
-use super::{DesignSpec, Layout};
+use super::{DesignSpec, Enters, Layout, LightPlan};
 use crate::network::activation::Activation;
 use crate::network::track_kind::TrackKind;
 
@@ -21,5 +21,5 @@ pub const SPEC: DesignSpec = DesignSpec {
     paper_params: 0,
     // The linear design's rate, not measured for this one.
     cosine_rate: 5e-4,
-    linear: true,
+    light: LightPlan::Basis(&[Enters::Combine, Enters::Combine]),
 };

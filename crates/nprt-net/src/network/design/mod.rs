@@ -12,6 +12,8 @@ mod prt;
 
 use crate::choice::named_choice;
 use crate::network::activation::Activation;
+use crate::network::encoder::CODE_SIZE;
+use crate::network::light_entry::LightEntry;
 use crate::network::track_kind::TrackKind;
 
 /// Size of the transport code ŝ.
@@ -26,6 +28,26 @@ pub enum Layout {
     Transfer { width: usize },
 }
 
+/// Where a track's light code enters it, as a design states it ([`LightEntry`] adds the rows).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Enters {
+    /// Φ's first layer reads the code beside its per-row input (the paper's).
+    FirstLayer,
+    /// Φ reads its per-row input alone and outputs K transfer coefficients per term and
+    /// channel, dotted with the code at the combine: the track is linear in the lighting.
+    Combine,
+}
+
+/// What makes a design's light code, and where the code enters each track.
+pub enum LightPlan {
+    /// The paper's convolutional encoder F_L; its code ê enters every track's Φ at its first
+    /// layer.
+    Encoder,
+    /// The map's projection e = P·E on a basis of K functions per colour channel (`--basis`);
+    /// it enters each track, in `tracks`' order, as listed.
+    Basis(&'static [Enters]),
+}
+
 /// One design, as its file states it.
 pub struct DesignSpec {
     pub name: &'static str,
@@ -38,10 +60,8 @@ pub struct DesignSpec {
     pub paper_params: usize,
     /// The peak learning rate measured best under the cosine schedule (`recipe_rate`).
     pub cosine_rate: f64,
-    /// Whether the lighting enters linearly: a basis projection e = P·E instead of the
-    /// encoder, and shading networks that read ŝ alone and output K transfer coefficients per
-    /// term and channel, dotted with e.
-    pub linear: bool,
+    /// Its light code and where it enters each track.
+    pub light: LightPlan,
 }
 
 /// The transport design (the paper's Table 1).
@@ -100,9 +120,36 @@ impl Design {
         self.spec().default_activation
     }
 
-    /// Whether the lighting enters linearly, through a basis (see [`DesignSpec::linear`]).
-    pub fn is_linear(self) -> bool {
-        self.spec().linear
+    /// Whether the light code is the map's projection on a basis (`--basis`) rather than the
+    /// encoder's.
+    pub fn reads_basis(self) -> bool {
+        matches!(self.spec().light, LightPlan::Basis(_))
+    }
+
+    /// Whether every track is linear in the lighting (its code enters at the combine): what
+    /// learning transfer vectors (`--targets transfer`) needs.
+    pub fn linear_in_light(self) -> bool {
+        match self.spec().light {
+            LightPlan::Encoder => false,
+            LightPlan::Basis(enters) => enters.iter().all(|e| *e == Enters::Combine),
+        }
+    }
+
+    /// Each track's light entry, in `tracks`' order, for a basis of `basis_size` functions per
+    /// channel (ignored with the encoder).
+    pub fn entries(self, basis_size: usize) -> Vec<LightEntry> {
+        let spec = self.spec();
+        let first_layer = |code_size| LightEntry::first_layer(self.has_transfer(), code_size);
+        match spec.light {
+            LightPlan::Encoder => vec![first_layer(CODE_SIZE); spec.tracks.len()],
+            LightPlan::Basis(enters) => enters
+                .iter()
+                .map(|e| match e {
+                    Enters::FirstLayer => first_layer(3 * basis_size),
+                    Enters::Combine => LightEntry::Combine { k: basis_size },
+                })
+                .collect(),
+        }
     }
 
     /// Whether the design splits transport from shading (a still camera then keeps ŝ).
@@ -119,6 +166,13 @@ mod tests {
     fn each_design_file_names_its_design() {
         for d in Design::ALL {
             assert_eq!(d.spec().name, d.name());
+        }
+    }
+
+    #[test]
+    fn a_basis_plan_names_an_entry_for_each_track() {
+        for d in Design::ALL {
+            assert_eq!(d.entries(9).len(), d.spec().tracks.len(), "{d}");
         }
     }
 

@@ -1,6 +1,6 @@
 //! The paper's PRT-inspired design: F_T(inputs) = ŝ, then Φ(ŝ, ê) → radiance.
 
-use super::{DesignSpec, Layout};
+use super::{DesignSpec, Layout, LightPlan};
 use crate::network::activation::Activation;
 use crate::network::track_kind::TrackKind;
 
@@ -11,5 +11,5 @@ pub const SPEC: DesignSpec = DesignSpec {
     default_activation: Activation::Siren,
     paper_params: 186_947,
     cosine_rate: 5e-4,
-    linear: false,
+    light: LightPlan::Encoder,
 };
