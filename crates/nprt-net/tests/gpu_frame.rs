@@ -408,3 +408,52 @@ fn the_linear_design_shades_as_on_the_cpu_engine() {
         );
     }
 }
+
+/// A design mixing the light's two entries (linear-diffuse: its diffuse track at the combine,
+/// its specular track's first layer reading the same projection) shades as on the CPU engine,
+/// in f32 and f16, under a first lighting and a second one on the pixels the first kept (a
+/// lighting change runs the combine for one track and the shading network for the other).
+#[test]
+fn a_design_mixing_the_lights_entries_shades_as_on_the_cpu_engine() {
+    if !GpuDevice::probe() {
+        return;
+    }
+    let device = GpuDevice::get().unwrap();
+    let features = room_features();
+    let gain = [4.0, 1.0, 0.5];
+    let maps =
+        ["builtin:sky:25:40", "builtin:indoor:3"].map(|m| nprt_scene::open_envmap(m).unwrap());
+    for (seed, basis) in [(52, "sh:2"), (53, "learned:8")] {
+        let config = ModelConfig {
+            encoder_width: 64,
+            basis: Some(basis.parse().unwrap()),
+            ..ModelConfig::new(Design::LinearDiffuse, None)
+        };
+        let net = config.build(&mut Init::new(seed));
+        for half in [false, true] {
+            let mut gpu = GpuNetwork::new(&net, gain, 64, MapNorm::Channel).unwrap();
+            gpu.set_half(half).unwrap();
+            let px = gpu.pixels(&features);
+            for map in &maps {
+                let code = gpu.encode_map(map, 30.0, 64, MapNorm::Channel);
+                let rgb = gpu.radiance(&px, &code);
+                let input = config.light_input(map, 30.0);
+                let want_code = net.light.forward(&input.pixels, 64).codes().to_vec();
+                let code_error = relative_difference(&code.read(&device).0, &want_code);
+                let scale = std::array::from_fn(|k| input.scale[k] * gain[k]);
+                let want = net.radiance(&features, &want_code, scale, None);
+                let name = format!("{basis} {} {}", gpu.precision_name(), map.name());
+                assert!(code_error < 1e-5, "{name}: light code off by {code_error}");
+                if half {
+                    let error = mean_relative_difference(&rgb, &want);
+                    eprintln!("linear-diffuse {name}: mean error {error:.2e}");
+                    assert!(error < 1e-2, "{name}: off by {error} of the mean");
+                } else {
+                    let error = relative_difference(&rgb, &want);
+                    eprintln!("linear-diffuse {name}: code {code_error:.2e}, radiance {error:.2e}");
+                    assert!(error < 1e-5, "{name}: radiance off by {error}");
+                }
+            }
+        }
+    }
+}

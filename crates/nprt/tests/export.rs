@@ -198,6 +198,41 @@ fn the_recipes_linear_model_exports_and_its_page_matches_the_cpu_engine() {
     std::fs::remove_dir_all(&dir).unwrap();
 }
 
+/// A design mixing the light's entries exports too (linear-diffuse: its diffuse track's
+/// transfer coefficients dotted with the basis' code at the combine, its specular track's
+/// first layer reading that code after ŝ), and its page makes the CPU engine's image.
+#[test]
+fn a_design_mixing_the_lights_entries_exports_and_its_page_matches_the_cpu_engine() {
+    let dir = fresh_dir("export-mixed");
+    // ReLU shading networks, as for the linear design above.
+    let flags = [
+        "--arch",
+        "linear-diffuse",
+        "--basis",
+        "sh:2",
+        "--activation",
+        "relu",
+    ];
+    let model = tiny_room_model(&dir, &flags);
+    let out = dir.join("export");
+    #[rustfmt::skip]
+    ok(&["export", model.to_str().unwrap(), "--out", out.to_str().unwrap(), "--example-res", "48x36"]);
+    let manifest: Value =
+        serde_json::from_slice(&std::fs::read(out.join("export.json")).unwrap()).unwrap();
+    assert_eq!(manifest["code_size"], 27);
+    let tracks = manifest["tracks"].as_array().unwrap();
+    assert_eq!(tracks[0]["coefficients"], 9, "{manifest}");
+    assert!(tracks[0]["code_rows"].is_null(), "{manifest}");
+    let after_s = nprt_net::TRANSPORT_CODE;
+    assert_eq!(
+        tracks[1]["code_rows"],
+        serde_json::json!([after_s, after_s + 27])
+    );
+    assert!(tracks[1]["coefficients"].is_null(), "{manifest}");
+    page_matches_the_cpu_engine(&out);
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
 /// The `--precision f16` kernels: WGSL, HLSL where naga writes it (not the tensor-core one),
 /// no GLSL (naga writes no f16 GLSL), each gap said in export.json; and every transport layer's
 /// weight in `weights_f16.bin` as the f32 weight rounded to f16, rows padded with zeros to a

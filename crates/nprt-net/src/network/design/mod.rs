@@ -7,6 +7,7 @@ mod albedo;
 mod baseline;
 mod dsep;
 mod linear;
+mod linear_diffuse;
 mod linear_direct;
 mod prt;
 
@@ -82,6 +83,10 @@ pub enum Design {
     /// Beyond the paper: the linear design with one MLP per track from the inputs to the
     /// transfer matrix (no ŝ).
     LinearDirect,
+    /// Beyond the paper: D/S's tracks on the basis projection, the diffuse one linear in the
+    /// lighting (as the linear design's), the specular one's Φ reading the projection through
+    /// its first layer (as the paper's Φ reads ê).
+    LinearDiffuse,
 }
 
 named_choice!(Design, "design", {
@@ -91,6 +96,7 @@ named_choice!(Design, "design", {
     Dsep => "dsep",
     Linear => "linear",
     LinearDirect => "linear-direct",
+    LinearDiffuse => "linear-diffuse",
 });
 
 impl Design {
@@ -106,6 +112,7 @@ impl Design {
             Design::Dsep => &dsep::SPEC,
             Design::Linear => &linear::SPEC,
             Design::LinearDirect => &linear_direct::SPEC,
+            Design::LinearDiffuse => &linear_diffuse::SPEC,
         }
     }
 
