@@ -26,16 +26,16 @@ pub enum LightEntry {
 }
 
 impl LightEntry {
-    /// The paper's, for a code of `code_size` values: after ŝ ([ŝ, code]) behind a transfer
-    /// network, else first ([code, inputs]).
-    pub fn first_layer(after_transfer: bool, code_size: usize) -> Self {
-        match after_transfer {
-            true => LightEntry::FirstLayer {
-                code_row: crate::network::design::TRANSPORT_CODE,
+    /// The paper's, for a code of `code_size` values: after the `own` rows of a per-row input
+    /// (ŝ behind a transfer network: [ŝ, code]), else first ([code, inputs]).
+    pub fn first_layer(own: Option<usize>, code_size: usize) -> Self {
+        match own {
+            Some(own) => LightEntry::FirstLayer {
+                code_row: own,
                 own_row: 0,
                 code_size,
             },
-            false => LightEntry::FirstLayer {
+            None => LightEntry::FirstLayer {
                 code_row: 0,
                 own_row: code_size,
                 code_size,
@@ -93,12 +93,12 @@ mod tests {
     #[test]
     fn the_code_and_the_own_input_share_no_row() {
         // [ê, inputs] and [ŝ, ê]: the code's rows end where the inputs start, or start where ŝ ends.
-        let first = LightEntry::first_layer(false, CODE_SIZE);
+        let first = LightEntry::first_layer(None, CODE_SIZE);
         assert_eq!(
             (first.code_rows(), first.own_row()),
             (Some(0..CODE_SIZE), CODE_SIZE)
         );
-        let after = LightEntry::first_layer(true, CODE_SIZE);
+        let after = LightEntry::first_layer(Some(TRANSPORT_CODE), CODE_SIZE);
         let rows = TRANSPORT_CODE..TRANSPORT_CODE + CODE_SIZE;
         assert_eq!((after.code_rows(), after.own_row()), (Some(rows), 0));
         let linear = LightEntry::Combine { k: 25 };

@@ -146,7 +146,8 @@ impl Design {
     /// channel (ignored with the encoder).
     pub fn entries(self, basis_size: usize) -> Vec<LightEntry> {
         let spec = self.spec();
-        let first_layer = |code_size| LightEntry::first_layer(self.has_transfer(), code_size);
+        let own = self.has_transfer().then_some(TRANSPORT_CODE);
+        let first_layer = |code_size| LightEntry::first_layer(own, code_size);
         match spec.light {
             LightPlan::Encoder => vec![first_layer(CODE_SIZE); spec.tracks.len()],
             LightPlan::Basis(enters) => enters
