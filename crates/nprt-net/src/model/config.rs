@@ -87,6 +87,16 @@ impl ModelConfig {
         self.basis.unwrap_or_default()
     }
 
+    /// The SH band whose transfer vectors this model can learn (`--targets transfer`): its
+    /// basis' band where the basis is SH and every track is linear in the lighting; None
+    /// otherwise.
+    pub fn transfer_band(&self) -> Option<usize> {
+        match (self.design.linear_in_light(), self.light_basis()) {
+            (true, BasisChoice::Sh { band }) => Some(band),
+            _ => None,
+        }
+    }
+
     /// How this model's light model takes a map's texels: as they are for the linear design's
     /// basis, through log(1 + x) for the encoder.
     pub fn texels(&self) -> Texels {

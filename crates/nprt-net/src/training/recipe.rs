@@ -79,12 +79,8 @@ impl Recipe {
     /// What a model of `config` learns on a dataset whose transfer vectors are `recorded`: the
     /// vectors where the recipe takes them and they hold the model's basis, else radiance.
     pub fn targets(&self, config: &ModelConfig, recorded: Option<TransferBasis>) -> Targets {
-        let holds = match (
-            config.design.linear_in_light(),
-            config.light_basis(),
-            recorded,
-        ) {
-            (true, BasisChoice::Sh { band }, Some(t)) => t.band as usize >= band,
+        let holds = match (config.transfer_band(), recorded) {
+            (Some(band), Some(t)) => t.band as usize >= band,
             _ => false,
         };
         match self.transfer_targets && holds {

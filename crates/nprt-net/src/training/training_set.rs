@@ -13,7 +13,6 @@ use rayon::prelude::*;
 use crate::encoding::features::{sample_features, FEATURES};
 use crate::model::config::{ModelConfig, TRAINING_COPIES};
 use crate::network::encoder::LightInput;
-use crate::network::light_basis::BasisChoice;
 
 /// The foreground pixels of one view: its records in the dataset's pack and its map.
 pub struct ViewSamples {
@@ -143,14 +142,13 @@ impl TrainingSet {
     /// L at least the model's band).
     pub fn transfer(&self, config: &ModelConfig) -> Result<usize> {
         let scene = &self.manifest.settings.scene;
-        let band = match (config.design.linear_in_light(), config.light_basis()) {
-            (true, BasisChoice::Sh { band }) => band,
-            _ => bail!(
+        let Some(band) = config.transfer_band() else {
+            bail!(
                 "--targets transfer trains the linear design on an SH basis (--arch linear \
                  --basis sh:L, or another design whose every track is linear in the lighting), \
                  whose coefficients the transfer vectors are; this is {}",
                 config.label()
-            ),
+            )
         };
         match self.manifest.settings.transfer {
             Some(t) if t.band as usize >= band => Ok(config.light_basis().size()),
