@@ -4,6 +4,8 @@
 //! each track ([`KeptRows`]). A linear track's shading outputs are transfer coefficients, each
 //! term's value their dot product with the light code.
 
+use std::ops::Range;
+
 use rayon::prelude::*;
 
 use super::accumulate;
@@ -13,11 +15,11 @@ use super::samples::Samples;
 use crate::encoding::features::FEATURES;
 use crate::encoding::hash_grid;
 use crate::loss::Loss;
-use crate::network::design::TRANSPORT_CODE;
 use crate::network::light_entry::LightEntry;
 use crate::network::mlp::Mlp;
 use crate::network::nprt_net::NprtNet;
 use crate::network::track::Track;
+use crate::network::track_plan::{Step, TrackPlan};
 use crate::parameters::Parameters;
 
 mod kept_rows;
@@ -52,14 +54,25 @@ struct TrackPass {
     x: Vec<f32>,
     /// Gradient at those inputs (for the grid's part).
     d_x: Vec<f32>,
-    transfer: Tape,
-    shading: Tape,
+    /// Each step's tape, in the order of the track's plan.
+    tapes: Vec<Tape>,
     /// Each term's value per row and channel: the exp of the shading network's outputs, or
     /// for a linear track their dot product with the light code.
     terms: Vec<f32>,
-    /// Gradients at the shading network's outputs and at ŝ.
-    d_out: Vec<f32>,
-    d_transfer: Vec<f32>,
+    /// The gradient at each step's outputs.
+    d: Vec<Vec<f32>>,
+}
+
+impl TrackPass {
+    /// The last step's outputs (when it ran).
+    fn outputs(&self) -> &[f32] {
+        self.tapes.last().map_or(&[], |t| t.output())
+    }
+
+    /// The gradient at the last step's outputs.
+    fn d_outputs(&mut self) -> &mut Vec<f32> {
+        self.d.last_mut().expect("sized by backward")
+    }
 }
 
 thread_local! {
@@ -109,15 +122,9 @@ impl Track {
         self.kind.reads_all() && self.grid.is_none()
     }
 
-    /// Width of the first layer's per-row input: the features read plus the grid's encoding.
-    fn width(&self) -> usize {
-        self.kind.inputs().len() + self.grid.as_ref().map_or(0, |_| hash_grid::OUTPUTS)
-    }
-
-    /// The light code as the shading network's first layer reads it; None for a linear
-    /// track, whose shading network does not see it.
-    fn shared<'a>(&self, light: Lighting<'a>) -> Option<SharedInput<'a>> {
-        self.light.code_rows().map(|weight_rows| SharedInput {
+    /// The light code as `step`'s first layer reads it; None where it does not.
+    fn shared<'a>(step: &Step, light: Lighting<'a>) -> Option<SharedInput<'a>> {
+        step.code_rows.clone().map(|weight_rows| SharedInput {
             weight_rows,
             values: light.codes,
             group: light.view,
@@ -182,8 +189,8 @@ impl Track {
     }
 
     /// Forward over `n` rows of `features` under `light`. `known` holds what a still camera
-    /// keeps of these rows ([`Self::kept_width`]) when it is known already: ŝ, or Φ's outputs
-    /// (neither depends on the lighting).
+    /// keeps of these rows ([`Self::kept_width`]) when it is known already: the outputs of the
+    /// plan's steps before the light enters, which do not run again.
     fn forward(
         &self,
         features: &[f32],
@@ -193,30 +200,23 @@ impl Track {
         pass: &mut TrackPass,
         purpose: Pass,
     ) {
-        let out = match known {
-            Some(outputs) if self.light.after_networks() => outputs,
-            _ => {
-                let shared = self.shared(light);
-                let shared = shared.as_ref();
-                let x = self.inputs(features, &mut pass.x, n);
-                // A known ŝ (only a track with a transfer network keeps one before Φ).
-                let s = match known {
-                    Some(s) => MatRef::new(s, n, TRANSPORT_CODE),
-                    None => self.shading_input(x, &mut pass.transfer, purpose),
-                };
-                self.shading.forward(s, shared, &mut pass.shading, purpose);
-                pass.shading.output()
-            }
+        let plan = self.plan();
+        let start = known.map_or(0, |_| plan.kept);
+        self.run_steps(&plan, start..plan.steps.len(), features, light, known, pass, purpose);
+        let TrackPass { tapes, terms, .. } = pass;
+        let out = match (start == plan.steps.len(), known) {
+            (true, Some(outputs)) => outputs,
+            _ => tapes.last().expect("a step ran").output(),
         };
-        pass.terms.clear();
+        terms.clear();
         let LightEntry::Combine { k } = self.light else {
-            pass.terms.extend(out.iter().map(|o| o.exp()));
+            terms.extend(out.iter().map(|o| o.exp()));
             return;
         };
         // Term t, channel c: Σ_j T[(t·K + j)·3 + c] · e[j·3 + c].
         let per_row = self.term_values();
-        pass.terms.resize(n * per_row, 0.0);
-        for (r, (terms, t)) in (pass.terms.chunks_exact_mut(per_row))
+        terms.resize(n * per_row, 0.0);
+        for (r, (terms, t)) in (terms.chunks_exact_mut(per_row))
             .zip(out.chunks_exact(per_row * k))
             .enumerate()
         {
@@ -229,15 +229,32 @@ impl Track {
         }
     }
 
-    /// What Φ reads per row of the inputs `x`: ŝ, run through the transfer network on `tape`,
-    /// or `x` itself where there is none.
-    fn shading_input<'a>(&self, x: MatRef<'a>, tape: &'a mut Tape, purpose: Pass) -> MatRef<'a> {
-        match &self.transfer {
-            Some(ft) => {
-                ft.forward(x, None, tape, purpose);
-                MatRef::new(tape.output(), x.rows, TRANSPORT_CODE)
-            }
-            None => x,
+    /// Runs the plan's `steps` over the rows of `features`, each on its tape in `pass`: the
+    /// first reads the track's inputs, or `known` (the outputs of the step before it).
+    #[allow(clippy::too_many_arguments)]
+    fn run_steps(
+        &self,
+        plan: &TrackPlan,
+        steps: Range<usize>,
+        features: &[f32],
+        light: Lighting,
+        known: Option<&[f32]>,
+        pass: &mut TrackPass,
+        purpose: Pass,
+    ) {
+        let n = features.len() / FEATURES;
+        pass.tapes.resize_with(plan.steps.len(), Tape::default);
+        let first = steps.start;
+        for i in steps {
+            let step = &plan.steps[i];
+            let (before, here) = pass.tapes.split_at_mut(i);
+            let input = match (i == first, known) {
+                (true, Some(k)) => MatRef::new(k, n, step.own_width),
+                (true, None) => self.inputs(features, &mut pass.x, n),
+                (false, _) => MatRef::new(before[i - 1].output(), n, step.own_width),
+            };
+            let shared = Self::shared(step, light);
+            (self.mlp(step.net)).forward(input, shared.as_ref(), &mut here[0], purpose);
         }
     }
 
@@ -248,7 +265,7 @@ impl Track {
         self.kind.radiance(f, e)
     }
 
-    /// The gradient at the shading network's outputs, into `pass.d_out`, from the gradient
+    /// The gradient at the shading network's outputs (the last step's), from the gradient
     /// `dr` at this track's radiance (before the scale); a linear track adds the gradient at
     /// each row's light code to `d_codes`.
     fn d_outputs(
@@ -260,11 +277,13 @@ impl Track {
         d_codes: &mut [f32],
     ) {
         let (outs, per_row) = (self.shading.d_out(), self.term_values());
-        pass.d_out.resize(pass.terms.len() / per_row * outs, 0.0);
-        let rows = pass
-            .d_out
+        let TrackPass { tapes, terms, d, .. } = pass;
+        let out = tapes.last().expect("forward ran").output();
+        let d_out = d.last_mut().expect("sized by backward");
+        d_out.resize(terms.len() / per_row * outs, 0.0);
+        let rows = d_out
             .chunks_exact_mut(outs)
-            .zip(pass.terms.chunks_exact(per_row));
+            .zip(terms.chunks_exact(per_row));
         let LightEntry::Combine { k } = self.light else {
             for (r, (d, e)) in rows.enumerate() {
                 let f = &features[r * FEATURES..];
@@ -272,7 +291,6 @@ impl Track {
             }
             return;
         };
-        let out = pass.shading.output();
         let mut d_terms = vec![0.0; per_row];
         for (r, (d, _)) in rows.enumerate() {
             let f = &features[r * FEATURES..];
@@ -293,8 +311,9 @@ impl Track {
     }
 
     /// Backward of [`Self::forward`] from the gradient `upstream` at the radiance or the
-    /// transfer vector: adds parameter gradients to `grads` and the gradient at each view's
-    /// light code to `d_codes` (`views ×` the code's size).
+    /// transfer vector, through the plan's steps in reverse: adds parameter gradients to
+    /// `grads` and the gradient at each view's light code to `d_codes` (`views ×` the code's
+    /// size).
     fn backward(
         &self,
         pass: &mut TrackPass,
@@ -305,59 +324,46 @@ impl Track {
         d_codes: &mut [f32],
     ) {
         let n = features.len() / FEATURES;
-        let shared = self.shared(light);
-        let shared = shared.as_ref();
+        let plan = self.plan();
+        pass.d.resize_with(plan.steps.len(), Vec::new);
+        // A linear track's code gradient comes from its outputs, at the combine.
         match upstream {
             Upstream::Radiance(dr) => self.d_outputs(pass, features, dr, light, d_codes),
             Upstream::Transfer(dt) => self.d_transfer_outputs(pass, features, dt),
         }
-        // A linear track's code gradient came from its outputs; its shading network has none.
-        let d_codes = shared.map(|_| d_codes);
         let TrackPass {
-            x,
-            d_x,
-            transfer,
-            shading,
-            d_out,
-            d_transfer,
-            ..
+            x, d_x, tapes, d, ..
         } = pass;
-        // The gradient at the first layer's inputs is needed only to train the grid.
-        let d_input = match self.grid {
-            Some(_) => {
-                d_x.resize(n * self.width(), 0.0);
-                Some(d_x.as_mut_slice())
-            }
-            None => None,
-        };
-        match (&self.transfer, &mut grads.transfer) {
-            (Some(ft), Some(g)) => {
-                d_transfer.resize(n * TRANSPORT_CODE, 0.0);
-                let s = MatRef::new(transfer.output(), n, TRANSPORT_CODE);
-                self.shading.backward(
-                    s,
-                    shared,
-                    shading,
-                    d_out,
-                    &mut grads.shading,
-                    Some(d_transfer),
-                    d_codes,
-                );
-                let x = self.gathered(features, x, n);
-                ft.backward(x, None, transfer, d_transfer, g, d_input, None);
-            }
-            _ => {
-                let x = self.gathered(features, x, n);
-                self.shading.backward(
-                    x,
-                    shared,
-                    shading,
-                    d_out,
-                    &mut grads.shading,
-                    d_input,
-                    d_codes,
-                );
-            }
+        // The gradient at the first step's inputs is needed only to train the grid.
+        if self.grid.is_some() {
+            d_x.resize(n * self.width(), 0.0);
+        }
+        for (i, step) in plan.steps.iter().enumerate().rev() {
+            let (d_before, d_here) = d.split_at_mut(i);
+            let (before, here) = tapes.split_at_mut(i);
+            let (input, d_input) = match i {
+                0 => (
+                    self.gathered(features, x, n),
+                    self.grid.as_ref().map(|_| d_x.as_mut_slice()),
+                ),
+                _ => {
+                    let d = &mut d_before[i - 1];
+                    d.resize(n * step.own_width, 0.0);
+                    let input = MatRef::new(before[i - 1].output(), n, step.own_width);
+                    (input, Some(d.as_mut_slice()))
+                }
+            };
+            let shared = Self::shared(step, light);
+            let d_shared = shared.as_ref().map(|_| &mut *d_codes);
+            (self.mlp(step.net)).backward(
+                input,
+                shared.as_ref(),
+                &mut here[0],
+                &mut d_here[0],
+                grads.mlp_mut(step.net),
+                d_input,
+                d_shared,
+            );
         }
         self.grid_backward(features, d_x, grads);
     }
@@ -423,19 +429,24 @@ impl NprtNet {
         self.tracks
             .iter()
             .map(|t| {
-                let transfer = t.transfer.as_ref().map_or(0.0, dense);
-                let unlit = if transfer_known { 0.0 } else { transfer };
-                match t.light {
-                    LightEntry::FirstLayer { code_size, .. } => {
-                        let code = 2.0 * (code_size * t.shading.layers[0].d_out) as f64;
-                        dense(&t.shading) - code + unlit
-                    }
-                    // The dot products with the code; a still camera keeps Φ's outputs.
-                    LightEntry::Combine { .. } => {
-                        let networks = dense(&t.shading) + transfer;
-                        2.0 * t.shading.d_out() as f64 + if transfer_known { 0.0 } else { networks }
-                    }
-                }
+                let plan = t.plan();
+                let steps = plan.steps.iter().enumerate();
+                // A still camera's kept steps do not run again; a code's share of a first
+                // layer is made once per lighting.
+                let run = steps.filter(|(i, _)| !transfer_known || *i >= plan.kept);
+                let networks: f64 = run
+                    .map(|(_, s)| {
+                        let m = t.mlp(s.net);
+                        let code = s.code_rows.as_ref().map_or(0, |r| r.len());
+                        dense(m) - 2.0 * (code * m.layers[0].d_out) as f64
+                    })
+                    .sum();
+                // The dot products with the code where the light enters at the combine.
+                let dots = match t.light.after_networks() {
+                    true => 2.0 * plan.last().outputs as f64,
+                    false => 0.0,
+                };
+                networks + dots
             })
             .sum()
     }

@@ -72,12 +72,8 @@ pub fn layer_table(net: &NprtNet) -> Vec<LayerRow> {
                 params: grid.num_params(),
             });
         }
-        let parts = [
-            ("transfer", track.transfer.as_ref()),
-            ("shading", Some(&track.shading)),
-        ];
-        for (part, mlp) in parts {
-            let Some(mlp) = mlp else { continue };
+        for step in track.plan().steps {
+            let (part, mlp) = (step.net.name(), track.mlp(step.net));
             for (l, ([i, o], layer)) in mlp.shapes().into_iter().zip(&mlp.layers).enumerate() {
                 let last = l + 1 == mlp.layers.len();
                 let act = if last {

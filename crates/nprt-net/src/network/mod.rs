@@ -12,6 +12,7 @@ pub mod nprt_net;
 pub mod radiance_cache;
 pub mod track;
 pub mod track_kind;
+pub mod track_plan;
 pub mod unet;
 
 // The layers, nprt-engine's, under the paths the networks have always used.

@@ -1,7 +1,7 @@
 //! One transport track of a design: an optional transfer network on the pixel inputs and the
 //! shading network on the transport and light codes.
 
-use crate::encoding::hash_grid::HashGrid;
+use crate::encoding::hash_grid::{self, HashGrid};
 use crate::encoding::position_encoding::PositionEncoding;
 use crate::init::Init;
 use crate::network::activation::Activation;
@@ -9,6 +9,7 @@ use crate::network::design::{Design, Layout, TRANSPORT_CODE};
 use crate::network::light_entry::LightEntry;
 use crate::network::mlp::Mlp;
 use crate::network::track_kind::TrackKind;
+use crate::network::track_plan::{Net, TrackPlan};
 use crate::parameters::{child, Parameters, Visit, VisitMut};
 
 /// One transport track: an optional transfer network F_T on the pixel inputs, and the shading
@@ -74,16 +75,45 @@ impl Track {
     }
 }
 
+impl Track {
+    /// Width of the first network's per-row input: the inputs read plus the grid's encoding.
+    pub fn width(&self) -> usize {
+        self.kind.inputs().len() + self.grid.as_ref().map_or(0, |_| hash_grid::OUTPUTS)
+    }
+
+    /// Its networks in the order they run ([`TrackPlan`]).
+    pub fn plan(&self) -> TrackPlan {
+        let transfer = self.transfer.as_ref().map(Mlp::d_out);
+        TrackPlan::new(self.width(), transfer, self.shading.d_out(), self.light)
+    }
+
+    /// The network a step runs.
+    pub fn mlp(&self, net: Net) -> &Mlp {
+        match net {
+            Net::Transfer => self.transfer.as_ref().expect("a transfer step has its network"),
+            Net::Shading => &self.shading,
+        }
+    }
+
+    /// The network a step runs, to change (a gradient's).
+    pub fn mlp_mut(&mut self, net: Net) -> &mut Mlp {
+        match net {
+            Net::Transfer => self.transfer.as_mut().expect("a transfer step has its network"),
+            Net::Shading => &mut self.shading,
+        }
+    }
+}
+
 impl Parameters for Track {
     fn visit(&self, prefix: &str, f: &mut Visit) {
         self.grid.visit(&child(prefix, "grid"), f);
-        self.transfer.visit(&child(prefix, "transfer"), f);
-        self.shading.visit(&child(prefix, "shading"), f);
+        self.transfer.visit(&child(prefix, Net::Transfer.name()), f);
+        self.shading.visit(&child(prefix, Net::Shading.name()), f);
     }
 
     fn visit_mut(&mut self, prefix: &str, f: &mut VisitMut) {
         self.grid.visit_mut(&child(prefix, "grid"), f);
-        self.transfer.visit_mut(&child(prefix, "transfer"), f);
-        self.shading.visit_mut(&child(prefix, "shading"), f);
+        self.transfer.visit_mut(&child(prefix, Net::Transfer.name()), f);
+        self.shading.visit_mut(&child(prefix, Net::Shading.name()), f);
     }
 }

@@ -154,14 +154,30 @@ impl WeightFile {
                     })
                 });
                 let transfer = t.transfer.as_ref().map(|m| self.mlp(&format!("track{i}.transfer"), m));
+                // Its networks in the order they run, each by name, and how many of them run
+                // before the light enters (what a still camera keeps): the track's plan.
+                let plan = t.plan();
+                let steps: Vec<Value> = (plan.steps.iter())
+                    .map(|s| {
+                        json!({
+                            "network": s.net.name(),
+                            "own_row": s.own_row,
+                            "own_width": s.own_width,
+                            "code_rows": s.code_rows.as_ref().map(|r| [r.start, r.end]),
+                            "outputs": s.outputs,
+                        })
+                    })
+                    .collect();
                 json!({
                     "kind": t.kind.spec().name,
                     "kind_code": t.kind.code(),
                     "inputs": t.kind.inputs(),
-                    "width": t.kind.inputs().len() + t.grid.as_ref().map_or(0, |_| hash_grid::OUTPUTS),
+                    "width": t.width(),
                     "grid": grid,
                     "transfer": transfer,
                     "shading": self.mlp(&format!("track{i}.shading"), &t.shading),
+                    "steps": steps,
+                    "kept": plan.kept,
                     // Which weight rows of the shading network's first layer multiply the light
                     // code: after ŝ, or first for the baseline's [ê, inputs]; none for a
                     // linear track, whose shading network reads ŝ alone.

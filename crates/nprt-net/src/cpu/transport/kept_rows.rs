@@ -4,10 +4,9 @@
 
 use rayon::prelude::*;
 
-use super::{with_passes, BLOCK};
+use super::{with_passes, Lighting, BLOCK};
 use crate::cpu::dense::Pass;
 use crate::encoding::features::FEATURES;
-use crate::network::design::TRANSPORT_CODE;
 use crate::network::nprt_net::NprtNet;
 use crate::network::track::Track;
 
@@ -18,32 +17,26 @@ pub struct KeptRows {
 }
 
 impl Track {
-    /// Values per row a still camera keeps of this track: Φ's outputs where the light enters
-    /// at the combine, ŝ where it enters Φ behind a transfer network, none where Φ reads the
-    /// inputs and the code together (the baseline).
+    /// Values per row a still camera keeps of this track: the outputs of its plan's steps
+    /// before the light enters (Φ's where it enters at the combine, ŝ where it enters Φ behind
+    /// a transfer network), none where the first network reads the code (the baseline).
     pub fn kept_width(&self) -> usize {
-        match (self.light.after_networks(), &self.transfer) {
-            (true, _) => self.shading.d_out(),
-            (false, Some(_)) => TRANSPORT_CODE,
-            (false, None) => 0,
-        }
+        self.plan().kept_width()
     }
 
     /// What a still camera keeps of the rows of `features`, into `out` (`rows ×`
-    /// [`Self::kept_width`]): the networks run up to where the light enters.
+    /// [`Self::kept_width`]): the plan's steps run up to where the light enters.
     fn kept_block(&self, features: &[f32], out: &mut [f32]) {
+        let plan = self.plan();
+        // No step before the light reads a code.
+        let unlit = Lighting {
+            codes: &[],
+            view: &[],
+        };
         with_passes(1, |passes| {
             let pass = &mut passes[0];
-            let n = features.len() / FEATURES;
-            let x = self.inputs(features, &mut pass.x, n);
-            let s = self.shading_input(x, &mut pass.transfer, Pass::Infer);
-            if self.light.after_networks() {
-                self.shading
-                    .forward(s, None, &mut pass.shading, Pass::Infer);
-                out.copy_from_slice(pass.shading.output());
-            } else {
-                out.copy_from_slice(s.data);
-            }
+            self.run_steps(&plan, 0..plan.kept, features, unlit, None, pass, Pass::Infer);
+            out.copy_from_slice(pass.tapes[plan.kept - 1].output());
         })
     }
 }

@@ -21,7 +21,7 @@ impl Track {
         out: &mut [f32],
     ) {
         let (k, outs, per_row) = (self.linear(), self.shading.d_out(), self.term_values());
-        let t = &pass.shading.output()[r * outs..][..outs];
+        let t = &pass.outputs()[r * outs..][..outs];
         let f = &features[r * FEATURES..];
         // Two terms at most (D/S's): the row's values stay on the stack.
         let mut e = [0.0; 6];
@@ -36,13 +36,15 @@ impl Track {
         }
     }
 
-    /// The gradient at a linear track's outputs, into `pass.d_out`, from the gradient `dt` at
+    /// The gradient at a linear track's outputs (its last step's), from the gradient `dt` at
     /// each row's transfer vector (`rows × K × 3`).
     pub(super) fn d_transfer_outputs(&self, pass: &mut TrackPass, features: &[f32], dt: &[f32]) {
         let (k, outs, per_row) = (self.linear(), self.shading.d_out(), self.term_values());
-        pass.d_out.resize(pass.terms.len() / per_row * outs, 0.0);
+        let rows = pass.terms.len() / per_row;
+        let d_out = pass.d_outputs();
+        d_out.resize(rows * outs, 0.0);
         let mut d_terms = vec![0.0; per_row];
-        for (r, d) in pass.d_out.chunks_exact_mut(outs).enumerate() {
+        for (r, d) in d_out.chunks_exact_mut(outs).enumerate() {
             let f = &features[r * FEATURES..];
             for j in 0..k {
                 self.kind

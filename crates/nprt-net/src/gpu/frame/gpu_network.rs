@@ -95,7 +95,7 @@ impl GpuNetwork {
         Ok(GpuNetwork {
             light: gpu.upload(&light),
             biases: (layout.tracks.iter())
-                .map(|t| gpu.buffer(t.shading.layers[0].d_out))
+                .map(|t| gpu.buffer(t.mlp(t.plan.last().net).layers[0].d_out))
                 .collect(),
             inputs: KeptLast::default(),
             encoding: Mutex::new(()),
@@ -222,11 +222,9 @@ impl GpuNetwork {
         let gpu = &*self.gpu;
         let widest = (self.net.tracks.iter())
             .flat_map(|t| {
-                let transfer = t.transfer.iter().flat_map(|m| &m.layers);
-                transfer
-                    .chain(&t.shading.layers)
-                    .map(|l| l.d_out)
-                    .chain([t.width])
+                let steps = t.plan.steps.iter();
+                let layers = steps.flat_map(|s| &t.mlp(s.net).layers);
+                layers.map(|l| l.d_out).chain([t.width])
             })
             .max()
             .expect("a network has layers");
@@ -261,10 +259,11 @@ impl GpuNetwork {
         }
     }
 
-    /// Records what track `t` keeps of `n` rows of `features` for every lighting, everything
-    /// before the light enters: what its shading network reads (its inputs gathered, or its
-    /// transfer network's output ŝ; in f16 where the workspace is) or, where the light enters
-    /// at the combine, the shading network's outputs (f32).
+    /// Records what track `t` keeps of `n` rows of `features` for every lighting: its plan's
+    /// steps before the light enters, from its gathered inputs. It keeps what the step the
+    /// light enters reads (the last kept step's outputs, or the inputs where the first step
+    /// reads the light; in f16 where the workspace is) or, where the light enters at the
+    /// combine, the last step's outputs (f32).
     fn kept_rows(
         &self,
         pass: &mut wgpu::ComputePass,
@@ -275,57 +274,52 @@ impl GpuNetwork {
     ) -> PooledBuffer {
         let gpu = &*self.gpu;
         let (params, resolutions) = (&self.params, &self.resolutions);
-        let half = work.half();
-        let mut list = Vec::new();
-        let width = t.own_width();
-        let floats = match half {
+        let (plan, half) = (&t.plan, work.half());
+        let held = |width: usize| match half {
             true => held_halves(n, width).div_ceil(2),
             false => n * width,
         };
-        let kept = self.pool.take_pooled(gpu, floats);
+        // Each unlit step's outputs: the last into what is kept, the others into buffers
+        // that go back to the pool once recorded (the pass reads them before any later
+        // dispatch can write them).
+        let kept = match plan.lit() {
+            Some(lit) => self.pool.take_pooled(gpu, held(lit.own_width)),
+            None => self.pool.take_pooled(gpu, n * plan.last().outputs),
+        };
+        let between: Vec<PooledBuffer> = (plan.unlit().iter().rev().skip(1))
+            .map(|s| self.pool.take_pooled(gpu, held(s.outputs)))
+            .collect();
+        let mut list = Vec::new();
         let gathered = &work.f32[0];
-        let x = match (&t.transfer, half) {
-            (None, false) => &*kept,
+        // Where no step runs before the light, the inputs themselves are kept.
+        let x = match (plan.kept, half) {
+            (0, false) => &*kept,
             _ => gathered,
         };
         list.push(t.record_inputs(gpu, params, resolutions, [features, x], n));
-        match (&t.transfer, half) {
-            (None, false) => {}
-            (None, true) => {
-                list.push(gpu.half_rows([n, width, width], gathered, &kept));
-            }
-            (Some(transfer), _) => {
-                let first = FirstLayer {
-                    own_row: 0,
-                    count: t.width,
-                    bias: Bias::Column(params, transfer.layers[0].bias.offset),
-                };
-                let to = work.targets(transfer, work.held(&kept));
-                let x = Held::F32(gathered);
-                transfer.record_forward(gpu, &mut list, params, x, n, first, &to);
-            }
+        if (plan.kept, half) == (0, true) {
+            list.push(gpu.half_rows([n, t.width, t.width], gathered, &kept));
         }
-        // Where the light enters at the combine, Φ runs here too and its outputs are kept.
-        let outputs = t.light.after_networks().then(|| {
-            let out = self
-                .pool
-                .take_pooled(gpu, n * t.shading.layers.last().expect("layers").d_out);
-            let first = FirstLayer {
-                own_row: t.light.own_row(),
-                count: t.own_width(),
-                bias: Bias::Column(params, t.shading.layers[0].bias.offset),
+        let mut input = Held::F32(gathered);
+        for (i, step) in plan.unlit().iter().enumerate() {
+            let m = t.mlp(step.net);
+            let out = match (i + 1 == plan.kept, plan.lit()) {
+                (true, Some(_)) => work.held(&kept),
+                (true, None) => Held::F32(&kept),
+                (false, _) => work.held(&between[between.len() - 1 - i]),
             };
-            let to = work.targets(&t.shading, Held::F32(&out));
-            let x = work.held(&kept);
-            (t.shading).record_forward(gpu, &mut list, params, x, n, first, &to);
-            out
-        });
+            let first = FirstLayer {
+                own_row: step.own_row,
+                count: step.own_width,
+                bias: Bias::Column(params, m.layers[0].bias.offset),
+            };
+            m.record_forward(gpu, &mut list, params, input, n, first, &work.targets(m, out));
+            input = out;
+        }
         for d in list {
             d.record(pass);
         }
-        // Then what Φ read goes back to the pool: the pass reads it before any later dispatch
-        // can write it.
-        outputs.unwrap_or(kept)
+        kept
     }
 
     /// The workspace for blocks of `rows` rows of activations at most `widest` wide: the kept
@@ -342,7 +336,7 @@ impl GpuNetwork {
             f32: [0, 1].map(|_| gpu.buffer(rows * widest)),
             f16: half.then(|| [0, 1].map(|_| gpu.half_buffer(held_halves(rows, widest)))),
             outputs: (self.net.tracks.iter())
-                .map(|t| gpu.buffer(rows * t.shading.layers.last().expect("layers").d_out))
+                .map(|t| gpu.buffer(rows * t.plan.last().outputs))
                 .collect(),
         });
         *kept = Some(work.clone());
@@ -372,7 +366,7 @@ impl GpuNetwork {
         let params = &self.params;
         // b' = b + ê·W[code rows]: the light slot's code through the first layer's code rows.
         for (t, bias) in self.net.tracks.iter().zip(&self.biases) {
-            if t.light.code_rows().is_some() {
+            if t.plan.lit().is_some() {
                 list.push(t.record_code_share(gpu, params, &self.light, 1, bias));
             }
         }
@@ -381,18 +375,18 @@ impl GpuNetwork {
                 .zip(&chunk.kept)
                 .zip(self.biases.iter().zip(&px.work.outputs))
             {
-                if t.light.after_networks() {
-                    continue;
-                }
-                // [ŝ, ê] (ŝ's rows first), or the baseline's [ê, inputs].
+                // The step the light enters, on what was kept ([ŝ, ê] with ŝ's rows first,
+                // or the baseline's [ê, inputs]).
+                let Some(step) = t.plan.lit() else { continue };
                 let first = FirstLayer {
-                    own_row: t.light.own_row(),
-                    count: t.own_width(),
+                    own_row: step.own_row,
+                    count: step.own_width,
                     bias: Bias::Column(bias, 0),
                 };
-                let to = px.work.targets(&t.shading, Held::F32(out));
+                let m = t.mlp(step.net);
+                let to = px.work.targets(m, Held::F32(out));
                 let x = px.work.held(kept);
-                (t.shading).record_forward(gpu, &mut list, params, x, chunk.rows, first, &to);
+                m.record_forward(gpu, &mut list, params, x, chunk.rows, first, &to);
             }
             // The tracks' radiance summed into rgb one track per dispatch (any number of
             // tracks), the last multiplied by the map's divisor and the model's gain.
@@ -401,7 +395,10 @@ impl GpuNetwork {
                 .zip(&px.work.outputs)
                 .zip(&chunk.kept);
             for (k, ((t, out), kept)) in outputs.enumerate() {
-                let out = if t.light.after_networks() { kept } else { out };
+                let out = match t.plan.lit() {
+                    Some(_) => out,
+                    None => kept,
+                };
                 let params = [
                     chunk.rows,
                     t.kind.code() as usize,

@@ -314,9 +314,9 @@ impl TrackAt {
         )
     }
 
-    /// The dispatch of the light code's share of the first shading layer: `codes` (`lights`
-    /// rows of the code) times the layer's code rows, plus its bias, into `out` (a row per
-    /// light), which the shading network then takes as its first bias.
+    /// The dispatch of the light code's share of the first layer of the step the light enters
+    /// (its plan's): `codes` (`lights` rows of the code) times the layer's code rows, plus its
+    /// bias, into `out` (a row per light), which that network then takes as its first bias.
     pub fn record_code_share(
         &self,
         gpu: &GpuDevice,
@@ -325,9 +325,9 @@ impl TrackAt {
         lights: usize,
         out: &wgpu::Buffer,
     ) -> Dispatch {
-        let first = &self.shading.layers[0];
-        let rows =
-            (self.light.code_rows()).expect("a track whose shading network reads the light code");
+        let step = self.plan.lit().expect("a track whose network reads the light code");
+        let first = &self.mlp(step.net).layers[0];
+        let rows = step.code_rows.clone().expect("the lit step reads the code");
         let (code_row, code_size) = (rows.start, rows.len());
         gpu.product(
             [lights, first.d_out, code_size],

@@ -9,13 +9,13 @@ use crate::gpu::layers::light_encoder::EncoderAt;
 use crate::gpu::layers::parameters::ParameterLayout;
 use crate::gpu::products::half_layers::{half_weight_halves, pad16, HalfLayers, HalfWeight};
 use crate::network::activation::Activation;
-use crate::network::design::TRANSPORT_CODE;
 use crate::network::encoder::CODE_SIZE;
 use crate::network::light_entry::LightEntry;
 use crate::network::light_model::LightModel;
 use crate::network::mlp::Mlp;
 use crate::network::nprt_net::NprtNet;
 use crate::network::track_kind::TrackKind;
+use crate::network::track_plan::{Net, TrackPlan};
 use nprt_gpu::Span;
 use nprt_gpu::{groups_for, Bind, Dispatch, GpuDevice};
 
@@ -127,14 +127,23 @@ pub struct TrackAt {
     pub grid: Option<Span>,
     pub transfer: Option<MlpAt>,
     pub shading: MlpAt,
+    /// Its networks in the order they run (the track's [`TrackPlan`]).
+    pub plan: TrackPlan,
 }
 
 impl TrackAt {
-    /// Width of the shading network's per-row input.
-    pub fn own_width(&self) -> usize {
-        match self.transfer {
-            Some(_) => TRANSPORT_CODE,
-            None => self.width,
+    /// The network a step runs.
+    pub fn mlp(&self, net: Net) -> &MlpAt {
+        match net {
+            Net::Transfer => self.transfer.as_ref().expect("a transfer step has its network"),
+            Net::Shading => &self.shading,
+        }
+    }
+
+    fn mlp_mut(&mut self, net: Net) -> &mut MlpAt {
+        match net {
+            Net::Transfer => self.transfer.as_mut().expect("a transfer step has its network"),
+            Net::Shading => &mut self.shading,
         }
     }
 }
@@ -173,6 +182,7 @@ impl NetworkLayout {
                     grid,
                     transfer,
                     shading: mlp_at(&t.shading, &mut spans),
+                    plan: t.plan(),
                 }
             })
             .collect();
@@ -188,11 +198,9 @@ impl NetworkLayout {
     /// multiplies, every other layer whole.
     pub fn hold_half(&mut self, gpu: &GpuDevice) {
         for t in &mut self.tracks {
-            let own = [t.light.own_row(), t.own_width()];
-            if let Some(m) = &mut t.transfer {
-                m.hold_half(gpu, [0, t.width]);
+            for step in t.plan.steps.clone() {
+                (t.mlp_mut(step.net)).hold_half(gpu, [step.own_row, step.own_width]);
             }
-            t.shading.hold_half(gpu, own);
         }
     }
 

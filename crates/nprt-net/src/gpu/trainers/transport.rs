@@ -1,6 +1,6 @@
 //! The transport networks' share of a training step: each track's inputs (with its hash
-//! grid's encoding), transfer and shading networks with each view's light code folded into the
-//! first shading layer's bias, the loss and its gradient at the tracks' outputs, and backward
+//! grid's encoding), then its plan's networks in order with each view's light code folded into
+//! the first bias of the step it enters, the loss and its gradient at the tracks' outputs, and backward
 //! into every parameter, the grids' tables and the light codes.
 
 use crate::gpu::kernels::{COMBINE, RADIANCE_LOSS, TRACK_GRADIENT, TRANSFER_LOSS};
@@ -16,7 +16,6 @@ use crate::gpu::products::half_layers::Held;
 use crate::gpu::products::operands::{Bias, Operand, Output};
 use crate::gpu::trainers::gpu_trainer::{BatchBuffers, GpuTrainer, TransferBuffers};
 use crate::loss::Loss;
-use crate::network::design::TRANSPORT_CODE;
 use nprt_gpu::{groups_for, Dispatch};
 
 /// One track's state over a batch.
@@ -24,10 +23,17 @@ struct TrackTape {
     x: wgpu::Buffer,
     /// Gradient at `x`, for a track with a hash grid.
     dx: Option<wgpu::Buffer>,
-    transfer: Option<MlpTape>,
-    shading: MlpTape,
-    /// Gradient at the shading network's outputs.
+    /// Each step's tape, in the order of the track's plan.
+    steps: Vec<MlpTape>,
+    /// Gradient at the last step's outputs.
     d_out: wgpu::Buffer,
+}
+
+impl TrackTape {
+    /// The last step's outputs, which the combine reads.
+    fn output(&self) -> &wgpu::Buffer {
+        &self.steps.last().expect("a track has a step").output
+    }
 }
 
 impl GpuTrainer {
@@ -91,7 +97,7 @@ impl GpuTrainer {
                 &params.map(|v| v as u32),
                 &[
                     &b.features,
-                    &tape.shading.output,
+                    tape.output(),
                     &b.codes,
                     &b.view,
                     &b.radiance_sum,
@@ -143,7 +149,7 @@ impl GpuTrainer {
                 &params,
                 &[
                     &b.features,
-                    &tape.shading.output,
+                    tape.output(),
                     &transfer.target,
                     &transfer.sum,
                     &transfer.d_transfer,
@@ -185,7 +191,7 @@ impl GpuTrainer {
                 &params.map(|v| v as u32),
                 &[
                     &b.features,
-                    &tape.shading.output,
+                    tape.output(),
                     &b.codes,
                     &b.view,
                     b.transfer.as_ref().map_or(&b.d_radiance, |t| &t.d_transfer),
@@ -207,55 +213,47 @@ impl GpuTrainer {
         }
     }
 
-    /// A track's forward pass over the batch.
+    /// A track's forward pass over the batch: its plan's steps in order, the step the light
+    /// enters with each view's light code folded into its first bias.
     fn track_forward(&self, plan: &mut Vec<Dispatch>, t: &TrackAt, b: &BatchBuffers) -> TrackTape {
         let gpu = &self.gpu;
         let x = gpu.buffer(b.rows * t.width);
         let (params, rows) = (&self.params, b.rows);
         plan.push(t.record_inputs(gpu, params, &self.resolutions, [&b.features, &x], rows));
-        let transfer = t.transfer.as_ref().map(|m| {
-            let tape = MlpTape::new(&self.gpu, m, rows);
-            let first = FirstLayer {
-                own_row: 0,
-                count: t.width,
-                bias: Bias::Column(params, m.layers[0].bias.offset),
-            };
-            let to = ForwardTargets::Tape(&tape);
-            m.record_forward(gpu, plan, params, Held::F32(&x), rows, first, &to);
-            tape
+        // The light code's share of the lit step's first layer, once per view.
+        let group_bias = t.plan.lit().map(|step| {
+            let bias = gpu.buffer(b.views * t.mlp(step.net).layers[0].d_out);
+            plan.push(t.record_code_share(gpu, params, &b.codes, b.views, &bias));
+            bias
         });
-        // The light code's share of the first shading layer, once per view (a linear track's
-        // shading network reads ŝ alone).
-        let first = &t.shading.layers[0];
-        let group_bias;
-        let bias = match t.light.code_rows() {
-            Some(_) => {
-                group_bias = gpu.buffer(b.views * first.d_out);
-                plan.push(t.record_code_share(gpu, params, &b.codes, b.views, &group_bias));
-                Bias::Group(&group_bias, &b.view)
-            }
-            None => Bias::Column(params, first.bias.offset),
-        };
-        let shading = MlpTape::new(&self.gpu, &t.shading, rows);
-        let input = transfer.as_ref().map_or(&x, |tape| &tape.output);
-        let first_layer = FirstLayer {
-            own_row: t.light.own_row(),
-            count: t.own_width(),
-            bias,
-        };
-        let to = ForwardTargets::Tape(&shading);
-        let input = Held::F32(input);
-        (t.shading).record_forward(gpu, plan, params, input, rows, first_layer, &to);
+        let mut steps: Vec<MlpTape> = Vec::with_capacity(t.plan.steps.len());
+        for step in &t.plan.steps {
+            let m = t.mlp(step.net);
+            let tape = MlpTape::new(gpu, m, rows);
+            let bias = match (&step.code_rows, &group_bias) {
+                (Some(_), Some(group)) => Bias::Group(group, &b.view),
+                _ => Bias::Column(params, m.layers[0].bias.offset),
+            };
+            let first = FirstLayer {
+                own_row: step.own_row,
+                count: step.own_width,
+                bias,
+            };
+            let input = Held::F32(steps.last().map_or(&x, |s| &s.output));
+            let to = ForwardTargets::Tape(&tape);
+            m.record_forward(gpu, plan, params, input, rows, first, &to);
+            steps.push(tape);
+        }
         TrackTape {
             dx: t.grid.map(|_| gpu.buffer(b.rows * t.width)),
             x,
-            transfer,
-            d_out: gpu.buffer(b.rows * t.shading.layers.last().expect("a layer").d_out),
-            shading,
+            steps,
+            d_out: gpu.buffer(b.rows * t.plan.last().outputs),
         }
     }
 
-    /// A track's backward pass, from the gradient at its shading outputs in `tape.d_out`.
+    /// A track's backward pass, from the gradient at its last step's outputs in `tape.d_out`,
+    /// through its plan's steps in reverse.
     fn track_backward(
         &self,
         plan: &mut Vec<Dispatch>,
@@ -264,24 +262,21 @@ impl GpuTrainer {
         b: &BatchBuffers,
     ) {
         let gpu = &self.gpu;
-        let first = &t.shading.layers[0];
-        let own_row = t.light.own_row();
-        let code_row = t.light.code_rows().map_or(0, |rows| rows.start);
-        let code_size = t.light.code_inputs();
-        let code_weights = first.weight.offset + code_row * first.d_out;
-        // The shading network's input gradient: at ŝ, or at the baseline's inputs (needed only
-        // to train its grid).
-        let d_s = t
-            .transfer
-            .as_ref()
-            .map(|_| gpu.buffer(b.rows * TRANSPORT_CODE));
-        let d_input = d_s.as_ref().or(tape.dx.as_ref());
-        let input = tape.transfer.as_ref().map_or(&tape.x, |tr| &tr.output);
-        // The code's rows of the first shading weight and the code's gradient, from each
+        let steps = &t.plan.steps;
+        // The gradient at each step's outputs but the last's (its next step's input).
+        let d_between: Vec<wgpu::Buffer> = (steps.iter().skip(1))
+            .map(|s| gpu.buffer(b.rows * s.own_width))
+            .collect();
+        // The code's rows of the lit step's first weight and the code's gradient, from each
         // view's sums of the gradient at that layer's pre-activation (which also make its
-        // bias's). A linear track's first layer has a bias of its own instead.
-        let d_views = gpu.buffer(b.views * first.d_out);
+        // bias's).
+        let d_views = gpu.buffer(b.views * t.mlp(t.plan.last().net).layers[0].d_out);
         let from_views = |plan: &mut Vec<Dispatch>| {
+            let step = t.plan.lit().expect("only the lit step sums by view");
+            let first = &t.mlp(step.net).layers[0];
+            let code = step.code_rows.clone().expect("the lit step reads the code");
+            let code_size = code.len();
+            let code_weights = first.weight.offset + code.start * first.d_out;
             plan.push(self.gpu.product(
                 [code_size, first.d_out, b.views],
                 Operand::transposed(&b.codes, 0, code_size),
@@ -310,24 +305,25 @@ impl GpuTrainer {
             d_views: &d_views,
             then: &from_views,
         };
-        self.trainable().mlp_backward(
-            plan,
-            &t.shading,
-            &tape.shading,
-            (input, own_row, t.own_width()),
-            &tape.d_out,
-            d_input,
-            t.light.code_rows().map(|_| &view_sums),
-        );
-        if let (Some(m), Some(tr), Some(d_s)) = (&t.transfer, &tape.transfer, &d_s) {
+        for (i, step) in steps.iter().enumerate().rev() {
+            let input = match i {
+                0 => &tape.x,
+                _ => &tape.steps[i - 1].output,
+            };
+            let d_out = d_between.get(i).unwrap_or(&tape.d_out);
+            // At the first step, the gradient at the inputs is needed only to train the grid.
+            let d_input = match i {
+                0 => tape.dx.as_ref(),
+                _ => Some(&d_between[i - 1]),
+            };
             self.trainable().mlp_backward(
                 plan,
-                m,
-                tr,
-                (&tape.x, 0, t.width),
-                d_s,
-                tape.dx.as_ref(),
-                None,
+                t.mlp(step.net),
+                &tape.steps[i],
+                (input, step.own_row, step.own_width),
+                d_out,
+                d_input,
+                step.code_rows.as_ref().map(|_| &view_sums),
             );
         }
         self.grid_backward(plan, t, tape, b);

@@ -114,9 +114,9 @@ async function main() {
     count: t.inputs.length,
     width: t.width,
     grid: t.grid ? tensor(t.grid.table).buffer : null,
-    transfer: t.transfer ? mlp(t.transfer) : null,
-    shading: mlp(t.shading),
-    codeRows: t.code_rows,
+    // Its networks in the order they run, and how many run before the light enters.
+    steps: t.steps.map((s) => ({ mlp: mlp(t[s.network]), ownRow: s.own_row, ownWidth: s.own_width, codeRows: s.code_rows })),
+    kept: t.kept,
     coefficients: t.coefficients ?? 0,
   }));
   const empty = room(4);
@@ -130,9 +130,9 @@ async function main() {
   const rowInputs = new Float32Array(rows * perRow);
   foreground.forEach((p, r) => rowInputs.set(gbuffer.subarray(p * per, p * per + perRow), r * perRow));
   const features = upload(rowInputs);
-  const widest = Math.max(...tracks.flatMap((t) => [t.width, ...(t.transfer?.layers ?? []).concat(t.shading.layers).map((l) => l.dOut)]));
+  const widest = Math.max(...tracks.flatMap((t) => [t.width, ...t.steps.flatMap((s) => s.mlp.layers.map((l) => l.dOut))]));
   const scratch = [room(rows * widest), room(rows * widest)];
-  const outputs = tracks.map((t) => room(rows * t.shading.layers.at(-1).dOut));
+  const outputs = tracks.map((t) => room(rows * t.steps.at(-1).mlp.layers.at(-1).dOut));
   const rgb = room(rows * 3);
 
   // 1. The light code (once per lighting change): the convolution blocks, then a dense layer;
@@ -159,21 +159,20 @@ async function main() {
   }
   if (toCode) denseLayer(pass, toCode, x, 1, toCode.dIn, 0, toCode.bias, 0, code);
 
-  // 2. What does not depend on the lighting (once per camera): each track's inputs and, where
-  // it has one, its transfer network's output ŝ; for a linear track, whose shading network
-  // does not read the code, that network's outputs too (its transfer coefficients).
+  // 2. What does not depend on the lighting (once per camera): each track's inputs, then its
+  // networks before the light enters (`kept` of its `steps`; ŝ where it has a transfer
+  // network). Where the light enters at the combine (a linear track) they are all of them,
+  // the last writing the track's outputs (its transfer coefficients).
   const kept = tracks.map((t, i) => {
-    const inputs = t.transfer ? scratch[0] : room(rows * t.width);
+    const inputs = t.kept > 0 ? scratch[0] : room(rows * t.width);
     dispatch(pass, 'track_inputs', { rows, count: t.count, width: t.width, grid: t.grid ? 1 : 0 },
       [features, t.index, t.grid ?? empty, resolutions, inputs], groups('track_inputs', rows));
     let s = inputs;
-    if (t.transfer) {
-      s = room(rows * t.transfer.layers.at(-1).dOut);
-      runMlp(pass, t.transfer, inputs, rows, { dIn: t.width, wRow: 0 }, scratch, s);
-    }
-    if (!t.codeRows) {
-      runMlp(pass, t.shading, s, rows, { dIn: t.shading.layers[0].dIn, wRow: 0 }, scratch, outputs[i]);
-    }
+    t.steps.slice(0, t.kept).forEach((step, j) => {
+      const out = j === t.steps.length - 1 ? outputs[i] : room(rows * step.mlp.layers.at(-1).dOut);
+      runMlp(pass, step.mlp, s, rows, { dIn: step.ownWidth, wRow: step.ownRow }, scratch, out);
+      s = out;
+    });
     return s;
   });
   pass.end();
@@ -186,15 +185,15 @@ async function main() {
     const encoder = device.createCommandEncoder();
     const pass = encoder.beginComputePass();
     tracks.forEach((t, i) => {
-      const first = t.shading.layers[0];
-      if (!t.codeRows) return;
+      // The step the light enters, if any (the last).
+      const step = t.steps[t.kept];
+      if (!step) return;
+      const first = step.mlp.layers[0];
       const bias = room(first.dOut);
       // b' = b + ê·W[code rows]: the first layer's code rows over one row.
-      denseLayer(pass, first, code, 1, codeSize, t.codeRows[0], first.bias, 0, bias);
-      // The rows that multiply the pixel's own inputs: before ê's (ŝ first), or after them.
-      const codeFirst = t.codeRows[0] === 0;
-      const dIn = first.dIn - codeSize;
-      runMlp(pass, t.shading, kept[i], rows, { dIn, wRow: codeFirst ? codeSize : 0, bias }, scratch, outputs[i]);
+      denseLayer(pass, first, code, 1, codeSize, step.codeRows[0], first.bias, 0, bias);
+      // Then the rows that multiply the pixel's own inputs: before ê's (ŝ first), or after them.
+      runMlp(pass, step.mlp, kept[i], rows, { dIn: step.ownWidth, wRow: step.ownRow, bias }, scratch, outputs[i]);
     });
     // The tracks' radiance summed into rgb one track per dispatch, the last scaled.
     tracks.forEach((t, i) => {
