@@ -102,6 +102,15 @@ enum Upstream<'a> {
     Transfer(&'a [f32]),
 }
 
+/// What the first of a run of a track's steps reads.
+#[derive(Clone, Copy)]
+enum StepInput<'a> {
+    /// The rows' features, from which the track gathers its inputs.
+    Features(&'a [f32]),
+    /// The outputs of the step before it, as a still camera keeps them, for this many rows.
+    Kept(&'a [f32], usize),
+}
+
 /// The light codes of a block: each view's code, and each row's view.
 #[derive(Clone, Copy)]
 struct Lighting<'a> {
@@ -201,8 +210,11 @@ impl Track {
         purpose: Pass,
     ) {
         let plan = self.plan();
-        let start = known.map_or(0, |_| plan.kept);
-        self.run_steps(&plan, start..plan.steps.len(), features, light, known, pass, purpose);
+        let (start, input) = match known {
+            Some(kept) => (plan.kept, StepInput::Kept(kept, n)),
+            None => (0, StepInput::Features(features)),
+        };
+        self.run_steps(&plan, start..plan.steps.len(), input, light, pass, purpose);
         let TrackPass { tapes, terms, .. } = pass;
         let out = match (start == plan.steps.len(), known) {
             (true, Some(outputs)) => outputs,
@@ -229,32 +241,33 @@ impl Track {
         }
     }
 
-    /// Runs the plan's `steps` over the rows of `features`, each on its tape in `pass`: the
-    /// first reads the track's inputs, or `known` (the outputs of the step before it).
-    #[allow(clippy::too_many_arguments)]
+    /// Runs the plan's `steps` over the rows, each on its tape in `pass`, the first reading
+    /// `input`.
     fn run_steps(
         &self,
         plan: &TrackPlan,
         steps: Range<usize>,
-        features: &[f32],
+        input: StepInput,
         light: Lighting,
-        known: Option<&[f32]>,
         pass: &mut TrackPass,
         purpose: Pass,
     ) {
-        let n = features.len() / FEATURES;
+        let n = match input {
+            StepInput::Features(features) => features.len() / FEATURES,
+            StepInput::Kept(_, rows) => rows,
+        };
         pass.tapes.resize_with(plan.steps.len(), Tape::default);
         let first = steps.start;
         for i in steps {
             let step = &plan.steps[i];
             let (before, here) = pass.tapes.split_at_mut(i);
-            let input = match (i == first, known) {
-                (true, Some(k)) => MatRef::new(k, n, step.own_width),
-                (true, None) => self.inputs(features, &mut pass.x, n),
+            let x = match (i == first, input) {
+                (true, StepInput::Kept(kept, _)) => MatRef::new(kept, n, step.own_width),
+                (true, StepInput::Features(features)) => self.inputs(features, &mut pass.x, n),
                 (false, _) => MatRef::new(before[i - 1].output(), n, step.own_width),
             };
             let shared = Self::shared(step, light);
-            (self.mlp(step.net)).forward(input, shared.as_ref(), &mut here[0], purpose);
+            (self.mlp(step.net)).forward(x, shared.as_ref(), &mut here[0], purpose);
         }
     }
 

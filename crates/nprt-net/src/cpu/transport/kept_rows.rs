@@ -4,7 +4,7 @@
 
 use rayon::prelude::*;
 
-use super::{with_passes, Lighting, BLOCK};
+use super::{with_passes, Lighting, StepInput, BLOCK};
 use crate::cpu::dense::Pass;
 use crate::encoding::features::FEATURES;
 use crate::network::nprt_net::NprtNet;
@@ -35,7 +35,8 @@ impl Track {
         };
         with_passes(1, |passes| {
             let pass = &mut passes[0];
-            self.run_steps(&plan, 0..plan.kept, features, unlit, None, pass, Pass::Infer);
+            let input = StepInput::Features(features);
+            self.run_steps(&plan, 0..plan.kept, input, unlit, pass, Pass::Infer);
             out.copy_from_slice(pass.tapes[plan.kept - 1].output());
         })
     }
