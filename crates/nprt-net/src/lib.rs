@@ -5,8 +5,8 @@
 //! does, in layers, each using only those before it:
 //! 1. the shared pieces: `precision`, `parameters` (the one weight type every network is),
 //!    `init` (how parameters start), `loss`;
-//! 2. `encoding` (what the networks see), then `network` (layers, encoder, track kinds,
-//!    designs, the U-Net, the radiance cache), then `optimiser` (Adam, and the steps an engine
+//! 2. `encoding` (what the networks see), then `network` (layers, encoder, track kinds and
+//!    plans, designs, the U-Net, the radiance cache), then `optimiser` (Adam, and the steps an engine
 //!    takes) and `model` (config and folder);
 //! 3. the engines: `cpu` (the CPU engine, on the networks' own weights), `gpu` (our own GPU
 //!    kernels, feature `gpu`, which read the same weights), `shading` (a trained network as

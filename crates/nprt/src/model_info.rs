@@ -95,9 +95,9 @@ fn info(a: ModelInfoArgs) -> Result<()> {
 
 fn print_description(s: &ModelSummary) {
     let config = &s.config;
-    let light = match config.design.reads_basis() {
-        true => format!("light basis {} on a", config.light_basis()),
-        false => "light encoder input".into(),
+    let light = match config.basis_in_use() {
+        Some(b) => format!("light basis {b} on a"),
+        None => "light encoder input".into(),
     };
     println!(
         "design {} ({} transport layers), {light} {}×{} map, map normalised by its {}, direct light {}, position encoding {}",

@@ -87,6 +87,12 @@ impl ModelConfig {
         self.basis.unwrap_or_default()
     }
 
+    /// The basis this model's light model projects maps on; None for a design with the
+    /// encoder.
+    pub fn basis_in_use(&self) -> Option<BasisChoice> {
+        self.design.reads_basis().then(|| self.light_basis())
+    }
+
     /// The SH band whose transfer vectors this model can learn (`--targets transfer`): its
     /// basis' band where the basis is SH and every track is linear in the lighting; None
     /// otherwise.
@@ -100,9 +106,9 @@ impl ModelConfig {
     /// How this model's light model takes a map's texels: as they are for the linear design's
     /// basis, through log(1 + x) for the encoder.
     pub fn texels(&self) -> Texels {
-        match self.design.reads_basis() {
-            true => Texels::Linear,
-            false => Texels::Log,
+        match self.basis_in_use() {
+            Some(_) => Texels::Linear,
+            None => Texels::Log,
         }
     }
 
@@ -129,20 +135,14 @@ impl ModelConfig {
             DirectLight::Learned => "",
             DirectLight::Traced => "+direct",
         };
-        let basis = match self.design.reads_basis() {
-            true => format!("+{}", self.light_basis()),
-            false => String::new(),
-        };
+        let basis = (self.basis_in_use()).map_or(String::new(), |b| format!("+{b}"));
         format!("{}{basis}{activation}{grid}{direct}", self.design.name())
     }
 
     /// What the model is, for the one line each command prints of what it runs: "linear
     /// design on sh:2 (siren), direct light traced".
     pub fn describe(&self) -> String {
-        let basis = match self.design.reads_basis() {
-            true => format!(" on {}", self.light_basis()),
-            false => String::new(),
-        };
+        let basis = (self.basis_in_use()).map_or(String::new(), |b| format!(" on {b}"));
         let grid = match self.encoding {
             PositionEncoding::None => "",
             PositionEncoding::HashGrid => ", hash grid",
@@ -157,9 +157,9 @@ impl ModelConfig {
     /// activation, which both change what the same weights compute (an edit of model.json's
     /// activation went undetected).
     pub fn weights_tag(&self) -> String {
-        match self.design.reads_basis() {
-            true => format!("{}:{}:{}", self.design, self.activation, self.light_basis()),
-            false => format!("{}:{}", self.design.name(), self.activation),
+        match self.basis_in_use() {
+            Some(b) => format!("{}:{}:{b}", self.design, self.activation),
+            None => format!("{}:{}", self.design.name(), self.activation),
         }
     }
 
@@ -169,10 +169,7 @@ impl ModelConfig {
     /// hash grid).
     pub fn floats_bound(&self) -> u128 {
         let w = self.encoder_width as u128;
-        let basis = match self.design.reads_basis() {
-            true => self.light_basis().size() as u128 * w * w / 2,
-            false => 0,
-        };
+        let basis = (self.basis_in_use()).map_or(0, |b| b.size() as u128 * w * w / 2);
         basis + (16 << 20)
     }
 
@@ -181,14 +178,9 @@ impl ModelConfig {
     /// in the available memory, naming its size: `--basis learned:1024 --encoder-width 1024`
     /// took 12.8 GB and aborted under a memory limit.
     pub fn ensure_memory(&self, copies: u128, what: &str) -> anyhow::Result<()> {
-        let basis = match self.design.reads_basis() {
-            true => format!(
-                " (basis {} at encoder width {})",
-                self.light_basis(),
-                self.encoder_width
-            ),
-            false => String::new(),
-        };
+        let basis = (self.basis_in_use()).map_or(String::new(), |b| {
+            format!(" (basis {b} at encoder width {})", self.encoder_width)
+        });
         nprt_io::ensure_memory(
             self.floats_bound() * 4 * copies,
             &format!(

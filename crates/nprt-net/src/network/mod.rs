@@ -1,7 +1,7 @@
-//! The networks: the light encoder or basis, dense layers and their activations, the transport tracks and
-//! their kinds, the designs, the whole network, the Deep Shading U-Net and the Neural
-//! Radiance Cache's network, each of them `crate::parameters` to the model file and the
-//! optimiser.
+//! The networks: the light encoder or basis, dense layers and their activations, the
+//! transport tracks, their kinds and plans (the order every engine runs a track's networks in),
+//! the designs, the whole network, the Deep Shading U-Net and the Neural Radiance Cache's
+//! network, each of them `crate::parameters` to the model file and the optimiser.
 
 pub mod design;
 pub mod encoder;
