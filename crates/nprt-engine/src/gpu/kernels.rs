@@ -76,3 +76,58 @@ pub const CONV_INPUT_BACKWARD: KernelSource = kernel!(convolutions / "conv_input
 /// Threads `conv_input_backward` takes per input value: one per quarter of the channels.
 pub const CONV_INPUT_BACKWARD_THREADS: usize = 4;
 pub const CONV_WEIGHT_BACKWARD: KernelSource = kernel!(convolutions / "conv_weight_backward");
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Whether `want` appears in `source` in order, each a whole line (trimmed) of it.
+    fn in_order(source: &str, want: &[String]) -> Result<(), String> {
+        let mut lines = source.lines().map(str::trim);
+        for w in want {
+            if !lines.any(|l| l == w) {
+                return Err(w.clone());
+            }
+        }
+        Ok(())
+    }
+
+    /// The tensor-core products' 4 × 4 tile of 16 × 16 sums, spelt out in each kernel (WGSL
+    /// has no arrays of cooperative matrices), described once here and each kernel held to it
+    /// line by line: the 16 sums declared, a_i · b_j added into sum (i, j) (`half_mlp_coop` a
+    /// column of the tile at a time, each from one load of W), and sum (i, j) drained to row
+    /// block i and column block j.
+    #[test]
+    fn the_tensor_core_kernels_spell_out_one_4x4_tile() {
+        let ij = || (0..4).flat_map(|i| (0..4).map(move |j| (i, j)));
+        let sums: Vec<String> = (ij())
+            .map(|(i, j)| format!("var c{i}{j} = coop_mat16x16<f32, C>();"))
+            .collect();
+        let by_row: Vec<String> = (ij())
+            .map(|(i, j)| format!("c{i}{j} = coopMultiplyAdd(a{i}, b{j}, c{i}{j});"))
+            .collect();
+        let by_column: Vec<String> = (ij())
+            .map(|(j, i)| format!("c{i}{j} = coopMultiplyAdd(a{i}, b, c{i}{j});"))
+            .collect();
+        let offset = |base: &str, block: usize| format!("{base} + {}u", 16 * block);
+        let drains = |row: &dyn Fn(usize) -> String, col: &dyn Fn(usize) -> String| {
+            (ij())
+                .map(|(i, j)| format!("drain(c{i}{j}, sg, lane, {}, {});", row(i), col(j)))
+                .collect::<Vec<String>>()
+        };
+        let blocks = drains(&|i| offset("row0", i), &|j| offset("col0", j));
+        let layer = drains(&|i| format!("{}u", 16 * i), &|j| format!("col{j}"));
+        let kernels = [
+            (&HALF_DENSE_COOP, &by_row, &blocks),
+            (&HALF_TRAIN_COOP, &by_row, &blocks),
+            (&HALF_WEIGHT_GRAD_COOP, &by_row, &blocks),
+            (&HALF_MLP_COOP, &by_column, &layer),
+        ];
+        for (kernel, products, drained) in kernels {
+            let tile = [sums.clone(), products.clone(), drained.clone()].concat();
+            if let Err(missing) = in_order(kernel.wgsl, &tile) {
+                panic!("{}: no line '{missing}' where the tile needs it", kernel.name);
+            }
+        }
+    }
+}

@@ -70,19 +70,19 @@ fn main(@builtin(workgroup_id) group: vec3<u32>, @builtin(local_invocation_index
         c32 = coopMultiplyAdd(a3, b2, c32);
         c33 = coopMultiplyAdd(a3, b3, c33);
     }
-    drain(c00, sg, lane, row0, col0);
-    drain(c01, sg, lane, row0, col0 + 16u);
-    drain(c02, sg, lane, row0, col0 + 32u);
-    drain(c03, sg, lane, row0, col0 + 48u);
-    drain(c10, sg, lane, row0 + 16u, col0);
+    drain(c00, sg, lane, row0 + 0u, col0 + 0u);
+    drain(c01, sg, lane, row0 + 0u, col0 + 16u);
+    drain(c02, sg, lane, row0 + 0u, col0 + 32u);
+    drain(c03, sg, lane, row0 + 0u, col0 + 48u);
+    drain(c10, sg, lane, row0 + 16u, col0 + 0u);
     drain(c11, sg, lane, row0 + 16u, col0 + 16u);
     drain(c12, sg, lane, row0 + 16u, col0 + 32u);
     drain(c13, sg, lane, row0 + 16u, col0 + 48u);
-    drain(c20, sg, lane, row0 + 32u, col0);
+    drain(c20, sg, lane, row0 + 32u, col0 + 0u);
     drain(c21, sg, lane, row0 + 32u, col0 + 16u);
     drain(c22, sg, lane, row0 + 32u, col0 + 32u);
     drain(c23, sg, lane, row0 + 32u, col0 + 48u);
-    drain(c30, sg, lane, row0 + 48u, col0);
+    drain(c30, sg, lane, row0 + 48u, col0 + 0u);
     drain(c31, sg, lane, row0 + 48u, col0 + 16u);
     drain(c32, sg, lane, row0 + 48u, col0 + 32u);
     drain(c33, sg, lane, row0 + 48u, col0 + 48u);
