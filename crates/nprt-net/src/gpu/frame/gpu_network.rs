@@ -286,7 +286,8 @@ impl GpuNetwork {
             Some(lit) => self.pool.take_pooled(gpu, held(lit.own_width)),
             None => self.pool.take_pooled(gpu, n * plan.last().outputs),
         };
-        let between: Vec<PooledBuffer> = (plan.unlit().iter().rev().skip(1))
+        let between: Vec<PooledBuffer> = (plan.unlit().iter())
+            .take(plan.kept.saturating_sub(1))
             .map(|s| self.pool.take_pooled(gpu, held(s.outputs)))
             .collect();
         let mut list = Vec::new();
@@ -306,7 +307,7 @@ impl GpuNetwork {
             let out = match (i + 1 == plan.kept, plan.lit()) {
                 (true, Some(_)) => work.held(&kept),
                 (true, None) => Held::F32(&kept),
-                (false, _) => work.held(&between[between.len() - 1 - i]),
+                (false, _) => work.held(&between[i]),
             };
             let first = FirstLayer {
                 own_row: step.own_row,

@@ -1,7 +1,6 @@
 //! Where each tensor of a network lies in the flat parameter buffers, in the network's own
 //! structure (encoder blocks, tracks, layers), as the training step's dispatches address them.
 
-use crate::encoding::hash_grid;
 use crate::gpu::kernels::HALF_WEIGHT_COPIES;
 use crate::gpu::layers::layer_at::DenseAt;
 use crate::gpu::layers::light_basis::BasisAt;
@@ -178,7 +177,7 @@ impl NetworkLayout {
                     light: t.light,
                     index: gpu.upload(&index),
                     count: index.len(),
-                    width: index.len() + grid.map_or(0, |_| hash_grid::OUTPUTS),
+                    width: t.width(),
                     grid,
                     transfer,
                     shading: mlp_at(&t.shading, &mut spans),
